@@ -1,0 +1,82 @@
+//! Errors of the core: bad bodies, bad time functions, bad steps and unstable runs.
+
+use crate::material::MaterialError;
+use thiserror::Error;
+
+/// Everything the core refuses, each message naming the offending item and the fix.
+#[derive(Debug, Error)]
+pub enum CoreError {
+    /// A material constant out of range.
+    #[error("body `{body}`: {source}")]
+    Material {
+        /// Body name.
+        body: String,
+        /// What is wrong.
+        source: MaterialError,
+    },
+    /// A tetrahedron with zero or negative reference volume.
+    #[error(
+        "body `{body}`: tetrahedron {tet} has reference volume {volume:e} m^3 (must be positive): \
+         reorient or remove it (the mesh reader reorients inverted tetrahedra; a zero volume \
+         means coincident or coplanar nodes)"
+    )]
+    BadTet {
+        /// Body name.
+        body: String,
+        /// Tetrahedron index within the body.
+        tet: usize,
+        /// Its signed volume.
+        volume: f64,
+    },
+    /// A tetrahedron refers to a particle that does not exist.
+    #[error("body `{body}`: tetrahedron {tet} refers to particle {node}, but there are only {count}")]
+    NodeOutOfRange {
+        /// Body name.
+        body: String,
+        /// Tetrahedron index.
+        tet: usize,
+        /// The particle index.
+        node: u32,
+        /// The number of particles.
+        count: usize,
+    },
+    /// A body without tetrahedra.
+    #[error("body `{0}` has no tetrahedra")]
+    EmptyBody(String),
+    /// A time function that is not piecewise linear in non-decreasing time.
+    #[error("time function: {0}")]
+    TimeFunction(String),
+    /// A user-given time step above the stable bound.
+    #[error(
+        "dt = {dt:e} s is above the stable bound {bound:e} s (limited by {limiter}); use dt = \
+         \"auto\" or a value of at most {bound:e}"
+    )]
+    StepTooLarge {
+        /// Requested step.
+        dt: f64,
+        /// Stable bound.
+        bound: f64,
+        /// The model that limits the step.
+        limiter: String,
+    },
+    /// A particle with zero mass that is not fixed in every direction.
+    #[error(
+        "particle {particle} has no mass and is not fully fixed: every particle must belong to a \
+         tetrahedron of positive volume"
+    )]
+    Massless {
+        /// Particle index.
+        particle: usize,
+    },
+    /// A non-finite acceleration appeared.
+    #[error(
+        "the run became unstable at t = {time:e} s: particle {particle} has a non-finite \
+         acceleration; the step is probably too large or a tetrahedron inverted"
+    )]
+    NonFinite {
+        /// Simulated time.
+        time: f64,
+        /// First offending particle.
+        particle: usize,
+    },
+}

@@ -1,0 +1,41 @@
+//! Uniform gravity: the force m g on every particle.
+
+use crate::model::Model;
+use crate::state::State;
+use crate::Vec3;
+
+/// Uniform gravitational acceleration acting on every particle.
+#[derive(Clone, Debug)]
+pub struct Gravity {
+    g: Vec3,
+}
+
+impl Gravity {
+    /// Gravity with acceleration `g` (m/s²).
+    pub fn new(g: Vec3) -> Gravity {
+        Gravity { g }
+    }
+}
+
+impl Model for Gravity {
+    fn name(&self) -> &str {
+        "gravity"
+    }
+
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3]) {
+        for (f, m) in force.iter_mut().zip(&state.mass) {
+            *f += *m * self.g;
+        }
+    }
+
+    fn potential_energy(&self, state: &State) -> Option<f64> {
+        Some(
+            -state
+                .mass
+                .iter()
+                .zip(&state.position)
+                .map(|(m, x)| m * self.g.dot(x))
+                .sum::<f64>(),
+        )
+    }
+}

@@ -1,0 +1,42 @@
+//! A force shared equally by a set of particles, scaled by a time function (the scene's
+//! `[[load]]`).
+
+use crate::model::Model;
+use crate::state::State;
+use crate::time_function::TimeFunction;
+use crate::Vec3;
+
+/// A total force F·φ(t) divided equally among a set of particles.
+#[derive(Clone, Debug)]
+pub struct NodalLoad {
+    name: String,
+    particles: Vec<u32>,
+    per_particle: Vec3,
+    factor: TimeFunction,
+}
+
+impl NodalLoad {
+    /// The total force `total` (N) shared by `particles` (non-empty), scaled by `factor`.
+    pub fn new(name: &str, particles: Vec<u32>, total: Vec3, factor: TimeFunction) -> NodalLoad {
+        let per_particle = total / particles.len().max(1) as f64;
+        NodalLoad {
+            name: name.to_string(),
+            particles,
+            per_particle,
+            factor,
+        }
+    }
+}
+
+impl Model for NodalLoad {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3]) {
+        let f = self.per_particle * self.factor.value(state.time);
+        for &p in &self.particles {
+            force[p as usize] += f;
+        }
+    }
+}

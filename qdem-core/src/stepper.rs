@@ -1,0 +1,106 @@
+//! The [`Stepper`] trait and what every stepper shares: force evaluation into accelerations
+//! with fixity, and the choice of the time step from the models' stable bounds.
+
+use crate::error::CoreError;
+use crate::model::Model;
+use crate::state::State;
+use crate::Vec3;
+use rayon::prelude::*;
+
+/// Particles per parallel task in per-particle loops.
+pub(crate) const PARTICLE_CHUNK: usize = 4096;
+
+/// Advances a [`State`] by one step under a list of models, without knowing their physics.
+pub trait Stepper {
+    /// A short name for messages and summaries.
+    fn name(&self) -> &str;
+
+    /// The step size (s).
+    fn dt(&self) -> f64;
+
+    /// Makes the accelerations consistent with the forces at the current state; call once
+    /// before the first step.
+    fn initialize(&mut self, state: &mut State, models: &mut [Box<dyn Model>])
+        -> Result<(), CoreError>;
+
+    /// Advances `state` by one step.
+    fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError>;
+}
+
+/// Sums the forces of all models into `force` (resized and zeroed here) and sets
+/// a = f/m, zero in fixed directions. Fails on a non-finite acceleration.
+pub fn compute_accelerations(
+    state: &mut State,
+    models: &mut [Box<dyn Model>],
+    force: &mut Vec<Vec3>,
+) -> Result<(), CoreError> {
+    force.clear();
+    force.resize(state.len(), Vec3::zeros());
+    for model in models.iter_mut() {
+        model.add_forces(state, force);
+    }
+    let (mass, fixed) = (&state.mass, &state.fixed);
+    state
+        .acceleration
+        .par_iter_mut()
+        .with_min_len(PARTICLE_CHUNK)
+        .enumerate()
+        .for_each(|(i, a)| {
+            let mut acc = force[i] / mass[i];
+            for axis in 0..3 {
+                if fixed[i].contains(axis) {
+                    acc[axis] = 0.0;
+                }
+            }
+            *a = acc;
+        });
+    match state.acceleration.iter().position(|a| !a.iter().all(|c| c.is_finite())) {
+        Some(particle) => Err(CoreError::NonFinite {
+            time: state.time,
+            particle,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Checks that every particle that is free in some direction has a positive mass.
+pub fn check_masses(state: &State) -> Result<(), CoreError> {
+    let bad = (0..state.len()).find(|&i| {
+        let free = (0..3).any(|axis| !state.fixed[i].contains(axis));
+        free && !(state.mass[i] > 0.0)
+    });
+    match bad {
+        Some(particle) => Err(CoreError::Massless { particle }),
+        None => Ok(()),
+    }
+}
+
+/// The smallest stable step over all models and the name of the model that sets it.
+pub fn stable_step(state: &State, models: &[Box<dyn Model>]) -> Option<(f64, String)> {
+    models
+        .iter()
+        .filter_map(|m| m.stable_dt(state).map(|dt| (dt, m.name().to_string())))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// Chooses the step: `safety` times the stable bound when `requested` is `None`, otherwise the
+/// requested step, refused if it exceeds the bound.
+pub fn choose_step(
+    state: &State,
+    models: &[Box<dyn Model>],
+    requested: Option<f64>,
+    safety: f64,
+) -> Result<f64, CoreError> {
+    let (bound, limiter) =
+        stable_step(state, models).unwrap_or((f64::INFINITY, "nothing".to_string()));
+    match requested {
+        Some(dt) if dt > bound => Err(CoreError::StepTooLarge { dt, bound, limiter }),
+        Some(dt) => Ok(dt),
+        None if bound.is_finite() => Ok(safety * bound),
+        None => Err(CoreError::StepTooLarge {
+            dt: f64::INFINITY,
+            bound,
+            limiter: "no model bounds the step; give dt".to_string(),
+        }),
+    }
+}

@@ -1,0 +1,269 @@
+//! A deformable QDEM body: a set of tetrahedra sharing particles, as a [`Model`].
+//!
+//! Each step computes the Kelvin–Voigt stress and the four particle forces of every
+//! tetrahedron in parallel into a buffer (paper 000 Eqs. 1–10, see [`crate::tet_kernel`]), then
+//! sums them per particle over a fixed incidence list (Eq. 11). The gather runs in parallel over
+//! particles, each summing its own incident entries in ascending order, so the result is
+//! bit-identical for any number of threads (no atomics, no reduction-order dependence).
+//! Elastic materials take a path without the viscous stress.
+
+use crate::error::CoreError;
+use crate::material::{Lame, Material};
+use crate::model::Model;
+use crate::stable_step::{critical_step, element_rate_bound};
+use crate::state::State;
+use crate::tet_kernel::{
+    deformation_gradient, edge_matrix, strain_energy, tet_stress, vertex_forces, von_mises,
+};
+use crate::{Mat3, Vec3};
+use rayon::prelude::*;
+
+/// Tetrahedra per parallel task: large enough to amortise scheduling, small enough to balance.
+const TET_CHUNK: usize = 2048;
+/// Particles per parallel task in the gather.
+const PARTICLE_CHUNK: usize = 4096;
+
+/// A deformable body of linear QDEM tetrahedra.
+#[derive(Clone, Debug)]
+pub struct TetBody {
+    name: String,
+    material: Material,
+    elastic: Lame,
+    viscous: Lame,
+    tets: Vec<[u32; 4]>,
+    dm_inv: Vec<Mat3>,
+    volume: Vec<f64>,
+    first: usize,
+    incidence_start: Vec<u32>,
+    incidence: Vec<u32>,
+    tet_forces: Vec<Vec3>,
+    omega_squared: f64,
+    damping_rate: f64,
+}
+
+impl TetBody {
+    /// Builds a body from tetrahedra given as indices into `reference` (the positions of all
+    /// particles of the scene). Every tetrahedron must have positive reference volume.
+    pub fn new(
+        name: &str,
+        reference: &[Vec3],
+        tets: Vec<[u32; 4]>,
+        material: Material,
+    ) -> Result<TetBody, CoreError> {
+        material.validate().map_err(|source| CoreError::Material {
+            body: name.to_string(),
+            source,
+        })?;
+        if tets.is_empty() {
+            return Err(CoreError::EmptyBody(name.to_string()));
+        }
+        let mut dm_inv = Vec::with_capacity(tets.len());
+        let mut volume = Vec::with_capacity(tets.len());
+        for (index, tet) in tets.iter().enumerate() {
+            for &node in tet {
+                if node as usize >= reference.len() {
+                    return Err(CoreError::NodeOutOfRange {
+                        body: name.to_string(),
+                        tet: index,
+                        node,
+                        count: reference.len(),
+                    });
+                }
+            }
+            let x = tet.map(|n| reference[n as usize]);
+            let dm = edge_matrix(&x);
+            let v = dm.determinant() / 6.0;
+            let scale = dm.norm().powi(3);
+            let inverse = dm.try_inverse().filter(|_| v > 1e-12 * scale);
+            let Some(inverse) = inverse else {
+                return Err(CoreError::BadTet {
+                    body: name.to_string(),
+                    tet: index,
+                    volume: v,
+                });
+            };
+            dm_inv.push(inverse);
+            volume.push(v);
+        }
+        let (first, incidence_start, incidence) = incidence_lists(&tets);
+        let elastic = material.elastic_lame();
+        let viscous = material.viscous_lame();
+        let omega_squared = rate_bound(&dm_inv, &material, elastic);
+        let damping_rate = if material.is_elastic() {
+            0.0
+        } else {
+            rate_bound(&dm_inv, &material, viscous)
+        };
+        Ok(TetBody {
+            name: name.to_string(),
+            tet_forces: vec![Vec3::zeros(); 4 * tets.len()],
+            material,
+            elastic,
+            viscous,
+            tets,
+            dm_inv,
+            volume,
+            first,
+            incidence_start,
+            incidence,
+            omega_squared,
+            damping_rate,
+        })
+    }
+
+    /// The body's tetrahedra (indices into the scene's particles).
+    pub fn tets(&self) -> &[[u32; 4]] {
+        &self.tets
+    }
+
+    /// The body's material.
+    pub fn material(&self) -> &Material {
+        &self.material
+    }
+
+    /// Total reference volume (m³).
+    pub fn volume(&self) -> f64 {
+        self.volume.iter().sum()
+    }
+
+    /// Adds a quarter of each tetrahedron's mass to each of its particles (paper 000 §2.4).
+    pub fn lump_mass(&self, mass: &mut [f64]) {
+        for (tet, v) in self.tets.iter().zip(&self.volume) {
+            let quarter = 0.25 * self.material.density * v;
+            for &n in tet {
+                mass[n as usize] += quarter;
+            }
+        }
+    }
+
+    /// Upper bound of the squared highest angular frequency, max over tetrahedra of
+    /// λ_max(M_e⁻¹K_e) (1/s²).
+    pub fn omega_squared_bound(&self) -> f64 {
+        self.omega_squared
+    }
+
+    /// Von Mises stress (Pa) and volumetric strain det F − 1 of every tetrahedron.
+    pub fn tet_fields(&self, state: &State) -> (Vec<f64>, Vec<f64>) {
+        let viscous = !self.material.is_elastic();
+        (0..self.tets.len())
+            .into_par_iter()
+            .with_min_len(TET_CHUNK)
+            .map(|e| {
+                let x = self.tets[e].map(|n| state.position[n as usize]);
+                let v = viscous.then(|| self.tets[e].map(|n| state.velocity[n as usize]));
+                let (t, _) = tet_stress(&x, v.as_ref(), &self.dm_inv[e], self.pair(), self.vpair());
+                let j = deformation_gradient(&x, &self.dm_inv[e]).determinant();
+                (von_mises(&t), j - 1.0)
+            })
+            .unzip()
+    }
+
+    fn pair(&self) -> (f64, f64) {
+        (self.elastic.lambda, self.elastic.mu)
+    }
+
+    fn vpair(&self) -> (f64, f64) {
+        (self.viscous.lambda, self.viscous.mu)
+    }
+
+    /// Stage 1: stress and particle forces of every tetrahedron into the buffer.
+    fn compute_tet_forces<const VISCOUS: bool>(&mut self, state: &State) {
+        let (elastic, viscous) = (self.pair(), self.vpair());
+        let (tets, dm_inv) = (&self.tets, &self.dm_inv);
+        self.tet_forces
+            .par_chunks_mut(4 * TET_CHUNK)
+            .enumerate()
+            .for_each(|(chunk, out)| {
+                let start = chunk * TET_CHUNK;
+                for (local, f) in out.chunks_exact_mut(4).enumerate() {
+                    let e = start + local;
+                    let tet = &tets[e];
+                    let x = tet.map(|n| state.position[n as usize]);
+                    let v = VISCOUS.then(|| tet.map(|n| state.velocity[n as usize]));
+                    let (t, cof) = tet_stress(&x, v.as_ref(), &dm_inv[e], elastic, viscous);
+                    f.copy_from_slice(&vertex_forces(&t, &cof));
+                }
+            });
+    }
+
+    /// Stage 2: per-particle sums over the incidence list, in a fixed order (Eq. 11).
+    fn gather(&self, force: &mut [Vec3]) {
+        let count = self.incidence_start.len() - 1;
+        let (starts, entries, buffer) = (&self.incidence_start, &self.incidence, &self.tet_forces);
+        force[self.first..self.first + count]
+            .par_iter_mut()
+            .with_min_len(PARTICLE_CHUNK)
+            .enumerate()
+            .for_each(|(i, f)| {
+                let range = starts[i] as usize..starts[i + 1] as usize;
+                let mut sum = Vec3::zeros();
+                for &entry in &entries[range] {
+                    sum += buffer[entry as usize];
+                }
+                *f += sum;
+            });
+    }
+}
+
+/// Largest element rate bound over all tetrahedra, for an elastic or a viscous Lamé pair.
+fn rate_bound(dm_inv: &[Mat3], material: &Material, lame: Lame) -> f64 {
+    dm_inv
+        .par_iter()
+        .map(|m| element_rate_bound(m, material.density, lame))
+        .reduce(|| 0.0, f64::max)
+}
+
+/// Compressed incidence lists: for each particle from the smallest to the largest index the
+/// tetrahedra use, the buffer entries `4·tet + corner` that belong to it, in ascending order.
+fn incidence_lists(tets: &[[u32; 4]]) -> (usize, Vec<u32>, Vec<u32>) {
+    let first = tets.iter().flatten().min().copied().unwrap_or(0) as usize;
+    let last = tets.iter().flatten().max().copied().unwrap_or(0) as usize;
+    let mut start = vec![0u32; last - first + 2];
+    for &n in tets.iter().flatten() {
+        start[n as usize - first + 1] += 1;
+    }
+    for i in 1..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut fill = start.clone();
+    let mut entries = vec![0u32; 4 * tets.len()];
+    for (e, tet) in tets.iter().enumerate() {
+        for (corner, &n) in tet.iter().enumerate() {
+            let slot = &mut fill[n as usize - first];
+            entries[*slot as usize] = (4 * e + corner) as u32;
+            *slot += 1;
+        }
+    }
+    (first, start, entries)
+}
+
+impl Model for TetBody {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3]) {
+        if self.material.is_elastic() {
+            self.compute_tet_forces::<false>(state);
+        } else {
+            self.compute_tet_forces::<true>(state);
+        }
+        self.gather(force);
+    }
+
+    fn stable_dt(&self, _state: &State) -> Option<f64> {
+        Some(critical_step(self.omega_squared, self.damping_rate))
+    }
+
+    fn potential_energy(&self, state: &State) -> Option<f64> {
+        let (lambda, mu) = self.pair();
+        let energy = (0..self.tets.len())
+            .map(|e| {
+                let x = self.tets[e].map(|n| state.position[n as usize]);
+                let f = deformation_gradient(&x, &self.dm_inv[e]);
+                strain_energy(&f, self.volume[e], lambda, mu)
+            })
+            .sum();
+        Some(energy)
+    }
+}
