@@ -1,0 +1,225 @@
+//! From the raw, file-id based parse to a checked [`TetMesh`]: node ids resolved,
+//! duplicate tetrahedra merged, unused nodes dropped and the rest renumbered (file order kept),
+//! negative tetrahedra reoriented, degenerate ones rejected, physical groups turned into
+//! node sets.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use crate::error::{MeshError, MeshWarning};
+use crate::msh::RawMesh;
+use crate::quality::{max_edge, signed_volume6};
+use crate::{PhysicalGroup, TetMesh};
+
+/// A tetrahedron is degenerate when `|6V| <= DEGENERATE_TOL * (longest edge)^3`.
+pub const DEGENERATE_TOL: f64 = 1e-12;
+
+const NONE: u32 = u32::MAX;
+
+/// File node id to index in the raw node list.
+enum IdMap {
+    Dense(Vec<u32>),
+    Sparse(HashMap<u64, u32>),
+}
+
+impl IdMap {
+    fn new(ids: &[u64], file: &Path) -> Result<IdMap, MeshError> {
+        let dup = |node_id| MeshError::DuplicateNode { file: file.to_path_buf(), node_id };
+        let max = ids.iter().copied().max().unwrap_or(0);
+        let dense_limit = (ids.len() as u64).saturating_mul(4).saturating_add(1024);
+        if max <= dense_limit {
+            let mut map = vec![NONE; max as usize + 1];
+            for (k, &id) in ids.iter().enumerate() {
+                let slot = &mut map[id as usize];
+                if *slot != NONE {
+                    return Err(dup(id));
+                }
+                *slot = k as u32;
+            }
+            Ok(IdMap::Dense(map))
+        } else {
+            let mut map = HashMap::with_capacity(ids.len());
+            for (k, &id) in ids.iter().enumerate() {
+                if map.insert(id, k as u32).is_some() {
+                    return Err(dup(id));
+                }
+            }
+            Ok(IdMap::Sparse(map))
+        }
+    }
+
+    fn get(&self, id: u64) -> Option<u32> {
+        match self {
+            IdMap::Dense(v) => usize::try_from(id).ok().and_then(|i| v.get(i)).copied().filter(|&k| k != NONE),
+            IdMap::Sparse(m) => m.get(&id).copied(),
+        }
+    }
+}
+
+/// Builds the checked mesh from the raw parse.
+pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarning>), MeshError> {
+    let mut warnings = Vec::new();
+    for (&type_id, &(count, first_element_id)) in &raw.unknown {
+        warnings.push(MeshWarning::IgnoredUnknownElements { type_id, count, first_element_id });
+    }
+    if raw.tets.is_empty() {
+        return Err(MeshError::NoTetrahedra { file: file.to_path_buf() });
+    }
+    if raw.node_ids.len() >= NONE as usize || raw.tets.len() >= NONE as usize {
+        return Err(MeshError::Malformed {
+            file: file.to_path_buf(),
+            location: crate::Location::Byte(0),
+            message: "more than 2^32 - 1 nodes or tetrahedra".to_string(),
+        });
+    }
+    let map = IdMap::new(&raw.node_ids, file)?;
+    let undefined = |element_id, node_id| MeshError::UndefinedNode { file: file.to_path_buf(), element_id, node_id };
+
+    // Exact duplicates (same id and nodes): keep the first.
+    let mut order: Vec<u32> = (0..raw.tets.len() as u32).collect();
+    order.sort_by_key(|&k| {
+        let t = &raw.tets[k as usize];
+        (t.id, t.nodes, k)
+    });
+    let mut keep = vec![true; raw.tets.len()];
+    let mut dups = 0usize;
+    let mut first_dup = None;
+    for w in order.windows(2) {
+        let (a, b) = (&raw.tets[w[0] as usize], &raw.tets[w[1] as usize]);
+        if a.id == b.id && a.nodes == b.nodes {
+            keep[w[1] as usize] = false;
+            dups += 1;
+            first_dup.get_or_insert(b.id);
+        }
+    }
+    if let Some(first_element_id) = first_dup {
+        warnings.push(MeshWarning::DuplicateTets { count: dups, first_element_id });
+    }
+
+    // Resolve node ids; mark used nodes.
+    let mut used = vec![false; raw.node_ids.len()];
+    let mut tets_raw: Vec<[u32; 4]> = Vec::with_capacity(raw.tets.len());
+    let mut tet_ids: Vec<u64> = Vec::with_capacity(raw.tets.len());
+    for (t, _) in raw.tets.iter().zip(&keep).filter(|(_, &k)| k) {
+        let mut r = [0u32; 4];
+        for (slot, &id) in r.iter_mut().zip(&t.nodes) {
+            *slot = map.get(id).ok_or_else(|| undefined(t.id, id))?;
+            used[*slot as usize] = true;
+        }
+        tets_raw.push(r);
+        tet_ids.push(t.id);
+    }
+
+    // Renumber in file order.
+    let mut new_index = vec![NONE; raw.node_ids.len()];
+    let mut nodes = Vec::with_capacity(raw.node_ids.len());
+    let mut dropped = 0usize;
+    let mut first_dropped = None;
+    for (k, &u) in used.iter().enumerate() {
+        if u {
+            new_index[k] = nodes.len() as u32;
+            nodes.push(raw.coords[k]);
+        } else {
+            dropped += 1;
+            first_dropped.get_or_insert(raw.node_ids[k]);
+        }
+    }
+    if let Some(first_node_id) = first_dropped {
+        warnings.push(MeshWarning::DroppedUnusedNodes { count: dropped, first_node_id });
+    }
+
+    // Orientation and degeneracy.
+    let mut tets = Vec::with_capacity(tets_raw.len());
+    let mut flipped = 0usize;
+    let mut first_flipped = None;
+    for (r, &id) in tets_raw.iter().zip(&tet_ids) {
+        let mut t = r.map(|k| new_index[k as usize]);
+        let p = t.map(|k| nodes[k as usize]);
+        let v6 = signed_volume6(&p);
+        let h = max_edge(&p);
+        if !(v6.abs() > DEGENERATE_TOL * h * h * h) {
+            let nodes_ids = r.map(|k| raw.node_ids[k as usize]);
+            return Err(MeshError::DegenerateTet {
+                file: file.to_path_buf(),
+                element_id: id,
+                nodes: nodes_ids,
+                coords: p,
+                volume6: v6,
+            });
+        }
+        if v6 < 0.0 {
+            t.swap(2, 3);
+            flipped += 1;
+            first_flipped.get_or_insert(id);
+        }
+        tets.push(t);
+    }
+    if let Some(first_element_id) = first_flipped {
+        warnings.push(MeshWarning::ReorientedTets { count: flipped, first_element_id });
+    }
+
+    let groups = groups(&raw, &map, &new_index, file, &mut warnings)?;
+    Ok((TetMesh { nodes, tets, groups }, warnings))
+}
+
+/// Physical groups as sorted node sets (new indices), sorted by (dim, tag).
+fn groups(
+    raw: &RawMesh,
+    map: &IdMap,
+    new_index: &[u32],
+    file: &Path,
+    warnings: &mut Vec<MeshWarning>,
+) -> Result<Vec<PhysicalGroup>, MeshError> {
+    // Every group named or referenced, in (dim, tag) order.
+    let mut keys: Vec<(u8, i32)> = raw.names.iter().map(|&(d, t, _)| (d, t)).collect();
+    keys.extend(raw.sources.iter().flatten().copied());
+    keys.sort_unstable();
+    keys.dedup();
+    let slot: HashMap<(u8, i32), usize> = keys.iter().enumerate().map(|(k, &g)| (g, k)).collect();
+    let src_slots: Vec<Vec<usize>> = raw.sources.iter().map(|s| s.iter().map(|g| slot[g]).collect()).collect();
+    let mut sets: Vec<Vec<u32>> = vec![Vec::new(); keys.len()];
+
+    // All tetrahedra, dropped duplicates included (same nodes, maybe other groups).
+    for t in &raw.tets {
+        for &g in &src_slots[t.src as usize] {
+            for &id in &t.nodes {
+                // Resolved above: every tetrahedron's nodes exist and are used.
+                if let Some(k) = map.get(id) {
+                    sets[g].push(new_index[k as usize]);
+                }
+            }
+        }
+    }
+    for e in &raw.others {
+        let slots = &src_slots[e.src as usize];
+        for &id in &raw.other_nodes[e.start..e.start + e.len] {
+            let k = map.get(id).ok_or_else(|| MeshError::UndefinedNode {
+                file: file.to_path_buf(),
+                element_id: e.id,
+                node_id: id,
+            })?;
+            let n = new_index[k as usize];
+            if n != NONE {
+                for &g in slots {
+                    sets[g].push(n);
+                }
+            }
+        }
+    }
+
+    let mut out = Vec::with_capacity(keys.len());
+    for ((dim, tag), mut nodes) in keys.into_iter().zip(sets) {
+        nodes.sort_unstable();
+        nodes.dedup();
+        let name = raw
+            .names
+            .iter()
+            .find(|&&(d, t, _)| d == dim && t == tag)
+            .map_or_else(|| format!("{dim}:{tag}"), |(_, _, n)| n.clone());
+        if nodes.is_empty() {
+            warnings.push(MeshWarning::EmptyGroup { name: name.clone(), dim, tag });
+        }
+        out.push(PhysicalGroup { name, dim, tag, nodes });
+    }
+    Ok(out)
+}
