@@ -1,0 +1,242 @@
+//! Building a simulation from a scene: meshes read and reordered, particles of all bodies laid
+//! out one body after another in one [`State`], and only the models the scene needs: a
+//! [`TetBody`] per body, [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per load.
+
+use crate::scene::{Scene, Selection, TimeStep};
+use qdem_core::{
+    choose_step, stable_step, CoreError, Dofs, Gravity, Material, Model, NodalLoad, State,
+    TetBody, TimeFunction, Vec3,
+};
+use qdem_mesh::{read_msh, MeshError, MeshStats, TetMesh};
+use std::ops::Range;
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// Why a scene could not be turned into a simulation.
+#[derive(Debug, Error)]
+pub enum BuildError {
+    /// A mesh could not be read or lacks a group.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// The core refused a body, a ramp or the time step.
+    #[error("{scene}: {source}")]
+    Core {
+        /// The scene file.
+        scene: PathBuf,
+        /// What the core refused.
+        source: CoreError,
+    },
+    /// A fix or load selects no particle.
+    #[error("{scene}: {what} on body `{body}` selects no particle: {fix}")]
+    EmptySelection {
+        /// The scene file.
+        scene: PathBuf,
+        /// `[[fix]]` or `[[load]]` with its index.
+        what: String,
+        /// The body.
+        body: String,
+        /// How to fix it.
+        fix: &'static str,
+    },
+}
+
+/// What the output needs to know about one body.
+#[derive(Clone, Debug)]
+pub struct BodyInfo {
+    /// Body name.
+    pub name: String,
+    /// Its particles in the state.
+    pub particles: Range<usize>,
+    /// Index of its [`TetBody`] in [`Simulation::models`].
+    pub model: usize,
+    /// Mesh statistics.
+    pub stats: MeshStats,
+    /// Mesh file.
+    pub mesh: PathBuf,
+}
+
+/// A probe resolved to a particle.
+#[derive(Clone, Debug)]
+pub struct ProbePoint {
+    /// Probe name.
+    pub name: String,
+    /// Sampled particle.
+    pub particle: usize,
+    /// Distance from the requested point to the particle (m).
+    pub distance: f64,
+}
+
+/// A ready-to-run simulation.
+pub struct Simulation {
+    /// The scene it was built from.
+    pub scene: Scene,
+    /// Particles of all bodies.
+    pub state: State,
+    /// Bodies first (in scene order), then gravity, then loads.
+    pub models: Vec<Box<dyn Model>>,
+    /// Per-body output information.
+    pub bodies: Vec<BodyInfo>,
+    /// Probes in scene order.
+    pub probes: Vec<ProbePoint>,
+    /// The stable bound (s) and the model that sets it.
+    pub stable_dt: (f64, String),
+    /// The step that will be used (s).
+    pub dt: f64,
+    /// Mesh warnings, one line each, naming the file.
+    pub warnings: Vec<String>,
+}
+
+impl Simulation {
+    /// Reads the meshes and builds every model of `scene`.
+    pub fn build(scene: Scene) -> Result<Simulation, BuildError> {
+        let core = |source| BuildError::Core {
+            scene: scene.path.clone(),
+            source,
+        };
+        let mut warnings = Vec::new();
+        let mut meshes = Vec::new();
+        let mut reference = Vec::new();
+        let mut ranges = Vec::new();
+        for body in &scene.bodies {
+            let path = scene.mesh_path(body);
+            let (mut mesh, mesh_warnings) = read_msh(&path)?;
+            warnings.extend(mesh_warnings.iter().map(|w| format!("{}: {w}", path.display())));
+            if body.reorder {
+                mesh.reorder_for_locality();
+            }
+            let start = reference.len();
+            reference.extend(mesh.nodes.iter().map(|p| Vec3::from(*p)));
+            ranges.push(start..reference.len());
+            meshes.push((mesh, path));
+        }
+        let mut state = State::at_rest(reference);
+        let mut models: Vec<Box<dyn Model>> = Vec::new();
+        let mut bodies = Vec::new();
+        for ((body, (mesh, path)), range) in scene.bodies.iter().zip(&meshes).zip(&ranges) {
+            let material = scene.material(&body.material).expect("validated scene");
+            let tets = offset_tets(mesh, range.start);
+            let tet_body = TetBody::new(&body.name, &state.reference, tets, core_material(material))
+                .map_err(core)?;
+            tet_body.lump_mass(&mut state.mass);
+            bodies.push(BodyInfo {
+                name: body.name.clone(),
+                particles: range.clone(),
+                model: models.len(),
+                stats: mesh.stats(),
+                mesh: path.clone(),
+            });
+            models.push(Box::new(tet_body));
+        }
+        let body_index = |name: &str| scene.bodies.iter().position(|b| b.name == name).expect("validated scene");
+        for (i, fix) in scene.fixes.iter().enumerate() {
+            let b = body_index(&fix.body);
+            let what = format!("[[fix]] #{}", i + 1);
+            let selected = select(&scene, &meshes[b], &fix.selection, &what, &fix.body)?;
+            let dofs = (0..3).filter(|&a| fix.dofs[a]).map(|a| ["x", "y", "z"][a]).collect::<String>();
+            let dofs = Dofs::parse(&dofs).unwrap_or(Dofs::ALL);
+            for n in selected {
+                state.fix(ranges[b].start + n as usize, dofs);
+            }
+        }
+        if scene.run.gravity.iter().any(|&g| g != 0.0) {
+            models.push(Box::new(Gravity::new(Vec3::from(scene.run.gravity))));
+        }
+        for (i, load) in scene.loads.iter().enumerate() {
+            let b = body_index(&load.body);
+            let what = format!("[[load]] #{}", i + 1);
+            let selected = select(&scene, &meshes[b], &load.selection, &what, &load.body)?;
+            let particles = selected.iter().map(|&n| (ranges[b].start + n as usize) as u32).collect();
+            let ramp = if load.ramp.points.is_empty() {
+                TimeFunction::constant(1.0)
+            } else {
+                TimeFunction::new(load.ramp.points.iter().map(|p| (p[0], p[1])).collect()).map_err(core)?
+            };
+            models.push(Box::new(NodalLoad::new(&what, particles, Vec3::from(load.total_force), ramp)));
+        }
+        let probes = scene
+            .probes
+            .iter()
+            .map(|p| {
+                let b = body_index(&p.body);
+                nearest_particle(&state, ranges[b].clone(), Vec3::from(p.point), &p.name)
+            })
+            .collect();
+        let stable_dt = stable_step(&state, &models).unwrap_or((f64::INFINITY, String::new()));
+        let requested = match scene.run.dt {
+            TimeStep::Auto => None,
+            TimeStep::Fixed(dt) => Some(dt),
+        };
+        let mut dt = choose_step(&state, &models, requested, scene.run.dt_safety).map_err(core)?;
+        if requested.is_none() {
+            // Shrink the automatic step so that a whole number of steps reaches t_end.
+            dt = scene.run.t_end / (scene.run.t_end / dt).ceil();
+        }
+        Ok(Simulation { scene, state, models, bodies, probes, stable_dt, dt, warnings })
+    }
+
+    /// Number of steps to reach `t_end` (the last one may end slightly past it for a fixed dt).
+    pub fn steps(&self) -> u64 {
+        (self.scene.run.t_end / self.dt - 1e-9).ceil().max(0.0) as u64
+    }
+
+    /// Number of tetrahedra in all bodies.
+    pub fn tets(&self) -> usize {
+        self.bodies.iter().map(|b| b.stats.tets).sum()
+    }
+
+    /// The [`TetBody`] of a body.
+    pub fn tet_body(&self, body: &BodyInfo) -> &TetBody {
+        let model: &dyn std::any::Any = self.models[body.model].as_ref();
+        model.downcast_ref::<TetBody>().expect("a body's model is a TetBody")
+    }
+}
+
+fn core_material(m: &crate::scene::Material) -> Material {
+    Material {
+        density: m.density,
+        young: m.young,
+        poisson: m.poisson,
+        shear_viscosity: m.shear_viscosity,
+        bulk_viscosity: m.bulk_viscosity,
+    }
+}
+
+fn offset_tets(mesh: &TetMesh, offset: usize) -> Vec<[u32; 4]> {
+    let offset = offset as u32;
+    mesh.tets.iter().map(|t| t.map(|n| n + offset)).collect()
+}
+
+/// Mesh-local particle indices of a selection; an empty selection is an error.
+fn select(
+    scene: &Scene,
+    (mesh, path): &(TetMesh, PathBuf),
+    selection: &Selection,
+    what: &str,
+    body: &str,
+) -> Result<Vec<u32>, BuildError> {
+    let nodes = match selection {
+        Selection::Group(name) => mesh.require_group(name, path)?.nodes.clone(),
+        Selection::Box([min, max]) => mesh.nodes_in_box(*min, *max),
+    };
+    if nodes.is_empty() {
+        let fix = match selection {
+            Selection::Group(_) => "the physical group has no mesh node; check the .geo",
+            Selection::Box(_) => "enlarge the box (its bounds are inclusive) or check its units",
+        };
+        return Err(BuildError::EmptySelection {
+            scene: scene.path.clone(),
+            what: what.to_string(),
+            body: body.to_string(),
+            fix,
+        });
+    }
+    Ok(nodes)
+}
+
+fn nearest_particle(state: &State, range: Range<usize>, point: Vec3, name: &str) -> ProbePoint {
+    let (particle, distance) = range
+        .map(|i| (i, (state.reference[i] - point).norm()))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("a body has particles");
+    ProbePoint { name: name.to_string(), particle, distance }
+}

@@ -1,0 +1,17 @@
+//! # qdem-io
+//!
+//! Scene files and outputs of qdem:
+//!
+//! - [`scene`]: the TOML scene format (a public contract), parsed with serde and validated with
+//!   messages that name the file, line and key.
+//! - [`build`]: turns a scene into a [`build::Simulation`]: one [`qdem_core::State`] for all
+//!   bodies and only the models the scene needs.
+//! - [`runner`]: the run loop, sampling probes and writing snapshots.
+//! - [`output`]: atomic writers for VTU/PVD, probe CSV and summary JSON.
+//! - [`spectrum`]: dominant frequency of a probe record by FFT.
+
+pub mod build;
+pub mod output;
+pub mod runner;
+pub mod scene;
+pub mod spectrum;

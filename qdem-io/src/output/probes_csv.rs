@@ -1,0 +1,163 @@
+//! Probe time histories as CSV, written row by row during a run.
+//!
+//! Layout: a header line `t,P.ux,P.uy,P.uz,P.vx,P.vy,P.vz,P.ax,P.ay,P.az,...` (nine columns
+//! per probe `P`: displacement, velocity, acceleration), then one line per sample time.
+//! Numbers are written with the shortest decimal form that parses back to the same `f64`
+//! (plain notation for magnitudes in `[1e-5, 1e16)` and zero, scientific `1.5e-7`
+//! otherwise; NaN and infinities as `NaN`, `inf`, `-inf`), so nothing is lost.
+//!
+//! The file is an [`AtomicFile`]: it appears under its name only on [`ProbeCsv::finish`];
+//! a run that fails leaves any previous file untouched.
+
+use std::io::Write;
+use std::path::Path;
+
+use nalgebra::Vector3;
+
+use super::atomic::AtomicFile;
+use super::error::{IoStage, OutputError};
+use super::write_f64;
+
+/// The column suffixes written for each probe, in order.
+pub const PROBE_COLUMNS: [&str; 9] = ["ux", "uy", "uz", "vx", "vy", "vz", "ax", "ay", "az"];
+
+/// A probe CSV being written.
+///
+/// # Example
+/// ```
+/// # use qdem_io::output::ProbeCsv;
+/// use nalgebra::Vector3;
+/// let path = std::env::temp_dir().join(format!("qdem-doc-{}-probes.csv", std::process::id()));
+/// let mut csv = ProbeCsv::create(&path, &["tip".to_string()]).unwrap();
+/// let (u, v, a) = (Vector3::new(0.0, 0.0, -1e-4), Vector3::zeros(), Vector3::zeros());
+/// csv.row(0.5, &[[u, v, a]]).unwrap();
+/// csv.finish().unwrap();
+/// let text = std::fs::read_to_string(&path).unwrap();
+/// assert!(text.starts_with("t,tip.ux,tip.uy,"));
+/// # std::fs::remove_file(&path).unwrap();
+/// ```
+#[derive(Debug)]
+pub struct ProbeCsv {
+    /// The file being written.
+    file: AtomicFile,
+    /// The number of probes (columns per row: `1 + 9 * num_probes`).
+    num_probes: usize,
+    /// The number of data rows written.
+    num_rows: usize,
+}
+
+impl ProbeCsv {
+    /// Creates the temporary file for `path` and writes the header.
+    ///
+    /// # Errors
+    /// [`OutputError::InvalidName`] if a probe name is empty, is used twice, or contains a
+    /// comma, a double quote or a control character (names are written unquoted);
+    /// [`OutputError::Io`] (or [`OutputError::NoFileName`]) if the file cannot be created.
+    pub fn create(path: &Path, probe_names: &[String]) -> Result<Self, OutputError> {
+        for (i, name) in probe_names.iter().enumerate() {
+            let reason = if name.is_empty() {
+                Some("probe names must not be empty")
+            } else if name.contains([',', '"']) || name.chars().any(char::is_control) {
+                Some("probe names must not contain commas, double quotes or control characters")
+            } else if probe_names[..i].contains(name) {
+                Some("the same probe name is used twice")
+            } else {
+                None
+            };
+            if let Some(reason) = reason {
+                return Err(OutputError::InvalidName {
+                    path: path.to_path_buf(),
+                    name: name.clone(),
+                    reason,
+                });
+            }
+        }
+        let mut file = AtomicFile::create_as(path, "probe CSV")?;
+        let header = (|| {
+            let w = file.writer();
+            w.write_all(b"t")?;
+            for name in probe_names {
+                for col in PROBE_COLUMNS {
+                    write!(w, ",{name}.{col}")?;
+                }
+            }
+            w.write_all(b"\n")
+        })();
+        if let Err(source) = header {
+            return Err(file.error(IoStage::Write, source));
+        }
+        Ok(Self {
+            file,
+            num_probes: probe_names.len(),
+            num_rows: 0,
+        })
+    }
+
+    /// The number of probes (as given to [`ProbeCsv::create`]).
+    #[must_use]
+    pub fn num_probes(&self) -> usize {
+        self.num_probes
+    }
+
+    /// The number of data rows written so far.
+    #[must_use]
+    pub fn num_rows(&self) -> usize {
+        self.num_rows
+    }
+
+    /// The path the file will have after [`ProbeCsv::finish`].
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        self.file.path()
+    }
+
+    /// Writes one row: time `t`, then for each probe its displacement, velocity and
+    /// acceleration (`samples[i] = [u, v, a]`).
+    ///
+    /// # Errors
+    /// [`OutputError::Length`] if `samples.len()` is not the number of probes,
+    /// [`OutputError::NonFinite`] if `t` is NaN or infinite (sample values may be
+    /// non-finite: a diverging run should still be visible), [`OutputError::Io`] if writing
+    /// fails. Nothing is written on a validation error.
+    pub fn row(&mut self, t: f64, samples: &[[Vector3<f64>; 3]]) -> Result<(), OutputError> {
+        if samples.len() != self.num_probes {
+            return Err(OutputError::Length {
+                path: self.file.path().to_path_buf(),
+                name: "probe samples".to_string(),
+                expected: self.num_probes,
+                found: samples.len(),
+            });
+        }
+        if !t.is_finite() {
+            return Err(OutputError::NonFinite {
+                path: self.file.path().to_path_buf(),
+                what: "probe sample time",
+                value: t,
+            });
+        }
+        let result = (|| {
+            let w = self.file.writer();
+            write_f64(w, t)?;
+            for sample in samples {
+                for v in sample {
+                    for x in v.iter() {
+                        w.write_all(b",")?;
+                        write_f64(w, *x)?;
+                    }
+                }
+            }
+            w.write_all(b"\n")
+        })();
+        result.map_err(|source| self.file.error(IoStage::Write, source))?;
+        self.num_rows += 1;
+        Ok(())
+    }
+
+    /// Flushes, syncs and renames the file into place.
+    ///
+    /// # Errors
+    /// [`OutputError::Io`] if that fails; the target is then untouched.
+    pub fn finish(self) -> Result<(), OutputError> {
+        self.file.commit()
+    }
+}

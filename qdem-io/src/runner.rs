@@ -1,0 +1,248 @@
+//! The run loop: steps a [`Simulation`] to `t_end`, sampling probes and writing VTU
+//! snapshots at their intervals, and a summary at the end. Every output file is written
+//! atomically; a run stopped by an instability still commits the probe rows up to the failure.
+//!
+//! The loop is an explicit pipeline: step → probes → snapshot → progress.
+
+use crate::build::Simulation;
+use crate::output::{write_summary, write_vtu, OutputError, ProbeCsv, PvdIndex, VtuGrid};
+use qdem_core::{CoreError, Stepper, Vec3, Verlet};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use thiserror::Error;
+
+/// Why a run stopped early.
+#[derive(Debug, Error)]
+pub enum RunError {
+    /// An output could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// The output directory could not be created.
+    #[error("cannot create the output directory {path}: {source}")]
+    OutputDir {
+        /// The directory.
+        path: PathBuf,
+        /// The io error.
+        source: std::io::Error,
+    },
+    /// The stepper failed (an instability).
+    #[error("{scene}: {source}")]
+    Core {
+        /// The scene file.
+        scene: PathBuf,
+        /// What went wrong.
+        source: CoreError,
+    },
+}
+
+/// Where the run is, for a progress display.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Steps done.
+    pub step: u64,
+    /// Steps in the whole run.
+    pub steps: u64,
+    /// Simulated time (s).
+    pub time: f64,
+    /// Steps per wall-clock second so far.
+    pub steps_per_second: f64,
+    /// Estimated wall-clock seconds left.
+    pub eta_seconds: f64,
+}
+
+/// What a finished run reports (also written to `summary.json`).
+#[derive(Clone, Debug)]
+pub struct RunReport {
+    /// Steps taken.
+    pub steps: u64,
+    /// Step size (s).
+    pub dt: f64,
+    /// Final simulated time (s).
+    pub final_time: f64,
+    /// Wall-clock seconds of the stepping loop, outputs included.
+    pub wall_seconds: f64,
+    /// Tetrahedron-steps per wall-clock second.
+    pub tet_steps_per_second: f64,
+    /// Rows written to `probes.csv`.
+    pub probe_rows: usize,
+    /// VTU snapshots written.
+    pub vtu_files: usize,
+}
+
+/// Samples that fall due: the first at t = 0, then every `every` seconds (to the nearest step).
+struct Schedule {
+    every: f64,
+    next: f64,
+}
+
+impl Schedule {
+    fn new(every: f64) -> Schedule {
+        Schedule { every, next: 0.0 }
+    }
+
+    /// Whether a sample is due at `time`, given the step `dt`; advances past it if so.
+    fn due(&mut self, time: f64, dt: f64) -> bool {
+        if self.every <= 0.0 || time < self.next - 0.5 * dt {
+            return false;
+        }
+        while self.next <= time + 0.5 * dt {
+            self.next += self.every;
+        }
+        true
+    }
+}
+
+/// Runs `sim` to its end time, writing `probes.csv`, `summary.json` and, if asked,
+/// `vtu/state_NNNNN.vtu` with `results.pvd` into `out_dir`. `progress` is called about twice
+/// a second of wall-clock time.
+pub fn run(
+    sim: &mut Simulation,
+    out_dir: &Path,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<RunReport, RunError> {
+    let dir_error = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| RunError::OutputDir { path, source }
+    };
+    std::fs::create_dir_all(out_dir).map_err(dir_error(out_dir))?;
+    let vtu_dir = out_dir.join("vtu");
+    if sim.scene.output.writes_vtu() {
+        std::fs::create_dir_all(&vtu_dir).map_err(dir_error(&vtu_dir))?;
+    }
+    let names: Vec<String> = sim.probes.iter().map(|p| p.name.clone()).collect();
+    let mut csv = ProbeCsv::create(&out_dir.join("probes.csv"), &names)?;
+    let steps = sim.steps();
+    let probe_every = sim.scene.run.probe_every.unwrap_or(sim.scene.run.t_end / 1000.0);
+    let mut probe_schedule = Schedule::new(probe_every);
+    let mut vtu_schedule = Schedule::new(sim.scene.output.vtu_every);
+    let mut pvd = PvdIndex::new();
+    let mut stepper = Verlet::new(sim.dt);
+    let start = Instant::now();
+    let mut last_report = start;
+    let outcome = (|| -> Result<(), RunError> {
+        stepper
+            .initialize(&mut sim.state, &mut sim.models)
+            .map_err(|source| core_error(sim, source))?;
+        for step in 0..=steps {
+            if step > 0 {
+                stepper
+                    .step(&mut sim.state, &mut sim.models)
+                    .map_err(|source| core_error(sim, source))?;
+            }
+            let (time, dt) = (sim.state.time, sim.dt);
+            if probe_schedule.due(time, dt) {
+                csv.row(time, &probe_samples(sim))?;
+            }
+            if vtu_schedule.due(time, dt) {
+                let file = format!("vtu/state_{:05}.vtu", pvd.len());
+                write_snapshot(sim, &out_dir.join(&file))?;
+                pvd.push(time, file);
+                pvd.write(&out_dir.join("results.pvd"))?;
+            }
+            if step % 64 == 0 && last_report.elapsed().as_secs_f64() > 0.5 {
+                last_report = Instant::now();
+                progress(&progress_at(step, steps, time, start));
+            }
+        }
+        Ok(())
+    })();
+    let wall_seconds = start.elapsed().as_secs_f64();
+    let probe_rows = csv.num_rows();
+    csv.finish()?;
+    outcome?;
+    let tet_steps = (sim.tets() as f64) * steps as f64;
+    let report = RunReport {
+        steps,
+        dt: sim.dt,
+        final_time: sim.state.time,
+        wall_seconds,
+        tet_steps_per_second: tet_steps / wall_seconds.max(1e-9),
+        probe_rows,
+        vtu_files: pvd.len(),
+    };
+    write_summary(&out_dir.join("summary.json"), &summary_json(sim, &report))?;
+    Ok(report)
+}
+
+fn core_error(sim: &Simulation, source: CoreError) -> RunError {
+    RunError::Core {
+        scene: sim.scene.path.clone(),
+        source,
+    }
+}
+
+fn progress_at(step: u64, steps: u64, time: f64, start: Instant) -> Progress {
+    let elapsed = start.elapsed().as_secs_f64();
+    let rate = step as f64 / elapsed.max(1e-9);
+    Progress {
+        step,
+        steps,
+        time,
+        steps_per_second: rate,
+        eta_seconds: (steps - step) as f64 / rate.max(1e-9),
+    }
+}
+
+fn probe_samples(sim: &Simulation) -> Vec<[Vec3; 3]> {
+    let s = &sim.state;
+    sim.probes
+        .iter()
+        .map(|p| [s.displacement(p.particle), s.velocity[p.particle], s.acceleration[p.particle]])
+        .collect()
+}
+
+/// One VTU of all bodies: reference points with displacement and velocity per particle, von
+/// Mises stress and volumetric strain per tetrahedron.
+fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
+    let s = &sim.state;
+    let displacement: Vec<Vec3> = (0..s.len()).map(|i| s.displacement(i)).collect();
+    let mut tets = Vec::new();
+    let (mut von_mises, mut volumetric) = (Vec::new(), Vec::new());
+    for body in &sim.bodies {
+        let tet_body = sim.tet_body(body);
+        tets.extend_from_slice(tet_body.tets());
+        let (vm, vol) = tet_body.tet_fields(s);
+        von_mises.extend(vm);
+        volumetric.extend(vol);
+    }
+    let grid = VtuGrid {
+        points: &s.reference,
+        tets: &tets,
+        point_vectors: vec![("displacement", &displacement), ("velocity", &s.velocity)],
+        cell_scalars: vec![("von_mises", &von_mises), ("volumetric_strain", &volumetric)],
+    };
+    write_vtu(path, &grid)
+}
+
+fn summary_json(sim: &Simulation, report: &RunReport) -> serde_json::Value {
+    json!({
+        "scene": sim.scene.path.display().to_string(),
+        "integrator": "verlet",
+        "steps": report.steps,
+        "dt": report.dt,
+        "stable_dt": sim.stable_dt.0,
+        "dt_limited_by": sim.stable_dt.1,
+        "t_end": sim.scene.run.t_end,
+        "final_time": report.final_time,
+        "wall_seconds": report.wall_seconds,
+        "particles": sim.state.len(),
+        "tets": sim.tets(),
+        "tet_steps_per_second": report.tet_steps_per_second,
+        "threads": rayon::current_num_threads(),
+        "probe_rows": report.probe_rows,
+        "vtu_files": report.vtu_files,
+        "kinetic_energy": sim.state.kinetic_energy(),
+        "bodies": sim.bodies.iter().map(|b| json!({
+            "name": b.name,
+            "mesh": b.mesh.display().to_string(),
+            "particles": b.particles.len(),
+            "tets": b.stats.tets,
+        })).collect::<Vec<_>>(),
+        "probes": sim.probes.iter().map(|p| json!({
+            "name": p.name,
+            "particle": p.particle,
+            "distance": p.distance,
+        })).collect::<Vec<_>>(),
+    })
+}

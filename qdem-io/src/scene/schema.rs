@@ -1,0 +1,365 @@
+//! The data types of a scene: what a scene file deserializes into.
+//!
+//! Most tables deserialize straight into their public type. `[[fix]]` and `[[load]]` go through
+//! private raw forms first, because their `group`/`box` pair becomes a single [`Selection`] and
+//! their `dofs`/`ramp` are checked and normalised; that happens during
+//! validation ([`super::Scene::parse`]).
+
+use std::fmt;
+use std::path::PathBuf;
+
+use serde::de::{self, Deserializer, Visitor};
+use serde::{Deserialize, Serialize, Serializer};
+
+/// The error message for a `dt` that is neither `"auto"` nor a number.
+pub(crate) const DT_MESSAGE: &str = "dt must be \"auto\" or a number of seconds";
+
+/// `[run]`: how long and how to integrate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Run {
+    /// Simulated end time, s. Required, > 0.
+    pub t_end: f64,
+    /// Time step: `"auto"` (default) or a fixed number of seconds.
+    #[serde(default)]
+    pub dt: TimeStep,
+    /// Time integrator; default [`Integrator::Verlet`].
+    #[serde(default)]
+    pub integrator: Integrator,
+    /// Gravitational acceleration, m/s²; default zero.
+    #[serde(default)]
+    pub gravity: [f64; 3],
+    /// Simulated time between two rows of `probes.csv`, s (> 0). Optional: `None` leaves the
+    /// choice to the run loop.
+    #[serde(default)]
+    pub probe_every: Option<f64>,
+    /// Fraction of the stable time-step bound used when `dt = "auto"`, in (0, 1]; default
+    /// [`Run::DEFAULT_DT_SAFETY`].
+    #[serde(default = "default_dt_safety")]
+    pub dt_safety: f64,
+}
+
+impl Run {
+    /// The `dt_safety` used when the scene does not give one.
+    pub const DEFAULT_DT_SAFETY: f64 = 0.9;
+}
+
+fn default_dt_safety() -> f64 {
+    Run::DEFAULT_DT_SAFETY
+}
+
+/// `[run] dt`: the time step.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum TimeStep {
+    /// `dt = "auto"`: `dt_safety` times the stable bound computed from the models.
+    #[default]
+    Auto,
+    /// `dt = <seconds>`: a fixed step (refused later if above the stable bound).
+    Fixed(f64),
+}
+
+impl<'de> Deserialize<'de> for TimeStep {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct TimeStepVisitor;
+
+        impl<'de> Visitor<'de> for TimeStepVisitor {
+            type Value = TimeStep;
+
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("\"auto\" or a number of seconds")
+            }
+
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<TimeStep, E> {
+                if v == "auto" {
+                    Ok(TimeStep::Auto)
+                } else {
+                    Err(E::custom(DT_MESSAGE))
+                }
+            }
+
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<TimeStep, E> {
+                Ok(TimeStep::Fixed(v))
+            }
+
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<TimeStep, E> {
+                Ok(TimeStep::Fixed(v as f64))
+            }
+
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<TimeStep, E> {
+                Ok(TimeStep::Fixed(v as f64))
+            }
+
+            fn visit_bool<E: de::Error>(self, _: bool) -> Result<TimeStep, E> {
+                Err(E::custom(DT_MESSAGE))
+            }
+
+            fn visit_map<A: de::MapAccess<'de>>(self, _: A) -> Result<TimeStep, A::Error> {
+                Err(de::Error::custom(DT_MESSAGE))
+            }
+
+            fn visit_seq<A: de::SeqAccess<'de>>(self, _: A) -> Result<TimeStep, A::Error> {
+                Err(de::Error::custom(DT_MESSAGE))
+            }
+        }
+
+        deserializer.deserialize_any(TimeStepVisitor)
+    }
+}
+
+impl Serialize for TimeStep {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        match self {
+            TimeStep::Auto => serializer.serialize_str("auto"),
+            TimeStep::Fixed(dt) => serializer.serialize_f64(*dt),
+        }
+    }
+}
+
+/// `[run] integrator`: the time integration scheme.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Integrator {
+    /// Explicit velocity Verlet (central difference), as in the QDEM paper.
+    #[default]
+    #[serde(rename = "verlet")]
+    Verlet,
+}
+
+impl Integrator {
+    /// Every integrator, in the order the error messages list them.
+    pub const ALL: &'static [Integrator] = &[Integrator::Verlet];
+
+    /// The name used in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Verlet => "verlet",
+        }
+    }
+}
+
+/// `[[material]]`: a linear elastic (optionally Kelvin–Voigt viscous) isotropic material.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Unique name that `[[body]] material` refers to.
+    pub name: String,
+    /// Mass density, kg/m³ (> 0).
+    pub density: f64,
+    /// Young's modulus, Pa (> 0).
+    pub young: f64,
+    /// Poisson's ratio ν, in (−1, 0.5).
+    pub poisson: f64,
+    /// Shear viscosity μ_D, Pa·s (≥ 0); default 0.
+    #[serde(default)]
+    pub shear_viscosity: f64,
+    /// Bulk viscosity λ_D + 2/3 μ_D, Pa·s (≥ 0); default 0.
+    #[serde(default)]
+    pub bulk_viscosity: f64,
+}
+
+/// `[[body]]`: a continuum body meshed with tetrahedra.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Body {
+    /// Unique name that fixes, loads and probes refer to.
+    pub name: String,
+    /// The gmsh mesh file as written in the scene, relative to the scene file's directory
+    /// (see [`super::Scene::mesh_path`]).
+    pub mesh: PathBuf,
+    /// Name of a `[[material]]`.
+    pub material: String,
+    /// Reorder nodes for memory locality after import; default `true`.
+    #[serde(default = "default_true")]
+    pub reorder: bool,
+}
+
+fn default_true() -> bool {
+    true
+}
+
+/// Which particles of a body a fix or load applies to.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Selection {
+    /// `group = "name"`: the nodes of a gmsh physical group.
+    Group(String),
+    /// `box = [[xmin, ymin, zmin], [xmax, ymax, zmax]]`: every particle inside the closed box.
+    Box([[f64; 3]; 2]),
+}
+
+/// `[[fix]]`: prescribed zero displacement of some degrees of freedom.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Fix {
+    /// Name of the `[[body]]`.
+    pub body: String,
+    /// The particles that are fixed.
+    pub selection: Selection,
+    /// Fixed directions as an `[x, y, z]` mask, from `dofs = "xyz"` (default all three).
+    pub dofs: [bool; 3],
+}
+
+/// `[[load]]`: a total force shared equally by the selected particles, scaled by a ramp.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Load {
+    /// Name of the `[[body]]`.
+    pub body: String,
+    /// The particles that carry the load.
+    pub selection: Selection,
+    /// Total force, N, divided equally among the selected particles.
+    pub total_force: [f64; 3],
+    /// Time factor applied to `total_force`.
+    pub ramp: Ramp,
+}
+
+/// A piecewise-linear time factor given by `(t, factor)` points.
+///
+/// Between points the factor is interpolated linearly; before the first point the first factor
+/// holds, after the last point the last factor holds. Two points with the same time make a jump:
+/// the first value is reached from the left, the second holds from that time on. No points
+/// means a constant factor 1 (the default when `ramp` is absent).
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+#[serde(transparent)]
+pub struct Ramp {
+    /// The `[t, factor]` points, times non-decreasing, at most two per time.
+    pub points: Vec<[f64; 2]>,
+}
+
+impl Ramp {
+    /// A constant factor 1.
+    pub fn constant() -> Ramp {
+        Ramp::default()
+    }
+
+    /// The factor at time `t`.
+    ///
+    /// ```
+    /// use qdem_io::scene::Ramp;
+    /// let ramp = Ramp { points: vec![[0.0, 0.0], [1.0, 1.0], [2.0, 1.0], [2.0, 0.0]] };
+    /// assert_eq!(ramp.factor(-1.0), 0.0);
+    /// assert_eq!(ramp.factor(0.5), 0.5);
+    /// assert_eq!(ramp.factor(1.999), 1.0);
+    /// assert_eq!(ramp.factor(2.0), 0.0);
+    /// assert_eq!(ramp.factor(9.0), 0.0);
+    /// assert_eq!(Ramp::constant().factor(3.0), 1.0);
+    /// ```
+    pub fn factor(&self, t: f64) -> f64 {
+        let p = &self.points;
+        let Some(first) = p.first() else {
+            return 1.0;
+        };
+        if t < first[0] {
+            return first[1];
+        }
+        // The last point with time <= t: at a jump this is the second (right) value.
+        let i = p.partition_point(|q| q[0] <= t) - 1;
+        match p.get(i + 1) {
+            None => p[i][1],
+            Some(next) => {
+                let [t0, f0] = p[i];
+                let [t1, f1] = *next;
+                if t1 > t0 {
+                    f0 + (f1 - f0) * (t - t0) / (t1 - t0)
+                } else {
+                    f0
+                }
+            }
+        }
+    }
+}
+
+/// `[[probe]]`: a particle whose state is written to `probes.csv`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Probe {
+    /// Unique name (the CSV column prefix).
+    pub name: String,
+    /// Name of the `[[body]]`.
+    pub body: String,
+    /// The particle of the body nearest to this point (in the reference configuration) is
+    /// sampled.
+    pub point: [f64; 3],
+}
+
+/// `[output]`: where and how often to write results.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Output {
+    /// Output directory as written (default `"out"`); the command line's `--out` overrides it.
+    #[serde(default = "default_out_dir")]
+    pub dir: PathBuf,
+    /// Simulated time between VTU snapshots, s; 0 (the default) writes none.
+    #[serde(default)]
+    pub vtu_every: f64,
+}
+
+impl Output {
+    /// Whether VTU snapshots are requested.
+    pub fn writes_vtu(&self) -> bool {
+        self.vtu_every > 0.0
+    }
+}
+
+impl Default for Output {
+    fn default() -> Output {
+        Output {
+            dir: default_out_dir(),
+            vtu_every: 0.0,
+        }
+    }
+}
+
+fn default_out_dir() -> PathBuf {
+    PathBuf::from("out")
+}
+
+/// `[[fix]]` as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawFix {
+    pub body: String,
+    #[serde(default)]
+    pub group: Option<String>,
+    #[serde(default, rename = "box")]
+    pub bbox: Option<[[f64; 3]; 2]>,
+    #[serde(default = "default_dofs")]
+    pub dofs: String,
+}
+
+fn default_dofs() -> String {
+    "xyz".to_owned()
+}
+
+/// `[[load]]` as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawLoad {
+    pub body: String,
+    #[serde(default)]
+    pub group: Option<String>,
+    #[serde(default, rename = "box")]
+    pub bbox: Option<[[f64; 3]; 2]>,
+    pub total_force: [f64; 3],
+    #[serde(default)]
+    pub ramp: Option<Vec<[f64; 2]>>,
+}
+
+/// The whole file as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawScene {
+    pub run: Run,
+    #[serde(default, rename = "material")]
+    pub materials: Vec<Material>,
+    #[serde(default, rename = "body")]
+    pub bodies: Vec<Body>,
+    #[serde(default, rename = "fix")]
+    pub fixes: Vec<RawFix>,
+    #[serde(default, rename = "load")]
+    pub loads: Vec<RawLoad>,
+    #[serde(default, rename = "probe")]
+    pub probes: Vec<Probe>,
+    #[serde(default)]
+    pub output: Output,
+}
+
+/// Top-level keys that are arrays of tables (`[[name]]`), for messages.
+pub(crate) const ARRAY_TABLES: &[&str] = &["material", "body", "fix", "load", "probe"];

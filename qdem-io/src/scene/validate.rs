@@ -1,0 +1,641 @@
+//! Semantic validation: everything serde cannot check. Every problem is collected (not just
+//! the first) and reported in file order, each naming its table and saying how to fix it.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use super::error::{Diagnostic, SceneError};
+use super::schema::{Fix, Load, Ramp, RawFix, RawLoad, RawScene, Selection, TimeStep};
+use super::spans::SpanIndex;
+use super::suggest::did_you_mean;
+use super::Scene;
+
+/// Collects located problems.
+struct Checker<'a> {
+    path: &'a Path,
+    text: Option<&'a str>,
+    spans: Option<&'a SpanIndex>,
+    found: Vec<(Option<usize>, Diagnostic)>,
+}
+
+impl Checker<'_> {
+    fn offset(&self, at: &[&str]) -> Option<usize> {
+        self.spans.and_then(|s| s.offset(at))
+    }
+
+    fn line_of(&self, at: &[&str]) -> Option<usize> {
+        let offset = self.offset(at)?;
+        Some(super::error::line_col(self.text?, offset).0)
+    }
+
+    fn error(&mut self, at: &[&str], message: String) {
+        let offset = self.offset(at);
+        let d = Diagnostic::at(self.path, self.text, offset, message);
+        self.found.push((offset, d));
+    }
+
+    /// Check that every component is finite; true when they all are.
+    fn finite(&mut self, at: &[&str], label: &str, key: &str, values: &[f64]) -> bool {
+        let bad: Vec<String> = values
+            .iter()
+            .filter(|v| !v.is_finite())
+            .map(|v| v.to_string())
+            .collect();
+        if bad.is_empty() {
+            return true;
+        }
+        self.error(
+            at,
+            format!(
+                "{label}: `{key}` must be a finite number, not {}",
+                bad.join(", ")
+            ),
+        );
+        false
+    }
+
+    /// A finite, strictly positive number.
+    fn positive(&mut self, at: &[&str], label: &str, key: &str, v: f64, unit: &str) {
+        if self.finite(at, label, key, &[v]) && v <= 0.0 {
+            self.error(
+                at,
+                format!("{label}: {key} = {v}: must be positive ({unit}); give a value above 0"),
+            );
+        }
+    }
+
+    /// A finite, non-negative number.
+    fn non_negative(&mut self, at: &[&str], label: &str, key: &str, v: f64, unit: &str) {
+        if self.finite(at, label, key, &[v]) && v < 0.0 {
+            self.error(
+                at,
+                format!("{label}: {key} = {v}: must not be negative ({unit}); use 0 to disable"),
+            );
+        }
+    }
+
+    /// The line where `name` was first defined, for duplicate messages.
+    fn first_seen(&self, table: &str, index: usize) -> String {
+        let i = index.to_string();
+        match self.line_of(&[table, &i, "name"]) {
+            Some(line) => format!("line {line}"),
+            None => format!("[[{table}]] #{}", index + 1),
+        }
+    }
+}
+
+fn label(table: &str, index: usize, name: Option<&str>) -> String {
+    match name {
+        Some(n) if !n.is_empty() => format!("[[{table}]] {n:?}"),
+        _ => format!("[[{table}]] #{}", index + 1),
+    }
+}
+
+fn quoted_names<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    names
+        .map(|n| format!("{n:?}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Check names: non-empty and unique within their table.
+fn unique_names<'n>(
+    c: &mut Checker<'_>,
+    table: &str,
+    names: impl Iterator<Item = &'n str>,
+) -> HashMap<&'n str, usize> {
+    let mut seen: HashMap<&str, usize> = HashMap::new();
+    for (i, name) in names.enumerate() {
+        let idx = i.to_string();
+        let at = [table, idx.as_str(), "name"];
+        if name.is_empty() {
+            c.error(
+                &at,
+                format!("{}: name is empty; give it a name", label(table, i, None)),
+            );
+            continue;
+        }
+        if let Some(&first) = seen.get(name) {
+            let where_ = c.first_seen(table, first);
+            c.error(
+                &at,
+                format!(
+                    "{} (#{}): duplicate {table} name {name:?}, already used at {where_}; rename one of them",
+                    label(table, i, Some(name)),
+                    i + 1
+                ),
+            );
+        } else {
+            seen.insert(name, i);
+        }
+    }
+    seen
+}
+
+/// Check a reference to a body by name.
+fn body_ref(
+    c: &mut Checker<'_>,
+    at: &[&str],
+    owner: &str,
+    body: &str,
+    bodies: &HashMap<&str, usize>,
+    body_names: &[&str],
+) {
+    if bodies.contains_key(body) {
+        return;
+    }
+    let mut m = format!("{owner}: body {body:?} is not defined");
+    if let Some(s) = did_you_mean(body, body_names.iter().copied()) {
+        m.push_str(&format!("; did you mean {s:?}?"));
+    }
+    if body_names.is_empty() {
+        m.push_str(" (no [[body]] is defined)");
+    } else {
+        m.push_str(&format!(
+            " (defined bodies: {})",
+            quoted_names(body_names.iter().copied())
+        ));
+    }
+    c.error(at, m);
+}
+
+/// Turn `group`/`box` into a [`Selection`], reporting problems.
+fn selection(
+    c: &mut Checker<'_>,
+    table: &str,
+    idx: &str,
+    owner: &str,
+    group: &Option<String>,
+    bbox: &Option<[[f64; 3]; 2]>,
+) -> Option<Selection> {
+    match (group, bbox) {
+        (Some(_), Some(_)) => {
+            c.error(
+                &[table, idx, "box"],
+                format!("{owner}: give either `group` or `box`, not both; remove one of them"),
+            );
+            None
+        }
+        (None, None) => {
+            c.error(
+                &[table, idx],
+                format!(
+                    "{owner}: no particles selected; add `group = \"<physical group>\"` or \
+                     `box = [[xmin, ymin, zmin], [xmax, ymax, zmax]]`"
+                ),
+            );
+            None
+        }
+        (Some(g), None) => {
+            if g.is_empty() {
+                c.error(
+                    &[table, idx, "group"],
+                    format!("{owner}: group is empty; name a gmsh physical group"),
+                );
+                None
+            } else {
+                Some(Selection::Group(g.clone()))
+            }
+        }
+        (None, Some(b)) => {
+            let at = [table, idx, "box"];
+            if !c.finite(
+                &at,
+                owner,
+                "box",
+                &[b[0][0], b[0][1], b[0][2], b[1][0], b[1][1], b[1][2]],
+            ) {
+                return None;
+            }
+            let mut ok = true;
+            for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+                if b[0][axis] > b[1][axis] {
+                    c.error(
+                        &at,
+                        format!(
+                            "{owner}: box min {name} = {} is above max {name} = {}; write \
+                             box = [[xmin, ymin, zmin], [xmax, ymax, zmax]]",
+                            b[0][axis], b[1][axis]
+                        ),
+                    );
+                    ok = false;
+                }
+            }
+            ok.then_some(Selection::Box(*b))
+        }
+    }
+}
+
+/// Parse `dofs` ("xyz", "xz", …) into an `[x, y, z]` mask.
+fn dofs(c: &mut Checker<'_>, at: &[&str], owner: &str, dofs: &str) -> Option<[bool; 3]> {
+    if dofs.is_empty() {
+        c.error(
+            at,
+            format!(
+                "{owner}: dofs is empty; give a non-empty subset of \"xyz\", e.g. \"xyz\" or \"z\""
+            ),
+        );
+        return None;
+    }
+    let mut mask = [false; 3];
+    for ch in dofs.chars() {
+        let axis = match ch {
+            'x' => 0,
+            'y' => 1,
+            'z' => 2,
+            other => {
+                c.error(
+                    at,
+                    format!(
+                        "{owner}: dofs = {dofs:?}: `{other}` is not a direction; use only the \
+                         letters x, y, z (lower case)"
+                    ),
+                );
+                return None;
+            }
+        };
+        if mask[axis] {
+            c.error(
+                at,
+                format!("{owner}: dofs = {dofs:?}: `{ch}` appears twice; give each letter once"),
+            );
+            return None;
+        }
+        mask[axis] = true;
+    }
+    Some(mask)
+}
+
+fn ramp(c: &mut Checker<'_>, idx: &str, owner: &str, points: &Option<Vec<[f64; 2]>>) -> Ramp {
+    let Some(points) = points else {
+        return Ramp::constant();
+    };
+    let at = ["load", idx, "ramp"];
+    if points.is_empty() {
+        c.error(
+            &at,
+            format!(
+                "{owner}: ramp has no points; give at least one [t, factor] point, or remove \
+                 `ramp` for a constant factor 1"
+            ),
+        );
+        return Ramp::constant();
+    }
+    let flat: Vec<f64> = points.iter().flatten().copied().collect();
+    if !c.finite(&at, owner, "ramp", &flat) {
+        return Ramp::constant();
+    }
+    for (k, w) in points.windows(2).enumerate() {
+        if w[1][0] < w[0][0] {
+            let i = (k + 1).to_string();
+            c.error(
+                &["load", idx, "ramp", &i],
+                format!(
+                    "{owner}: ramp times must not decrease, but point {} (t = {}) comes after \
+                     t = {}; sort the points by time",
+                    k + 2,
+                    w[1][0],
+                    w[0][0]
+                ),
+            );
+        }
+    }
+    for (k, w) in points.windows(3).enumerate() {
+        if w[0][0] == w[1][0] && w[1][0] == w[2][0] {
+            let i = (k + 2).to_string();
+            c.error(
+                &["load", idx, "ramp", &i],
+                format!(
+                    "{owner}: ramp has more than two points at t = {}; a jump needs exactly two \
+                     (the value before and the value after)",
+                    w[0][0]
+                ),
+            );
+        }
+    }
+    Ramp {
+        points: points.clone(),
+    }
+}
+
+/// Validate a parsed scene, turning it into a [`Scene`], or list every problem.
+pub(crate) fn validate(
+    raw: RawScene,
+    path: &Path,
+    text: Option<&str>,
+    spans: Option<&SpanIndex>,
+) -> Result<Scene, SceneError> {
+    let mut c = Checker {
+        path,
+        text,
+        spans,
+        found: Vec::new(),
+    };
+
+    // [run]
+    let run = &raw.run;
+    c.positive(&["run", "t_end"], "[run]", "t_end", run.t_end, "seconds");
+    if let TimeStep::Fixed(dt) = run.dt {
+        c.positive(&["run", "dt"], "[run]", "dt", dt, "seconds, or \"auto\"");
+    }
+    c.finite(&["run", "gravity"], "[run]", "gravity", &run.gravity);
+    if let Some(every) = run.probe_every {
+        c.positive(
+            &["run", "probe_every"],
+            "[run]",
+            "probe_every",
+            every,
+            "seconds",
+        );
+    }
+    let safety = run.dt_safety;
+    if c.finite(&["run", "dt_safety"], "[run]", "dt_safety", &[safety])
+        && !(safety > 0.0 && safety <= 1.0)
+    {
+        c.error(
+            &["run", "dt_safety"],
+            format!(
+                "[run]: dt_safety = {safety}: must be in (0, 1], the fraction of the stable time \
+                 step used by dt = \"auto\"; e.g. 0.9"
+            ),
+        );
+    }
+
+    // [[material]]
+    if raw.materials.is_empty() {
+        c.error(
+            &[],
+            "no [[material]] is defined; a scene needs at least one material".to_owned(),
+        );
+    }
+    let materials = unique_names(
+        &mut c,
+        "material",
+        raw.materials.iter().map(|m| m.name.as_str()),
+    );
+    for (i, m) in raw.materials.iter().enumerate() {
+        let idx = i.to_string();
+        let l = label("material", i, Some(&m.name));
+        c.positive(
+            &["material", &idx, "density"],
+            &l,
+            "density",
+            m.density,
+            "kg/m³",
+        );
+        c.positive(&["material", &idx, "young"], &l, "young", m.young, "Pa");
+        let at = ["material", idx.as_str(), "poisson"];
+        let nu = m.poisson;
+        if c.finite(&at, &l, "poisson", &[nu]) {
+            if nu >= 0.5 {
+                c.error(
+                    &at,
+                    format!(
+                        "{l}: poisson = {nu}: ν must be below 0.5 (incompressible materials are \
+                         not supported by an explicit step; use 0.49 at most)"
+                    ),
+                );
+            } else if nu <= -1.0 {
+                c.error(
+                    &at,
+                    format!(
+                        "{l}: poisson = {nu}: ν must be above −1 (the material would be unstable)"
+                    ),
+                );
+            }
+        }
+        c.non_negative(
+            &["material", &idx, "shear_viscosity"],
+            &l,
+            "shear_viscosity",
+            m.shear_viscosity,
+            "Pa s",
+        );
+        c.non_negative(
+            &["material", &idx, "bulk_viscosity"],
+            &l,
+            "bulk_viscosity",
+            m.bulk_viscosity,
+            "Pa s",
+        );
+    }
+    let material_names: Vec<&str> = raw.materials.iter().map(|m| m.name.as_str()).collect();
+
+    // [[body]]
+    if raw.bodies.is_empty() {
+        c.error(
+            &[],
+            "no [[body]] is defined; a scene needs at least one body".to_owned(),
+        );
+    }
+    let bodies = unique_names(&mut c, "body", raw.bodies.iter().map(|b| b.name.as_str()));
+    let body_names: Vec<&str> = raw.bodies.iter().map(|b| b.name.as_str()).collect();
+    for (i, b) in raw.bodies.iter().enumerate() {
+        let idx = i.to_string();
+        let l = label("body", i, Some(&b.name));
+        if b.mesh.as_os_str().is_empty() {
+            c.error(
+                &["body", &idx, "mesh"],
+                format!("{l}: mesh is empty; give the gmsh file, relative to the scene file"),
+            );
+        }
+        if !materials.contains_key(b.material.as_str()) {
+            let mut m = format!("{l}: material {:?} is not defined", b.material);
+            if let Some(s) = did_you_mean(&b.material, material_names.iter().copied()) {
+                m.push_str(&format!("; did you mean {s:?}?"));
+            }
+            if material_names.is_empty() {
+                m.push_str(" (no [[material]] is defined)");
+            } else {
+                m.push_str(&format!(
+                    " (defined materials: {})",
+                    quoted_names(material_names.iter().copied())
+                ));
+            }
+            c.error(&["body", &idx, "material"], m);
+        }
+    }
+
+    // [[fix]]
+    let mut fixes = Vec::with_capacity(raw.fixes.len());
+    for (i, f) in raw.fixes.iter().enumerate() {
+        let idx = i.to_string();
+        let l = label("fix", i, None);
+        body_ref(
+            &mut c,
+            &["fix", &idx, "body"],
+            &l,
+            &f.body,
+            &bodies,
+            &body_names,
+        );
+        let sel = selection(&mut c, "fix", &idx, &l, &f.group, &f.bbox);
+        let mask = dofs(&mut c, &["fix", &idx, "dofs"], &l, &f.dofs);
+        if let (Some(selection), Some(dofs)) = (sel, mask) {
+            fixes.push(Fix {
+                body: f.body.clone(),
+                selection,
+                dofs,
+            });
+        }
+    }
+
+    // [[load]]
+    let mut loads = Vec::with_capacity(raw.loads.len());
+    for (i, ld) in raw.loads.iter().enumerate() {
+        let idx = i.to_string();
+        let l = label("load", i, None);
+        body_ref(
+            &mut c,
+            &["load", &idx, "body"],
+            &l,
+            &ld.body,
+            &bodies,
+            &body_names,
+        );
+        let sel = selection(&mut c, "load", &idx, &l, &ld.group, &ld.bbox);
+        c.finite(
+            &["load", &idx, "total_force"],
+            &l,
+            "total_force",
+            &ld.total_force,
+        );
+        let ramp = ramp(&mut c, &idx, &l, &ld.ramp);
+        if let Some(selection) = sel {
+            loads.push(Load {
+                body: ld.body.clone(),
+                selection,
+                total_force: ld.total_force,
+                ramp,
+            });
+        }
+    }
+
+    // [[probe]]
+    unique_names(&mut c, "probe", raw.probes.iter().map(|p| p.name.as_str()));
+    for (i, p) in raw.probes.iter().enumerate() {
+        let idx = i.to_string();
+        let l = label("probe", i, Some(&p.name));
+        body_ref(
+            &mut c,
+            &["probe", &idx, "body"],
+            &l,
+            &p.body,
+            &bodies,
+            &body_names,
+        );
+        c.finite(&["probe", &idx, "point"], &l, "point", &p.point);
+    }
+
+    // [output]
+    c.non_negative(
+        &["output", "vtu_every"],
+        "[output]",
+        "vtu_every",
+        raw.output.vtu_every,
+        "seconds",
+    );
+
+    if !c.found.is_empty() {
+        let mut found = c.found;
+        found.sort_by_key(|(offset, _)| offset.unwrap_or(usize::MAX));
+        return Err(SceneError::Invalid(
+            found.into_iter().map(|(_, d)| d).collect(),
+        ));
+    }
+    Ok(Scene {
+        run: raw.run,
+        materials: raw.materials,
+        bodies: raw.bodies,
+        fixes,
+        loads,
+        probes: raw.probes,
+        output: raw.output,
+        path: path.to_path_buf(),
+    })
+}
+
+/// The scene in its as-written form, to re-run [`validate`] on a scene built in code.
+pub(crate) fn to_raw(scene: &Scene) -> RawScene {
+    fn split(sel: &Selection) -> (Option<String>, Option<[[f64; 3]; 2]>) {
+        match sel {
+            Selection::Group(g) => (Some(g.clone()), None),
+            Selection::Box(b) => (None, Some(*b)),
+        }
+    }
+    RawScene {
+        run: scene.run.clone(),
+        materials: scene.materials.clone(),
+        bodies: scene.bodies.clone(),
+        fixes: scene
+            .fixes
+            .iter()
+            .map(|f| {
+                let (group, bbox) = split(&f.selection);
+                let dofs = ['x', 'y', 'z']
+                    .iter()
+                    .zip(f.dofs)
+                    .filter(|(_, on)| *on)
+                    .map(|(c, _)| *c)
+                    .collect();
+                RawFix {
+                    body: f.body.clone(),
+                    group,
+                    bbox,
+                    dofs,
+                }
+            })
+            .collect(),
+        loads: scene
+            .loads
+            .iter()
+            .map(|l| {
+                let (group, bbox) = split(&l.selection);
+                RawLoad {
+                    body: l.body.clone(),
+                    group,
+                    bbox,
+                    total_force: l.total_force,
+                    ramp: (!l.ramp.points.is_empty()).then(|| l.ramp.points.clone()),
+                }
+            })
+            .collect(),
+        probes: scene.probes.clone(),
+        output: scene.output.clone(),
+    }
+}
+
+/// Problems with the files a scene refers to: every body's mesh must exist.
+pub(crate) fn missing_files(
+    scene: &Scene,
+    text: Option<&str>,
+    spans: Option<&SpanIndex>,
+) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    for (i, b) in scene.bodies.iter().enumerate() {
+        let resolved = scene.mesh_path(b);
+        if resolved.is_file() {
+            continue;
+        }
+        let idx = i.to_string();
+        let offset = spans.and_then(|s| s.offset(&["body", &idx, "mesh"]));
+        let what = if resolved.exists() {
+            "is not a file"
+        } else {
+            "does not exist"
+        };
+        out.push(Diagnostic::at(
+            &scene.path,
+            text,
+            offset,
+            format!(
+                "{}: mesh file {} {what} (mesh = {:?} is resolved relative to the scene file's \
+                 directory)",
+                label("body", i, Some(&b.name)),
+                resolved.display(),
+                b.mesh.display().to_string()
+            ),
+        ));
+    }
+    out
+}

@@ -1,0 +1,781 @@
+//! Every error names the scene path (with line and column where known), the table and key,
+//! and the suggestion or the fix.
+
+use std::path::Path;
+
+use qdem_io::scene::{Scene, SceneError};
+
+const PATH: &str = "scenes/scene.toml";
+
+/// The example scene, without comments so that line numbers are easy to count.
+const BASE: &str = r#"[run]
+t_end = 2.0
+dt = "auto"
+integrator = "verlet"
+gravity = [0.0, 0.0, 0.0]
+probe_every = 1e-4
+dt_safety = 0.9
+
+[[material]]
+name = "concrete"
+density = 2350.0
+young = 45e9
+poisson = 0.167
+shear_viscosity = 0.0
+bulk_viscosity = 0.0
+
+[[body]]
+name = "beam"
+mesh = "cantilever.msh"
+material = "concrete"
+reorder = true
+
+[[fix]]
+body = "beam"
+group = "clamp"
+dofs = "xyz"
+
+[[load]]
+body = "beam"
+group = "tip"
+total_force = [0.0, 0.0, -200.0]
+ramp = [[0.0, 0.0], [1.0, 1.0]]
+
+[[probe]]
+name = "tip"
+body = "beam"
+point = [2.4, 0.125, 0.11]
+
+[output]
+dir = "out"
+vtu_every = 0.01
+"#;
+
+/// BASE with `from` replaced (exactly one occurrence) by `to`.
+fn with(from: &str, to: &str) -> String {
+    assert_eq!(
+        BASE.matches(from).count(),
+        1,
+        "`{from}` must occur once in BASE"
+    );
+    BASE.replacen(from, to, 1)
+}
+
+/// Parse `text`, expecting an error; returns it with its message.
+fn error(text: &str) -> (SceneError, String) {
+    let err = Scene::parse(text, Path::new(PATH)).expect_err("the scene should be refused");
+    let msg = err.to_string();
+    println!("{msg}");
+    (err, msg)
+}
+
+/// Assert `msg` contains every part.
+#[track_caller]
+fn assert_has(msg: &str, parts: &[&str]) {
+    for part in parts {
+        assert!(msg.contains(part), "expected {part:?} in:\n{msg}");
+    }
+}
+
+#[test]
+fn base_is_valid() {
+    Scene::parse(BASE, Path::new(PATH)).unwrap();
+}
+
+// ---- TOML syntax -------------------------------------------------------------------------
+
+#[test]
+fn syntax_error_is_located() {
+    let (err, msg) = error(&with("t_end = 2.0", "t_end = 2.0.0"));
+    assert!(matches!(err, SceneError::Syntax(_)));
+    assert!(msg.starts_with("scenes/scene.toml:2:"), "{msg}");
+    assert_has(&msg, &["invalid TOML"]);
+}
+
+#[test]
+fn duplicate_key_is_a_syntax_error() {
+    let (_, msg) = error(&with("t_end = 2.0", "t_end = 2.0\nt_end = 3.0"));
+    assert!(msg.starts_with("scenes/scene.toml:3:"), "{msg}");
+}
+
+// ---- schema: unknown keys and tables ------------------------------------------------------
+
+#[test]
+fn unknown_key_in_run_suggests_the_right_one() {
+    let (err, msg) = error(&with("t_end = 2.0", "t_ned = 2.0"));
+    assert!(matches!(err, SceneError::Schema(_)));
+    assert_eq!(
+        msg,
+        "scenes/scene.toml:2:1: unknown key `t_ned` in [run]; did you mean `t_end`?"
+    );
+}
+
+#[test]
+fn unknown_key_case_insensitive_match() {
+    let (_, msg) = error(&with("dt_safety = 0.9", "DT_Safety = 0.9"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:7:1:",
+            "`DT_Safety` in [run]",
+            "did you mean `dt_safety`?",
+        ],
+    );
+}
+
+#[test]
+fn unknown_key_without_suggestion_lists_valid_keys() {
+    let (_, msg) = error(&with("t_end = 2.0", "t_end = 2.0\ncolor = 1"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:3:1:",
+            "unknown key `color` in [run]",
+            "valid keys:",
+            "`t_end`",
+            "`dt_safety`",
+        ],
+    );
+    assert!(!msg.contains("did you mean"), "{msg}");
+}
+
+#[test]
+fn unknown_key_in_array_table_names_the_element() {
+    let (_, msg) = error(&with("density = 2350.0", "densty = 2350.0"));
+    assert_eq!(
+        msg,
+        "scenes/scene.toml:11:1: unknown key `densty` in [[material]] \"concrete\"; did you mean `density`?"
+    );
+    let (_, msg) = error(&with("dofs = \"xyz\"", "dof = \"xyz\""));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:26:1:",
+            "unknown key `dof` in [[fix]] #1",
+            "did you mean `dofs`?",
+        ],
+    );
+    let (_, msg) = error(&with("total_force =", "totalforce ="));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:31:1:",
+            "[[load]] #1",
+            "did you mean `total_force`?",
+        ],
+    );
+    let (_, msg) = error(&with("point = ", "pointt = "));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:37:1:",
+            "[[probe]] \"tip\"",
+            "did you mean `point`?",
+        ],
+    );
+    let (_, msg) = error(&with("reorder = true", "reoder = true"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:21:1:",
+            "[[body]] \"beam\"",
+            "did you mean `reorder`?",
+        ],
+    );
+}
+
+#[test]
+fn unknown_key_in_output() {
+    let (_, msg) = error(&with("vtu_every = 0.01", "vtu_evry = 0.01"));
+    assert_eq!(
+        msg,
+        "scenes/scene.toml:41:1: unknown key `vtu_evry` in [output]; did you mean `vtu_every`?"
+    );
+}
+
+#[test]
+fn unknown_top_level_table_suggests_the_right_one() {
+    let (err, msg) = error(&with("[output]", "[outptu]"));
+    assert!(matches!(err, SceneError::Schema(_)));
+    assert_eq!(
+        msg,
+        "scenes/scene.toml:39:2: unknown table `[outptu]`; did you mean `[output]`?"
+    );
+    let (_, msg) = error(&with("[[body]]", "[[bodies]]"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:17:3:",
+            "unknown table `[[bodies]]`",
+            "did you mean `[[body]]`?",
+        ],
+    );
+    let (_, msg) = error(&with("[[material]]", "[[Material]]"));
+    assert_has(
+        &msg,
+        &[
+            "unknown table `[[Material]]`",
+            "did you mean `[[material]]`?",
+        ],
+    );
+}
+
+#[test]
+fn unknown_top_level_table_without_suggestion_lists_tables() {
+    let (_, msg) = error(&format!("{BASE}\n[contacts]\nk = 1\n"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:43:2:",
+            "unknown table `[contacts]`",
+            "[run]",
+            "[[material]]",
+            "[output]",
+        ],
+    );
+}
+
+#[test]
+fn unknown_top_level_key() {
+    let (_, msg) = error(&format!("titel = \"x\"\n{BASE}"));
+    assert_has(
+        &msg,
+        &["scenes/scene.toml:1:1:", "unknown top-level key `titel`"],
+    );
+}
+
+#[test]
+fn nested_unknown_table() {
+    let (_, msg) = error(&format!("{BASE}\n[output.extra]\nk = 1\n"));
+    assert_has(
+        &msg,
+        &["scenes/scene.toml:43:9:", "unknown key `extra` in [output]"],
+    );
+}
+
+// ---- schema: values ---------------------------------------------------------------------
+
+#[test]
+fn unknown_integrator_lists_valid_ones() {
+    let (err, msg) = error(&with("integrator = \"verlet\"", "integrator = \"rk4\""));
+    assert!(matches!(err, SceneError::Schema(_)));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:4:14:",
+            "`rk4`",
+            "`integrator` in [run]",
+            "valid values: `verlet`",
+        ],
+    );
+    let (_, msg) = error(&with("integrator = \"verlet\"", "integrator = \"verlt\""));
+    assert_has(&msg, &["did you mean `verlet`?"]);
+}
+
+#[test]
+fn dt_must_be_auto_or_seconds() {
+    for bad in ["\"automatic\"", "true", "[1.0]"] {
+        let (err, msg) = error(&with("dt = \"auto\"", &format!("dt = {bad}")));
+        assert!(matches!(err, SceneError::Schema(_)));
+        assert_has(
+            &msg,
+            &[
+                "scenes/scene.toml:3:6:",
+                "[run]",
+                "dt must be \"auto\" or a number of seconds",
+            ],
+        );
+    }
+}
+
+#[test]
+fn wrong_type_names_key_and_table() {
+    let (_, msg) = error(&with("t_end = 2.0", "t_end = \"2 s\""));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:2:9:",
+            "`t_end` in [run]",
+            "expected a number",
+        ],
+    );
+    let (_, msg) = error(&with("gravity = [0.0, 0.0, 0.0]", "gravity = [0.0, 0.0]"));
+    assert_has(
+        &msg,
+        &["scenes/scene.toml:5:11:", "`gravity` in [run]", "length 2"],
+    );
+    let (_, msg) = error(&with("young = 45e9", "young = \"45 GPa\""));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:12:9:",
+            "`young` in [[material]] \"concrete\"",
+        ],
+    );
+    let (_, msg) = error(&with(
+        "point = [2.4, 0.125, 0.11]",
+        "point = [2.4, \"a\", 0.11]",
+    ));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:37:15:",
+            "`point[1]` in [[probe]] \"tip\"",
+        ],
+    );
+}
+
+#[test]
+fn missing_key_names_table() {
+    let (_, msg) = error(&with("t_end = 2.0\n", ""));
+    assert_has(
+        &msg,
+        &["scenes/scene.toml:1:1:", "missing key `t_end` in [run]"],
+    );
+    let (_, msg) = error(&with("young = 45e9\n", ""));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:9:1:",
+            "missing key `young` in [[material]] \"concrete\"",
+        ],
+    );
+    let (_, msg) = error(&with("total_force = [0.0, 0.0, -200.0]\n", ""));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:28:1:",
+            "missing key `total_force` in [[load]] #1",
+        ],
+    );
+}
+
+#[test]
+fn missing_run_table() {
+    let text = BASE.replacen("[run]\n", "", 1).replace("t_end = 2.0\ndt = \"auto\"\nintegrator = \"verlet\"\ngravity = [0.0, 0.0, 0.0]\nprobe_every = 1e-4\ndt_safety = 0.9\n", "");
+    let (_, msg) = error(&text);
+    assert_has(&msg, &["scenes/scene.toml", "missing table `[run]`"]);
+}
+
+// ---- semantics: numbers -------------------------------------------------------------------
+
+#[test]
+fn poisson_at_or_above_half_is_refused_with_advice() {
+    let (err, msg) = error(&with("poisson = 0.167", "poisson = 0.5"));
+    assert!(matches!(err, SceneError::Invalid(_)));
+    assert_eq!(
+        msg,
+        "scenes/scene.toml:13:11: [[material]] \"concrete\": poisson = 0.5: ν must be below 0.5 \
+         (incompressible materials are not supported by an explicit step; use 0.49 at most)"
+    );
+    let (_, msg) = error(&with("poisson = 0.167", "poisson = -1.0"));
+    assert_has(&msg, &["scenes/scene.toml:13:11:", "ν must be above −1"]);
+}
+
+#[test]
+fn material_constants_must_be_positive() {
+    let (_, msg) = error(&with("density = 2350.0", "density = 0.0"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:11:11:",
+            "[[material]] \"concrete\"",
+            "density = 0",
+            "must be positive",
+        ],
+    );
+    let (_, msg) = error(&with("young = 45e9", "young = -1.0"));
+    assert_has(
+        &msg,
+        &["scenes/scene.toml:12:9:", "young = -1", "must be positive"],
+    );
+    let (_, msg) = error(&with("shear_viscosity = 0.0", "shear_viscosity = -2.0"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:14:19:",
+            "shear_viscosity = -2",
+            "must not be negative",
+        ],
+    );
+    let (_, msg) = error(&with("bulk_viscosity = 0.0", "bulk_viscosity = -2.0"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:15:18:",
+            "bulk_viscosity = -2",
+            "must not be negative",
+        ],
+    );
+}
+
+#[test]
+fn run_values_are_checked() {
+    let (_, msg) = error(&with("t_end = 2.0", "t_end = 0.0"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:2:9:",
+            "[run]: t_end = 0",
+            "must be positive",
+        ],
+    );
+    let (_, msg) = error(&with("dt = \"auto\"", "dt = -1e-6"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:3:6:",
+            "[run]: dt = -0.000001",
+            "must be positive",
+        ],
+    );
+    let (_, msg) = error(&with("dt = \"auto\"", "dt = 0"));
+    assert_has(
+        &msg,
+        &["scenes/scene.toml:3:6:", "dt = 0", "must be positive"],
+    );
+    for bad in ["0.0", "1.5", "-0.1"] {
+        let (_, msg) = error(&with("dt_safety = 0.9", &format!("dt_safety = {bad}")));
+        assert_has(
+            &msg,
+            &[
+                "scenes/scene.toml:7:13:",
+                "[run]: dt_safety",
+                "must be in (0, 1]",
+            ],
+        );
+    }
+    Scene::parse(&with("dt_safety = 0.9", "dt_safety = 1.0"), Path::new(PATH)).unwrap();
+    let (_, msg) = error(&with("probe_every = 1e-4", "probe_every = 0"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:6:15:",
+            "[run]: probe_every = 0",
+            "must be positive",
+        ],
+    );
+    let (_, msg) = error(&with("vtu_every = 0.01", "vtu_every = -0.01"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:41:13:",
+            "[output]: vtu_every = -0.01",
+            "must not be negative",
+        ],
+    );
+    Scene::parse(&with("vtu_every = 0.01", "vtu_every = 0"), Path::new(PATH)).unwrap();
+}
+
+#[test]
+fn numbers_must_be_finite() {
+    let (_, msg) = error(&with(
+        "gravity = [0.0, 0.0, 0.0]",
+        "gravity = [0.0, nan, 0.0]",
+    ));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:5:11:",
+            "[run]: `gravity` must be a finite number, not NaN",
+        ],
+    );
+    let (_, msg) = error(&with("young = 45e9", "young = inf"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:12:9:",
+            "`young` must be a finite number, not inf",
+        ],
+    );
+    let (_, msg) = error(&with(
+        "point = [2.4, 0.125, 0.11]",
+        "point = [2.4, -inf, 0.11]",
+    ));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:37:9:",
+            "[[probe]] \"tip\"",
+            "`point` must be a finite number",
+        ],
+    );
+    let (_, msg) = error(&with(
+        "total_force = [0.0, 0.0, -200.0]",
+        "total_force = [0.0, 0.0, nan]",
+    ));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:31:15:",
+            "[[load]] #1",
+            "`total_force` must be a finite",
+        ],
+    );
+    let (_, msg) = error(&with("dt = \"auto\"", "dt = inf"));
+    assert_has(
+        &msg,
+        &["scenes/scene.toml:3:6:", "`dt` must be a finite number"],
+    );
+}
+
+// ---- semantics: names and references -----------------------------------------------------
+
+#[test]
+fn duplicate_names() {
+    let material = "[[material]]\nname = \"concrete\"\ndensity = 1.0\nyoung = 1.0\npoisson = 0.2\n";
+    let (_, msg) = error(&format!("{BASE}\n{material}"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:44:8:",
+            "[[material]] \"concrete\" (#2)",
+            "duplicate material name \"concrete\"",
+            "line 10",
+            "rename",
+        ],
+    );
+    let body = "[[body]]\nname = \"beam\"\nmesh = \"b.msh\"\nmaterial = \"concrete\"\n";
+    let (_, msg) = error(&format!("{BASE}\n{body}"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:44:8:",
+            "duplicate body name \"beam\"",
+            "line 18",
+        ],
+    );
+    let probe = "[[probe]]\nname = \"tip\"\nbody = \"beam\"\npoint = [0, 0, 0]\n";
+    let (_, msg) = error(&format!("{BASE}\n{probe}"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:44:8:",
+            "duplicate probe name \"tip\"",
+            "line 35",
+        ],
+    );
+}
+
+#[test]
+fn undefined_material_suggests_and_lists() {
+    let (err, msg) = error(&with("material = \"concrete\"", "material = \"concret\""));
+    assert!(matches!(err, SceneError::Invalid(_)));
+    assert_eq!(
+        msg,
+        "scenes/scene.toml:20:12: [[body]] \"beam\": material \"concret\" is not defined; did you \
+         mean \"concrete\"? (defined materials: \"concrete\")"
+    );
+    let (_, msg) = error(&with("material = \"concrete\"", "material = \"granite\""));
+    assert_has(
+        &msg,
+        &[
+            "material \"granite\" is not defined",
+            "defined materials: \"concrete\"",
+        ],
+    );
+    assert!(!msg.contains("did you mean"), "{msg}");
+}
+
+#[test]
+fn unknown_body_in_fix_load_probe() {
+    let text = BASE.replace("body = \"beam\"", "body = \"bean\"");
+    let (err, msg) = error(&text);
+    // All three are reported, one per line, in file order.
+    assert_eq!(err.diagnostics().len(), 3, "{msg}");
+    let lines: Vec<&str> = msg.lines().collect();
+    assert_eq!(lines.len(), 3);
+    assert_has(
+        lines[0],
+        &[
+            "scenes/scene.toml:24:8:",
+            "[[fix]] #1: body \"bean\" is not defined",
+            "did you mean \"beam\"?",
+            "defined bodies: \"beam\"",
+        ],
+    );
+    assert_has(
+        lines[1],
+        &["scenes/scene.toml:29:8:", "[[load]] #1: body \"bean\""],
+    );
+    assert_has(
+        lines[2],
+        &[
+            "scenes/scene.toml:36:8:",
+            "[[probe]] \"tip\": body \"bean\"",
+        ],
+    );
+}
+
+#[test]
+fn at_least_one_material_and_body() {
+    let text = "[run]\nt_end = 1.0\n";
+    let (err, msg) = error(text);
+    assert_eq!(err.diagnostics().len(), 2, "{msg}");
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml: no [[material]] is defined",
+            "scenes/scene.toml: no [[body]] is defined",
+        ],
+    );
+}
+
+// ---- semantics: fixes, loads, ramps, boxes -------------------------------------------------
+
+#[test]
+fn selection_needs_exactly_one_of_group_and_box() {
+    let (_, msg) = error(&with(
+        "group = \"clamp\"",
+        "group = \"clamp\"\nbox = [[0, 0, 0], [1, 1, 1]]",
+    ));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:26:7:",
+            "[[fix]] #1: give either `group` or `box`, not both",
+        ],
+    );
+    let (_, msg) = error(&with("group = \"tip\"\n", ""));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:28:1:",
+            "[[load]] #1: no particles selected",
+            "group = ",
+            "box = [[xmin",
+        ],
+    );
+}
+
+#[test]
+fn box_min_must_not_exceed_max() {
+    let (_, msg) = error(&with("group = \"clamp\"", "box = [[0, 2, 0], [1, 1, 1]]"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:25:7:",
+            "[[fix]] #1: box min y = 2 is above max y = 1",
+        ],
+    );
+    // A flat box (min == max) is fine.
+    Scene::parse(
+        &with("group = \"clamp\"", "box = [[0, 0, 0], [0, 1, 1]]"),
+        Path::new(PATH),
+    )
+    .unwrap();
+}
+
+#[test]
+fn dofs_are_checked() {
+    let (_, msg) = error(&with("dofs = \"xyz\"", "dofs = \"\""));
+    assert_has(
+        &msg,
+        &["scenes/scene.toml:26:8:", "[[fix]] #1: dofs is empty"],
+    );
+    let (_, msg) = error(&with("dofs = \"xyz\"", "dofs = \"xw\""));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:26:8:",
+            "`w` is not a direction",
+            "x, y, z",
+        ],
+    );
+    let (_, msg) = error(&with("dofs = \"xyz\"", "dofs = \"xx\""));
+    assert_has(&msg, &["scenes/scene.toml:26:8:", "`x` appears twice"]);
+    let (_, msg) = error(&with("dofs = \"xyz\"", "dofs = \"X\""));
+    assert_has(&msg, &["`X` is not a direction"]);
+}
+
+#[test]
+fn ramps_are_checked() {
+    let ramp = "ramp = [[0.0, 0.0], [1.0, 1.0]]";
+    let (_, msg) = error(&with(ramp, "ramp = []"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:32:8:",
+            "[[load]] #1: ramp has no points",
+            "constant factor 1",
+        ],
+    );
+    let (_, msg) = error(&with(ramp, "ramp = [[0.0, 0.0], [2.0, 1.0], [1.0, 1.0]]"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:32:",
+            "ramp times must not decrease",
+            "point 3 (t = 1)",
+        ],
+    );
+    let (_, msg) = error(&with(
+        ramp,
+        "ramp = [[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [1.0, 2.0]]",
+    ));
+    assert_has(
+        &msg,
+        &["scenes/scene.toml:32:", "more than two points at t = 1"],
+    );
+    let (_, msg) = error(&with(ramp, "ramp = [[0.0, 0.0], [1.0, nan]]"));
+    assert_has(
+        &msg,
+        &["scenes/scene.toml:32:8:", "`ramp` must be a finite number"],
+    );
+    // A jump (two points at one time) is fine.
+    Scene::parse(
+        &with(ramp, "ramp = [[0.0, 0.0], [2.0, 1.0], [2.0, 0.0]]"),
+        Path::new(PATH),
+    )
+    .unwrap();
+}
+
+// ---- collecting -----------------------------------------------------------------------------
+
+#[test]
+fn semantic_errors_are_collected_in_file_order() {
+    let text = with("poisson = 0.167", "poisson = 0.5")
+        .replace("t_end = 2.0", "t_end = -2.0")
+        .replace("dofs = \"xyz\"", "dofs = \"\"")
+        .replace("material = \"concrete\"", "material = \"steel\"");
+    let (err, msg) = error(&text);
+    let lines: Vec<&str> = msg.lines().collect();
+    assert_eq!(err.diagnostics().len(), 4, "{msg}");
+    assert_eq!(lines.len(), 4);
+    assert!(
+        lines[0].starts_with("scenes/scene.toml:2:9: [run]: t_end"),
+        "{msg}"
+    );
+    assert!(lines[1].starts_with("scenes/scene.toml:13:11:"), "{msg}");
+    assert!(lines[2].starts_with("scenes/scene.toml:20:12:"), "{msg}");
+    assert!(lines[3].starts_with("scenes/scene.toml:26:8:"), "{msg}");
+    assert!(lines.iter().all(|l| l.starts_with(PATH)));
+}
+
+#[test]
+fn in_code_validation_has_no_positions() {
+    let mut scene = Scene::parse(BASE, Path::new(PATH)).unwrap();
+    scene.materials[0].poisson = 0.5;
+    scene.fixes[0].dofs = [false; 3];
+    let err = scene.validate().unwrap_err();
+    let msg = err.to_string();
+    assert_eq!(err.diagnostics().len(), 2, "{msg}");
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml: [[material]] \"concrete\": poisson = 0.5",
+            "scenes/scene.toml: [[fix]] #1: dofs is empty",
+        ],
+    );
+}
+
+#[test]
+fn missing_mesh_names_resolved_path() {
+    let scene = Scene::parse(BASE, Path::new("/nonexistent/dir/scene.toml")).unwrap();
+    let err = scene.validate_files().unwrap_err();
+    assert!(matches!(err, SceneError::MissingFiles(_)));
+    assert_has(
+        &err.to_string(),
+        &["/nonexistent/dir/scene.toml: [[body]] \"beam\": mesh file /nonexistent/dir/cantilever.msh does not exist"],
+    );
+}
