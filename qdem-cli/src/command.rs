@@ -1,0 +1,256 @@
+//! Command-line parsing and the four commands. Errors from the libraries are rendered once,
+//! by `main`, through [`CliError`]'s `Display`.
+
+use crate::{bench, progress, verify};
+use qdem_io::build::{BuildError, Simulation};
+use qdem_io::runner::{run, RunError};
+use qdem_io::scene::{Scene, SceneError};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use thiserror::Error;
+
+/// Usage text.
+pub const USAGE: &str = "\
+usage:
+  qdem run SCENE [--out DIR] [--threads N]   run a scene; outputs go to DIR (default: the scene's [output] dir)
+  qdem check SCENE [--threads N]             validate a scene; print meshes, mass, stable dt, cost estimate
+  qdem verify [--json] [--full]              run the analytical fixtures (--full adds the cantilever meshes)
+  qdem bench [--json] [--tets N,N,..] [--threads N,N,..] [--steps N]
+                                             kernel throughput on structured meshes, tet-steps/s";
+
+/// Everything the command line reports as an error.
+#[derive(Debug, Error)]
+pub enum CliError {
+    /// Bad command-line usage.
+    #[error("{0}\n{USAGE}")]
+    Usage(String),
+    /// A scene that does not parse or validate.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A scene that cannot be built.
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    /// A run that failed.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// A verification fixture that failed to run or missed its tolerance.
+    #[error("{0}")]
+    Verify(String),
+    /// The thread pool could not be set up.
+    #[error("cannot start {threads} threads: {message}")]
+    Threads {
+        /// Requested threads.
+        threads: usize,
+        /// Why.
+        message: String,
+    },
+}
+
+/// Parsed options common to the commands.
+#[derive(Debug, Default)]
+struct Options {
+    positional: Vec<String>,
+    out: Option<PathBuf>,
+    threads: Option<usize>,
+    json: bool,
+    full: bool,
+    tets: Option<Vec<usize>>,
+    thread_list: Option<Vec<usize>>,
+    steps: Option<usize>,
+}
+
+fn parse_list(flag: &str, value: &str) -> Result<Vec<usize>, CliError> {
+    value
+        .split(',')
+        .map(|v| {
+            v.trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|&n| n > 0)
+                .ok_or_else(|| CliError::Usage(format!("{flag} takes positive whole numbers, got `{value}`")))
+        })
+        .collect()
+}
+
+fn parse(args: &[String], allowed: &[&str]) -> Result<Options, CliError> {
+    let mut o = Options::default();
+    let mut it = args.iter();
+    while let Some(arg) = it.next() {
+        if !arg.starts_with("--") {
+            o.positional.push(arg.clone());
+            continue;
+        }
+        if !allowed.contains(&arg.as_str()) {
+            return Err(CliError::Usage(format!("unknown option `{arg}`")));
+        }
+        let mut value = || {
+            it.next()
+                .cloned()
+                .ok_or_else(|| CliError::Usage(format!("`{arg}` needs a value")))
+        };
+        match arg.as_str() {
+            "--out" => o.out = Some(PathBuf::from(value()?)),
+            "--json" => o.json = true,
+            "--full" => o.full = true,
+            "--steps" => o.steps = Some(parse_list(arg, &value()?)?[0]),
+            "--tets" => o.tets = Some(parse_list(arg, &value()?)?),
+            "--threads" if allowed.contains(&"--thread-list") => {
+                o.thread_list = Some(parse_list(arg, &value()?)?)
+            }
+            "--threads" => o.threads = Some(parse_list(arg, &value()?)?[0]),
+            _ => unreachable!("every allowed option is matched"),
+        }
+    }
+    Ok(o)
+}
+
+fn one_scene(o: &Options, command: &str) -> Result<PathBuf, CliError> {
+    match o.positional.as_slice() {
+        [scene] => Ok(PathBuf::from(scene)),
+        [] => Err(CliError::Usage(format!("`qdem {command}` needs a scene file"))),
+        more => Err(CliError::Usage(format!("`qdem {command}` takes one scene file, got {}", more.len()))),
+    }
+}
+
+fn set_threads(threads: Option<usize>) -> Result<(), CliError> {
+    if let Some(threads) = threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build_global()
+            .map_err(|e| CliError::Threads { threads, message: e.to_string() })?;
+    }
+    Ok(())
+}
+
+/// Runs the command named by the first argument.
+pub fn dispatch(args: &[String]) -> Result<(), CliError> {
+    let Some((command, rest)) = args.split_first() else {
+        return Err(CliError::Usage("no command given".into()));
+    };
+    match command.as_str() {
+        "run" => {
+            let o = parse(rest, &["--out", "--threads"])?;
+            set_threads(o.threads)?;
+            run_scene(&one_scene(&o, "run")?, o.out.as_deref())
+        }
+        "check" => {
+            let o = parse(rest, &["--threads"])?;
+            set_threads(o.threads)?;
+            check_scene(&one_scene(&o, "check")?)
+        }
+        "verify" => {
+            let o = parse(rest, &["--json", "--full"])?;
+            verify::run_and_print(o.json, o.full)
+        }
+        "bench" => {
+            let o = parse(rest, &["--json", "--tets", "--threads", "--thread-list", "--steps"])?;
+            bench::run_and_print(&bench::BenchPlan::new(o.tets, o.thread_list, o.steps), o.json);
+            Ok(())
+        }
+        "help" | "--help" | "-h" => {
+            println!("{USAGE}");
+            Ok(())
+        }
+        other => Err(CliError::Usage(format!("unknown command `{other}`"))),
+    }
+}
+
+fn run_scene(path: &Path, out: Option<&Path>) -> Result<(), CliError> {
+    let scene = Scene::load(path)?;
+    let out_dir = match out {
+        Some(dir) => dir.to_path_buf(),
+        None => path.parent().unwrap_or(Path::new(".")).join(&scene.output.dir),
+    };
+    let mut sim = Simulation::build(scene)?;
+    for w in &sim.warnings {
+        eprintln!("warning: {w}");
+    }
+    eprintln!(
+        "qdem run {}: {} particles, {} tets, dt = {:.4e} s ({:.0}% of the stable bound), {} steps, {} threads",
+        path.display(),
+        sim.state.len(),
+        sim.tets(),
+        sim.dt,
+        100.0 * sim.dt / sim.stable_dt.0,
+        sim.steps(),
+        rayon::current_num_threads()
+    );
+    let t_end = sim.scene.run.t_end;
+    let show = progress::enabled();
+    let mut on_progress = |p: &qdem_io::runner::Progress| {
+        if show {
+            progress::draw(p, t_end)
+        }
+    };
+    let report = run(&mut sim, &out_dir, &mut on_progress);
+    if show {
+        progress::finish();
+    }
+    let report = report?;
+    eprintln!(
+        "done: {} steps in {:.2} s ({:.3e} tet-steps/s); outputs in {}",
+        report.steps,
+        report.wall_seconds,
+        report.tet_steps_per_second,
+        out_dir.display()
+    );
+    Ok(())
+}
+
+fn check_scene(path: &Path) -> Result<(), CliError> {
+    let scene = Scene::load(path)?;
+    let mut sim = Simulation::build(scene)?;
+    println!("scene {}: valid", path.display());
+    for w in &sim.warnings {
+        println!("warning: {w}");
+    }
+    for body in &sim.bodies {
+        let s = &body.stats;
+        let mass: f64 = sim.state.mass[body.particles.clone()].iter().sum();
+        println!(
+            "body `{}` ({}): {} particles, {} tets, volume {:.6e} m^3, mass {:.6e} kg, edges {:.4e}..{:.4e} m, worst quality {:.3} (tet {})",
+            body.name,
+            body.mesh.display(),
+            s.nodes,
+            s.tets,
+            s.volume,
+            mass,
+            s.min_edge,
+            s.max_edge,
+            s.worst_quality,
+            s.worst_tet
+        );
+    }
+    for p in &sim.probes {
+        println!("probe `{}`: particle {} at {:.3e} m from the requested point", p.name, p.particle, p.distance);
+    }
+    let (bound, limiter) = &sim.stable_dt;
+    println!("stable dt bound {bound:.6e} s (set by `{limiter}`); dt used {:.6e} s; {} steps to t_end = {} s", sim.dt, sim.steps(), sim.scene.run.t_end);
+    let per_step = measure_step_cost(&mut sim, 20);
+    let total = per_step * sim.steps() as f64;
+    println!(
+        "measured {:.3e} s/step on {} threads ({:.3e} tet-steps/s): estimated run time {} (outputs not counted)",
+        per_step,
+        rayon::current_num_threads(),
+        sim.tets() as f64 / per_step,
+        progress::clock(total)
+    );
+    Ok(())
+}
+
+/// Wall seconds per step measured over `n` steps on a copy of the state.
+fn measure_step_cost(sim: &mut Simulation, n: usize) -> f64 {
+    use qdem_core::{Stepper, Verlet};
+    let mut state = sim.state.clone();
+    let mut stepper = Verlet::new(sim.dt);
+    if stepper.initialize(&mut state, &mut sim.models).is_err() {
+        return f64::NAN;
+    }
+    let start = Instant::now();
+    for _ in 0..n {
+        if stepper.step(&mut state, &mut sim.models).is_err() {
+            return f64::NAN;
+        }
+    }
+    start.elapsed().as_secs_f64() / n as f64
+}
