@@ -2,6 +2,7 @@
 //! by `main`, through [`CliError`]'s `Display`.
 
 use crate::{bench, progress, verify};
+use qdem_bench::throughput::BenchPlan;
 use qdem_io::build::{BuildError, Simulation};
 use qdem_io::runner::{run, RunError};
 use qdem_io::scene::{Scene, SceneError};
@@ -51,11 +52,10 @@ pub enum CliError {
 struct Options {
     positional: Vec<String>,
     out: Option<PathBuf>,
-    threads: Option<usize>,
+    threads: Option<Vec<usize>>,
     json: bool,
     full: bool,
     tets: Option<Vec<usize>>,
-    thread_list: Option<Vec<usize>>,
     steps: Option<usize>,
 }
 
@@ -94,10 +94,7 @@ fn parse(args: &[String], allowed: &[&str]) -> Result<Options, CliError> {
             "--full" => o.full = true,
             "--steps" => o.steps = Some(parse_list(arg, &value()?)?[0]),
             "--tets" => o.tets = Some(parse_list(arg, &value()?)?),
-            "--threads" if allowed.contains(&"--thread-list") => {
-                o.thread_list = Some(parse_list(arg, &value()?)?)
-            }
-            "--threads" => o.threads = Some(parse_list(arg, &value()?)?[0]),
+            "--threads" => o.threads = Some(parse_list(arg, &value()?)?),
             _ => unreachable!("every allowed option is matched"),
         }
     }
@@ -112,8 +109,12 @@ fn one_scene(o: &Options, command: &str) -> Result<PathBuf, CliError> {
     }
 }
 
-fn set_threads(threads: Option<usize>) -> Result<(), CliError> {
-    if let Some(threads) = threads {
+/// Sets the global thread pool from `--threads N` (one number for `run` and `check`).
+fn set_threads(threads: Option<&[usize]>) -> Result<(), CliError> {
+    if let Some(list) = threads {
+        let [threads] = *list else {
+            return Err(CliError::Usage("--threads takes one number here".into()));
+        };
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build_global()
@@ -130,12 +131,12 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
     match command.as_str() {
         "run" => {
             let o = parse(rest, &["--out", "--threads"])?;
-            set_threads(o.threads)?;
+            set_threads(o.threads.as_deref())?;
             run_scene(&one_scene(&o, "run")?, o.out.as_deref())
         }
         "check" => {
             let o = parse(rest, &["--threads"])?;
-            set_threads(o.threads)?;
+            set_threads(o.threads.as_deref())?;
             check_scene(&one_scene(&o, "check")?)
         }
         "verify" => {
@@ -143,8 +144,8 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
             verify::run_and_print(o.json, o.full)
         }
         "bench" => {
-            let o = parse(rest, &["--json", "--tets", "--threads", "--thread-list", "--steps"])?;
-            bench::run_and_print(&bench::BenchPlan::new(o.tets, o.thread_list, o.steps), o.json);
+            let o = parse(rest, &["--json", "--tets", "--threads", "--steps"])?;
+            bench::run_and_print(&BenchPlan::new(o.tets, o.threads, o.steps), o.json);
             Ok(())
         }
         "help" | "--help" | "-h" => {

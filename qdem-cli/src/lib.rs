@@ -1,8 +1,9 @@
 //! # qdem-cli
 //!
 //! The `qdem` command: `run`, `check`, `verify` and `bench`. The binary is a thin shell over
-//! [`command::dispatch`]; the verification fixtures ([`verify`]) and the throughput benchmark
-//! ([`bench`]) are library code so that tests and the criterion benches use the same code.
+//! [`command::dispatch`]; the verification fixtures ([`verify`]) are library code so that the
+//! tests run exactly what `qdem verify` prints, and the throughput measurement lives in
+//! `qdem-bench` beside the criterion benches that share it.
 
 pub mod bench;
 pub mod command;

@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# The test command of README.md: installs the Python client the tests read our output with
+# (meshio), then runs every test of the workspace. Works on a fresh machine with cargo and
+# python3.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if ! python3 -c "import meshio" 2>/dev/null; then
+    python3 -m pip install --quiet --disable-pip-version-check meshio
+fi
+cargo test --workspace --all-targets
+cargo test --workspace --doc
