@@ -15,13 +15,23 @@ fn main() {
         match qdem_mesh::read_msh(path) {
             Ok((mut mesh, warnings)) => {
                 let read = t0.elapsed();
-                println!("{}: read in {:.1} ms", path.display(), read.as_secs_f64() * 1e3);
+                println!(
+                    "{}: read in {:.1} ms",
+                    path.display(),
+                    read.as_secs_f64() * 1e3
+                );
                 for w in &warnings {
                     println!("  warning: {w}");
                 }
                 println!("  {:?}", mesh.stats());
                 for g in &mesh.groups {
-                    println!("  group \"{}\" (dim {}, tag {}): {} nodes", g.name, g.dim, g.tag, g.nodes.len());
+                    println!(
+                        "  group \"{}\" (dim {}, tag {}): {} nodes",
+                        g.name,
+                        g.dim,
+                        g.tag,
+                        g.nodes.len()
+                    );
                 }
                 let bw = mesh.bandwidth();
                 let t1 = Instant::now();
@@ -34,7 +44,11 @@ fn main() {
                 );
                 let t2 = Instant::now();
                 let surf = mesh.surface_triangles();
-                println!("  {} surface triangles in {:.1} ms", surf.len(), t2.elapsed().as_secs_f64() * 1e3);
+                println!(
+                    "  {} surface triangles in {:.1} ms",
+                    surf.len(),
+                    t2.elapsed().as_secs_f64() * 1e3
+                );
             }
             Err(e) => {
                 eprintln!("error: {e}");

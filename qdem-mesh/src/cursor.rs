@@ -28,7 +28,14 @@ fn is_ws(b: u8) -> bool {
 
 impl<'a> Cursor<'a> {
     pub fn new(data: &'a [u8], file: &'a Path) -> Self {
-        Cursor { data, pos: 0, file, binary: false, big_endian: false, size_t: 8 }
+        Cursor {
+            data,
+            pos: 0,
+            file,
+            binary: false,
+            big_endian: false,
+            size_t: 8,
+        }
     }
 
     pub fn file(&self) -> &'a Path {
@@ -70,7 +77,8 @@ impl<'a> Cursor<'a> {
     }
 
     fn bad_number(&self, pos: usize, what: &str, token: &[u8]) -> MeshError {
-        let mut text = String::from_utf8_lossy(&token[..token.len().min(MAX_TOKEN_ECHO)]).into_owned();
+        let mut text =
+            String::from_utf8_lossy(&token[..token.len().min(MAX_TOKEN_ECHO)]).into_owned();
         if token.len() > MAX_TOKEN_ECHO {
             text.push_str("...");
         }
@@ -218,10 +226,13 @@ impl<'a> Cursor<'a> {
         if trim(line) == what.as_bytes() {
             Ok(())
         } else {
-            let found = String::from_utf8_lossy(&line[..line.len().min(MAX_TOKEN_ECHO)]).into_owned();
+            let found =
+                String::from_utf8_lossy(&line[..line.len().min(MAX_TOKEN_ECHO)]).into_owned();
             Err(self.malformed_at(
                 start,
-                format!("expected {what}, found `{found}` (a count in ${name} does not match its data)"),
+                format!(
+                    "expected {what}, found `{found}` (a count in ${name} does not match its data)"
+                ),
             ))
         }
     }
@@ -310,7 +321,8 @@ impl<'a> Cursor<'a> {
     pub fn bin_count(&mut self, what: &str, min_bytes: usize) -> Result<usize, MeshError> {
         let start = self.pos;
         let v = self.bin_size(what)?;
-        let n = usize::try_from(v).map_err(|_| self.bad_number(start, what, v.to_string().as_bytes()))?;
+        let n = usize::try_from(v)
+            .map_err(|_| self.bad_number(start, what, v.to_string().as_bytes()))?;
         self.check_count(n, min_bytes, what)?;
         Ok(n)
     }
@@ -324,7 +336,10 @@ pub(crate) fn parse_int(tok: &[u8]) -> Option<i64> {
 /// `line` without leading and trailing ASCII whitespace.
 pub(crate) fn trim(line: &[u8]) -> &[u8] {
     let start = line.iter().position(|&b| !is_ws(b)).unwrap_or(line.len());
-    let end = line.iter().rposition(|&b| !is_ws(b)).map_or(start, |k| k + 1);
+    let end = line
+        .iter()
+        .rposition(|&b| !is_ws(b))
+        .map_or(start, |k| k + 1);
     &line[start..end.max(start)]
 }
 
@@ -361,6 +376,12 @@ mod tests {
         assert_eq!(c.bin_i32("i").unwrap(), 1);
         c.big_endian = true;
         assert_eq!(c.bin_i32("i").unwrap(), 1);
-        assert!(matches!(c.bin_i32("i"), Err(MeshError::Truncated { location: Location::Byte(8), .. })));
+        assert!(matches!(
+            c.bin_i32("i"),
+            Err(MeshError::Truncated {
+                location: Location::Byte(8),
+                ..
+            })
+        ));
     }
 }

@@ -228,8 +228,8 @@ pub enum MeshError {
         element_id: u64,
         /// Its node ids as in the file.
         nodes: [u64; 4],
-        /// Its corner coordinates.
-        coords: [[f64; 3]; 4],
+        /// Its corner coordinates (boxed to keep the error small).
+        coords: Box<[[f64; 3]; 4]>,
         /// Six times its signed volume.
         volume6: f64,
     },
@@ -313,22 +313,35 @@ pub enum MeshWarning {
 impl fmt::Display for MeshWarning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            MeshWarning::ReorientedTets { count, first_element_id } => write!(
+            MeshWarning::ReorientedTets {
+                count,
+                first_element_id,
+            } => write!(
                 f,
                 "{count} tetrahedra had negative volume and were reoriented (two nodes swapped), \
                  the first is element {first_element_id}"
             ),
-            MeshWarning::DroppedUnusedNodes { count, first_node_id } => write!(
+            MeshWarning::DroppedUnusedNodes {
+                count,
+                first_node_id,
+            } => write!(
                 f,
                 "{count} nodes are not used by any tetrahedron and were dropped (nodes \
                  renumbered), the first is node {first_node_id}"
             ),
-            MeshWarning::IgnoredUnknownElements { type_id, count, first_element_id } => write!(
+            MeshWarning::IgnoredUnknownElements {
+                type_id,
+                count,
+                first_element_id,
+            } => write!(
                 f,
                 "{count} elements of unknown gmsh type {type_id} were ignored, the first is \
                  element {first_element_id}"
             ),
-            MeshWarning::DuplicateTets { count, first_element_id } => write!(
+            MeshWarning::DuplicateTets {
+                count,
+                first_element_id,
+            } => write!(
                 f,
                 "{count} duplicate tetrahedra (same id and nodes) were kept once, the first is \
                  element {first_element_id}"

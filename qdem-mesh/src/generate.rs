@@ -32,11 +32,20 @@ const KUHN: [([usize; 3], bool); 6] = [
 /// assert!((m.volume() - 6.0).abs() < 1e-12);
 /// ```
 pub fn structured_box(min: [f64; 3], max: [f64; 3], cells: [usize; 3]) -> TetMesh {
-    assert!(cells.iter().all(|&c| c > 0), "structured_box: every cell count must be positive");
-    assert!((0..3).all(|d| min[d] < max[d]), "structured_box: need min < max on every axis");
+    assert!(
+        cells.iter().all(|&c| c > 0),
+        "structured_box: every cell count must be positive"
+    );
+    assert!(
+        (0..3).all(|d| min[d] < max[d]),
+        "structured_box: need min < max on every axis"
+    );
     let [nx, ny, nz] = cells;
     let total = (nx + 1) * (ny + 1) * (nz + 1);
-    assert!(u32::try_from(total).is_ok(), "structured_box: too many nodes");
+    assert!(
+        u32::try_from(total).is_ok(),
+        "structured_box: too many nodes"
+    );
     let coord = |d: usize, i: usize| {
         if i == cells[d] {
             max[d]
@@ -89,8 +98,17 @@ pub fn structured_box(min: [f64; 3], max: [f64; 3], cells: [usize; 3]) -> TetMes
                     }
                 }
             }
-            PhysicalGroup { name: (*name).to_string(), dim: 2, tag: g as i32 + 1, nodes: set }
+            PhysicalGroup {
+                name: (*name).to_string(),
+                dim: 2,
+                tag: g as i32 + 1,
+                nodes: set,
+            }
         })
         .collect();
-    TetMesh { nodes, tets, groups }
+    TetMesh {
+        nodes,
+        tets,
+        groups,
+    }
 }

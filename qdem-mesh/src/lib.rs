@@ -36,6 +36,8 @@
 //! validation stage resolves ids, checks geometry and builds node sets; so every format goes
 //! through the same checks. No third-party MSH crate is used: the one available reads 4.1 only.
 
+#![warn(missing_docs)]
+
 mod cursor;
 mod element_types;
 mod error;

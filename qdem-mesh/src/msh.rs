@@ -111,7 +111,12 @@ impl RawMesh {
             Kind::Lower { .. } if src != 0 => {
                 let start = self.other_nodes.len();
                 self.other_nodes.extend_from_slice(nodes);
-                self.others.push(RawElem { id, src, start, len: nodes.len() });
+                self.others.push(RawElem {
+                    id,
+                    src,
+                    start,
+                    len: nodes.len(),
+                });
             }
             _ => {}
         }
@@ -194,7 +199,11 @@ pub fn parse_msh(bytes: &[u8], file: &Path) -> Result<(TetMesh, Vec<MeshWarning>
     c.skip_ws();
     match c.line() {
         Some((line, _)) if trim(line) == b"$MeshFormat" => {}
-        _ => return Err(MeshError::NotMsh { file: file.to_path_buf() }),
+        _ => {
+            return Err(MeshError::NotMsh {
+                file: file.to_path_buf(),
+            })
+        }
     }
     let version = mesh_format(&mut c)?;
     let mut raw = RawMesh::new();
@@ -202,12 +211,19 @@ pub fn parse_msh(bytes: &[u8], file: &Path) -> Result<(TetMesh, Vec<MeshWarning>
         let Some((line, start)) = c.line() else { break };
         let header = trim(line);
         let name = match header.strip_prefix(b"$") {
-            Some(n) if !n.is_empty() && !n.starts_with(b"End") && !n.iter().any(|b| b.is_ascii_whitespace()) => {
+            Some(n)
+                if !n.is_empty()
+                    && !n.starts_with(b"End")
+                    && !n.iter().any(|b| b.is_ascii_whitespace()) =>
+            {
                 String::from_utf8_lossy(n).into_owned()
             }
             _ => {
                 let shown = String::from_utf8_lossy(&header[..header.len().min(40)]).into_owned();
-                return Err(c.malformed_at(start, format!("expected a section header like $Nodes, found `{shown}`")));
+                return Err(c.malformed_at(
+                    start,
+                    format!("expected a section header like $Nodes, found `{shown}`"),
+                ));
             }
         };
         match (name.as_str(), version) {
@@ -218,7 +234,10 @@ pub fn parse_msh(bytes: &[u8], file: &Path) -> Result<(TetMesh, Vec<MeshWarning>
             ("Nodes", Version::V2) => msh2::nodes(&mut c, &mut raw)?,
             ("Elements", Version::V2) => msh2::elements(&mut c, &mut raw)?,
             ("PartitionedEntities", _) => {
-                return Err(MeshError::Partitioned { file: file.to_path_buf(), location: c.location_at(start) })
+                return Err(MeshError::Partitioned {
+                    file: file.to_path_buf(),
+                    location: c.location_at(start),
+                })
             }
             (other, _) => c.skip_section(other)?,
         }
@@ -242,10 +261,14 @@ fn mesh_format(c: &mut Cursor) -> Result<Version, MeshError> {
     if fields.len() < 3 {
         return Err(unsupported());
     }
-    let parse = |t: &[u8]| std::str::from_utf8(t).ok().and_then(|s| s.parse::<f64>().ok());
+    let parse = |t: &[u8]| {
+        std::str::from_utf8(t)
+            .ok()
+            .and_then(|s| s.parse::<f64>().ok())
+    };
     let version = match parse(fields[0]) {
         Some(v) if (2.0..3.0).contains(&v) => Version::V2,
-        Some(v) if v == 4.1 => Version::V41,
+        Some(_) if fields[0] == b"4.1" => Version::V41,
         _ => return Err(unsupported()),
     };
     let binary = match fields[1] {
@@ -269,7 +292,9 @@ fn mesh_format(c: &mut Cursor) -> Result<Version, MeshError> {
             _ => {
                 return Err(c.malformed_at(
                     at,
-                    format!("the binary endianness marker should be the int 1, found bytes {marker:?}"),
+                    format!(
+                        "the binary endianness marker should be the int 1, found bytes {marker:?}"
+                    ),
                 ))
             }
         };
@@ -284,10 +309,12 @@ fn physical_names(c: &mut Cursor, raw: &mut RawMesh) -> Result<(), MeshError> {
     for _ in 0..n {
         let start = c.pos();
         let dim = c.int32("the dimension of a physical name")?;
-        let dim = u8::try_from(dim)
-            .ok()
-            .filter(|d| *d <= 3)
-            .ok_or_else(|| c.malformed_at(start, format!("physical group dimension {dim} is not 0, 1, 2 or 3")))?;
+        let dim = u8::try_from(dim).ok().filter(|d| *d <= 3).ok_or_else(|| {
+            c.malformed_at(
+                start,
+                format!("physical group dimension {dim} is not 0, 1, 2 or 3"),
+            )
+        })?;
         let tag = c.int32("the tag of a physical name")?;
         let Some((rest, _)) = c.line() else {
             return Err(c.truncated("a physical name"));
@@ -297,7 +324,8 @@ fn physical_names(c: &mut Cursor, raw: &mut RawMesh) -> Result<(), MeshError> {
             .strip_prefix(b"\"")
             .and_then(|r| r.strip_suffix(b"\""))
             .unwrap_or(rest);
-        raw.names.push((dim, tag, String::from_utf8_lossy(name).into_owned()));
+        raw.names
+            .push((dim, tag, String::from_utf8_lossy(name).into_owned()));
     }
     c.expect_end("PhysicalNames")
 }

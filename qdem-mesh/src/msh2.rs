@@ -65,7 +65,10 @@ fn elements_ascii(c: &mut Cursor, raw: &mut RawMesh) -> Result<(), MeshError> {
     for _ in 0..n {
         let (line, start) = c.data_line("an element")?;
         let mut toks = split_ws(line);
-        let mut next = |what: &str| toks.next().ok_or_else(|| c.malformed_at(start, format!("element line ends before {what}")));
+        let mut next = |what: &str| {
+            toks.next()
+                .ok_or_else(|| c.malformed_at(start, format!("element line ends before {what}")))
+        };
         let id_tok = next("its id")?;
         let type_tok = next("its type")?;
         let ntags_tok = next("its number of tags")?;
@@ -76,7 +79,10 @@ fn elements_ascii(c: &mut Cursor, raw: &mut RawMesh) -> Result<(), MeshError> {
         let mut rest = split_ws(line).skip(3);
         for k in 0..ntags {
             let Some(t) = rest.next() else {
-                return Err(c.malformed_at(start, format!("element {id} has fewer than the {ntags} tags it announces")));
+                return Err(c.malformed_at(
+                    start,
+                    format!("element {id} has fewer than the {ntags} tags it announces"),
+                ));
             };
             let v = c.i32_in(t, start, "an element tag")?;
             if k == 0 {
@@ -100,7 +106,10 @@ fn elements_ascii(c: &mut Cursor, raw: &mut RawMesh) -> Result<(), MeshError> {
         if nodes.len() != nn {
             return Err(c.malformed_at(
                 start,
-                format!("element {id} of type {type_id} has {} nodes, expected {nn}", nodes.len()),
+                format!(
+                    "element {id} of type {type_id} has {} nodes, expected {nn}",
+                    nodes.len()
+                ),
             ));
         }
         let src = source(raw, dim, phys);
@@ -124,13 +133,20 @@ fn elements_binary(c: &mut Cursor, raw: &mut RawMesh) -> Result<(), MeshError> {
         if follow > n - done {
             return Err(c.malformed_at(
                 header,
-                format!("an element block of {follow} elements exceeds the {} elements left", n - done),
+                format!(
+                    "an element block of {follow} elements exceeds the {} elements left",
+                    n - done
+                ),
             ));
         }
         let kind = Kind::of(type_id);
         let nn = match kind {
             Kind::BadVolume { name } => {
-                let id = if follow > 0 { c.bin_u32("an element id")? } else { 0 };
+                let id = if follow > 0 {
+                    c.bin_u32("an element id")?
+                } else {
+                    0
+                };
                 return Err(unsupported(c.file(), id, type_id, name));
             }
             Kind::Unknown => {
@@ -142,7 +158,11 @@ fn elements_binary(c: &mut Cursor, raw: &mut RawMesh) -> Result<(), MeshError> {
             }
             _ => kind.nodes().unwrap_or(0),
         };
-        let dim = if let Kind::Lower { dim, .. } = kind { dim } else { 3 };
+        let dim = if let Kind::Lower { dim, .. } = kind {
+            dim
+        } else {
+            3
+        };
         let per = usize::try_from(ntags)
             .ok()
             .and_then(|t| t.checked_add(1 + nn))

@@ -8,7 +8,12 @@ use crate::cursor::{split_ws, Cursor};
 use crate::error::MeshError;
 use crate::msh::{unsupported, Kind, RawMesh};
 
-fn count(c: &mut Cursor, what: &str, min_ascii: usize, min_binary: usize) -> Result<usize, MeshError> {
+fn count(
+    c: &mut Cursor,
+    what: &str,
+    min_ascii: usize,
+    min_binary: usize,
+) -> Result<usize, MeshError> {
     if c.binary {
         c.bin_count(what, min_binary)
     } else {
@@ -57,7 +62,11 @@ pub(crate) fn entities(c: &mut Cursor, raw: &mut RawMesh) -> Result<(), MeshErro
     for (dim, &n) in per_dim.iter().enumerate() {
         let dim = dim as u8;
         // A point: tag, 3 doubles, a count; anything else: tag, 6 doubles, 2 counts.
-        let min_binary = if dim == 0 { 4 + 24 + c.size_t } else { 4 + 48 + 2 * c.size_t };
+        let min_binary = if dim == 0 {
+            4 + 24 + c.size_t
+        } else {
+            4 + 48 + 2 * c.size_t
+        };
         c.check_count(n, if c.binary { min_binary } else { 10 }, "the entities")?;
         for _ in 0..n {
             let tag = int(c, "an entity tag")?;
@@ -154,7 +163,12 @@ pub(crate) fn elements(c: &mut Cursor, raw: &mut RawMesh) -> Result<(), MeshErro
                     let tok = split_ws(line).next().unwrap_or(b"");
                     let id = c.id_in(tok, start, "an element tag")?;
                     if dim == 3 {
-                        return Err(unsupported(c.file(), id, type_id, &format!("element of unknown type {type_id}")));
+                        return Err(unsupported(
+                            c.file(),
+                            id,
+                            type_id,
+                            &format!("element of unknown type {type_id}"),
+                        ));
                     }
                     raw.note_unknown(type_id, id);
                 }
@@ -180,7 +194,10 @@ pub(crate) fn elements(c: &mut Cursor, raw: &mut RawMesh) -> Result<(), MeshErro
                 if nodes.len() != nn {
                     return Err(c.malformed_at(
                         start,
-                        format!("element {id} of type {type_id} has {} nodes, expected {nn}", nodes.len()),
+                        format!(
+                            "element {id} of type {type_id} has {} nodes, expected {nn}",
+                            nodes.len()
+                        ),
                     ));
                 }
                 id

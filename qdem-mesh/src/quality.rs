@@ -32,7 +32,11 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 fn norm(a: [f64; 3]) -> f64 {
@@ -50,7 +54,10 @@ pub fn signed_volume6(p: &[[f64; 3]; 4]) -> f64 {
 
 /// The longest edge length of a tetrahedron.
 pub fn max_edge(p: &[[f64; 3]; 4]) -> f64 {
-    TET_EDGES.iter().map(|&(a, b)| norm(sub(p[a], p[b]))).fold(0.0, f64::max)
+    TET_EDGES
+        .iter()
+        .map(|&(a, b)| norm(sub(p[a], p[b])))
+        .fold(0.0, f64::max)
 }
 
 /// Radius ratio `3 r / R` of a tetrahedron (inradius r, circumradius R): 1 for the regular
@@ -142,7 +149,12 @@ mod tests {
 
     #[test]
     fn regular_tet_has_quality_one() {
-        let p = [[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]];
+        let p = [
+            [1.0, 1.0, 1.0],
+            [1.0, -1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+            [-1.0, -1.0, 1.0],
+        ];
         assert!((radius_ratio(&p) - 1.0).abs() < 1e-12);
         let v = signed_volume6(&p) / 6.0;
         assert!((v.abs() - 8.0 / 3.0).abs() < 1e-12);
@@ -150,13 +162,23 @@ mod tests {
 
     #[test]
     fn corner_tet() {
-        let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let p = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
         assert_eq!(signed_volume6(&p), 1.0);
         let q = radius_ratio(&p);
         // r = 1/(3+sqrt 3), R = sqrt(3)/2.
         let expect = 3.0 / (3.0 + 3f64.sqrt()) / (3f64.sqrt() / 2.0);
         assert!((q - expect).abs() < 1e-12, "{q} {expect}");
-        let flat = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
+        let flat = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
         assert_eq!(radius_ratio(&flat), 0.0);
     }
 }

@@ -20,29 +20,44 @@ pub struct NodeGraph {
 impl NodeGraph {
     /// Builds the graph of tetrahedron edges over `nodes` nodes.
     ///
+    /// ```
+    /// let g = qdem_mesh::NodeGraph::from_tets(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+    /// assert_eq!(g.neighbours(1), &[0, 2, 3, 4]);
+    /// assert_eq!(g.neighbours(4), &[1, 2, 3]);
+    /// ```
+    ///
     /// # Panics
     /// If a tetrahedron refers to a node `>= nodes`.
     pub fn from_tets(nodes: usize, tets: &[[u32; 4]]) -> NodeGraph {
-        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(tets.len() * 12);
+        // Each undirected edge once as (low, high), sorted; rows then fill in sorted order:
+        // node a first receives its lower neighbours (ascending), then its higher ones.
+        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(tets.len() * 6);
         for t in tets {
             for &(a, b) in &TET_EDGES {
-                let (a, b) = (t[a], t[b]);
+                let (a, b) = (t[a].min(t[b]), t[a].max(t[b]));
                 if a != b {
                     edges.push((a, b));
-                    edges.push((b, a));
                 }
             }
         }
         edges.sort_unstable();
         edges.dedup();
         let mut offsets = vec![0usize; nodes + 1];
-        for &(a, _) in &edges {
+        for &(a, b) in &edges {
             offsets[a as usize + 1] += 1;
+            offsets[b as usize + 1] += 1;
         }
         for i in 0..nodes {
             offsets[i + 1] += offsets[i];
         }
-        let adj = edges.into_iter().map(|(_, b)| b).collect();
+        let mut fill = offsets[..nodes].to_vec();
+        let mut adj = vec![0u32; offsets[nodes]];
+        for &(a, b) in &edges {
+            adj[fill[a as usize]] = b;
+            fill[a as usize] += 1;
+            adj[fill[b as usize]] = a;
+            fill[b as usize] += 1;
+        }
         NodeGraph { offsets, adj }
     }
 
@@ -123,7 +138,12 @@ impl NodeGraph {
             while let Some(i) = queue.pop_front() {
                 result.push(i);
                 nbrs.clear();
-                nbrs.extend(self.neighbours(i as usize).iter().copied().filter(|&j| !placed[j as usize]));
+                nbrs.extend(
+                    self.neighbours(i as usize)
+                        .iter()
+                        .copied()
+                        .filter(|&j| !placed[j as usize]),
+                );
                 nbrs.sort_unstable_by_key(|&j| (self.degree(j as usize), j));
                 for &j in &nbrs {
                     placed[j as usize] = true;
@@ -141,7 +161,11 @@ impl TetMesh {
     pub fn bandwidth(&self) -> usize {
         self.tets
             .iter()
-            .flat_map(|t| TET_EDGES.iter().map(move |&(a, b)| t[a].abs_diff(t[b]) as usize))
+            .flat_map(|t| {
+                TET_EDGES
+                    .iter()
+                    .map(move |&(a, b)| t[a].abs_diff(t[b]) as usize)
+            })
             .max()
             .unwrap_or(0)
     }
@@ -153,7 +177,11 @@ impl TetMesh {
     /// If `new_of_old` is not a permutation of `0..nodes.len()`.
     pub fn renumber_nodes(&mut self, new_of_old: &[u32]) {
         let n = self.nodes.len();
-        assert_eq!(new_of_old.len(), n, "renumber_nodes: permutation has the wrong length");
+        assert_eq!(
+            new_of_old.len(),
+            n,
+            "renumber_nodes: permutation has the wrong length"
+        );
         let mut nodes = vec![[f64::NAN; 3]; n];
         let mut seen = vec![false; n];
         for (old, &new) in new_of_old.iter().enumerate() {
@@ -177,14 +205,23 @@ impl TetMesh {
     /// tetrahedra sorted by their smallest node (ties by their other nodes). Groups are
     /// remapped; tetrahedron orientation is kept. Returns nothing; use
     /// [`TetMesh::rcm_permutation`] and [`TetMesh::renumber_nodes`] to keep the permutation.
+    ///
+    /// # Panics
+    /// If a tetrahedron refers to a node index out of range.
     pub fn reorder_for_locality(&mut self) {
         let new_of_old = self.rcm_permutation();
         self.renumber_nodes(&new_of_old);
-        self.tets.sort_by_key(|t| {
-            let mut s = *t;
-            s.sort_unstable();
-            s
-        });
+        let mut keyed: Vec<([u32; 4], [u32; 4])> = self
+            .tets
+            .iter()
+            .map(|t| {
+                let mut s = *t;
+                s.sort_unstable();
+                (s, *t)
+            })
+            .collect();
+        keyed.sort_unstable();
+        self.tets = keyed.into_iter().map(|(_, t)| t).collect();
     }
 
     /// The reverse Cuthill–McKee renumbering as `new_of_old` (see

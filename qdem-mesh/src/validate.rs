@@ -24,7 +24,10 @@ enum IdMap {
 
 impl IdMap {
     fn new(ids: &[u64], file: &Path) -> Result<IdMap, MeshError> {
-        let dup = |node_id| MeshError::DuplicateNode { file: file.to_path_buf(), node_id };
+        let dup = |node_id| MeshError::DuplicateNode {
+            file: file.to_path_buf(),
+            node_id,
+        };
         let max = ids.iter().copied().max().unwrap_or(0);
         let dense_limit = (ids.len() as u64).saturating_mul(4).saturating_add(1024);
         if max <= dense_limit {
@@ -50,7 +53,11 @@ impl IdMap {
 
     fn get(&self, id: u64) -> Option<u32> {
         match self {
-            IdMap::Dense(v) => usize::try_from(id).ok().and_then(|i| v.get(i)).copied().filter(|&k| k != NONE),
+            IdMap::Dense(v) => usize::try_from(id)
+                .ok()
+                .and_then(|i| v.get(i))
+                .copied()
+                .filter(|&k| k != NONE),
             IdMap::Sparse(m) => m.get(&id).copied(),
         }
     }
@@ -60,10 +67,16 @@ impl IdMap {
 pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarning>), MeshError> {
     let mut warnings = Vec::new();
     for (&type_id, &(count, first_element_id)) in &raw.unknown {
-        warnings.push(MeshWarning::IgnoredUnknownElements { type_id, count, first_element_id });
+        warnings.push(MeshWarning::IgnoredUnknownElements {
+            type_id,
+            count,
+            first_element_id,
+        });
     }
     if raw.tets.is_empty() {
-        return Err(MeshError::NoTetrahedra { file: file.to_path_buf() });
+        return Err(MeshError::NoTetrahedra {
+            file: file.to_path_buf(),
+        });
     }
     if raw.node_ids.len() >= NONE as usize || raw.tets.len() >= NONE as usize {
         return Err(MeshError::Malformed {
@@ -73,17 +86,24 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
         });
     }
     let map = IdMap::new(&raw.node_ids, file)?;
-    let undefined = |element_id, node_id| MeshError::UndefinedNode { file: file.to_path_buf(), element_id, node_id };
+    let undefined = |element_id, node_id| MeshError::UndefinedNode {
+        file: file.to_path_buf(),
+        element_id,
+        node_id,
+    };
 
     // Exact duplicates (same id and nodes): keep the first.
-    let mut order: Vec<u32> = (0..raw.tets.len() as u32).collect();
-    order.sort_by_key(|&k| {
-        let t = &raw.tets[k as usize];
-        (t.id, t.nodes, k)
-    });
     let mut keep = vec![true; raw.tets.len()];
     let mut dups = 0usize;
     let mut first_dup = None;
+    let mut order: Vec<u32> = Vec::new();
+    if !raw.tets.windows(2).all(|w| w[0].id < w[1].id) {
+        order = (0..raw.tets.len() as u32).collect();
+        order.sort_unstable_by_key(|&k| {
+            let t = &raw.tets[k as usize];
+            (t.id, t.nodes, k)
+        });
+    }
     for w in order.windows(2) {
         let (a, b) = (&raw.tets[w[0] as usize], &raw.tets[w[1] as usize]);
         if a.id == b.id && a.nodes == b.nodes {
@@ -93,7 +113,10 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
         }
     }
     if let Some(first_element_id) = first_dup {
-        warnings.push(MeshWarning::DuplicateTets { count: dups, first_element_id });
+        warnings.push(MeshWarning::DuplicateTets {
+            count: dups,
+            first_element_id,
+        });
     }
 
     // Resolve node ids; mark used nodes.
@@ -125,7 +148,10 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
         }
     }
     if let Some(first_node_id) = first_dropped {
-        warnings.push(MeshWarning::DroppedUnusedNodes { count: dropped, first_node_id });
+        warnings.push(MeshWarning::DroppedUnusedNodes {
+            count: dropped,
+            first_node_id,
+        });
     }
 
     // Orientation and degeneracy.
@@ -137,13 +163,14 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
         let p = t.map(|k| nodes[k as usize]);
         let v6 = signed_volume6(&p);
         let h = max_edge(&p);
-        if !(v6.abs() > DEGENERATE_TOL * h * h * h) {
+        let scale = DEGENERATE_TOL * h * h * h;
+        if !v6.is_finite() || !scale.is_finite() || v6.abs() <= scale {
             let nodes_ids = r.map(|k| raw.node_ids[k as usize]);
             return Err(MeshError::DegenerateTet {
                 file: file.to_path_buf(),
                 element_id: id,
                 nodes: nodes_ids,
-                coords: p,
+                coords: Box::new(p),
                 volume6: v6,
             });
         }
@@ -155,11 +182,21 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
         tets.push(t);
     }
     if let Some(first_element_id) = first_flipped {
-        warnings.push(MeshWarning::ReorientedTets { count: flipped, first_element_id });
+        warnings.push(MeshWarning::ReorientedTets {
+            count: flipped,
+            first_element_id,
+        });
     }
 
     let groups = groups(&raw, &map, &new_index, file, &mut warnings)?;
-    Ok((TetMesh { nodes, tets, groups }, warnings))
+    Ok((
+        TetMesh {
+            nodes,
+            tets,
+            groups,
+        },
+        warnings,
+    ))
 }
 
 /// Physical groups as sorted node sets (new indices), sorted by (dim, tag).
@@ -176,7 +213,11 @@ fn groups(
     keys.sort_unstable();
     keys.dedup();
     let slot: HashMap<(u8, i32), usize> = keys.iter().enumerate().map(|(k, &g)| (g, k)).collect();
-    let src_slots: Vec<Vec<usize>> = raw.sources.iter().map(|s| s.iter().map(|g| slot[g]).collect()).collect();
+    let src_slots: Vec<Vec<usize>> = raw
+        .sources
+        .iter()
+        .map(|s| s.iter().map(|g| slot[g]).collect())
+        .collect();
     let mut sets: Vec<Vec<u32>> = vec![Vec::new(); keys.len()];
 
     // All tetrahedra, dropped duplicates included (same nodes, maybe other groups).
@@ -217,9 +258,18 @@ fn groups(
             .find(|&&(d, t, _)| d == dim && t == tag)
             .map_or_else(|| format!("{dim}:{tag}"), |(_, _, n)| n.clone());
         if nodes.is_empty() {
-            warnings.push(MeshWarning::EmptyGroup { name: name.clone(), dim, tag });
+            warnings.push(MeshWarning::EmptyGroup {
+                name: name.clone(),
+                dim,
+                tag,
+            });
         }
-        out.push(PhysicalGroup { name, dim, tag, nodes });
+        out.push(PhysicalGroup {
+            name,
+            dim,
+            tag,
+            nodes,
+        });
     }
     Ok(out)
 }

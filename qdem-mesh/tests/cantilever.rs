@@ -22,14 +22,20 @@ fn cantilever_fixtures() {
         assert_eq!(mesh.nodes[k as usize], centre, "{name}");
         assert_eq!(mesh.require_group("tip_centre", &path).unwrap().nodes, [k]);
         let clamp = mesh.require_group("clamp", &path).unwrap();
-        assert!(clamp.nodes.iter().all(|&n| mesh.nodes[n as usize][0] == 0.0));
+        assert!(clamp
+            .nodes
+            .iter()
+            .all(|&n| mesh.nodes[n as usize][0] == 0.0));
         assert_eq!(clamp.nodes, mesh.nodes_in_box([-1.0; 3], [0.0, 1.0, 1.0]));
         let tip = mesh.require_group("tip", &path).unwrap();
         assert!(tip.nodes.contains(&k));
         assert!(tip.nodes.iter().all(|&n| mesh.nodes[n as usize][0] == 2.4));
         assert_eq!(mesh.group("beam").unwrap().nodes.len(), nodes);
         let s = mesh.stats();
-        assert!(s.worst_quality > 0.05 && s.worst_quality <= 1.0, "{name}: {s:?}");
+        assert!(
+            s.worst_quality > 0.05 && s.worst_quality <= 1.0,
+            "{name}: {s:?}"
+        );
         let bw = mesh.bandwidth();
         mesh.reorder_for_locality();
         assert!(mesh.bandwidth() < bw, "{name}");

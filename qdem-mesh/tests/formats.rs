@@ -20,13 +20,17 @@ const FORMATS: [&str; 8] = [
 ];
 
 fn read(name: &str) -> TetMesh {
-    let (mesh, warnings) = read_msh(&fixture(&format!("msh/{name}"))).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let (mesh, warnings) =
+        read_msh(&fixture(&format!("msh/{name}"))).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert!(warnings.is_empty(), "{name}: {warnings:?}");
     mesh
 }
 
 fn summary(m: &TetMesh) -> Vec<(String, u8, usize)> {
-    m.groups.iter().map(|g| (g.name.clone(), g.dim, g.nodes.len())).collect()
+    m.groups
+        .iter()
+        .map(|g| (g.name.clone(), g.dim, g.nodes.len()))
+        .collect()
 }
 
 #[test]
@@ -46,9 +50,16 @@ fn reference_mesh_is_the_box() {
     for &n in &m.group("right").unwrap().nodes {
         assert!((m.nodes[n as usize][0] - 0.3).abs() < 1e-15);
     }
-    assert!(m.tets.iter().enumerate().all(|(t, _)| m.tet_volume(t) > 0.0));
+    assert!(m
+        .tets
+        .iter()
+        .enumerate()
+        .all(|(t, _)| m.tet_volume(t) > 0.0));
     // The named groups are exactly the nodes on those faces.
-    assert_eq!(m.group("left").unwrap().nodes, m.nodes_in_box([-1.0, -1.0, -1.0], [0.0, 1.0, 1.0]));
+    assert_eq!(
+        m.group("left").unwrap().nodes,
+        m.nodes_in_box([-1.0, -1.0, -1.0], [0.0, 1.0, 1.0])
+    );
 }
 
 #[test]
@@ -61,7 +72,13 @@ fn all_formats_agree() {
         assert!(rel(m.volume(), reference.volume()) < 1e-12, "{name}");
         assert!(rel(m.volume(), BOX_VOLUME) < 1e-12, "{name}");
         assert_eq!(summary(&m), summary(&reference), "{name}");
-        assert!(m.tets.iter().enumerate().all(|(t, _)| m.tet_volume(t) > 0.0), "{name}");
+        assert!(
+            m.tets
+                .iter()
+                .enumerate()
+                .all(|(t, _)| m.tet_volume(t) > 0.0),
+            "{name}"
+        );
     }
 }
 
@@ -74,7 +91,10 @@ fn gmsh_files_agree_node_for_node() {
         let m = read(name);
         assert_eq!(m.nodes.len(), reference.nodes.len(), "{name}");
         for (p, q) in m.nodes.iter().zip(&reference.nodes) {
-            assert!((0..3).all(|d| (p[d] - q[d]).abs() < 1e-15), "{name}: {p:?} {q:?}");
+            assert!(
+                (0..3).all(|d| (p[d] - q[d]).abs() < 1e-15),
+                "{name}: {p:?} {q:?}"
+            );
         }
         assert_eq!(m.tets, reference.tets, "{name}");
         assert_eq!(m.groups, reference.groups, "{name}");
@@ -111,7 +131,11 @@ fn swap_msh22(b: &[u8]) -> Vec<u8> {
     // Nodes.
     let nodes = find(b, 0, b"$Nodes\n") + 7;
     let eol = find(b, nodes, b"\n");
-    let n: usize = std::str::from_utf8(&b[nodes..eol]).unwrap().trim().parse().unwrap();
+    let n: usize = std::str::from_utf8(&b[nodes..eol])
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
     let mut p = eol + 1;
     for _ in 0..n {
         p = swap_words(&mut out, p, &[4, 8, 8, 8]);
@@ -119,7 +143,11 @@ fn swap_msh22(b: &[u8]) -> Vec<u8> {
     // Elements.
     let elems = find(b, 0, b"$Elements\n") + 10;
     let eol = find(b, elems, b"\n");
-    let n: usize = std::str::from_utf8(&b[elems..eol]).unwrap().trim().parse().unwrap();
+    let n: usize = std::str::from_utf8(&b[elems..eol])
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
     let mut p = eol + 1;
     let mut done = 0;
     let int = |b: &[u8], p: usize| i32::from_le_bytes(b[p..p + 4].try_into().unwrap()) as usize;

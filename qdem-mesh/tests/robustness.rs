@@ -46,7 +46,10 @@ impl Rng {
 
 /// Iterations per file; `QDEM_FUZZ_ITERS` raises it for a longer local run.
 fn iterations() -> usize {
-    std::env::var("QDEM_FUZZ_ITERS").ok().and_then(|s| s.parse().ok()).unwrap_or(300)
+    std::env::var("QDEM_FUZZ_ITERS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(300)
 }
 
 #[test]
@@ -69,6 +72,29 @@ fn corrupted_bytes_never_panic() {
             }
             // Ok or Err are both fine; a panic fails the test.
             let _ = parse_msh(&b, &path);
+        }
+    }
+}
+
+#[test]
+fn hostile_words_in_binary_files_never_panic() {
+    // Overwrite an 8-byte window at every 7th offset with huge, negative or zero values: this
+    // hits every count, size_t, tag and type field of the binary sections.
+    let words: [[u8; 8]; 4] = [
+        [0xff; 8],
+        [0xff, 0xff, 0xff, 0x7f, 0xff, 0xff, 0xff, 0x7f],
+        [0; 8],
+        [0x00, 0x00, 0x00, 0x80, 0x00, 0x00, 0x00, 0x80],
+    ];
+    for name in ["box_gmsh41_binary.msh", "box_gmsh22_binary.msh"] {
+        let path = fixture(&format!("msh/{name}"));
+        let bytes = std::fs::read(&path).unwrap();
+        for at in (0..bytes.len().saturating_sub(8)).step_by(7) {
+            for w in &words {
+                let mut b = bytes.clone();
+                b[at..at + 8].copy_from_slice(w);
+                let _ = parse_msh(&b, &path);
+            }
         }
     }
 }

@@ -42,7 +42,9 @@ fn box_counts_volume_orientation_and_surface() {
             .iter()
             .map(|t| {
                 let a = tri_area_vector(&m, t);
-                let c: Vec<f64> = (0..3).map(|d| t.iter().map(|&k| m.nodes[k as usize][d]).sum::<f64>() / 3.0).collect();
+                let c: Vec<f64> = (0..3)
+                    .map(|d| t.iter().map(|&k| m.nodes[k as usize][d]).sum::<f64>() / 3.0)
+                    .collect();
                 (c[0] * a[0] + c[1] * a[1] + c[2] * a[2]) / 3.0
             })
             .sum();
@@ -53,7 +55,10 @@ fn box_counts_volume_orientation_and_surface() {
         for &k in &m.group("xmax").unwrap().nodes {
             assert_eq!(m.nodes[k as usize][0], max[0]);
         }
-        assert_eq!(m.group("ymin").unwrap().nodes, m.nodes_in_box([-9.0; 3], [9.0, min[1], 9.0]));
+        assert_eq!(
+            m.group("ymin").unwrap().nodes,
+            m.nodes_in_box([-9.0; 3], [9.0, min[1], 9.0])
+        );
         let mut surf = m.surface_nodes();
         let mut all: Vec<u32> = m.groups.iter().flat_map(|g| g.nodes.clone()).collect();
         all.sort_unstable();
@@ -76,7 +81,9 @@ fn shuffle(m: &mut TetMesh, seed: u64) {
     let mut perm: Vec<u32> = (0..n as u32).collect();
     let mut s = seed;
     for i in (1..n).rev() {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         let j = ((s >> 33) % (i as u64 + 1)) as usize;
         perm.swap(i, j);
     }
@@ -97,7 +104,11 @@ fn reorder_keeps_geometry_and_reduces_bandwidth() {
     for (g0, g1) in before.groups.iter().zip(&m.groups) {
         assert_eq!(g0.name, g1.name);
         let pts = |mesh: &TetMesh, g: &qdem_mesh::PhysicalGroup| {
-            let mut p: Vec<[u64; 3]> = g.nodes.iter().map(|&k| mesh.nodes[k as usize].map(f64::to_bits)).collect();
+            let mut p: Vec<[u64; 3]> = g
+                .nodes
+                .iter()
+                .map(|&k| mesh.nodes[k as usize].map(f64::to_bits))
+                .collect();
             p.sort_unstable();
             p
         };
@@ -123,7 +134,10 @@ fn reorder_keeps_geometry_and_reduces_bandwidth() {
     let mins: Vec<u32> = m.tets.iter().map(|t| *t.iter().min().unwrap()).collect();
     assert!(mins.windows(2).all(|w| w[0] <= w[1]));
     // Surfaces survive too.
-    assert_eq!(m.surface_triangles().len(), before.surface_triangles().len());
+    assert_eq!(
+        m.surface_triangles().len(),
+        before.surface_triangles().len()
+    );
 }
 
 #[test]
@@ -142,5 +156,8 @@ fn stats_on_a_regular_mesh() {
     assert!((s.worst_quality - q).abs() < 1e-12);
     assert!(s.worst_tet < s.tets);
     let empty = TetMesh::default().stats();
-    assert_eq!((empty.tets, empty.min_edge, empty.worst_quality), (0, 0.0, 0.0));
+    assert_eq!(
+        (empty.tets, empty.min_edge, empty.worst_quality),
+        (0, 0.0, 0.0)
+    );
 }
