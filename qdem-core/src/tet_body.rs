@@ -19,9 +19,9 @@ use crate::{Mat3, Vec3};
 use rayon::prelude::*;
 
 /// Tetrahedra per parallel task: large enough to amortise scheduling, small enough to balance.
-const TET_CHUNK: usize = 2048;
+const TET_CHUNK: usize = 512;
 /// Particles per parallel task in the gather.
-const PARTICLE_CHUNK: usize = 4096;
+const PARTICLE_CHUNK: usize = 1024;
 
 /// A deformable body of linear QDEM tetrahedra.
 #[derive(Clone, Debug)]

@@ -5,7 +5,7 @@
 use crate::scene::{Scene, Selection, TimeStep};
 use qdem_core::{
     choose_step, stable_step, CoreError, Dofs, Gravity, Material, Model, NodalLoad, State,
-    TetBody, TimeFunction, Vec3,
+    TetBody, Vec3,
 };
 use qdem_mesh::{read_msh, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
@@ -146,11 +146,7 @@ impl Simulation {
             let what = format!("[[load]] #{}", i + 1);
             let selected = select(&scene, &meshes[b], &load.selection, &what, &load.body)?;
             let particles = selected.iter().map(|&n| (ranges[b].start + n as usize) as u32).collect();
-            let ramp = if load.ramp.points.is_empty() {
-                TimeFunction::constant(1.0)
-            } else {
-                TimeFunction::new(load.ramp.points.iter().map(|p| (p[0], p[1])).collect()).map_err(core)?
-            };
+            let ramp = load.ramp.time_function().map_err(core)?;
             models.push(Box::new(NodalLoad::new(&what, particles, Vec3::from(load.total_force), ramp)));
         }
         let probes = scene

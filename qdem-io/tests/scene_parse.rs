@@ -115,8 +115,8 @@ fn example_parses_to_expected_values() {
     assert_eq!(l.selection, Selection::Group("tip".into()));
     assert_eq!(l.total_force, [0.0, 0.0, -200.0]);
     assert_eq!(l.ramp.points, vec![[0.0, 0.0], [1.0, 1.0]]);
-    assert_eq!(l.ramp.factor(0.25), 0.25);
-    assert_eq!(l.ramp.factor(5.0), 1.0);
+    assert_eq!(l.ramp.time_function().unwrap().value(0.25), 0.25);
+    assert_eq!(l.ramp.time_function().unwrap().value(5.0), 1.0);
 
     assert_eq!(scene.probes.len(), 1);
     let p = &scene.probes[0];
@@ -191,11 +191,11 @@ total_force = [0, 0, 1]
     assert_eq!(scene.fixes[0].dofs, [true, false, true]);
     assert_eq!(scene.fixes[1].dofs, [true, true, true]); // default "xyz"
     let ramp = &scene.loads[0].ramp;
-    assert_eq!(ramp.factor(1.5), 1.0);
-    assert_eq!(ramp.factor(2.0), 0.0);
-    assert_eq!(ramp.factor(3.0), 0.0);
+    assert_eq!(ramp.time_function().unwrap().value(1.5), 1.0);
+    assert_eq!(ramp.time_function().unwrap().value(2.0), 0.0);
+    assert_eq!(ramp.time_function().unwrap().value(3.0), 0.0);
     assert_eq!(scene.loads[1].ramp, Ramp::constant());
-    assert_eq!(scene.loads[1].ramp.factor(10.0), 1.0);
+    assert_eq!(scene.loads[1].ramp.time_function().unwrap().value(10.0), 1.0);
     scene.validate().unwrap();
 }
 

@@ -229,40 +229,22 @@ impl Ramp {
         Ramp::default()
     }
 
-    /// The factor at time `t`.
+    /// The ramp as the core's time function (a constant 1 when it has no points). The scene's
+    /// validation has already refused ramps the core would refuse.
     ///
     /// ```
     /// use qdem_io::scene::Ramp;
     /// let ramp = Ramp { points: vec![[0.0, 0.0], [1.0, 1.0], [2.0, 1.0], [2.0, 0.0]] };
-    /// assert_eq!(ramp.factor(-1.0), 0.0);
-    /// assert_eq!(ramp.factor(0.5), 0.5);
-    /// assert_eq!(ramp.factor(1.999), 1.0);
-    /// assert_eq!(ramp.factor(2.0), 0.0);
-    /// assert_eq!(ramp.factor(9.0), 0.0);
-    /// assert_eq!(Ramp::constant().factor(3.0), 1.0);
+    /// let f = ramp.time_function().unwrap();
+    /// assert_eq!(f.value(0.5), 0.5);
+    /// assert_eq!(f.value(2.0), 0.0);
+    /// assert_eq!(Ramp::constant().time_function().unwrap().value(3.0), 1.0);
     /// ```
-    pub fn factor(&self, t: f64) -> f64 {
-        let p = &self.points;
-        let Some(first) = p.first() else {
-            return 1.0;
-        };
-        if t < first[0] {
-            return first[1];
+    pub fn time_function(&self) -> Result<qdem_core::TimeFunction, qdem_core::CoreError> {
+        if self.points.is_empty() {
+            return Ok(qdem_core::TimeFunction::constant(1.0));
         }
-        // The last point with time <= t: at a jump this is the second (right) value.
-        let i = p.partition_point(|q| q[0] <= t) - 1;
-        match p.get(i + 1) {
-            None => p[i][1],
-            Some(next) => {
-                let [t0, f0] = p[i];
-                let [t1, f1] = *next;
-                if t1 > t0 {
-                    f0 + (f1 - f0) * (t - t0) / (t1 - t0)
-                } else {
-                    f0
-                }
-            }
-        }
+        qdem_core::TimeFunction::new(self.points.iter().map(|p| (p[0], p[1])).collect())
     }
 }
 
