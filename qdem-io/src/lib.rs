@@ -9,9 +9,11 @@
 //! - [`runner`]: the run loop, sampling probes and writing snapshots.
 //! - [`output`]: atomic writers for VTU/PVD, probe CSV and summary JSON.
 //! - [`spectrum`]: dominant frequency of a probe record by FFT.
+//! - [`plot`]: SVG line plots beside the CSVs.
 
 pub mod build;
 pub mod output;
+pub mod plot;
 pub mod runner;
 pub mod scene;
 pub mod spectrum;

@@ -1,11 +1,13 @@
 //! The run loop: steps a [`Simulation`] to `t_end`, sampling probes and writing VTU
-//! snapshots at their intervals, and a summary at the end. Every output file is written
+//! snapshots at their intervals, and a summary and a plot of the probe displacements
+//! (`probes.svg`, beside `probes.csv`) at the end. Every output file is written
 //! atomically; a run stopped by an instability still commits the probe rows up to the failure.
 //!
 //! The loop is an explicit pipeline: step → probes → snapshot → progress.
 
 use crate::build::Simulation;
 use crate::output::{write_summary, write_vtu, OutputError, ProbeCsv, PvdIndex, VtuGrid};
+use crate::plot::{line_plot_svg, Labels, Series};
 use qdem_core::{CoreError, Stepper, Vec3, Verlet};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -112,6 +114,7 @@ pub fn run(
     }
     let names: Vec<String> = sim.probes.iter().map(|p| p.name.clone()).collect();
     let mut csv = ProbeCsv::create(&out_dir.join("probes.csv"), &names)?;
+    let mut history: Vec<Vec<(f64, f64)>> = vec![Vec::new(); 3 * names.len()];
     let steps = sim.steps();
     let probe_every = sim.scene.run.probe_every.unwrap_or(sim.scene.run.t_end / 1000.0);
     let mut probe_schedule = Schedule::new(probe_every);
@@ -132,7 +135,13 @@ pub fn run(
             }
             let (time, dt) = (sim.state.time, sim.dt);
             if probe_schedule.due(time, dt) {
-                csv.row(time, &probe_samples(sim))?;
+                let samples = probe_samples(sim);
+                for (p, sample) in samples.iter().enumerate() {
+                    for axis in 0..3 {
+                        history[3 * p + axis].push((time, sample[0][axis]));
+                    }
+                }
+                csv.row(time, &samples)?;
             }
             if vtu_schedule.due(time, dt) {
                 let file = format!("vtu/state_{:05}.vtu", pvd.len());
@@ -150,6 +159,9 @@ pub fn run(
     let wall_seconds = start.elapsed().as_secs_f64();
     let probe_rows = csv.num_rows();
     csv.finish()?;
+    if !names.is_empty() {
+        plot_probes(&out_dir.join("probes.svg"), &names, &history)?;
+    }
     outcome?;
     let tet_steps = (sim.tets() as f64) * steps as f64;
     let report = RunReport {
@@ -163,6 +175,21 @@ pub fn run(
     };
     write_summary(&out_dir.join("summary.json"), &summary_json(sim, &report))?;
     Ok(report)
+}
+
+/// Displacement of every probe against time, one curve per component.
+fn plot_probes(path: &Path, names: &[String], history: &[Vec<(f64, f64)>]) -> Result<(), OutputError> {
+    let labels: Vec<String> = names
+        .iter()
+        .flat_map(|n| ["ux", "uy", "uz"].map(|c| format!("{n}.{c}")))
+        .collect();
+    let series: Vec<Series<'_>> = labels
+        .iter()
+        .zip(history)
+        .map(|(label, points)| Series { label, points })
+        .collect();
+    let labels = Labels { title: "probe displacements", x: "t (s)", y: "displacement (m)" };
+    line_plot_svg(path, &labels, &series)
 }
 
 fn core_error(sim: &Simulation, source: CoreError) -> RunError {

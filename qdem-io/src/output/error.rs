@@ -36,6 +36,14 @@ impl fmt::Display for IoStage {
 /// Every variant names the path of the output file it concerns.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
+    /// A plot could not be drawn.
+    #[error("cannot draw the plot `{path}`: {message}")]
+    Plot {
+        /// The SVG file.
+        path: PathBuf,
+        /// What the plotting library reported.
+        message: String,
+    },
     /// An I/O operation failed. The target file was left untouched.
     #[error("{stage} {what} `{path}` (temporary file `{temp}`): {source}")]
     Io {

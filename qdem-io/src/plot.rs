@@ -1,0 +1,87 @@
+//! Line plots as SVG, written atomically beside the CSV they draw (probe time series,
+//! spectra). One panel per call, several named series, automatic ranges.
+
+use crate::output::{write_atomic, OutputError};
+use plotters::prelude::*;
+use std::path::Path;
+
+/// One named curve.
+pub struct Series<'a> {
+    /// Legend label.
+    pub label: &'a str,
+    /// (x, y) points.
+    pub points: &'a [(f64, f64)],
+}
+
+/// Axis titles and the plot title.
+pub struct Labels<'a> {
+    /// Title above the panel.
+    pub title: &'a str,
+    /// x-axis title.
+    pub x: &'a str,
+    /// y-axis title.
+    pub y: &'a str,
+}
+
+const COLOURS: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
+
+/// Most points drawn per curve: longer series are thinned by a stride (the CSV keeps all).
+const MAX_POINTS: usize = 4000;
+
+/// Range of the finite values, widened when empty or flat.
+fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    if !(lo <= hi) {
+        return (0.0, 1.0);
+    }
+    let pad = if hi > lo { 0.05 * (hi - lo) } else { lo.abs().max(1e-30) };
+    (lo - pad, hi + pad)
+}
+
+/// Draws `series` into an SVG file at `path` (written atomically).
+pub fn line_plot_svg(path: &Path, labels: &Labels<'_>, series: &[Series<'_>]) -> Result<(), OutputError> {
+    let (x0, x1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
+    let (y0, y1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 500)).into_drawing_area();
+        let draw = || -> Result<(), Box<dyn std::error::Error + '_>> {
+            root.fill(&WHITE)?;
+            let mut chart = ChartBuilder::on(&root)
+                .caption(labels.title, ("sans-serif", 20))
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(80)
+                .build_cartesian_2d(x0..x1, y0..y1)?;
+            chart
+                .configure_mesh()
+                .x_desc(labels.x)
+                .y_desc(labels.y)
+                .y_label_formatter(&|v| format!("{v:.3e}"))
+                .draw()?;
+            for (i, s) in series.iter().enumerate() {
+                let colour = COLOURS[i % COLOURS.len()];
+                let stride = s.points.len().div_ceil(MAX_POINTS).max(1);
+                let points = s.points.iter().step_by(stride).copied();
+                chart
+                    .draw_series(LineSeries::new(points, colour.stroke_width(1)))?
+                    .label(s.label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
+            }
+            chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw()?;
+            root.present()?;
+            Ok(())
+        };
+        draw().map_err(|e| OutputError::Plot { path: path.to_path_buf(), message: e.to_string() })?;
+    }
+    write_atomic(path, |w| w.write_all(svg.as_bytes()))
+}
