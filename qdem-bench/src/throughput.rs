@@ -21,7 +21,11 @@ pub struct BenchPlan {
 
 impl BenchPlan {
     /// The plan from the command line, defaulting to 10⁴, 10⁵, 10⁶ tets on 1 and 2 threads.
-    pub fn new(tets: Option<Vec<usize>>, threads: Option<Vec<usize>>, steps: Option<usize>) -> BenchPlan {
+    pub fn new(
+        tets: Option<Vec<usize>>,
+        threads: Option<Vec<usize>>,
+        steps: Option<usize>,
+    ) -> BenchPlan {
         BenchPlan {
             tets: tets.unwrap_or_else(|| vec![10_000, 100_000, 1_000_000]),
             threads: threads.unwrap_or_else(|| vec![1, 2]),
@@ -87,7 +91,10 @@ pub fn block(tets: usize, viscous: bool) -> (TetBody, State) {
 
 /// Times Verlet steps of `block(tets, viscous)` on `threads` threads.
 pub fn measure(tets: usize, viscous: bool, threads: usize, steps: Option<usize>) -> BenchResult {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
     pool.install(|| {
         let (body, mut state) = block(tets, viscous);
         let tets = body.tets().len();
@@ -121,7 +128,10 @@ pub fn measure(tets: usize, viscous: bool, threads: usize, steps: Option<usize>)
 pub fn triad_bandwidth(threads: usize) -> f64 {
     use rayon::prelude::*;
     let n = 16 << 20;
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
     pool.install(|| {
         let (b, c) = (vec![1.0f64; n], vec![2.0f64; n]);
         let mut a = vec![0.0f64; n];
@@ -143,7 +153,10 @@ pub fn triad_bandwidth(threads: usize) -> f64 {
 pub fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
         .unwrap_or_else(|| "unknown".into())
 }
-

@@ -7,25 +7,52 @@ use serde_json::json;
 /// Runs the plan and prints a table or one JSON document.
 pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
     let mut results = Vec::new();
-    let bandwidth: Vec<(usize, f64)> = plan.threads.iter().map(|&t| (t, triad_bandwidth(t))).collect();
+    let bandwidth: Vec<(usize, f64)> = plan
+        .threads
+        .iter()
+        .map(|&t| (t, triad_bandwidth(t)))
+        .collect();
     if !as_json {
-        println!("machine: {} ({} cores available)", cpu_model(), std::thread::available_parallelism().map_or(0, |n| n.get()));
+        println!(
+            "machine: {} ({} cores available)",
+            cpu_model(),
+            std::thread::available_parallelism().map_or(0, |n| n.get())
+        );
         for (t, bw) in &bandwidth {
             println!("triad bandwidth, {t} threads: {:.2} GB/s", bw / 1e9);
         }
-        println!("{:>9} {:>9} {:>8} {:>7} {:>6} {:>14} {:>10} {:>10}", "tets", "particles", "material", "threads", "steps", "tet-steps/s", "B/tet-step", "% of triad");
+        println!(
+            "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14} {:>10} {:>10}",
+            "tets",
+            "particles",
+            "material",
+            "threads",
+            "steps",
+            "tet-steps/s",
+            "B/tet-step",
+            "% of triad"
+        );
     }
     for &tets in &plan.tets {
         for viscous in [false, true] {
             for &threads in &plan.threads {
                 let r = measure(tets, viscous, threads, plan.steps);
-                let bw = bandwidth.iter().find(|b| b.0 == threads).map_or(f64::NAN, |b| b.1);
+                let bw = bandwidth
+                    .iter()
+                    .find(|b| b.0 == threads)
+                    .map_or(f64::NAN, |b| b.1);
                 let fraction = r.tet_steps_per_second() * r.bytes_per_tet_step() / bw;
                 if !as_json {
                     println!(
                         "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14.4e} {:>10.0} {:>9.0}%",
-                        r.tets, r.particles, if viscous { "visco" } else { "elastic" }, threads, r.steps,
-                        r.tet_steps_per_second(), r.bytes_per_tet_step(), 100.0 * fraction
+                        r.tets,
+                        r.particles,
+                        if viscous { "visco" } else { "elastic" },
+                        threads,
+                        r.steps,
+                        r.tet_steps_per_second(),
+                        r.bytes_per_tet_step(),
+                        100.0 * fraction
                     );
                 }
                 results.push(json!({

@@ -67,7 +67,11 @@ fn parse_list(flag: &str, value: &str) -> Result<Vec<usize>, CliError> {
                 .parse::<usize>()
                 .ok()
                 .filter(|&n| n > 0)
-                .ok_or_else(|| CliError::Usage(format!("{flag} takes positive whole numbers, got `{value}`")))
+                .ok_or_else(|| {
+                    CliError::Usage(format!(
+                        "{flag} takes positive whole numbers, got `{value}`"
+                    ))
+                })
         })
         .collect()
 }
@@ -104,8 +108,13 @@ fn parse(args: &[String], allowed: &[&str]) -> Result<Options, CliError> {
 fn one_scene(o: &Options, command: &str) -> Result<PathBuf, CliError> {
     match o.positional.as_slice() {
         [scene] => Ok(PathBuf::from(scene)),
-        [] => Err(CliError::Usage(format!("`qdem {command}` needs a scene file"))),
-        more => Err(CliError::Usage(format!("`qdem {command}` takes one scene file, got {}", more.len()))),
+        [] => Err(CliError::Usage(format!(
+            "`qdem {command}` needs a scene file"
+        ))),
+        more => Err(CliError::Usage(format!(
+            "`qdem {command}` takes one scene file, got {}",
+            more.len()
+        ))),
     }
 }
 
@@ -118,7 +127,10 @@ fn set_threads(threads: Option<&[usize]>) -> Result<(), CliError> {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build_global()
-            .map_err(|e| CliError::Threads { threads, message: e.to_string() })?;
+            .map_err(|e| CliError::Threads {
+                threads,
+                message: e.to_string(),
+            })?;
     }
     Ok(())
 }
@@ -160,7 +172,10 @@ fn run_scene(path: &Path, out: Option<&Path>) -> Result<(), CliError> {
     let scene = Scene::load(path)?;
     let out_dir = match out {
         Some(dir) => dir.to_path_buf(),
-        None => path.parent().unwrap_or(Path::new(".")).join(&scene.output.dir),
+        None => path
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join(&scene.output.dir),
     };
     let mut sim = Simulation::build(scene)?;
     for w in &sim.warnings {
@@ -223,7 +238,10 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
         );
     }
     for p in &sim.probes {
-        println!("probe `{}`: particle {} at {:.3e} m from the requested point", p.name, p.particle, p.distance);
+        println!(
+            "probe `{}`: particle {} at {:.3e} m from the requested point",
+            p.name, p.particle, p.distance
+        );
     }
     let (bound, limiter) = &sim.stable_dt;
     println!("stable dt bound {bound:.6e} s (set by `{limiter}`); dt used {:.6e} s; {} steps to t_end = {} s", sim.dt, sim.steps(), sim.scene.run.t_end);

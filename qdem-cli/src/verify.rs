@@ -11,7 +11,9 @@
 use crate::command::CliError;
 use qdem_core::tet_kernel::{edge_matrix, tet_stress, vertex_forces};
 use qdem_core::tet_subdomain::subdomain_forces;
-use qdem_core::{Mat3, Material, Model, NodalLoad, State, Stepper, TetBody, TimeFunction, Vec3, Verlet};
+use qdem_core::{
+    Mat3, Material, Model, NodalLoad, State, Stepper, TetBody, TimeFunction, Vec3, Verlet,
+};
 use qdem_io::build::Simulation;
 use qdem_io::runner::run;
 use qdem_io::scene::Scene;
@@ -44,7 +46,13 @@ pub struct Row {
 }
 
 impl Row {
-    fn relative(fixture: &str, analytical: f64, computed: f64, tolerance: Option<f64>, start: Instant) -> Row {
+    fn relative(
+        fixture: &str,
+        analytical: f64,
+        computed: f64,
+        tolerance: Option<f64>,
+        start: Instant,
+    ) -> Row {
         Row {
             fixture: fixture.to_string(),
             analytical,
@@ -63,7 +71,9 @@ impl Row {
 
 /// A deterministic generator for the random tetrahedra of the oracle fixture.
 fn lcg(seed: &mut u64) -> f64 {
-    *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    *seed = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
     (*seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
 }
 
@@ -75,7 +85,8 @@ pub fn oracle_agreement() -> Row {
     let mut worst = 0.0f64;
     let mut done = 0;
     while done < 10_000 {
-        let mut x: [Vec3; 4] = std::array::from_fn(|_| Vec3::new(lcg(&mut seed), lcg(&mut seed), lcg(&mut seed)));
+        let mut x: [Vec3; 4] =
+            std::array::from_fn(|_| Vec3::new(lcg(&mut seed), lcg(&mut seed), lcg(&mut seed)));
         let det = edge_matrix(&x).determinant();
         if det.abs() < 1e-3 {
             continue;
@@ -99,10 +110,21 @@ pub fn oracle_agreement() -> Row {
         }
         done += 1;
     }
-    Row { fixture: "closed-form force vs 12-triangle subdomains (Eqs. 9-10), max rel. diff".into(), analytical: 0.0, computed: worst, error: worst, tolerance: Some(1e-12), seconds: start.elapsed().as_secs_f64() }
+    Row {
+        fixture: "closed-form force vs 12-triangle subdomains (Eqs. 9-10), max rel. diff".into(),
+        analytical: 0.0,
+        computed: worst,
+        error: worst,
+        tolerance: Some(1e-12),
+        seconds: start.elapsed().as_secs_f64(),
+    }
 }
 
-fn block_body(cells: [usize; 3], size: [f64; 3], material: Material) -> (TetBody, State, qdem_mesh::TetMesh) {
+fn block_body(
+    cells: [usize; 3],
+    size: [f64; 3],
+    material: Material,
+) -> (TetBody, State, qdem_mesh::TetMesh) {
     let mesh = structured_box([0.0; 3], size, cells);
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let body = TetBody::new("block", &reference, mesh.tets.clone(), material).expect("valid block");
@@ -132,7 +154,14 @@ pub fn rigid_spin() -> Row {
     let mut force = vec![Vec3::zeros(); state.len()];
     body.add_forces(&state, &mut force);
     let worst = force.iter().map(|f| f.norm()).fold(0.0, f64::max) / (45e9 * 0.1 * 0.1);
-    Row { fixture: "rigid rotation 1 rad + spin 1000 rad/s, max force / (E h^2)".into(), analytical: 0.0, computed: worst, error: worst, tolerance: Some(1e-13), seconds: start.elapsed().as_secs_f64() }
+    Row {
+        fixture: "rigid rotation 1 rad + spin 1000 rad/s, max force / (E h^2)".into(),
+        analytical: 0.0,
+        computed: worst,
+        error: worst,
+        tolerance: Some(1e-13),
+        seconds: start.elapsed().as_secs_f64(),
+    }
 }
 
 /// Drift of the Verlet invariant H = K + U − (∆t²/8) aᵀMa (exactly conserved by velocity
@@ -151,7 +180,12 @@ pub fn energy_conservation() -> Row {
     stepper.initialize(&mut state, &mut models).expect("stable");
     let invariant = |s: &State, models: &[Box<dyn Model>]| {
         let u = models[0].potential_energy(s).expect("elastic body");
-        let a2: f64 = s.mass.iter().zip(&s.acceleration).map(|(m, a)| m * a.norm_squared()).sum();
+        let a2: f64 = s
+            .mass
+            .iter()
+            .zip(&s.acceleration)
+            .map(|(m, a)| m * a.norm_squared())
+            .sum();
         s.kinetic_energy() + u - dt * dt / 8.0 * a2
     };
     let h0 = invariant(&state, &models);
@@ -162,7 +196,14 @@ pub fn energy_conservation() -> Row {
             drift = drift.max((invariant(&state, &models) - h0).abs() / h0);
         }
     }
-    Row { fixture: "undamped free vibration, 10^4 steps: energy drift".into(), analytical: 0.0, computed: drift, error: drift, tolerance: Some(1e-6), seconds: start.elapsed().as_secs_f64() }
+    Row {
+        fixture: "undamped free vibration, 10^4 steps: energy drift".into(),
+        analytical: 0.0,
+        computed: drift,
+        error: drift,
+        tolerance: Some(1e-6),
+        seconds: start.elapsed().as_secs_f64(),
+    }
 }
 
 /// Mean x-velocity of the particles in the plane x = `plane`.
@@ -187,13 +228,22 @@ pub fn p_wave_speed() -> Row {
             (t, (std::f64::consts::PI * t / duration).sin().powi(2))
         })
         .collect();
-    let near = |x0: f64| -> Vec<usize> { (0..state.len()).filter(|&i| (state.reference[i].x - x0).abs() < 1e-9).collect() };
+    let near = |x0: f64| -> Vec<usize> {
+        (0..state.len())
+            .filter(|&i| (state.reference[i].x - x0).abs() < 1e-9)
+            .collect()
+    };
     let planes = [near(0.25 * length), near(0.75 * length)];
     let end = mesh.group("xmin").expect("group").nodes.clone();
     let dt = 0.9 * body.stable_dt(&state).expect("bound");
     let mut models: Vec<Box<dyn Model>> = vec![
         Box::new(body),
-        Box::new(NodalLoad::new("pulse", end, Vec3::new(1e4, 0.0, 0.0), TimeFunction::new(pulse).expect("pulse"))),
+        Box::new(NodalLoad::new(
+            "pulse",
+            end,
+            Vec3::new(1e4, 0.0, 0.0),
+            TimeFunction::new(pulse).expect("pulse"),
+        )),
     ];
     let mut stepper = Verlet::new(dt);
     stepper.initialize(&mut state, &mut models).expect("stable");
@@ -210,12 +260,20 @@ pub fn p_wave_speed() -> Row {
     }
     let centroid = |m: [f64; 2]| m[1] / m[0];
     let computed = 0.5 * length / (centroid(moments[1]) - centroid(moments[0]));
-    Row::relative("bar P-wave speed sqrt(E/rho) (m/s)", c, computed, Some(0.02), start)
+    Row::relative(
+        "bar P-wave speed sqrt(E/rho) (m/s)",
+        c,
+        computed,
+        Some(0.02),
+        start,
+    )
 }
 
 /// Directory of the shipped fixtures.
 pub fn fixtures_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("fixtures")
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join("fixtures")
 }
 
 /// Steady tip deflection (µm, mean over 1–2 s) and first bending frequency (Hz, FFT after
@@ -224,17 +282,28 @@ pub fn cantilever(scene: &Path, out: &Path) -> Result<(f64, f64, usize), CliErro
     let mut sim = Simulation::build(Scene::load(scene)?)?;
     let tets = sim.tets();
     run(&mut sim, out, &mut |_| {})?;
-    let text = std::fs::read_to_string(out.join("probes.csv")).map_err(|e| CliError::Verify(format!("{}: {e}", out.display())))?;
+    let text = std::fs::read_to_string(out.join("probes.csv"))
+        .map_err(|e| CliError::Verify(format!("{}: {e}", out.display())))?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    let column = header.iter().position(|h| *h == "tip.uz").ok_or_else(|| CliError::Verify("no tip.uz column".into()))?;
+    let column = header
+        .iter()
+        .position(|h| *h == "tip.uz")
+        .ok_or_else(|| CliError::Verify("no tip.uz column".into()))?;
     let rows: Vec<(f64, f64)> = lines
         .map(|l| {
-            let f: Vec<f64> = l.split(',').map(|v| v.parse().unwrap_or(f64::NAN)).collect();
+            let f: Vec<f64> = l
+                .split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect();
             (f[0], f[column])
         })
         .collect();
-    let steady: Vec<f64> = rows.iter().filter(|r| r.0 >= 1.0 && r.0 <= 2.0).map(|r| r.1).collect();
+    let steady: Vec<f64> = rows
+        .iter()
+        .filter(|r| r.0 >= 1.0 && r.0 <= 2.0)
+        .map(|r| r.1)
+        .collect();
     let mean = steady.iter().sum::<f64>() / steady.len().max(1) as f64;
     let free: Vec<f64> = rows.iter().filter(|r| r.0 > 2.0).map(|r| r.1).collect();
     let dt = sim.scene.run.probe_every.unwrap_or(1e-4);
@@ -244,21 +313,40 @@ pub fn cantilever(scene: &Path, out: &Path) -> Result<(f64, f64, usize), CliErro
 
 fn cantilever_rows(rows: &mut Vec<Row>) -> Result<(), CliError> {
     for lc in ["100", "070", "050"] {
-        let scene = fixtures_dir().join("cantilever").join(format!("cantilever_lc{lc}.toml"));
+        let scene = fixtures_dir()
+            .join("cantilever")
+            .join(format!("cantilever_lc{lc}.toml"));
         let out = std::env::temp_dir().join(format!("qdem-verify-{}-lc{lc}", std::process::id()));
         let start = Instant::now();
         let (uz, f1, tets) = cantilever(&scene, &out)?;
         let _ = std::fs::remove_dir_all(&out);
         let name = format!("cantilever lc=0.{lc} ({tets} tets)");
-        rows.push(Row::relative(&format!("{name}: tip uz (um) vs CalculiX C3D10"), CANTILEVER_TIP_UZ_UM, uz, None, start));
-        rows.push(Row::relative(&format!("{name}: f1 (Hz) vs CalculiX C3D10"), CANTILEVER_F1_HZ, f1, None, start));
+        rows.push(Row::relative(
+            &format!("{name}: tip uz (um) vs CalculiX C3D10"),
+            CANTILEVER_TIP_UZ_UM,
+            uz,
+            None,
+            start,
+        ));
+        rows.push(Row::relative(
+            &format!("{name}: f1 (Hz) vs CalculiX C3D10"),
+            CANTILEVER_F1_HZ,
+            f1,
+            None,
+            start,
+        ));
     }
     Ok(())
 }
 
 /// Runs the fixtures, prints a table (or JSON), and fails if any row misses its tolerance.
 pub fn run_and_print(as_json: bool, full: bool) -> Result<(), CliError> {
-    let mut rows = vec![oracle_agreement(), rigid_spin(), energy_conservation(), p_wave_speed()];
+    let mut rows = vec![
+        oracle_agreement(),
+        rigid_spin(),
+        energy_conservation(),
+        p_wave_speed(),
+    ];
     if full {
         cantilever_rows(&mut rows)?;
     }
@@ -269,17 +357,37 @@ pub fn run_and_print(as_json: bool, full: bool) -> Result<(), CliError> {
             .collect();
         println!("{}", serde_json::to_string_pretty(&doc).expect("json"));
     } else {
-        println!("{:<72} {:>13} {:>13} {:>10} {:>9} {:>8}  ", "fixture", "analytical", "computed", "rel.error", "tol", "cpu s");
+        println!(
+            "{:<72} {:>13} {:>13} {:>10} {:>9} {:>8}  ",
+            "fixture", "analytical", "computed", "rel.error", "tol", "cpu s"
+        );
         for r in &rows {
             let tol = r.tolerance.map_or("-".to_string(), |t| format!("{t:.0e}"));
-            let verdict = if r.tolerance.is_none() { "info" } else if r.passed() { "ok" } else { "FAIL" };
-            println!("{:<72} {:>13.6e} {:>13.6e} {:>10.2e} {:>9} {:>8.2}  {verdict}", r.fixture, r.analytical, r.computed, r.error, tol, r.seconds);
+            let verdict = if r.tolerance.is_none() {
+                "info"
+            } else if r.passed() {
+                "ok"
+            } else {
+                "FAIL"
+            };
+            println!(
+                "{:<72} {:>13.6e} {:>13.6e} {:>10.2e} {:>9} {:>8.2}  {verdict}",
+                r.fixture, r.analytical, r.computed, r.error, tol, r.seconds
+            );
         }
     }
-    let failed: Vec<&str> = rows.iter().filter(|r| !r.passed()).map(|r| r.fixture.as_str()).collect();
+    let failed: Vec<&str> = rows
+        .iter()
+        .filter(|r| !r.passed())
+        .map(|r| r.fixture.as_str())
+        .collect();
     if failed.is_empty() {
         Ok(())
     } else {
-        Err(CliError::Verify(format!("{} fixture(s) outside tolerance: {}", failed.len(), failed.join("; "))))
+        Err(CliError::Verify(format!(
+            "{} fixture(s) outside tolerance: {}",
+            failed.len(),
+            failed.join("; ")
+        )))
     }
 }

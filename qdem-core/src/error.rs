@@ -29,7 +29,9 @@ pub enum CoreError {
         volume: f64,
     },
     /// A tetrahedron refers to a particle that does not exist.
-    #[error("body `{body}`: tetrahedron {tet} refers to particle {node}, but there are only {count}")]
+    #[error(
+        "body `{body}`: tetrahedron {tet} refers to particle {node}, but there are only {count}"
+    )]
     NodeOutOfRange {
         /// Body name.
         body: String,

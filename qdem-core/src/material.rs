@@ -144,6 +144,9 @@ mod tests {
         assert_eq!(bad(|m| m.density = -1.0), MaterialError::Density(-1.0));
         assert_eq!(bad(|m| m.young = 0.0), MaterialError::Young(0.0));
         assert_eq!(bad(|m| m.poisson = 0.5), MaterialError::Poisson(0.5));
-        assert!(matches!(bad(|m| m.bulk_viscosity = f64::NAN), MaterialError::Viscosity { .. }));
+        assert!(matches!(
+            bad(|m| m.bulk_viscosity = f64::NAN),
+            MaterialError::Viscosity { .. }
+        ));
     }
 }

@@ -125,19 +125,6 @@ impl State {
             .map(|(m, v)| 0.5 * m * v.norm_squared())
             .sum()
     }
-
-    /// Total mass (kg).
-    pub fn total_mass(&self) -> f64 {
-        self.mass.iter().sum()
-    }
-
-    /// Total linear momentum Σ m v (kg m/s).
-    pub fn momentum(&self) -> Vec3 {
-        self.mass
-            .iter()
-            .zip(&self.velocity)
-            .fold(Vec3::zeros(), |p, (m, v)| p + *m * v)
-    }
 }
 
 #[cfg(test)]

@@ -20,8 +20,11 @@ pub trait Stepper {
 
     /// Makes the accelerations consistent with the forces at the current state; call once
     /// before the first step.
-    fn initialize(&mut self, state: &mut State, models: &mut [Box<dyn Model>])
-        -> Result<(), CoreError>;
+    fn initialize(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+    ) -> Result<(), CoreError>;
 
     /// Advances `state` by one step.
     fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError>;
@@ -54,7 +57,11 @@ pub fn compute_accelerations(
             }
             *a = acc;
         });
-    match state.acceleration.iter().position(|a| !a.iter().all(|c| c.is_finite())) {
+    match state
+        .acceleration
+        .iter()
+        .position(|a| !a.iter().all(|c| c.is_finite()))
+    {
         Some(particle) => Err(CoreError::NonFinite {
             time: state.time,
             particle,
@@ -67,7 +74,7 @@ pub fn compute_accelerations(
 pub fn check_masses(state: &State) -> Result<(), CoreError> {
     let bad = (0..state.len()).find(|&i| {
         let free = (0..3).any(|axis| !state.fixed[i].contains(axis));
-        free && !(state.mass[i] > 0.0)
+        free && state.mass[i].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
     });
     match bad {
         Some(particle) => Err(CoreError::Massless { particle }),

@@ -116,16 +116,6 @@ impl TetBody {
         &self.tets
     }
 
-    /// The body's material.
-    pub fn material(&self) -> &Material {
-        &self.material
-    }
-
-    /// Total reference volume (m³).
-    pub fn volume(&self) -> f64 {
-        self.volume.iter().sum()
-    }
-
     /// Adds a quarter of each tetrahedron's mass to each of its particles (paper 000 §2.4).
     pub fn lump_mass(&self, mass: &mut [f64]) {
         for (tet, v) in self.tets.iter().zip(&self.volume) {
@@ -134,12 +124,6 @@ impl TetBody {
                 mass[n as usize] += quarter;
             }
         }
-    }
-
-    /// Upper bound of the squared highest angular frequency, max over tetrahedra of
-    /// λ_max(M_e⁻¹K_e) (1/s²).
-    pub fn omega_squared_bound(&self) -> f64 {
-        self.omega_squared
     }
 
     /// Von Mises stress (Pa) and volumetric strain det F − 1 of every tetrahedron.

@@ -22,12 +22,6 @@ pub fn edge_matrix(x: &[Vec3; 4]) -> Mat3 {
     Mat3::from_columns(&[x[1] - x[0], x[2] - x[0], x[3] - x[0]])
 }
 
-/// Signed volume det(dX)/6 of a tetrahedron; positive when (x₁−x₀, x₂−x₀, x₃−x₀) is right-handed.
-#[inline]
-pub fn signed_volume(x: &[Vec3; 4]) -> f64 {
-    edge_matrix(x).determinant() / 6.0
-}
-
 /// Deformation gradient F = dx · dX⁻¹ of Eq. 1, from the current positions and the inverse of
 /// the reference edge matrix.
 #[inline(always)]

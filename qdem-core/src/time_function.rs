@@ -27,7 +27,10 @@ impl TimeFunction {
         if points.is_empty() {
             return bad("needs at least one (t, factor) point".into());
         }
-        if let Some(p) = points.iter().find(|p| !(p.0.is_finite() && p.1.is_finite())) {
+        if let Some(p) = points
+            .iter()
+            .find(|p| !(p.0.is_finite() && p.1.is_finite()))
+        {
             return bad(format!("point ({}, {}) is not finite", p.0, p.1));
         }
         for (i, w) in points.windows(2).enumerate() {

@@ -50,9 +50,20 @@ fn in_pool(threads: usize) -> State {
 #[test]
 fn one_and_two_threads_give_bit_identical_states() {
     let (a, b) = (in_pool(1), in_pool(2));
-    assert!(a.displacement(a.len() - 1).norm() > 0.0, "the run must move");
+    assert!(
+        a.displacement(a.len() - 1).norm() > 0.0,
+        "the run must move"
+    );
     let bits = |s: &State| -> Vec<u64> {
-        s.position.iter().chain(&s.velocity).chain(&s.acceleration).flat_map(|v| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>()).collect()
+        s.position
+            .iter()
+            .chain(&s.velocity)
+            .chain(&s.acceleration)
+            .flat_map(|v| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>())
+            .collect()
     };
-    assert!(bits(&a) == bits(&b), "states differ between 1 and 2 threads");
+    assert!(
+        bits(&a) == bits(&b),
+        "states differ between 1 and 2 threads"
+    );
 }

@@ -9,7 +9,10 @@ const YOUNG: f64 = 45e9;
 
 fn block() -> (Vec<Vec3>, Vec<[u32; 4]>) {
     let mesh = structured_box([0.0; 3], [1.0, 0.6, 0.4], [4, 3, 2]);
-    (mesh.nodes.iter().map(|p| Vec3::from(*p)).collect(), mesh.tets)
+    (
+        mesh.nodes.iter().map(|p| Vec3::from(*p)).collect(),
+        mesh.tets,
+    )
 }
 
 fn viscoelastic() -> Material {
@@ -78,7 +81,17 @@ fn uniform_strain_reproduces_hooke_and_balances_interior_particles() {
     let (reference, tets) = block();
     let material = Material::elastic(2350.0, YOUNG, 0.167);
     let lame = material.elastic_lame();
-    let f = Mat3::new(1.0 + 2e-4, 5e-5, 0.0, -3e-5, 1.0 - 1e-4, 4e-5, 1e-5, 0.0, 1.0 + 6e-5);
+    let f = Mat3::new(
+        1.0 + 2e-4,
+        5e-5,
+        0.0,
+        -3e-5,
+        1.0 - 1e-4,
+        4e-5,
+        1e-5,
+        0.0,
+        1.0 + 6e-5,
+    );
     let expected = elastic_stress(&f, lame.lambda, lame.mu);
     // B − I cancels all but ~|ε| of F's digits: the round-off floor of the stress is about
     // ε_machine / |ε|. Allow 100 times that (|ε| ≈ 1e-4 here: 2.2e-10).
@@ -88,7 +101,9 @@ fn uniform_strain_reproduces_hooke_and_balances_interior_particles() {
     for tet in &tets {
         let xr = tet.map(|n| reference[n as usize]);
         let xc = tet.map(|n| x[n as usize]);
-        let dm_inv = qdem_core::tet_kernel::edge_matrix(&xr).try_inverse().unwrap();
+        let dm_inv = qdem_core::tet_kernel::edge_matrix(&xr)
+            .try_inverse()
+            .unwrap();
         let got_f = deformation_gradient(&xc, &dm_inv);
         assert!((got_f - f).norm() < 1e-14);
         let (t, _) = tet_stress(&xc, None, &dm_inv, (lame.lambda, lame.mu), (0.0, 0.0));
@@ -113,6 +128,9 @@ fn uniform_strain_reproduces_hooke_and_balances_interior_particles() {
     }
     let scale = expected.norm() * 0.25 * 0.2 * 0.2;
     for (got, want) in force.iter().zip(&expected_force) {
-        assert!((got - want).norm() < tol * scale, "force {got:?}, expected {want:?}");
+        assert!(
+            (got - want).norm() < tol * scale,
+            "force {got:?}, expected {want:?}"
+        );
     }
 }

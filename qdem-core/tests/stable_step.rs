@@ -20,19 +20,29 @@ fn body_and_state(material: Material) -> (Vec<Box<dyn Model>>, State) {
 fn largest_eigenvalue(models: &mut [Box<dyn Model>], state: &mut State) -> f64 {
     let n = state.len();
     let mut u: Vec<Vec3> = (0..n)
-        .map(|i| Vec3::new((i as f64 * 1.3).sin(), (i as f64 * 0.7).cos(), (i as f64 * 2.1).sin()))
+        .map(|i| {
+            Vec3::new(
+                (i as f64 * 1.3).sin(),
+                (i as f64 * 0.7).cos(),
+                (i as f64 * 2.1).sin(),
+            )
+        })
         .collect();
     let mut force = Vec::new();
     let mut lambda = 0.0;
     let m_dot = |a: &[Vec3], b: &[Vec3], mass: &[f64]| -> f64 {
-        a.iter().zip(b).zip(mass).map(|((x, y), m)| m * x.dot(y)).sum()
+        a.iter()
+            .zip(b)
+            .zip(mass)
+            .map(|((x, y), m)| m * x.dot(y))
+            .sum()
     };
     for _ in 0..3000 {
         let norm = m_dot(&u, &u, &state.mass).sqrt();
         u.iter_mut().for_each(|v| *v /= norm);
         let amp = 1e-9;
-        for i in 0..n {
-            state.position[i] = state.reference[i] + amp * u[i];
+        for ((x, x0), ui) in state.position.iter_mut().zip(&state.reference).zip(&u) {
+            *x = x0 + amp * ui;
         }
         compute_accelerations(state, models, &mut force).unwrap();
         // M⁻¹K u = −a / amp; Rayleigh quotient in the M inner product (M⁻¹K is M-symmetric).
@@ -50,15 +60,25 @@ fn element_bound_is_an_upper_bound_and_tight_within_a_factor_two() {
     let bound = models[0].stable_dt(&state).unwrap();
     let exact_lambda = largest_eigenvalue(&mut models, &mut state);
     let exact_dt = 2.0 / exact_lambda.sqrt();
-    assert!(bound <= exact_dt, "bound {bound:e} above the true limit {exact_dt:e}");
-    assert!(bound > 0.5 * exact_dt, "bound {bound:e} far below the true limit {exact_dt:e}");
+    assert!(
+        bound <= exact_dt,
+        "bound {bound:e} above the true limit {exact_dt:e}"
+    );
+    assert!(
+        bound > 0.5 * exact_dt,
+        "bound {bound:e} far below the true limit {exact_dt:e}"
+    );
 }
 
 fn run_free_vibration(dt: f64) -> f64 {
     let material = Material::elastic(2350.0, 45e9, 0.167);
     let (mut models, mut state) = body_and_state(material);
     for (i, v) in state.velocity.iter_mut().enumerate() {
-        *v = Vec3::new((i as f64).sin(), (i as f64 * 1.7).cos(), (i as f64 * 0.3).sin()) * 1e-3;
+        *v = Vec3::new(
+            (i as f64).sin(),
+            (i as f64 * 1.7).cos(),
+            (i as f64 * 0.3).sin(),
+        ) * 1e-3;
     }
     let mut stepper = Verlet::new(dt);
     stepper.initialize(&mut state, &mut models).unwrap();
@@ -88,7 +108,10 @@ fn viscosity_shrinks_the_bound_and_a_larger_user_step_is_refused() {
     viscous.shear_viscosity = 5e4;
     let (models_e, state) = body_and_state(elastic);
     let (models_v, _) = body_and_state(viscous);
-    let (dt_e, dt_v) = (models_e[0].stable_dt(&state).unwrap(), models_v[0].stable_dt(&state).unwrap());
+    let (dt_e, dt_v) = (
+        models_e[0].stable_dt(&state).unwrap(),
+        models_v[0].stable_dt(&state).unwrap(),
+    );
     assert!(dt_v < dt_e);
     match choose_step(&state, &models_v, Some(1.01 * dt_v), 0.9) {
         Err(CoreError::StepTooLarge { bound, .. }) => assert_eq!(bound, dt_v),
@@ -96,6 +119,8 @@ fn viscosity_shrinks_the_bound_and_a_larger_user_step_is_refused() {
     }
     let auto = choose_step(&state, &models_v, None, 0.9).unwrap();
     assert_eq!(auto, 0.9 * dt_v);
-    let message = choose_step(&state, &models_v, Some(1.0), 0.9).unwrap_err().to_string();
+    let message = choose_step(&state, &models_v, Some(1.0), 0.9)
+        .unwrap_err()
+        .to_string();
     assert!(message.contains(&format!("{dt_v:e}")), "{message}");
 }

@@ -4,8 +4,8 @@
 
 use crate::scene::{Scene, Selection, TimeStep};
 use qdem_core::{
-    choose_step, stable_step, CoreError, Dofs, Gravity, Material, Model, NodalLoad, State,
-    TetBody, Vec3,
+    choose_step, stable_step, CoreError, Dofs, Gravity, Material, Model, NodalLoad, State, TetBody,
+    Vec3,
 };
 use qdem_mesh::{read_msh, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
@@ -100,7 +100,11 @@ impl Simulation {
         for body in &scene.bodies {
             let path = scene.mesh_path(body);
             let (mut mesh, mesh_warnings) = read_msh(&path)?;
-            warnings.extend(mesh_warnings.iter().map(|w| format!("{}: {w}", path.display())));
+            warnings.extend(
+                mesh_warnings
+                    .iter()
+                    .map(|w| format!("{}: {w}", path.display())),
+            );
             if body.reorder {
                 mesh.reorder_for_locality();
             }
@@ -115,8 +119,9 @@ impl Simulation {
         for ((body, (mesh, path)), range) in scene.bodies.iter().zip(&meshes).zip(&ranges) {
             let material = scene.material(&body.material).expect("validated scene");
             let tets = offset_tets(mesh, range.start);
-            let tet_body = TetBody::new(&body.name, &state.reference, tets, core_material(material))
-                .map_err(core)?;
+            let tet_body =
+                TetBody::new(&body.name, &state.reference, tets, core_material(material))
+                    .map_err(core)?;
             tet_body.lump_mass(&mut state.mass);
             bodies.push(BodyInfo {
                 name: body.name.clone(),
@@ -127,12 +132,21 @@ impl Simulation {
             });
             models.push(Box::new(tet_body));
         }
-        let body_index = |name: &str| scene.bodies.iter().position(|b| b.name == name).expect("validated scene");
+        let body_index = |name: &str| {
+            scene
+                .bodies
+                .iter()
+                .position(|b| b.name == name)
+                .expect("validated scene")
+        };
         for (i, fix) in scene.fixes.iter().enumerate() {
             let b = body_index(&fix.body);
             let what = format!("[[fix]] #{}", i + 1);
             let selected = select(&scene, &meshes[b], &fix.selection, &what, &fix.body)?;
-            let dofs = (0..3).filter(|&a| fix.dofs[a]).map(|a| ["x", "y", "z"][a]).collect::<String>();
+            let dofs = (0..3)
+                .filter(|&a| fix.dofs[a])
+                .map(|a| ["x", "y", "z"][a])
+                .collect::<String>();
             let dofs = Dofs::parse(&dofs).unwrap_or(Dofs::ALL);
             for n in selected {
                 state.fix(ranges[b].start + n as usize, dofs);
@@ -145,9 +159,17 @@ impl Simulation {
             let b = body_index(&load.body);
             let what = format!("[[load]] #{}", i + 1);
             let selected = select(&scene, &meshes[b], &load.selection, &what, &load.body)?;
-            let particles = selected.iter().map(|&n| (ranges[b].start + n as usize) as u32).collect();
+            let particles = selected
+                .iter()
+                .map(|&n| (ranges[b].start + n as usize) as u32)
+                .collect();
             let ramp = load.ramp.time_function().map_err(core)?;
-            models.push(Box::new(NodalLoad::new(&what, particles, Vec3::from(load.total_force), ramp)));
+            models.push(Box::new(NodalLoad::new(
+                &what,
+                particles,
+                Vec3::from(load.total_force),
+                ramp,
+            )));
         }
         let probes = scene
             .probes
@@ -167,7 +189,16 @@ impl Simulation {
             // Shrink the automatic step so that a whole number of steps reaches t_end.
             dt = scene.run.t_end / (scene.run.t_end / dt).ceil();
         }
-        Ok(Simulation { scene, state, models, bodies, probes, stable_dt, dt, warnings })
+        Ok(Simulation {
+            scene,
+            state,
+            models,
+            bodies,
+            probes,
+            stable_dt,
+            dt,
+            warnings,
+        })
     }
 
     /// Number of steps to reach `t_end` (the last one may end slightly past it for a fixed dt).
@@ -183,7 +214,9 @@ impl Simulation {
     /// The [`TetBody`] of a body.
     pub fn tet_body(&self, body: &BodyInfo) -> &TetBody {
         let model: &dyn std::any::Any = self.models[body.model].as_ref();
-        model.downcast_ref::<TetBody>().expect("a body's model is a TetBody")
+        model
+            .downcast_ref::<TetBody>()
+            .expect("a body's model is a TetBody")
     }
 }
 
@@ -234,5 +267,9 @@ fn nearest_particle(state: &State, range: Range<usize>, point: Vec3, name: &str)
         .map(|i| (i, (state.reference[i] - point).norm()))
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .expect("a body has particles");
-    ProbePoint { name: name.to_string(), particle, distance }
+    ProbePoint {
+        name: name.to_string(),
+        particle,
+        distance,
+    }
 }

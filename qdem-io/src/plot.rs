@@ -39,16 +39,26 @@ const MAX_POINTS: usize = 4000;
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
-    if !(lo <= hi) {
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if lo > hi {
         return (0.0, 1.0);
     }
-    let pad = if hi > lo { 0.05 * (hi - lo) } else { lo.abs().max(1e-30) };
+    let pad = if hi > lo {
+        0.05 * (hi - lo)
+    } else {
+        lo.abs().max(1e-30)
+    };
     (lo - pad, hi + pad)
 }
 
 /// Draws `series` into an SVG file at `path` (written atomically).
-pub fn line_plot_svg(path: &Path, labels: &Labels<'_>, series: &[Series<'_>]) -> Result<(), OutputError> {
+pub fn line_plot_svg(
+    path: &Path,
+    labels: &Labels<'_>,
+    series: &[Series<'_>],
+) -> Result<(), OutputError> {
     let (x0, x1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
     let (y0, y1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
     let mut svg = String::new();
@@ -77,11 +87,18 @@ pub fn line_plot_svg(path: &Path, labels: &Labels<'_>, series: &[Series<'_>]) ->
                     .label(s.label)
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
             }
-            chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw()?;
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()?;
             root.present()?;
             Ok(())
         };
-        draw().map_err(|e| OutputError::Plot { path: path.to_path_buf(), message: e.to_string() })?;
+        draw().map_err(|e| OutputError::Plot {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
     }
     write_atomic(path, |w| w.write_all(svg.as_bytes()))
 }

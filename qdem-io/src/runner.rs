@@ -56,6 +56,8 @@ pub struct Progress {
 /// What a finished run reports (also written to `summary.json`).
 #[derive(Clone, Debug)]
 pub struct RunReport {
+    /// The stepper's name.
+    pub integrator: String,
     /// Steps taken.
     pub steps: u64,
     /// Step size (s).
@@ -116,7 +118,11 @@ pub fn run(
     let mut csv = ProbeCsv::create(&out_dir.join("probes.csv"), &names)?;
     let mut history: Vec<Vec<(f64, f64)>> = vec![Vec::new(); 3 * names.len()];
     let steps = sim.steps();
-    let probe_every = sim.scene.run.probe_every.unwrap_or(sim.scene.run.t_end / 1000.0);
+    let probe_every = sim
+        .scene
+        .run
+        .probe_every
+        .unwrap_or(sim.scene.run.t_end / 1000.0);
     let mut probe_schedule = Schedule::new(probe_every);
     let mut vtu_schedule = Schedule::new(sim.scene.output.vtu_every);
     let mut pvd = PvdIndex::new();
@@ -165,6 +171,7 @@ pub fn run(
     outcome?;
     let tet_steps = (sim.tets() as f64) * steps as f64;
     let report = RunReport {
+        integrator: stepper.name().to_string(),
         steps,
         dt: sim.dt,
         final_time: sim.state.time,
@@ -178,7 +185,11 @@ pub fn run(
 }
 
 /// Displacement of every probe against time, one curve per component.
-fn plot_probes(path: &Path, names: &[String], history: &[Vec<(f64, f64)>]) -> Result<(), OutputError> {
+fn plot_probes(
+    path: &Path,
+    names: &[String],
+    history: &[Vec<(f64, f64)>],
+) -> Result<(), OutputError> {
     let labels: Vec<String> = names
         .iter()
         .flat_map(|n| ["ux", "uy", "uz"].map(|c| format!("{n}.{c}")))
@@ -188,7 +199,11 @@ fn plot_probes(path: &Path, names: &[String], history: &[Vec<(f64, f64)>]) -> Re
         .zip(history)
         .map(|(label, points)| Series { label, points })
         .collect();
-    let labels = Labels { title: "probe displacements", x: "t (s)", y: "displacement (m)" };
+    let labels = Labels {
+        title: "probe displacements",
+        x: "t (s)",
+        y: "displacement (m)",
+    };
     line_plot_svg(path, &labels, &series)
 }
 
@@ -215,7 +230,13 @@ fn probe_samples(sim: &Simulation) -> Vec<[Vec3; 3]> {
     let s = &sim.state;
     sim.probes
         .iter()
-        .map(|p| [s.displacement(p.particle), s.velocity[p.particle], s.acceleration[p.particle]])
+        .map(|p| {
+            [
+                s.displacement(p.particle),
+                s.velocity[p.particle],
+                s.acceleration[p.particle],
+            ]
+        })
         .collect()
 }
 
@@ -237,7 +258,10 @@ fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
         points: &s.reference,
         tets: &tets,
         point_vectors: vec![("displacement", &displacement), ("velocity", &s.velocity)],
-        cell_scalars: vec![("von_mises", &von_mises), ("volumetric_strain", &volumetric)],
+        cell_scalars: vec![
+            ("von_mises", &von_mises),
+            ("volumetric_strain", &volumetric),
+        ],
     };
     write_vtu(path, &grid)
 }
@@ -245,7 +269,7 @@ fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
 fn summary_json(sim: &Simulation, report: &RunReport) -> serde_json::Value {
     json!({
         "scene": sim.scene.path.display().to_string(),
-        "integrator": "verlet",
+        "integrator": report.integrator,
         "steps": report.steps,
         "dt": report.dt,
         "stable_dt": sim.stable_dt.0,

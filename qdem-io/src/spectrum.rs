@@ -27,7 +27,9 @@ pub fn dominant_frequency(samples: &[f64], dt: f64) -> Option<f64> {
         .chain(std::iter::repeat(Complex::new(0.0, 0.0)))
         .take(padded)
         .collect();
-    FftPlanner::new().plan_fft_forward(padded).process(&mut buffer);
+    FftPlanner::new()
+        .plan_fft_forward(padded)
+        .process(&mut buffer);
     let magnitude: Vec<f64> = buffer[..padded / 2].iter().map(|c| c.norm()).collect();
     let (peak, &largest) = magnitude
         .iter()
@@ -37,7 +39,11 @@ pub fn dominant_frequency(samples: &[f64], dt: f64) -> Option<f64> {
     if largest <= 0.0 || peak + 1 >= magnitude.len() {
         return None;
     }
-    let (a, b, c) = (magnitude[peak - 1].ln(), largest.ln(), magnitude[peak + 1].ln());
+    let (a, b, c) = (
+        magnitude[peak - 1].ln(),
+        largest.ln(),
+        magnitude[peak + 1].ln(),
+    );
     let shift = 0.5 * (a - c) / (a - 2.0 * b + c);
     Some((peak as f64 + shift) / (padded as f64 * dt))
 }
@@ -51,7 +57,9 @@ mod tests {
         let dt = 1e-4;
         let f = 26.874;
         // One second of signal: the raw bin width is 1 Hz.
-        let s: Vec<f64> = (0..10_000).map(|i| 3.0 + (2.0 * std::f64::consts::PI * f * i as f64 * dt).sin()).collect();
+        let s: Vec<f64> = (0..10_000)
+            .map(|i| 3.0 + (2.0 * std::f64::consts::PI * f * i as f64 * dt).sin())
+            .collect();
         let got = dominant_frequency(&s, dt).unwrap();
         assert!((got - f).abs() < 0.01, "{got}");
     }

@@ -195,7 +195,10 @@ total_force = [0, 0, 1]
     assert_eq!(ramp.time_function().unwrap().value(2.0), 0.0);
     assert_eq!(ramp.time_function().unwrap().value(3.0), 0.0);
     assert_eq!(scene.loads[1].ramp, Ramp::constant());
-    assert_eq!(scene.loads[1].ramp.time_function().unwrap().value(10.0), 1.0);
+    assert_eq!(
+        scene.loads[1].ramp.time_function().unwrap().value(10.0),
+        1.0
+    );
     scene.validate().unwrap();
 }
 
