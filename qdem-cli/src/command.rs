@@ -118,6 +118,15 @@ fn one_scene(o: &Options, command: &str) -> Result<PathBuf, CliError> {
     }
 }
 
+fn no_positional(o: &Options, command: &str) -> Result<(), CliError> {
+    match o.positional.first() {
+        Some(extra) => Err(CliError::Usage(format!(
+            "`qdem {command}` takes no argument `{extra}`"
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// Sets the global thread pool from `--threads N` (one number for `run` and `check`).
 fn set_threads(threads: Option<&[usize]>) -> Result<(), CliError> {
     if let Some(list) = threads {
@@ -153,10 +162,12 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
         }
         "verify" => {
             let o = parse(rest, &["--json", "--full"])?;
+            no_positional(&o, "verify")?;
             verify::run_and_print(o.json, o.full)
         }
         "bench" => {
             let o = parse(rest, &["--json", "--tets", "--threads", "--steps"])?;
+            no_positional(&o, "bench")?;
             bench::run_and_print(&BenchPlan::new(o.tets, o.threads, o.steps), o.json);
             Ok(())
         }

@@ -15,6 +15,7 @@
 
 pub mod error;
 pub mod gravity;
+pub mod linear_tet;
 pub mod material;
 pub mod model;
 pub mod nodal_load;

@@ -2,6 +2,7 @@
 //! out one body after another in one [`State`], and only the models the scene needs: a
 //! [`TetBody`] per body, [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per load.
 
+use crate::scene::suggest::did_you_mean;
 use crate::scene::{Scene, Selection, TimeStep};
 use qdem_core::{
     choose_step, stable_step, CoreError, Dofs, Gravity, Material, Model, NodalLoad, State, TetBody,
@@ -25,6 +26,28 @@ pub enum BuildError {
         scene: PathBuf,
         /// What the core refused.
         source: CoreError,
+    },
+    /// A fix or load names a physical group the body's mesh does not have.
+    #[error(
+        "{scene}: {what} on body `{body}`: the mesh {mesh} has no physical group `{group}`{hint} \
+         (available: {available}); fix: name one of them, or select particles with box = \
+         [[xmin, ymin, zmin], [xmax, ymax, zmax]]"
+    )]
+    MissingGroup {
+        /// The scene file.
+        scene: PathBuf,
+        /// `[[fix]]` or `[[load]]` with its index.
+        what: String,
+        /// The body.
+        body: String,
+        /// The mesh file.
+        mesh: String,
+        /// The requested group.
+        group: String,
+        /// `; did you mean `…`?` or nothing.
+        hint: String,
+        /// The groups the mesh has, comma-separated.
+        available: String,
     },
     /// A fix or load selects no particle.
     #[error("{scene}: {what} on body `{body}` selects no particle: {fix}")]
@@ -244,7 +267,10 @@ fn select(
     body: &str,
 ) -> Result<Vec<u32>, BuildError> {
     let nodes = match selection {
-        Selection::Group(name) => mesh.require_group(name, path)?.nodes.clone(),
+        Selection::Group(name) => match mesh.group(name) {
+            Some(group) => group.nodes.clone(),
+            None => return Err(missing_group(scene, mesh, path, name, what, body)),
+        },
         Selection::Box([min, max]) => mesh.nodes_in_box(*min, *max),
     };
     if nodes.is_empty() {
@@ -260,6 +286,32 @@ fn select(
         });
     }
     Ok(nodes)
+}
+
+fn missing_group(
+    scene: &Scene,
+    mesh: &TetMesh,
+    path: &std::path::Path,
+    name: &str,
+    what: &str,
+    body: &str,
+) -> BuildError {
+    let names: Vec<&str> = mesh.groups.iter().map(|g| g.name.as_str()).collect();
+    let hint = did_you_mean(name, names.iter().copied())
+        .map_or(String::new(), |s| format!("; did you mean `{s}`?"));
+    BuildError::MissingGroup {
+        scene: scene.path.clone(),
+        what: what.to_string(),
+        body: body.to_string(),
+        mesh: path.display().to_string(),
+        group: name.to_string(),
+        hint,
+        available: names
+            .iter()
+            .map(|n| format!("`{n}`"))
+            .collect::<Vec<_>>()
+            .join(", "),
+    }
 }
 
 fn nearest_particle(state: &State, range: Range<usize>, point: Vec3, name: &str) -> ProbePoint {

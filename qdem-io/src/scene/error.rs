@@ -82,7 +82,11 @@ pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The scene file could not be read.
-    #[error("{}: cannot read the scene file: {source}", path.display())]
+    #[error(
+        "{}: cannot read the scene file: {source}; check the path (a relative path is taken \
+         from the working directory)",
+        path.display()
+    )]
     Read {
         /// The scene file.
         path: PathBuf,

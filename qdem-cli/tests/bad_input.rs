@@ -1,0 +1,477 @@
+//! Bad input through the `qdem` binary: every case must end with a non-zero exit status and one
+//! clean message on stderr that starts with `error: `, names the offending file (and the line,
+//! element id or key where there is one), says what to do, and is not a panic.
+//!
+//! The scenes and meshes live in `fixtures/bad/`; each scene refers to its mesh by a path
+//! relative to the scene file.
+
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+const QDEM: &str = env!("CARGO_BIN_EXE_qdem");
+
+/// The workspace root.
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("qdem-cli lies in the workspace")
+        .to_path_buf()
+}
+
+/// A file of `fixtures/bad/`, as an absolute path.
+fn bad(name: &str) -> PathBuf {
+    workspace().join("fixtures/bad").join(name)
+}
+
+/// A unique temporary directory, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(tag: &str) -> TempDir {
+        static COUNTER: AtomicUsize = AtomicUsize::new(0);
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        let dir = std::env::temp_dir().join(format!(
+            "qdem-cli-bad-{tag}-{}-{}-{nanos}",
+            std::process::id(),
+            COUNTER.fetch_add(1, Ordering::Relaxed)
+        ));
+        std::fs::create_dir_all(&dir).expect("create the temporary directory");
+        TempDir(dir)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Runs `qdem ARGS` in `cwd` (the workspace root when `None`).
+fn qdem_in<S: AsRef<OsStr>>(cwd: Option<&Path>, args: &[S]) -> Output {
+    let root = workspace();
+    Command::new(QDEM)
+        .args(args)
+        .current_dir(cwd.unwrap_or(&root))
+        .env("CI", "1")
+        .output()
+        .expect("start the qdem binary")
+}
+
+fn qdem<S: AsRef<OsStr>>(args: &[S]) -> Output {
+    qdem_in(None, args)
+}
+
+/// Phrases by which a message tells the user what to do.
+const ADVICE: &[&str] = &[
+    "fix:",
+    "did you mean",
+    "use ",
+    "give ",
+    "add ",
+    "check ",
+    "usage:",
+    "resolved relative to",
+];
+
+/// Asserts a clean failure: non-zero exit (1, not a panic's 101), stderr starting with
+/// `error: ` that contains every string of `needles`, says what to do, and has no panic. Returns
+/// stderr.
+fn assert_clean_error(what: &str, out: &Output, needles: &[&str]) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let context = format!("{what}\n--- stderr ---\n{stderr}\n--- stdout ---\n{stdout}");
+    assert!(
+        !out.status.success(),
+        "{what}: expected a failure, got success\n{context}"
+    );
+    assert!(
+        !stderr.contains("panicked"),
+        "{what}: the program panicked\n{context}"
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{what}: expected exit status 1\n{context}"
+    );
+    assert!(
+        stderr.starts_with("error: "),
+        "{what}: stderr does not start with `error: `\n{context}"
+    );
+    for needle in needles {
+        assert!(
+            stderr.contains(needle),
+            "{what}: stderr does not contain {needle:?}\n{context}"
+        );
+    }
+    assert!(
+        ADVICE.iter().any(|a| stderr.contains(a)),
+        "{what}: stderr does not say what to do (none of {ADVICE:?})\n{context}"
+    );
+    stderr
+}
+
+/// The 1-based line of `file` that contains `text` outside comments (exactly one line must).
+fn line_of(file: &Path, text: &str) -> usize {
+    let content = std::fs::read_to_string(file).expect("read the fixture");
+    let lines: Vec<usize> = content
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim_start().starts_with('#') && l.contains(text))
+        .map(|(i, _)| i + 1)
+        .collect();
+    assert_eq!(
+        lines.len(),
+        1,
+        "{text:?} must appear on exactly one line of {}",
+        file.display()
+    );
+    lines[0]
+}
+
+/// Runs `qdem check SCENE` and `qdem run SCENE --out DIR`; both must fail with the same
+/// clean message containing `needles`, `check` must print nothing on stdout and `run` must not
+/// create its output directory. Returns the message of `check`.
+fn check_and_run(scene: &Path, needles: &[&str]) -> String {
+    let check = qdem(&[OsStr::new("check"), scene.as_os_str()]);
+    let message = assert_clean_error(&format!("qdem check {}", scene.display()), &check, needles);
+    assert!(
+        check.stdout.is_empty(),
+        "qdem check {} printed on stdout although the scene is bad:\n{}",
+        scene.display(),
+        String::from_utf8_lossy(&check.stdout)
+    );
+
+    let tmp = TempDir::new("run");
+    let out_dir = tmp.0.join("out");
+    let run = qdem(&[
+        OsStr::new("run"),
+        scene.as_os_str(),
+        OsStr::new("--out"),
+        out_dir.as_os_str(),
+    ]);
+    let run_message = assert_clean_error(&format!("qdem run {}", scene.display()), &run, needles);
+    assert!(
+        run_message.ends_with(&message),
+        "qdem run and qdem check report the same problem differently:\ncheck: {message}\nrun: {run_message}"
+    );
+    assert!(
+        !out_dir.exists(),
+        "qdem run created its output directory for a bad scene"
+    );
+    message
+}
+
+// ---------------------------------------------------------------------------------------------
+// Meshes
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn truncated_mesh_names_file_and_line() {
+    let scene = bad("truncated_mesh.toml");
+    let mesh = scene.parent().unwrap().join("truncated_elements.msh");
+    // The file ends in the middle of line 501 (500 complete lines, then a partial element).
+    let text = std::fs::read_to_string(&mesh).unwrap();
+    assert!(!text.ends_with('\n') && text.contains("$Elements") && !text.contains("$EndElements"));
+    let last_line = text.lines().count();
+    let at = format!("{}:{last_line}", mesh.display());
+    check_and_run(&scene, &[&at, "truncated", "fix:"]);
+}
+
+#[test]
+fn hexahedron_mesh_names_file_element_and_type() {
+    let scene = bad("hexahedron_mesh.toml");
+    let mesh = scene.parent().unwrap().join("../msh/bad_hexahedron.msh");
+    let path = mesh.display().to_string();
+    check_and_run(
+        &scene,
+        &[
+            &path,
+            "element 10",
+            "Hexahedron",
+            "type 5",
+            "tetrahedra",
+            "fix:",
+        ],
+    );
+}
+
+#[test]
+fn missing_physical_group_lists_the_available_groups() {
+    let scene = bad("missing_group.toml");
+    let mesh = scene
+        .parent()
+        .unwrap()
+        .join("../cantilever/cantilever_lc100.msh");
+    let path = mesh.display().to_string();
+    let scene_path = scene.display().to_string();
+    let message = check_and_run(
+        &scene,
+        &[
+            &scene_path,
+            "[[fix]] #1",
+            &path,
+            "`clmap`",
+            "did you mean `clamp`",
+            "available",
+            "fix:",
+        ],
+    );
+    for group in ["`clamp`", "`tip`", "`beam`", "`tip_centre`"] {
+        assert!(
+            message.contains(group),
+            "the available group {group} is not listed:\n{message}"
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene files
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn unknown_scene_key_has_line_and_suggestion() {
+    let scene = bad("unknown_key.toml");
+    let line = line_of(&scene, "t_ned");
+    let at = format!("{}:{line}:", scene.display());
+    check_and_run(
+        &scene,
+        &[&at, "unknown key `t_ned`", "[run]", "did you mean `t_end`"],
+    );
+}
+
+#[test]
+fn poisson_ratio_of_one_half_is_refused() {
+    let scene = bad("poisson_half.toml");
+    let line = line_of(&scene, "poisson = 0.5");
+    let at = format!("{}:{line}:", scene.display());
+    check_and_run(&scene, &[&at, "poisson = 0.5", "below 0.5", "use 0.49"]);
+}
+
+#[test]
+fn negative_density_is_refused() {
+    let scene = bad("negative_density.toml");
+    let line = line_of(&scene, "density = -2350.0");
+    let at = format!("{}:{line}:", scene.display());
+    check_and_run(
+        &scene,
+        &[
+            &at,
+            "density = -2350",
+            "must be positive",
+            "give a value above 0",
+        ],
+    );
+}
+
+#[test]
+fn time_step_above_the_stable_bound_gives_bound_and_auto() {
+    let scene = bad("dt_too_large.toml");
+    let path = scene.display().to_string();
+    let message = check_and_run(&scene, &[&path, "dt = 1e-3", "stable bound", "\"auto\""]);
+    // The bound is a number of seconds, a few microseconds on the lc100 mesh.
+    let bound: f64 = message
+        .split("stable bound ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|word| word.parse().ok())
+        .unwrap_or_else(|| panic!("no number after `stable bound` in:\n{message}"));
+    assert!(
+        (1e-6..1e-5).contains(&bound),
+        "stable bound {bound} s is not in [1e-6, 1e-5) s for the lc100 cantilever:\n{message}"
+    );
+}
+
+#[test]
+fn scene_file_that_does_not_exist() {
+    let scene = bad("no_such_scene.toml");
+    assert!(!scene.exists());
+    let path = scene.display().to_string();
+    for command in ["check", "run"] {
+        let out = qdem(&[OsStr::new(command), scene.as_os_str()]);
+        assert_clean_error(
+            &format!("qdem {command} {path}"),
+            &out,
+            &[&path, "cannot read the scene file"],
+        );
+    }
+}
+
+#[test]
+fn mesh_file_that_does_not_exist_names_the_resolved_path() {
+    let scene = bad("missing_mesh.toml");
+    let resolved = scene.parent().unwrap().join("no_such_mesh.msh");
+    assert!(!resolved.exists());
+    let line = line_of(&scene, "no_such_mesh.msh");
+    let at = format!("{}:{line}:", scene.display());
+    let resolved = resolved.display().to_string();
+    check_and_run(&scene, &[&at, &resolved, "does not exist"]);
+
+    // With a relative scene path the message still names a path that leads to the mesh's
+    // location from the working directory.
+    let dir = scene.parent().unwrap();
+    let out = qdem_in(Some(dir), &["check", "missing_mesh.toml"]);
+    let message = assert_clean_error(
+        "qdem check missing_mesh.toml (relative)",
+        &out,
+        &["missing_mesh.toml"],
+    );
+    let named = message
+        .split("mesh file ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .unwrap_or_else(|| panic!("no `mesh file PATH` in:\n{message}"));
+    assert!(
+        dir.join(named)
+            .components()
+            .eq(dir.join("no_such_mesh.msh").components()),
+        "named path {named:?}, taken from the working directory {}, is not the mesh's path",
+        dir.display()
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Command lines
+// ---------------------------------------------------------------------------------------------
+
+/// A valid scene, so that only the command line is wrong.
+fn good_scene() -> PathBuf {
+    workspace().join("fixtures/cantilever/cantilever_lc100.toml")
+}
+
+#[test]
+fn no_command() {
+    let out = qdem::<&str>(&[]);
+    assert_clean_error(
+        "qdem",
+        &out,
+        &["no command given", "usage:", "qdem run SCENE"],
+    );
+}
+
+#[test]
+fn unknown_command() {
+    let out = qdem(&["frobnicate"]);
+    assert_clean_error(
+        "qdem frobnicate",
+        &out,
+        &["unknown command `frobnicate`", "usage:"],
+    );
+}
+
+#[test]
+fn verify_and_bench_refuse_stray_arguments() {
+    for command in ["verify", "bench"] {
+        let out = qdem(&[command, "foo"]);
+        let needle = format!("`qdem {command}` takes no argument `foo`");
+        assert_clean_error(&format!("qdem {command} foo"), &out, &[&needle, "usage:"]);
+    }
+}
+
+#[test]
+fn run_and_check_without_a_scene() {
+    for command in ["run", "check"] {
+        let out = qdem(&[command]);
+        let needle = format!("`qdem {command}` needs a scene file");
+        assert_clean_error(&format!("qdem {command}"), &out, &[&needle, "usage:"]);
+    }
+    let out = qdem(&["check", "a.toml", "b.toml"]);
+    assert_clean_error(
+        "qdem check a.toml b.toml",
+        &out,
+        &["takes one scene file", "usage:"],
+    );
+}
+
+#[test]
+fn zero_threads() {
+    let tmp = TempDir::new("threads0");
+    let out_dir = tmp.0.join("out");
+    let scene = good_scene();
+    let run = qdem(&[
+        OsStr::new("run"),
+        scene.as_os_str(),
+        OsStr::new("--threads"),
+        OsStr::new("0"),
+        OsStr::new("--out"),
+        out_dir.as_os_str(),
+    ]);
+    assert_clean_error(
+        "qdem run SCENE --threads 0",
+        &run,
+        &["--threads", "`0`", "positive", "usage:"],
+    );
+    assert!(
+        !out_dir.exists(),
+        "qdem run --threads 0 created its output directory"
+    );
+    let check = qdem(&[
+        OsStr::new("check"),
+        scene.as_os_str(),
+        OsStr::new("--threads"),
+        OsStr::new("0"),
+    ]);
+    assert_clean_error(
+        "qdem check SCENE --threads 0",
+        &check,
+        &["--threads", "`0`", "usage:"],
+    );
+    let word = qdem(&[
+        OsStr::new("check"),
+        scene.as_os_str(),
+        OsStr::new("--threads"),
+        OsStr::new("two"),
+    ]);
+    assert_clean_error(
+        "qdem check SCENE --threads two",
+        &word,
+        &["--threads", "`two`", "usage:"],
+    );
+}
+
+#[test]
+fn unknown_option() {
+    let scene = good_scene();
+    let out = qdem(&[
+        OsStr::new("run"),
+        scene.as_os_str(),
+        OsStr::new("--frobnicate"),
+    ]);
+    assert_clean_error(
+        "qdem run SCENE --frobnicate",
+        &out,
+        &["unknown option `--frobnicate`", "usage:"],
+    );
+    let out = qdem(&["verify", "--out", "x"]);
+    assert_clean_error(
+        "qdem verify --out x",
+        &out,
+        &["unknown option `--out`", "usage:"],
+    );
+}
+
+#[test]
+fn option_without_its_value() {
+    let scene = good_scene();
+    let out = qdem(&[OsStr::new("run"), scene.as_os_str(), OsStr::new("--out")]);
+    assert_clean_error(
+        "qdem run SCENE --out",
+        &out,
+        &["`--out` needs a value", "usage:"],
+    );
+}
+
+/// `--thread-list` is in bench's list of allowed options (as a marker for how `--threads` is
+/// parsed), so it passes the unknown-option check and reaches `unreachable!`.
+#[test]
+fn bench_thread_list_is_an_error_not_a_panic() {
+    let out = qdem(&["bench", "--thread-list", "2"]);
+    assert_clean_error(
+        "qdem bench --thread-list 2",
+        &out,
+        &["--thread-list", "usage:"],
+    );
+}
