@@ -29,25 +29,20 @@ pub enum BuildError {
     },
     /// A fix or load names a physical group the body's mesh does not have.
     #[error(
-        "{scene}: {what} on body `{body}`: the mesh {mesh} has no physical group `{group}`{hint} \
-         (available: {available}); fix: name one of them, or select particles with box = \
-         [[xmin, ymin, zmin], [xmax, ymax, zmax]]"
+        "{scene}: {what}: the mesh {mesh} has no physical group `{group}`{candidates}; fix: \
+         name one of them, or select particles with box = [[xmin, ymin, zmin], [xmax, ymax, zmax]]"
     )]
     MissingGroup {
         /// The scene file.
         scene: PathBuf,
-        /// `[[fix]]` or `[[load]]` with its index.
+        /// `[[fix]] #N on body `name`` or the same for a load.
         what: String,
-        /// The body.
-        body: String,
         /// The mesh file.
         mesh: String,
         /// The requested group.
         group: String,
-        /// `; did you mean `…`?` or nothing.
-        hint: String,
-        /// The groups the mesh has, comma-separated.
-        available: String,
+        /// `; did you mean `…`?` if a name is close, then `(available: …)`.
+        candidates: String,
     },
     /// A fix or load selects no particle.
     #[error("{scene}: {what} on body `{body}` selects no particle: {fix}")]
@@ -299,18 +294,13 @@ fn missing_group(
     let names: Vec<&str> = mesh.groups.iter().map(|g| g.name.as_str()).collect();
     let hint = did_you_mean(name, names.iter().copied())
         .map_or(String::new(), |s| format!("; did you mean `{s}`?"));
+    let available: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
     BuildError::MissingGroup {
         scene: scene.path.clone(),
-        what: what.to_string(),
-        body: body.to_string(),
+        what: format!("{what} on body `{body}`"),
         mesh: path.display().to_string(),
         group: name.to_string(),
-        hint,
-        available: names
-            .iter()
-            .map(|n| format!("`{n}`"))
-            .collect::<Vec<_>>()
-            .join(", "),
+        candidates: format!("{hint} (available: {})", available.join(", ")),
     }
 }
 
