@@ -6,9 +6,12 @@
 //! of undamped free vibration; the bar P-wave speed √(E/ρ). With `--full`, the paper's
 //! cantilever (§3.1, Eqs. 12–13) on every fixture mesh: the steady tip deflection (mean over
 //! 1–2 s) and the first bending frequency (FFT of the free vibration after unloading at 2 s),
-//! against the converged CalculiX answer of `shared/references/cantilever.md`.
+//! against the converged CalculiX answer of `shared/references/cantilever.md`, and the
+//! deflection against the small-strain linear-tet static solve on the same mesh (the kernel's
+//! own oracle: they must agree in the small-strain limit).
 
 use crate::command::CliError;
+use qdem_core::linear_tet::LinearTets;
 use qdem_core::tet_kernel::{edge_matrix, tet_stress, vertex_forces};
 use qdem_core::tet_subdomain::subdomain_forces;
 use qdem_core::{
@@ -276,6 +279,28 @@ pub fn fixtures_dir() -> PathBuf {
         .join("fixtures")
 }
 
+/// Tip deflection (µm) of a cantilever scene's mesh, loads (at t = 1.5 s) and fixity, from the
+/// independent small-strain linear-tet static solve of [`qdem_core::linear_tet`].
+pub fn cantilever_static(scene: &Path) -> Result<f64, CliError> {
+    let mut sim = Simulation::build(Scene::load(scene)?)?;
+    sim.state.time = 1.5;
+    let mut load = vec![Vec3::zeros(); sim.state.len()];
+    for model in sim.models.iter_mut() {
+        model.add_forces(&sim.state, &mut load);
+    }
+    let body = &sim.bodies[0];
+    let tet_body = sim.tet_body(body);
+    let lame = sim.scene.materials[0].clone();
+    let lame = qdem_core::Material::elastic(lame.density, lame.young, lame.poisson).elastic_lame();
+    let oracle = LinearTets::new(&sim.state.reference, tet_body.tets(), lame);
+    let solution = oracle.solve(&load, &sim.state.fixed, 1e-13);
+    let tip = sim
+        .probes
+        .first()
+        .ok_or_else(|| CliError::Verify("the cantilever scene has no probe".into()))?;
+    Ok(solution.displacement[tip.particle].z * 1e6)
+}
+
 /// Steady tip deflection (µm, mean over 1–2 s) and first bending frequency (Hz, FFT after
 /// unloading at 2 s) of a cantilever scene, run through the normal run loop into `out`.
 pub fn cantilever(scene: &Path, out: &Path) -> Result<(f64, f64, usize), CliError> {
@@ -318,9 +343,25 @@ fn cantilever_rows(rows: &mut Vec<Row>) -> Result<(), CliError> {
             .join(format!("cantilever_lc{lc}.toml"));
         let out = std::env::temp_dir().join(format!("qdem-verify-{}-lc{lc}", std::process::id()));
         let start = Instant::now();
+        let static_uz = cantilever_static(&scene)?;
         let (uz, f1, tets) = cantilever(&scene, &out)?;
         let _ = std::fs::remove_dir_all(&out);
         let name = format!("cantilever lc=0.{lc} ({tets} tets)");
+        // Issue 3's bound for explicit QDEM against a static solve on the same mesh.
+        rows.push(Row::relative(
+            &format!("{name}: explicit tip uz vs same-mesh linear-tet static"),
+            static_uz,
+            uz,
+            Some(5e-4),
+            start,
+        ));
+        rows.push(Row::relative(
+            &format!("{name}: linear-tet static tip uz (um) vs CalculiX"),
+            CANTILEVER_TIP_UZ_UM,
+            static_uz,
+            None,
+            start,
+        ));
         rows.push(Row::relative(
             &format!("{name}: tip uz (um) vs CalculiX C3D10"),
             CANTILEVER_TIP_UZ_UM,
