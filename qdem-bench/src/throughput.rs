@@ -5,7 +5,7 @@
 //! per tet-step is judged.
 
 use qdem_core::{Material, Model, State, Stepper, TetBody, Vec3, Verlet};
-use qdem_mesh::structured_box;
+use qdem_mesh::{structured_box, TetMesh};
 use std::time::Instant;
 
 /// What to measure.
@@ -69,10 +69,53 @@ impl BenchResult {
     }
 }
 
-/// A structured block of about `tets` tetrahedra with the cantilever's material.
-pub fn block(tets: usize, viscous: bool) -> (TetBody, State) {
+/// The ordering of a benchmark mesh's nodes and tetrahedra.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ordering {
+    /// The generator's lexicographic order.
+    Structured,
+    /// Nodes and tetrahedra in a random (seeded) order: what an unsorted mesh file may give.
+    Shuffled,
+    /// Shuffled, then [`TetMesh::reorder_for_locality`] (reverse Cuthill–McKee).
+    Reordered,
+}
+
+/// A structured unit cube of about `tets` tetrahedra (6 per cell) in the given ordering.
+pub fn block_mesh(tets: usize, ordering: Ordering) -> TetMesh {
     let n = ((tets as f64 / 6.0).cbrt().round() as usize).max(1);
-    let mesh = structured_box([0.0; 3], [1.0, 1.0, 1.0], [n, n, n]);
+    let mut mesh = structured_box([0.0; 3], [1.0, 1.0, 1.0], [n, n, n]);
+    if ordering != Ordering::Structured {
+        let mut seed = 12345u64;
+        let nodes = shuffled(mesh.nodes.len(), &mut seed);
+        mesh.renumber_nodes(&nodes);
+        let order = shuffled(mesh.tets.len(), &mut seed);
+        let mut tets = mesh.tets.clone();
+        for (old, &new) in order.iter().enumerate() {
+            tets[new as usize] = mesh.tets[old];
+        }
+        mesh.tets = tets;
+    }
+    if ordering == Ordering::Reordered {
+        mesh.reorder_for_locality();
+    }
+    mesh
+}
+
+/// A seeded random permutation of 0..n (new index of each old index).
+fn shuffled(n: usize, seed: &mut u64) -> Vec<u32> {
+    let mut p: Vec<u32> = (0..n as u32).collect();
+    for i in (1..n).rev() {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        p.swap(i, (*seed >> 33) as usize % (i + 1));
+    }
+    p
+}
+
+/// A body over `mesh` with the cantilever's material (viscous: μ_D = 10⁴, κ_D = 10³ Pa s) and
+/// its state with a small smooth velocity, so that the kernel works on a deformed state.
+pub fn body_on(mesh: TetMesh, viscous: bool) -> (TetBody, State) {
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let mut material = Material::elastic(2350.0, 45e9, 0.167);
     if viscous {
@@ -82,21 +125,36 @@ pub fn block(tets: usize, viscous: bool) -> (TetBody, State) {
     let body = TetBody::new("block", &reference, mesh.tets, material).expect("valid block");
     let mut state = State::at_rest(reference);
     body.lump_mass(&mut state.mass);
-    // A small smooth initial velocity so that the kernel works on a deformed state.
     for (v, x) in state.velocity.iter_mut().zip(&state.reference) {
         *v = Vec3::new((3.0 * x.y).sin(), (2.0 * x.z).cos(), (x.x * 5.0).sin()) * 1e-3;
     }
     (body, state)
 }
 
+/// A structured block of about `tets` tetrahedra in generator order (see [`body_on`]).
+pub fn block(tets: usize, viscous: bool) -> (TetBody, State) {
+    body_on(block_mesh(tets, Ordering::Structured), viscous)
+}
+
 /// Times Verlet steps of `block(tets, viscous)` on `threads` threads.
 pub fn measure(tets: usize, viscous: bool, threads: usize, steps: Option<usize>) -> BenchResult {
+    measure_ordered(tets, Ordering::Structured, viscous, threads, steps)
+}
+
+/// Times Verlet steps of a block in the given node ordering on `threads` threads.
+pub fn measure_ordered(
+    tets: usize,
+    ordering: Ordering,
+    viscous: bool,
+    threads: usize,
+    steps: Option<usize>,
+) -> BenchResult {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .expect("thread pool");
     pool.install(|| {
-        let (body, mut state) = block(tets, viscous);
+        let (body, mut state) = body_on(block_mesh(tets, ordering), viscous);
         let tets = body.tets().len();
         let dt = 0.9 * body.stable_dt(&state).expect("a body bounds the step");
         let mut models: Vec<Box<dyn Model>> = vec![Box::new(body)];

@@ -1,7 +1,9 @@
 //! `qdem bench`: prints the throughput measurements of [`qdem_bench::throughput`] as a table
 //! or as one JSON document.
 
-use qdem_bench::throughput::{cpu_model, measure, triad_bandwidth, BenchPlan};
+use qdem_bench::throughput::{
+    cpu_model, measure, measure_ordered, triad_bandwidth, BenchPlan, Ordering,
+};
 use serde_json::json;
 
 /// Runs the plan and prints a table or one JSON document.
@@ -67,12 +69,35 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
             }
         }
     }
+    let locality = locality_rows(plan, as_json);
     if as_json {
         let doc = json!({
+            "locality": locality,
             "machine": { "cpu": cpu_model(), "cores": std::thread::available_parallelism().map_or(0, |n| n.get()) },
             "triad_bandwidth_bytes_per_second": bandwidth.iter().map(|(t, b)| json!({"threads": t, "value": b})).collect::<Vec<_>>(),
             "results": results,
         });
         println!("{}", serde_json::to_string_pretty(&doc).expect("json"));
     }
+}
+
+/// Effect of node ordering: the largest planned block, elastic, on the most threads, in
+/// generator order, shuffled, and shuffled then reordered (reverse Cuthill–McKee).
+fn locality_rows(plan: &BenchPlan, as_json: bool) -> Vec<serde_json::Value> {
+    let (Some(&tets), Some(&threads)) = (plan.tets.iter().max(), plan.threads.iter().max()) else {
+        return Vec::new();
+    };
+    if !as_json {
+        println!("node ordering, {tets} tets, elastic, {threads} threads:");
+    }
+    [Ordering::Structured, Ordering::Shuffled, Ordering::Reordered]
+        .into_iter()
+        .map(|ordering| {
+            let r = measure_ordered(tets, ordering, false, threads, plan.steps);
+            if !as_json {
+                println!("{:>12?} {:>14.4e} tet-steps/s", ordering, r.tet_steps_per_second());
+            }
+            json!({"ordering": format!("{ordering:?}").to_lowercase(), "tets": r.tets, "threads": threads, "tet_steps_per_second": r.tet_steps_per_second()})
+        })
+        .collect()
 }
