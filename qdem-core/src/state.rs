@@ -36,6 +36,11 @@ impl Dofs {
         (mask != 0).then_some(Dofs(mask))
     }
 
+    /// The set of the directions flagged in an `[x, y, z]` mask.
+    pub fn from_mask(mask: [bool; 3]) -> Dofs {
+        Dofs((0..3).filter(|&a| mask[a]).map(|a| 1u8 << a).sum())
+    }
+
     /// Whether direction `axis` (0 = x, 1 = y, 2 = z) is in the set.
     #[inline]
     pub fn contains(self, axis: usize) -> bool {
@@ -139,6 +144,16 @@ mod tests {
         for bad in ["", "xx", "w", "x y"] {
             assert_eq!(Dofs::parse(bad), None, "{bad:?}");
         }
+    }
+
+    #[test]
+    fn masks_and_text_agree() {
+        assert_eq!(
+            Dofs::from_mask([true, false, true]),
+            Dofs::parse("xz").unwrap()
+        );
+        assert_eq!(Dofs::from_mask([true; 3]), Dofs::ALL);
+        assert!(Dofs::from_mask([false; 3]).is_empty());
     }
 
     #[test]

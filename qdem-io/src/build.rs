@@ -104,97 +104,39 @@ pub struct Simulation {
     pub warnings: Vec<String>,
 }
 
+/// A body's mesh as read, with its file and its particles' place in the state.
+struct PlacedMesh {
+    mesh: TetMesh,
+    path: PathBuf,
+    particles: Range<usize>,
+}
+
 impl Simulation {
-    /// Reads the meshes and builds every model of `scene`.
+    /// Reads the meshes and builds every model of `scene`: bodies, then gravity (only if
+    /// non-zero), then loads; fixes go into the state.
     pub fn build(scene: Scene) -> Result<Simulation, BuildError> {
         let core = |source| BuildError::Core {
             scene: scene.path.clone(),
             source,
         };
-        let mut warnings = Vec::new();
-        let mut meshes = Vec::new();
-        let mut reference = Vec::new();
-        let mut ranges = Vec::new();
-        for body in &scene.bodies {
-            let path = scene.mesh_path(body);
-            let (mut mesh, mesh_warnings) = read_msh(&path)?;
-            warnings.extend(
-                mesh_warnings
-                    .iter()
-                    .map(|w| format!("{}: {w}", path.display())),
-            );
-            if body.reorder {
-                mesh.reorder_for_locality();
-            }
-            let start = reference.len();
-            reference.extend(mesh.nodes.iter().map(|p| Vec3::from(*p)));
-            ranges.push(start..reference.len());
-            meshes.push((mesh, path));
-        }
-        let mut state = State::at_rest(reference);
+        let (meshes, warnings) = read_meshes(&scene)?;
+        let reference = meshes
+            .iter()
+            .flat_map(|m| m.mesh.nodes.iter().map(|p| Vec3::from(*p)));
+        let mut state = State::at_rest(reference.collect());
         let mut models: Vec<Box<dyn Model>> = Vec::new();
-        let mut bodies = Vec::new();
-        for ((body, (mesh, path)), range) in scene.bodies.iter().zip(&meshes).zip(&ranges) {
-            let material = scene.material(&body.material).expect("validated scene");
-            let tets = offset_tets(mesh, range.start);
-            let tet_body =
-                TetBody::new(&body.name, &state.reference, tets, core_material(material))
-                    .map_err(core)?;
-            tet_body.lump_mass(&mut state.mass);
-            bodies.push(BodyInfo {
-                name: body.name.clone(),
-                particles: range.clone(),
-                model: models.len(),
-                stats: mesh.stats(),
-                mesh: path.clone(),
-            });
-            models.push(Box::new(tet_body));
-        }
-        let body_index = |name: &str| {
-            scene
-                .bodies
-                .iter()
-                .position(|b| b.name == name)
-                .expect("validated scene")
-        };
-        for (i, fix) in scene.fixes.iter().enumerate() {
-            let b = body_index(&fix.body);
-            let what = format!("[[fix]] #{}", i + 1);
-            let selected = select(&scene, &meshes[b], &fix.selection, &what, &fix.body)?;
-            let dofs = (0..3)
-                .filter(|&a| fix.dofs[a])
-                .map(|a| ["x", "y", "z"][a])
-                .collect::<String>();
-            let dofs = Dofs::parse(&dofs).unwrap_or(Dofs::ALL);
-            for n in selected {
-                state.fix(ranges[b].start + n as usize, dofs);
-            }
-        }
+        let bodies = build_bodies(&scene, &meshes, &mut state, &mut models).map_err(core)?;
+        apply_fixes(&scene, &meshes, &mut state)?;
         if scene.run.gravity.iter().any(|&g| g != 0.0) {
             models.push(Box::new(Gravity::new(Vec3::from(scene.run.gravity))));
         }
-        for (i, load) in scene.loads.iter().enumerate() {
-            let b = body_index(&load.body);
-            let what = format!("[[load]] #{}", i + 1);
-            let selected = select(&scene, &meshes[b], &load.selection, &what, &load.body)?;
-            let particles = selected
-                .iter()
-                .map(|&n| (ranges[b].start + n as usize) as u32)
-                .collect();
-            let ramp = load.ramp.time_function().map_err(core)?;
-            models.push(Box::new(NodalLoad::new(
-                &what,
-                particles,
-                Vec3::from(load.total_force),
-                ramp,
-            )));
-        }
+        build_loads(&scene, &meshes, &mut models)?;
         let probes = scene
             .probes
             .iter()
             .map(|p| {
-                let b = body_index(&p.body);
-                nearest_particle(&state, ranges[b].clone(), Vec3::from(p.point), &p.name)
+                let range = meshes[body_index(&scene, &p.body)].particles.clone();
+                nearest_particle(&state, range, Vec3::from(p.point), &p.name)
             })
             .collect();
         let stable_dt = stable_step(&state, &models).unwrap_or((f64::INFINITY, String::new()));
@@ -238,6 +180,110 @@ impl Simulation {
     }
 }
 
+/// Reads (and reorders, unless the body says not to) every body's mesh, laying the bodies'
+/// particles out one after another.
+fn read_meshes(scene: &Scene) -> Result<(Vec<PlacedMesh>, Vec<String>), BuildError> {
+    let mut warnings = Vec::new();
+    let mut meshes: Vec<PlacedMesh> = Vec::new();
+    for body in &scene.bodies {
+        let path = scene.mesh_path(body);
+        let (mut mesh, mesh_warnings) = read_msh(&path)?;
+        warnings.extend(
+            mesh_warnings
+                .iter()
+                .map(|w| format!("{}: {w}", path.display())),
+        );
+        if body.reorder {
+            mesh.reorder_for_locality();
+        }
+        let start = meshes.last().map_or(0, |m| m.particles.end);
+        let particles = start..start + mesh.nodes.len();
+        meshes.push(PlacedMesh {
+            mesh,
+            path,
+            particles,
+        });
+    }
+    Ok((meshes, warnings))
+}
+
+/// One [`TetBody`] per body, its lumped mass added to the state.
+fn build_bodies(
+    scene: &Scene,
+    meshes: &[PlacedMesh],
+    state: &mut State,
+    models: &mut Vec<Box<dyn Model>>,
+) -> Result<Vec<BodyInfo>, CoreError> {
+    let mut bodies = Vec::new();
+    for (body, placed) in scene.bodies.iter().zip(meshes) {
+        let material = scene.material(&body.material).expect("validated scene");
+        let tets = offset_tets(&placed.mesh, placed.particles.start);
+        let tet_body = TetBody::new(&body.name, &state.reference, tets, core_material(material))?;
+        tet_body.lump_mass(&mut state.mass);
+        bodies.push(BodyInfo {
+            name: body.name.clone(),
+            particles: placed.particles.clone(),
+            model: models.len(),
+            stats: placed.mesh.stats(),
+            mesh: placed.path.clone(),
+        });
+        models.push(Box::new(tet_body));
+    }
+    Ok(bodies)
+}
+
+/// Fixes the selected directions of the selected particles of every `[[fix]]`.
+fn apply_fixes(scene: &Scene, meshes: &[PlacedMesh], state: &mut State) -> Result<(), BuildError> {
+    for (i, fix) in scene.fixes.iter().enumerate() {
+        let placed = &meshes[body_index(scene, &fix.body)];
+        let what = format!("[[fix]] #{}", i + 1);
+        for n in select(scene, placed, &fix.selection, &what, &fix.body)? {
+            state.fix(
+                placed.particles.start + n as usize,
+                Dofs::from_mask(fix.dofs),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// A [`NodalLoad`] per `[[load]]`.
+fn build_loads(
+    scene: &Scene,
+    meshes: &[PlacedMesh],
+    models: &mut Vec<Box<dyn Model>>,
+) -> Result<(), BuildError> {
+    for (i, load) in scene.loads.iter().enumerate() {
+        let placed = &meshes[body_index(scene, &load.body)];
+        let what = format!("[[load]] #{}", i + 1);
+        let selected = select(scene, placed, &load.selection, &what, &load.body)?;
+        let start = placed.particles.start;
+        let particles = selected
+            .iter()
+            .map(|&n| (start + n as usize) as u32)
+            .collect();
+        let ramp = load
+            .ramp
+            .time_function()
+            .map_err(|source| BuildError::Core {
+                scene: scene.path.clone(),
+                source,
+            })?;
+        let total = Vec3::from(load.total_force);
+        models.push(Box::new(NodalLoad::new(&what, particles, total, ramp)));
+    }
+    Ok(())
+}
+
+/// Index of a body that the validated scene guarantees to exist.
+fn body_index(scene: &Scene, name: &str) -> usize {
+    scene
+        .bodies
+        .iter()
+        .position(|b| b.name == name)
+        .expect("validated scene")
+}
+
 fn core_material(m: &crate::scene::Material) -> Material {
     Material {
         density: m.density,
@@ -256,11 +302,12 @@ fn offset_tets(mesh: &TetMesh, offset: usize) -> Vec<[u32; 4]> {
 /// Mesh-local particle indices of a selection; an empty selection is an error.
 fn select(
     scene: &Scene,
-    (mesh, path): &(TetMesh, PathBuf),
+    placed: &PlacedMesh,
     selection: &Selection,
     what: &str,
     body: &str,
 ) -> Result<Vec<u32>, BuildError> {
+    let (mesh, path) = (&placed.mesh, &placed.path);
     let nodes = match selection {
         Selection::Group(name) => match mesh.group(name) {
             Some(group) => group.nodes.clone(),
