@@ -15,7 +15,8 @@ pub const USAGE: &str = "\
 usage:
   qdem run SCENE [--out DIR] [--threads N]   run a scene; outputs go to DIR (default: the scene's [output] dir)
   qdem check SCENE [--threads N]             validate a scene; print meshes, mass, stable dt, cost estimate
-  qdem verify [--json] [--full]              run the analytical fixtures (--full adds the cantilever meshes)
+  qdem verify [--json] [--full [--out DIR]]  run the analytical fixtures (--full adds the cantilever meshes,
+                                             keeping their outputs and plots in DIR, default out/verify)
   qdem bench [--json] [--tets N,N,..] [--threads N,N,..] [--steps N]
                                              kernel throughput on structured meshes, tet-steps/s";
 
@@ -161,9 +162,10 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
             check_scene(&one_scene(&o, "check")?)
         }
         "verify" => {
-            let o = parse(rest, &["--json", "--full"])?;
+            let o = parse(rest, &["--json", "--full", "--out"])?;
             no_positional(&o, "verify")?;
-            verify::run_and_print(o.json, o.full)
+            let out = o.out.unwrap_or_else(|| PathBuf::from("out/verify"));
+            verify::run_and_print(o.json, o.full.then_some(out.as_path()))
         }
         "bench" => {
             let o = parse(rest, &["--json", "--tets", "--threads", "--steps"])?;

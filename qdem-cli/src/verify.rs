@@ -18,9 +18,10 @@ use qdem_core::{
     Mat3, Material, Model, NodalLoad, State, Stepper, TetBody, TimeFunction, Vec3, Verlet,
 };
 use qdem_io::build::Simulation;
+use qdem_io::plot::{line_plot_svg, Labels, Series};
 use qdem_io::runner::run;
 use qdem_io::scene::Scene;
-use qdem_io::spectrum::dominant_frequency;
+use qdem_io::spectrum::{amplitude_spectrum, dominant_frequency};
 use qdem_mesh::structured_box;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -301,27 +302,42 @@ pub fn cantilever_static(scene: &Path) -> Result<f64, CliError> {
     Ok(solution.displacement[tip.particle].z * 1e6)
 }
 
-/// Steady tip deflection (µm, mean over 1–2 s) and first bending frequency (Hz, FFT after
-/// unloading at 2 s) of a cantilever scene, run through the normal run loop into `out`.
-pub fn cantilever(scene: &Path, out: &Path) -> Result<(f64, f64, usize), CliError> {
+/// What a cantilever run gives.
+pub struct CantileverRun {
+    /// Tetrahedra of the mesh.
+    pub tets: usize,
+    /// Steady tip deflection, mean over 1–2 s (µm).
+    pub tip_uz_um: f64,
+    /// First bending frequency from the FFT of the free vibration after 2 s (Hz).
+    pub f1_hz: f64,
+    /// Wall seconds of the run.
+    pub wall_seconds: f64,
+    /// Amplitude spectrum of the free vibration (Hz, µm).
+    pub spectrum: Vec<(f64, f64)>,
+}
+
+/// Runs a cantilever scene through the normal run loop into `out` and reads its probe record
+/// back from `probes.csv`.
+pub fn cantilever(scene: &Path, out: &Path) -> Result<CantileverRun, CliError> {
     let mut sim = Simulation::build(Scene::load(scene)?)?;
     let tets = sim.tets();
-    run(&mut sim, out, &mut |_| {})?;
-    let text = std::fs::read_to_string(out.join("probes.csv"))
-        .map_err(|e| CliError::Verify(format!("{}: {e}", out.display())))?;
+    let report = run(&mut sim, out, &mut |_| {})?;
+    let csv = out.join("probes.csv");
+    let text = std::fs::read_to_string(&csv)
+        .map_err(|e| CliError::Verify(format!("{}: {e}", csv.display())))?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
     let column = header
         .iter()
         .position(|h| *h == "tip.uz")
-        .ok_or_else(|| CliError::Verify("no tip.uz column".into()))?;
+        .ok_or_else(|| CliError::Verify(format!("{}: no tip.uz column", csv.display())))?;
     let rows: Vec<(f64, f64)> = lines
         .map(|l| {
             let f: Vec<f64> = l
                 .split(',')
                 .map(|v| v.parse().unwrap_or(f64::NAN))
                 .collect();
-            (f[0], f[column])
+            (f[0], f[column] * 1e6)
         })
         .collect();
     let steady: Vec<f64> = rows
@@ -329,29 +345,40 @@ pub fn cantilever(scene: &Path, out: &Path) -> Result<(f64, f64, usize), CliErro
         .filter(|r| r.0 >= 1.0 && r.0 <= 2.0)
         .map(|r| r.1)
         .collect();
-    let mean = steady.iter().sum::<f64>() / steady.len().max(1) as f64;
     let free: Vec<f64> = rows.iter().filter(|r| r.0 > 2.0).map(|r| r.1).collect();
     let dt = sim.scene.run.probe_every.unwrap_or(1e-4);
-    let frequency = dominant_frequency(&free, dt).unwrap_or(f64::NAN);
-    Ok((mean * 1e6, frequency, tets))
+    Ok(CantileverRun {
+        tets,
+        tip_uz_um: steady.iter().sum::<f64>() / steady.len().max(1) as f64,
+        f1_hz: dominant_frequency(&free, dt).unwrap_or(f64::NAN),
+        wall_seconds: report.wall_seconds,
+        spectrum: amplitude_spectrum(&free, dt),
+    })
 }
 
-fn cantilever_rows(rows: &mut Vec<Row>) -> Result<(), CliError> {
+fn plot(path: &Path, labels: &Labels<'_>, series: &[Series<'_>]) -> Result<(), CliError> {
+    line_plot_svg(path, labels, series).map_err(|e| CliError::Verify(e.to_string()))
+}
+
+/// The cantilever on every fixture mesh: rows, the outputs of each run under `out`, its
+/// spectrum, and the error against tetrahedra and against wall time (speed versus error).
+fn cantilever_rows(rows: &mut Vec<Row>, out: &Path) -> Result<(), CliError> {
+    let mut convergence = [Vec::new(), Vec::new()];
+    let mut speed = Vec::new();
     for lc in ["100", "070", "050"] {
         let scene = fixtures_dir()
             .join("cantilever")
             .join(format!("cantilever_lc{lc}.toml"));
-        let out = std::env::temp_dir().join(format!("qdem-verify-{}-lc{lc}", std::process::id()));
+        let dir = out.join(format!("cantilever_lc{lc}"));
         let start = Instant::now();
         let static_uz = cantilever_static(&scene)?;
-        let (uz, f1, tets) = cantilever(&scene, &out)?;
-        let _ = std::fs::remove_dir_all(&out);
-        let name = format!("cantilever lc=0.{lc} ({tets} tets)");
+        let r = cantilever(&scene, &dir)?;
+        let name = format!("cantilever lc=0.{lc} ({} tets)", r.tets);
         // Issue 3's bound for explicit QDEM against a static solve on the same mesh.
         rows.push(Row::relative(
             &format!("{name}: explicit tip uz vs same-mesh linear-tet static"),
             static_uz,
-            uz,
+            r.tip_uz_um,
             Some(5e-4),
             start,
         ));
@@ -365,31 +392,89 @@ fn cantilever_rows(rows: &mut Vec<Row>) -> Result<(), CliError> {
         rows.push(Row::relative(
             &format!("{name}: tip uz (um) vs CalculiX C3D10"),
             CANTILEVER_TIP_UZ_UM,
-            uz,
+            r.tip_uz_um,
             None,
             start,
         ));
         rows.push(Row::relative(
             &format!("{name}: f1 (Hz) vs CalculiX C3D10"),
             CANTILEVER_F1_HZ,
-            f1,
+            r.f1_hz,
             None,
             start,
         ));
+        let band: Vec<(f64, f64)> = r
+            .spectrum
+            .iter()
+            .copied()
+            .filter(|p| p.0 <= 100.0)
+            .collect();
+        let title = format!("tip uz after release, {name}");
+        plot(
+            &dir.join("spectrum.svg"),
+            &Labels {
+                title: &title,
+                x: "f (Hz)",
+                y: "amplitude (um)",
+            },
+            &[Series {
+                label: "tip.uz",
+                points: &band,
+            }],
+        )?;
+        let error = 100.0 * (r.tip_uz_um / CANTILEVER_TIP_UZ_UM - 1.0).abs();
+        convergence[0].push((r.tets as f64, error));
+        convergence[1].push((
+            r.tets as f64,
+            100.0 * (static_uz / CANTILEVER_TIP_UZ_UM - 1.0).abs(),
+        ));
+        speed.push((r.wall_seconds, error));
     }
-    Ok(())
+    let labels = Labels {
+        title: "cantilever tip deflection: error against CalculiX C3D10",
+        x: "tetrahedra",
+        y: "error (%)",
+    };
+    plot(
+        &out.join("cantilever_error_vs_tets.svg"),
+        &labels,
+        &[
+            Series {
+                label: "explicit QDEM (mean 1-2 s)",
+                points: &convergence[0],
+            },
+            Series {
+                label: "linear-tet static, same mesh",
+                points: &convergence[1],
+            },
+        ],
+    )?;
+    let labels = Labels {
+        title: "cantilever: speed versus error (explicit QDEM, 3 s simulated)",
+        x: "wall seconds",
+        y: "tip error (%)",
+    };
+    plot(
+        &out.join("cantilever_error_vs_time.svg"),
+        &labels,
+        &[Series {
+            label: "explicit QDEM",
+            points: &speed,
+        }],
+    )
 }
 
-/// Runs the fixtures, prints a table (or JSON), and fails if any row misses its tolerance.
-pub fn run_and_print(as_json: bool, full: bool) -> Result<(), CliError> {
+/// Runs the fixtures (with `full`, the cantilever too, its outputs under that directory),
+/// prints a table (or JSON), and fails if any row misses its tolerance.
+pub fn run_and_print(as_json: bool, full: Option<&Path>) -> Result<(), CliError> {
     let mut rows = vec![
         oracle_agreement(),
         rigid_spin(),
         energy_conservation(),
         p_wave_speed(),
     ];
-    if full {
-        cantilever_rows(&mut rows)?;
+    if let Some(out) = full {
+        cantilever_rows(&mut rows, out)?;
     }
     if as_json {
         let doc: Vec<_> = rows
