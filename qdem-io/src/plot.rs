@@ -53,6 +53,19 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// Tick label: plain for magnitudes between 10⁻² and 10⁵, scientific otherwise.
+fn tick(v: &f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || (1e-2..1e5).contains(&a) {
+        format!("{v:.3}")
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
 /// Draws `series` into an SVG file at `path` (written atomically).
 pub fn line_plot_svg(
     path: &Path,
@@ -76,7 +89,7 @@ pub fn line_plot_svg(
                 .configure_mesh()
                 .x_desc(labels.x)
                 .y_desc(labels.y)
-                .y_label_formatter(&|v| format!("{v:.3e}"))
+                .y_label_formatter(&tick)
                 .draw()?;
             for (i, s) in series.iter().enumerate() {
                 let colour = COLOURS[i % COLOURS.len()];
@@ -101,4 +114,19 @@ pub fn line_plot_svg(
         })?;
     }
     write_atomic(path, |w| w.write_all(svg.as_bytes()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_labels_are_plain_for_moderate_values_and_scientific_otherwise() {
+        assert_eq!(tick(&60.0), "60");
+        assert_eq!(tick(&100.0), "100");
+        assert_eq!(tick(&0.125), "0.125");
+        assert_eq!(tick(&0.0), "0");
+        assert_eq!(tick(&-6.4e-5), "-6.40e-5");
+        assert_eq!(tick(&2.5e7), "2.50e7");
+    }
 }
