@@ -81,4 +81,40 @@ pub enum CoreError {
         /// First offending particle.
         particle: usize,
     },
+    /// Newmark parameters outside the range of paper 001 Eq. 16.
+    #[error(
+        "newmark: beta = {beta} and gamma = {gamma} are outside 0 <= gamma <= 1, \
+         0 <= 2 beta <= 1 (paper 001 Eq. 16); use beta = 0.25, gamma = 0.5 (average \
+         acceleration) or beta = 0, gamma = 0.5 (central difference)"
+    )]
+    NewmarkParameters {
+        /// β.
+        beta: f64,
+        /// γ.
+        gamma: f64,
+    },
+    /// An implicit or static solve met a model that cannot give its tangent.
+    #[error(
+        "model `{model}` gives no tangent stiffness, so it cannot be stepped implicitly or \
+         solved statically: use an explicit stepper (verlet, or newmark with beta = 0)"
+    )]
+    NoTangent {
+        /// The model's name.
+        model: String,
+    },
+    /// The matrix of an implicit or static solve is not positive definite.
+    #[error(
+        "the {what} matrix ({dofs} free degrees of freedom) is not positive definite: a body is \
+         probably not constrained against rigid motion (fix some of its nodes) or a free \
+         particle belongs to no tetrahedron"
+    )]
+    NotPositiveDefinite {
+        /// Which matrix: "stiffness" or "effective".
+        what: &'static str,
+        /// Number of free degrees of freedom.
+        dofs: usize,
+    },
+    /// The sparse linear algebra failed for a reason other than definiteness.
+    #[error("sparse factorisation failed: {0}")]
+    Sparse(String),
 }

@@ -1,6 +1,7 @@
 //! Uniform gravity: the force m g on every particle.
 
 use crate::model::Model;
+use crate::sparse::Tangent;
 use crate::state::State;
 use crate::Vec3;
 
@@ -26,6 +27,11 @@ impl Model for Gravity {
         for (f, m) in force.iter_mut().zip(&state.mass) {
             *f += *m * self.g;
         }
+    }
+
+    /// Position- and velocity-independent: no tangent.
+    fn add_tangent(&self, _state: &State, _tangent: &mut Tangent) -> bool {
+        true
     }
 
     fn potential_energy(&self, state: &State) -> Option<f64> {

@@ -7,7 +7,9 @@
 //! - [`Model`]: a source of forces (a [`TetBody`], [`Gravity`], a [`NodalLoad`], …) that also
 //!   states the stable time step it allows.
 //! - [`Stepper`]: advances the state under a list of models; [`Verlet`] is the explicit
-//!   velocity Verlet of the QDEM paper.
+//!   velocity Verlet of the QDEM paper; [`Newmark`] the Newmark-β family of paper 001 §3,
+//!   explicit (β = 0) or implicit (β > 0, a sparse Cholesky solve per step, [`sparse`]);
+//!   [`StaticSolver`] the linear static solve K u = f.
 //!
 //! The QDEM tetrahedron (Nishiura, Sakaguchi & Aikawa 2017, Eqs. 1–11) is in [`tet_kernel`],
 //! with the literal 12-triangle subdomain construction kept as its oracle in
@@ -18,9 +20,12 @@ pub mod gravity;
 pub mod linear_tet;
 pub mod material;
 pub mod model;
+pub mod newmark;
 pub mod nodal_load;
+pub mod sparse;
 pub mod stable_step;
 pub mod state;
+pub mod static_solve;
 pub mod stepper;
 pub mod tet_body;
 pub mod tet_kernel;
@@ -37,8 +42,11 @@ pub use error::CoreError;
 pub use gravity::Gravity;
 pub use material::Material;
 pub use model::Model;
+pub use newmark::{Newmark, TangentUpdate};
 pub use nodal_load::NodalLoad;
+pub use sparse::{FactorStats, Tangent};
 pub use state::{Dofs, State};
+pub use static_solve::StaticSolver;
 pub use stepper::{choose_step, stable_step, Stepper};
 pub use tet_body::TetBody;
 pub use time_function::TimeFunction;

@@ -2,8 +2,10 @@
 //!
 //! A scene is a list of models (continuum bodies, loads, gravity, later contacts and bonds);
 //! a stepper asks each for its forces and for the largest step it tolerates. Models a scene
-//! does not need are never built.
+//! does not need are never built. For implicit and static solves a model also adds its tangent
+//! stiffness and damping into a [`Tangent`] (the optional implicit hook).
 
+use crate::sparse::Tangent;
 use crate::state::State;
 use crate::Vec3;
 
@@ -28,5 +30,15 @@ pub trait Model: std::any::Any + Send + Sync {
     fn potential_energy(&self, state: &State) -> Option<f64> {
         let _ = state;
         None
+    }
+
+    /// Adds this model's tangent stiffness K = −∂f/∂x and damping C = −∂f/∂v, linearised at
+    /// `state`, into `tangent` (3×3 blocks per particle pair, DOF 3·particle + axis), and
+    /// returns `true`; a model whose force does not depend on positions or velocities adds
+    /// nothing and returns `true`. The default returns `false`: the model cannot be stepped
+    /// implicitly (paper 001 Eq. 26 needs K and C).
+    fn add_tangent(&self, state: &State, tangent: &mut Tangent) -> bool {
+        let _ = (state, tangent);
+        false
     }
 }

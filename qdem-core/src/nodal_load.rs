@@ -2,6 +2,7 @@
 //! `[[load]]`).
 
 use crate::model::Model;
+use crate::sparse::Tangent;
 use crate::state::State;
 use crate::time_function::TimeFunction;
 use crate::Vec3;
@@ -38,5 +39,10 @@ impl Model for NodalLoad {
         for &p in &self.particles {
             force[p as usize] += f;
         }
+    }
+
+    /// Position- and velocity-independent: no tangent.
+    fn add_tangent(&self, _state: &State, _tangent: &mut Tangent) -> bool {
+        true
     }
 }

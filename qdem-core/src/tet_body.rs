@@ -6,10 +6,18 @@
 //! particles, each summing its own incident entries in ascending order, so the result is
 //! bit-identical for any number of threads (no atomics, no reduction-order dependence).
 //! Elastic materials take a path without the viscous stress.
+//!
+//! For implicit and static solves the body adds its tangent (the [`Model::add_tangent`] hook):
+//! the small-strain linear-tetrahedron stiffness K_e = V Gᵀ D G per element, with the volume V
+//! and shape-function gradients G of the current configuration, and the same operator with the
+//! viscous Lamé pair for the damping C_e. This is the exact linearisation of Eqs. 1–10 about an
+//! unstrained configuration (it omits the stress-dependent geometric stiffness, of the order of
+//! the strain), so for small strain f(x + ∆x, v) ≈ f(x, v) − K ∆x (paper 001 Eq. 20).
 
 use crate::error::CoreError;
 use crate::material::{Lame, Material};
 use crate::model::Model;
+use crate::sparse::Tangent;
 use crate::stable_step::{critical_step, element_rate_bound};
 use crate::state::State;
 use crate::tet_kernel::{
@@ -189,6 +197,27 @@ impl TetBody {
     }
 }
 
+/// Volume and shape-function gradients ∇N₀..∇N₃ of a tetrahedron at positions `x` (zero
+/// gradients for a degenerate one, which then adds no tangent).
+fn current_gradients(x: &[Vec3; 4]) -> (f64, [Vec3; 4]) {
+    let dx = edge_matrix(x);
+    let inverse = dx.try_inverse().unwrap_or_else(Mat3::zeros);
+    let g: [Vec3; 3] = std::array::from_fn(|k| inverse.row(k).transpose());
+    (
+        dx.determinant() / 6.0,
+        [-(g[0] + g[1] + g[2]), g[0], g[1], g[2]],
+    )
+}
+
+/// Block (a, b) of the linear-tet operator V Gᵀ D G with the Lamé pair (λ, μ):
+/// V (λ g_a g_bᵀ + μ g_b g_aᵀ + μ (g_a·g_b) I).
+fn lame_block(volume: f64, ga: &Vec3, gb: &Vec3, (lambda, mu): (f64, f64)) -> Mat3 {
+    (ga * gb.transpose() * lambda
+        + gb * ga.transpose() * mu
+        + Mat3::from_diagonal_element(mu * ga.dot(gb)))
+        * volume
+}
+
 /// Largest element rate bound over all tetrahedra, for an elastic or a viscous Lamé pair.
 fn rate_bound(dm_inv: &[Mat3], material: &Material, lame: Lame) -> f64 {
     dm_inv
@@ -233,6 +262,23 @@ impl Model for TetBody {
             self.compute_tet_forces::<true>(state);
         }
         self.gather(force);
+    }
+
+    fn add_tangent(&self, state: &State, tangent: &mut Tangent) -> bool {
+        let viscous = !self.material.is_elastic();
+        for tet in &self.tets {
+            let (volume, g) = current_gradients(&tet.map(|n| state.position[n as usize]));
+            for (a, &i) in tet.iter().enumerate() {
+                for (b, &j) in tet.iter().enumerate() {
+                    let (i, j) = (i as usize, j as usize);
+                    tangent.add_stiffness(i, j, &lame_block(volume, &g[a], &g[b], self.pair()));
+                    if viscous {
+                        tangent.add_damping(i, j, &lame_block(volume, &g[a], &g[b], self.vpair()));
+                    }
+                }
+            }
+        }
+        true
     }
 
     fn stable_dt(&self, _state: &State) -> Option<f64> {

@@ -1,0 +1,334 @@
+//! Sparse assembly and Cholesky factorisation for the implicit Newmark step (paper 001 Eq. 26)
+//! and the linear static solve.
+//!
+//! - [`Tangent`] collects the models' tangent stiffness K and damping C as 3×3 blocks per
+//!   particle pair in global numbering (DOF 3·particle + axis). Only the lower triangle
+//!   (row ≥ column) is kept: both matrices are symmetric and the Cholesky factorisation reads
+//!   the lower triangle only.
+//! - [`FreeDofs`] eliminates the constraints of Eqs. 23 and 27 (B∆u = 0, Bü = 0 with B selecting
+//!   the fixed directions): fixed DOFs are removed from the system, the others numbered
+//!   compactly in ascending order (so the lower triangle stays lower).
+//! - [`assemble`] forms s_M M + s_C C + s_K K over the free DOFs (M the lumped mass), e.g.
+//!   M + γ∆t C + β∆t² K of Eq. 26 or K alone for a static solve.
+//! - [`SparseCholesky`] factorises such a matrix with faer's sparse LLᵀ. The symbolic analysis
+//!   (fill-reducing AMD ordering, elimination tree, supernodes) is kept and reused as long as the
+//!   sparsity pattern is unchanged; the numeric factorisation runs only when asked, and a solve
+//!   is a pair of triangular solves.
+
+use crate::error::CoreError;
+use crate::state::Dofs;
+use crate::{Mat3, Vec3};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymmetricOrdering,
+};
+use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
+use faer::{Conj, MatMut, Side};
+use std::time::Instant;
+
+/// One stored matrix entry (row, column, value).
+pub type Entry = Triplet<usize, usize, f64>;
+
+/// Marker in [`FreeDofs`] for a fixed DOF.
+const FIXED: usize = usize::MAX;
+
+/// The tangent stiffness K = −∂f/∂x and damping C = −∂f/∂v of a scene, as lower-triangle
+/// triplets in global DOF numbering; duplicates are summed on assembly.
+#[derive(Clone, Debug, Default)]
+pub struct Tangent {
+    stiffness: Vec<Entry>,
+    damping: Vec<Entry>,
+}
+
+impl Tangent {
+    /// An empty tangent.
+    pub fn new() -> Tangent {
+        Tangent::default()
+    }
+
+    /// Removes every entry, keeping the allocations.
+    pub fn clear(&mut self) {
+        self.stiffness.clear();
+        self.damping.clear();
+    }
+
+    /// Adds the stiffness block K_ij (∂ of the force on particle i by the position of j,
+    /// negated). Entries above the diagonal are dropped: add every block of a symmetric matrix.
+    pub fn add_stiffness(&mut self, i: usize, j: usize, block: &Mat3) {
+        push_lower(&mut self.stiffness, i, j, block);
+    }
+
+    /// Adds the damping block C_ij, as [`Tangent::add_stiffness`] does for K.
+    pub fn add_damping(&mut self, i: usize, j: usize, block: &Mat3) {
+        push_lower(&mut self.damping, i, j, block);
+    }
+}
+
+/// Pushes the entries of block (i, j) that lie on or below the diagonal.
+fn push_lower(list: &mut Vec<Entry>, i: usize, j: usize, block: &Mat3) {
+    for a in 0..3 {
+        for b in 0..3 {
+            let (row, col) = (3 * i + a, 3 * j + b);
+            if row >= col {
+                list.push(Triplet::new(row, col, block[(a, b)]));
+            }
+        }
+    }
+}
+
+/// The numbering of the free DOFs: fixed DOFs (Eqs. 23, 27) are eliminated.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FreeDofs {
+    index: Vec<usize>,
+    count: usize,
+}
+
+impl FreeDofs {
+    /// Numbers the free directions of every particle in ascending DOF order.
+    pub fn new(fixed: &[Dofs]) -> FreeDofs {
+        let mut count = 0;
+        let index = fixed
+            .iter()
+            .flat_map(|d| (0..3).map(move |axis| d.contains(axis)))
+            .map(|is_fixed| {
+                if is_fixed {
+                    FIXED
+                } else {
+                    count += 1;
+                    count - 1
+                }
+            })
+            .collect();
+        FreeDofs { index, count }
+    }
+
+    /// Number of free DOFs (the size of the system).
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    /// Whether every DOF is fixed.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// The system index of global DOF `dof`, `None` if it is fixed.
+    #[inline]
+    pub fn index(&self, dof: usize) -> Option<usize> {
+        let i = self.index[dof];
+        (i != FIXED).then_some(i)
+    }
+
+    /// Copies the free components of per-particle vectors into `out` (length [`Self::len`]).
+    pub fn gather(&self, v: &[Vec3], out: &mut [f64]) {
+        for (dof, &i) in self.index.iter().enumerate() {
+            if i != FIXED {
+                out[i] = v[dof / 3][dof % 3];
+            }
+        }
+    }
+
+    /// Writes a system vector back to per-particle vectors, zero in fixed directions.
+    pub fn scatter(&self, x: &[f64], out: &mut [Vec3]) {
+        for (dof, &i) in self.index.iter().enumerate() {
+            out[dof / 3][dof % 3] = if i == FIXED { 0.0 } else { x[i] };
+        }
+    }
+}
+
+/// Coefficients of the combination s_M M + s_C C + s_K K that [`assemble`] forms.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scales {
+    /// Factor of the lumped mass M.
+    pub mass: f64,
+    /// Factor of the damping C.
+    pub damping: f64,
+    /// Factor of the stiffness K.
+    pub stiffness: f64,
+}
+
+/// Assembles s_M M + s_C C + s_K K over the free DOFs, lower triangle, duplicates summed
+/// (the left-hand side of paper 001 Eq. 26 with s = (1, γ∆t, β∆t²)). A term with a zero factor
+/// is left out of the pattern. `entries` is scratch space owned by the caller.
+pub fn assemble(
+    tangent: &Tangent,
+    mass: &[f64],
+    dofs: &FreeDofs,
+    scales: Scales,
+    entries: &mut Vec<Entry>,
+) -> Result<SparseColMat<usize, f64>, CoreError> {
+    entries.clear();
+    let terms = [
+        (&tangent.stiffness, scales.stiffness),
+        (&tangent.damping, scales.damping),
+    ];
+    for (list, scale) in terms.into_iter().filter(|t| t.1 != 0.0) {
+        entries.extend(list.iter().filter_map(|e| {
+            let (row, col) = (dofs.index(e.row)?, dofs.index(e.col)?);
+            Some(Triplet::new(row, col, scale * e.val))
+        }));
+    }
+    if scales.mass != 0.0 {
+        entries.extend((0..3 * mass.len()).filter_map(|dof| {
+            let i = dofs.index(dof)?;
+            Some(Triplet::new(i, i, scales.mass * mass[dof / 3]))
+        }));
+    }
+    SparseColMat::try_new_from_triplets(dofs.len(), dofs.len(), entries).map_err(sparse_error)
+}
+
+/// Size, sparsity and cost of the last factorisation (for `qdem check`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FactorStats {
+    /// Order of the matrix (free DOFs).
+    pub dofs: usize,
+    /// Stored non-zeros of the matrix (lower triangle).
+    pub nonzeros: usize,
+    /// Stored values of the Cholesky factor L (its fill; supernodes are stored dense).
+    pub factor_nonzeros: usize,
+    /// Time of the last symbolic analysis (s).
+    pub symbolic_seconds: f64,
+    /// Time of the last numeric factorisation (s).
+    pub numeric_seconds: f64,
+    /// Number of symbolic analyses so far (one per sparsity pattern met).
+    pub analyses: usize,
+    /// Number of numeric factorisations so far.
+    pub factorizations: usize,
+}
+
+/// The symbolic analysis of one sparsity pattern, with the scratch space its solves need.
+struct Analysis {
+    pattern: SymbolicSparseColMat<usize>,
+    symbolic: SymbolicCholesky<usize>,
+    solve_scratch: MemBuffer,
+}
+
+impl std::fmt::Debug for Analysis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Analysis")
+            .field("pattern", &self.pattern)
+            .field("symbolic", &self.symbolic)
+            .finish_non_exhaustive()
+    }
+}
+
+/// A sparse LLᵀ factorisation that keeps its symbolic analysis per sparsity pattern.
+#[derive(Debug, Default)]
+pub struct SparseCholesky {
+    analysis: Option<Analysis>,
+    values: Vec<f64>,
+    factored: bool,
+    stats: FactorStats,
+}
+
+impl SparseCholesky {
+    /// An empty factorisation.
+    pub fn new() -> SparseCholesky {
+        SparseCholesky::default()
+    }
+
+    /// Whether a numeric factorisation is available for [`Self::solve_in_place`].
+    pub fn is_factored(&self) -> bool {
+        self.factored
+    }
+
+    /// Statistics of the last analysis and factorisation.
+    pub fn stats(&self) -> &FactorStats {
+        &self.stats
+    }
+
+    /// Factorises the symmetric matrix `a`, given by its lower triangle: the symbolic analysis
+    /// is redone only if the pattern differs from the last one. `what` names the matrix in the
+    /// error raised when it is not positive definite.
+    pub fn factorize(
+        &mut self,
+        a: SparseColMatRef<'_, usize, f64>,
+        what: &'static str,
+    ) -> Result<(), CoreError> {
+        self.factored = false;
+        self.analyse(a)?;
+        let symbolic = &self.analysis.as_ref().expect("analysed above").symbolic;
+        let par = faer::get_global_parallelism();
+        let mut scratch =
+            MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
+        self.values.resize(symbolic.len_val(), 0.0);
+        let start = Instant::now();
+        symbolic
+            .factorize_numeric_llt(
+                &mut self.values,
+                a,
+                Side::Lower,
+                Default::default(),
+                par,
+                MemStack::new(&mut scratch),
+                Default::default(),
+            )
+            .map_err(|_| CoreError::NotPositiveDefinite {
+                what,
+                dofs: a.nrows(),
+            })?;
+        self.stats.numeric_seconds = start.elapsed().as_secs_f64();
+        self.stats.factorizations += 1;
+        self.factored = true;
+        Ok(())
+    }
+
+    /// Runs the symbolic analysis of `a` unless its pattern is the one analysed last.
+    fn analyse(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<(), CoreError> {
+        let pattern = a.symbolic();
+        let same = self.analysis.as_ref().is_some_and(|old| {
+            old.pattern.col_ptr() == pattern.col_ptr() && old.pattern.row_idx() == pattern.row_idx()
+        });
+        if same {
+            return Ok(());
+        }
+        let start = Instant::now();
+        let symbolic = factorize_symbolic_cholesky(
+            pattern,
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            Default::default(),
+        )
+        .map_err(sparse_error)?;
+        self.stats = FactorStats {
+            dofs: a.nrows(),
+            nonzeros: pattern.compute_nnz(),
+            factor_nonzeros: symbolic.len_val(),
+            symbolic_seconds: start.elapsed().as_secs_f64(),
+            numeric_seconds: 0.0,
+            analyses: self.stats.analyses + 1,
+            factorizations: self.stats.factorizations,
+        };
+        let solve_scratch = MemBuffer::new(
+            symbolic.solve_in_place_scratch::<f64>(1, faer::get_global_parallelism()),
+        );
+        self.analysis = Some(Analysis {
+            pattern: pattern.to_owned().map_err(sparse_error)?,
+            symbolic,
+            solve_scratch,
+        });
+        Ok(())
+    }
+
+    /// Overwrites `rhs` with A⁻¹ rhs (forward and backward triangular solves).
+    ///
+    /// # Panics
+    /// If no factorisation is available or `rhs` has the wrong length.
+    pub fn solve_in_place(&mut self, rhs: &mut [f64]) {
+        assert!(self.factored, "solve_in_place before a factorisation");
+        let analysis = self.analysis.as_mut().expect("factored implies analysed");
+        let n = rhs.len();
+        let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
+        LltRef::new(&analysis.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            rhs,
+            faer::get_global_parallelism(),
+            MemStack::new(&mut analysis.solve_scratch),
+        );
+    }
+}
+
+/// Maps a faer error to a core error.
+fn sparse_error(e: impl std::fmt::Debug) -> CoreError {
+    CoreError::Sparse(format!("{e:?}"))
+}

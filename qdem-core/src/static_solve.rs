@@ -1,0 +1,82 @@
+//! Linear static solve K u = f (paper 001 Eq. 17 with the incremental form of Eqs. 19–20 taken
+//! from the reference state in one step, the constraints of Eq. 23 eliminated).
+//!
+//! f is the total force the models give on the reference configuration at the requested time
+//! (loads and gravity; the internal force vanishes there), K the models' tangent stiffness at
+//! the reference configuration ([`crate::Model::add_tangent`]). For QDEM tetrahedra this is the
+//! small-strain linear-tetrahedron stiffness, so the answer is the mesh's linear FEM solution.
+//! K is assembled and factorised by [`SparseCholesky`] on the first solve (with the fixity of
+//! that moment) and reused for every later load level: one further force evaluation and two
+//! triangular solves per level.
+
+use crate::error::CoreError;
+use crate::model::Model;
+use crate::newmark::{collect_tangent, sum_forces};
+use crate::sparse::{assemble, FactorStats, FreeDofs, Scales, SparseCholesky, Tangent};
+use crate::state::State;
+use crate::Vec3;
+
+/// A linear static solver that keeps the factorisation of K across load levels.
+#[derive(Debug, Default)]
+pub struct StaticSolver {
+    dofs: Option<FreeDofs>,
+    cholesky: SparseCholesky,
+    force: Vec<Vec3>,
+    rhs: Vec<f64>,
+}
+
+impl StaticSolver {
+    /// A solver with nothing factorised yet.
+    pub fn new() -> StaticSolver {
+        StaticSolver::default()
+    }
+
+    /// Size, fill and factorisation time of K; `None` before the first solve.
+    pub fn factor_stats(&self) -> Option<&FactorStats> {
+        self.cholesky.is_factored().then(|| self.cholesky.stats())
+    }
+
+    /// Solves K u = f(`time`) and sets `state` to the static answer at `time`: positions
+    /// X + u, zero velocities and accelerations.
+    pub fn solve(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        time: f64,
+    ) -> Result<(), CoreError> {
+        state.time = time;
+        state.position.clone_from(&state.reference);
+        state.velocity.fill(Vec3::zeros());
+        state.acceleration.fill(Vec3::zeros());
+        if !self.cholesky.is_factored() {
+            self.factorize(state, models)?;
+        }
+        sum_forces(state, models, &mut self.force);
+        let dofs = self.dofs.as_ref().expect("factorised above");
+        self.rhs.resize(dofs.len(), 0.0);
+        dofs.gather(&self.force, &mut self.rhs);
+        self.cholesky.solve_in_place(&mut self.rhs);
+        let mut u = vec![Vec3::zeros(); state.len()];
+        dofs.scatter(&self.rhs, &mut u);
+        for (x, d) in state.position.iter_mut().zip(&u) {
+            *x += d;
+        }
+        Ok(())
+    }
+
+    /// Assembles K at the reference state and factorises it.
+    fn factorize(&mut self, state: &State, models: &[Box<dyn Model>]) -> Result<(), CoreError> {
+        let mut tangent = Tangent::new();
+        collect_tangent(state, models, &mut tangent)?;
+        let dofs = FreeDofs::new(&state.fixed);
+        let scales = Scales {
+            mass: 0.0,
+            damping: 0.0,
+            stiffness: 1.0,
+        };
+        let matrix = assemble(&tangent, &state.mass, &dofs, scales, &mut Vec::new())?;
+        self.cholesky.factorize(matrix.as_ref(), "stiffness")?;
+        self.dofs = Some(dofs);
+        Ok(())
+    }
+}
