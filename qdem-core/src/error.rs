@@ -104,15 +104,36 @@ pub enum CoreError {
     },
     /// The matrix of an implicit or static solve is not positive definite.
     #[error(
-        "the {what} matrix ({dofs} free degrees of freedom) is not positive definite: a body is \
-         probably not constrained against rigid motion (fix some of its nodes) or a free \
-         particle belongs to no tetrahedron"
+        "the {what} matrix ({dofs} free degrees of freedom) is not positive definite: {detail}"
     )]
     NotPositiveDefinite {
         /// Which matrix: "stiffness" or "effective".
         what: &'static str,
         /// Number of free degrees of freedom.
         dofs: usize,
+        /// The particle whose pivot failed, where the factorisation tells it.
+        particle: Option<usize>,
+        /// The model (body) that owns that particle, if any does.
+        body: Option<String>,
+        /// The diagnosis: the failing pivot, the bodies free to move rigidly, and the fix.
+        detail: String,
+    },
+    /// A deformable body of a static (or massless implicit) solve that its constraints leave
+    /// free to move rigidly, so the system is singular.
+    #[error(
+        "body `{body}` is not constrained against rigid motion ({modes} of its 6 rigid-body \
+         modes are free), so the {what} matrix is singular: {fix}"
+    )]
+    Unconstrained {
+        /// The body's name.
+        body: String,
+        /// How many independent rigid-body motions (of 3 translations and 3 rotations) its
+        /// fixed directions leave free.
+        modes: usize,
+        /// Which matrix: "stiffness" or "effective".
+        what: &'static str,
+        /// What to do about it.
+        fix: &'static str,
     },
     /// The sparse linear algebra failed for a reason other than definiteness.
     #[error("sparse factorisation failed: {0}")]

@@ -41,4 +41,12 @@ pub trait Model: std::any::Any + Send + Sync {
         let _ = (state, tangent);
         false
     }
+
+    /// The particles this model's elements join, in ascending order (the nodes of a deformable
+    /// body), used to name a body that is not constrained against rigid motion when an
+    /// implicit or static system is singular. The default, for models that own no particles
+    /// (loads, gravity, springs to ground), is empty.
+    fn particles(&self) -> Vec<usize> {
+        Vec::new()
+    }
 }

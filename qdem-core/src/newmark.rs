@@ -37,7 +37,9 @@
 
 use crate::error::CoreError;
 use crate::model::Model;
-use crate::sparse::{assemble, Entry, FactorStats, FreeDofs, Scales, SparseCholesky, Tangent};
+use crate::sparse::{
+    assemble, explain_failure, Entry, FactorStats, FreeDofs, Scales, SparseCholesky, Tangent,
+};
 use crate::state::State;
 use crate::stepper::{check_masses, compute_accelerations, Stepper, PARTICLE_CHUNK};
 use crate::Vec3;
@@ -126,7 +128,10 @@ impl Newmark {
         &self.force
     }
 
-    /// Assembles M + γ∆t C + β∆t² K (Eq. 26) at `state` and factorises it.
+    /// Assembles M + γ∆t C + β∆t² K (Eq. 26) at `state` and factorises it. With positive
+    /// masses (checked at [`Stepper::initialize`]) the matrix is positive definite even for a
+    /// body free to move rigidly, so free bodies are not refused; a failed factorisation is
+    /// explained by [`explain_failure`].
     fn refactor(&mut self, state: &State, models: &[Box<dyn Model>]) -> Result<(), CoreError> {
         let scales = Scales {
             mass: 1.0,
@@ -143,7 +148,17 @@ impl Newmark {
             scales,
             &mut system.entries,
         )?;
-        system.cholesky.factorize(matrix.as_ref(), "effective")?;
+        if let Err(error) = system.cholesky.factorize(matrix.as_ref(), "effective") {
+            let pivot = system.cholesky.failed_pivot();
+            return Err(explain_failure(
+                error,
+                pivot,
+                &dofs,
+                state,
+                models,
+                &system.tangent,
+            ));
+        }
         system.dofs = Some(dofs);
         Ok(())
     }

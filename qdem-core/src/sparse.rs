@@ -14,16 +14,23 @@
 //!   (fill-reducing AMD ordering, elimination tree, supernodes) is kept and reused as long as the
 //!   sparsity pattern is unchanged; the numeric factorisation runs only when asked, and a solve
 //!   is a pair of triangular solves.
+//! - [`unconstrained_bodies`] finds the deformable bodies that the constraints leave free to
+//!   move rigidly (a singular stiffness), and [`explain_failure`] turns a failed factorisation
+//!   into a message naming the particle of the failing pivot, its body and the free bodies.
 
 use crate::error::CoreError;
-use crate::state::Dofs;
+use crate::model::Model;
+use crate::state::{Dofs, State};
 use crate::{Mat3, Vec3};
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltError;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
 use faer::{Conj, MatMut, Side};
+use nalgebra::{Matrix6, SMatrix, SymmetricEigen, Vector6};
+use std::collections::HashMap;
 use std::time::Instant;
 
 /// One stored matrix entry (row, column, value).
@@ -31,6 +38,13 @@ pub type Entry = Triplet<usize, usize, f64>;
 
 /// Marker in [`FreeDofs`] for a fixed DOF.
 const FIXED: usize = usize::MAX;
+
+/// What to do about a deformable body that is free to move rigidly.
+pub const FIX_HINT: &str = "fix at least 3 non-collinear particles of it, or a face, with [[fix]]";
+
+/// The diagnosis of a matrix that is not positive definite when no cause is known.
+const GENERIC_CAUSE: &str = "a body is probably not constrained against rigid motion (fix some \
+                             of its nodes) or a free particle belongs to no tetrahedron";
 
 /// The tangent stiffness K = −∂f/∂x and damping C = −∂f/∂v of a scene, as lower-triangle
 /// triplets in global DOF numbering; duplicates are summed on assembly.
@@ -61,6 +75,11 @@ impl Tangent {
     /// Adds the damping block C_ij, as [`Tangent::add_stiffness`] does for K.
     pub fn add_damping(&mut self, i: usize, j: usize, block: &Mat3) {
         push_lower(&mut self.damping, i, j, block);
+    }
+
+    /// The stored stiffness entries (lower triangle, global DOFs, duplicates not summed).
+    pub fn stiffness_entries(&self) -> &[Entry] {
+        &self.stiffness
     }
 }
 
@@ -117,6 +136,15 @@ impl FreeDofs {
     pub fn index(&self, dof: usize) -> Option<usize> {
         let i = self.index[dof];
         (i != FIXED).then_some(i)
+    }
+
+    /// The global DOF (3·particle + axis) of system index `i`, `None` if out of range.
+    pub fn dof(&self, i: usize) -> Option<usize> {
+        if i >= self.count {
+            return None;
+        }
+        // System indices ascend with the DOF: the i-th free DOF.
+        self.index.iter().position(|&k| k == i)
     }
 
     /// Copies the free components of per-particle vectors into `out` (length [`Self::len`]).
@@ -218,6 +246,7 @@ pub struct SparseCholesky {
     analysis: Option<Analysis>,
     values: Vec<f64>,
     factored: bool,
+    failed_pivot: Option<usize>,
     stats: FactorStats,
 }
 
@@ -232,6 +261,12 @@ impl SparseCholesky {
         self.factored
     }
 
+    /// The system index (in the matrix's own ordering) of the pivot that was not positive in
+    /// the last [`Self::factorize`], where faer tells it; `None` after a success.
+    pub fn failed_pivot(&self) -> Option<usize> {
+        self.failed_pivot
+    }
+
     /// Statistics of the last analysis and factorisation.
     pub fn stats(&self) -> &FactorStats {
         &self.stats
@@ -239,13 +274,15 @@ impl SparseCholesky {
 
     /// Factorises the symmetric matrix `a`, given by its lower triangle: the symbolic analysis
     /// is redone only if the pattern differs from the last one. `what` names the matrix in the
-    /// error raised when it is not positive definite.
+    /// error raised when it is not positive definite; the failing pivot is then kept for
+    /// [`Self::failed_pivot`] (see [`explain_failure`] for a message naming its body).
     pub fn factorize(
         &mut self,
         a: SparseColMatRef<'_, usize, f64>,
         what: &'static str,
     ) -> Result<(), CoreError> {
         self.factored = false;
+        self.failed_pivot = None;
         self.analyse(a)?;
         let symbolic = &self.analysis.as_ref().expect("analysed above").symbolic;
         let par = faer::get_global_parallelism();
@@ -253,20 +290,25 @@ impl SparseCholesky {
             MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
         self.values.resize(symbolic.len_val(), 0.0);
         let start = Instant::now();
-        symbolic
-            .factorize_numeric_llt(
-                &mut self.values,
-                a,
-                Side::Lower,
-                Default::default(),
-                par,
-                MemStack::new(&mut scratch),
-                Default::default(),
-            )
-            .map_err(|_| CoreError::NotPositiveDefinite {
+        let result = symbolic.factorize_numeric_llt(
+            &mut self.values,
+            a,
+            Side::Lower,
+            Default::default(),
+            par,
+            MemStack::new(&mut scratch),
+            Default::default(),
+        );
+        if let Err(error) = result {
+            self.failed_pivot = failed_column(&error, symbolic);
+            return Err(CoreError::NotPositiveDefinite {
                 what,
                 dofs: a.nrows(),
-            })?;
+                particle: None,
+                body: None,
+                detail: GENERIC_CAUSE.to_string(),
+            });
+        }
         self.stats.numeric_seconds = start.elapsed().as_secs_f64();
         self.stats.factorizations += 1;
         self.factored = true;
@@ -326,6 +368,225 @@ impl SparseCholesky {
             MemStack::new(&mut analysis.solve_scratch),
         );
     }
+}
+
+/// The column, in the matrix's own ordering, of the pivot faer found not positive. faer reports
+/// it in the fill-reducing order, one-based from its simplicial and zero-based from its
+/// supernodal factorisation.
+fn failed_column(error: &LltError, symbolic: &SymbolicCholesky<usize>) -> Option<usize> {
+    let LltError::NonPositivePivot { index } = *error;
+    let permuted = match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(_) => index.checked_sub(1)?,
+        SymbolicCholeskyRaw::Supernodal(_) => index,
+    };
+    if permuted >= symbolic.ncols() {
+        return None;
+    }
+    Some(match symbolic.perm() {
+        Some(perm) => perm.arrays().0[permuted],
+        None => permuted,
+    })
+}
+
+/// Turns a [`CoreError::NotPositiveDefinite`] from [`SparseCholesky::factorize`] into one that
+/// names the particle of the failing pivot (`pivot`, a system index of `dofs`, from
+/// [`SparseCholesky::failed_pivot`]) and the model that owns it, and lists the bodies that the
+/// constraints leave free to move rigidly ([`unconstrained_bodies`]) with the fix. Any other
+/// error is returned unchanged.
+pub fn explain_failure(
+    error: CoreError,
+    pivot: Option<usize>,
+    dofs: &FreeDofs,
+    state: &State,
+    models: &[Box<dyn Model>],
+    tangent: &Tangent,
+) -> CoreError {
+    let CoreError::NotPositiveDefinite { what, dofs: n, .. } = error else {
+        return error;
+    };
+    let (mut particle, mut body) = (None, None);
+    let mut detail = match pivot.and_then(|i| dofs.dof(i)) {
+        Some(dof) => {
+            let p = dof / 3;
+            particle = Some(p);
+            body = models
+                .iter()
+                .find(|m| m.particles().binary_search(&p).is_ok())
+                .map(|m| m.name().to_string());
+            let axis = ["x", "y", "z"][dof % 3];
+            match &body {
+                Some(name) => {
+                    format!("the pivot of particle {p} ({axis}) of body `{name}` is not positive; ")
+                }
+                None => format!(
+                    "the pivot of particle {p} ({axis}), which belongs to no body, is not \
+                     positive; "
+                ),
+            }
+        }
+        None => "the factorisation did not tell which pivot failed; ".to_string(),
+    };
+    let free = unconstrained_bodies(state, models, tangent, dofs);
+    if free.is_empty() {
+        detail.push_str(GENERIC_CAUSE);
+    } else {
+        let names: Vec<String> = free
+            .iter()
+            .map(|(name, modes)| format!("`{name}` ({modes} of 6 rigid-body modes free)"))
+            .collect();
+        detail.push_str(&format!(
+            "not constrained against rigid motion: {}; for each, {FIX_HINT}",
+            names.join(", ")
+        ));
+    }
+    CoreError::NotPositiveDefinite {
+        what,
+        dofs: n,
+        particle,
+        body,
+        detail,
+    }
+}
+
+/// The models owning particles ([`Model::particles`], i.e. deformable bodies) that the fixed
+/// directions of `dofs` leave free to move rigidly with no stiffness against it, each with the
+/// number of its free rigid-body modes (of 3 translations and 3 rotations, at the current
+/// positions).
+///
+/// A mode counts when it vanishes in every fixed direction of the body's particles and the
+/// stiffness of `tangent` (all models together, so bonds to other bodies count) maps it to zero
+/// in every free direction, up to rounding: the stiffness matrix over the free DOFs is then
+/// singular. The check is sufficient, not necessary (bodies that are only free together, as a
+/// group, are not found), so it never refuses a solvable system.
+pub fn unconstrained_bodies(
+    state: &State,
+    models: &[Box<dyn Model>],
+    tangent: &Tangent,
+    dofs: &FreeDofs,
+) -> Vec<(String, usize)> {
+    models
+        .iter()
+        .filter_map(|m| {
+            let modes = free_rigid_modes(state, &m.particles(), tangent, dofs);
+            (modes > 0).then(|| (m.name().to_string(), modes))
+        })
+        .collect()
+}
+
+/// Relative size below which a rigid mode counts as unconstrained or as stress-free.
+const RIGID_TOLERANCE: f64 = 1e-8;
+
+/// The number of rigid-body modes of the particles `particles` that the fixity leaves free and
+/// the stiffness does not resist (see [`unconstrained_bodies`]).
+fn free_rigid_modes(
+    state: &State,
+    particles: &[usize],
+    tangent: &Tangent,
+    dofs: &FreeDofs,
+) -> usize {
+    if particles.is_empty() {
+        return 0;
+    }
+    let centre =
+        particles.iter().map(|&i| state.position[i]).sum::<Vec3>() / particles.len() as f64;
+    let size = particles
+        .iter()
+        .map(|&i| (state.position[i] - centre).norm())
+        .fold(0.0, f64::max);
+    if size.is_nan() || size <= 0.0 {
+        return 0;
+    }
+    // Rigid motion v = (translation, rotation) at particle i: t_i = R_i v, R_i = [I | −[r]×],
+    // r the scaled arm, so that every mode is of order one.
+    let modes = |i: usize| -> SMatrix<f64, 3, 6> {
+        let r = (state.position[i] - centre) / size;
+        let mut m = SMatrix::<f64, 3, 6>::zeros();
+        m.fixed_view_mut::<3, 3>(0, 0).copy_from(&Mat3::identity());
+        m.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&(-r.cross_matrix()));
+        m
+    };
+    let fixed = |i: usize, axis: usize| dofs.index(3 * i + axis).is_none();
+    let mut gram = Matrix6::zeros();
+    let mut rows = 0usize;
+    for &i in particles {
+        let m = modes(i);
+        for axis in (0..3).filter(|&a| fixed(i, a)) {
+            let row = m.row(axis).transpose();
+            gram += row * row.transpose();
+            rows += 1;
+        }
+    }
+    let eigen = SymmetricEigen::new(gram);
+    let null: Vec<Vector6<f64>> = (0..6)
+        .filter(|&k| eigen.eigenvalues[k] <= 1e-10 * rows.max(1) as f64)
+        .map(|k| eigen.eigenvectors.column(k).into_owned())
+        .collect();
+    if null.is_empty() {
+        return 0;
+    }
+    // The null modes as displacements of the body's free DOFs, then K t over all free DOFs.
+    let mut local = vec![usize::MAX; state.len()];
+    for (k, &i) in particles.iter().enumerate() {
+        local[i] = k;
+    }
+    let motion: Vec<Vec<f64>> = null
+        .iter()
+        .map(|v| {
+            let mut t = vec![0.0; 3 * particles.len()];
+            for (k, &i) in particles.iter().enumerate() {
+                let u = modes(i) * v;
+                for axis in (0..3).filter(|&a| !fixed(i, a)) {
+                    t[3 * k + axis] = u[axis];
+                }
+            }
+            t
+        })
+        .collect();
+    let inside = |dof: usize| {
+        let k = local[dof / 3];
+        (k != usize::MAX).then(|| 3 * k + dof % 3)
+    };
+    let mut product = vec![vec![0.0; 3 * particles.len()]; null.len()];
+    let mut outside: HashMap<usize, Vec<f64>> = HashMap::new();
+    let mut diagonal = vec![0.0; 3 * particles.len()];
+    let mut add = |row: usize, col: usize, value: f64| {
+        let Some(c) = inside(col) else { return };
+        if dofs.index(row).is_none() || dofs.index(col).is_none() {
+            return;
+        }
+        match inside(row) {
+            Some(r) => {
+                if r == c {
+                    diagonal[r] += value;
+                }
+                for (y, t) in product.iter_mut().zip(&motion) {
+                    y[r] += value * t[c];
+                }
+            }
+            None => {
+                let y = outside.entry(row).or_insert_with(|| vec![0.0; null.len()]);
+                for (y, t) in y.iter_mut().zip(&motion) {
+                    *y += value * t[c];
+                }
+            }
+        }
+    };
+    for e in tangent.stiffness_entries() {
+        add(e.row, e.col, e.val);
+        if e.row != e.col {
+            add(e.col, e.row, e.val);
+        }
+    }
+    let stiffness = diagonal.iter().fold(0.0, |m: f64, d| m.max(d.abs()));
+    (0..null.len())
+        .filter(|&k| {
+            let scale = motion[k].iter().fold(0.0, |m: f64, t| m.max(t.abs()));
+            let inner = product[k].iter().fold(0.0, |m: f64, y| m.max(y.abs()));
+            let outer = outside.values().fold(0.0, |m: f64, y| m.max(y[k].abs()));
+            scale > 0.0 && inner.max(outer) <= RIGID_TOLERANCE * stiffness * scale
+        })
+        .count()
 }
 
 /// Maps a faer error to a core error.

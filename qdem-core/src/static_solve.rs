@@ -8,11 +8,20 @@
 //! K is assembled and factorised by [`SparseCholesky`] on the first solve (with the fixity of
 //! that moment) and reused for every later load level: one further force evaluation and two
 //! triangular solves per level.
+//!
+//! K alone is singular when a deformable body is free to move rigidly (no or too few fixed
+//! directions), so such a body is refused before factorising with
+//! [`CoreError::Unconstrained`], naming it ([`crate::sparse::unconstrained_bodies`]); any other
+//! failed factorisation names the particle of the failing pivot and its body
+//! ([`crate::sparse::explain_failure`]).
 
 use crate::error::CoreError;
 use crate::model::Model;
 use crate::newmark::{collect_tangent, sum_forces};
-use crate::sparse::{assemble, FactorStats, FreeDofs, Scales, SparseCholesky, Tangent};
+use crate::sparse::{
+    assemble, explain_failure, unconstrained_bodies, FactorStats, FreeDofs, Scales, SparseCholesky,
+    Tangent, FIX_HINT,
+};
 use crate::state::State;
 use crate::Vec3;
 
@@ -64,18 +73,35 @@ impl StaticSolver {
         Ok(())
     }
 
-    /// Assembles K at the reference state and factorises it.
+    /// Assembles K at the reference state and factorises it; refuses a body free to move
+    /// rigidly first.
     fn factorize(&mut self, state: &State, models: &[Box<dyn Model>]) -> Result<(), CoreError> {
         let mut tangent = Tangent::new();
         collect_tangent(state, models, &mut tangent)?;
         let dofs = FreeDofs::new(&state.fixed);
+        if let Some((body, modes)) = unconstrained_bodies(state, models, &tangent, &dofs)
+            .into_iter()
+            .next()
+        {
+            return Err(CoreError::Unconstrained {
+                body,
+                modes,
+                what: "stiffness",
+                fix: FIX_HINT,
+            });
+        }
         let scales = Scales {
             mass: 0.0,
             damping: 0.0,
             stiffness: 1.0,
         };
         let matrix = assemble(&tangent, &state.mass, &dofs, scales, &mut Vec::new())?;
-        self.cholesky.factorize(matrix.as_ref(), "stiffness")?;
+        if let Err(error) = self.cholesky.factorize(matrix.as_ref(), "stiffness") {
+            let pivot = self.cholesky.failed_pivot();
+            return Err(explain_failure(
+                error, pivot, &dofs, state, models, &tangent,
+            ));
+        }
         self.dofs = Some(dofs);
         Ok(())
     }

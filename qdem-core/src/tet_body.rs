@@ -281,6 +281,15 @@ impl Model for TetBody {
         true
     }
 
+    fn particles(&self) -> Vec<usize> {
+        self.incidence_start
+            .windows(2)
+            .enumerate()
+            .filter(|(_, w)| w[1] > w[0])
+            .map(|(i, _)| self.first + i)
+            .collect()
+    }
+
     fn stable_dt(&self, _state: &State) -> Option<f64> {
         Some(critical_step(self.omega_squared, self.damping_rate))
     }
