@@ -3,8 +3,10 @@
 
 use crate::{bench, progress, verify};
 use qdem_bench::throughput::BenchPlan;
+use qdem_core::{Newmark, StaticSolver, Stepper};
 use qdem_io::build::{BuildError, Simulation};
-use qdem_io::runner::{run, RunError};
+use qdem_io::runner::{make_stepper, run, RunError};
+use qdem_io::scene::Integrator;
 use qdem_io::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -164,6 +166,11 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
         "verify" => {
             let o = parse(rest, &["--json", "--full", "--out"])?;
             no_positional(&o, "verify")?;
+            if o.out.is_some() && !o.full {
+                return Err(CliError::Usage(
+                    "`qdem verify --out DIR` goes with `--full`".into(),
+                ));
+            }
             let out = o.out.unwrap_or_else(|| PathBuf::from("out/verify"));
             verify::run_and_print(o.json, o.full.then_some(out.as_path()))
         }
@@ -195,12 +202,13 @@ fn run_scene(path: &Path, out: Option<&Path>) -> Result<(), CliError> {
         eprintln!("warning: {w}");
     }
     eprintln!(
-        "qdem run {}: {} particles, {} tets, dt = {:.4e} s ({:.0}% of the stable bound), {} steps, {} threads",
+        "qdem run {}: {} particles, {} tets, {} with dt = {:.4e} s ({:.3}x the explicit stable bound), {} steps, {} threads",
         path.display(),
         sim.state.len(),
         sim.tets(),
+        sim.scene.run.integrator.name(),
         sim.dt,
-        100.0 * sim.dt / sim.stable_dt.0,
+        sim.dt / sim.stable_dt.0,
         sim.steps(),
         rayon::current_num_threads()
     );
@@ -257,8 +265,16 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
         );
     }
     let (bound, limiter) = &sim.stable_dt;
-    println!("stable dt bound {bound:.6e} s (set by `{limiter}`); dt used {:.6e} s; {} steps to t_end = {} s", sim.dt, sim.steps(), sim.scene.run.t_end);
-    let per_step = measure_step_cost(&mut sim, 20);
+    println!(
+        "integrator {}: dt {:.6e} s ({:.3}x the explicit stable bound {bound:.6e} s set by `{limiter}`); {} steps to t_end = {} s",
+        sim.scene.run.integrator.name(),
+        sim.dt,
+        sim.dt / bound,
+        sim.steps(),
+        sim.scene.run.t_end
+    );
+    report_factorisation(&mut sim)?;
+    let per_step = measure_step_cost(&mut sim, 20)?;
     let total = per_step * sim.steps() as f64;
     println!(
         "measured {:.3e} s/step on {} threads ({:.3e} tet-steps/s): estimated run time {} (outputs not counted)",
@@ -270,19 +286,63 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Wall seconds per step measured over `n` steps on a copy of the state.
-fn measure_step_cost(sim: &mut Simulation, n: usize) -> f64 {
-    use qdem_core::{Stepper, Verlet};
+/// Wall seconds per step of the scene's own stepper, measured over `n` steps on a copy of the
+/// state (the first step, which factorises an implicit system, is not timed).
+fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<f64, CliError> {
     let mut state = sim.state.clone();
-    let mut stepper = Verlet::new(sim.dt);
-    if stepper.initialize(&mut state, &mut sim.models).is_err() {
-        return f64::NAN;
-    }
+    let mut stepper = make_stepper(sim).map_err(|e| CliError::Verify(e.to_string()))?;
+    let run_error = |source| RunError::Core {
+        scene: sim.scene.path.clone(),
+        source,
+    };
+    stepper
+        .initialize(&mut state, &mut sim.models)
+        .map_err(run_error)?;
     let start = Instant::now();
     for _ in 0..n {
-        if stepper.step(&mut state, &mut sim.models).is_err() {
-            return f64::NAN;
-        }
+        stepper
+            .step(&mut state, &mut sim.models)
+            .map_err(run_error)?;
     }
-    start.elapsed().as_secs_f64() / n as f64
+    Ok(start.elapsed().as_secs_f64() / n as f64)
+}
+
+/// For implicit Newmark and static scenes: the sparse system's size, non-zeros, Cholesky fill
+/// and factorisation time, from factorising it once on a copy of the state.
+fn report_factorisation(sim: &mut Simulation) -> Result<(), CliError> {
+    let run = &sim.scene.run;
+    let mut state = sim.state.clone();
+    let run_error = |source| RunError::Core {
+        scene: sim.scene.path.clone(),
+        source,
+    };
+    let stats = match run.integrator {
+        Integrator::Newmark if run.beta > 0.0 => {
+            let mut stepper = Newmark::new(run.beta, run.gamma, sim.dt).map_err(run_error)?;
+            stepper
+                .initialize(&mut state, &mut sim.models)
+                .map_err(run_error)?;
+            stepper.factor_stats().cloned()
+        }
+        Integrator::Static => {
+            let mut solver = StaticSolver::new();
+            solver
+                .solve(&mut state, &mut sim.models, run.t_end)
+                .map_err(run_error)?;
+            solver.factor_stats().cloned()
+        }
+        _ => None,
+    };
+    if let Some(s) = stats {
+        println!(
+            "implicit system: {} unknowns, {} non-zeros (lower triangle), factor {} non-zeros (fill {:.1}x); symbolic {:.3e} s, numeric {:.3e} s",
+            s.dofs,
+            s.nonzeros,
+            s.factor_nonzeros,
+            s.factor_nonzeros as f64 / s.nonzeros.max(1) as f64,
+            s.symbolic_seconds,
+            s.numeric_seconds
+        );
+    }
+    Ok(())
 }

@@ -15,12 +15,13 @@ use qdem_core::linear_tet::LinearTets;
 use qdem_core::tet_kernel::{edge_matrix, tet_stress, vertex_forces};
 use qdem_core::tet_subdomain::subdomain_forces;
 use qdem_core::{
-    Mat3, Material, Model, NodalLoad, State, Stepper, TetBody, TimeFunction, Vec3, Verlet,
+    Mat3, Material, Model, NodalLoad, State, StaticSolver, Stepper, TetBody, TimeFunction, Vec3,
+    Verlet,
 };
 use qdem_io::build::Simulation;
 use qdem_io::plot::{line_plot_svg, Labels, Series};
-use qdem_io::runner::run;
-use qdem_io::scene::Scene;
+use qdem_io::runner::{run, RunError};
+use qdem_io::scene::{Integrator, Scene, TimeStep};
 use qdem_io::spectrum::{amplitude_spectrum, dominant_frequency};
 use qdem_mesh::structured_box;
 use serde_json::json;
@@ -302,6 +303,37 @@ pub fn cantilever_static(scene: &Path) -> Result<f64, CliError> {
     Ok(solution.displacement[tip.particle].z * 1e6)
 }
 
+/// The cantilever scene stepped by implicit average-acceleration Newmark at ∆t = 10⁻⁴ s
+/// (about 370 steps per period of the first mode).
+fn implicit_variant(scene: &Path) -> Result<Scene, CliError> {
+    let mut s = Scene::load(scene)?;
+    s.run.integrator = Integrator::Newmark;
+    s.run.beta = 0.25;
+    s.run.gamma = 0.5;
+    s.run.dt = TimeStep::Fixed(1e-4);
+    s.output.vtu_every = 0.0;
+    Ok(s)
+}
+
+/// Tip deflection (µm) of the scene's `integrator = "static"` solve at t = 1.5 s (full load).
+fn static_solve_tip(scene: &Path) -> Result<f64, CliError> {
+    let mut sim = Simulation::build(Scene::load(scene)?)?;
+    let mut solver = StaticSolver::new();
+    solver
+        .solve(&mut sim.state, &mut sim.models, 1.5)
+        .map_err(|source| {
+            CliError::Run(RunError::Core {
+                scene: scene.to_path_buf(),
+                source,
+            })
+        })?;
+    let tip = sim
+        .probes
+        .first()
+        .ok_or_else(|| CliError::Verify("the cantilever scene has no probe".into()))?;
+    Ok(sim.state.displacement(tip.particle).z * 1e6)
+}
+
 /// What a cantilever run gives.
 pub struct CantileverRun {
     /// Tetrahedra of the mesh.
@@ -318,8 +350,8 @@ pub struct CantileverRun {
 
 /// Runs a cantilever scene through the normal run loop into `out` and reads its probe record
 /// back from `probes.csv`.
-pub fn cantilever(scene: &Path, out: &Path) -> Result<CantileverRun, CliError> {
-    let mut sim = Simulation::build(Scene::load(scene)?)?;
+pub fn cantilever(scene: Scene, out: &Path) -> Result<CantileverRun, CliError> {
+    let mut sim = Simulation::build(scene)?;
     let tets = sim.tets();
     let report = run(&mut sim, out, &mut |_| {})?;
     let csv = out.join("probes.csv");
@@ -372,8 +404,35 @@ fn cantilever_rows(rows: &mut Vec<Row>, out: &Path) -> Result<(), CliError> {
         let dir = out.join(format!("cantilever_lc{lc}"));
         let start = Instant::now();
         let static_uz = cantilever_static(&scene)?;
-        let r = cantilever(&scene, &dir)?;
+        let r = cantilever(Scene::load(&scene)?, &dir)?;
         let name = format!("cantilever lc=0.{lc} ({} tets)", r.tets);
+        let start_implicit = Instant::now();
+        let implicit = cantilever(
+            implicit_variant(&scene)?,
+            &out.join(format!("cantilever_lc{lc}_newmark")),
+        )?;
+        rows.push(Row::relative(
+            &format!("{name}: implicit Newmark dt=1e-4 tip uz vs explicit"),
+            r.tip_uz_um,
+            implicit.tip_uz_um,
+            Some(5e-4),
+            start_implicit,
+        ));
+        rows.push(Row::relative(
+            &format!("{name}: implicit Newmark dt=1e-4 f1 (Hz) vs explicit"),
+            r.f1_hz,
+            implicit.f1_hz,
+            None,
+            start_implicit,
+        ));
+        let start_static = Instant::now();
+        rows.push(Row::relative(
+            &format!("{name}: static solve (faer Cholesky) vs linear-tet CG oracle"),
+            static_uz,
+            static_solve_tip(&scene)?,
+            Some(1e-8),
+            start_static,
+        ));
         // Issue 3's bound for explicit QDEM against a static solve on the same mesh.
         rows.push(Row::relative(
             &format!("{name}: explicit tip uz vs same-mesh linear-tet static"),

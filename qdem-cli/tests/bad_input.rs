@@ -449,7 +449,7 @@ fn unknown_option() {
     assert_clean_error(
         "qdem verify --out x",
         &out,
-        &["unknown option `--out`", "usage:"],
+        &["`qdem verify --out DIR` goes with `--full`", "usage:"],
     );
 }
 

@@ -3,7 +3,7 @@
 //! [`TetBody`] per body, [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per load.
 
 use crate::scene::suggest::did_you_mean;
-use crate::scene::{Scene, Selection, TimeStep};
+use crate::scene::{Integrator, Scene, Selection, TimeStep};
 use qdem_core::{
     choose_step, stable_step, CoreError, Dofs, Gravity, Material, Model, NodalLoad, State, TetBody,
     Vec3,
@@ -140,15 +140,7 @@ impl Simulation {
             })
             .collect();
         let stable_dt = stable_step(&state, &models).unwrap_or((f64::INFINITY, String::new()));
-        let requested = match scene.run.dt {
-            TimeStep::Auto => None,
-            TimeStep::Fixed(dt) => Some(dt),
-        };
-        let mut dt = choose_step(&state, &models, requested, scene.run.dt_safety).map_err(core)?;
-        if requested.is_none() {
-            // Shrink the automatic step so that a whole number of steps reaches t_end.
-            dt = scene.run.t_end / (scene.run.t_end / dt).ceil();
-        }
+        let dt = choose_dt(&scene, &state, &models).map_err(core)?;
         Ok(Simulation {
             scene,
             state,
@@ -273,6 +265,32 @@ fn build_loads(
         models.push(Box::new(NodalLoad::new(&what, particles, total, ramp)));
     }
     Ok(())
+}
+
+/// The step of the scene's integrator: for Verlet and explicit Newmark (β = 0) the stable
+/// bound times `dt_safety` (or the user's dt, refused above the bound); for implicit Newmark
+/// the user's dt; for the static solve the load-level interval (`dt`, else `probe_every`,
+/// else t_end/100). An automatic step is shrunk so that a whole number of steps reaches t_end.
+fn choose_dt(scene: &Scene, state: &State, models: &[Box<dyn Model>]) -> Result<f64, CoreError> {
+    let run = &scene.run;
+    let requested = match run.dt {
+        TimeStep::Auto => None,
+        TimeStep::Fixed(dt) => Some(dt),
+    };
+    let explicit = match run.integrator {
+        Integrator::Verlet => true,
+        Integrator::Newmark => run.beta == 0.0,
+        Integrator::Static => false,
+    };
+    let dt = match (explicit, requested) {
+        (true, _) => choose_step(state, models, requested, run.dt_safety)?,
+        (false, Some(dt)) => return Ok(dt),
+        (false, None) => run.probe_every.unwrap_or(run.t_end / 100.0),
+    };
+    Ok(match requested {
+        Some(dt) => dt,
+        None => run.t_end / (run.t_end / dt).ceil(),
+    })
 }
 
 /// Index of a body that the validated scene guarantees to exist.

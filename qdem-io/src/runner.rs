@@ -8,7 +8,8 @@
 use crate::build::Simulation;
 use crate::output::{write_summary, write_vtu, OutputError, ProbeCsv, PvdIndex, VtuGrid};
 use crate::plot::{line_plot_svg, Labels, Series};
-use qdem_core::{CoreError, Stepper, Vec3, Verlet};
+use crate::scene::Integrator;
+use qdem_core::{CoreError, Model, Newmark, State, StaticSolver, Stepper, Vec3, Verlet};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -126,7 +127,7 @@ pub fn run(
     let mut probe_schedule = Schedule::new(probe_every);
     let mut vtu_schedule = Schedule::new(sim.scene.output.vtu_every);
     let mut pvd = PvdIndex::new();
-    let mut stepper = Verlet::new(sim.dt);
+    let mut stepper = make_stepper(sim).map_err(|source| core_error(sim, source))?;
     let start = Instant::now();
     let mut last_report = start;
     let outcome = (|| -> Result<(), RunError> {
@@ -205,6 +206,50 @@ fn plot_probes(
         y: "displacement (m)",
     };
     line_plot_svg(path, &labels, &series)
+}
+
+/// The scene's stepper with the simulation's step.
+pub fn make_stepper(sim: &Simulation) -> Result<Box<dyn Stepper>, CoreError> {
+    let run = &sim.scene.run;
+    Ok(match run.integrator {
+        Integrator::Verlet => Box::new(Verlet::new(sim.dt)),
+        Integrator::Newmark => Box::new(Newmark::new(run.beta, run.gamma, sim.dt)?),
+        Integrator::Static => Box::new(StaticSteps {
+            solver: StaticSolver::new(),
+            dt: sim.dt,
+        }),
+    })
+}
+
+/// The static solve as a stepper: each step advances the load time by `dt` and solves
+/// K·u = f(t) with the factorisation of the first solve.
+struct StaticSteps {
+    solver: StaticSolver,
+    dt: f64,
+}
+
+impl Stepper for StaticSteps {
+    fn name(&self) -> &str {
+        "static"
+    }
+
+    fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    fn initialize(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+    ) -> Result<(), CoreError> {
+        let time = state.time;
+        self.solver.solve(state, models, time)
+    }
+
+    fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {
+        let time = state.time + self.dt;
+        self.solver.solve(state, models, time)
+    }
 }
 
 fn core_error(sim: &Simulation, source: CoreError) -> RunError {

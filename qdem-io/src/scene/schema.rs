@@ -37,6 +37,21 @@ pub struct Run {
     /// [`Run::DEFAULT_DT_SAFETY`].
     #[serde(default = "default_dt_safety")]
     pub dt_safety: f64,
+    /// Newmark β (paper 001 Eq. 13), for `integrator = "newmark"`; default ¼ (average
+    /// acceleration, implicit). β = 0 with γ = ½ is explicit central difference.
+    #[serde(default = "default_beta")]
+    pub beta: f64,
+    /// Newmark γ (paper 001 Eq. 14), for `integrator = "newmark"`; default ½.
+    #[serde(default = "default_gamma")]
+    pub gamma: f64,
+}
+
+fn default_beta() -> f64 {
+    0.25
+}
+
+fn default_gamma() -> f64 {
+    0.5
 }
 
 impl Run {
@@ -122,16 +137,27 @@ pub enum Integrator {
     #[default]
     #[serde(rename = "verlet")]
     Verlet,
+    /// Newmark-β with `beta` and `gamma` (paper 001 Eqs. 13–16, 22–27): implicit for β > 0
+    /// (needs a numeric `dt`), explicit central difference for β = 0.
+    #[serde(rename = "newmark")]
+    Newmark,
+    /// Linear static solve K·u = f at every `dt` (default: every `probe_every`) of the load
+    /// ramp up to `t_end`; velocities and accelerations are zero.
+    #[serde(rename = "static")]
+    Static,
 }
 
 impl Integrator {
     /// Every integrator, in the order the error messages list them.
-    pub const ALL: &'static [Integrator] = &[Integrator::Verlet];
+    pub const ALL: &'static [Integrator] =
+        &[Integrator::Verlet, Integrator::Newmark, Integrator::Static];
 
     /// The name used in scene files.
     pub fn name(self) -> &'static str {
         match self {
             Integrator::Verlet => "verlet",
+            Integrator::Newmark => "newmark",
+            Integrator::Static => "static",
         }
     }
 }

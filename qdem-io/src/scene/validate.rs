@@ -5,7 +5,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use super::error::{Diagnostic, SceneError};
-use super::schema::{Fix, Load, Ramp, RawFix, RawLoad, RawScene, Selection, TimeStep};
+use super::schema::{Fix, Integrator, Load, Ramp, RawFix, RawLoad, RawScene, Selection, TimeStep};
 use super::spans::SpanIndex;
 use super::suggest::did_you_mean;
 use super::Scene;
@@ -359,6 +359,29 @@ pub(crate) fn validate(
                  step used by dt = \"auto\"; e.g. 0.9"
             ),
         );
+    }
+
+    if run.integrator == Integrator::Newmark {
+        let (beta, gamma) = (run.beta, run.gamma);
+        if c.finite(&["run", "beta"], "[run]", "beta", &[beta, gamma])
+            && !((0.0..=1.0).contains(&gamma) && (0.0..=0.5).contains(&beta))
+        {
+            c.error(
+                &["run", "beta"],
+                format!(
+                    "[run]: beta = {beta}, gamma = {gamma}: Newmark needs 0 <= gamma <= 1 and \
+                     0 <= 2 beta <= 1 (paper 001 Eq. 16); e.g. beta = 0.25, gamma = 0.5"
+                ),
+            );
+        }
+        if beta > 0.0 && run.dt == TimeStep::Auto {
+            c.error(
+                &["run", "dt"],
+                "[run]: implicit Newmark (beta > 0) has no stable-step bound to choose dt from: \
+                 give dt in seconds"
+                    .to_owned(),
+            );
+        }
     }
 
     // [[material]]
