@@ -1,6 +1,8 @@
 //! `qdem bench`: prints the throughput measurements of [`qdem_bench::throughput`] as a table
 //! or as one JSON document.
 
+use crate::command::CliError;
+use qdem_bench::implicit::measure_implicit;
 use qdem_bench::throughput::{
     cpu_model, measure, measure_ordered, triad_bandwidth, BenchPlan, Ordering,
 };
@@ -100,4 +102,61 @@ fn locality_rows(plan: &BenchPlan, as_json: bool) -> Vec<serde_json::Value> {
             json!({"ordering": format!("{ordering:?}").to_lowercase(), "tets": r.tets, "threads": threads, "tet_steps_per_second": r.tet_steps_per_second()})
         })
         .collect()
+}
+
+/// `qdem bench --implicit`: the implicit path's costs against the number of unknowns, by
+/// default on blocks of about 10⁴, 10⁵ and 3 × 10⁵ unknowns.
+pub fn implicit_and_print(
+    tets: Option<Vec<usize>>,
+    threads: usize,
+    as_json: bool,
+) -> Result<(), CliError> {
+    let sizes = tets.unwrap_or_else(|| vec![16_000, 180_000, 550_000]);
+    if !as_json {
+        println!("machine: {}, {threads} threads", cpu_model());
+        println!(
+            "{:>8} {:>8} {:>10} {:>12} {:>9} {:>9} {:>9} {:>9} {:>9} {:>10}",
+            "tets",
+            "unknowns",
+            "nnz(A)",
+            "nnz(L)",
+            "assemble",
+            "symbolic",
+            "numeric",
+            "solve",
+            "step",
+            "step/solve"
+        );
+    }
+    let mut results = Vec::new();
+    for size in sizes {
+        let r = measure_implicit(size, threads).map_err(|e| CliError::Verify(e.to_string()))?;
+        let ratio = r.step_seconds / r.solve_seconds;
+        if !as_json {
+            println!(
+                "{:>8} {:>8} {:>10} {:>12} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>10.2}",
+                r.tets,
+                r.dofs,
+                r.nonzeros,
+                r.factor_nonzeros,
+                r.assembly_seconds,
+                r.symbolic_seconds,
+                r.numeric_seconds,
+                r.solve_seconds,
+                r.step_seconds,
+                ratio
+            );
+        }
+        results.push(json!({
+            "tets": r.tets, "unknowns": r.dofs, "nonzeros": r.nonzeros, "factor_nonzeros": r.factor_nonzeros,
+            "assembly_seconds": r.assembly_seconds, "symbolic_seconds": r.symbolic_seconds,
+            "numeric_seconds": r.numeric_seconds, "solve_seconds": r.solve_seconds,
+            "step_seconds": r.step_seconds, "step_over_solve": ratio,
+        }));
+    }
+    if as_json {
+        let doc = json!({"machine": {"cpu": cpu_model(), "threads": threads}, "implicit": results});
+        println!("{}", serde_json::to_string_pretty(&doc).expect("json"));
+    }
+    Ok(())
 }

@@ -20,7 +20,9 @@ usage:
   qdem verify [--json] [--full [--out DIR]]  run the analytical fixtures (--full adds the cantilever meshes,
                                              keeping their outputs and plots in DIR, default out/verify)
   qdem bench [--json] [--tets N,N,..] [--threads N,N,..] [--steps N]
-                                             kernel throughput on structured meshes, tet-steps/s";
+                                             kernel throughput on structured meshes, tet-steps/s
+  qdem bench --implicit [--json] [--tets N,..] [--threads N]
+                                             sparse Cholesky: factorisation, solve and implicit step vs unknowns";
 
 /// Everything the command line reports as an error.
 #[derive(Debug, Error)]
@@ -58,6 +60,7 @@ struct Options {
     threads: Option<Vec<usize>>,
     json: bool,
     full: bool,
+    implicit: bool,
     tets: Option<Vec<usize>>,
     steps: Option<usize>,
 }
@@ -99,6 +102,7 @@ fn parse(args: &[String], allowed: &[&str]) -> Result<Options, CliError> {
             "--out" => o.out = Some(PathBuf::from(value()?)),
             "--json" => o.json = true,
             "--full" => o.full = true,
+            "--implicit" => o.implicit = true,
             "--steps" => o.steps = Some(parse_list(arg, &value()?)?[0]),
             "--tets" => o.tets = Some(parse_list(arg, &value()?)?),
             "--threads" => o.threads = Some(parse_list(arg, &value()?)?),
@@ -175,8 +179,19 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
             verify::run_and_print(o.json, o.full.then_some(out.as_path()))
         }
         "bench" => {
-            let o = parse(rest, &["--json", "--tets", "--threads", "--steps"])?;
+            let o = parse(
+                rest,
+                &["--json", "--tets", "--threads", "--steps", "--implicit"],
+            )?;
             no_positional(&o, "bench")?;
+            if o.implicit {
+                let threads = o
+                    .threads
+                    .as_deref()
+                    .and_then(|t| t.last().copied())
+                    .unwrap_or(2);
+                return bench::implicit_and_print(o.tets, threads, o.json);
+            }
             bench::run_and_print(&BenchPlan::new(o.tets, o.threads, o.steps), o.json);
             Ok(())
         }

@@ -1,0 +1,90 @@
+//! Cost of the implicit path (paper 001 Eqs. 22–27 with faer's sparse Cholesky) against the
+//! number of unknowns: assembly of M + γ∆t C + β∆t² K, symbolic analysis, numeric
+//! factorisation, one forward/backward solve, and one implicit Newmark step that reuses the
+//! factorisation (force evaluation + solve + update), on a structured block clamped on one face.
+
+use crate::throughput::{block_mesh, body_on, Ordering};
+use qdem_core::sparse::{assemble, FreeDofs, Scales, SparseCholesky};
+use qdem_core::{CoreError, Dofs, Model, Newmark, Stepper, Tangent};
+use std::time::Instant;
+
+/// One measurement of the implicit path.
+#[derive(Clone, Debug)]
+pub struct ImplicitResult {
+    /// Tetrahedra.
+    pub tets: usize,
+    /// Unknowns after eliminating the clamped face.
+    pub dofs: usize,
+    /// Non-zeros of the lower triangle of the system matrix.
+    pub nonzeros: usize,
+    /// Stored values of the Cholesky factor.
+    pub factor_nonzeros: usize,
+    /// Assembly seconds.
+    pub assembly_seconds: f64,
+    /// Symbolic analysis seconds.
+    pub symbolic_seconds: f64,
+    /// Numeric factorisation seconds.
+    pub numeric_seconds: f64,
+    /// Seconds of one forward and backward triangular solve.
+    pub solve_seconds: f64,
+    /// Seconds of one implicit Newmark step with the factorisation reused.
+    pub step_seconds: f64,
+}
+
+/// Measures the implicit path on a block of about `tets` tetrahedra on `threads` threads.
+pub fn measure_implicit(tets: usize, threads: usize) -> Result<ImplicitResult, CoreError> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
+    pool.install(|| {
+        let mesh = block_mesh(tets, Ordering::Structured);
+        let clamp = mesh.group("xmin").expect("structured groups").nodes.clone();
+        let (body, mut state) = body_on(mesh, false);
+        for n in clamp {
+            state.fix(n as usize, Dofs::ALL);
+        }
+        let dt = 1e-4;
+        let tets = body.tets().len();
+        let start = Instant::now();
+        let mut tangent = Tangent::new();
+        body.add_tangent(&state, &mut tangent);
+        let dofs = FreeDofs::new(&state.fixed);
+        let scales = Scales {
+            mass: 1.0,
+            damping: 0.5 * dt,
+            stiffness: 0.25 * dt * dt,
+        };
+        let matrix = assemble(&tangent, &state.mass, &dofs, scales, &mut Vec::new())?;
+        let assembly_seconds = start.elapsed().as_secs_f64();
+        let mut cholesky = SparseCholesky::new();
+        cholesky.factorize(matrix.as_ref(), "benchmark system")?;
+        let stats = cholesky.stats().clone();
+        let mut rhs = vec![1.0; dofs.len()];
+        let start = Instant::now();
+        let solves = 5;
+        for _ in 0..solves {
+            cholesky.solve_in_place(&mut rhs);
+        }
+        let solve_seconds = start.elapsed().as_secs_f64() / solves as f64;
+        let mut models: Vec<Box<dyn Model>> = vec![Box::new(body)];
+        let mut stepper = Newmark::average_acceleration(dt);
+        stepper.initialize(&mut state, &mut models)?;
+        let steps = 5;
+        let start = Instant::now();
+        for _ in 0..steps {
+            stepper.step(&mut state, &mut models)?;
+        }
+        Ok(ImplicitResult {
+            tets,
+            dofs: stats.dofs,
+            nonzeros: stats.nonzeros,
+            factor_nonzeros: stats.factor_nonzeros,
+            assembly_seconds,
+            symbolic_seconds: stats.symbolic_seconds,
+            numeric_seconds: stats.numeric_seconds,
+            solve_seconds,
+            step_seconds: start.elapsed().as_secs_f64() / steps as f64,
+        })
+    })
+}
