@@ -41,7 +41,9 @@ use crate::sparse::{
     assemble, explain_failure, Entry, FactorStats, FreeDofs, Scales, SparseCholesky, Tangent,
 };
 use crate::state::State;
-use crate::stepper::{check_masses, compute_accelerations, Stepper, PARTICLE_CHUNK};
+use crate::stepper::{
+    check_finite, check_masses, compute_accelerations, sum_forces, Stepper, PARTICLE_CHUNK,
+};
 use crate::Vec3;
 use rayon::prelude::*;
 
@@ -191,30 +193,6 @@ pub(crate) fn collect_tangent(
     match models.iter().find(|m| !m.add_tangent(state, tangent)) {
         Some(model) => Err(CoreError::NoTangent {
             model: model.name().to_string(),
-        }),
-        None => Ok(()),
-    }
-}
-
-/// Sums the forces of all models at `state` into `force` (resized and zeroed here).
-pub(crate) fn sum_forces(state: &State, models: &mut [Box<dyn Model>], force: &mut Vec<Vec3>) {
-    force.clear();
-    force.resize(state.len(), Vec3::zeros());
-    for model in models.iter_mut() {
-        model.add_forces(state, force);
-    }
-}
-
-/// Fails on the first particle with a non-finite acceleration.
-fn check_finite(state: &State) -> Result<(), CoreError> {
-    match state
-        .acceleration
-        .iter()
-        .position(|a| !a.iter().all(|c| c.is_finite()))
-    {
-        Some(particle) => Err(CoreError::NonFinite {
-            time: state.time,
-            particle,
         }),
         None => Ok(()),
     }

@@ -17,12 +17,13 @@
 
 use crate::error::CoreError;
 use crate::model::Model;
-use crate::newmark::{collect_tangent, sum_forces};
+use crate::newmark::collect_tangent;
 use crate::sparse::{
     assemble, explain_failure, unconstrained_bodies, FactorStats, FreeDofs, Scales, SparseCholesky,
     Tangent, FIX_HINT,
 };
 use crate::state::State;
+use crate::stepper::sum_forces;
 use crate::Vec3;
 
 /// A linear static solver that keeps the factorisation of K across load levels.

@@ -30,6 +30,30 @@ pub trait Stepper {
     fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError>;
 }
 
+/// Sums the forces of all models at `state` into `force` (resized and zeroed here).
+pub(crate) fn sum_forces(state: &State, models: &mut [Box<dyn Model>], force: &mut Vec<Vec3>) {
+    force.clear();
+    force.resize(state.len(), Vec3::zeros());
+    for model in models.iter_mut() {
+        model.add_forces(state, force);
+    }
+}
+
+/// Fails on the first particle with a non-finite acceleration.
+pub(crate) fn check_finite(state: &State) -> Result<(), CoreError> {
+    match state
+        .acceleration
+        .iter()
+        .position(|a| !a.iter().all(|c| c.is_finite()))
+    {
+        Some(particle) => Err(CoreError::NonFinite {
+            time: state.time,
+            particle,
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Sums the forces of all models into `force` (resized and zeroed here) and sets
 /// a = f/m, zero in fixed directions. Fails on a non-finite acceleration.
 pub fn compute_accelerations(
@@ -37,11 +61,7 @@ pub fn compute_accelerations(
     models: &mut [Box<dyn Model>],
     force: &mut Vec<Vec3>,
 ) -> Result<(), CoreError> {
-    force.clear();
-    force.resize(state.len(), Vec3::zeros());
-    for model in models.iter_mut() {
-        model.add_forces(state, force);
-    }
+    sum_forces(state, models, force);
     let (mass, fixed) = (&state.mass, &state.fixed);
     state
         .acceleration
@@ -57,17 +77,7 @@ pub fn compute_accelerations(
             }
             *a = acc;
         });
-    match state
-        .acceleration
-        .iter()
-        .position(|a| !a.iter().all(|c| c.is_finite()))
-    {
-        Some(particle) => Err(CoreError::NonFinite {
-            time: state.time,
-            particle,
-        }),
-        None => Ok(()),
-    }
+    check_finite(state)
 }
 
 /// Checks that every particle that is free in some direction has a positive mass.
