@@ -5,49 +5,17 @@
 //! The scenes and meshes live in `fixtures/bad/`; each scene refers to its mesh by a path
 //! relative to the scene file.
 
+mod common;
+use common::{workspace, TempDir};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 const QDEM: &str = env!("CARGO_BIN_EXE_qdem");
-
-/// The workspace root.
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("qdem-cli lies in the workspace")
-        .to_path_buf()
-}
 
 /// A file of `fixtures/bad/`, as an absolute path.
 fn bad(name: &str) -> PathBuf {
     workspace().join("fixtures/bad").join(name)
-}
-
-/// A unique temporary directory, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        static COUNTER: AtomicUsize = AtomicUsize::new(0);
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.as_nanos());
-        let dir = std::env::temp_dir().join(format!(
-            "qdem-cli-bad-{tag}-{}-{}-{nanos}",
-            std::process::id(),
-            COUNTER.fetch_add(1, Ordering::Relaxed)
-        ));
-        std::fs::create_dir_all(&dir).expect("create the temporary directory");
-        TempDir(dir)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 /// Runs `qdem ARGS` in `cwd` (the workspace root when `None`).
@@ -146,7 +114,7 @@ fn check_and_run(scene: &Path, needles: &[&str]) -> String {
     );
 
     let tmp = TempDir::new("run");
-    let out_dir = tmp.0.join("out");
+    let out_dir = tmp.path().join("out");
     let run = qdem(&[
         OsStr::new("run"),
         scene.as_os_str(),
@@ -389,7 +357,7 @@ fn run_and_check_without_a_scene() {
 #[test]
 fn zero_threads() {
     let tmp = TempDir::new("threads0");
-    let out_dir = tmp.0.join("out");
+    let out_dir = tmp.path().join("out");
     let scene = good_scene();
     let run = qdem(&[
         OsStr::new("run"),

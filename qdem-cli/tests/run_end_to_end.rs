@@ -3,10 +3,11 @@
 //! back by meshio, and bit-identical probes for 1 and 2 threads.
 
 use std::collections::HashMap;
+mod common;
+use common::{workspace, TempDir};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 const QDEM: &str = env!("CARGO_BIN_EXE_qdem");
 
@@ -19,42 +20,6 @@ const TETS: u64 = 915;
 const T_END: f64 = 0.02;
 const PROBE_EVERY: f64 = 1e-3;
 const VTU_EVERY: f64 = 0.01;
-
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("qdem-cli lies in the workspace")
-        .to_path_buf()
-}
-
-/// A unique temporary directory, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        static COUNTER: AtomicUsize = AtomicUsize::new(0);
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.as_nanos());
-        let dir = std::env::temp_dir().join(format!(
-            "qdem-cli-e2e-{tag}-{}-{}-{nanos}",
-            std::process::id(),
-            COUNTER.fetch_add(1, Ordering::Relaxed)
-        ));
-        std::fs::create_dir_all(&dir).expect("create the temporary directory");
-        TempDir(dir)
-    }
-
-    fn path(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// Replaces the one line of `text` that equals `from` (after trimming) by `to`.
 fn replace_line(text: &str, from: &str, to: &str) -> String {

@@ -1,28 +1,12 @@
 //! Atomic writes: failures keep the previous content and leave no temporary file;
 //! streamed files appear only on commit; the summary JSON goes through the same path.
 
+mod common;
+use common::*;
 use std::io::{self, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use qdem_io::output::{write_atomic, write_summary, AtomicFile, IoStage, OutputError};
-
-/// A fresh, empty directory for one test.
-fn test_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("qdem-io-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// The names of all entries of `dir`.
-fn entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
 
 #[test]
 fn failing_writer_keeps_previous_content_and_no_temp_file() {

@@ -7,15 +7,9 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use nalgebra::{Matrix3, Vector3};
+mod common;
+use common::test_dir;
 use qdem_io::output::{write_vtu, VtuGrid};
-
-/// A fresh, empty directory for one test.
-fn test_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("qdem-io-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// The linear field u(x) = A x + b; must match `A`, `B` in `tests/meshio_check.py`.
 fn displacement_field(x: &Vector3<f64>) -> Vector3<f64> {

@@ -1,28 +1,11 @@
 //! PVD collection and probe CSV: exact text layout, and numbers that parse back to the
 //! same `f64`.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::*;
 
 use nalgebra::Vector3;
 use qdem_io::output::{OutputError, ProbeCsv, PvdIndex};
-
-/// A fresh, empty directory for one test.
-fn test_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("qdem-io-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// The names of all entries of `dir`.
-fn entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
 
 #[test]
 fn pvd_is_complete_after_each_write() {

@@ -1,28 +1,11 @@
 //! VTU writer: exact round trip of a small mesh through a hand-written reader, validation
 //! errors, and failure cleanup.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::*;
 
 use nalgebra::Vector3;
 use qdem_io::output::{write_vtu, OutputError, VtuGrid};
-
-/// A fresh, empty directory for one test.
-fn test_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("qdem-io-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// The names of all entries of `dir`.
-fn entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
 
 fn b64_decode(text: &str) -> Vec<u8> {
     fn val(c: u8) -> u32 {
