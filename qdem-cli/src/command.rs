@@ -39,6 +39,9 @@ pub enum CliError {
     /// A run that failed.
     #[error(transparent)]
     Run(#[from] RunError),
+    /// A cantilever run of `verify --full` failed.
+    #[error(transparent)]
+    Study(#[from] qdem_bench::cantilever::StudyError),
     /// A verification fixture that failed to run or missed its tolerance.
     #[error("{0}")]
     Verify(String),

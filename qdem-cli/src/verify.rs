@@ -11,6 +11,9 @@
 //! own oracle: they must agree in the small-strain limit).
 
 use crate::command::CliError;
+use qdem_bench::cantilever::{
+    cantilever, cantilever_scene, newmark_variant, CALCULIX_F1_HZ, CALCULIX_TIP_UZ_UM,
+};
 use qdem_core::linear_tet::LinearTets;
 use qdem_core::tet_kernel::{edge_matrix, tet_stress, vertex_forces};
 use qdem_core::tet_subdomain::subdomain_forces;
@@ -20,18 +23,12 @@ use qdem_core::{
 };
 use qdem_io::build::Simulation;
 use qdem_io::plot::{line_plot_svg, Labels, Series};
-use qdem_io::runner::{run, RunError};
-use qdem_io::scene::{Integrator, Scene, TimeStep};
-use qdem_io::spectrum::{amplitude_spectrum, dominant_frequency};
+use qdem_io::runner::RunError;
+use qdem_io::scene::Scene;
 use qdem_mesh::structured_box;
 use serde_json::json;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
-
-/// The cantilever's converged 3D answer (CalculiX C3D10, shared/references/cantilever.md).
-pub const CANTILEVER_TIP_UZ_UM: f64 = -92.651;
-/// The cantilever's first vertical bending frequency, CalculiX C3D10 (Hz).
-pub const CANTILEVER_F1_HZ: f64 = 26.874;
 
 /// One verification result.
 #[derive(Clone, Debug)]
@@ -274,13 +271,6 @@ pub fn p_wave_speed() -> Row {
     )
 }
 
-/// Directory of the shipped fixtures.
-pub fn fixtures_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .join("fixtures")
-}
-
 /// Tip deflection (µm) of a cantilever scene's mesh, loads (at t = 1.5 s) and fixity, from the
 /// independent small-strain linear-tet static solve of [`qdem_core::linear_tet`].
 pub fn cantilever_static(scene: &Path) -> Result<f64, CliError> {
@@ -303,18 +293,6 @@ pub fn cantilever_static(scene: &Path) -> Result<f64, CliError> {
     Ok(solution.displacement[tip.particle].z * 1e6)
 }
 
-/// The cantilever scene stepped by implicit average-acceleration Newmark at ∆t = 10⁻⁴ s
-/// (about 370 steps per period of the first mode).
-fn implicit_variant(scene: &Path) -> Result<Scene, CliError> {
-    let mut s = Scene::load(scene)?;
-    s.run.integrator = Integrator::Newmark;
-    s.run.beta = 0.25;
-    s.run.gamma = 0.5;
-    s.run.dt = TimeStep::Fixed(1e-4);
-    s.output.vtu_every = 0.0;
-    Ok(s)
-}
-
 /// Tip deflection (µm) of the scene's `integrator = "static"` solve at t = 1.5 s (full load).
 fn static_solve_tip(scene: &Path) -> Result<f64, CliError> {
     let mut sim = Simulation::build(Scene::load(scene)?)?;
@@ -334,60 +312,6 @@ fn static_solve_tip(scene: &Path) -> Result<f64, CliError> {
     Ok(sim.state.displacement(tip.particle).z * 1e6)
 }
 
-/// What a cantilever run gives.
-pub struct CantileverRun {
-    /// Tetrahedra of the mesh.
-    pub tets: usize,
-    /// Steady tip deflection, mean over 1–2 s (µm).
-    pub tip_uz_um: f64,
-    /// First bending frequency from the FFT of the free vibration after 2 s (Hz).
-    pub f1_hz: f64,
-    /// Wall seconds of the run.
-    pub wall_seconds: f64,
-    /// Amplitude spectrum of the free vibration (Hz, µm).
-    pub spectrum: Vec<(f64, f64)>,
-}
-
-/// Runs a cantilever scene through the normal run loop into `out` and reads its probe record
-/// back from `probes.csv`.
-pub fn cantilever(scene: Scene, out: &Path) -> Result<CantileverRun, CliError> {
-    let mut sim = Simulation::build(scene)?;
-    let tets = sim.tets();
-    let report = run(&mut sim, out, &mut |_| {})?;
-    let csv = out.join("probes.csv");
-    let text = std::fs::read_to_string(&csv)
-        .map_err(|e| CliError::Verify(format!("{}: {e}", csv.display())))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    let column = header
-        .iter()
-        .position(|h| *h == "tip.uz")
-        .ok_or_else(|| CliError::Verify(format!("{}: no tip.uz column", csv.display())))?;
-    let rows: Vec<(f64, f64)> = lines
-        .map(|l| {
-            let f: Vec<f64> = l
-                .split(',')
-                .map(|v| v.parse().unwrap_or(f64::NAN))
-                .collect();
-            (f[0], f[column] * 1e6)
-        })
-        .collect();
-    let steady: Vec<f64> = rows
-        .iter()
-        .filter(|r| r.0 >= 1.0 && r.0 <= 2.0)
-        .map(|r| r.1)
-        .collect();
-    let free: Vec<f64> = rows.iter().filter(|r| r.0 > 2.0).map(|r| r.1).collect();
-    let dt = sim.scene.run.probe_every.unwrap_or(1e-4);
-    Ok(CantileverRun {
-        tets,
-        tip_uz_um: steady.iter().sum::<f64>() / steady.len().max(1) as f64,
-        f1_hz: dominant_frequency(&free, dt).unwrap_or(f64::NAN),
-        wall_seconds: report.wall_seconds,
-        spectrum: amplitude_spectrum(&free, dt),
-    })
-}
-
 fn plot(path: &Path, labels: &Labels<'_>, series: &[Series<'_>]) -> Result<(), CliError> {
     line_plot_svg(path, labels, series).map_err(|e| CliError::Verify(e.to_string()))
 }
@@ -398,9 +322,7 @@ fn cantilever_rows(rows: &mut Vec<Row>, out: &Path) -> Result<(), CliError> {
     let mut convergence = [Vec::new(), Vec::new()];
     let mut speed = Vec::new();
     for lc in ["100", "070", "050"] {
-        let scene = fixtures_dir()
-            .join("cantilever")
-            .join(format!("cantilever_lc{lc}.toml"));
+        let scene = cantilever_scene(lc);
         let dir = out.join(format!("cantilever_lc{lc}"));
         let start = Instant::now();
         let static_uz = cantilever_static(&scene)?;
@@ -408,7 +330,7 @@ fn cantilever_rows(rows: &mut Vec<Row>, out: &Path) -> Result<(), CliError> {
         let name = format!("cantilever lc=0.{lc} ({} tets)", r.tets);
         let start_implicit = Instant::now();
         let implicit = cantilever(
-            implicit_variant(&scene)?,
+            newmark_variant(&scene, 1e-4)?,
             &out.join(format!("cantilever_lc{lc}_newmark")),
         )?;
         rows.push(Row::relative(
@@ -443,21 +365,21 @@ fn cantilever_rows(rows: &mut Vec<Row>, out: &Path) -> Result<(), CliError> {
         ));
         rows.push(Row::relative(
             &format!("{name}: linear-tet static tip uz (um) vs CalculiX"),
-            CANTILEVER_TIP_UZ_UM,
+            CALCULIX_TIP_UZ_UM,
             static_uz,
             None,
             start,
         ));
         rows.push(Row::relative(
             &format!("{name}: tip uz (um) vs CalculiX C3D10"),
-            CANTILEVER_TIP_UZ_UM,
+            CALCULIX_TIP_UZ_UM,
             r.tip_uz_um,
             None,
             start,
         ));
         rows.push(Row::relative(
             &format!("{name}: f1 (Hz) vs CalculiX C3D10"),
-            CANTILEVER_F1_HZ,
+            CALCULIX_F1_HZ,
             r.f1_hz,
             None,
             start,
@@ -481,11 +403,11 @@ fn cantilever_rows(rows: &mut Vec<Row>, out: &Path) -> Result<(), CliError> {
                 points: &band,
             }],
         )?;
-        let error = 100.0 * (r.tip_uz_um / CANTILEVER_TIP_UZ_UM - 1.0).abs();
+        let error = 100.0 * (r.tip_uz_um / CALCULIX_TIP_UZ_UM - 1.0).abs();
         convergence[0].push((r.tets as f64, error));
         convergence[1].push((
             r.tets as f64,
-            100.0 * (static_uz / CANTILEVER_TIP_UZ_UM - 1.0).abs(),
+            100.0 * (static_uz / CALCULIX_TIP_UZ_UM - 1.0).abs(),
         ));
         speed.push((r.wall_seconds, error));
     }
