@@ -3,10 +3,8 @@
 
 use crate::{bench, progress, verify};
 use qdem_bench::throughput::BenchPlan;
-use qdem_core::{Newmark, StaticSolver, Stepper};
 use qdem_io::build::{BuildError, Simulation};
 use qdem_io::runner::{make_stepper, run, RunError};
-use qdem_io::scene::Integrator;
 use qdem_io::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -291,7 +289,6 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
         sim.steps(),
         sim.scene.run.t_end
     );
-    report_factorisation(&mut sim)?;
     let per_step = measure_step_cost(&mut sim, 20)?;
     let total = per_step * sim.steps() as f64;
     println!(
@@ -305,53 +302,20 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
 }
 
 /// Wall seconds per step of the scene's own stepper, measured over `n` steps on a copy of the
-/// state (the first step, which factorises an implicit system, is not timed).
+/// state; for implicit and static scenes also prints the sparse system's size, non-zeros,
+/// Cholesky fill and factorisation time from the stepper's one factorisation (in
+/// `initialize`, which is not timed).
 fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<f64, CliError> {
-    let mut state = sim.state.clone();
-    let mut stepper = make_stepper(sim).map_err(|e| CliError::Verify(e.to_string()))?;
     let run_error = |source| RunError::Core {
         scene: sim.scene.path.clone(),
         source,
     };
+    let mut state = sim.state.clone();
+    let mut stepper = make_stepper(sim).map_err(run_error)?;
     stepper
         .initialize(&mut state, &mut sim.models)
         .map_err(run_error)?;
-    let start = Instant::now();
-    for _ in 0..n {
-        stepper
-            .step(&mut state, &mut sim.models)
-            .map_err(run_error)?;
-    }
-    Ok(start.elapsed().as_secs_f64() / n as f64)
-}
-
-/// For implicit Newmark and static scenes: the sparse system's size, non-zeros, Cholesky fill
-/// and factorisation time, from factorising it once on a copy of the state.
-fn report_factorisation(sim: &mut Simulation) -> Result<(), CliError> {
-    let run = &sim.scene.run;
-    let mut state = sim.state.clone();
-    let run_error = |source| RunError::Core {
-        scene: sim.scene.path.clone(),
-        source,
-    };
-    let stats = match run.integrator {
-        Integrator::Newmark if run.beta > 0.0 => {
-            let mut stepper = Newmark::new(run.beta, run.gamma, sim.dt).map_err(run_error)?;
-            stepper
-                .initialize(&mut state, &mut sim.models)
-                .map_err(run_error)?;
-            stepper.factor_stats().cloned()
-        }
-        Integrator::Static => {
-            let mut solver = StaticSolver::new();
-            solver
-                .solve(&mut state, &mut sim.models, run.t_end)
-                .map_err(run_error)?;
-            solver.factor_stats().cloned()
-        }
-        _ => None,
-    };
-    if let Some(s) = stats {
+    if let Some(s) = stepper.factor_stats() {
         println!(
             "implicit system: {} unknowns, {} non-zeros (lower triangle), factor {} non-zeros (fill {:.1}x); symbolic {:.3e} s, numeric {:.3e} s",
             s.dofs,
@@ -362,5 +326,11 @@ fn report_factorisation(sim: &mut Simulation) -> Result<(), CliError> {
             s.numeric_seconds
         );
     }
-    Ok(())
+    let start = Instant::now();
+    for _ in 0..n {
+        stepper
+            .step(&mut state, &mut sim.models)
+            .map_err(run_error)?;
+    }
+    Ok(start.elapsed().as_secs_f64() / n as f64)
 }

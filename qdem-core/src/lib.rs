@@ -46,7 +46,7 @@ pub use newmark::{Newmark, TangentUpdate};
 pub use nodal_load::NodalLoad;
 pub use sparse::{FactorStats, Tangent};
 pub use state::{Dofs, State};
-pub use static_solve::StaticSolver;
+pub use static_solve::{StaticSolver, StaticSteps};
 pub use stepper::{choose_step, stable_step, Stepper};
 pub use tet_body::TetBody;
 pub use time_function::TimeFunction;

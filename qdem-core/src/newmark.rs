@@ -116,15 +116,6 @@ impl Newmark {
         self.beta > 0.0
     }
 
-    /// Size, fill and factorisation time of the effective matrix; `None` before the first
-    /// factorisation or for an explicit stepper.
-    pub fn factor_stats(&self) -> Option<&FactorStats> {
-        self.system
-            .cholesky
-            .is_factored()
-            .then(|| self.system.cholesky.stats())
-    }
-
     /// The force buffer of the last evaluation (N per particle).
     pub fn forces(&self) -> &[Vec3] {
         &self.force
@@ -241,6 +232,13 @@ impl Stepper for Newmark {
 
     fn dt(&self) -> f64 {
         self.dt
+    }
+
+    fn factor_stats(&self) -> Option<&FactorStats> {
+        self.system
+            .cholesky
+            .is_factored()
+            .then(|| self.system.cholesky.stats())
     }
 
     fn initialize(

@@ -23,7 +23,7 @@ use crate::sparse::{
     Tangent, FIX_HINT,
 };
 use crate::state::State;
-use crate::stepper::sum_forces;
+use crate::stepper::{sum_forces, Stepper};
 use crate::Vec3;
 
 /// A linear static solver that keeps the factorisation of K across load levels.
@@ -105,5 +105,51 @@ impl StaticSolver {
         }
         self.dofs = Some(dofs);
         Ok(())
+    }
+}
+
+/// The static solve as a [`Stepper`] (`integrator = "static"`): each step advances the load
+/// time by `dt` and solves K·u = f(t), reusing the factorisation of the first solve.
+#[derive(Debug)]
+pub struct StaticSteps {
+    solver: StaticSolver,
+    dt: f64,
+}
+
+impl StaticSteps {
+    /// Load levels every `dt` seconds of the ramp.
+    pub fn new(dt: f64) -> StaticSteps {
+        StaticSteps {
+            solver: StaticSolver::new(),
+            dt,
+        }
+    }
+}
+
+impl Stepper for StaticSteps {
+    fn name(&self) -> &str {
+        "static"
+    }
+
+    fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    fn initialize(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+    ) -> Result<(), CoreError> {
+        let time = state.time;
+        self.solver.solve(state, models, time)
+    }
+
+    fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {
+        let time = state.time + self.dt;
+        self.solver.solve(state, models, time)
+    }
+
+    fn factor_stats(&self) -> Option<&FactorStats> {
+        self.solver.factor_stats()
     }
 }

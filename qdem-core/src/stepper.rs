@@ -3,6 +3,7 @@
 
 use crate::error::CoreError;
 use crate::model::Model;
+use crate::sparse::FactorStats;
 use crate::state::State;
 use crate::Vec3;
 use rayon::prelude::*;
@@ -28,6 +29,12 @@ pub trait Stepper {
 
     /// Advances `state` by one step.
     fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError>;
+
+    /// Size and cost of the sparse factorisation, for steppers that solve a linear system;
+    /// `None` for explicit steppers and before the first factorisation.
+    fn factor_stats(&self) -> Option<&FactorStats> {
+        None
+    }
 }
 
 /// Sums the forces of all models at `state` into `force` (resized and zeroed here).

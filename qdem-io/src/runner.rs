@@ -9,7 +9,7 @@ use crate::build::Simulation;
 use crate::output::{write_summary, write_vtu, OutputError, ProbeCsv, PvdIndex, VtuGrid};
 use crate::plot::{line_plot_svg, Labels, Series};
 use crate::scene::Integrator;
-use qdem_core::{CoreError, Model, Newmark, State, StaticSolver, Stepper, Vec3, Verlet};
+use qdem_core::{CoreError, Newmark, StaticSteps, Stepper, Vec3, Verlet};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -214,42 +214,8 @@ pub fn make_stepper(sim: &Simulation) -> Result<Box<dyn Stepper>, CoreError> {
     Ok(match run.integrator {
         Integrator::Verlet => Box::new(Verlet::new(sim.dt)),
         Integrator::Newmark => Box::new(Newmark::new(run.beta, run.gamma, sim.dt)?),
-        Integrator::Static => Box::new(StaticSteps {
-            solver: StaticSolver::new(),
-            dt: sim.dt,
-        }),
+        Integrator::Static => Box::new(StaticSteps::new(sim.dt)),
     })
-}
-
-/// The static solve as a stepper: each step advances the load time by `dt` and solves
-/// K·u = f(t) with the factorisation of the first solve.
-struct StaticSteps {
-    solver: StaticSolver,
-    dt: f64,
-}
-
-impl Stepper for StaticSteps {
-    fn name(&self) -> &str {
-        "static"
-    }
-
-    fn dt(&self) -> f64 {
-        self.dt
-    }
-
-    fn initialize(
-        &mut self,
-        state: &mut State,
-        models: &mut [Box<dyn Model>],
-    ) -> Result<(), CoreError> {
-        let time = state.time;
-        self.solver.solve(state, models, time)
-    }
-
-    fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {
-        let time = state.time + self.dt;
-        self.solver.solve(state, models, time)
-    }
 }
 
 fn core_error(sim: &Simulation, source: CoreError) -> RunError {
