@@ -154,7 +154,7 @@ pub fn rigid_spin() -> Row {
         state.velocity[i] = omega.cross(&state.position[i]);
     }
     let mut force = vec![Vec3::zeros(); state.len()];
-    body.add_forces(&state, &mut force);
+    body.add_forces(&state, &mut force, &mut []);
     let worst = force.iter().map(|f| f.norm()).fold(0.0, f64::max) / (45e9 * 0.1 * 0.1);
     Row {
         fixture: "rigid rotation 1 rad + spin 1000 rad/s, max force / (E h^2)".into(),
@@ -278,7 +278,7 @@ pub fn cantilever_static(scene: &Path) -> Result<f64, CliError> {
     sim.state.time = 1.5;
     let mut load = vec![Vec3::zeros(); sim.state.len()];
     for model in sim.models.iter_mut() {
-        model.add_forces(&sim.state, &mut load);
+        model.add_forces(&sim.state, &mut load, &mut []);
     }
     let body = &sim.bodies[0];
     let tet_body = sim.tet_body(body);

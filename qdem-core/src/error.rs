@@ -135,6 +135,30 @@ pub enum CoreError {
         /// What to do about it.
         fix: &'static str,
     },
+    /// A rigid body without positive mass or principal moments of inertia.
+    #[error(
+        "rigid body `{body}` has mass {mass:e} kg and principal moments {inertia:?} kg m^2; \
+         all must be positive: give it a mesh with volume or contact spheres of positive radius"
+    )]
+    BadRigidBody {
+        /// Body name.
+        body: String,
+        /// Its mass.
+        mass: f64,
+        /// Its principal moments of inertia.
+        inertia: [f64; 3],
+    },
+    /// A stepper that cannot integrate rigid bodies met one.
+    #[error(
+        "the {stepper} stepper cannot integrate rigid bodies (the scene has {count}); use \
+         integrator = \"verlet\""
+    )]
+    RigidNeedsVerlet {
+        /// The stepper's name.
+        stepper: String,
+        /// Number of rigid bodies.
+        count: usize,
+    },
     /// The sparse linear algebra failed for a reason other than definiteness.
     #[error("sparse factorisation failed: {0}")]
     Sparse(String),

@@ -23,7 +23,7 @@ impl Model for Gravity {
         "gravity"
     }
 
-    fn add_forces(&mut self, state: &State, force: &mut [Vec3]) {
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
         for (f, m) in force.iter_mut().zip(&state.mass) {
             *f += *m * self.g;
         }

@@ -3,7 +3,7 @@
 //! The continuum kernel of qdem and the small API everything else builds on:
 //!
 //! - [`State`]: structure-of-arrays storage of particle positions, velocities, accelerations,
-//!   lumped masses and fixity.
+//!   lumped masses and fixity, plus the rotation of rigid bodies ([`rigid_body`]).
 //! - [`Model`]: a source of forces (a [`TetBody`], [`Gravity`], a [`NodalLoad`], …) that also
 //!   states the stable time step it allows.
 //! - [`Stepper`]: advances the state under a list of models; [`Verlet`] is the explicit
@@ -18,10 +18,12 @@
 pub mod error;
 pub mod gravity;
 pub mod linear_tet;
+pub mod local_damping;
 pub mod material;
 pub mod model;
 pub mod newmark;
 pub mod nodal_load;
+pub mod rigid_body;
 pub mod sparse;
 pub mod stable_step;
 pub mod state;
@@ -44,6 +46,7 @@ pub use material::Material;
 pub use model::Model;
 pub use newmark::{Newmark, TangentUpdate};
 pub use nodal_load::NodalLoad;
+pub use rigid_body::RigidBodies;
 pub use sparse::{FactorStats, Tangent};
 pub use state::{Dofs, State};
 pub use static_solve::{StaticSolver, StaticSteps};

@@ -16,8 +16,12 @@ pub trait Model: std::any::Any + Send + Sync {
     fn name(&self) -> &str;
 
     /// Adds this model's force on every particle it acts on into `force` (one entry per particle
-    /// of `state`), at `state.time`, `state.position` and `state.velocity`.
-    fn add_forces(&mut self, state: &State, force: &mut [Vec3]);
+    /// of `state`), at `state.time`, `state.position` and `state.velocity`, and the torque it
+    /// exerts on rigid bodies beyond that of its particle forces into `torque` (one entry per
+    /// rigid body of `state.rigid`, empty when there is none). A force on a particle of a rigid
+    /// body acts on the body through that particle; only a force applied away from every
+    /// particle (a contact on a rigid sphere's surface) needs `torque`.
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]);
 
     /// The largest step (s) explicit central-difference stepping tolerates for this model, from
     /// a rigorous bound; `None` if the model does not limit the step.

@@ -42,7 +42,8 @@ use crate::sparse::{
 };
 use crate::state::State;
 use crate::stepper::{
-    check_finite, check_masses, compute_accelerations, sum_forces, Stepper, PARTICLE_CHUNK,
+    check_finite, check_masses, compute_accelerations, refuse_rigid, sum_forces, Stepper,
+    PARTICLE_CHUNK,
 };
 use crate::Vec3;
 use rayon::prelude::*;
@@ -65,6 +66,7 @@ pub struct Newmark {
     dt: f64,
     update: TangentUpdate,
     force: Vec<Vec3>,
+    torque: Vec<Vec3>,
     system: ImplicitSystem,
 }
 
@@ -91,6 +93,7 @@ impl Newmark {
             dt,
             update: TangentUpdate::Fixed,
             force: Vec::new(),
+            torque: Vec::new(),
             system: ImplicitSystem::default(),
         })
     }
@@ -163,7 +166,7 @@ impl Newmark {
         state: &mut State,
         models: &mut [Box<dyn Model>],
     ) -> Result<(), CoreError> {
-        sum_forces(state, models, &mut self.force);
+        sum_forces(state, models, &mut self.force, &mut self.torque);
         let system = &mut self.system;
         let dofs = system.dofs.as_ref().expect("factorised before stepping");
         system.rhs.resize(dofs.len(), 0.0);
@@ -246,8 +249,9 @@ impl Stepper for Newmark {
         state: &mut State,
         models: &mut [Box<dyn Model>],
     ) -> Result<(), CoreError> {
+        refuse_rigid(state, "newmark")?;
         check_masses(state)?;
-        compute_accelerations(state, models, &mut self.force)?;
+        compute_accelerations(state, models, &mut self.force, &mut self.torque)?;
         if self.is_implicit() {
             self.refactor(state, models)?;
         }
@@ -263,7 +267,7 @@ impl Stepper for Newmark {
             }
             self.solve_accelerations(state, models)?;
         } else {
-            compute_accelerations(state, models, &mut self.force)?;
+            compute_accelerations(state, models, &mut self.force, &mut self.torque)?;
         }
         correct(state, dt, beta, gamma);
         Ok(())

@@ -34,7 +34,7 @@ impl Model for NodalLoad {
         &self.name
     }
 
-    fn add_forces(&mut self, state: &State, force: &mut [Vec3]) {
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
         let f = self.per_particle * self.factor.value(state.time);
         for &p in &self.particles {
             force[p as usize] += f;

@@ -5,6 +5,7 @@
 //! shares it, §2.4) and a per-direction fixity mask. Models read the state and write forces;
 //! steppers advance it. All numerical code works on the slices directly.
 
+use crate::rigid_body::RigidBodies;
 use crate::Vec3;
 
 /// A subset of the three translational directions, stored as a bit mask (x = 1, y = 2, z = 4).
@@ -77,6 +78,8 @@ pub struct State {
     pub mass: Vec<f64>,
     /// Fixed directions per particle: a fixed direction keeps zero velocity and acceleration.
     pub fixed: Vec<Dofs>,
+    /// Rotation of the rigid bodies (empty when the scene has none).
+    pub rigid: RigidBodies,
 }
 
 impl State {
@@ -91,6 +94,7 @@ impl State {
             acceleration: vec![Vec3::zeros(); n],
             mass: vec![0.0; n],
             fixed: vec![Dofs::NONE; n],
+            rigid: RigidBodies::default(),
         }
     }
 
@@ -122,13 +126,23 @@ impl State {
         }
     }
 
-    /// Kinetic energy ½ Σ m v² (J).
+    /// Kinetic energy ½ Σ m v² + ½ Σ ω·L (J): members of rigid bodies are massless, so a
+    /// rigid body counts once, through its centre particle and its rotation.
     pub fn kinetic_energy(&self) -> f64 {
         self.mass
             .iter()
             .zip(&self.velocity)
             .map(|(m, v)| 0.5 * m * v.norm_squared())
-            .sum()
+            .sum::<f64>()
+            + self.rigid.kinetic_energy()
+    }
+
+    /// Linear momentum Σ m v (kg m/s).
+    pub fn momentum(&self) -> Vec3 {
+        self.mass
+            .iter()
+            .zip(&self.velocity)
+            .fold(Vec3::zeros(), |p, (m, v)| p + *m * v)
     }
 }
 

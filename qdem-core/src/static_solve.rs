@@ -23,7 +23,7 @@ use crate::sparse::{
     Tangent, FIX_HINT,
 };
 use crate::state::State;
-use crate::stepper::{sum_forces, Stepper};
+use crate::stepper::{refuse_rigid, sum_forces, Stepper};
 use crate::Vec3;
 
 /// A linear static solver that keeps the factorisation of K across load levels.
@@ -54,6 +54,7 @@ impl StaticSolver {
         models: &mut [Box<dyn Model>],
         time: f64,
     ) -> Result<(), CoreError> {
+        refuse_rigid(state, "static")?;
         state.time = time;
         state.position.clone_from(&state.reference);
         state.velocity.fill(Vec3::zeros());
@@ -61,7 +62,7 @@ impl StaticSolver {
         if !self.cholesky.is_factored() {
             self.factorize(state, models)?;
         }
-        sum_forces(state, models, &mut self.force);
+        sum_forces(state, models, &mut self.force, &mut Vec::new());
         let dofs = self.dofs.as_ref().expect("factorised above");
         self.rhs.resize(dofs.len(), 0.0);
         dofs.gather(&self.force, &mut self.rhs);

@@ -3,6 +3,7 @@
 
 use crate::error::CoreError;
 use crate::model::Model;
+use crate::rigid_body::reduce_member_forces;
 use crate::sparse::FactorStats;
 use crate::state::State;
 use crate::Vec3;
@@ -37,12 +38,34 @@ pub trait Stepper {
     }
 }
 
-/// Sums the forces of all models at `state` into `force` (resized and zeroed here).
-pub(crate) fn sum_forces(state: &State, models: &mut [Box<dyn Model>], force: &mut Vec<Vec3>) {
+/// Fails unless the state has no rigid body: for steppers that integrate translations only.
+pub(crate) fn refuse_rigid(state: &State, stepper: &str) -> Result<(), CoreError> {
+    match state.rigid.len() {
+        0 => Ok(()),
+        count => Err(CoreError::RigidNeedsVerlet {
+            stepper: stepper.to_string(),
+            count,
+        }),
+    }
+}
+
+/// Sums the forces and torques of all models at `state` into `force` and `torque` (resized and
+/// zeroed here), then moves the forces on members of rigid bodies onto their bodies.
+pub(crate) fn sum_forces(
+    state: &State,
+    models: &mut [Box<dyn Model>],
+    force: &mut Vec<Vec3>,
+    torque: &mut Vec<Vec3>,
+) {
     force.clear();
     force.resize(state.len(), Vec3::zeros());
+    torque.clear();
+    torque.resize(state.rigid.len(), Vec3::zeros());
     for model in models.iter_mut() {
-        model.add_forces(state, force);
+        model.add_forces(state, force, torque);
+    }
+    if !state.rigid.is_empty() {
+        reduce_member_forces(state, force, torque);
     }
 }
 
@@ -61,21 +84,44 @@ pub(crate) fn check_finite(state: &State) -> Result<(), CoreError> {
     }
 }
 
-/// Sums the forces of all models into `force` (resized and zeroed here) and sets
-/// a = f/m, zero in fixed directions. Fails on a non-finite acceleration.
+/// Fails on the first rigid body with a non-finite torque.
+pub(crate) fn check_finite_torque(state: &State, torque: &[Vec3]) -> Result<(), CoreError> {
+    match torque.iter().position(|t| !t.iter().all(|c| c.is_finite())) {
+        Some(body) => Err(CoreError::NonFinite {
+            time: state.time,
+            particle: state.rigid.center[body],
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Sums the forces of all models into `force` and `torque` (resized and zeroed here) and sets
+/// a = f/m, zero in fixed directions and on members of rigid bodies. Fails on a non-finite
+/// acceleration.
 pub fn compute_accelerations(
     state: &mut State,
     models: &mut [Box<dyn Model>],
     force: &mut Vec<Vec3>,
+    torque: &mut Vec<Vec3>,
 ) -> Result<(), CoreError> {
-    sum_forces(state, models, force);
-    let (mass, fixed) = (&state.mass, &state.fixed);
+    sum_forces(state, models, force, torque);
+    set_accelerations(state, force)
+}
+
+/// Sets a = f/m, zero in fixed directions and on members of rigid bodies (which follow their
+/// body). Fails on a non-finite acceleration.
+pub(crate) fn set_accelerations(state: &mut State, force: &[Vec3]) -> Result<(), CoreError> {
+    let (mass, fixed, rigid) = (&state.mass, &state.fixed, &state.rigid);
     state
         .acceleration
         .par_iter_mut()
         .with_min_len(PARTICLE_CHUNK)
         .enumerate()
         .for_each(|(i, a)| {
+            if rigid.body_of_member(i).is_some() {
+                *a = Vec3::zeros();
+                return;
+            }
             let mut acc = force[i] / mass[i];
             for axis in 0..3 {
                 if fixed[i].contains(axis) {
@@ -87,10 +133,12 @@ pub fn compute_accelerations(
     check_finite(state)
 }
 
-/// Checks that every particle that is free in some direction has a positive mass.
+/// Checks that every particle that is free in some direction, and no member of a rigid body,
+/// has a positive mass.
 pub fn check_masses(state: &State) -> Result<(), CoreError> {
     let bad = (0..state.len()).find(|&i| {
-        let free = (0..3).any(|axis| !state.fixed[i].contains(axis));
+        let free = (0..3).any(|axis| !state.fixed[i].contains(axis))
+            && state.rigid.body_of_member(i).is_none();
         free && state.mass[i].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
     });
     match bad {

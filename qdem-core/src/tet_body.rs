@@ -255,7 +255,7 @@ impl Model for TetBody {
         &self.name
     }
 
-    fn add_forces(&mut self, state: &State, force: &mut [Vec3]) {
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
         if self.material.is_elastic() {
             self.compute_tet_forces::<false>(state);
         } else {

@@ -19,7 +19,7 @@ fn qdem_force(reference: &[Vec3], tets: &[[u32; 4]], material: &Material, u: &[V
         *x += d;
     }
     let mut force = vec![Vec3::zeros(); reference.len()];
-    body.add_forces(&state, &mut force);
+    body.add_forces(&state, &mut force, &mut []);
     force
 }
 

@@ -14,7 +14,7 @@ impl Model for Spring {
         "spring"
     }
 
-    fn add_forces(&mut self, state: &State, force: &mut [Vec3]) {
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
         force[0] -= self.k * state.displacement(0);
     }
 
@@ -107,7 +107,7 @@ impl Model for Opaque {
         "opaque"
     }
 
-    fn add_forces(&mut self, _state: &State, _force: &mut [Vec3]) {}
+    fn add_forces(&mut self, _state: &State, _force: &mut [Vec3], _torque: &mut [Vec3]) {}
 }
 
 #[test]

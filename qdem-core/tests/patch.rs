@@ -34,7 +34,7 @@ fn largest_relative_force(positions: Vec<Vec3>, velocities: Vec<Vec3>) -> f64 {
     state.position = positions;
     state.velocity = velocities;
     let mut force = vec![Vec3::zeros(); state.len()];
-    body.add_forces(&state, &mut force);
+    body.add_forces(&state, &mut force, &mut []);
     let edge = 0.2f64;
     force.iter().map(|f| f.norm()).fold(0.0, f64::max) / (YOUNG * edge * edge)
 }
@@ -117,7 +117,7 @@ fn uniform_strain_reproduces_hooke_and_balances_interior_particles() {
     let mut state = State::at_rest(reference.clone());
     state.position = x.clone();
     let mut force = vec![Vec3::zeros(); state.len()];
-    body.add_forces(&state, &mut force);
+    body.add_forces(&state, &mut force, &mut []);
     let mut expected_force = vec![Vec3::zeros(); state.len()];
     for tri in mesh.surface_triangles() {
         let [a, b, c] = tri.map(|n| x[n as usize]);

@@ -128,7 +128,7 @@ impl Model for Springs {
         "springs"
     }
 
-    fn add_forces(&mut self, state: &State, force: &mut [Vec3]) {
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
         for (i, f) in force.iter_mut().enumerate().take(self.count) {
             if i != self.loose {
                 *f -= state.displacement(i);

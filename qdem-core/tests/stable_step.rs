@@ -44,7 +44,7 @@ fn largest_eigenvalue(models: &mut [Box<dyn Model>], state: &mut State) -> f64 {
         for ((x, x0), ui) in state.position.iter_mut().zip(&state.reference).zip(&u) {
             *x = x0 + amp * ui;
         }
-        compute_accelerations(state, models, &mut force).unwrap();
+        compute_accelerations(state, models, &mut force, &mut Vec::new()).unwrap();
         // M⁻¹K u = −a / amp; Rayleigh quotient in the M inner product (M⁻¹K is M-symmetric).
         let next: Vec<Vec3> = state.acceleration.iter().map(|a| -a / amp).collect();
         lambda = m_dot(&next, &u, &state.mass);

@@ -1,0 +1,189 @@
+//! Broad phase: a uniform cell grid with a skin distance (a Verlet list).
+//!
+//! Spheres are binned into cubic cells of side 2 r_max + skin, keyed by their integer cell
+//! coordinates and sorted by key; every occupied cell is then compared with itself and with the
+//! neighbour cells of larger key (13 of the 26 on average), so each candidate pair is visited
+//! once, in parallel over cells. A pair is kept when the gap between its surfaces is below the
+//! skin and its spheres belong to different bodies. The list is sorted by (a, b), a < b, so it
+//! does not depend on the number of threads, and is rebuilt only when some sphere has moved more
+//! than half the skin since the last build (then no pair outside the list can have come into
+//! contact). Cost O(N log N) per build; there is no O(N²) path.
+
+use qdem_core::Vec3;
+use rayon::prelude::*;
+
+/// The spheres the broad phase sorts: centres, radii and owning bodies.
+pub struct SphereSet<'a> {
+    /// Centres (m).
+    pub center: &'a [Vec3],
+    /// Radii (m).
+    pub radius: &'a [f64],
+    /// Owning body of each sphere; spheres of one body never pair.
+    pub body: &'a [u32],
+}
+
+/// Integer cell coordinates of every sphere and the grid's key function.
+struct Grid {
+    origin: Vec3,
+    inverse_cell: f64,
+    dims: [u64; 3],
+}
+
+impl Grid {
+    fn new(center: &[Vec3], cell: f64) -> Grid {
+        let (lo, hi) = center.iter().fold(
+            (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
+            |(lo, hi), x| (lo.inf(x), hi.sup(x)),
+        );
+        // Spheres spread over a very large region get larger cells, so that keys fit in u64.
+        let mut inverse_cell = 1.0 / cell;
+        let cells = |inv: f64| [0, 1, 2].map(|k| ((hi[k] - lo[k]) * inv) as u64 + 1);
+        while cells(inverse_cell)
+            .iter()
+            .map(|&d| d as f64)
+            .product::<f64>()
+            > 1e18
+        {
+            inverse_cell *= 0.5;
+        }
+        let dims = cells(inverse_cell);
+        Grid {
+            origin: lo,
+            inverse_cell,
+            dims,
+        }
+    }
+
+    fn coords(&self, x: &Vec3) -> [u64; 3] {
+        [0, 1, 2]
+            .map(|k| (((x[k] - self.origin[k]) * self.inverse_cell) as u64).min(self.dims[k] - 1))
+    }
+
+    fn key(&self, c: [u64; 3]) -> u64 {
+        c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2])
+    }
+}
+
+/// All pairs (a, b), a < b, of spheres of different bodies whose surfaces are less than `skin`
+/// apart, sorted.
+pub fn find_pairs(spheres: &SphereSet, skin: f64) -> Vec<(u32, u32)> {
+    let n = spheres.center.len();
+    if n < 2 {
+        return Vec::new();
+    }
+    let r_max = spheres.radius.iter().cloned().fold(0.0, f64::max);
+    let grid = Grid::new(spheres.center, 2.0 * r_max + skin);
+    let mut keyed: Vec<(u64, u32)> = spheres
+        .center
+        .par_iter()
+        .enumerate()
+        .map(|(i, x)| (grid.key(grid.coords(x)), i as u32))
+        .collect();
+    keyed.par_sort_unstable();
+    let mut cell_start: Vec<usize> = (0..n)
+        .filter(|&i| i == 0 || keyed[i].0 != keyed[i - 1].0)
+        .collect();
+    let cell_keys: Vec<u64> = cell_start.iter().map(|&s| keyed[s].0).collect();
+    cell_start.push(n);
+    let members = |c: usize| &keyed[cell_start[c]..cell_start[c + 1]];
+    let mut pairs: Vec<(u32, u32)> = (0..cell_keys.len())
+        .into_par_iter()
+        .with_min_len(64)
+        .fold(Vec::new, |mut out, c| {
+            let here = members(c);
+            let first = spheres.center[here[0].1 as usize];
+            let base = grid.coords(&first);
+            for (k, &(_, i)) in here.iter().enumerate() {
+                for &(_, j) in &here[k + 1..] {
+                    push_if_near(spheres, skin, i, j, &mut out);
+                }
+            }
+            for neighbour in forward_neighbours(&grid, base) {
+                if let Ok(d) = cell_keys.binary_search(&neighbour) {
+                    for &(_, i) in here {
+                        for &(_, j) in members(d) {
+                            push_if_near(spheres, skin, i, j, &mut out);
+                        }
+                    }
+                }
+            }
+            out
+        })
+        .reduce(Vec::new, |mut a, mut b| {
+            a.append(&mut b);
+            a
+        });
+    pairs.par_sort_unstable();
+    pairs
+}
+
+/// Keys of the neighbour cells of `c` with a larger key than `c`'s own.
+fn forward_neighbours(grid: &Grid, c: [u64; 3]) -> impl Iterator<Item = u64> + '_ {
+    let own = grid.key(c);
+    (0..27).filter_map(move |m| {
+        let offset = [m % 3, (m / 3) % 3, m / 9].map(|o| o as i64 - 1);
+        let mut cell = [0u64; 3];
+        for k in 0..3 {
+            let v = c[k] as i64 + offset[k];
+            if v < 0 || v >= grid.dims[k] as i64 {
+                return None;
+            }
+            cell[k] = v as u64;
+        }
+        let key = grid.key(cell);
+        (key > own).then_some(key)
+    })
+}
+
+#[inline]
+fn push_if_near(spheres: &SphereSet, skin: f64, i: u32, j: u32, out: &mut Vec<(u32, u32)>) {
+    let (iu, ju) = (i as usize, j as usize);
+    if spheres.body[iu] == spheres.body[ju] {
+        return;
+    }
+    let reach = spheres.radius[iu] + spheres.radius[ju] + skin;
+    if (spheres.center[iu] - spheres.center[ju]).norm_squared() < reach * reach {
+        out.push((i.min(j), i.max(j)));
+    }
+}
+
+/// The largest distance any sphere has moved from `reference` (m).
+pub fn max_displacement(center: &[Vec3], reference: &[Vec3]) -> f64 {
+    center
+        .par_iter()
+        .zip(reference.par_iter())
+        .map(|(x, x0)| (x - x0).norm_squared())
+        .reduce(|| 0.0, f64::max)
+        .sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn brute_force(spheres: &SphereSet, skin: f64) -> Vec<(u32, u32)> {
+        let n = spheres.center.len() as u32;
+        let mut out = Vec::new();
+        for i in 0..n {
+            for j in i + 1..n {
+                push_if_near(spheres, skin, i, j, &mut out);
+            }
+        }
+        out
+    }
+
+    proptest! {
+        #[test]
+        fn the_grid_finds_exactly_the_brute_force_pairs(
+            points in proptest::collection::vec((0.0..1.0f64, 0.0..1.0f64, 0.0..0.3f64, 0.01..0.08f64, 0u32..40), 2..300),
+            skin in 0.0..0.05f64,
+        ) {
+            let center: Vec<Vec3> = points.iter().map(|p| Vec3::new(p.0, p.1, p.2)).collect();
+            let radius: Vec<f64> = points.iter().map(|p| p.3).collect();
+            let body: Vec<u32> = points.iter().map(|p| p.4).collect();
+            let set = SphereSet { center: &center, radius: &radius, body: &body };
+            prop_assert_eq!(find_pairs(&set, skin), brute_force(&set, skin));
+        }
+    }
+}

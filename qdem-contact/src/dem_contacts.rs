@@ -1,0 +1,585 @@
+//! The contact model: contact spheres on bodies, walls, and the step pipeline
+//! broad phase → narrow phase → contact forces → gather.
+//!
+//! Paper 000 §4 puts a sphere at each surface vertex of a QDEM body, used only for contact;
+//! a rigid body's spheres sit on its members or at its centre ([`qdem_core::rigid_body`]).
+//! Spheres of one body never interact. Each evaluation
+//! 1. reads the sphere centres from their particles,
+//! 2. rebuilds the pair and wall candidate lists if some sphere (or wall) moved more than the
+//!    skin allows ([`crate::broad_phase`]), carrying the tangential springs of surviving
+//!    pairs over,
+//! 3. evaluates the law of every candidate pair and wall contact in parallel into per-contact
+//!    buffers,
+//! 4. gathers them per sphere over a fixed incidence list (no atomics, so results do not depend
+//!    on the thread count) and adds them, in sphere order, to the particle forces, and the
+//!    moment of each contact force about its sphere's centre to the sphere's rigid body.
+//!
+//! The contact point is at x_a + (r_a − δ/2) n; its velocity includes the rigid body's spin,
+//! v + ω × (x_cp − x). Tangential springs grow by the relative displacement over the time since
+//! the previous evaluation, so the model needs no step size.
+
+use crate::broad_phase::{find_pairs, max_displacement, SphereSet};
+use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
+use crate::error::ContactError;
+use crate::wall::Wall;
+use qdem_core::{Model, State, Vec3};
+use rayon::prelude::*;
+
+/// Marks a sphere that is no part of a rigid body.
+const NOT_RIGID: u32 = u32::MAX;
+
+/// Contacts per parallel task.
+const CONTACT_CHUNK: usize = 2048;
+
+/// Overlap, as a fraction of the reduced radius, at which the stable step evaluates Hertz's
+/// stiffness (which grows as √δ).
+pub const REFERENCE_OVERLAP: f64 = 0.05;
+
+/// Contacts per sphere assumed by the stable-step bound.
+pub const COORDINATION: f64 = 6.0;
+
+/// One contact sphere as the builder describes it.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactSphere {
+    /// The particle at its centre.
+    pub particle: usize,
+    /// Its radius (m).
+    pub radius: f64,
+    /// The body it belongs to (index into the body names).
+    pub body: usize,
+    /// The body's elastic constants (index into the materials), used by Hertz–Mindlin.
+    pub material: usize,
+}
+
+/// The scene-wide contact settings.
+#[derive(Clone, Debug)]
+pub struct ContactSettings {
+    /// The law.
+    pub law: ContactLaw,
+    /// Friction coefficient between spheres of different bodies.
+    pub friction: f64,
+    /// Skin distance of the candidate lists (m).
+    pub skin: f64,
+}
+
+/// Per-contact buffers of a candidate list: who, spring history, and this step's force on
+/// the first partner and contact point.
+#[derive(Default)]
+struct ContactList {
+    first: Vec<u32>,
+    second: Vec<u32>,
+    history: Vec<Vec3>,
+    force: Vec<Vec3>,
+    point: Vec<Vec3>,
+}
+
+impl ContactList {
+    /// Replaces the list by `keys`, sorted, keeping the springs of pairs that stay.
+    fn rebuild(&mut self, keys: Vec<(u32, u32)>) {
+        let mut history = vec![Vec3::zeros(); keys.len()];
+        let mut old = 0;
+        for (k, key) in keys.iter().enumerate() {
+            while old < self.first.len() && (self.first[old], self.second[old]) < *key {
+                old += 1;
+            }
+            if old < self.first.len() && (self.first[old], self.second[old]) == *key {
+                history[k] = self.history[old];
+            }
+        }
+        self.first = keys.iter().map(|k| k.0).collect();
+        self.second = keys.iter().map(|k| k.1).collect();
+        self.history = history;
+        self.force = vec![Vec3::zeros(); keys.len()];
+        self.point = vec![Vec3::zeros(); keys.len()];
+    }
+
+    fn len(&self) -> usize {
+        self.first.len()
+    }
+}
+
+/// Contact spheres, walls and their contacts: a [`Model`].
+pub struct DemContacts {
+    name: String,
+    particle: Vec<u32>,
+    radius: Vec<f64>,
+    body: Vec<u32>,
+    rigid: Vec<u32>,
+    mass: Vec<f64>,
+    lever: Vec<f64>,
+    material: Vec<u32>,
+    body_names: Vec<String>,
+    materials: usize,
+    elasticity: Vec<PairElasticity>,
+    wall_elasticity: Vec<PairElasticity>,
+    settings: ContactSettings,
+    walls: Vec<Wall>,
+    last_time: Option<f64>,
+    center: Vec<Vec3>,
+    built_at: Vec<Vec3>,
+    built_time: f64,
+    built: bool,
+    pairs: ContactList,
+    wall_contacts: ContactList,
+    incidence_start: Vec<u32>,
+    incidence: Vec<u32>,
+    wall_start: Vec<u32>,
+    sphere_force: Vec<(Vec3, Vec3)>,
+    rebuilds: u64,
+}
+
+impl DemContacts {
+    /// Contacts between `spheres` (of bodies `body_names`, with elastic constants (E, ν) per
+    /// material) and against `walls`, at the state's current configuration.
+    pub fn new(
+        state: &State,
+        spheres: &[ContactSphere],
+        body_names: Vec<String>,
+        materials: &[(f64, f64)],
+        settings: ContactSettings,
+        walls: Vec<Wall>,
+    ) -> DemContacts {
+        let rigid: Vec<u32> = spheres
+            .iter()
+            .map(|s| {
+                let b = state
+                    .rigid
+                    .body_of_member(s.particle)
+                    .or_else(|| state.rigid.center.iter().position(|&c| c == s.particle));
+                b.map_or(NOT_RIGID, |b| b as u32)
+            })
+            .collect();
+        let carrier = |s: &ContactSphere, r: u32| match r {
+            NOT_RIGID => s.particle,
+            b => state.rigid.center[b as usize],
+        };
+        let mass = spheres
+            .iter()
+            .zip(&rigid)
+            .map(|(s, &r)| state.mass[carrier(s, r)])
+            .collect();
+        let lever = spheres
+            .iter()
+            .zip(&rigid)
+            .map(|(s, &r)| match r {
+                NOT_RIGID => 0.0,
+                b => {
+                    let arm = state.position[s.particle] - state.position[carrier(s, r)];
+                    (arm.norm() + s.radius).powi(2) / state.rigid.inertia[b as usize].min()
+                }
+            })
+            .collect();
+        let elasticity = materials
+            .iter()
+            .flat_map(|a| materials.iter().map(|b| PairElasticity::new(*a, Some(*b))))
+            .collect();
+        let wall_elasticity = materials
+            .iter()
+            .map(|a| PairElasticity::new(*a, None))
+            .collect();
+        DemContacts {
+            name: "contact".to_string(),
+            particle: spheres.iter().map(|s| s.particle as u32).collect(),
+            radius: spheres.iter().map(|s| s.radius).collect(),
+            body: spheres.iter().map(|s| s.body as u32).collect(),
+            rigid,
+            mass,
+            lever,
+            material: spheres.iter().map(|s| s.material as u32).collect(),
+            body_names,
+            materials: materials.len(),
+            elasticity,
+            wall_elasticity,
+            settings,
+            walls,
+            last_time: None,
+            center: Vec::new(),
+            built_at: Vec::new(),
+            built_time: 0.0,
+            built: false,
+            pairs: ContactList::default(),
+            wall_contacts: ContactList::default(),
+            incidence_start: Vec::new(),
+            incidence: Vec::new(),
+            wall_start: Vec::new(),
+            sphere_force: vec![(Vec3::zeros(), Vec3::zeros()); spheres.len()],
+            rebuilds: 0,
+        }
+    }
+
+    /// Number of contact spheres.
+    pub fn spheres(&self) -> usize {
+        self.particle.len()
+    }
+
+    /// Number of candidate pairs and wall candidates in the current lists.
+    pub fn candidates(&self) -> usize {
+        self.pairs.len() + self.wall_contacts.len()
+    }
+
+    /// Number of touching contacts (sphere–sphere and sphere–wall) at the last evaluation.
+    pub fn contacts(&self) -> usize {
+        self.pairs
+            .force
+            .iter()
+            .chain(&self.wall_contacts.force)
+            .filter(|f| **f != Vec3::zeros())
+            .count()
+    }
+
+    /// How many times the candidate lists were rebuilt.
+    pub fn rebuilds(&self) -> u64 {
+        self.rebuilds
+    }
+
+    /// The total force the spheres exert on wall `w` at the last evaluation (N).
+    pub fn wall_force(&self, w: usize) -> Vec3 {
+        let c = &self.wall_contacts;
+        (0..c.len())
+            .filter(|&k| c.second[k] as usize == w)
+            .fold(Vec3::zeros(), |sum, k| sum - c.force[k])
+    }
+
+    /// Fails if two bodies, or a body and a wall, overlap at the current configuration by more
+    /// than `tolerance` times the reduced radius (the sphere radius for walls).
+    pub fn check_initial_overlaps(
+        &mut self,
+        state: &State,
+        tolerance: f64,
+    ) -> Result<(), ContactError> {
+        self.read_centers(state);
+        self.rebuild(state.time);
+        for k in 0..self.pairs.len() {
+            let (a, b) = (self.pairs.first[k] as usize, self.pairs.second[k] as usize);
+            let radius = reduced(self.radius[a], self.radius[b]);
+            let overlap =
+                self.radius[a] + self.radius[b] - (self.center[b] - self.center[a]).norm();
+            if overlap > tolerance * radius {
+                return Err(ContactError::InitialOverlap {
+                    a: self.body_names[self.body[a] as usize].clone(),
+                    b: self.body_names[self.body[b] as usize].clone(),
+                    overlap,
+                    radius,
+                    tolerance: 100.0 * tolerance,
+                    at_a: self.center[a].into(),
+                    at_b: self.center[b].into(),
+                });
+            }
+        }
+        for k in 0..self.wall_contacts.len() {
+            let (s, w) = (
+                self.wall_contacts.first[k] as usize,
+                self.wall_contacts.second[k] as usize,
+            );
+            let (overlap, _) = self.walls[w].overlap(&self.center[s], self.radius[s], state.time);
+            if overlap > tolerance * self.radius[s] {
+                return Err(ContactError::InitialWallOverlap {
+                    body: self.body_names[self.body[s] as usize].clone(),
+                    wall: w + 1,
+                    overlap,
+                    radius: self.radius[s],
+                    tolerance: 100.0 * tolerance,
+                    at: self.center[s].into(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn read_centers(&mut self, state: &State) {
+        let particle = &self.particle;
+        self.center.resize(particle.len(), Vec3::zeros());
+        self.center
+            .par_iter_mut()
+            .zip(particle.par_iter())
+            .with_min_len(CONTACT_CHUNK)
+            .for_each(|(c, &p)| *c = state.position[p as usize]);
+    }
+
+    /// Whether some pair outside the lists may have come within reach since the last build.
+    fn needs_rebuild(&self, time: f64) -> bool {
+        if !self.built {
+            return true;
+        }
+        let moved = max_displacement(&self.center, &self.built_at);
+        let wall_moved = self
+            .walls
+            .iter()
+            .map(|w| w.velocity().norm() * (time - self.built_time).abs())
+            .fold(0.0, f64::max);
+        2.0 * moved >= self.settings.skin || moved + wall_moved >= self.settings.skin
+    }
+
+    /// Broad phase: new candidate lists and the incidence of pairs per sphere.
+    fn rebuild(&mut self, time: f64) {
+        let skin = self.settings.skin;
+        let set = SphereSet {
+            center: &self.center,
+            radius: &self.radius,
+            body: &self.body,
+        };
+        self.pairs.rebuild(find_pairs(&set, skin));
+        let walls = &self.walls;
+        let (center, radius) = (&self.center, &self.radius);
+        let wall_keys: Vec<(u32, u32)> = (0..center.len())
+            .into_par_iter()
+            .with_min_len(CONTACT_CHUNK)
+            .flat_map_iter(|s| {
+                walls.iter().enumerate().filter_map(move |(w, wall)| {
+                    wall.is_candidate(&center[s], radius[s], skin, time)
+                        .then_some((s as u32, w as u32))
+                })
+            })
+            .collect();
+        self.wall_contacts.rebuild(wall_keys);
+        self.build_incidence();
+        self.built_at.clone_from(&self.center);
+        self.built_time = time;
+        self.built = true;
+        self.rebuilds += 1;
+    }
+
+    /// For each sphere, its pairs (2k for the first partner of pair k, 2k + 1 for the second)
+    /// in ascending pair order, and the start of its run of wall contacts.
+    fn build_incidence(&mut self) {
+        let n = self.particle.len();
+        let mut start = vec![0u32; n + 1];
+        for (&a, &b) in self.pairs.first.iter().zip(&self.pairs.second) {
+            start[a as usize + 1] += 1;
+            start[b as usize + 1] += 1;
+        }
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut incidence = vec![0u32; 2 * self.pairs.len()];
+        for (k, (&a, &b)) in self.pairs.first.iter().zip(&self.pairs.second).enumerate() {
+            incidence[fill[a as usize] as usize] = 2 * k as u32;
+            fill[a as usize] += 1;
+            incidence[fill[b as usize] as usize] = 2 * k as u32 + 1;
+            fill[b as usize] += 1;
+        }
+        let mut wall_start = vec![0u32; n + 1];
+        for &s in &self.wall_contacts.first {
+            wall_start[s as usize + 1] += 1;
+        }
+        for i in 0..n {
+            wall_start[i + 1] += wall_start[i];
+        }
+        self.incidence_start = start;
+        self.incidence = incidence;
+        self.wall_start = wall_start;
+    }
+
+    /// Velocity of the material point at `x` of sphere `s`.
+    #[inline]
+    fn point_velocity(&self, state: &State, s: usize, x: &Vec3) -> Vec3 {
+        let v = state.velocity[self.particle[s] as usize];
+        match self.rigid[s] {
+            NOT_RIGID => v,
+            b => v + state.rigid.angular_velocity[b as usize].cross(&(x - self.center[s])),
+        }
+    }
+
+    /// Geometry of the pair of spheres a < b: (geometry, contact point, elasticity); `None`
+    /// when apart.
+    #[inline]
+    fn pair_geometry(
+        &self,
+        state: &State,
+        a: usize,
+        b: usize,
+    ) -> Option<(PairGeometry, Vec3, PairElasticity)> {
+        let d = self.center[b] - self.center[a];
+        let distance = d.norm();
+        let overlap = self.radius[a] + self.radius[b] - distance;
+        if overlap <= 0.0 || distance == 0.0 {
+            return None;
+        }
+        let normal = d / distance;
+        let point = self.center[a] + (self.radius[a] - 0.5 * overlap) * normal;
+        let velocity =
+            self.point_velocity(state, a, &point) - self.point_velocity(state, b, &point);
+        let (ma, mb) = (self.mass[a], self.mass[b]);
+        let geometry = PairGeometry {
+            overlap,
+            normal,
+            velocity,
+            radius: reduced(self.radius[a], self.radius[b]),
+            mass: ma * mb / (ma + mb),
+            friction: self.settings.friction,
+        };
+        let e =
+            self.elasticity[self.material[a] as usize * self.materials + self.material[b] as usize];
+        Some((geometry, point, e))
+    }
+
+    /// Geometry of the contact of sphere s with wall w.
+    #[inline]
+    fn wall_geometry(
+        &self,
+        state: &State,
+        s: usize,
+        w: usize,
+    ) -> Option<(PairGeometry, Vec3, PairElasticity)> {
+        let wall = &self.walls[w];
+        let (overlap, normal) = wall.overlap(&self.center[s], self.radius[s], state.time);
+        if overlap <= 0.0 || normal == Vec3::zeros() {
+            return None;
+        }
+        let point = self.center[s] + (self.radius[s] - 0.5 * overlap) * normal;
+        let geometry = PairGeometry {
+            overlap,
+            normal,
+            velocity: self.point_velocity(state, s, &point) - wall.velocity(),
+            radius: self.radius[s],
+            mass: self.mass[s],
+            friction: wall.friction,
+        };
+        Some((
+            geometry,
+            point,
+            self.wall_elasticity[self.material[s] as usize],
+        ))
+    }
+
+    /// Narrow phase and law over one list, in parallel.
+    fn evaluate_list(&mut self, state: &State, dt: f64, walls: bool) {
+        let mut list = std::mem::take(if walls {
+            &mut self.wall_contacts
+        } else {
+            &mut self.pairs
+        });
+        let law = &self.settings.law;
+        let this = &*self;
+        let (first, second) = (&list.first, &list.second);
+        list.history
+            .par_iter_mut()
+            .zip(list.force.par_iter_mut())
+            .zip(list.point.par_iter_mut())
+            .with_min_len(CONTACT_CHUNK)
+            .enumerate()
+            .for_each(|(k, ((history, force), point))| {
+                let (i, j) = (first[k] as usize, second[k] as usize);
+                let contact = if walls {
+                    this.wall_geometry(state, i, j)
+                } else {
+                    this.pair_geometry(state, i, j)
+                };
+                match contact {
+                    Some((g, x, e)) => {
+                        *force = law.force(&g, &e, history, dt);
+                        *point = x;
+                    }
+                    None => {
+                        *history = Vec3::zeros();
+                        *force = Vec3::zeros();
+                    }
+                }
+            });
+        *(if walls {
+            &mut self.wall_contacts
+        } else {
+            &mut self.pairs
+        }) = list;
+    }
+
+    /// Per-sphere sums of contact forces, and their moments about the sphere's centre for
+    /// spheres of rigid bodies, in a fixed order.
+    fn gather(&mut self) {
+        let (pairs, walls) = (&self.pairs, &self.wall_contacts);
+        let (start, incidence, wall_start) =
+            (&self.incidence_start, &self.incidence, &self.wall_start);
+        let (center, rigid) = (&self.center, &self.rigid);
+        self.sphere_force
+            .par_iter_mut()
+            .with_min_len(CONTACT_CHUNK)
+            .enumerate()
+            .for_each(|(s, out)| {
+                let (mut f, mut t) = (Vec3::zeros(), Vec3::zeros());
+                let spins = rigid[s] != NOT_RIGID;
+                for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
+                    let k = (e / 2) as usize;
+                    let fk = if e % 2 == 0 {
+                        pairs.force[k]
+                    } else {
+                        -pairs.force[k]
+                    };
+                    f += fk;
+                    if spins {
+                        t += (pairs.point[k] - center[s]).cross(&fk);
+                    }
+                }
+                for k in wall_start[s] as usize..wall_start[s + 1] as usize {
+                    f += walls.force[k];
+                    if spins {
+                        t += (walls.point[k] - center[s]).cross(&walls.force[k]);
+                    }
+                }
+                *out = (f, t);
+            });
+    }
+}
+
+/// r_a r_b / (r_a + r_b).
+#[inline]
+fn reduced(a: f64, b: f64) -> f64 {
+    a * b / (a + b)
+}
+
+impl Model for DemContacts {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
+        let dt = self.last_time.map_or(0.0, |t| state.time - t);
+        self.last_time = Some(state.time);
+        self.read_centers(state);
+        if self.needs_rebuild(state.time) {
+            self.rebuild(state.time);
+        }
+        self.evaluate_list(state, dt, false);
+        self.evaluate_list(state, dt, true);
+        self.gather();
+        for (s, (f, t)) in self.sphere_force.iter().enumerate() {
+            force[self.particle[s] as usize] += f;
+            if self.rigid[s] != NOT_RIGID {
+                torque[self.rigid[s] as usize] += t;
+            }
+        }
+    }
+
+    /// 2/ω with ω² = 2 z k (1/m + ℓ²/I) over all spheres: z = [`COORDINATION`] contacts of the
+    /// stiffest kind (normal or tangential; Hertz's at an overlap of [`REFERENCE_OVERLAP`] of
+    /// the radius) on the sphere's carrier of mass m, plus the rotation a force at lever arm ℓ
+    /// gives a rigid body of smallest principal moment I. This is Gershgorin's bound on
+    /// M⁻¹K for that many contacts per sphere.
+    fn stable_dt(&self, _state: &State) -> Option<f64> {
+        let law = &self.settings.law;
+        let omega_squared = (0..self.particle.len())
+            .map(|s| {
+                let m = self.material[s] as usize;
+                let r = self.radius[s];
+                let e = self.wall_elasticity[m];
+                let (kn, kt) = law.stiffness(REFERENCE_OVERLAP * r, r, &e);
+                2.0 * COORDINATION * kn.max(kt) * (1.0 / self.mass[s] + self.lever[s])
+            })
+            .fold(0.0, f64::max);
+        (omega_squared > 0.0).then(|| 2.0 / omega_squared.sqrt())
+    }
+
+    fn potential_energy(&self, state: &State) -> Option<f64> {
+        let law = &self.settings.law;
+        let (p, w) = (&self.pairs, &self.wall_contacts);
+        let pairs = (0..p.len()).filter_map(|k| {
+            self.pair_geometry(state, p.first[k] as usize, p.second[k] as usize)
+                .map(|(g, _, e)| law.energy(&g, &e, &p.history[k]))
+        });
+        let walls = (0..w.len()).filter_map(|k| {
+            self.wall_geometry(state, w.first[k] as usize, w.second[k] as usize)
+                .map(|(g, _, e)| law.energy(&g, &e, &w.history[k]))
+        });
+        Some(pairs.chain(walls).sum())
+    }
+}

@@ -1,0 +1,34 @@
+//! # qdem-contact
+//!
+//! Contact between bodies for qdem, as in DEM: spheres at body vertices (paper 000 §4),
+//! linear Voigt springs with a Coulomb slider or Hertz–Mindlin with a Mohr–Coulomb limit
+//! (paper 003 §3), plane and triangulated walls, found by a deterministic cell-grid broad phase.
+//!
+//! - [`DemContacts`]: the [`qdem_core::Model`] that owns the spheres, walls and contact lists
+//!   and runs broad phase → narrow phase → forces → gather each evaluation.
+//! - [`broad_phase`]: the cell grid with a skin.
+//! - [`contact_law`], [`linear_spring`], [`hertz_mindlin`], [`coulomb`]: the laws.
+//! - [`plane_wall`], [`mesh_wall`], [`wall`]: the walls.
+//!
+//! Rigid bodies are integrated by qdem-core ([`qdem_core::rigid_body`]); their spheres add the
+//! moment of each contact force about the sphere's centre to the body's torque.
+
+pub mod broad_phase;
+pub mod contact_law;
+pub mod coulomb;
+pub mod dem_contacts;
+pub mod error;
+pub mod hertz_mindlin;
+pub mod linear_spring;
+pub mod mesh_wall;
+pub mod plane_wall;
+pub mod wall;
+
+pub use contact_law::{ContactLaw, PairElasticity, PairGeometry};
+pub use dem_contacts::{ContactSettings, ContactSphere, DemContacts};
+pub use error::ContactError;
+pub use hertz_mindlin::HertzMindlin;
+pub use linear_spring::LinearSpring;
+pub use mesh_wall::MeshWall;
+pub use plane_wall::PlaneWall;
+pub use wall::{Wall, WallShape};

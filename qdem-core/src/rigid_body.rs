@@ -1,0 +1,302 @@
+//! Rigid bodies: six degrees of freedom for bodies a scene declares rigid, so that scenes which
+//! need no deformation do not pay for it (paper 003 §3 models its ballast as rigid clumps).
+//!
+//! A rigid body is a *centre particle* of the [`State`] at its centre of mass, carrying the
+//! body's mass and its translational degrees of freedom (integrated like any particle), plus a
+//! rotation stored here: the orientation q of its principal frame, its principal moments of
+//! inertia I, and its angular momentum L and velocity ω = R I⁻¹ Rᵀ L in the world frame.
+//! The body's mesh nodes stay in the state as massless *members* whose positions and
+//! velocities follow the pose, x = c + R s and v = v_c + ω × R s, so that contact spheres,
+//! probes, loads and output see them like any particle. Forces that models put on members
+//! reach the body as a force and a torque about c ([`reduce_member_forces`]).
+//!
+//! Rotation is integrated in the leapfrog form of velocity Verlet: L_{n+½} = L_n + ½∆t τ_n,
+//! q_{n+1} = exp(ω_{½}∆t) q_n with ω_{½} taken at the half-way orientation,
+//! L_{n+1} = L_{n+½} + ½∆t τ_{n+1}. Without torque L is conserved exactly and a body with equal
+//! principal moments spins at a constant rate.
+
+use crate::error::CoreError;
+use crate::state::State;
+use crate::{Mat3, Vec3};
+use nalgebra::{Rotation3, SymmetricEigen, UnitQuaternion};
+use rayon::prelude::*;
+
+/// Marks a particle that is no member of any rigid body.
+const NO_BODY: u32 = u32::MAX;
+
+/// The rotational state of every rigid body of a scene, one entry per body in each array,
+/// and the members that follow each body.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RigidBodies {
+    /// The centre particle of each body: at the centre of mass, with the body's mass.
+    pub center: Vec<usize>,
+    /// Orientation of each body's principal frame (body → world).
+    pub orientation: Vec<UnitQuaternion<f64>>,
+    /// Principal moments of inertia about the centre of mass (kg m²).
+    pub inertia: Vec<Vec3>,
+    /// Angular momentum about the centre of mass, world frame (kg m²/s).
+    pub angular_momentum: Vec<Vec3>,
+    /// Angular velocity, world frame (rad/s), kept equal to R I⁻¹ Rᵀ L.
+    pub angular_velocity: Vec<Vec3>,
+    /// Bodies whose rotation is held fixed (a body fixed in all three directions).
+    pub spin_fixed: Vec<bool>,
+    member_start: Vec<usize>,
+    member: Vec<usize>,
+    member_body: Vec<u32>,
+    offset: Vec<Vec3>,
+    owner: Vec<u32>,
+}
+
+impl RigidBodies {
+    /// Number of rigid bodies.
+    pub fn len(&self) -> usize {
+        self.center.len()
+    }
+
+    /// Whether the scene has no rigid body.
+    pub fn is_empty(&self) -> bool {
+        self.center.is_empty()
+    }
+
+    /// The rigid body particle `i` is a member of, if any.
+    #[inline]
+    pub fn body_of_member(&self, i: usize) -> Option<usize> {
+        match self.owner.get(i) {
+            Some(&b) if b != NO_BODY => Some(b as usize),
+            _ => None,
+        }
+    }
+
+    /// The member particles of body `b`.
+    pub fn members(&self, b: usize) -> &[usize] {
+        &self.member[self.member_start[b]..self.member_start[b + 1]]
+    }
+
+    /// Rotational kinetic energy ½ Σ ω·L (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        self.angular_velocity
+            .iter()
+            .zip(&self.angular_momentum)
+            .map(|(w, l)| 0.5 * w.dot(l))
+            .sum()
+    }
+
+    /// Sets L_b (world frame) and the angular velocity that follows from it.
+    pub fn set_angular_momentum(&mut self, b: usize, l: Vec3) {
+        self.angular_momentum[b] = l;
+        self.angular_velocity[b] = self.omega_from(b, &l);
+    }
+
+    /// Sets ω_b (world frame) and the angular momentum R I Rᵀ ω.
+    pub fn set_angular_velocity(&mut self, b: usize, w: Vec3) {
+        let r = self.orientation[b];
+        let l = r * self.inertia[b].component_mul(&(r.inverse() * w));
+        self.set_angular_momentum(b, l);
+    }
+
+    fn omega_from(&self, b: usize, l: &Vec3) -> Vec3 {
+        let r = self.orientation[b];
+        r * (r.inverse() * l).component_div(&self.inertia[b])
+    }
+
+    /// L += h τ for every body whose spin is free, then ω from L.
+    pub fn kick(&mut self, torque: &[Vec3], h: f64) {
+        let (orientation, inertia) = (&self.orientation, &self.inertia);
+        self.angular_momentum
+            .par_iter_mut()
+            .zip(self.angular_velocity.par_iter_mut())
+            .zip(self.spin_fixed.par_iter())
+            .enumerate()
+            .for_each(|(b, ((l, w), &fixed))| {
+                if fixed {
+                    *l = Vec3::zeros();
+                    *w = Vec3::zeros();
+                    return;
+                }
+                *l += h * torque[b];
+                let r = orientation[b];
+                *w = r * (r.inverse() * *l).component_div(&inertia[b]);
+            });
+    }
+
+    /// q ← exp(ω_{½}∆t) q for every body, with ω_{½} the angular velocity at the half-way
+    /// orientation exp(ω∆t/2) q under the (drift-constant) L; then ω at the new orientation.
+    /// Exact for equal principal moments, second order otherwise.
+    pub fn rotate(&mut self, dt: f64) {
+        let (inertia, momentum) = (&self.inertia, &self.angular_momentum);
+        self.orientation
+            .par_iter_mut()
+            .zip(self.angular_velocity.par_iter_mut())
+            .enumerate()
+            .for_each(|(b, (q, w))| {
+                let spin = |r: UnitQuaternion<f64>| {
+                    r * (r.inverse() * momentum[b]).component_div(&inertia[b])
+                };
+                let half = UnitQuaternion::from_scaled_axis(0.5 * dt * *w) * *q;
+                *q = UnitQuaternion::from_scaled_axis(dt * spin(half)) * *q;
+                *w = spin(*q);
+            });
+    }
+}
+
+impl State {
+    /// Turns particle `center` into the centre of a rigid body of mass `state.mass[center]`,
+    /// with `inertia` the inertia tensor (kg m², world axes) about that particle at the current
+    /// configuration, and `members` the particles that follow the body (made massless here).
+    /// Returns the body's index.
+    pub fn add_rigid_body(
+        &mut self,
+        name: &str,
+        center: usize,
+        members: &[usize],
+        inertia: Mat3,
+    ) -> Result<usize, CoreError> {
+        let (moments, axes) = principal_axes(inertia);
+        if !(moments.min() > 0.0) || !self.mass[center].is_finite() || self.mass[center] <= 0.0 {
+            return Err(CoreError::BadRigidBody {
+                body: name.to_string(),
+                mass: self.mass[center],
+                inertia: moments.into(),
+            });
+        }
+        let n = self.len();
+        let rigid = &mut self.rigid;
+        if rigid.owner.len() < n {
+            rigid.owner.resize(n, NO_BODY);
+        }
+        let b = rigid.center.len();
+        if rigid.member_start.is_empty() {
+            rigid.member_start.push(0);
+        }
+        let c = self.position[center];
+        for &m in members {
+            rigid.owner[m] = b as u32;
+            rigid.member.push(m);
+            rigid.member_body.push(b as u32);
+            rigid.offset.push(axes.inverse() * (self.position[m] - c));
+            self.mass[m] = 0.0;
+        }
+        rigid.member_start.push(rigid.member.len());
+        rigid.center.push(center);
+        rigid.orientation.push(axes);
+        rigid.inertia.push(moments);
+        rigid.angular_momentum.push(Vec3::zeros());
+        rigid.angular_velocity.push(Vec3::zeros());
+        rigid.spin_fixed.push(false);
+        place_members(self);
+        Ok(b)
+    }
+}
+
+/// Principal moments and the rotation from the principal frame to the world frame.
+fn principal_axes(inertia: Mat3) -> (Vec3, UnitQuaternion<f64>) {
+    let eigen = SymmetricEigen::new(inertia);
+    let mut axes = eigen.eigenvectors;
+    if axes.determinant() < 0.0 {
+        axes.column_mut(2).neg_mut();
+    }
+    let rotation = Rotation3::from_matrix_unchecked(axes);
+    (
+        eigen.eigenvalues,
+        UnitQuaternion::from_rotation_matrix(&rotation),
+    )
+}
+
+/// Puts every member at x = c + R s with velocity v = v_c + ω × R s.
+pub fn place_members(state: &mut State) {
+    let rigid = &state.rigid;
+    let (position, velocity) = (&state.position, &state.velocity);
+    let placed: Vec<(Vec3, Vec3)> = rigid
+        .member_body
+        .par_iter()
+        .zip(rigid.offset.par_iter())
+        .map(|(&b, s)| {
+            let b = b as usize;
+            let c = rigid.center[b];
+            let arm = rigid.orientation[b] * s;
+            (
+                position[c] + arm,
+                velocity[c] + rigid.angular_velocity[b].cross(&arm),
+            )
+        })
+        .collect();
+    for (&m, (x, v)) in state.rigid.member.iter().zip(placed) {
+        state.position[m] = x;
+        state.velocity[m] = v;
+    }
+}
+
+/// Moves the forces models put on members onto their bodies: the centre particle receives
+/// Σ f and the body the torque Σ (x − c) × f. Member forces are zeroed.
+pub fn reduce_member_forces(state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
+    let rigid = &state.rigid;
+    for b in 0..rigid.len() {
+        let c = rigid.center[b];
+        let (mut total, mut moment) = (Vec3::zeros(), Vec3::zeros());
+        for &m in rigid.members(b) {
+            let f = std::mem::take(&mut force[m]);
+            total += f;
+            moment += (state.position[m] - state.position[c]).cross(&f);
+        }
+        force[c] += total;
+        torque[b] += moment;
+    }
+}
+
+/// The inertia tensor about `center` of point masses `mass` at `points`.
+pub fn point_inertia(center: Vec3, points: &[Vec3], mass: &[f64]) -> Mat3 {
+    points.iter().zip(mass).fold(Mat3::zeros(), |acc, (x, &m)| {
+        let r = x - center;
+        acc + m * (Mat3::identity() * r.norm_squared() - r * r.transpose())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn body_with_members() -> State {
+        // A centre particle with two massless members on the x axis.
+        let mut s = State::at_rest(vec![
+            Vec3::zeros(),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(-1.0, 0.0, 0.0),
+        ]);
+        s.mass = vec![2.0, 1.0, 1.0];
+        let inertia = Mat3::from_diagonal(&Vec3::new(0.1, 2.0, 3.0));
+        s.add_rigid_body("b", 0, &[1, 2], inertia).unwrap();
+        s
+    }
+
+    #[test]
+    fn members_follow_a_rotation_and_lose_their_mass() {
+        let mut s = body_with_members();
+        assert_eq!(s.mass, vec![2.0, 0.0, 0.0]);
+        s.rigid.set_angular_velocity(0, Vec3::new(0.0, 0.0, 1.0));
+        s.rigid.rotate(std::f64::consts::FRAC_PI_2);
+        place_members(&mut s);
+        assert!((s.position[1] - Vec3::new(0.0, 1.0, 0.0)).norm() < 1e-14);
+        assert!((s.velocity[1] - Vec3::new(-1.0, 0.0, 0.0)).norm() < 1e-14);
+        assert_eq!(s.rigid.body_of_member(2), Some(0));
+        assert_eq!(s.rigid.body_of_member(0), None);
+    }
+
+    #[test]
+    fn member_forces_become_force_and_torque() {
+        let s = body_with_members();
+        let mut force = vec![Vec3::zeros(), Vec3::new(0.0, 1.0, 0.0), Vec3::zeros()];
+        let mut torque = vec![Vec3::zeros()];
+        reduce_member_forces(&s, &mut force, &mut torque);
+        assert_eq!(force[0], Vec3::new(0.0, 1.0, 0.0));
+        assert_eq!(force[1], Vec3::zeros());
+        assert!((torque[0] - Vec3::new(0.0, 0.0, 1.0)).norm() < 1e-15);
+    }
+
+    #[test]
+    fn a_massless_or_flat_body_is_refused() {
+        let mut s = State::at_rest(vec![Vec3::zeros()]);
+        s.mass[0] = 1.0;
+        let flat = Mat3::from_diagonal(&Vec3::new(0.0, 1.0, 1.0));
+        assert!(s.add_rigid_body("b", 0, &[], flat).is_err());
+    }
+}
