@@ -3,10 +3,11 @@
 //! Speed measurements of qdem: [`implicit`] times the sparse Cholesky path against the number
 //! of unknowns; [`throughput`] holds the structured-mesh kernel benchmark used
 //! by the criterion benches (`cargo bench -p qdem-bench`) and by `qdem bench` (JSON output);
-//! [`cantilever`] runs the paper's cantilever and measures it; [`speed_vs_error`] is the study
+//! [`granular`] is the settled sphere packing compared with LIGGGHTS; [`cantilever`] runs the paper's cantilever and measures it; [`speed_vs_error`] is the study
 //! behind `docs/speed-vs-error.md` (binary `study`).
 
 pub mod cantilever;
+pub mod granular;
 pub mod implicit;
 pub mod speed_vs_error;
 pub mod throughput;

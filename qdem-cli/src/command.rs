@@ -3,7 +3,7 @@
 
 use crate::{bench, progress, verify};
 use qdem_bench::throughput::BenchPlan;
-use qdem_io::build::{BuildError, Simulation};
+use qdem_io::build::{BodyKind, BuildError, Simulation};
 use qdem_io::runner::{make_stepper, run, RunError};
 use qdem_io::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
@@ -259,9 +259,13 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
     }
     for body in &sim.bodies {
         let s = &body.stats;
-        let mass: f64 = sim.state.mass[body.particles.clone()].iter().sum();
+        let mass = sim.body_mass(body);
+        let kind = match body.kind {
+            BodyKind::Rigid { .. } => "rigid",
+            BodyKind::Deformable { .. } => "deformable",
+        };
         println!(
-            "body `{}` ({}): {} particles, {} tets, volume {:.6e} m^3, mass {:.6e} kg, edges {:.4e}..{:.4e} m, worst quality {:.3} (tet {})",
+            "body `{}` ({}, {kind}): {} particles, {} tets, volume {:.6e} m^3, mass {:.6e} kg, edges {:.4e}..{:.4e} m, worst quality {:.3} (tet {})",
             body.name,
             body.mesh.display(),
             s.nodes,
@@ -272,6 +276,14 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
             s.max_edge,
             s.worst_quality,
             s.worst_tet
+        );
+    }
+    if let Some(contacts) = sim.contacts() {
+        println!(
+            "contact: {} spheres, {} walls, {} candidate pairs and wall contacts at the start",
+            contacts.spheres(),
+            contacts.walls(),
+            contacts.candidates()
         );
     }
     for p in &sim.probes {

@@ -281,7 +281,9 @@ pub fn cantilever_static(scene: &Path) -> Result<f64, CliError> {
         model.add_forces(&sim.state, &mut load, &mut []);
     }
     let body = &sim.bodies[0];
-    let tet_body = sim.tet_body(body);
+    let tet_body = sim
+        .tet_body(body)
+        .ok_or_else(|| CliError::Verify("the cantilever must be deformable".into()))?;
     let lame = sim.scene.materials[0].clone();
     let lame = qdem_core::Material::elastic(lame.density, lame.young, lame.poisson).elastic_lame();
     let oracle = LinearTets::new(&sim.state.reference, tet_body.tets(), lame);

@@ -443,3 +443,55 @@ fn bench_thread_list_is_an_error_not_a_panic() {
         &["--thread-list", "usage:"],
     );
 }
+
+#[test]
+fn zero_contact_stiffness_is_refused_on_its_line() {
+    let scene = bad("contact_zero_stiffness.toml");
+    let line = line_of(&scene, "normal_stiffness = 0.0");
+    check_and_run(
+        &scene,
+        &[
+            &format!("contact_zero_stiffness.toml:{line}:"),
+            "must be positive",
+        ],
+    );
+}
+
+#[test]
+fn contact_radius_larger_than_the_body_is_refused() {
+    check_and_run(
+        &bad("contact_radius_too_large.toml"),
+        &[
+            "body `block`",
+            "contact_radius = 0.06",
+            "at most 5.0000e-2 m",
+        ],
+    );
+}
+
+#[test]
+fn hertz_mindlin_with_spring_constants_is_refused() {
+    check_and_run(
+        &bad("contact_hertz_with_stiffness.toml"),
+        &["hertz-mindlin takes its stiffness", "young and poisson"],
+    );
+}
+
+#[test]
+fn rigid_body_with_newmark_is_refused() {
+    check_and_run(
+        &bad("rigid_newmark.toml"),
+        &["rigid bodies are integrated by integrator = \"verlet\" only"],
+    );
+}
+
+#[test]
+fn interpenetrating_bodies_are_refused_before_the_run() {
+    check_and_run(
+        &bad("contact_overlap.toml"),
+        &[
+            "bodies `left` and `right` overlap by 5.000e-3 m",
+            "move them apart",
+        ],
+    );
+}

@@ -400,3 +400,25 @@ fn one_and_two_threads_give_identical_probes() {
         );
     }
 }
+
+#[test]
+fn contact_scene_gives_identical_outputs_for_1_and_2_threads() {
+    // Two deformable cubes colliding and a rigid cube on a triangulated floor.
+    let tmp = TempDir::new("contact-threads");
+    let scene = workspace().join("fixtures/contact/collision.toml");
+    let mut outputs = Vec::new();
+    for threads in [1, 2] {
+        let out = tmp.path().join(format!("out{threads}"));
+        run(&scene, &out, threads);
+        let csv = std::fs::read(out.join("probes.csv")).expect("read probes.csv");
+        let last = pvd_entries(&out.join("results.pvd"))
+            .last()
+            .expect("a snapshot")
+            .1
+            .clone();
+        let vtu = std::fs::read(out.join(&last)).expect("read the last VTU");
+        outputs.push((csv, vtu));
+    }
+    assert!(outputs[0].0.len() > 1000, "probes.csv has rows");
+    assert!(outputs[0] == outputs[1], "1 and 2 threads differ");
+}

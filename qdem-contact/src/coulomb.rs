@@ -7,20 +7,21 @@
 //! μ F_n (F_n ≥ 0 the normal force), the contact slides: F_t is scaled back to μ F_n and ξ is
 //! reset to the elongation that gives that force, ξ = −(F_t + c_t v_t)/k_t, as LIGGGHTS does.
 
+use crate::contact_law::PairGeometry;
 use qdem_core::Vec3;
 
-/// The tangential force on a and the updated spring elongation.
+/// The tangential force on a for the contact `g` with normal force `normal_force`, spring
+/// `stiffness` and dashpot `damping`, and the updated spring elongation `history`.
 #[inline]
 pub fn tangential_force(
-    normal: &Vec3,
-    velocity: &Vec3,
+    g: &PairGeometry,
     normal_force: f64,
     stiffness: f64,
     damping: f64,
-    friction: f64,
     history: &mut Vec3,
     dt: f64,
 ) -> Vec3 {
+    let (normal, velocity, friction) = (&g.normal, &g.velocity, g.friction);
     let v_t = velocity - normal * normal.dot(velocity);
     let length = history.norm();
     let projected = *history - normal * normal.dot(history);
@@ -50,17 +51,27 @@ pub fn tangential_force(
 mod tests {
     use super::*;
 
+    fn contact(normal: Vec3, velocity: Vec3, friction: f64) -> PairGeometry {
+        PairGeometry {
+            overlap: 1e-3,
+            normal,
+            velocity,
+            radius: 1.0,
+            mass: 1.0,
+            friction,
+        }
+    }
+
     #[test]
     fn sticks_below_the_limit_and_slides_at_it() {
-        let n = Vec3::z();
-        let v = Vec3::new(1.0, 0.0, 0.5);
+        let g = contact(Vec3::z(), Vec3::new(1.0, 0.0, 0.5), 0.5);
         let mut xi = Vec3::zeros();
-        let f = tangential_force(&n, &v, 100.0, 1e3, 0.0, 0.5, &mut xi, 0.01);
+        let f = tangential_force(&g, 100.0, 1e3, 0.0, &mut xi, 0.01);
         assert!((f - Vec3::new(-10.0, 0.0, 0.0)).norm() < 1e-12);
         for _ in 0..10 {
-            tangential_force(&n, &v, 100.0, 1e3, 0.0, 0.5, &mut xi, 0.01);
+            tangential_force(&g, 100.0, 1e3, 0.0, &mut xi, 0.01);
         }
-        let f = tangential_force(&n, &v, 100.0, 1e3, 0.0, 0.5, &mut xi, 0.01);
+        let f = tangential_force(&g, 100.0, 1e3, 0.0, &mut xi, 0.01);
         assert!((f.norm() - 50.0).abs() < 1e-12);
         assert!((xi.norm() - 0.05).abs() < 1e-15);
     }
@@ -68,9 +79,23 @@ mod tests {
     #[test]
     fn the_spring_turns_with_the_normal_and_keeps_its_length() {
         let mut xi = Vec3::new(0.0, 0.0, 0.0);
-        tangential_force(&Vec3::z(), &Vec3::x(), 1.0, 1.0, 0.0, 10.0, &mut xi, 0.1);
+        tangential_force(
+            &contact(Vec3::z(), Vec3::x(), 10.0),
+            1.0,
+            1.0,
+            0.0,
+            &mut xi,
+            0.1,
+        );
         let n = Vec3::new(0.6, 0.0, 0.8);
-        tangential_force(&n, &Vec3::zeros(), 1.0, 1.0, 0.0, 10.0, &mut xi, 0.1);
+        tangential_force(
+            &contact(n, Vec3::zeros(), 10.0),
+            1.0,
+            1.0,
+            0.0,
+            &mut xi,
+            0.1,
+        );
         assert!(xi.dot(&n).abs() < 1e-15);
         assert!((xi.norm() - 0.1).abs() < 1e-15);
     }

@@ -22,6 +22,7 @@ use crate::broad_phase::{find_pairs, max_displacement, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
 use crate::error::ContactError;
 use crate::wall::Wall;
+use qdem_core::stable_step::critical_step;
 use qdem_core::{Model, State, Vec3};
 use rayon::prelude::*;
 
@@ -210,6 +211,11 @@ impl DemContacts {
     /// Number of contact spheres.
     pub fn spheres(&self) -> usize {
         self.particle.len()
+    }
+
+    /// Number of walls.
+    pub fn walls(&self) -> usize {
+        self.walls.len()
     }
 
     /// Number of candidate pairs and wall candidates in the current lists.
@@ -550,23 +556,50 @@ impl Model for DemContacts {
         }
     }
 
-    /// 2/ω with ω² = 2 z k (1/m + ℓ²/I) over all spheres: z = [`COORDINATION`] contacts of the
-    /// stiffest kind (normal or tangential; Hertz's at an overlap of [`REFERENCE_OVERLAP`] of
-    /// the radius) on the sphere's carrier of mass m, plus the rotation a force at lever arm ℓ
-    /// gives a rigid body of smallest principal moment I. This is Gershgorin's bound on
-    /// M⁻¹K for that many contacts per sphere.
+    /// The critical step 2/(√(ω² + γ²/4) + γ/2) of Gershgorin's bounds on M⁻¹K and M⁻¹C
+    /// ([`qdem_core::stable_step::critical_step`]) for the worst carrier of spheres: ω² =
+    /// 2 Σ k (1/m + ℓ²/I), γ = 2 Σ c (1/m + ℓ²/I) with c = 2ζ√(k m), summed over the contacts
+    /// a carrier can have at once: [`COORDINATION`] for a vertex sphere of a deformable body or
+    /// a rigid single sphere, one per sphere for a rigid body with several (all of them may
+    /// rest on one wall). k is the stiffest of the normal and tangential springs (Hertz's at an
+    /// overlap of [`REFERENCE_OVERLAP`] of the radius), m the carrier's mass, ℓ the lever arm
+    /// of a contact on a rigid body about its centre and I its smallest principal moment.
     fn stable_dt(&self, _state: &State) -> Option<f64> {
         let law = &self.settings.law;
-        let omega_squared = (0..self.particle.len())
-            .map(|s| {
-                let m = self.material[s] as usize;
-                let r = self.radius[s];
-                let e = self.wall_elasticity[m];
-                let (kn, kt) = law.stiffness(REFERENCE_OVERLAP * r, r, &e);
-                2.0 * COORDINATION * kn.max(kt) * (1.0 / self.mass[s] + self.lever[s])
-            })
-            .fold(0.0, f64::max);
-        (omega_squared > 0.0).then(|| 2.0 / omega_squared.sqrt())
+        let zeta = law.damping_ratio();
+        let n_rigid = self
+            .rigid
+            .iter()
+            .filter(|&&r| r != NOT_RIGID)
+            .map(|&r| r as usize + 1)
+            .max()
+            .unwrap_or(0);
+        let mut per_body = vec![(0.0, 0.0, 0usize); n_rigid];
+        let mut worst = (0.0f64, 0.0f64);
+        for s in 0..self.particle.len() {
+            let r = self.radius[s];
+            let e = self.wall_elasticity[self.material[s] as usize];
+            let (kn, kt) = law.stiffness(REFERENCE_OVERLAP * r, r, &e);
+            let k = kn.max(kt);
+            let compliance = 1.0 / self.mass[s] + self.lever[s];
+            let (w, g) = (
+                k * compliance,
+                2.0 * zeta * (k * self.mass[s]).sqrt() * compliance,
+            );
+            match self.rigid[s] {
+                NOT_RIGID => worst = (worst.0.max(COORDINATION * w), worst.1.max(COORDINATION * g)),
+                b => {
+                    let entry = &mut per_body[b as usize];
+                    *entry = (entry.0 + w, entry.1 + g, entry.2 + 1);
+                }
+            }
+        }
+        for (w, g, count) in per_body {
+            let scale = if count == 1 { COORDINATION } else { 1.0 };
+            worst = (worst.0.max(scale * w), worst.1.max(scale * g));
+        }
+        let (omega_squared, damping_rate) = (2.0 * worst.0, 2.0 * worst.1);
+        (omega_squared > 0.0).then(|| critical_step(omega_squared, damping_rate))
     }
 
     fn potential_energy(&self, state: &State) -> Option<f64> {

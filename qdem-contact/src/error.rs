@@ -9,8 +9,8 @@ pub enum ContactError {
     /// Two bodies interpenetrate at the start beyond the tolerance.
     #[error(
         "bodies `{a}` and `{b}` overlap by {overlap:.3e} m at the start (spheres at {at_a:?} and \
-         {at_b:?}), more than {tolerance:.0}% of their reduced radius {radius:.3e} m: move them \
-         apart (`translate` in [[body]]) or reduce `contact_radius`"
+         {at_b:?}), more than {tolerance:.0}% of their reduced radius {radius:.3e} m; fix: move \
+         them apart (`translate` in [[body]]) or use a smaller `contact_radius`"
     )]
     InitialOverlap {
         /// First body.
@@ -31,8 +31,8 @@ pub enum ContactError {
     /// A body penetrates a wall at the start beyond the tolerance.
     #[error(
         "body `{body}` penetrates wall {wall} by {overlap:.3e} m at the start (sphere at {at:?}), \
-         more than {tolerance:.0}% of the contact radius {radius:.3e} m: move the body (`translate`) \
-         or the wall (`point`)"
+         more than {tolerance:.0}% of the contact radius {radius:.3e} m; fix: move the body \
+         (`translate`) or the wall (`point`)"
     )]
     InitialWallOverlap {
         /// The body.

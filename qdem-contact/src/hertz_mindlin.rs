@@ -44,16 +44,7 @@ impl HertzMindlin {
         };
         let rate = g.velocity.dot(&g.normal);
         let normal = (2.0 / 3.0) * s_n * g.overlap + gamma_n * rate;
-        let tangential = tangential_force(
-            &g.normal,
-            &g.velocity,
-            normal,
-            s_t,
-            gamma_t,
-            g.friction,
-            history,
-            dt,
-        );
+        let tangential = tangential_force(g, normal, s_t, gamma_t, history, dt);
         tangential - normal * g.normal
     }
 

@@ -34,16 +34,7 @@ impl LinearSpring {
             (0.0, 0.0)
         };
         let normal = self.normal_stiffness * g.overlap + c_n * rate;
-        let tangential = tangential_force(
-            &g.normal,
-            &g.velocity,
-            normal,
-            self.tangential_stiffness,
-            c_t,
-            g.friction,
-            history,
-            dt,
-        );
+        let tangential = tangential_force(g, normal, self.tangential_stiffness, c_t, history, dt);
         tangential - normal * g.normal
     }
 

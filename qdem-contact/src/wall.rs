@@ -10,7 +10,7 @@ pub enum WallShape {
     /// An infinite plane.
     Plane(PlaneWall),
     /// A triangulated surface.
-    Mesh(MeshWall),
+    Mesh(Box<MeshWall>),
 }
 
 /// A rigid wall: a shape and its friction coefficient against spheres.

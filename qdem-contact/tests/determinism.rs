@@ -25,6 +25,11 @@ fn run() -> State {
         }
     }
     let (mut state, spheres) = rigid_spheres(&centers, R, 2700.0);
+    // Random-looking velocities so that contacts form within the run.
+    for (i, v) in state.velocity.iter_mut().enumerate() {
+        let f = |m: usize| ((i * m) % 101) as f64 / 101.0 - 0.5;
+        *v = Vec3::new(f(37), f(53), f(71));
+    }
     let side = 2.1 * 12.0 * R + 0.4 * R;
     let plane = |point: Vec3, normal: Vec3| Wall {
         shape: WallShape::Plane(PlaneWall::new(point, normal, Vec3::zeros())),

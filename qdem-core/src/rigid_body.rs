@@ -152,7 +152,8 @@ impl State {
         inertia: Mat3,
     ) -> Result<usize, CoreError> {
         let (moments, axes) = principal_axes(inertia);
-        if !(moments.min() > 0.0) || !self.mass[center].is_finite() || self.mass[center] <= 0.0 {
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(moments.min()) || !positive(self.mass[center]) {
             return Err(CoreError::BadRigidBody {
                 body: name.to_string(),
                 mass: self.mass[center],
@@ -230,7 +231,7 @@ pub fn place_members(state: &mut State) {
 /// Σ f and the body the torque Σ (x − c) × f. Member forces are zeroed.
 pub fn reduce_member_forces(state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
     let rigid = &state.rigid;
-    for b in 0..rigid.len() {
+    for (b, body_torque) in torque.iter_mut().enumerate() {
         let c = rigid.center[b];
         let (mut total, mut moment) = (Vec3::zeros(), Vec3::zeros());
         for &m in rigid.members(b) {
@@ -239,8 +240,36 @@ pub fn reduce_member_forces(state: &State, force: &mut [Vec3], torque: &mut [Vec
             moment += (state.position[m] - state.position[c]).cross(&f);
         }
         force[c] += total;
-        torque[b] += moment;
+        *body_torque += moment;
     }
+}
+
+/// Mass (kg), centre of mass and inertia tensor about it (kg m², world axes) of a solid of
+/// `density` filling the tetrahedra `tets` over `points`: the exact integrals over each
+/// tetrahedron, ∫ r rᵀ dV = V/20 (Σ rᵢ rᵢᵀ + (Σ rᵢ)(Σ rᵢ)ᵀ) with r relative to the centre.
+pub fn tet_mass_properties(points: &[Vec3], tets: &[[u32; 4]], density: f64) -> (f64, Vec3, Mat3) {
+    let corners = |t: &[u32; 4]| t.map(|n| points[n as usize]);
+    let volume = |x: &[Vec3; 4]| (x[1] - x[0]).cross(&(x[2] - x[0])).dot(&(x[3] - x[0])) / 6.0;
+    let (mut total, mut moment) = (0.0, Vec3::zeros());
+    for t in tets {
+        let x = corners(t);
+        let v = volume(&x);
+        total += v;
+        moment += v * (x[0] + x[1] + x[2] + x[3]) / 4.0;
+    }
+    let center = moment / total;
+    let mut second = Mat3::zeros();
+    for t in tets {
+        let x = corners(t).map(|p| p - center);
+        let sum = x[0] + x[1] + x[2] + x[3];
+        let own = x
+            .iter()
+            .fold(Mat3::zeros(), |acc, r| acc + r * r.transpose());
+        second += volume(&corners(t)) / 20.0 * (own + sum * sum.transpose());
+    }
+    let second = density * second;
+    let inertia = Mat3::identity() * second.trace() - second;
+    (density * total, center, inertia)
 }
 
 /// The inertia tensor about `center` of point masses `mass` at `points`.
@@ -290,6 +319,27 @@ mod tests {
         assert_eq!(force[0], Vec3::new(0.0, 1.0, 0.0));
         assert_eq!(force[1], Vec3::zeros());
         assert!((torque[0] - Vec3::new(0.0, 0.0, 1.0)).norm() < 1e-15);
+    }
+
+    #[test]
+    fn a_cube_of_tetrahedra_has_the_cube_inertia() {
+        // The unit cube split into 6 tetrahedra around its diagonal.
+        let points: Vec<Vec3> = (0..8)
+            .map(|i| Vec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+            .collect();
+        let tets = [
+            [0, 1, 3, 7],
+            [0, 1, 7, 5],
+            [0, 5, 7, 4],
+            [0, 3, 2, 7],
+            [0, 2, 6, 7],
+            [0, 6, 4, 7],
+        ];
+        let (mass, center, inertia) = tet_mass_properties(&points, &tets, 2.0);
+        assert!((mass - 2.0).abs() < 1e-14);
+        assert!((center - Vec3::repeat(0.5)).norm() < 1e-14);
+        let expected = Mat3::identity() * (2.0 * 2.0 / 12.0);
+        assert!((inertia - expected).norm() < 1e-14, "{inertia}");
     }
 
     #[test]

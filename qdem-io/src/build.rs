@@ -1,9 +1,16 @@
-//! Building a simulation from a scene: meshes read and reordered, particles of all bodies laid
-//! out one body after another in one [`State`], and only the models the scene needs: a
-//! [`TetBody`] per body, [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per load.
+//! Building a simulation from a scene: meshes read, reordered and placed (`rotate_deg`,
+//! `translate`), particles of all bodies laid out one body after another in one [`State`]
+//! (then one centre particle per rigid body), and only the models the scene needs: a
+//! [`TetBody`] per deformable body (a rigid body gets none: its mass and inertia come from its
+//! tetrahedra, [`qdem_core::rigid_body`]), contacts only when bodies carry contact spheres
+//! ([`crate::contact_build`]), [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per
+//! load.
 
 use crate::scene::suggest::did_you_mean;
 use crate::scene::{Integrator, Scene, Selection, TimeStep};
+use nalgebra::Rotation3;
+use qdem_contact::DemContacts;
+use qdem_core::rigid_body::tet_mass_properties;
 use qdem_core::{
     choose_step, stable_step, CoreError, Dofs, Gravity, Material, Model, NodalLoad, State, TetBody,
     Vec3,
@@ -44,6 +51,32 @@ pub enum BuildError {
         /// `; did you mean `…`?` if a name is close, then `(available: …)`.
         candidates: String,
     },
+    /// The contact set-up is refused (initial overlap, a bad wall, a sphere too large).
+    #[error("{scene}: {source}")]
+    Contact {
+        /// The scene file.
+        scene: PathBuf,
+        /// What is wrong.
+        source: Box<qdem_contact::ContactError>,
+    },
+    /// A body's contact radius is too large for it.
+    #[error(
+        "{scene}: body `{body}`: contact_radius = {radius} m is more than half its smallest \
+         extent {extent:.4e} m, so its spheres stick out through the opposite side: use a \
+         radius of at most {limit:.4e} m"
+    )]
+    ContactRadius {
+        /// The scene file.
+        scene: PathBuf,
+        /// The body.
+        body: String,
+        /// Its contact radius.
+        radius: f64,
+        /// Its smallest bounding-box extent.
+        extent: f64,
+        /// Half that extent.
+        limit: f64,
+    },
     /// A fix or load selects no particle.
     #[error("{scene}: {what} on body `{body}` selects no particle: {fix}")]
     EmptySelection {
@@ -58,15 +91,35 @@ pub enum BuildError {
     },
 }
 
+/// How a body is integrated.
+#[derive(Clone, Debug)]
+pub enum BodyKind {
+    /// A QDEM body: index of its [`TetBody`] in [`Simulation::models`].
+    Deformable {
+        /// The model index.
+        model: usize,
+    },
+    /// A rigid body: its index in `state.rigid`, its centre particle and its tetrahedra (for
+    /// output).
+    Rigid {
+        /// Index into [`State::rigid`].
+        body: usize,
+        /// Its centre particle.
+        center: usize,
+        /// Its tetrahedra, as state particle indices.
+        tets: Vec<[u32; 4]>,
+    },
+}
+
 /// What the output needs to know about one body.
 #[derive(Clone, Debug)]
 pub struct BodyInfo {
     /// Body name.
     pub name: String,
-    /// Its particles in the state.
+    /// Its particles in the state (a rigid body's members; its centre comes after all bodies).
     pub particles: Range<usize>,
-    /// Index of its [`TetBody`] in [`Simulation::models`].
-    pub model: usize,
+    /// Deformable or rigid.
+    pub kind: BodyKind,
     /// Mesh statistics.
     pub stats: MeshStats,
     /// Mesh file.
@@ -104,11 +157,11 @@ pub struct Simulation {
     pub warnings: Vec<String>,
 }
 
-/// A body's mesh as read, with its file and its particles' place in the state.
-struct PlacedMesh {
-    mesh: TetMesh,
-    path: PathBuf,
-    particles: Range<usize>,
+/// A body's mesh as read and placed, with its file and its particles' place in the state.
+pub(crate) struct PlacedMesh {
+    pub(crate) mesh: TetMesh,
+    pub(crate) path: PathBuf,
+    pub(crate) particles: Range<usize>,
 }
 
 impl Simulation {
@@ -127,6 +180,10 @@ impl Simulation {
         let mut models: Vec<Box<dyn Model>> = Vec::new();
         let bodies = build_bodies(&scene, &meshes, &mut state, &mut models).map_err(core)?;
         apply_fixes(&scene, &meshes, &mut state)?;
+        fix_rigid_bodies(&bodies, &mut state);
+        if let Some(contacts) = crate::contact_build::build_contacts(&scene, &meshes, &state)? {
+            models.push(Box::new(contacts));
+        }
         if scene.run.gravity.iter().any(|&g| g != 0.0) {
             models.push(Box::new(Gravity::new(Vec3::from(scene.run.gravity))));
         }
@@ -135,8 +192,13 @@ impl Simulation {
             .probes
             .iter()
             .map(|p| {
-                let range = meshes[body_index(&scene, &p.body)].particles.clone();
-                nearest_particle(&state, range, Vec3::from(p.point), &p.name)
+                let body = &bodies[body_index(&scene, &p.body)];
+                let center = match body.kind {
+                    BodyKind::Rigid { center, .. } => Some(center),
+                    BodyKind::Deformable { .. } => None,
+                };
+                let candidates = body.particles.clone().chain(center);
+                nearest_particle(&state, candidates, Vec3::from(p.point), &p.name)
             })
             .collect();
         let stable_dt = stable_step(&state, &models).unwrap_or((f64::INFINITY, String::new()));
@@ -163,12 +225,29 @@ impl Simulation {
         self.bodies.iter().map(|b| b.stats.tets).sum()
     }
 
-    /// The [`TetBody`] of a body.
-    pub fn tet_body(&self, body: &BodyInfo) -> &TetBody {
-        let model: &dyn std::any::Any = self.models[body.model].as_ref();
-        model
-            .downcast_ref::<TetBody>()
-            .expect("a body's model is a TetBody")
+    /// The [`TetBody`] of a deformable body; `None` for a rigid one.
+    pub fn tet_body(&self, body: &BodyInfo) -> Option<&TetBody> {
+        let BodyKind::Deformable { model } = body.kind else {
+            return None;
+        };
+        let model: &dyn std::any::Any = self.models[model].as_ref();
+        model.downcast_ref::<TetBody>()
+    }
+
+    /// The mass of a body (kg).
+    pub fn body_mass(&self, body: &BodyInfo) -> f64 {
+        match body.kind {
+            BodyKind::Deformable { .. } => self.state.mass[body.particles.clone()].iter().sum(),
+            BodyKind::Rigid { center, .. } => self.state.mass[center],
+        }
+    }
+
+    /// The contact model, if the scene has contacts.
+    pub fn contacts(&self) -> Option<&DemContacts> {
+        self.models.iter().find_map(|m| {
+            let m: &dyn std::any::Any = m.as_ref();
+            m.downcast_ref::<DemContacts>()
+        })
     }
 }
 
@@ -188,6 +267,7 @@ fn read_meshes(scene: &Scene) -> Result<(Vec<PlacedMesh>, Vec<String>), BuildErr
         if body.reorder {
             mesh.reorder_for_locality();
         }
+        place(&mut mesh, body.rotate_deg, body.translate);
         let start = meshes.last().map_or(0, |m| m.particles.end);
         let particles = start..start + mesh.nodes.len();
         meshes.push(PlacedMesh {
@@ -199,7 +279,29 @@ fn read_meshes(scene: &Scene) -> Result<(Vec<PlacedMesh>, Vec<String>), BuildErr
     Ok((meshes, warnings))
 }
 
-/// One [`TetBody`] per body, its lumped mass added to the state.
+/// Rotates the nodes about their centroid by `degrees` about x, then y, then z, then
+/// translates them.
+fn place(mesh: &mut TetMesh, degrees: [f64; 3], shift: [f64; 3]) {
+    if degrees == [0.0; 3] && shift == [0.0; 3] {
+        return;
+    }
+    let [rx, ry, rz] = degrees.map(f64::to_radians);
+    let rotation = Rotation3::from_axis_angle(&Vec3::z_axis(), rz)
+        * Rotation3::from_axis_angle(&Vec3::y_axis(), ry)
+        * Rotation3::from_axis_angle(&Vec3::x_axis(), rx);
+    let centroid = mesh
+        .nodes
+        .iter()
+        .fold(Vec3::zeros(), |c, p| c + Vec3::from(*p))
+        / mesh.nodes.len() as f64;
+    for p in &mut mesh.nodes {
+        let x = centroid + rotation * (Vec3::from(*p) - centroid) + Vec3::from(shift);
+        *p = x.into();
+    }
+}
+
+/// One [`TetBody`] per deformable body, its lumped mass added to the state; one rigid body
+/// (a new centre particle at its centre of mass) per rigid body. Sets initial velocities.
 fn build_bodies(
     scene: &Scene,
     meshes: &[PlacedMesh],
@@ -210,18 +312,67 @@ fn build_bodies(
     for (body, placed) in scene.bodies.iter().zip(meshes) {
         let material = scene.material(&body.material).expect("validated scene");
         let tets = offset_tets(&placed.mesh, placed.particles.start);
-        let tet_body = TetBody::new(&body.name, &state.reference, tets, core_material(material))?;
-        tet_body.lump_mass(&mut state.mass);
+        let velocity = Vec3::from(body.velocity);
+        let kind = if body.rigid {
+            let (mass, center, inertia) =
+                tet_mass_properties(&state.reference, &tets, material.density);
+            let c = state.len();
+            state.reference.push(center);
+            state.position.push(center);
+            state.velocity.push(velocity);
+            state.acceleration.push(Vec3::zeros());
+            state.mass.push(mass);
+            state.fixed.push(Dofs::NONE);
+            let members: Vec<usize> = placed.particles.clone().collect();
+            let index = state.add_rigid_body(&body.name, c, &members, inertia)?;
+            BodyKind::Rigid {
+                body: index,
+                center: c,
+                tets,
+            }
+        } else {
+            let core = core_material(material);
+            let tet_body = TetBody::new(&body.name, &state.reference, tets, core)?;
+            tet_body.lump_mass(&mut state.mass);
+            models.push(Box::new(tet_body));
+            BodyKind::Deformable {
+                model: models.len() - 1,
+            }
+        };
+        for i in placed.particles.clone() {
+            state.velocity[i] = velocity;
+        }
         bodies.push(BodyInfo {
             name: body.name.clone(),
             particles: placed.particles.clone(),
-            model: models.len(),
+            kind,
             stats: placed.mesh.stats(),
             mesh: placed.path.clone(),
         });
-        models.push(Box::new(tet_body));
     }
     Ok(bodies)
+}
+
+/// A rigid body is fixed in every direction any of its particles is fixed in, and its
+/// rotation too when all three are.
+fn fix_rigid_bodies(bodies: &[BodyInfo], state: &mut State) {
+    for body in bodies {
+        let BodyKind::Rigid {
+            body: b, center, ..
+        } = body.kind
+        else {
+            continue;
+        };
+        let dofs = body
+            .particles
+            .clone()
+            .fold(Dofs::NONE, |d, i| d.union(state.fixed[i]));
+        state.fix(center, dofs);
+        if dofs == Dofs::ALL {
+            state.rigid.spin_fixed[b] = true;
+            state.rigid.set_angular_velocity(b, Vec3::zeros());
+        }
+    }
 }
 
 /// Fixes the selected directions of the selected particles of every `[[fix]]`.
@@ -294,7 +445,7 @@ fn choose_dt(scene: &Scene, state: &State, models: &[Box<dyn Model>]) -> Result<
 }
 
 /// Index of a body that the validated scene guarantees to exist.
-fn body_index(scene: &Scene, name: &str) -> usize {
+pub(crate) fn body_index(scene: &Scene, name: &str) -> usize {
     scene
         .bodies
         .iter()
@@ -302,7 +453,7 @@ fn body_index(scene: &Scene, name: &str) -> usize {
         .expect("validated scene")
 }
 
-fn core_material(m: &crate::scene::Material) -> Material {
+pub(crate) fn core_material(m: &crate::scene::Material) -> Material {
     Material {
         density: m.density,
         young: m.young,
@@ -369,8 +520,14 @@ fn missing_group(
     }
 }
 
-fn nearest_particle(state: &State, range: Range<usize>, point: Vec3, name: &str) -> ProbePoint {
-    let (particle, distance) = range
+/// The candidate particle nearest to `point` (a rigid body's candidates include its centre).
+fn nearest_particle(
+    state: &State,
+    candidates: impl Iterator<Item = usize>,
+    point: Vec3,
+    name: &str,
+) -> ProbePoint {
+    let (particle, distance) = candidates
         .map(|i| (i, (state.reference[i] - point).norm()))
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .expect("a body has particles");

@@ -12,6 +12,7 @@
 //! - [`plot`]: SVG line plots beside the CSVs.
 
 pub mod build;
+mod contact_build;
 pub mod output;
 pub mod plot;
 pub mod runner;

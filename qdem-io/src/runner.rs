@@ -5,7 +5,7 @@
 //!
 //! The loop is an explicit pipeline: step → probes → snapshot → progress.
 
-use crate::build::Simulation;
+use crate::build::{BodyKind, Simulation};
 use crate::output::{write_summary, write_vtu, OutputError, ProbeCsv, PvdIndex, VtuGrid};
 use crate::plot::{line_plot_svg, Labels, Series};
 use crate::scene::Integrator;
@@ -212,7 +212,10 @@ fn plot_probes(
 pub fn make_stepper(sim: &Simulation) -> Result<Box<dyn Stepper>, CoreError> {
     let run = &sim.scene.run;
     Ok(match run.integrator {
-        Integrator::Verlet => Box::new(Verlet::new(sim.dt)),
+        Integrator::Verlet => {
+            let damping = sim.scene.contact.as_ref().map_or(0.0, |c| c.local_damping);
+            Box::new(Verlet::new(sim.dt).with_local_damping(damping))
+        }
         Integrator::Newmark => Box::new(Newmark::new(run.beta, run.gamma, sim.dt)?),
         Integrator::Static => Box::new(StaticSteps::new(sim.dt)),
     })
@@ -259,11 +262,20 @@ fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
     let mut tets = Vec::new();
     let (mut von_mises, mut volumetric) = (Vec::new(), Vec::new());
     for body in &sim.bodies {
-        let tet_body = sim.tet_body(body);
-        tets.extend_from_slice(tet_body.tets());
-        let (vm, vol) = tet_body.tet_fields(s);
-        von_mises.extend(vm);
-        volumetric.extend(vol);
+        match (&body.kind, sim.tet_body(body)) {
+            (_, Some(tet_body)) => {
+                tets.extend_from_slice(tet_body.tets());
+                let (vm, vol) = tet_body.tet_fields(s);
+                von_mises.extend(vm);
+                volumetric.extend(vol);
+            }
+            (BodyKind::Rigid { tets: rigid, .. }, None) => {
+                tets.extend_from_slice(rigid);
+                von_mises.extend(std::iter::repeat_n(0.0, rigid.len()));
+                volumetric.extend(std::iter::repeat_n(0.0, rigid.len()));
+            }
+            (BodyKind::Deformable { .. }, None) => unreachable!("a deformable body has a TetBody"),
+        }
     }
     let grid = VtuGrid {
         points: &s.reference,

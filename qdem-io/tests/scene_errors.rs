@@ -222,12 +222,12 @@ fn unknown_top_level_table_suggests_the_right_one() {
 
 #[test]
 fn unknown_top_level_table_without_suggestion_lists_tables() {
-    let (_, msg) = error(&format!("{BASE}\n[contacts]\nk = 1\n"));
+    let (_, msg) = error(&format!("{BASE}\n[solver]\nk = 1\n"));
     assert_has(
         &msg,
         &[
             "scenes/scene.toml:43:2:",
-            "unknown table `[contacts]`",
+            "unknown table `[solver]`",
             "[run]",
             "[[material]]",
             "[output]",

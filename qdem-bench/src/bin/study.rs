@@ -1,25 +1,99 @@
-//! `study speed-vs-error [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]`:
-//! regenerates `docs/speed-vs-error.md` and its plots (about 25 minutes on 2 cores, dominated by
-//! the explicit run on the finest mesh).
+//! - `study speed-vs-error [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]`:
+//!   regenerates `docs/speed-vs-error.md` and its plots (about 25 minutes on 2 cores, dominated
+//!   by the explicit run on the finest mesh).
+//! - `study packing --spheres N --out DIR [--settle SECONDS]`: pours and settles N rigid
+//!   spheres and writes `DIR/packing.csv` and `DIR/packing.json` (the granular benchmark).
+//! - `study dem-throughput --packing DIR --steps S`: times qdem on that packing and prints one
+//!   JSON object.
 
 use qdem_bench::cantilever::fixtures_dir;
+use qdem_bench::granular::{throughput, Packing};
 use qdem_bench::speed_vs_error::{run_study, write_report};
 use qdem_bench::throughput::cpu_model;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+const USAGE: &str = "usage: study speed-vs-error [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]
+       study packing --spheres N --out DIR [--settle SECONDS]
+       study dem-throughput --packing DIR --steps S";
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.first().map(String::as_str) != Some("speed-vs-error") {
-        eprintln!("usage: study speed-vs-error [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]");
-        return ExitCode::FAILURE;
-    }
     let option = |name: &str| {
         args.iter()
             .position(|a| a == name)
             .and_then(|i| args.get(i + 1))
             .cloned()
     };
+    match args.first().map(String::as_str) {
+        Some("speed-vs-error") => speed_vs_error(&option),
+        Some("packing") => packing(&option),
+        Some("dem-throughput") => dem_throughput(&option),
+        _ => {
+            eprintln!("{USAGE}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// A required numeric option, or a message.
+fn number<T: std::str::FromStr>(
+    option: &dyn Fn(&str) -> Option<String>,
+    name: &str,
+    default: Option<T>,
+) -> Result<T, String> {
+    match (option(name), default) {
+        (Some(v), _) => v
+            .parse()
+            .map_err(|_| format!("{name} takes a number, got `{v}`")),
+        (None, Some(d)) => Ok(d),
+        (None, None) => Err(format!("{name} is required\n{USAGE}")),
+    }
+}
+
+fn packing(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
+    let run = || -> Result<PathBuf, String> {
+        let n: usize = number(option, "--spheres", None)?;
+        let settle: f64 = number(option, "--settle", Some(0.4))?;
+        let out = option("--out").ok_or(format!("--out is required\n{USAGE}"))?;
+        let mut packing = Packing::lattice(n);
+        packing.settle(settle).map_err(|e| e.to_string())?;
+        packing.write(out.as_ref()).map_err(|e| e.to_string())?;
+        Ok(PathBuf::from(out))
+    };
+    match run() {
+        Ok(dir) => {
+            eprintln!("wrote {}/packing.csv and packing.json", dir.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn dem_throughput(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
+    let run = || -> Result<String, String> {
+        let steps: usize = number(option, "--steps", None)?;
+        let dir = option("--packing").ok_or(format!("--packing is required\n{USAGE}"))?;
+        let packing = Packing::read(dir.as_ref()).map_err(|e| e.to_string())?;
+        let record = throughput(&packing, steps).map_err(|e| e.to_string())?;
+        Ok(record.to_string())
+    };
+    match run() {
+        Ok(json) => {
+            println!("{json}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn speed_vs_error(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
     let docs =
         option("--docs").map_or_else(|| fixtures_dir().join("..").join("docs"), PathBuf::from);
     let work = option("--work").map_or_else(|| PathBuf::from("out/study"), PathBuf::from);

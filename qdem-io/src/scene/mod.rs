@@ -42,7 +42,8 @@ mod validate;
 
 pub use error::{Diagnostic, SceneError};
 pub use schema::{
-    Body, Fix, Integrator, Load, Material, Output, Probe, Ramp, Run, Selection, TimeStep,
+    Body, Contact, ContactLawName, Fix, Integrator, Load, Material, Output, Probe, Ramp, Run,
+    Selection, TimeStep, Wall,
 };
 
 use schema::RawScene;
@@ -72,6 +73,11 @@ use spans::SpanIndex;
 /// mesh = "cantilever.msh"     # relative to the scene file
 /// material = "concrete"
 /// reorder = true              # optional
+/// contact_radius = 0.012      # m, optional: spheres at the surface vertices
+/// rigid = false               # optional: integrate as a rigid body
+/// translate = [0.0, 0.0, 0.0] # m, optional, after the rotation
+/// rotate_deg = [0.0, 0.0, 0.0]  # optional, about the centroid: x, then y, then z
+/// velocity = [0.0, 0.0, 0.0]  # m/s, optional initial velocity
 ///
 /// [[fix]]
 /// body = "beam"
@@ -88,6 +94,20 @@ use spans::SpanIndex;
 /// name = "tip"
 /// body = "beam"
 /// point = [2.4, 0.125, 0.11]
+///
+/// [contact]                   # needed when a body has contact_radius
+/// law = "linear"              # or "hertz-mindlin" (from each body's young and poisson)
+/// normal_stiffness = 1.613e9  # N/m, linear law
+/// tangential_stiffness = 0.672e9
+/// friction = 0.577
+/// damping_ratio = 0.0         # optional, in [0, 1)
+/// local_damping = 0.0         # optional, in [0, 1) (PFC's 0.7 for packing)
+///
+/// [[wall]]
+/// point = [0.0, 0.0, -0.5]    # a plane through point with normal towards the bodies,
+/// normal = [0.0, 0.0, 1.0]    # or mesh = "obstacle.msh" (its boundary surface)
+/// friction = 0.5              # optional, default [contact] friction
+/// velocity = [0.0, 0.0, 0.0]  # m/s, optional
 ///
 /// [output]
 /// dir = "out"
@@ -110,6 +130,10 @@ pub struct Scene {
     pub fixes: Vec<Fix>,
     /// `[[load]]`, in file order.
     pub loads: Vec<Load>,
+    /// `[contact]`, when bodies touch.
+    pub contact: Option<Contact>,
+    /// `[[wall]]`, in file order.
+    pub walls: Vec<Wall>,
     /// `[[probe]]`, in file order.
     pub probes: Vec<Probe>,
     /// `[output]` (defaults when absent).
@@ -170,6 +194,11 @@ impl Scene {
     /// `mesh` is kept as is).
     pub fn mesh_path(&self, body: &Body) -> PathBuf {
         self.base_dir().join(&body.mesh)
+    }
+
+    /// The mesh file of a mesh wall, resolved like [`Scene::mesh_path`].
+    pub fn wall_mesh_path(&self, mesh: &Path) -> PathBuf {
+        self.base_dir().join(mesh)
     }
 
     /// The material called `name`.

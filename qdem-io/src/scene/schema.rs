@@ -196,6 +196,94 @@ pub struct Body {
     /// Reorder nodes for memory locality after import; default `true`.
     #[serde(default = "default_true")]
     pub reorder: bool,
+    /// Radius (m) of the contact spheres put at the body's surface vertices (paper 000 §4);
+    /// `None` (the default): the body touches nothing.
+    #[serde(default)]
+    pub contact_radius: Option<f64>,
+    /// Integrate the body as a rigid body (6 degrees of freedom, mass and inertia from its
+    /// tetrahedra) instead of a deformable one; default `false`.
+    #[serde(default)]
+    pub rigid: bool,
+    /// Translation applied to the mesh after the rotation (m); default zero.
+    #[serde(default)]
+    pub translate: [f64; 3],
+    /// Rotation of the mesh about its nodes' centroid, in degrees about x, then y, then z
+    /// (fixed axes); default zero.
+    #[serde(default)]
+    pub rotate_deg: [f64; 3],
+    /// Initial velocity of every particle of the body (m/s); default zero.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+}
+
+/// `[contact].law`: the contact law between spheres of different bodies and against walls.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum ContactLawName {
+    /// Linear Voigt spring (`normal_stiffness`, `tangential_stiffness`) with a Coulomb slider.
+    #[default]
+    #[serde(rename = "linear")]
+    Linear,
+    /// Hertz–Mindlin from the bodies' `young` and `poisson`, with a Mohr–Coulomb limit.
+    #[serde(rename = "hertz-mindlin")]
+    HertzMindlin,
+}
+
+/// `[contact]`: how bodies with contact spheres touch each other and the walls.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Contact {
+    /// The law; default linear.
+    #[serde(default)]
+    pub law: ContactLawName,
+    /// Normal spring constant k_n (N/m), required by the linear law.
+    #[serde(default)]
+    pub normal_stiffness: Option<f64>,
+    /// Tangential spring constant k_t (N/m), required by the linear law.
+    #[serde(default)]
+    pub tangential_stiffness: Option<f64>,
+    /// Coulomb friction coefficient between bodies (and walls that give none); default 0.
+    #[serde(default)]
+    pub friction: f64,
+    /// Damping ratio ζ of the contact dashpots, in [0, 1); default 0 (paper 000: the
+    /// viscosity is in the bulk).
+    #[serde(default)]
+    pub damping_ratio: f64,
+    /// PFC's local non-viscous damping fraction, in [0, 1) (paper 003: 0.7 for quasi-static
+    /// packing); default 0.
+    #[serde(default)]
+    pub local_damping: f64,
+    /// Skin distance of the neighbour lists (m); default a quarter of the smallest contact
+    /// radius.
+    #[serde(default)]
+    pub skin: Option<f64>,
+    /// Largest overlap allowed at the start, as a fraction of the reduced radius; default 0.05.
+    #[serde(default = "default_overlap_tolerance")]
+    pub overlap_tolerance: f64,
+}
+
+fn default_overlap_tolerance() -> f64 {
+    0.05
+}
+
+/// `[[wall]]`: a rigid plane (`point`, `normal`) or triangulated surface (`mesh`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Wall {
+    /// A point of the plane (m).
+    #[serde(default)]
+    pub point: Option<[f64; 3]>,
+    /// The plane's normal, pointing to the side where bodies are (any length).
+    #[serde(default)]
+    pub normal: Option<[f64; 3]>,
+    /// A tetrahedral gmsh mesh whose boundary surface is the wall, relative to the scene file.
+    #[serde(default)]
+    pub mesh: Option<PathBuf>,
+    /// Friction coefficient against bodies; default `[contact] friction`.
+    #[serde(default)]
+    pub friction: Option<f64>,
+    /// Constant velocity of the wall (m/s); default zero.
+    #[serde(default)]
+    pub velocity: [f64; 3],
 }
 
 fn default_true() -> bool {
@@ -366,8 +454,12 @@ pub(crate) struct RawScene {
     #[serde(default, rename = "probe")]
     pub probes: Vec<Probe>,
     #[serde(default)]
+    pub contact: Option<Contact>,
+    #[serde(default, rename = "wall")]
+    pub walls: Vec<Wall>,
+    #[serde(default)]
     pub output: Output,
 }
 
 /// Top-level keys that are arrays of tables (`[[name]]`), for messages.
-pub(crate) const ARRAY_TABLES: &[&str] = &["material", "body", "fix", "load", "probe"];
+pub(crate) const ARRAY_TABLES: &[&str] = &["material", "body", "fix", "load", "probe", "wall"];

@@ -5,7 +5,9 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use super::error::{Diagnostic, SceneError};
-use super::schema::{Fix, Integrator, Load, Ramp, RawFix, RawLoad, RawScene, Selection, TimeStep};
+use super::schema::{
+    ContactLawName, Fix, Integrator, Load, Ramp, RawFix, RawLoad, RawScene, Selection, TimeStep,
+};
 use super::spans::SpanIndex;
 use super::suggest::did_you_mean;
 use super::Scene;
@@ -550,6 +552,8 @@ pub(crate) fn validate(
         c.finite(&["probe", &idx, "point"], &l, "point", &p.point);
     }
 
+    contact_tables(&mut c, &raw);
+
     // [output]
     c.non_negative(
         &["output", "vtu_every"],
@@ -573,9 +577,199 @@ pub(crate) fn validate(
         fixes,
         loads,
         probes: raw.probes,
+        contact: raw.contact,
+        walls: raw.walls,
         output: raw.output,
         path: path.to_path_buf(),
     })
+}
+
+/// A number in [0, 1).
+fn fraction(c: &mut Checker<'_>, at: &[&str], label: &str, key: &str, v: f64, meaning: &str) {
+    if c.finite(at, label, key, &[v]) && !(0.0..1.0).contains(&v) {
+        c.error(
+            at,
+            format!("{label}: {key} = {v}: must be in [0, 1) ({meaning})"),
+        );
+    }
+}
+
+/// The body keys of contact, `[contact]` and `[[wall]]`.
+fn contact_tables(c: &mut Checker<'_>, raw: &RawScene) {
+    let run = &raw.run;
+    let mut radii = Vec::new();
+    for (i, b) in raw.bodies.iter().enumerate() {
+        let idx = i.to_string();
+        let l = label("body", i, Some(&b.name));
+        if let Some(r) = b.contact_radius {
+            c.positive(
+                &["body", &idx, "contact_radius"],
+                &l,
+                "contact_radius",
+                r,
+                "m",
+            );
+            radii.push(r);
+        }
+        c.finite(&["body", &idx, "translate"], &l, "translate", &b.translate);
+        c.finite(
+            &["body", &idx, "rotate_deg"],
+            &l,
+            "rotate_deg",
+            &b.rotate_deg,
+        );
+        c.finite(&["body", &idx, "velocity"], &l, "velocity", &b.velocity);
+        if b.rigid && run.integrator != Integrator::Verlet {
+            c.error(
+                &["body", &idx, "rigid"],
+                format!(
+                    "{l}: rigid bodies are integrated by integrator = \"verlet\" only, not \
+                     {:?}; use verlet or make the body deformable",
+                    run.integrator.name()
+                ),
+            );
+        }
+    }
+    let Some(contact) = &raw.contact else {
+        if !radii.is_empty() {
+            c.error(
+                &[],
+                "a [[body]] has contact_radius but there is no [contact] table: add one with \
+                 law, normal_stiffness, tangential_stiffness and friction"
+                    .to_owned(),
+            );
+        }
+        if !raw.walls.is_empty() {
+            c.error(
+                &["wall", "0"],
+                "[[wall]] needs a [contact] table and bodies with contact_radius".to_owned(),
+            );
+        }
+        return;
+    };
+    let l = "[contact]";
+    if radii.is_empty() {
+        c.error(
+            &["contact"],
+            "[contact]: no [[body]] has contact_radius, so nothing can touch: give the bodies \
+             that touch a contact_radius (m)"
+                .to_owned(),
+        );
+    }
+    match contact.law {
+        ContactLawName::Linear => {
+            for (key, v) in [
+                ("normal_stiffness", contact.normal_stiffness),
+                ("tangential_stiffness", contact.tangential_stiffness),
+            ] {
+                match v {
+                    Some(k) => c.positive(&["contact", key], l, key, k, "N/m"),
+                    None => c.error(
+                        &["contact", "law"],
+                        format!("{l}: the linear law needs {key} (N/m), e.g. 1.6e9"),
+                    ),
+                }
+            }
+        }
+        ContactLawName::HertzMindlin => {
+            for (key, v) in [
+                ("normal_stiffness", contact.normal_stiffness),
+                ("tangential_stiffness", contact.tangential_stiffness),
+            ] {
+                if v.is_some() {
+                    c.error(
+                        &["contact", key],
+                        format!(
+                            "{l}: {key} is for the linear law; hertz-mindlin takes its \
+                             stiffness from each body's young and poisson: remove it, or use law = \"linear\""
+                        ),
+                    );
+                }
+            }
+        }
+    }
+    c.non_negative(
+        &["contact", "friction"],
+        l,
+        "friction",
+        contact.friction,
+        "",
+    );
+    fraction(
+        c,
+        &["contact", "damping_ratio"],
+        l,
+        "damping_ratio",
+        contact.damping_ratio,
+        "0 for no dashpot",
+    );
+    fraction(
+        c,
+        &["contact", "local_damping"],
+        l,
+        "local_damping",
+        contact.local_damping,
+        "0 for none, 0.7 for quasi-static packing",
+    );
+    if contact.local_damping > 0.0 && run.integrator != Integrator::Verlet {
+        c.error(
+            &["contact", "local_damping"],
+            format!("{l}: local_damping needs integrator = \"verlet\""),
+        );
+    }
+    if !radii.is_empty() && run.integrator != Integrator::Verlet && run.beta > 0.0 {
+        c.error(
+            &["run", "integrator"],
+            "[run]: contacts need an explicit integrator (verlet, or newmark with beta = 0): \
+             contact forces have no tangent"
+                .to_owned(),
+        );
+    }
+    if let Some(skin) = contact.skin {
+        c.positive(&["contact", "skin"], l, "skin", skin, "m");
+    }
+    c.positive(
+        &["contact", "overlap_tolerance"],
+        l,
+        "overlap_tolerance",
+        contact.overlap_tolerance,
+        "fraction of the reduced radius",
+    );
+    for (i, w) in raw.walls.iter().enumerate() {
+        wall(c, i, w);
+    }
+}
+
+fn wall(c: &mut Checker<'_>, i: usize, w: &super::schema::Wall) {
+    let idx = i.to_string();
+    let l = label("wall", i, None);
+    match (&w.point, &w.normal, &w.mesh) {
+        (Some(p), Some(n), None) => {
+            c.finite(&["wall", &idx, "point"], &l, "point", p);
+            if c.finite(&["wall", &idx, "normal"], &l, "normal", n) && n.iter().all(|&v| v == 0.0) {
+                c.error(
+                    &["wall", &idx, "normal"],
+                    format!("{l}: normal is zero; give the direction towards the bodies"),
+                );
+            }
+        }
+        (None, None, Some(mesh)) if mesh.as_os_str().is_empty() => c.error(
+            &["wall", &idx, "mesh"],
+            format!("{l}: mesh is empty; give a gmsh file relative to the scene file"),
+        ),
+        (None, None, Some(_)) => {}
+        _ => c.error(
+            &["wall", &idx],
+            format!(
+                "{l}: give either point and normal (a plane) or mesh (a triangulated wall), not \
+                 both and not only one of point and normal"
+            ),
+        ),
+    }
+    if let Some(f) = w.friction {
+        c.non_negative(&["wall", &idx, "friction"], &l, "friction", f, "");
+    }
+    c.finite(&["wall", &idx, "velocity"], &l, "velocity", &w.velocity);
 }
 
 /// The scene in its as-written form, to re-run [`validate`] on a scene built in code.
@@ -624,6 +818,8 @@ pub(crate) fn to_raw(scene: &Scene) -> RawScene {
             })
             .collect(),
         probes: scene.probes.clone(),
+        contact: scene.contact.clone(),
+        walls: scene.walls.clone(),
         output: scene.output.clone(),
     }
 }
@@ -657,6 +853,26 @@ pub(crate) fn missing_files(
                 label("body", i, Some(&b.name)),
                 resolved.display(),
                 b.mesh.display().to_string()
+            ),
+        ));
+    }
+    for (i, w) in scene.walls.iter().enumerate() {
+        let Some(mesh) = &w.mesh else { continue };
+        let resolved = scene.wall_mesh_path(mesh);
+        if resolved.is_file() {
+            continue;
+        }
+        let idx = i.to_string();
+        let offset = spans.and_then(|s| s.offset(&["wall", &idx, "mesh"]));
+        out.push(Diagnostic::at(
+            &scene.path,
+            text,
+            offset,
+            format!(
+                "{}: mesh file {} does not exist (resolved relative to the scene file's \
+                 directory)",
+                label("wall", i, None),
+                resolved.display()
             ),
         ));
     }

@@ -1,0 +1,321 @@
+//! The granular benchmark of issue 4: a dense, settled packing of rigid spheres (Hertz–Mindlin,
+//! friction, damping, gravity) in a box of plane walls, and the throughput of qdem on it in
+//! sphere-steps per second. `study packing` writes the packing for both qdem and LIGGGHTS
+//! (`qdem-bench/scripts/liggghts_compare.py` runs the two side by side on the same file and
+//! time step); `study dem-throughput` times qdem on it.
+//!
+//! Material: E = 50 MPa (soft, as DEM benchmarks use to afford a long step), ν = 0.25,
+//! ρ = 2700 kg/m³, μ = 0.5, restitution 0.5 (damping ratio ζ = −ln e/√(π² + ln² e)),
+//! radius 5 mm, skin 1 mm; the step is 20% of the Rayleigh time, LIGGGHTS's recommended limit,
+//! or 90% of qdem's own bound if that is smaller.
+
+use qdem_contact::{
+    ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, PlaneWall, Wall,
+    WallShape,
+};
+use qdem_core::{Gravity, Mat3, Model, State, Stepper, Vec3, Verlet};
+use serde_json::{json, Value};
+use std::path::Path;
+use std::time::Instant;
+use thiserror::Error;
+
+/// Sphere radius (m).
+pub const RADIUS: f64 = 0.005;
+const DENSITY: f64 = 2700.0;
+const YOUNG: f64 = 5e7;
+const POISSON: f64 = 0.25;
+const FRICTION: f64 = 0.5;
+const RESTITUTION: f64 = 0.5;
+const SKIN: f64 = 0.001;
+const GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
+
+/// Why the granular study failed.
+#[derive(Debug, Error)]
+pub enum GranularError {
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// A packing file is malformed.
+    #[error("{path}: {reason}")]
+    Format {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The run failed.
+    #[error("the granular run failed: {0}")]
+    Core(#[from] qdem_core::CoreError),
+}
+
+/// A packing: sphere centres in a box with an open top.
+#[derive(Clone, Debug)]
+pub struct Packing {
+    /// Sphere centres (m).
+    pub centers: Vec<Vec3>,
+    /// Box corners (m); the floor is z = lower.z.
+    pub lower: Vec3,
+    /// Upper corner (the top is open).
+    pub upper: Vec3,
+}
+
+/// ζ from the restitution coefficient e.
+pub fn damping_ratio(restitution: f64) -> f64 {
+    let l = restitution.ln();
+    -l / (std::f64::consts::PI.powi(2) + l * l).sqrt()
+}
+
+/// The Rayleigh time π r √(ρ/G)/(0.1631ν + 0.8766) (s).
+pub fn rayleigh_time() -> f64 {
+    let shear = YOUNG / (2.0 * (1.0 + POISSON));
+    std::f64::consts::PI * RADIUS * (DENSITY / shear).sqrt() / (0.1631 * POISSON + 0.8766)
+}
+
+/// The step of both codes: 20% of the Rayleigh time (LIGGGHTS's recommended limit) or 90% of
+/// qdem's stable bound for the packing's models, whichever is smaller.
+pub fn time_step(state: &State, models: &[Box<dyn Model>]) -> f64 {
+    let bound = qdem_core::stable_step(state, models).map_or(f64::INFINITY, |b| b.0);
+    (0.2 * rayleigh_time()).min(0.9 * bound)
+}
+
+impl Packing {
+    /// `n` spheres on a loose lattice (spacing 2.2 r, a deterministic jitter) over a square
+    /// base of about ∛n spheres a side.
+    pub fn lattice(n: usize) -> Packing {
+        let side = (n as f64).cbrt().ceil() as usize;
+        let pitch = 2.2 * RADIUS;
+        let centers = (0..n)
+            .map(|m| {
+                let (i, j, k) = (m % side, (m / side) % side, m / (side * side));
+                let jitter = ((i * 7 + j * 13 + k * 29) % 17) as f64 / 17.0 - 0.5;
+                Vec3::new(
+                    (i as f64 + 0.5) * pitch + 0.1 * RADIUS * jitter,
+                    (j as f64 + 0.5) * pitch - 0.1 * RADIUS * jitter,
+                    (k as f64 + 0.5) * pitch,
+                )
+            })
+            .collect();
+        let width = side as f64 * pitch;
+        Packing {
+            centers,
+            lower: Vec3::zeros(),
+            upper: Vec3::new(width, width, (n.div_ceil(side * side)) as f64 * pitch),
+        }
+    }
+
+    /// The floor and four side walls, normals inwards.
+    pub fn walls(&self) -> Vec<(Vec3, Vec3)> {
+        vec![
+            (self.lower, Vec3::z()),
+            (self.lower, Vec3::x()),
+            (self.lower, Vec3::y()),
+            (self.upper, -Vec3::x()),
+            (self.upper, -Vec3::y()),
+        ]
+    }
+
+    /// The state (one rigid body per sphere) and the models: contacts, gravity.
+    pub fn build(&self) -> (State, Vec<Box<dyn Model>>) {
+        let mut state = State::at_rest(self.centers.clone());
+        let mass = DENSITY * 4.0 / 3.0 * std::f64::consts::PI * RADIUS.powi(3);
+        let inertia = Mat3::identity() * (0.4 * mass * RADIUS * RADIUS);
+        for i in 0..self.centers.len() {
+            state.mass[i] = mass;
+            state
+                .add_rigid_body("sphere", i, &[], inertia)
+                .expect("a sphere has positive mass and inertia");
+        }
+        let spheres: Vec<ContactSphere> = (0..self.centers.len())
+            .map(|i| ContactSphere {
+                particle: i,
+                radius: RADIUS,
+                body: i,
+                material: 0,
+            })
+            .collect();
+        let walls = self
+            .walls()
+            .into_iter()
+            .map(|(p, n)| Wall {
+                shape: WallShape::Plane(PlaneWall::new(p, n, Vec3::zeros())),
+                friction: FRICTION,
+            })
+            .collect();
+        let settings = ContactSettings {
+            law: ContactLaw::HertzMindlin(HertzMindlin {
+                damping_ratio: damping_ratio(RESTITUTION),
+            }),
+            friction: FRICTION,
+            skin: SKIN,
+        };
+        let names = vec!["sphere".to_string(); self.centers.len()];
+        let contacts = DemContacts::new(
+            &state,
+            &spheres,
+            names,
+            &[(YOUNG, POISSON)],
+            settings,
+            walls,
+        );
+        let models: Vec<Box<dyn Model>> = vec![
+            Box::new(contacts),
+            Box::new(Gravity::new(Vec3::from(GRAVITY))),
+        ];
+        (state, models)
+    }
+
+    /// Pours the lattice under gravity with local damping 0.7 for `seconds` of simulated time
+    /// and keeps the settled centres.
+    pub fn settle(&mut self, seconds: f64) -> Result<(), GranularError> {
+        let (mut state, mut models) = self.build();
+        let mut stepper = Verlet::new(time_step(&state, &models)).with_local_damping(0.7);
+        stepper.initialize(&mut state, &mut models)?;
+        while state.time < seconds {
+            stepper.step(&mut state, &mut models)?;
+        }
+        eprintln!(
+            "settled {} spheres for {seconds} s: kinetic energy {:.3e} J",
+            state.len(),
+            state.kinetic_energy()
+        );
+        self.centers = state.position;
+        Ok(())
+    }
+
+    /// Writes `packing.csv` and `packing.json` into `dir`.
+    pub fn write(&self, dir: &Path) -> Result<(), GranularError> {
+        let dt = {
+            let (state, models) = self.build();
+            time_step(&state, &models)
+        };
+        let io = |path: &Path| {
+            let path = path.display().to_string();
+            move |source| GranularError::Io { path, source }
+        };
+        std::fs::create_dir_all(dir).map_err(io(dir))?;
+        let mut csv = String::from("x,y,z,radius\n");
+        for c in &self.centers {
+            csv.push_str(&format!(
+                "{:.17e},{:.17e},{:.17e},{RADIUS:e}\n",
+                c.x, c.y, c.z
+            ));
+        }
+        let csv_path = dir.join("packing.csv");
+        std::fs::write(&csv_path, csv).map_err(io(&csv_path))?;
+        let top = self.centers.iter().map(|c| c.z).fold(0.0, f64::max) + RADIUS;
+        let walls: Vec<Value> = self
+            .walls()
+            .iter()
+            .map(|(p, n)| json!({"point": [p.x, p.y, p.z], "normal": [n.x, n.y, n.z]}))
+            .collect();
+        let meta = json!({
+            "spheres": self.centers.len(),
+            "box_min": [self.lower.x, self.lower.y, self.lower.z],
+            "box_max": [self.upper.x, self.upper.y, self.upper.z.max(top)],
+            "radius": RADIUS,
+            "density": DENSITY,
+            "youngs_modulus": YOUNG,
+            "poisson_ratio": POISSON,
+            "friction": FRICTION,
+            "restitution": RESTITUTION,
+            "damping_ratio": damping_ratio(RESTITUTION),
+            "gravity": GRAVITY,
+            "dt": dt,
+            "skin": SKIN,
+            "walls": walls,
+        });
+        let json_path = dir.join("packing.json");
+        let text = serde_json::to_string_pretty(&meta).expect("plain JSON");
+        std::fs::write(&json_path, text).map_err(io(&json_path))
+    }
+
+    /// Reads the centres of `dir/packing.csv` (box from `packing.json`).
+    pub fn read(dir: &Path) -> Result<Packing, GranularError> {
+        let csv_path = dir.join("packing.csv");
+        let text = std::fs::read_to_string(&csv_path).map_err(|source| GranularError::Io {
+            path: csv_path.display().to_string(),
+            source,
+        })?;
+        let bad = |line: usize, reason: &str| GranularError::Format {
+            path: format!("{}:{line}", csv_path.display()),
+            reason: reason.to_string(),
+        };
+        let mut centers = Vec::new();
+        for (n, line) in text.lines().enumerate().skip(1) {
+            let v: Vec<f64> = line
+                .split(',')
+                .map(|f| f.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| bad(n + 1, "expected four numbers x,y,z,radius"))?;
+            if v.len() != 4 || v[3] != RADIUS {
+                return Err(bad(n + 1, "expected x,y,z,radius with radius 0.005"));
+            }
+            centers.push(Vec3::new(v[0], v[1], v[2]));
+        }
+        let json_path = dir.join("packing.json");
+        let meta: Value = std::fs::read_to_string(&json_path)
+            .map_err(|source| GranularError::Io {
+                path: json_path.display().to_string(),
+                source,
+            })
+            .and_then(|t| {
+                serde_json::from_str(&t).map_err(|e| GranularError::Format {
+                    path: json_path.display().to_string(),
+                    reason: e.to_string(),
+                })
+            })?;
+        let corner = |key: &str| -> Result<Vec3, GranularError> {
+            let v: Option<Vec<f64>> = meta[key]
+                .as_array()
+                .map(|a| a.iter().filter_map(Value::as_f64).collect());
+            match v {
+                Some(v) if v.len() == 3 => Ok(Vec3::new(v[0], v[1], v[2])),
+                _ => Err(GranularError::Format {
+                    path: json_path.display().to_string(),
+                    reason: format!("`{key}` must be [x, y, z]"),
+                }),
+            }
+        };
+        Ok(Packing {
+            centers,
+            lower: corner("box_min")?,
+            upper: corner("box_max")?,
+        })
+    }
+}
+
+/// Times `steps` Verlet steps of the packing (after the initial force evaluation, as
+/// LIGGGHTS's "Loop time" excludes its set-up) and returns the JSON record.
+pub fn throughput(packing: &Packing, steps: usize) -> Result<Value, GranularError> {
+    let (mut state, mut models) = packing.build();
+    let dt = time_step(&state, &models);
+    let bound = qdem_core::stable_step(&state, &models).map_or(f64::INFINITY, |b| b.0);
+    let mut stepper = Verlet::new(dt);
+    stepper.initialize(&mut state, &mut models)?;
+    let start = Instant::now();
+    for _ in 0..steps {
+        stepper.step(&mut state, &mut models)?;
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let model: &dyn std::any::Any = models[0].as_ref();
+    let contacts = model.downcast_ref::<DemContacts>().expect("contacts first");
+    let n = packing.centers.len();
+    Ok(json!({
+        "code": "qdem",
+        "spheres": n,
+        "steps": steps,
+        "dt": dt,
+        "stable_bound": bound,
+        "wall_s": seconds,
+        "particle_steps_per_s": (n * steps) as f64 / seconds,
+        "threads": rayon::current_num_threads(),
+        "contacts": contacts.contacts(),
+        "rebuilds": contacts.rebuilds(),
+        "kinetic_energy": state.kinetic_energy(),
+    }))
+}

@@ -1,0 +1,152 @@
+//! Building the contact model of a scene: spheres at the surface vertices of every body with a
+//! `contact_radius` (interior vertices never touch anything, paper 000 §4), the `[contact]`
+//! law, and the `[[wall]]`s. A scene whose bodies carry no spheres gets no contact model, and
+//! the initial configuration is checked for interpenetration before anything runs.
+
+use crate::build::{body_index, BuildError, PlacedMesh};
+use crate::scene::{Contact, ContactLawName, Scene};
+use qdem_contact::{
+    ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, LinearSpring, MeshWall,
+    PlaneWall, Wall, WallShape,
+};
+use qdem_core::{State, Vec3};
+use qdem_mesh::read_msh;
+
+/// The contact model, or `None` when no body has contact spheres.
+pub(crate) fn build_contacts(
+    scene: &Scene,
+    meshes: &[PlacedMesh],
+    state: &State,
+) -> Result<Option<DemContacts>, BuildError> {
+    let Some(contact) = &scene.contact else {
+        return Ok(None);
+    };
+    let spheres = contact_spheres(scene, meshes)?;
+    if spheres.is_empty() {
+        return Ok(None);
+    }
+    let materials: Vec<(f64, f64)> = scene
+        .materials
+        .iter()
+        .map(|m| (m.young, m.poisson))
+        .collect();
+    let r_min = spheres
+        .iter()
+        .map(|s| s.radius)
+        .fold(f64::INFINITY, f64::min);
+    let settings = ContactSettings {
+        law: law(contact),
+        friction: contact.friction,
+        skin: contact.skin.unwrap_or(0.25 * r_min),
+    };
+    let walls = walls(scene, contact)?;
+    let names = scene.bodies.iter().map(|b| b.name.clone()).collect();
+    let mut model = DemContacts::new(state, &spheres, names, &materials, settings, walls);
+    model
+        .check_initial_overlaps(state, contact.overlap_tolerance)
+        .map_err(|source| BuildError::Contact {
+            scene: scene.path.clone(),
+            source: Box::new(source),
+        })?;
+    Ok(Some(model))
+}
+
+fn law(contact: &Contact) -> ContactLaw {
+    match contact.law {
+        ContactLawName::Linear => ContactLaw::Linear(LinearSpring {
+            normal_stiffness: contact.normal_stiffness.expect("validated scene"),
+            tangential_stiffness: contact.tangential_stiffness.expect("validated scene"),
+            damping_ratio: contact.damping_ratio,
+        }),
+        ContactLawName::HertzMindlin => ContactLaw::HertzMindlin(HertzMindlin {
+            damping_ratio: contact.damping_ratio,
+        }),
+    }
+}
+
+/// A sphere at every surface vertex of every body with a contact radius; refuses a radius
+/// larger than half the body's smallest extent.
+fn contact_spheres(scene: &Scene, meshes: &[PlacedMesh]) -> Result<Vec<ContactSphere>, BuildError> {
+    let mut spheres = Vec::new();
+    for (b, body) in scene.bodies.iter().enumerate() {
+        let Some(radius) = body.contact_radius else {
+            continue;
+        };
+        let placed = &meshes[body_index(scene, &body.name)];
+        let extent = smallest_extent(&placed.mesh.nodes);
+        if radius > 0.5 * extent {
+            return Err(BuildError::ContactRadius {
+                scene: scene.path.clone(),
+                body: body.name.clone(),
+                radius,
+                extent,
+                limit: 0.5 * extent,
+            });
+        }
+        let material = scene
+            .materials
+            .iter()
+            .position(|m| m.name == body.material)
+            .expect("validated scene");
+        spheres.extend(
+            placed
+                .mesh
+                .surface_nodes()
+                .into_iter()
+                .map(|n| ContactSphere {
+                    particle: placed.particles.start + n as usize,
+                    radius,
+                    body: b,
+                    material,
+                }),
+        );
+    }
+    Ok(spheres)
+}
+
+fn smallest_extent(nodes: &[[f64; 3]]) -> f64 {
+    (0..3)
+        .map(|k| {
+            let (lo, hi) = nodes
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                    (lo.min(p[k]), hi.max(p[k]))
+                });
+            hi - lo
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The scene's walls: planes, and meshes whose boundary triangles are the wall.
+fn walls(scene: &Scene, contact: &Contact) -> Result<Vec<Wall>, BuildError> {
+    scene
+        .walls
+        .iter()
+        .enumerate()
+        .map(|(i, w)| {
+            let velocity = Vec3::from(w.velocity);
+            let shape = match (&w.point, &w.normal, &w.mesh) {
+                (Some(p), Some(n), _) => {
+                    WallShape::Plane(PlaneWall::new(Vec3::from(*p), Vec3::from(*n), velocity))
+                }
+                (_, _, Some(mesh)) => {
+                    let path = scene.wall_mesh_path(mesh);
+                    let (tets, _) = read_msh(&path)?;
+                    let vertices: Vec<Vec3> = tets.nodes.iter().map(|p| Vec3::from(*p)).collect();
+                    let name = format!("[[wall]] #{} ({})", i + 1, path.display());
+                    let wall = MeshWall::new(&name, &vertices, &tets.surface_triangles(), velocity)
+                        .map_err(|source| BuildError::Contact {
+                            scene: scene.path.clone(),
+                            source: Box::new(source),
+                        })?;
+                    WallShape::Mesh(Box::new(wall))
+                }
+                _ => unreachable!("validated scene: a wall is a plane or a mesh"),
+            };
+            Ok(Wall {
+                shape,
+                friction: w.friction.unwrap_or(contact.friction),
+            })
+        })
+        .collect()
+}
