@@ -121,6 +121,11 @@ impl Packing {
 
     /// The state (one rigid body per sphere) and the models: contacts, gravity.
     pub fn build(&self) -> (State, Vec<Box<dyn Model>>) {
+        self.build_with(damping_ratio(RESTITUTION))
+    }
+
+    /// The same with contact damping ratio `zeta`.
+    fn build_with(&self, zeta: f64) -> (State, Vec<Box<dyn Model>>) {
         let mut state = State::at_rest(self.centers.clone());
         let mass = DENSITY * 4.0 / 3.0 * std::f64::consts::PI * RADIUS.powi(3);
         let inertia = Mat3::identity() * (0.4 * mass * RADIUS * RADIUS);
@@ -148,7 +153,7 @@ impl Packing {
             .collect();
         let settings = ContactSettings {
             law: ContactLaw::HertzMindlin(HertzMindlin {
-                damping_ratio: damping_ratio(RESTITUTION),
+                damping_ratio: zeta,
             }),
             friction: FRICTION,
             skin: SKIN,
@@ -169,10 +174,11 @@ impl Packing {
         (state, models)
     }
 
-    /// Pours the lattice under gravity with local damping 0.7 for `seconds` of simulated time
-    /// and keeps the settled centres.
+    /// Pours the lattice under gravity for `seconds` of simulated time and keeps the settled
+    /// centres. The pouring dissipates by local damping 0.7 instead of contact dashpots, whose
+    /// step bound is three times shorter, so that it takes a third of the steps.
     pub fn settle(&mut self, seconds: f64) -> Result<(), GranularError> {
-        let (mut state, mut models) = self.build();
+        let (mut state, mut models) = self.build_with(0.0);
         let mut stepper = Verlet::new(time_step(&state, &models)).with_local_damping(0.7);
         stepper.initialize(&mut state, &mut models)?;
         while state.time < seconds {

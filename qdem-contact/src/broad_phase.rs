@@ -5,9 +5,9 @@
 //! neighbour cells of larger key (13 of the 26 on average), so each candidate pair is visited
 //! once, in parallel over cells. A pair is kept when the gap between its surfaces is below the
 //! skin and its spheres belong to different bodies. The list is sorted by (a, b), a < b, so it
-//! does not depend on the number of threads, and is rebuilt only when some sphere has moved more
-//! than half the skin since the last build (then no pair outside the list can have come into
-//! contact). Cost O(N log N) per build; there is no O(N²) path.
+//! does not depend on the number of threads. The contact model rebuilds it only when some
+//! sphere has moved more than half the skin since the last build (then no pair outside the list
+//! can have come into contact). Cost O(N log N) per build; there is no O(N²) path.
 
 use qdem_core::Vec3;
 use rayon::prelude::*;
@@ -145,16 +145,6 @@ fn push_if_near(spheres: &SphereSet, skin: f64, i: u32, j: u32, out: &mut Vec<(u
     if (spheres.center[iu] - spheres.center[ju]).norm_squared() < reach * reach {
         out.push((i.min(j), i.max(j)));
     }
-}
-
-/// The largest distance any sphere has moved from `reference` (m).
-pub fn max_displacement(center: &[Vec3], reference: &[Vec3]) -> f64 {
-    center
-        .par_iter()
-        .zip(reference.par_iter())
-        .map(|(x, x0)| (x - x0).norm_squared())
-        .reduce(|| 0.0, f64::max)
-        .sqrt()
 }
 
 #[cfg(test)]

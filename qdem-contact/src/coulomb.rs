@@ -23,22 +23,24 @@ pub fn tangential_force(
 ) -> Vec3 {
     let (normal, velocity, friction) = (&g.normal, &g.velocity, g.friction);
     let v_t = velocity - normal * normal.dot(velocity);
-    let length = history.norm();
-    let projected = *history - normal * normal.dot(history);
-    let projected_length = projected.norm();
-    *history = if projected_length > 0.0 {
-        projected * (length / projected_length)
-    } else {
-        Vec3::zeros()
-    };
+    let length_squared = history.norm_squared();
+    if length_squared > 0.0 {
+        let projected = *history - normal * normal.dot(history);
+        let projected_squared = projected.norm_squared();
+        *history = if projected_squared > 0.0 {
+            projected * (length_squared / projected_squared).sqrt()
+        } else {
+            Vec3::zeros()
+        };
+    }
     *history += v_t * dt;
     let trial = -stiffness * *history - damping * v_t;
     let limit = friction * normal_force.max(0.0);
-    let magnitude = trial.norm();
-    if magnitude <= limit {
+    let magnitude_squared = trial.norm_squared();
+    if magnitude_squared <= limit * limit {
         return trial;
     }
-    let sliding = trial * (limit / magnitude);
+    let sliding = trial * (limit / magnitude_squared.sqrt());
     *history = if stiffness > 0.0 {
         -(sliding + damping * v_t) / stiffness
     } else {

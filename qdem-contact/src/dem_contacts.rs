@@ -18,7 +18,7 @@
 //! v + ω × (x_cp − x). Tangential springs grow by the relative displacement over the time since
 //! the previous evaluation, so the model needs no step size.
 
-use crate::broad_phase::{find_pairs, max_displacement, SphereSet};
+use crate::broad_phase::{find_pairs, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
 use crate::error::ContactError;
 use crate::wall::Wall;
@@ -61,6 +61,18 @@ pub struct ContactSettings {
     pub friction: f64,
     /// Skin distance of the candidate lists (m).
     pub skin: f64,
+}
+
+/// What the narrow phase reads of one sphere, kept together so that a pair touches two
+/// cache lines per sphere rather than one per array.
+#[derive(Clone, Copy, Debug, Default)]
+struct SphereNow {
+    center: Vec3,
+    velocity: Vec3,
+    spin: Vec3,
+    radius: f64,
+    mass: f64,
+    material: u32,
 }
 
 /// Per-contact buffers of a candidate list: who, spring history, and this step's force on
@@ -116,7 +128,7 @@ pub struct DemContacts {
     settings: ContactSettings,
     walls: Vec<Wall>,
     last_time: Option<f64>,
-    center: Vec<Vec3>,
+    now: Vec<SphereNow>,
     built_at: Vec<Vec3>,
     built_time: f64,
     built: bool,
@@ -154,7 +166,7 @@ impl DemContacts {
             NOT_RIGID => s.particle,
             b => state.rigid.center[b as usize],
         };
-        let mass = spheres
+        let mass: Vec<f64> = spheres
             .iter()
             .zip(&rigid)
             .map(|(s, &r)| state.mass[carrier(s, r)])
@@ -178,6 +190,16 @@ impl DemContacts {
             .iter()
             .map(|a| PairElasticity::new(*a, None))
             .collect();
+        let now: Vec<SphereNow> = spheres
+            .iter()
+            .zip(&mass)
+            .map(|(s, &m)| SphereNow {
+                radius: s.radius,
+                mass: m,
+                material: s.material as u32,
+                ..SphereNow::default()
+            })
+            .collect();
         DemContacts {
             name: "contact".to_string(),
             particle: spheres.iter().map(|s| s.particle as u32).collect(),
@@ -194,7 +216,7 @@ impl DemContacts {
             settings,
             walls,
             last_time: None,
-            center: Vec::new(),
+            now,
             built_at: Vec::new(),
             built_time: 0.0,
             built: false,
@@ -259,7 +281,7 @@ impl DemContacts {
             let (a, b) = (self.pairs.first[k] as usize, self.pairs.second[k] as usize);
             let radius = reduced(self.radius[a], self.radius[b]);
             let overlap =
-                self.radius[a] + self.radius[b] - (self.center[b] - self.center[a]).norm();
+                self.radius[a] + self.radius[b] - (self.now[b].center - self.now[a].center).norm();
             if overlap > tolerance * radius {
                 return Err(ContactError::InitialOverlap {
                     a: self.body_names[self.body[a] as usize].clone(),
@@ -267,8 +289,8 @@ impl DemContacts {
                     overlap,
                     radius,
                     tolerance: 100.0 * tolerance,
-                    at_a: self.center[a].into(),
-                    at_b: self.center[b].into(),
+                    at_a: self.now[a].center.into(),
+                    at_b: self.now[b].center.into(),
                 });
             }
         }
@@ -277,7 +299,8 @@ impl DemContacts {
                 self.wall_contacts.first[k] as usize,
                 self.wall_contacts.second[k] as usize,
             );
-            let (overlap, _) = self.walls[w].overlap(&self.center[s], self.radius[s], state.time);
+            let (overlap, _) =
+                self.walls[w].overlap(&self.now[s].center, self.radius[s], state.time);
             if overlap > tolerance * self.radius[s] {
                 return Err(ContactError::InitialWallOverlap {
                     body: self.body_names[self.body[s] as usize].clone(),
@@ -285,29 +308,45 @@ impl DemContacts {
                     overlap,
                     radius: self.radius[s],
                     tolerance: 100.0 * tolerance,
-                    at: self.center[s].into(),
+                    at: self.now[s].center.into(),
                 });
             }
         }
         Ok(())
     }
 
-    fn read_centers(&mut self, state: &State) {
-        let particle = &self.particle;
-        self.center.resize(particle.len(), Vec3::zeros());
-        self.center
+    /// Copies every sphere's centre, velocity and spin (its rigid body's angular velocity,
+    /// zero for a vertex of a deformable body) out of the state, in sphere order, and returns
+    /// the largest distance a sphere has moved since the last build (infinite before it).
+    fn read_centers(&mut self, state: &State) -> f64 {
+        let (particle, rigid, built_at) = (&self.particle, &self.rigid, &self.built_at);
+        let built = self.built && built_at.len() == particle.len();
+        let moved = self
+            .now
             .par_iter_mut()
-            .zip(particle.par_iter())
             .with_min_len(CONTACT_CHUNK)
-            .for_each(|(c, &p)| *c = state.position[p as usize]);
+            .enumerate()
+            .map(|(s, now)| {
+                let p = particle[s] as usize;
+                now.center = state.position[p];
+                now.velocity = state.velocity[p];
+                now.spin = match rigid[s] {
+                    NOT_RIGID => Vec3::zeros(),
+                    b => state.rigid.angular_velocity[b as usize],
+                };
+                if built {
+                    (now.center - built_at[s]).norm_squared()
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .reduce(|| 0.0, f64::max);
+        moved.sqrt()
     }
 
-    /// Whether some pair outside the lists may have come within reach since the last build.
-    fn needs_rebuild(&self, time: f64) -> bool {
-        if !self.built {
-            return true;
-        }
-        let moved = max_displacement(&self.center, &self.built_at);
+    /// Whether some pair outside the lists may have come within reach since the last build,
+    /// given the largest distance a sphere has moved.
+    fn needs_rebuild(&self, moved: f64, time: f64) -> bool {
         let wall_moved = self
             .walls
             .iter()
@@ -319,27 +358,28 @@ impl DemContacts {
     /// Broad phase: new candidate lists and the incidence of pairs per sphere.
     fn rebuild(&mut self, time: f64) {
         let skin = self.settings.skin;
+        let center: Vec<Vec3> = self.now.iter().map(|s| s.center).collect();
         let set = SphereSet {
-            center: &self.center,
+            center: &center,
             radius: &self.radius,
             body: &self.body,
         };
         self.pairs.rebuild(find_pairs(&set, skin));
         let walls = &self.walls;
-        let (center, radius) = (&self.center, &self.radius);
+        let (radius, center_ref) = (&self.radius, &center);
         let wall_keys: Vec<(u32, u32)> = (0..center.len())
             .into_par_iter()
             .with_min_len(CONTACT_CHUNK)
             .flat_map_iter(|s| {
                 walls.iter().enumerate().filter_map(move |(w, wall)| {
-                    wall.is_candidate(&center[s], radius[s], skin, time)
+                    wall.is_candidate(&center_ref[s], radius[s], skin, time)
                         .then_some((s as u32, w as u32))
                 })
             })
             .collect();
         self.wall_contacts.rebuild(wall_keys);
         self.build_incidence();
-        self.built_at.clone_from(&self.center);
+        self.built_at = center;
         self.built_time = time;
         self.built = true;
         self.rebuilds += 1;
@@ -377,46 +417,37 @@ impl DemContacts {
         self.wall_start = wall_start;
     }
 
-    /// Velocity of the material point at `x` of sphere `s`.
+    /// Velocity of the material point at `x` of sphere `s`: v + ω × (x − c).
     #[inline]
-    fn point_velocity(&self, state: &State, s: usize, x: &Vec3) -> Vec3 {
-        let v = state.velocity[self.particle[s] as usize];
-        match self.rigid[s] {
-            NOT_RIGID => v,
-            b => v + state.rigid.angular_velocity[b as usize].cross(&(x - self.center[s])),
-        }
+    fn point_velocity(now: &SphereNow, x: &Vec3) -> Vec3 {
+        now.velocity + now.spin.cross(&(x - now.center))
     }
 
     /// Geometry of the pair of spheres a < b: (geometry, contact point, elasticity); `None`
     /// when apart.
     #[inline]
-    fn pair_geometry(
-        &self,
-        state: &State,
-        a: usize,
-        b: usize,
-    ) -> Option<(PairGeometry, Vec3, PairElasticity)> {
-        let d = self.center[b] - self.center[a];
-        let distance = d.norm();
-        let overlap = self.radius[a] + self.radius[b] - distance;
-        if overlap <= 0.0 || distance == 0.0 {
+    fn pair_geometry(&self, a: usize, b: usize) -> Option<(PairGeometry, Vec3, PairElasticity)> {
+        let (sa, sb) = (&self.now[a], &self.now[b]);
+        let d = sb.center - sa.center;
+        let distance_squared = d.norm_squared();
+        let reach = sa.radius + sb.radius;
+        if distance_squared >= reach * reach || distance_squared == 0.0 {
             return None;
         }
+        let distance = distance_squared.sqrt();
+        let overlap = reach - distance;
         let normal = d / distance;
-        let point = self.center[a] + (self.radius[a] - 0.5 * overlap) * normal;
-        let velocity =
-            self.point_velocity(state, a, &point) - self.point_velocity(state, b, &point);
-        let (ma, mb) = (self.mass[a], self.mass[b]);
+        let point = sa.center + (sa.radius - 0.5 * overlap) * normal;
+        let velocity = Self::point_velocity(sa, &point) - Self::point_velocity(sb, &point);
         let geometry = PairGeometry {
             overlap,
             normal,
             velocity,
-            radius: reduced(self.radius[a], self.radius[b]),
-            mass: ma * mb / (ma + mb),
+            radius: reduced(sa.radius, sb.radius),
+            mass: sa.mass * sb.mass / (sa.mass + sb.mass),
             friction: self.settings.friction,
         };
-        let e =
-            self.elasticity[self.material[a] as usize * self.materials + self.material[b] as usize];
+        let e = self.elasticity[sa.material as usize * self.materials + sb.material as usize];
         Some((geometry, point, e))
     }
 
@@ -429,23 +460,24 @@ impl DemContacts {
         w: usize,
     ) -> Option<(PairGeometry, Vec3, PairElasticity)> {
         let wall = &self.walls[w];
-        let (overlap, normal) = wall.overlap(&self.center[s], self.radius[s], state.time);
+        let sphere = &self.now[s];
+        let (overlap, normal) = wall.overlap(&sphere.center, sphere.radius, state.time);
         if overlap <= 0.0 || normal == Vec3::zeros() {
             return None;
         }
-        let point = self.center[s] + (self.radius[s] - 0.5 * overlap) * normal;
+        let point = sphere.center + (sphere.radius - 0.5 * overlap) * normal;
         let geometry = PairGeometry {
             overlap,
             normal,
-            velocity: self.point_velocity(state, s, &point) - wall.velocity(),
-            radius: self.radius[s],
-            mass: self.mass[s],
+            velocity: Self::point_velocity(sphere, &point) - wall.velocity(),
+            radius: sphere.radius,
+            mass: sphere.mass,
             friction: wall.friction,
         };
         Some((
             geometry,
             point,
-            self.wall_elasticity[self.material[s] as usize],
+            self.wall_elasticity[sphere.material as usize],
         ))
     }
 
@@ -470,7 +502,7 @@ impl DemContacts {
                 let contact = if walls {
                     this.wall_geometry(state, i, j)
                 } else {
-                    this.pair_geometry(state, i, j)
+                    this.pair_geometry(i, j)
                 };
                 match contact {
                     Some((g, x, e)) => {
@@ -496,7 +528,7 @@ impl DemContacts {
         let (pairs, walls) = (&self.pairs, &self.wall_contacts);
         let (start, incidence, wall_start) =
             (&self.incidence_start, &self.incidence, &self.wall_start);
-        let (center, rigid) = (&self.center, &self.rigid);
+        let (now, rigid) = (&self.now, &self.rigid);
         self.sphere_force
             .par_iter_mut()
             .with_min_len(CONTACT_CHUNK)
@@ -513,13 +545,13 @@ impl DemContacts {
                     };
                     f += fk;
                     if spins {
-                        t += (pairs.point[k] - center[s]).cross(&fk);
+                        t += (pairs.point[k] - now[s].center).cross(&fk);
                     }
                 }
                 for k in wall_start[s] as usize..wall_start[s + 1] as usize {
                     f += walls.force[k];
                     if spins {
-                        t += (walls.point[k] - center[s]).cross(&walls.force[k]);
+                        t += (walls.point[k] - now[s].center).cross(&walls.force[k]);
                     }
                 }
                 *out = (f, t);
@@ -541,8 +573,8 @@ impl Model for DemContacts {
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
         let dt = self.last_time.map_or(0.0, |t| state.time - t);
         self.last_time = Some(state.time);
-        self.read_centers(state);
-        if self.needs_rebuild(state.time) {
+        let moved = self.read_centers(state);
+        if self.needs_rebuild(moved, state.time) {
             self.rebuild(state.time);
         }
         self.evaluate_list(state, dt, false);
@@ -606,7 +638,7 @@ impl Model for DemContacts {
         let law = &self.settings.law;
         let (p, w) = (&self.pairs, &self.wall_contacts);
         let pairs = (0..p.len()).filter_map(|k| {
-            self.pair_geometry(state, p.first[k] as usize, p.second[k] as usize)
+            self.pair_geometry(p.first[k] as usize, p.second[k] as usize)
                 .map(|(g, _, e)| law.energy(&g, &e, &p.history[k]))
         });
         let walls = (0..w.len()).filter_map(|k| {

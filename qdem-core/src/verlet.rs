@@ -87,6 +87,21 @@ fn half_kick(state: &mut State, dt: f64) {
         .for_each(|(v, a)| *v += half * a);
 }
 
+/// v += ½∆t a, then x += ∆t v, in one pass over all particles.
+fn kick_and_drift(state: &mut State, dt: f64) {
+    let half = 0.5 * dt;
+    state
+        .position
+        .par_iter_mut()
+        .zip(state.velocity.par_iter_mut())
+        .zip(state.acceleration.par_iter())
+        .with_min_len(PARTICLE_CHUNK)
+        .for_each(|((x, v), a)| {
+            *v += half * a;
+            *x += dt * *v;
+        });
+}
+
 impl Stepper for Verlet {
     fn name(&self) -> &str {
         "verlet"
@@ -110,17 +125,9 @@ impl Stepper for Verlet {
 
     fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {
         let dt = self.dt;
-        half_kick(state, dt);
+        kick_and_drift(state, dt);
         if !state.rigid.is_empty() {
             state.rigid.kick(&self.torque, 0.5 * dt);
-        }
-        state
-            .position
-            .par_iter_mut()
-            .zip(state.velocity.par_iter())
-            .with_min_len(PARTICLE_CHUNK)
-            .for_each(|(x, v)| *x += dt * v);
-        if !state.rigid.is_empty() {
             state.rigid.rotate(dt);
             place_members(state);
         }

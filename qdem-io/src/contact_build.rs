@@ -1,7 +1,8 @@
 //! Building the contact model of a scene: spheres at the surface vertices of every body with a
 //! `contact_radius` (interior vertices never touch anything, paper 000 §4), the `[contact]`
-//! law, and the `[[wall]]`s. A scene whose bodies carry no spheres gets no contact model, and
-//! the initial configuration is checked for interpenetration before anything runs.
+//! law, and the `[[wall]]`s. A scene in which nothing can touch (no sphere, or the spheres of a
+//! single body and no wall) gets no contact model, and the initial configuration is checked
+//! for interpenetration before anything runs.
 
 use crate::build::{body_index, BuildError, PlacedMesh};
 use crate::scene::{Contact, ContactLawName, Scene};
@@ -22,7 +23,8 @@ pub(crate) fn build_contacts(
         return Ok(None);
     };
     let spheres = contact_spheres(scene, meshes)?;
-    if spheres.is_empty() {
+    let single_body = spheres.windows(2).all(|w| w[0].body == w[1].body);
+    if spheres.is_empty() || (single_body && scene.walls.is_empty()) {
         return Ok(None);
     }
     let materials: Vec<(f64, f64)> = scene

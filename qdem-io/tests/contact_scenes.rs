@@ -78,3 +78,18 @@ fn a_block_sliding_on_a_mesh_wall_decelerates_at_mu_g() {
     assert!(v1.x > 0.0, "still sliding over the measured window");
     assert!((a / expected - 1.0).abs() < 0.01, "a = {a} vs {expected}");
 }
+
+#[test]
+fn a_lone_body_without_walls_gets_no_contact_model() {
+    let mut scene = Scene::load(&fixture("incline.toml")).unwrap();
+    let with_wall = Simulation::build(scene.clone()).unwrap();
+    assert!(with_wall.contacts().is_some());
+    scene.walls.clear();
+    // Nothing bounds the step of a lone rigid body: the scene must give one.
+    scene.run.dt = qdem_io::scene::TimeStep::Fixed(1e-4);
+    let alone = Simulation::build(scene).unwrap();
+    assert!(
+        alone.contacts().is_none(),
+        "one body and no wall: nothing can touch"
+    );
+}
