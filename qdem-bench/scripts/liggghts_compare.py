@@ -5,7 +5,7 @@ Usage (from the workspace root):
 
     python3 qdem-bench/scripts/liggghts_compare.py [--spheres 10000,100000] [--steps 2000]
         [--work out/liggghts] [--docs docs] [--np 2] [--fake-packing] [--regen-packing]
-        [--skip-qdem] [--wait-idle 300]
+        [--skip-qdem] [--no-build] [--repeats 3] [--wait-idle 300]
 
 For each sphere count N:
   1. qdem makes a settled packing
@@ -245,13 +245,25 @@ def fake_packing(n: int, d: Path) -> None:
 # ----------------------------------------------------------------------------- qdem side
 
 class Qdem:
-    def __init__(self) -> None:
-        log("building qdem-bench's study binary (cargo build --release -p qdem-bench --bin study)")
-        sh(["cargo", "build", "--release", "-p", "qdem-bench", "--bin", "study"], cwd=ROOT)
+    def __init__(self, work: Path, build: bool = True) -> None:
+        if build:
+            log("building qdem-bench's study binary "
+                "(cargo build --release -p qdem-bench --bin study)")
+            sh(["cargo", "build", "--release", "-p", "qdem-bench", "--bin", "study"], cwd=ROOT)
         target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
         if not target.is_absolute():
             target = ROOT / target
         self.exe = target / "release" / "study"
+        if not self.exe.exists():
+            sys.exit(f"error: no {self.exe}; run without --no-build")
+        # a private copy, so that a rebuild of the workspace during the study changes nothing
+        work.mkdir(parents=True, exist_ok=True)
+        copy = work / "study"
+        shutil.copy2(self.exe, copy)
+        self.exe = copy
+        rev = subprocess.run(["git", "describe", "--always", "--dirty"], cwd=ROOT,
+                             capture_output=True, text=True).stdout.strip()
+        self.version = f"qdem {rev or 'unknown'}" + ("" if build else " (prebuilt binary)")
 
     def packing(self, n: int, d: Path) -> None:
         log(f"qdem: settling a packing of {n} spheres into {d}")
@@ -288,6 +300,32 @@ def wall_commands(meta: dict) -> str:
     return "\n".join(lines)
 
 
+def wall_overlaps(meta: dict) -> str:
+    """An atom-style expression: how many of the walls a sphere overlaps (centre closer than its
+    radius c_rad to the plane, on either side)."""
+    terms = []
+    for w in meta["walls"]:
+        a = next(k for k in range(3) if abs(w["normal"][k]) > 1e-12)
+        terms.append(f"(abs({'xyz'[a]}-({fmt(w['point'][a])}))<c_rad)")
+    return "+".join(terms) if terms else "0"
+
+
+def restitution(meta: dict) -> float:
+    """The restitution for LIGGGHTS: packing.json's e, checked against qdem's damping ratio
+    (LIGGGHTS's beta = ln e / sqrt(ln^2 e + pi^2) = -zeta); if the two disagree, the e that
+    reproduces qdem's zeta, so that both codes damp alike."""
+    e = meta["restitution"]
+    zeta = meta.get("damping_ratio")
+    if zeta is None:
+        return e
+    e_zeta = math.exp(-math.pi * zeta / math.sqrt(1.0 - zeta * zeta)) if zeta < 1 else 0.0
+    if abs(e_zeta - e) > 1e-6 * max(e, 1e-12):
+        log(f"WARNING: packing.json's restitution {e} and damping_ratio {zeta} (e = {e_zeta:.9g}) "
+            "disagree; LIGGGHTS gets the e of qdem's damping ratio")
+        return e_zeta
+    return e
+
+
 def write_liggghts_inputs(meta: dict, spheres, steps: int, d: Path) -> Path:
     rmax = max(s[3] for s in spheres)
     lo = [min(meta["box_min"][k], min(s[k] - s[3] for s in spheres)) for k in range(3)]
@@ -308,6 +346,7 @@ def write_liggghts_inputs(meta: dict, spheres, steps: int, d: Path) -> Path:
     gmag = math.sqrt(sum(c * c for c in g))
     gdir = " ".join(fmt(c / gmag) for c in g) if gmag > 0 else "0.0 0.0 -1.0"
     e = meta["youngs_modulus"]
+    rest = restitution(meta)
     grid = ["*", "*", "*"]
     if gmag > 0:
         grid[max(range(3), key=lambda k: abs(g[k]))] = "1"
@@ -315,9 +354,9 @@ def write_liggghts_inputs(meta: dict, spheres, steps: int, d: Path) -> Path:
         "PROCS": " ".join(grid),
         "DATA": data.name, "SKIN": fmt(meta["skin"]), "E": fmt(e),
         "E_WALL": fmt(e * E_WALL_FACTOR), "E_WALL_FACTOR": f"{E_WALL_FACTOR:g}",
-        "NU": fmt(meta["poisson_ratio"]), "REST": fmt(meta["restitution"]),
+        "NU": fmt(meta["poisson_ratio"]), "REST": fmt(rest),
         "MU": fmt(meta["friction"]), "DT": fmt(meta["dt"]), "G_MAG": fmt(gmag), "G_DIR": gdir,
-        "WALLS": wall_commands(meta), "THERMO": str(max(1000, steps // 4)), "STEPS": str(steps),
+        "WALLS": wall_commands(meta), "WALL_OVERLAPS": wall_overlaps(meta), "THERMO": str(max(1000, steps // 4)), "STEPS": str(steps),
     }
     text = TEMPLATE.read_text()
     for k, v in subs.items():
@@ -346,32 +385,37 @@ def run_liggghts(exe: str, launcher: list[str], deck: Path, meta: dict, spheres)
     if not loops:
         sys.exit(f"error: no 'Loop time' line in {deck.parent}/liggghts.stdout")
     t, procs, steps, atoms = loops[0]  # the first run is the timed one; the second is `run 0`
-    # thermo of the final `run 0`: step atoms ke csum xlo xhi ylo yhi zlo zhi (LIGGGHTS prints
-    # the column of c_csum as "csum")
+    # thermo of the final `run 0` (LIGGGHTS prints the column of c_csum as "csum", v_xlo as "xlo")
     final = None
     lines = p.stdout.splitlines()
     for i, line in enumerate(lines):
         cols = line.split()
         if cols[:1] == ["Step"] and ("csum" in cols or "c_csum" in cols) and i + 1 < len(lines):
-            final = [float(v) for v in lines[i + 1].split()]
+            names = [c.split("_", 1)[1] if c[:2] in ("c_", "v_") else c for c in cols]
+            final = dict(zip(names, (float(v) for v in lines[i + 1].split())))
     if final is None:
         sys.exit(f"error: no final thermo line in {deck.parent}/liggghts.stdout")
-    contacts = None
-    if final:
-        contacts = int(round(final[3] / 2))
-        _, atoms_left, ke, _, xl, xh, yl, yh, zl, zh = final
-        bmin, bmax = meta["box_min"], meta["box_max"]
-        rmax = max(s[3] for s in spheres)
-        tol = 0.5 * rmax
-        inside = (xl > bmin[0] - tol and xh < bmax[0] + tol and yl > bmin[1] - tol
-                  and yh < bmax[1] + tol and zl > bmin[2] - tol)
-        log(f"LIGGGHTS final state: {int(atoms_left)} atoms, KE {ke:.4g} J, centres in "
-            f"x [{xl:.4g}, {xh:.4g}] y [{yl:.4g}, {yh:.4g}] z [{zl:.4g}, {zh:.4g}]; "
-            f"{contacts} sphere-sphere contacts; {'inside' if inside else 'OUTSIDE'} the walls")
-        if not inside or int(atoms_left) != len(spheres):
-            sys.exit("error: spheres left the box in the LIGGGHTS run")
+    pair_contacts = int(round(final["csum"] / 2))
+    wall_contacts = int(round(final["wsum"]))
+    contacts = pair_contacts + wall_contacts
+    atoms_left, ke = final["Atoms"], final["ket"] + final["erot"]
+    xl, xh, yl, yh, zl, zh = (final[k] for k in ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi"))
+    bmin, bmax = meta["box_min"], meta["box_max"]
+    rmax = max(s[3] for s in spheres)
+    tol = 0.5 * rmax
+    inside = (xl > bmin[0] - tol and xh < bmax[0] + tol and yl > bmin[1] - tol
+              and yh < bmax[1] + tol and zl > bmin[2] - tol)
+    log(f"LIGGGHTS final state: {int(atoms_left)} atoms, KE {ke:.4g} J, centres in "
+        f"x [{xl:.4g}, {xh:.4g}] y [{yl:.4g}, {yh:.4g}] z [{zl:.4g}, {zh:.4g}]; "
+        f"{pair_contacts} sphere-sphere + {wall_contacts} sphere-wall contacts; "
+        f"{'inside' if inside else 'OUTSIDE'} the walls")
+    if not inside or int(atoms_left) != len(spheres):
+        sys.exit("error: spheres left the box in the LIGGGHTS run")
+    builds = re.search(r"Neighbor list builds = (\d+)", p.stdout)
     return {"wall_s": float(t), "procs": int(procs), "steps": int(steps), "atoms": int(atoms),
-            "contacts": contacts}
+            "contacts": contacts, "sphere_sphere_contacts": pair_contacts,
+            "sphere_wall_contacts": wall_contacts, "kinetic_energy": ke,
+            "neighbor_builds": int(builds.group(1)) if builds else None}
 
 
 # ----------------------------------------------------------------------------- report
@@ -388,54 +432,74 @@ def sci(v) -> str:
     return "—" if v is None else f"{v:.3e}"
 
 
-def markdown(rows: list[dict], meta_by_n: dict, args, version: str, mpi_desc: str, machine: str,
-             fake: bool) -> str:
+def markdown(rows: list[dict], args, version: str, mpi_desc: str, machine: str,
+             liggghts_only: bool) -> str:
     cmd = (f"python3 qdem-bench/scripts/liggghts_compare.py --spheres "
            f"{','.join(map(str, args.spheres))} --steps {args.steps}"
+           + (f" --repeats {args.repeats}" if args.repeats != 3 else "")
            + (" --fake-packing" if args.fake_packing else "")
            + (" --skip-qdem" if args.skip_qdem else ""))
+    qv = next((r["version"] for r in rows if r["code"] == "qdem"), None)
     out = [BEGIN, "", "## DEM throughput against LIGGGHTS", ""]
     out.append(f"**Machine:** {machine}, {os.cpu_count()} cores. "
-               f"Measured {_dt.date.today().isoformat()}.")
+               f"Measured {_dt.date.today().isoformat()}"
+               + (f" ({qv})" if qv else "") + ".")
     out.append("")
-    out.append(f"**LIGGGHTS:** {version}; {mpi_desc}. Deck: "
-               "`qdem-bench/scripts/liggghts/bench.in.template` (filled in per run; the filled "
-               "deck and data file are left in the work folder).")
+    out.append(f"**LIGGGHTS:** {version}; {mpi_desc}; no MPI cut along gravity "
+               "(`processors * * 1`). Deck: `qdem-bench/scripts/liggghts/bench.in.template` "
+               "(filled in per run; the filled deck `in.bench`, data file and output are left in "
+               "`out/liggghts/nN/`). **qdem:** `study dem-throughput`, rayon threads.")
     out.append("")
-    out.append("**Same physics on both sides:** the same settled packing (qdem `study packing`), "
-               "rigid spheres with rotation, Hertz normal + Mindlin tangential with history, "
-               "Coulomb limit, no rolling friction or cohesion, gravity, the packing's density, E, "
-               "ν, μ, restitution e (LIGGGHTS β = ln e/√(ln²e+π²) = −ζ), time step and neighbour "
-               "skin (`neighbor SKIN bin`, `neigh_modify delay 0`); walls are rigid planes in qdem "
-               f"and LIGGGHTS `wall/gran` primitives of a wall type with E × {E_WALL_FACTOR:g} "
-               "(so sphere–wall E* → E/(1−ν²), R* = r). LIGGGHTS's time is its `Loop time` (the "
-               "run loop, setup excluded); qdem's is the `wall_s` that `study dem-throughput` "
-               "reports. Particle-steps/s = spheres × steps / wall time.")
+    out.append("**Same problem on both sides:** the same settled packing (`study packing`: a "
+               "lattice poured into a box of a floor and four side walls), started at rest; the "
+               "same time step (the one qdem ran), steps and neighbour skin (`neighbor SKIN bin`, "
+               "`neigh_modify delay 0`); rigid spheres with rotation, Hertz normal + Mindlin "
+               "tangential with history, Coulomb limit, no rolling friction or cohesion, gravity, "
+               "the packing's ρ, E, ν, μ and restitution e (LIGGGHTS β = ln e/√(ln²e+π²) = −ζ). "
+               "Walls are rigid planes in qdem and LIGGGHTS `wall/gran` primitives of a wall atom "
+               f"type with E × {E_WALL_FACTOR:g} (so sphere–wall E* → E/(1−ν²), R* = r; checked: "
+               "a sphere resting on the floor settles at the rigid-wall Hertz overlap to 8 digits).")
     out.append("")
-    out.append("| spheres | steps | dt (s) | code | run as | wall (s) | particle-steps/s | contacts at end | qdem / LIGGGHTS |")
-    out.append("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    out.append(f"**Timing:** the two codes alternate, {args.repeats} runs each, the fastest counts "
+               "(all are in `docs/liggghts_compare.json`, with how busy the other processes kept "
+               "the machine). LIGGGHTS's time is its `Loop time` (the run loop; set-up and the "
+               "first neighbour build excluded); qdem's the `wall_s` of `dem-throughput` (the "
+               "step loop after the initial force evaluation). Particle-steps/s = spheres × "
+               "steps / wall time.")
+    out.append("")
+    out.append("| spheres | steps | dt (s) | code | run as | wall (s) | particle-steps/s | "
+               "contacts at end | KE at end (J) | qdem / LIGGGHTS |")
+    out.append("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for n in sorted({r["spheres"] for r in rows}):
         rs = [r for r in rows if r["spheres"] == n]
         lig = next((r for r in rs if r["code"] == "liggghts"), None)
         for r in rs:
             ratio = ""
             if r["code"] == "qdem" and lig and r["particle_steps_per_s"] and lig["particle_steps_per_s"]:
-                ratio = f"{r['particle_steps_per_s'] / lig['particle_steps_per_s']:.2f}"
+                ratio = f"**{r['particle_steps_per_s'] / lig['particle_steps_per_s']:.2f}**"
             run_as = (f"{r['threads_or_procs']} threads" if r["code"] == "qdem"
                       else f"{r['threads_or_procs']} MPI procs")
-            out.append(f"| {n:,} | {r['steps']} | {r['dt']:g} | {r['code']} | {run_as} | "
+            out.append(f"| {n:,} | {r['steps']} | {r['dt']:.4g} | {r['code']} | {run_as} | "
                        f"{r['wall_s']:.2f} | {sci(r['particle_steps_per_s'])} | "
-                       f"{'—' if r['contacts'] is None else r['contacts']} | {ratio} |")
+                       f"{'—' if r['contacts'] is None else format(r['contacts'], ',')} | "
+                       f"{'—' if r.get('kinetic_energy') is None else format(r['kinetic_energy'], '.3g')} | "
+                       f"{ratio} |")
     out.append("")
-    out.append("Contacts: qdem's figure is what `dem-throughput` reports; LIGGGHTS's is "
-               "sphere–sphere contacts at the end (`compute contact/atom` summed / 2, untimed).")
-    if fake:
+    out.append("Contacts at the end of the run, sphere–sphere plus sphere–wall: qdem's as "
+               "`dem-throughput` reports them (pairs with a non-zero force); LIGGGHTS's from "
+               "`compute contact/atom` (summed, halved) plus the spheres closer to a wall than "
+               "their radius, counted after the timed run. KE: translational + rotational "
+               "(LIGGGHTS `compute ke` + `erotate/sphere`). The two runs start from the same "
+               "state and integrate the same law, so both agree closely; a KE far from 0 means "
+               "the packing was still moving (not fully settled), the same for both codes.")
+    if liggghts_only:
         out.append("")
         out.append("**LIGGGHTS only** (`--fake-packing` or `--skip-qdem`): "
                    + ("a loose lattice written by the script; " if args.fake_packing else "")
                    + "not a comparison.")
     out.append("")
-    out.append("Reproduce:")
+    out.append("Reproduce (installs the Debian package `liggghts` if it is missing; about "
+               "15 minutes for 10⁴ and 10⁵ spheres, most of it qdem settling the 10⁵ packing):")
     out.append("")
     out.append("```sh")
     out.append(cmd)
@@ -472,6 +536,8 @@ def main() -> None:
                     help="remake qdem's packing even if WORK/nN/packing.json exists")
     ap.add_argument("--skip-qdem", action="store_true",
                     help="time LIGGGHTS only, on the packings already in WORK/nN")
+    ap.add_argument("--no-build", action="store_true",
+                    help="use target/release/study as it is, without cargo build")
     ap.add_argument("--repeats", type=int, default=3,
                     help="timed runs of each code per sphere count, alternating; the fastest "
                     "counts (default 3)")
@@ -494,7 +560,7 @@ def main() -> None:
     machine = cpu_model()
     log(f"LIGGGHTS {version} at {exe}; {mpi_desc}; CPU {machine}")
     liggghts_only = args.fake_packing or args.skip_qdem
-    qdem = None if liggghts_only else Qdem()
+    qdem = None if liggghts_only else Qdem(work, build=not args.no_build)
 
     rows, metas = [], {}
     for n in args.spheres:
@@ -521,6 +587,17 @@ def main() -> None:
                 if q.get("spheres", n_real) != n_real or q["steps"] != args.steps:
                     sys.exit(f"error: qdem timed {q.get('spheres')} spheres for {q['steps']} "
                              f"steps; expected {n_real} for {args.steps}")
+                if rep == 0 and q["dt"] != meta["dt"]:
+                    # qdem picks its step from its own stability bound too; LIGGGHTS must use
+                    # the step qdem actually ran
+                    log(f"qdem ran dt = {q['dt']!r}, packing.json says {meta['dt']!r}: "
+                        "LIGGGHTS gets qdem's")
+                    meta = dict(meta, dt=q["dt"], dt_packing_json=meta["dt"])
+                    metas[n] = meta
+                    deck = write_liggghts_inputs(meta, spheres, args.steps, d)
+                elif q["dt"] != meta["dt"]:
+                    sys.exit(f"error: qdem's dt changed between runs ({meta['dt']!r} then "
+                             f"{q['dt']!r}): was the study binary rebuilt meanwhile?")
                 q_runs.append((q, busy, ol.cores))
                 log(f"qdem run {rep + 1}/{args.repeats}: {q}")
             busy = wait_idle(args.wait_idle)
@@ -538,11 +615,18 @@ def main() -> None:
             rows.append(row("qdem", n_real, q["steps"], q["dt"], q["wall_s"],
                             q.get("threads"), q.get("contacts"), machine,
                             reported_particle_steps_per_s=q.get("particle_steps_per_s"),
+                            version=qdem.version,
+                            **{k: q[k] for k in ("stable_bound", "rebuilds", "kinetic_energy")
+                               if k in q},
                             all_wall_s=[t[0]["wall_s"] for t in q_runs],
                             cpu_busy_before=round(busy, 3), other_cores_during=round(other, 3)))
         lg, busy, other = min(l_runs, key=lambda t: t[0]["wall_s"])
         rows.append(row("liggghts", n_real, lg["steps"], meta["dt"], lg["wall_s"], lg["procs"],
                         lg["contacts"], machine, version=version, launcher=mpi_desc,
+                        neighbor_builds=lg["neighbor_builds"],
+                        sphere_sphere_contacts=lg["sphere_sphere_contacts"],
+                        sphere_wall_contacts=lg["sphere_wall_contacts"],
+                        kinetic_energy=lg["kinetic_energy"],
                         all_wall_s=[t[0]["wall_s"] for t in l_runs],
                         cpu_busy_before=round(busy, 3), other_cores_during=round(other, 3),
                         deck=str(deck.relative_to(ROOT) if deck.is_relative_to(ROOT) else deck)))
@@ -557,7 +641,7 @@ def main() -> None:
         if qd and lg:
             qd["ratio_qdem_over_liggghts"] = qd["particle_steps_per_s"] / lg["particle_steps_per_s"]
 
-    section = markdown(rows, metas, args, version, mpi_desc, machine, liggghts_only)
+    section = markdown(rows, args, version, mpi_desc, machine, liggghts_only)
     out_json = json.dumps(rows, indent=2) + "\n"
     (work).mkdir(parents=True, exist_ok=True)
     (work / "liggghts_compare.json").write_text(out_json)
