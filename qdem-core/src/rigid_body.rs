@@ -118,6 +118,28 @@ impl RigidBodies {
             });
     }
 
+    /// [`RigidBodies::kick`] by ½∆t followed by [`RigidBodies::rotate`] by ∆t, in one pass:
+    /// the first half of a Verlet step.
+    pub fn kick_and_rotate(&mut self, torque: &[Vec3], dt: f64) {
+        let (inertia, fixed) = (&self.inertia, &self.spin_fixed);
+        self.orientation
+            .par_iter_mut()
+            .zip(self.angular_velocity.par_iter_mut())
+            .zip(self.angular_momentum.par_iter_mut())
+            .with_min_len(BODY_CHUNK)
+            .enumerate()
+            .for_each(|(b, ((q, w), l))| {
+                if fixed[b] {
+                    *l = Vec3::zeros();
+                    *w = Vec3::zeros();
+                    return;
+                }
+                *l += 0.5 * dt * torque[b];
+                *w = spin(q, &inertia[b], l);
+                rotate_one(q, w, &inertia[b], l, dt);
+            });
+    }
+
     /// q ← exp(ω_{½}∆t) q for every body, with ω_{½} the angular velocity at the half-way
     /// orientation exp(ω∆t/2) q under the (drift-constant) L; then ω at the new orientation.
     /// Exact for equal principal moments (a sphere: ω is constant and one exponential
@@ -129,17 +151,20 @@ impl RigidBodies {
             .zip(self.angular_velocity.par_iter_mut())
             .with_min_len(BODY_CHUNK)
             .enumerate()
-            .for_each(|(b, (q, w))| {
-                let moments = &inertia[b];
-                if moments.x == moments.y && moments.y == moments.z {
-                    *q = exp_map(dt * *w) * *q;
-                    return;
-                }
-                let half = exp_map(0.5 * dt * *w) * *q;
-                *q = exp_map(dt * spin(&half, moments, &momentum[b])) * *q;
-                *w = spin(q, moments, &momentum[b]);
-            });
+            .for_each(|(b, (q, w))| rotate_one(q, w, &inertia[b], &momentum[b], dt));
     }
+}
+
+/// The rotation of one body over ∆t under constant L (see [`RigidBodies::rotate`]).
+#[inline]
+fn rotate_one(q: &mut UnitQuaternion<f64>, w: &mut Vec3, moments: &Vec3, l: &Vec3, dt: f64) {
+    if moments.x == moments.y && moments.y == moments.z {
+        *q = exp_map(dt * *w) * *q;
+        return;
+    }
+    let half = exp_map(0.5 * dt * *w) * *q;
+    *q = exp_map(dt * spin(&half, moments, l)) * *q;
+    *w = spin(q, moments, l);
 }
 
 /// The rotation by the angle |v| about v, as a unit quaternion. Below 10⁻³ rad (every step
@@ -263,6 +288,9 @@ pub fn place_members(state: &mut State) {
 /// Σ f and the body the torque Σ (x − c) × f. Member forces are zeroed.
 pub fn reduce_member_forces(state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
     let rigid = &state.rigid;
+    if rigid.member.is_empty() {
+        return;
+    }
     for (b, body_torque) in torque.iter_mut().enumerate() {
         let c = rigid.center[b];
         let (mut total, mut moment) = (Vec3::zeros(), Vec3::zeros());

@@ -112,15 +112,15 @@ pub fn compute_accelerations(
 /// body). Fails on a non-finite acceleration.
 pub(crate) fn set_accelerations(state: &mut State, force: &[Vec3]) -> Result<(), CoreError> {
     let (mass, fixed, rigid) = (&state.mass, &state.fixed, &state.rigid);
-    state
+    let first_bad = state
         .acceleration
         .par_iter_mut()
         .with_min_len(PARTICLE_CHUNK)
         .enumerate()
-        .for_each(|(i, a)| {
+        .map(|(i, a)| {
             if rigid.body_of_member(i).is_some() {
                 *a = Vec3::zeros();
-                return;
+                return usize::MAX;
             }
             let mut acc = force[i] / mass[i];
             for axis in 0..3 {
@@ -129,8 +129,21 @@ pub(crate) fn set_accelerations(state: &mut State, force: &[Vec3]) -> Result<(),
                 }
             }
             *a = acc;
-        });
-    check_finite(state)
+            if acc.iter().all(|c| c.is_finite()) {
+                usize::MAX
+            } else {
+                i
+            }
+        })
+        .min()
+        .unwrap_or(usize::MAX);
+    match first_bad {
+        usize::MAX => Ok(()),
+        particle => Err(CoreError::NonFinite {
+            time: state.time,
+            particle,
+        }),
+    }
 }
 
 /// Checks that every particle that is free in some direction, and no member of a rigid body,

@@ -115,8 +115,7 @@ impl Stepper for Verlet {
         // x += ∆t (v + ½∆t a), v += ½∆t a, bit for bit.
         predict(state, dt, 0.0, 0.5);
         if !state.rigid.is_empty() {
-            state.rigid.kick(&self.torque, 0.5 * dt);
-            state.rigid.rotate(dt);
+            state.rigid.kick_and_rotate(&self.torque, dt);
             place_members(state);
         }
         self.evaluate(state, models)?;
