@@ -29,12 +29,18 @@ struct Grid {
     dims: [u64; 3],
 }
 
+/// The lower and upper corners of the axis-aligned box around `points` (infinite, inverted
+/// corners for none).
+pub fn bounds<'a>(points: impl IntoIterator<Item = &'a Vec3>) -> (Vec3, Vec3) {
+    points.into_iter().fold(
+        (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
+        |(lo, hi), x| (lo.inf(x), hi.sup(x)),
+    )
+}
+
 impl Grid {
     fn new(center: &[Vec3], cell: f64) -> Grid {
-        let (lo, hi) = center.iter().fold(
-            (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
-            |(lo, hi), x| (lo.inf(x), hi.sup(x)),
-        );
+        let (lo, hi) = bounds(center);
         // Spheres spread over a very large region get larger cells, so that keys fit in u64.
         let mut inverse_cell = 1.0 / cell;
         let cells = |inv: f64| [0, 1, 2].map(|k| ((hi[k] - lo[k]) * inv) as u64 + 1);

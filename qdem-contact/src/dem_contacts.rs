@@ -118,9 +118,7 @@ pub struct DemContacts {
     radius: Vec<f64>,
     body: Vec<u32>,
     rigid: Vec<u32>,
-    mass: Vec<f64>,
     lever: Vec<f64>,
-    material: Vec<u32>,
     body_names: Vec<String>,
     materials: usize,
     elasticity: Vec<PairElasticity>,
@@ -152,14 +150,18 @@ impl DemContacts {
         settings: ContactSettings,
         walls: Vec<Wall>,
     ) -> DemContacts {
+        // The rigid body of each sphere: through a member, or at the body's centre.
+        let mut body_of_center = vec![NOT_RIGID; state.len()];
+        for (b, &c) in state.rigid.center.iter().enumerate() {
+            body_of_center[c] = b as u32;
+        }
         let rigid: Vec<u32> = spheres
             .iter()
             .map(|s| {
-                let b = state
+                state
                     .rigid
                     .body_of_member(s.particle)
-                    .or_else(|| state.rigid.center.iter().position(|&c| c == s.particle));
-                b.map_or(NOT_RIGID, |b| b as u32)
+                    .map_or(body_of_center[s.particle], |b| b as u32)
             })
             .collect();
         let carrier = |s: &ContactSphere, r: u32| match r {
@@ -206,9 +208,7 @@ impl DemContacts {
             radius: spheres.iter().map(|s| s.radius).collect(),
             body: spheres.iter().map(|s| s.body as u32).collect(),
             rigid,
-            mass,
             lever,
-            material: spheres.iter().map(|s| s.material as u32).collect(),
             body_names,
             materials: materials.len(),
             elasticity,
@@ -258,14 +258,6 @@ impl DemContacts {
     /// How many times the candidate lists were rebuilt.
     pub fn rebuilds(&self) -> u64 {
         self.rebuilds
-    }
-
-    /// The total force the spheres exert on wall `w` at the last evaluation (N).
-    pub fn wall_force(&self, w: usize) -> Vec3 {
-        let c = &self.wall_contacts;
-        (0..c.len())
-            .filter(|&k| c.second[k] as usize == w)
-            .fold(Vec3::zeros(), |sum, k| sum - c.force[k])
     }
 
     /// Fails if two bodies, or a body and a wall, overlap at the current configuration by more
@@ -610,13 +602,14 @@ impl Model for DemContacts {
         let mut worst = (0.0f64, 0.0f64);
         for s in 0..self.particle.len() {
             let r = self.radius[s];
-            let e = self.wall_elasticity[self.material[s] as usize];
+            let sphere = &self.now[s];
+            let e = self.wall_elasticity[sphere.material as usize];
             let (kn, kt) = law.stiffness(REFERENCE_OVERLAP * r, r, &e);
             let k = kn.max(kt);
-            let compliance = 1.0 / self.mass[s] + self.lever[s];
+            let compliance = 1.0 / sphere.mass + self.lever[s];
             let (w, g) = (
                 k * compliance,
-                2.0 * zeta * (k * self.mass[s]).sqrt() * compliance,
+                2.0 * zeta * (k * sphere.mass).sqrt() * compliance,
             );
             match self.rigid[s] {
                 NOT_RIGID => worst = (worst.0.max(COORDINATION * w), worst.1.max(COORDINATION * g)),

@@ -5,6 +5,7 @@
 //! and a sphere over an edge or vertex is pushed away from that edge or vertex rather than
 //! twice by two faces. The surface is two-sided: a centre must not cross it.
 
+use crate::broad_phase::bounds;
 use crate::error::ContactError;
 use parry3d_f64::math::Vector;
 use parry3d_f64::query::PointQuery;
@@ -52,10 +53,7 @@ impl MeshWall {
                 wall: name.to_string(),
                 reason: e.to_string(),
             })?;
-        let (lower, upper) = vertices.iter().fold(
-            (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
-            |(lo, hi), x| (lo.inf(x), hi.sup(x)),
-        );
+        let (lower, upper) = bounds(vertices);
         Ok(MeshWall {
             mesh,
             velocity,

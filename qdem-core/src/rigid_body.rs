@@ -81,6 +81,18 @@ impl RigidBodies {
             .sum()
     }
 
+    /// Position and velocity of member slot `slot` from its body's pose.
+    #[inline]
+    fn placed(&self, slot: usize, position: &[Vec3], velocity: &[Vec3]) -> (Vec3, Vec3) {
+        let b = self.member_body[slot] as usize;
+        let c = self.center[b];
+        let arm = self.orientation[b] * self.offset[slot];
+        (
+            position[c] + arm,
+            velocity[c] + self.angular_velocity[b].cross(&arm),
+        )
+    }
+
     /// Sets L_b (world frame) and the angular velocity that follows from it.
     pub fn set_angular_momentum(&mut self, b: usize, l: Vec3) {
         self.angular_momentum[b] = l;
@@ -238,7 +250,12 @@ impl State {
         rigid.angular_momentum.push(Vec3::zeros());
         rigid.angular_velocity.push(Vec3::zeros());
         rigid.spin_fixed.push(false);
-        place_members(self);
+        for slot in rigid.member_start[b]..rigid.member_start[b + 1] {
+            let (x, v) = rigid.placed(slot, &self.position, &self.velocity);
+            let m = rigid.member[slot];
+            self.position[m] = x;
+            self.velocity[m] = v;
+        }
         Ok(b)
     }
 }
@@ -264,19 +281,9 @@ pub fn place_members(state: &mut State) {
         return;
     }
     let (position, velocity) = (&state.position, &state.velocity);
-    let placed: Vec<(Vec3, Vec3)> = rigid
-        .member_body
-        .par_iter()
-        .zip(rigid.offset.par_iter())
-        .map(|(&b, s)| {
-            let b = b as usize;
-            let c = rigid.center[b];
-            let arm = rigid.orientation[b] * s;
-            (
-                position[c] + arm,
-                velocity[c] + rigid.angular_velocity[b].cross(&arm),
-            )
-        })
+    let placed: Vec<(Vec3, Vec3)> = (0..rigid.member.len())
+        .into_par_iter()
+        .map(|slot| rigid.placed(slot, position, velocity))
         .collect();
     for (&m, (x, v)) in state.rigid.member.iter().zip(placed) {
         state.position[m] = x;

@@ -6,6 +6,7 @@
 
 use crate::build::{body_index, BuildError, PlacedMesh};
 use crate::scene::{Contact, ContactLawName, Scene};
+use qdem_contact::broad_phase::bounds;
 use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, LinearSpring, MeshWall,
     PlaneWall, Wall, WallShape,
@@ -107,16 +108,9 @@ fn contact_spheres(scene: &Scene, meshes: &[PlacedMesh]) -> Result<Vec<ContactSp
 }
 
 fn smallest_extent(nodes: &[[f64; 3]]) -> f64 {
-    (0..3)
-        .map(|k| {
-            let (lo, hi) = nodes
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                    (lo.min(p[k]), hi.max(p[k]))
-                });
-            hi - lo
-        })
-        .fold(f64::INFINITY, f64::min)
+    let points: Vec<Vec3> = nodes.iter().map(|p| Vec3::from(*p)).collect();
+    let (lower, upper) = bounds(&points);
+    (upper - lower).min()
 }
 
 /// The scene's walls: planes, and meshes whose boundary triangles are the wall.
