@@ -6,6 +6,31 @@ use thiserror::Error;
 /// What the contact model refuses.
 #[derive(Debug, Error)]
 pub enum ContactError {
+    /// A beam lattice cannot represent the material's Poisson's ratio.
+    #[error(
+        "bonded body `{body}`: a triangular beam lattice represents Poisson's ratios from about \
+         0.16 to below 1/3 (bonds with a non-negative shear coefficient), not {poisson}; fix: \
+         give `poisson` in that range"
+    )]
+    LatticePoisson {
+        /// Body name.
+        body: String,
+        /// The ratio asked for.
+        poisson: f64,
+    },
+    /// The rectangle is too small for the element size.
+    #[error(
+        "bonded body `{body}`: the rectangle {size:?} m holds fewer than two rows or columns at \
+         element size {element_size} m; fix: use a smaller `element_size`"
+    )]
+    TooCoarse {
+        /// Body name.
+        body: String,
+        /// Rectangle size.
+        size: [f64; 2],
+        /// Element size.
+        element_size: f64,
+    },
     /// Two bodies interpenetrate at the start beyond the tolerance.
     #[error(
         "bodies `{a}` and `{b}` overlap by {overlap:.3e} m at the start (spheres at {at_a:?} and \

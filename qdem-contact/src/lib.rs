@@ -10,9 +10,15 @@
 //! - [`contact_law`], [`linear_spring`], [`hertz_mindlin`], [`coulomb`]: the laws.
 //! - [`plane_wall`], [`mesh_wall`], [`wall`]: the walls.
 //!
+//! Beam-bonded DEM (paper 001), in 2D: [`BondedParticles`] with [`beam_bond`] (Timoshenko
+//! beam bonds that break), [`unbonded_contact`] (contacts of discs after breakage) and
+//! [`particle_packing`] (lattices of a rectangle and the bond section λ).
+//!
 //! Rigid bodies are integrated by qdem-core ([`qdem_core::rigid_body`]); their spheres add the
 //! moment of each contact force about the sphere's centre to the body's torque.
 
+pub mod beam_bond;
+pub mod bonded_particles;
 pub mod broad_phase;
 pub mod contact_law;
 pub mod coulomb;
@@ -21,14 +27,20 @@ pub mod error;
 pub mod hertz_mindlin;
 pub mod linear_spring;
 pub mod mesh_wall;
+pub mod particle_packing;
 pub mod plane_wall;
+pub mod unbonded_contact;
 pub mod wall;
 
+pub use beam_bond::{BeamBond, BeamSection};
+pub use bonded_particles::{BondSettings, BondedMaterial, BondedParticles};
 pub use contact_law::{ContactLaw, PairElasticity, PairGeometry};
 pub use dem_contacts::{ContactSettings, ContactSphere, DemContacts};
 pub use error::ContactError;
 pub use hertz_mindlin::HertzMindlin;
 pub use linear_spring::LinearSpring;
 pub use mesh_wall::MeshWall;
+pub use particle_packing::{lattice_section, LatticeSection, Packing, PackingKind};
 pub use plane_wall::PlaneWall;
+pub use unbonded_contact::{UnbondedLaw, UnbondedPair};
 pub use wall::{Wall, WallShape};

@@ -20,7 +20,9 @@ pub trait Model: std::any::Any + Send + Sync {
     /// exerts on rigid bodies beyond that of its particle forces into `torque` (one entry per
     /// rigid body of `state.rigid`, empty when there is none). A force on a particle of a rigid
     /// body acts on the body through that particle; only a force applied away from every
-    /// particle (a contact on a rigid sphere's surface) needs `torque`.
+    /// particle (a contact on a rigid sphere's surface) needs `torque`. When the particles have
+    /// rotational DOFs (`state.spin`), `torque` goes on with one moment per particle: entry
+    /// `state.rigid.len() + i` is the moment on particle `i`.
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]);
 
     /// The largest step (s) explicit central-difference stepping tolerates for this model, from
@@ -43,6 +45,27 @@ pub trait Model: std::any::Any + Send + Sync {
     /// implicitly (paper 001 Eq. 26 needs K and C).
     fn add_tangent(&self, state: &State, tangent: &mut Tangent) -> bool {
         let _ = (state, tangent);
+        false
+    }
+
+    /// After a trial step to `state`: the fraction α ∈ (0, 1) of the step's displacement
+    /// increment at which one of the model's events (a bond reaching its strength, an unbonded
+    /// contact opening) would have happened, if the step overshot it by more than the model
+    /// tolerates; the stepper then retakes the step with ∆t·√α (paper 001 Eqs. 29–30). `None`
+    /// when the step is acceptable. `forces_here` says whether the last
+    /// [`Model::add_forces`] was evaluated at exactly this state (explicit steps), so a model
+    /// may reuse what it computed there. May be called several times before
+    /// [`Model::commit_step`]; must not change the model's physics.
+    fn check_step(&mut self, state: &State, forces_here: bool) -> Option<f64> {
+        let _ = (state, forces_here);
+        None
+    }
+
+    /// Accepts the step that ended at `state` (after [`Model::check_step`]): applies its
+    /// events (breaks bonds, opens and closes contacts) and returns whether the tangent
+    /// ([`Model::add_tangent`]) changed, so that an implicit stepper refactorises.
+    fn commit_step(&mut self, state: &State) -> bool {
+        let _ = state;
         false
     }
 

@@ -51,33 +51,65 @@ use rayon::prelude::*;
 /// When the implicit stepper refactorises its effective matrix.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TangentUpdate {
-    /// Once, with K and C at the initial state: the tangent is fixed (linear small strain).
+    /// With K and C at the initial state, and again only when a model's events change its
+    /// tangent ([`Model::commit_step`]: bonds broken, contacts made or lost).
     #[default]
     Fixed,
     /// Every step, with K and C at the predicted state (large displacements or rotations).
     EveryStep,
 }
 
-/// The Newmark-β family with a fixed step: explicit for β = 0, implicit for β > 0.
+/// Retakes a step at most this many times (paper 001 Eq. 30) before accepting it.
+const MAX_RETAKES: usize = 8;
+/// The smallest α a retake uses: a step shrinks at most tenfold per retake.
+const MIN_ALPHA: f64 = 0.01;
+
+/// What the adaptive control and the events did (for summaries and the paper's Tables 1–2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StepCounts {
+    /// Steps rejected and retaken with ∆t·√α (Eqs. 29–30).
+    pub retakes: u64,
+    /// Accepted steps (sub-steps included: a retaken step is finished by further sub-steps so
+    /// that every step still ends at t + ∆t).
+    pub substeps: u64,
+    /// Accepted steps at whose end a model's tangent changed (bonds broke, contacts changed).
+    pub event_steps: u64,
+}
+
+/// The Newmark-β family: explicit for β = 0, implicit for β > 0, optionally adaptive.
 #[derive(Debug)]
 pub struct Newmark {
     beta: f64,
     gamma: f64,
     dt: f64,
     update: TangentUpdate,
+    adaptive: bool,
     force: Vec<Vec3>,
     torque: Vec<Vec3>,
     system: ImplicitSystem,
+    saved: Option<Box<State>>,
+    counts: StepCounts,
 }
 
-/// Buffers of the implicit solve of Eq. 26.
+/// Buffers of the implicit solve of Eq. 26: one factorisation for the nominal step and one
+/// for the last shorter sub-step of the adaptive control, so that a retake does not discard
+/// the factorisation the following steps reuse.
 #[derive(Debug, Default)]
 struct ImplicitSystem {
     tangent: Tangent,
+    tangent_current: bool,
     entries: Vec<Entry>,
     dofs: Option<FreeDofs>,
-    cholesky: SparseCholesky,
+    nominal: Factor,
+    substep: Factor,
     rhs: Vec<f64>,
+}
+
+/// A factorisation of M + γh C + β h² K for one step h.
+#[derive(Debug, Default)]
+struct Factor {
+    cholesky: SparseCholesky,
+    step: Option<f64>,
 }
 
 impl Newmark {
@@ -92,9 +124,12 @@ impl Newmark {
             gamma,
             dt,
             update: TangentUpdate::Fixed,
+            adaptive: false,
             force: Vec::new(),
             torque: Vec::new(),
             system: ImplicitSystem::default(),
+            saved: None,
+            counts: StepCounts::default(),
         })
     }
 
@@ -114,6 +149,15 @@ impl Newmark {
         self
     }
 
+    /// The same stepper with the adaptive control of paper 001 Eqs. 29–30: a step that a
+    /// model's [`Model::check_step`] rejects is retaken from its start with ∆t·√α, and the
+    /// remainder of the nominal step follows as further sub-steps (so outputs stay on the
+    /// nominal grid). Off by default.
+    pub fn with_adaptive(mut self, adaptive: bool) -> Newmark {
+        self.adaptive = adaptive;
+        self
+    }
+
     /// Whether a step solves a linear system (β > 0).
     pub fn is_implicit(&self) -> bool {
         self.beta > 0.0
@@ -124,28 +168,48 @@ impl Newmark {
         &self.force
     }
 
-    /// Assembles M + γ∆t C + β∆t² K (Eq. 26) at `state` and factorises it. With positive
-    /// masses (checked at [`Stepper::initialize`]) the matrix is positive definite even for a
-    /// body free to move rigidly, so free bodies are not refused; a failed factorisation is
-    /// explained by [`explain_failure`].
-    fn refactor(&mut self, state: &State, models: &[Box<dyn Model>]) -> Result<(), CoreError> {
+    /// Retakes, sub-steps and event steps so far.
+    pub fn counts(&self) -> StepCounts {
+        self.counts
+    }
+
+    /// Assembles M + γh C + β h² K (Eq. 26) for the step `h` and factorises it into the
+    /// nominal or the sub-step factor, collecting the tangent at `state` first unless it is
+    /// current. With positive masses (checked at [`Stepper::initialize`]) the matrix is
+    /// positive definite even for a body free to move rigidly, so free bodies are not refused;
+    /// a failed factorisation is explained by [`explain_failure`].
+    fn refactor(
+        &mut self,
+        state: &State,
+        models: &[Box<dyn Model>],
+        h: f64,
+    ) -> Result<(), CoreError> {
         let scales = Scales {
             mass: 1.0,
-            damping: self.gamma * self.dt,
-            stiffness: self.beta * self.dt * self.dt,
+            damping: self.gamma * h,
+            stiffness: self.beta * h * h,
         };
         let system = &mut self.system;
-        collect_tangent(state, models, &mut system.tangent)?;
-        let dofs = FreeDofs::new(&state.fixed);
+        if !system.tangent_current || self.update == TangentUpdate::EveryStep {
+            collect_tangent(state, models, &mut system.tangent)?;
+            system.tangent_current = true;
+        }
+        let dofs = FreeDofs::new(&state.node_fixity());
         let matrix = assemble(
             &system.tangent,
-            &state.mass,
+            &state.node_mass(),
             &dofs,
             scales,
             &mut system.entries,
         )?;
-        if let Err(error) = system.cholesky.factorize(matrix.as_ref(), "effective") {
-            let pivot = system.cholesky.failed_pivot();
+        let factor = if h == self.dt {
+            &mut system.nominal
+        } else {
+            &mut system.substep
+        };
+        factor.step = None;
+        if let Err(error) = factor.cholesky.factorize(matrix.as_ref(), "effective") {
+            let pivot = factor.cholesky.failed_pivot();
             return Err(explain_failure(
                 error,
                 pivot,
@@ -155,25 +219,109 @@ impl Newmark {
                 &system.tangent,
             ));
         }
+        factor.step = Some(h);
         system.dofs = Some(dofs);
         Ok(())
     }
 
     /// Solves Eq. 26 for a_{n+1} with the right-hand side f(t_{n+1}, x̃, ṽ) at the predicted
-    /// state, writing it into `state.acceleration` (zero in fixed directions).
+    /// state, refactorising first if no factorisation for the step `h` is current, and writes
+    /// it into the state's accelerations (zero in fixed directions).
     fn solve_accelerations(
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
+        h: f64,
     ) -> Result<(), CoreError> {
+        let nominal = h == self.dt;
+        let factor = if nominal {
+            &self.system.nominal
+        } else {
+            &self.system.substep
+        };
+        if factor.step != Some(h) || self.update == TangentUpdate::EveryStep {
+            self.refactor(state, models, h)?;
+        }
         sum_forces(state, models, &mut self.force, &mut self.torque);
         let system = &mut self.system;
         let dofs = system.dofs.as_ref().expect("factorised before stepping");
         system.rhs.resize(dofs.len(), 0.0);
-        dofs.gather(&self.force, &mut system.rhs);
-        system.cholesky.solve_in_place(&mut system.rhs);
-        dofs.scatter(&system.rhs, &mut state.acceleration);
+        let moments = &self.torque[state.rigid.len()..];
+        dofs.gather_nodes((&self.force, moments), &mut system.rhs);
+        let factor = if nominal {
+            &mut system.nominal
+        } else {
+            &mut system.substep
+        };
+        factor.cholesky.solve_in_place(&mut system.rhs);
+        dofs.scatter_nodes(
+            &system.rhs,
+            (&mut state.acceleration, &mut state.spin.acceleration),
+        );
         check_finite(state)
+    }
+
+    /// One Newmark step of length `h` from the current state, without events.
+    fn advance(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        h: f64,
+    ) -> Result<(), CoreError> {
+        let (beta, gamma) = (self.beta, self.gamma);
+        predict(state, h, beta, gamma);
+        if self.is_implicit() {
+            self.solve_accelerations(state, models, h)?;
+        } else {
+            compute_accelerations(state, models, &mut self.force, &mut self.torque)?;
+        }
+        correct(state, h, beta, gamma);
+        Ok(())
+    }
+
+    /// Advances by at most `span`: a full step, or with adaptive control a shorter one after
+    /// retakes (Eqs. 29–30); then lets the models commit their events. Returns the step taken.
+    fn advance_adaptively(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        span: f64,
+    ) -> Result<f64, CoreError> {
+        let mut h = span;
+        if self.adaptive {
+            match &mut self.saved {
+                Some(saved) => saved.as_mut().clone_from(state),
+                None => self.saved = Some(Box::new(state.clone())),
+            }
+        }
+        let forces_here = !self.is_implicit();
+        for retake in 0..=MAX_RETAKES {
+            self.advance(state, models, h)?;
+            let alpha = models
+                .iter_mut()
+                .filter_map(|m| m.check_step(state, forces_here))
+                .min_by(f64::total_cmp);
+            match (alpha, &self.saved) {
+                (Some(alpha), Some(saved)) if self.adaptive && retake < MAX_RETAKES => {
+                    state.clone_from(saved.as_ref());
+                    h *= alpha.clamp(MIN_ALPHA, 1.0).sqrt();
+                    self.counts.retakes += 1;
+                }
+                _ => break,
+            }
+        }
+        let changed = models
+            .iter_mut()
+            .fold(false, |changed, m| m.commit_step(state) | changed);
+        self.counts.substeps += 1;
+        if changed {
+            self.counts.event_steps += 1;
+            self.system.tangent_current = false;
+            self.system.nominal.step = None;
+            self.system.substep.step = None;
+            compute_accelerations(state, models, &mut self.force, &mut self.torque)?;
+        }
+        Ok(h)
     }
 }
 
@@ -193,35 +341,48 @@ pub(crate) fn collect_tangent(
 }
 
 /// The predictor of Eqs. 13–14 (the a_n, b_n of Eq. 22): x ← x + ∆t (v + (½ − β)∆t a),
-/// v ← v + (1 − γ)∆t a, t ← t + ∆t.
+/// v ← v + (1 − γ)∆t a, t ← t + ∆t; the same for the particles' rotations.
 pub fn predict(state: &mut State, dt: f64, beta: f64, gamma: f64) {
     let (cx, cv) = ((0.5 - beta) * dt, (1.0 - gamma) * dt);
-    state
-        .position
-        .par_iter_mut()
-        .zip(state.velocity.par_iter_mut())
-        .zip(state.acceleration.par_iter())
-        .with_min_len(PARTICLE_CHUNK)
-        .for_each(|((x, v), a)| {
-            *x += dt * (*v + cx * a);
-            *v += cv * a;
-        });
+    let update = |((x, v), a): ((&mut Vec3, &mut Vec3), &Vec3)| {
+        *x += dt * (*v + cx * a);
+        *v += cv * a;
+    };
+    for_each_dof(state, update);
     state.time += dt;
 }
 
-/// The corrector of Eqs. 24–25 with the new acceleration: x ← x + β∆t² a, v ← v + γ∆t a.
+/// The corrector of Eqs. 24–25 with the new acceleration: x ← x + β∆t² a, v ← v + γ∆t a,
+/// and the same for the particles' rotations.
 pub fn correct(state: &mut State, dt: f64, beta: f64, gamma: f64) {
     let (cx, cv) = (beta * dt * dt, gamma * dt);
+    let update = |((x, v), a): ((&mut Vec3, &mut Vec3), &Vec3)| {
+        *x += cx * a;
+        *v += cv * a;
+    };
+    for_each_dof(state, update);
+}
+
+/// Applies `update` to every (position, velocity, acceleration) triple, translations and
+/// rotations, in parallel.
+fn for_each_dof<F>(state: &mut State, update: F)
+where
+    F: Fn(((&mut Vec3, &mut Vec3), &Vec3)) + Sync + Send + Copy,
+{
     state
         .position
         .par_iter_mut()
         .zip(state.velocity.par_iter_mut())
         .zip(state.acceleration.par_iter())
         .with_min_len(PARTICLE_CHUNK)
-        .for_each(|((x, v), a)| {
-            *x += cx * a;
-            *v += cv * a;
-        });
+        .for_each(update);
+    let spin = &mut state.spin;
+    spin.angle
+        .par_iter_mut()
+        .zip(spin.velocity.par_iter_mut())
+        .zip(spin.acceleration.par_iter())
+        .with_min_len(PARTICLE_CHUNK)
+        .for_each(update);
 }
 
 impl Stepper for Newmark {
@@ -238,10 +399,12 @@ impl Stepper for Newmark {
     }
 
     fn factor_stats(&self) -> Option<&FactorStats> {
-        self.system
-            .cholesky
-            .is_factored()
-            .then(|| self.system.cholesky.stats())
+        let cholesky = &self.system.nominal.cholesky;
+        cholesky.is_factored().then(|| cholesky.stats())
+    }
+
+    fn counts(&self) -> StepCounts {
+        self.counts
     }
 
     fn initialize(
@@ -253,23 +416,20 @@ impl Stepper for Newmark {
         check_masses(state)?;
         compute_accelerations(state, models, &mut self.force, &mut self.torque)?;
         if self.is_implicit() {
-            self.refactor(state, models)?;
+            self.refactor(state, models, self.dt)?;
         }
         Ok(())
     }
 
+    /// Advances by ∆t; with adaptive control possibly in several sub-steps, the last ending
+    /// exactly at t + ∆t.
     fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {
-        let (dt, beta, gamma) = (self.dt, self.beta, self.gamma);
-        predict(state, dt, beta, gamma);
-        if self.is_implicit() {
-            if self.update == TangentUpdate::EveryStep || !self.system.cholesky.is_factored() {
-                self.refactor(state, models)?;
-            }
-            self.solve_accelerations(state, models)?;
-        } else {
-            compute_accelerations(state, models, &mut self.force, &mut self.torque)?;
+        let end = state.time + self.dt;
+        let mut remaining = self.dt;
+        while remaining > 1e-9 * self.dt {
+            remaining -= self.advance_adaptively(state, models, remaining)?;
         }
-        correct(state, dt, beta, gamma);
+        state.time = end;
         Ok(())
     }
 }

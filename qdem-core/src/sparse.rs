@@ -77,6 +77,22 @@ impl Tangent {
         push_lower(&mut self.damping, i, j, block);
     }
 
+    /// Adds K at (row DOF, column DOF), if on or below the diagonal: for models whose blocks
+    /// are mostly zero (a 2D beam couples x, y and the rotation about z only). A DOF is
+    /// 3·node + axis, node `state.len() + i` being the rotation of particle i.
+    pub fn add_stiffness_entry(&mut self, row: usize, col: usize, value: f64) {
+        if row >= col {
+            self.stiffness.push(Triplet::new(row, col, value));
+        }
+    }
+
+    /// Adds C at (row DOF, column DOF), as [`Tangent::add_stiffness_entry`] does for K.
+    pub fn add_damping_entry(&mut self, row: usize, col: usize, value: f64) {
+        if row >= col {
+            self.damping.push(Triplet::new(row, col, value));
+        }
+    }
+
     /// The stored stiffness entries (lower triangle, global DOFs, duplicates not summed).
     pub fn stiffness_entries(&self) -> &[Entry] {
         &self.stiffness
@@ -160,6 +176,37 @@ impl FreeDofs {
     pub fn scatter(&self, x: &[f64], out: &mut [Vec3]) {
         for (dof, &i) in self.index.iter().enumerate() {
             out[dof / 3][dof % 3] = if i == FIXED { 0.0 } else { x[i] };
+        }
+    }
+
+    /// [`FreeDofs::gather`] over generalised nodes: the particles' vectors `parts.0`, then
+    /// their rotations' `parts.1` (empty when nothing rotates).
+    pub fn gather_nodes(&self, parts: (&[Vec3], &[Vec3]), out: &mut [f64]) {
+        let n = parts.0.len();
+        for (dof, &i) in self.index.iter().enumerate() {
+            if i != FIXED {
+                let node = dof / 3;
+                let v = if node < n {
+                    &parts.0[node]
+                } else {
+                    &parts.1[node - n]
+                };
+                out[i] = v[dof % 3];
+            }
+        }
+    }
+
+    /// [`FreeDofs::scatter`] over generalised nodes, as [`FreeDofs::gather_nodes`] reads them.
+    pub fn scatter_nodes(&self, x: &[f64], parts: (&mut [Vec3], &mut [Vec3])) {
+        let n = parts.0.len();
+        for (dof, &i) in self.index.iter().enumerate() {
+            let node = dof / 3;
+            let v = if node < n {
+                &mut parts.0[node]
+            } else {
+                &mut parts.1[node - n]
+            };
+            v[dof % 3] = if i == FIXED { 0.0 } else { x[i] };
         }
     }
 }

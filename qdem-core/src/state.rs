@@ -80,6 +80,52 @@ pub struct State {
     pub fixed: Vec<Dofs>,
     /// Rotation of the rigid bodies (empty when the scene has none).
     pub rigid: RigidBodies,
+    /// Rotational degrees of freedom of the particles (empty unless the particles rotate,
+    /// as in bonded-particle DEM).
+    pub spin: ParticleSpin,
+}
+
+/// Rotational degrees of freedom of particles that carry them (the θ of paper 001's particles,
+/// with the moment of inertia J of Eq. 9): a small-rotation vector per particle, its rate and
+/// acceleration, the moment of inertia of the particle's shape (a disc or a sphere: one value)
+/// and the fixed rotation axes. Either every array is empty (no particle rotates) or every
+/// array has one entry per particle.
+///
+/// Rotations are integrated linearly, like translations (small rotations, the setting of the
+/// paper's beam matrices); a model that needs finite rotations uses [`crate::RigidBodies`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ParticleSpin {
+    /// Rotation vector θ (rad) about x, y, z.
+    pub angle: Vec<Vec3>,
+    /// Angular velocity θ̇ (rad/s).
+    pub velocity: Vec<Vec3>,
+    /// Angular acceleration θ̈ (rad/s²).
+    pub acceleration: Vec<Vec3>,
+    /// Moment of inertia J (kg m²).
+    pub inertia: Vec<f64>,
+    /// Fixed rotation axes per particle.
+    pub fixed: Vec<Dofs>,
+}
+
+impl ParticleSpin {
+    /// Number of particles with rotational DOFs (0 or all of them).
+    pub fn len(&self) -> usize {
+        self.angle.len()
+    }
+
+    /// Whether no particle rotates.
+    pub fn is_empty(&self) -> bool {
+        self.angle.is_empty()
+    }
+
+    /// Rotational kinetic energy ½ Σ J θ̇² (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        self.inertia
+            .iter()
+            .zip(&self.velocity)
+            .map(|(j, w)| 0.5 * j * w.norm_squared())
+            .sum()
+    }
 }
 
 impl State {
@@ -95,7 +141,41 @@ impl State {
             mass: vec![0.0; n],
             fixed: vec![Dofs::NONE; n],
             rigid: RigidBodies::default(),
+            spin: ParticleSpin::default(),
         }
+    }
+
+    /// Gives every particle rotational DOFs at rest, with moments of inertia `inertia` (one
+    /// per particle) and the rotation axes `fixed` fixed for all (`Dofs::parse("xy")` for
+    /// particles rotating in the x–y plane only).
+    ///
+    /// # Panics
+    /// If `inertia` does not have one entry per particle.
+    pub fn add_spin(&mut self, inertia: Vec<f64>, fixed: Dofs) {
+        let n = self.len();
+        assert_eq!(inertia.len(), n, "one moment of inertia per particle");
+        self.spin = ParticleSpin {
+            angle: vec![Vec3::zeros(); n],
+            velocity: vec![Vec3::zeros(); n],
+            acceleration: vec![Vec3::zeros(); n],
+            inertia,
+            fixed: vec![fixed; n],
+        };
+    }
+
+    /// Fixity of every generalised node: the particles' translations, then their rotations
+    /// (node `len() + i` is the rotation of particle `i`), the layout of the implicit system.
+    pub fn node_fixity(&self) -> Vec<Dofs> {
+        self.fixed.iter().chain(&self.spin.fixed).copied().collect()
+    }
+
+    /// Mass of every generalised node: the lumped masses, then the moments of inertia.
+    pub fn node_mass(&self) -> Vec<f64> {
+        self.mass
+            .iter()
+            .chain(&self.spin.inertia)
+            .copied()
+            .collect()
     }
 
     /// Number of particles.
@@ -126,7 +206,7 @@ impl State {
         }
     }
 
-    /// Kinetic energy ½ Σ m v² + ½ Σ ω·L (J): members of rigid bodies are massless, so a
+    /// Kinetic energy ½ Σ m v² + ½ Σ ω·L + ½ Σ J θ̇² (J): members of rigid bodies are massless, so a
     /// rigid body counts once, through its centre particle and its rotation.
     pub fn kinetic_energy(&self) -> f64 {
         self.mass
@@ -135,6 +215,7 @@ impl State {
             .map(|(m, v)| 0.5 * m * v.norm_squared())
             .sum::<f64>()
             + self.rigid.kinetic_energy()
+            + self.spin.kinetic_energy()
     }
 
     /// Linear momentum Σ m v (kg m/s).

@@ -32,6 +32,7 @@ pub struct StaticSolver {
     dofs: Option<FreeDofs>,
     cholesky: SparseCholesky,
     force: Vec<Vec3>,
+    torque: Vec<Vec3>,
     rhs: Vec<f64>,
 }
 
@@ -47,7 +48,7 @@ impl StaticSolver {
     }
 
     /// Solves K u = f(`time`) and sets `state` to the static answer at `time`: positions
-    /// X + u, zero velocities and accelerations.
+    /// X + u, rotations θ, zero velocities and accelerations.
     pub fn solve(
         &mut self,
         state: &mut State,
@@ -59,16 +60,21 @@ impl StaticSolver {
         state.position.clone_from(&state.reference);
         state.velocity.fill(Vec3::zeros());
         state.acceleration.fill(Vec3::zeros());
+        let spin = &mut state.spin;
+        for v in [&mut spin.angle, &mut spin.velocity, &mut spin.acceleration] {
+            v.fill(Vec3::zeros());
+        }
         if !self.cholesky.is_factored() {
             self.factorize(state, models)?;
         }
-        sum_forces(state, models, &mut self.force, &mut Vec::new());
+        sum_forces(state, models, &mut self.force, &mut self.torque);
         let dofs = self.dofs.as_ref().expect("factorised above");
         self.rhs.resize(dofs.len(), 0.0);
-        dofs.gather(&self.force, &mut self.rhs);
+        let moments = &self.torque[state.rigid.len()..];
+        dofs.gather_nodes((&self.force, moments), &mut self.rhs);
         self.cholesky.solve_in_place(&mut self.rhs);
         let mut u = vec![Vec3::zeros(); state.len()];
-        dofs.scatter(&self.rhs, &mut u);
+        dofs.scatter_nodes(&self.rhs, (&mut u, &mut state.spin.angle));
         for (x, d) in state.position.iter_mut().zip(&u) {
             *x += d;
         }
@@ -80,7 +86,7 @@ impl StaticSolver {
     fn factorize(&mut self, state: &State, models: &[Box<dyn Model>]) -> Result<(), CoreError> {
         let mut tangent = Tangent::new();
         collect_tangent(state, models, &mut tangent)?;
-        let dofs = FreeDofs::new(&state.fixed);
+        let dofs = FreeDofs::new(&state.node_fixity());
         if let Some((body, modes)) = unconstrained_bodies(state, models, &tangent, &dofs)
             .into_iter()
             .next()
@@ -97,7 +103,8 @@ impl StaticSolver {
             damping: 0.0,
             stiffness: 1.0,
         };
-        let matrix = assemble(&tangent, &state.mass, &dofs, scales, &mut Vec::new())?;
+        let mass = state.node_mass();
+        let matrix = assemble(&tangent, &mass, &dofs, scales, &mut Vec::new())?;
         if let Err(error) = self.cholesky.factorize(matrix.as_ref(), "stiffness") {
             let pivot = self.cholesky.failed_pivot();
             return Err(explain_failure(

@@ -3,6 +3,7 @@
 
 use crate::error::CoreError;
 use crate::model::Model;
+use crate::newmark::StepCounts;
 use crate::rigid_body::reduce_member_forces;
 use crate::sparse::FactorStats;
 use crate::state::State;
@@ -36,6 +37,11 @@ pub trait Stepper {
     fn factor_stats(&self) -> Option<&FactorStats> {
         None
     }
+
+    /// Retakes, sub-steps and event steps of an adaptive stepper; zero for the others.
+    fn counts(&self) -> StepCounts {
+        StepCounts::default()
+    }
 }
 
 /// Fails unless the state has no rigid body: for steppers that integrate translations only.
@@ -50,7 +56,7 @@ pub(crate) fn refuse_rigid(state: &State, stepper: &str) -> Result<(), CoreError
 }
 
 /// Sums the forces and torques of all models at `state` into `force` and `torque` (resized and
-/// zeroed here), then moves the forces on members of rigid bodies onto their bodies.
+/// zeroed here; rigid bodies' torques, then particles' moments), then moves the forces on members of rigid bodies onto their bodies.
 pub(crate) fn sum_forces(
     state: &State,
     models: &mut [Box<dyn Model>],
@@ -60,7 +66,7 @@ pub(crate) fn sum_forces(
     force.clear();
     force.resize(state.len(), Vec3::zeros());
     torque.clear();
-    torque.resize(state.rigid.len(), Vec3::zeros());
+    torque.resize(state.rigid.len() + state.spin.len(), Vec3::zeros());
     for model in models.iter_mut() {
         model.add_forces(state, force, torque);
     }
@@ -105,7 +111,54 @@ pub fn compute_accelerations(
     torque: &mut Vec<Vec3>,
 ) -> Result<(), CoreError> {
     sum_forces(state, models, force, torque);
-    set_accelerations(state, force)
+    set_accelerations(state, force)?;
+    set_spin_accelerations(state, &torque[state.rigid.len()..])
+}
+
+/// Sets θ̈ = M/J for the particles' rotations (`moment`: one per particle), zero about fixed
+/// axes. Fails on a non-finite value.
+pub(crate) fn set_spin_accelerations(state: &mut State, moment: &[Vec3]) -> Result<(), CoreError> {
+    let spin = &mut state.spin;
+    let (inertia, fixed) = (&spin.inertia, &spin.fixed);
+    let first_bad = spin
+        .acceleration
+        .par_iter_mut()
+        .with_min_len(PARTICLE_CHUNK)
+        .enumerate()
+        .map(|(i, a)| {
+            let mut acc = moment[i] / inertia[i];
+            for axis in 0..3 {
+                if fixed[i].contains(axis) {
+                    acc[axis] = 0.0;
+                }
+            }
+            *a = acc;
+            if acc.iter().all(|c| c.is_finite()) {
+                usize::MAX
+            } else {
+                i
+            }
+        })
+        .min()
+        .unwrap_or(usize::MAX);
+    match first_bad {
+        usize::MAX => Ok(()),
+        particle => Err(CoreError::NonFinite {
+            time: state.time,
+            particle,
+        }),
+    }
+}
+
+/// Fails if the particles have rotational DOFs: for steppers that integrate translations and
+/// rigid bodies only.
+pub(crate) fn refuse_spin(state: &State, stepper: &str) -> Result<(), CoreError> {
+    match state.spin.len() {
+        0 => Ok(()),
+        _ => Err(CoreError::SpinNeedsNewmark {
+            stepper: stepper.to_string(),
+        }),
+    }
 }
 
 /// Sets a = f/m, zero in fixed directions and on members of rigid bodies (which follow their
@@ -147,12 +200,15 @@ pub(crate) fn set_accelerations(state: &mut State, force: &[Vec3]) -> Result<(),
 }
 
 /// Checks that every particle that is free in some direction, and no member of a rigid body,
-/// has a positive mass.
+/// has a positive mass, and a positive moment of inertia if it may rotate.
 pub fn check_masses(state: &State) -> Result<(), CoreError> {
     let bad = (0..state.len()).find(|&i| {
         let free = (0..3).any(|axis| !state.fixed[i].contains(axis))
             && state.rigid.body_of_member(i).is_none();
-        free && state.mass[i].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        let turns = !state.spin.is_empty()
+            && (0..3).any(|axis| !state.spin.fixed[i].contains(axis))
+            && !(state.spin.inertia[i] > 0.0);
+        turns || free && state.mass[i].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
     });
     match bad {
         Some(particle) => Err(CoreError::Massless { particle }),

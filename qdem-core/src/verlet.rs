@@ -17,7 +17,8 @@ use crate::newmark::predict;
 use crate::rigid_body::place_members;
 use crate::state::State;
 use crate::stepper::{
-    check_finite_torque, check_masses, set_accelerations, sum_forces, Stepper, PARTICLE_CHUNK,
+    check_finite_torque, check_masses, refuse_spin, set_accelerations, sum_forces, Stepper,
+    PARTICLE_CHUNK,
 };
 use crate::Vec3;
 use rayon::prelude::*;
@@ -102,6 +103,7 @@ impl Stepper for Verlet {
         state: &mut State,
         models: &mut [Box<dyn Model>],
     ) -> Result<(), CoreError> {
+        refuse_spin(state, "verlet")?;
         check_masses(state)?;
         if !state.rigid.is_empty() {
             place_members(state);

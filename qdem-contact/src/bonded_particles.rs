@@ -1,0 +1,640 @@
+//! Beam-bonded DEM in 2D (paper 001 §2): discs with u, v, θ joined by Timoshenko beam bonds
+//! that break at their strength, and unbonded contacts between discs that touch.
+//!
+//! [`BondedParticles`] is the [`Model`]:
+//!
+//! - **forces**: every intact bond's K_b u_L + C_b u̇_L (Eqs. 7, 8, 10) and every touching pair's
+//!   unbonded force (Eqs. 5, 6) into per-bond buffers in parallel, gathered per particle over a
+//!   fixed incidence list (no atomics: bit-identical on any number of threads);
+//! - **tangent** (Eq. 4): K = Σ T K_d Tᵀ and C likewise, as DOF entries (x, y of particle p are
+//!   DOFs 3p, 3p+1, its θ is DOF 3(N + p) + 2, N the number of particles). A broken bond keeps
+//!   zero entries in the pattern so that breaking bonds never forces a new symbolic analysis;
+//! - **events** (§2.2, §4): after a trial step every intact bond's stress (Eq. 11) is
+//!   computed; a stress above the strength by more than the tolerance ε asks the stepper to
+//!   retake the step with α = (σ_lim − σ_n)/(σ_{n+1} − σ_n) (Eqs. 29–30), as does an unbonded
+//!   contact that opened early in the step; on commit, bonds at or above their strength
+//!   break and pairs that touch get unbonded contacts, and the tangent is reported changed;
+//! - **step bounds**: [`BondedParticles::critical_step_eq28`] is the paper's
+//!   ∆t_crit = min 2√(m_ii/k_ii) (Eq. 28), which is not a stability bound (it overestimates the
+//!   explicit limit); [`Model::stable_dt`] is the rigorous Gershgorin bound on M⁻¹K with the
+//!   damping, which explicit runs are checked against.
+//!
+//! Contact candidates are the pairs of broken bonds (the crack faces) and the pairs the cell
+//! grid of [`crate::broad_phase`] finds within a skin of the discs, rebuilt when a disc has
+//! moved more than half the skin.
+
+use crate::beam_bond::{to_global_matrix, BeamBond, Dof2};
+use crate::broad_phase::{find_pairs, SphereSet};
+use crate::error::ContactError;
+use crate::particle_packing::{lattice_section, Packing, SplitMix64};
+use crate::unbonded_contact::{PairKinematics, UnbondedLaw, UnbondedPair};
+use qdem_core::stable_step::critical_step;
+use qdem_core::{Model, State, Tangent, Vec3};
+use rayon::prelude::*;
+use std::collections::HashSet;
+
+/// Bonds per parallel task.
+const BOND_CHUNK: usize = 2048;
+
+/// How unbonded contacts and events behave.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BondSettings {
+    /// Unbonded contact law.
+    pub contact: UnbondedLaw,
+    /// Relative overshoot ε of a bond's strength (or of the step past a contact's opening)
+    /// above which a step is retaken.
+    pub tolerance: f64,
+    /// The nominal step (s), for the Taylor mid-point of Eq. 21.
+    pub dt: f64,
+}
+
+/// The material of a bonded body: the continuum it represents and its bonds' strength.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BondedMaterial {
+    /// Density ρ (kg/m³).
+    pub density: f64,
+    /// Young's modulus E (Pa), plane stress.
+    pub young: f64,
+    /// Poisson's ratio ν.
+    pub poisson: f64,
+    /// Out-of-plane thickness b (m).
+    pub thickness: f64,
+    /// Damping ratio ξ_b of the bonds (Eq. 8).
+    pub damping_ratio: f64,
+    /// Mean bond strength (Pa).
+    pub strength_mean: f64,
+    /// Standard deviation of the bond strength (Pa); 0 gives every bond the mean.
+    pub strength_std: f64,
+    /// Seed of the strengths.
+    pub seed: u64,
+}
+
+/// Discs joined by beam bonds, with unbonded contacts; see the module docs.
+#[derive(Debug)]
+pub struct BondedParticles {
+    name: String,
+    radius: Vec<f64>,
+    bonds: Vec<BeamBond>,
+    intact: Vec<bool>,
+    /// Per particle, the (bond, end) pairs touching it, in bond order (CSR).
+    incidence_start: Vec<usize>,
+    incidence: Vec<(u32, u8)>,
+    bond_force: Vec<[Dof2; 2]>,
+    stress_eval: Vec<f64>,
+    stress_trial: Vec<f64>,
+    stress_committed: Vec<f64>,
+    pairs: Vec<UnbondedPair>,
+    pair_index: HashSet<(u32, u32)>,
+    grid_reference: Vec<[f64; 2]>,
+    skin: f64,
+    settings: BondSettings,
+    broken: usize,
+    broken_log: Vec<(f64, u32)>,
+}
+
+impl BondedParticles {
+    /// Particles `0..radius.len()` of the state (discs in the x–y plane) joined by `bonds`.
+    pub fn new(
+        name: &str,
+        state: &State,
+        radius: Vec<f64>,
+        bonds: Vec<BeamBond>,
+        settings: BondSettings,
+    ) -> BondedParticles {
+        let n = radius.len();
+        let mut count = vec![0usize; n + 1];
+        for b in &bonds {
+            count[b.i as usize + 1] += 1;
+            count[b.j as usize + 1] += 1;
+        }
+        for p in 0..n {
+            count[p + 1] += count[p];
+        }
+        let mut fill = count.clone();
+        let mut incidence = vec![(0u32, 0u8); 2 * bonds.len()];
+        for (k, b) in bonds.iter().enumerate() {
+            for (end, p) in [(0u8, b.i), (1u8, b.j)] {
+                incidence[fill[p as usize]] = (k as u32, end);
+                fill[p as usize] += 1;
+            }
+        }
+        let m = bonds.len();
+        let max_r = radius.iter().cloned().fold(0.0, f64::max);
+        let mut model = BondedParticles {
+            name: name.to_string(),
+            radius,
+            intact: vec![true; m],
+            incidence_start: count,
+            incidence,
+            bond_force: vec![[[0.0; 3]; 2]; m],
+            stress_eval: vec![0.0; m],
+            stress_trial: vec![0.0; m],
+            stress_committed: vec![0.0; m],
+            bonds,
+            pairs: Vec::new(),
+            pair_index: HashSet::new(),
+            grid_reference: Vec::new(),
+            skin: 0.5 * max_r,
+            settings,
+            broken: 0,
+            broken_log: Vec::new(),
+        };
+        model.rebuild_candidates(state);
+        model
+    }
+
+    /// A state of the packing's discs at rest (x–y plane: z translation and x, y rotations
+    /// fixed, mass ρ·cell·b and J = m r²/2 each) and the model bonding them, the section from
+    /// [`lattice_section`] and strengths drawn from N(mean, std) with the material's seed
+    /// (bond order).
+    pub fn from_packing(
+        name: &str,
+        packing: &Packing,
+        material: &BondedMaterial,
+        settings: BondSettings,
+    ) -> Result<(State, BondedParticles), ContactError> {
+        let section = lattice_section(material.poisson).ok_or(ContactError::LatticePoisson {
+            body: name.to_string(),
+            poisson: material.poisson,
+        })?;
+        let reference = packing.centers.iter().map(|c| Vec3::new(c[0], c[1], 0.0));
+        let mut state = State::at_rest(reference.collect());
+        let mass = material.density * packing.cell_area * material.thickness;
+        let r = packing.radius();
+        state.mass.fill(mass);
+        state
+            .fixed
+            .fill(qdem_core::Dofs::parse("z").expect("valid"));
+        state.add_spin(
+            vec![0.5 * mass * r * r; packing.len()],
+            qdem_core::Dofs::parse("xy").expect("valid"),
+        );
+        let mut rng = SplitMix64(material.seed);
+        let bonds = packing
+            .bonds
+            .iter()
+            .map(|&(i, j)| {
+                let (xi, xj) = (packing.centers[i as usize], packing.centers[j as usize]);
+                let length = (xj[0] - xi[0]).hypot(xj[1] - xi[1]);
+                let strength = material.strength_mean + material.strength_std * rng.normal();
+                BeamBond::new(
+                    (i, xi),
+                    (j, xj),
+                    material.young,
+                    section.section(length, material.thickness),
+                    [mass, mass],
+                    [0.5 * mass * r * r; 2],
+                    material.damping_ratio,
+                    strength,
+                )
+            })
+            .collect();
+        let model = BondedParticles::new(name, &state, vec![r; packing.len()], bonds, settings);
+        Ok((state, model))
+    }
+
+    /// The bonds (broken ones included, see [`BondedParticles::is_intact`]).
+    pub fn bonds(&self) -> &[BeamBond] {
+        &self.bonds
+    }
+
+    /// Whether bond `k` still holds.
+    pub fn is_intact(&self, k: usize) -> bool {
+        self.intact[k]
+    }
+
+    /// Number of broken bonds.
+    pub fn broken(&self) -> usize {
+        self.broken
+    }
+
+    /// (time, bond) of every break, in order.
+    pub fn broken_log(&self) -> &[(f64, u32)] {
+        &self.broken_log
+    }
+
+    /// Number of pairs in unbonded contact at the last committed step.
+    pub fn touching(&self) -> usize {
+        self.pairs.iter().filter(|p| p.touching).count()
+    }
+
+    /// Disc radii (m).
+    pub fn radii(&self) -> &[f64] {
+        &self.radius
+    }
+
+    /// The stress (Eq. 11) of every bond at the last [`Model::check_step`] (Pa).
+    pub fn trial_stresses(&self) -> &[f64] {
+        &self.stress_trial
+    }
+
+    /// The stress (Eq. 11) of every bond at the last committed step (Pa).
+    pub fn stresses(&self) -> &[f64] {
+        &self.stress_committed
+    }
+
+    /// The paper's critical step ∆t_crit = min 2√(m_ii/k_ii) over the translational and
+    /// rotational DOFs (Eq. 28), k_ii the diagonal of the intact bonds' stiffness.
+    pub fn critical_step_eq28(&self, state: &State) -> f64 {
+        let mut diagonal = vec![[0.0; 3]; self.radius.len()];
+        for (b, _) in self.bonds.iter().zip(&self.intact).filter(|(_, &ok)| ok) {
+            let g = to_global_matrix(&b.local_stiffness(), b.axis);
+            for (end, p) in [(0, b.i), (1, b.j)] {
+                for c in 0..3 {
+                    diagonal[p as usize][c] += g[3 * end + c][3 * end + c];
+                }
+            }
+        }
+        diagonal
+            .iter()
+            .enumerate()
+            .flat_map(|(p, d)| {
+                let m = [state.mass[p], state.mass[p], state.spin.inertia[p]];
+                (0..3)
+                    .filter(move |&c| d[c] > 0.0)
+                    .map(move |c| 2.0 * (m[c] / d[c]).sqrt())
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Displacement and velocity (x, y, θ) of particle p.
+    #[inline]
+    fn dofs(state: &State, p: usize) -> (Dof2, Dof2) {
+        let (x, r) = (state.displacement(p), state.spin.angle[p][2]);
+        let (v, w) = (state.velocity[p], state.spin.velocity[p][2]);
+        ([x[0], x[1], r], [v[0], v[1], w])
+    }
+
+    /// Elastic end forces and stress of bond `b` at `state`.
+    #[inline]
+    fn bond_elastic(b: &BeamBond, state: &State) -> ([f64; 6], [f64; 6]) {
+        let (ui, _) = Self::dofs(state, b.i as usize);
+        let (uj, _) = Self::dofs(state, b.j as usize);
+        let local = b.to_local(&ui, &uj);
+        (local, b.local_forces(&local))
+    }
+
+    /// Stresses of the intact bonds at `state` into `out` (0 for broken bonds).
+    fn bond_stresses(&self, state: &State, out: &mut [f64]) {
+        out.par_iter_mut()
+            .with_min_len(BOND_CHUNK)
+            .zip(self.bonds.par_iter())
+            .zip(self.intact.par_iter())
+            .for_each(|((s, b), &intact)| {
+                *s = if intact {
+                    b.stress(&Self::bond_elastic(b, state).1)
+                } else {
+                    0.0
+                };
+            });
+    }
+
+    /// Kinematics of pair (i, j).
+    fn kinematics(&self, state: &State, i: usize, j: usize) -> PairKinematics {
+        let (ui, vi) = Self::dofs(state, i);
+        let (uj, vj) = Self::dofs(state, j);
+        let (xi, xj) = (state.position[i], state.position[j]);
+        PairKinematics {
+            x: [[xi[0], xi[1]], [xj[0], xj[1]]],
+            u: [ui, uj],
+            v: [vi, vj],
+            r: [self.radius[i], self.radius[j]],
+        }
+    }
+
+    /// A candidate pair (i, j) with rest distance `rest`.
+    fn candidate(&self, state: &State, i: u32, j: u32, rest: f64, stiffness: f64) -> UnbondedPair {
+        let (mi, mj) = (state.mass[i as usize], state.mass[j as usize]);
+        UnbondedPair {
+            i,
+            j,
+            rest,
+            normal_stiffness: stiffness,
+            reduced_mass: mi * mj / (mi + mj),
+            touching: false,
+            elastic: 0.0,
+            slip_reference: 0.0,
+            overlap: 0.0,
+        }
+    }
+
+    /// Normal stiffness of an unbonded contact: that of the pair's bond, or for pairs never
+    /// bonded, k_a of the first bond (the lattice's; k_a = λbE does not depend on length).
+    fn contact_stiffness(&self) -> f64 {
+        self.bonds.first().map_or(0.0, |b| b.stiffness[0])
+    }
+
+    /// Adds the non-bonded pairs within the skin (cell grid) to the candidates.
+    fn rebuild_candidates(&mut self, state: &State) {
+        let n = self.radius.len();
+        let center: Vec<Vec3> = state.position[..n].to_vec();
+        let body: Vec<u32> = (0..n as u32).collect();
+        let spheres = SphereSet {
+            center: &center,
+            radius: &self.radius,
+            body: &body,
+        };
+        let bonded: HashSet<(u32, u32)> = self
+            .bonds
+            .iter()
+            .zip(&self.intact)
+            .filter(|(_, &ok)| ok)
+            .map(|(b, _)| (b.i.min(b.j), b.i.max(b.j)))
+            .collect();
+        let k = self.contact_stiffness();
+        for (i, j) in find_pairs(&spheres, self.skin) {
+            let key = (i.min(j), i.max(j));
+            if !bonded.contains(&key) && self.pair_index.insert(key) {
+                let rest = self.radius[i as usize] + self.radius[j as usize];
+                let pair = self.candidate(state, key.0, key.1, rest, k);
+                self.pairs.push(pair);
+            }
+        }
+        self.grid_reference = center.iter().map(|x| [x[0], x[1]]).collect();
+    }
+
+    /// Whether some disc moved more than half the skin since the last grid.
+    fn moved_past_skin(&self, state: &State) -> bool {
+        let limit = 0.25 * self.skin * self.skin;
+        self.grid_reference
+            .par_iter()
+            .zip(state.position.par_iter())
+            .any(|(a, x)| (x[0] - a[0]).powi(2) + (x[1] - a[1]).powi(2) > limit)
+    }
+
+    /// Global DOF numbers of particle p's x, y and θ in a state of `n` particles.
+    #[inline]
+    fn dof_numbers(p: u32, n: usize) -> [usize; 3] {
+        let p = p as usize;
+        [3 * p, 3 * p + 1, 3 * (n + p) + 2]
+    }
+
+    /// Adds a 6×6 global matrix of pair (i, j) to the tangent.
+    fn add_block(
+        tangent: &mut Tangent,
+        n: usize,
+        (i, j): (u32, u32),
+        a: &[[f64; 6]; 6],
+        damping: bool,
+    ) {
+        let [di, dj] = [Self::dof_numbers(i, n), Self::dof_numbers(j, n)];
+        let dofs = [di[0], di[1], di[2], dj[0], dj[1], dj[2]];
+        for (r, row) in a.iter().enumerate() {
+            for (c, value) in row.iter().enumerate() {
+                let (dr, dc) = (dofs[r], dofs[c]);
+                let (dr, dc) = if dr >= dc { (dr, dc) } else { continue };
+                if damping {
+                    tangent.add_damping_entry(dr, dc, *value);
+                } else {
+                    tangent.add_stiffness_entry(dr, dc, *value);
+                }
+            }
+        }
+    }
+
+    /// The Taylor mid-point of the step from `state` (Eq. 21): u + ∆t u̇/2 + ∆t² ü/4.
+    fn midpoint(&self, state: &State, p: usize) -> (Dof2, [f64; 2]) {
+        let h = self.settings.dt;
+        let (u, v) = Self::dofs(state, p);
+        let (a, alpha) = (state.acceleration[p], state.spin.acceleration[p][2]);
+        let acc = [a[0], a[1], alpha];
+        let mid: Dof2 = std::array::from_fn(|c| u[c] + 0.5 * h * v[c] + 0.25 * h * h * acc[c]);
+        let x = state.reference[p];
+        (mid, [x[0] + mid[0], x[1] + mid[1]])
+    }
+}
+
+impl Model for BondedParticles {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
+        let bonds = &self.bonds;
+        self.bond_force
+            .par_iter_mut()
+            .with_min_len(BOND_CHUNK)
+            .zip(self.stress_eval.par_iter_mut())
+            .zip(bonds.par_iter().zip(self.intact.par_iter()))
+            .for_each(|((out, stress), (b, &intact))| {
+                if !intact {
+                    *out = [[0.0; 3]; 2];
+                    *stress = 0.0;
+                    return;
+                }
+                let (ui, vi) = Self::dofs(state, b.i as usize);
+                let (uj, vj) = Self::dofs(state, b.j as usize);
+                let local = b.to_local(&ui, &uj);
+                let elastic = b.local_forces(&local);
+                *stress = b.stress(&elastic);
+                let viscous = b.local_damping_forces(&b.to_local(&vi, &vj));
+                let total: [f64; 6] = std::array::from_fn(|k| -(elastic[k] + viscous[k]));
+                *out = b.to_global(&total);
+            });
+        let moment = &mut torque[state.rigid.len()..];
+        let (start, incidence, bond_force) =
+            (&self.incidence_start, &self.incidence, &self.bond_force);
+        force
+            .par_iter_mut()
+            .zip(moment.par_iter_mut())
+            .with_min_len(BOND_CHUNK)
+            .enumerate()
+            .take(self.radius.len())
+            .for_each(|(p, (f, m))| {
+                let mut sum = [0.0; 3];
+                for &(k, end) in &incidence[start[p]..start[p + 1]] {
+                    let g = &bond_force[k as usize][end as usize];
+                    sum[0] += g[0];
+                    sum[1] += g[1];
+                    sum[2] += g[2];
+                }
+                f[0] += sum[0];
+                f[1] += sum[1];
+                m[2] += sum[2];
+            });
+        let law = self.settings.contact;
+        for pair in &self.pairs {
+            let (i, j) = (pair.i as usize, pair.j as usize);
+            let k = self.kinematics(state, i, j);
+            if k.frame(pair.rest).overlap <= 0.0 {
+                continue;
+            }
+            let out = law.forces(pair, &k);
+            for (p, g) in [(i, out.force[0]), (j, out.force[1])] {
+                force[p][0] += g[0];
+                force[p][1] += g[1];
+                moment[p][2] += g[2];
+            }
+        }
+    }
+
+    fn stable_dt(&self, state: &State) -> Option<f64> {
+        let n = self.radius.len();
+        let mut k_rows = vec![[0.0; 3]; n];
+        let mut c_rows = vec![[0.0; 3]; n];
+        for b in self
+            .bonds
+            .iter()
+            .zip(&self.intact)
+            .filter(|(_, &ok)| ok)
+            .map(|(b, _)| b)
+        {
+            let k = to_global_matrix(&b.local_stiffness(), b.axis);
+            let c = to_global_matrix(&b.local_damping(), b.axis);
+            for (end, p) in [(0, b.i as usize), (1, b.j as usize)] {
+                for r in 0..3 {
+                    k_rows[p][r] += k[3 * end + r].iter().map(|v| v.abs()).sum::<f64>();
+                    c_rows[p][r] += c[3 * end + r].iter().map(|v| v.abs()).sum::<f64>();
+                }
+            }
+        }
+        let (mut omega2, mut rate) = (0.0f64, 0.0f64);
+        for p in 0..n {
+            let m = [state.mass[p], state.mass[p], state.spin.inertia[p]];
+            for r in 0..3 {
+                omega2 = omega2.max(k_rows[p][r] / m[r]);
+                rate = rate.max(c_rows[p][r] / m[r]);
+            }
+        }
+        (omega2 > 0.0).then(|| critical_step(omega2, rate))
+    }
+
+    fn potential_energy(&self, state: &State) -> Option<f64> {
+        let bonds: f64 = self
+            .bonds
+            .iter()
+            .zip(&self.intact)
+            .filter(|(_, &ok)| ok)
+            .map(|(b, _)| {
+                let (local, f) = Self::bond_elastic(b, state);
+                0.5 * local.iter().zip(&f).map(|(u, f)| u * f).sum::<f64>()
+            })
+            .sum();
+        let contacts: f64 = self
+            .pairs
+            .iter()
+            .map(|p| {
+                let d = self
+                    .kinematics(state, p.i as usize, p.j as usize)
+                    .frame(p.rest);
+                0.5 * p.normal_stiffness * d.overlap.max(0.0).powi(2)
+            })
+            .sum();
+        Some(bonds + contacts)
+    }
+
+    fn add_tangent(&self, state: &State, tangent: &mut Tangent) -> bool {
+        let n = state.len();
+        for (b, &intact) in self.bonds.iter().zip(&self.intact) {
+            let pair = (b.i, b.j);
+            if intact {
+                let k = to_global_matrix(&b.local_stiffness(), b.axis);
+                let c = to_global_matrix(&b.local_damping(), b.axis);
+                Self::add_block(tangent, n, pair, &k, false);
+                Self::add_block(tangent, n, pair, &c, true);
+            } else {
+                Self::add_block(tangent, n, pair, &[[0.0; 6]; 6], false);
+            }
+        }
+        let law = self.settings.contact;
+        for pair in self.pairs.iter().filter(|p| p.touching) {
+            let (i, j) = (pair.i as usize, pair.j as usize);
+            let (mid_i, xi) = self.midpoint(state, i);
+            let (mid_j, xj) = self.midpoint(state, j);
+            let k = PairKinematics {
+                x: [xi, xj],
+                u: [mid_i, mid_j],
+                v: [[0.0; 3]; 2],
+                r: [self.radius[i], self.radius[j]],
+            };
+            let frame = k.frame(pair.rest);
+            let sticking = !law.forces(pair, &k).sliding;
+            let key = (pair.i, pair.j);
+            let stiffness = law.matrix(pair, &frame, k.r, sticking, false);
+            Self::add_block(tangent, n, key, &stiffness, false);
+            let damping = law.matrix(pair, &frame, k.r, sticking, true);
+            Self::add_block(tangent, n, key, &damping, true);
+        }
+        true
+    }
+
+    fn check_step(&mut self, state: &State, forces_here: bool) -> Option<f64> {
+        if forces_here {
+            self.stress_trial.copy_from_slice(&self.stress_eval);
+        } else {
+            let mut trial = std::mem::take(&mut self.stress_trial);
+            self.bond_stresses(state, &mut trial);
+            self.stress_trial = trial;
+        }
+        let eps = self.settings.tolerance;
+        let bonds = self
+            .bonds
+            .par_iter()
+            .zip(self.stress_trial.par_iter().zip(&self.stress_committed))
+            .filter(|(b, (&now, _))| now > b.strength * (1.0 + eps))
+            .map(|(b, (&now, &before))| (b.strength - before) / (now - before))
+            .min_by(f64::total_cmp);
+        let opened = self
+            .pairs
+            .iter()
+            .filter(|p| p.touching)
+            .filter_map(|p| {
+                let now = self
+                    .kinematics(state, p.i as usize, p.j as usize)
+                    .frame(p.rest)
+                    .overlap;
+                (now < 0.0).then_some((p, now))
+            })
+            .filter_map(|(p, now)| {
+                let alpha = p.overlap / (p.overlap - now);
+                (alpha < 1.0 - eps).then_some(alpha)
+            })
+            .min_by(f64::total_cmp);
+        match (bonds, opened) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    fn commit_step(&mut self, state: &State) -> bool {
+        let mut changed = false;
+        for k in 0..self.bonds.len() {
+            if self.intact[k] && self.stress_trial[k] >= self.bonds[k].strength {
+                self.intact[k] = false;
+                self.broken += 1;
+                self.broken_log.push((state.time, k as u32));
+                changed = true;
+                let b = self.bonds[k];
+                let key = (b.i.min(b.j), b.i.max(b.j));
+                if self.pair_index.insert(key) {
+                    let rest = b
+                        .length
+                        .min(self.radius[b.i as usize] + self.radius[b.j as usize]);
+                    let pair = self.candidate(state, key.0, key.1, rest, b.stiffness[0]);
+                    self.pairs.push(pair);
+                }
+            }
+        }
+        self.stress_committed.copy_from_slice(&self.stress_trial);
+        if self.moved_past_skin(state) {
+            self.rebuild_candidates(state);
+        }
+        let law = self.settings.contact;
+        for idx in 0..self.pairs.len() {
+            let pair = self.pairs[idx];
+            let k = self.kinematics(state, pair.i as usize, pair.j as usize);
+            let frame = k.frame(pair.rest);
+            let touching = frame.overlap > 0.0;
+            let out = law.forces(&pair, &k);
+            let p = &mut self.pairs[idx];
+            if touching != p.touching {
+                changed = true;
+            }
+            p.touching = touching;
+            p.elastic = if touching { out.elastic } else { 0.0 };
+            p.slip_reference = frame.slip;
+            p.overlap = frame.overlap;
+        }
+        changed
+    }
+}
