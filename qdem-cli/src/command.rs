@@ -3,6 +3,7 @@
 
 use crate::{bench, progress, verify};
 use qdem_bench::throughput::BenchPlan;
+use qdem_core::Model as _;
 use qdem_io::build::{BodyKind, BuildError, Simulation};
 use qdem_io::runner::{make_stepper, run, RunError};
 use qdem_io::scene::{Scene, SceneError};
@@ -240,11 +241,22 @@ fn run_scene(path: &Path, out: Option<&Path>) -> Result<(), CliError> {
         progress::finish();
     }
     let report = report?;
+    if let Some((time, particle, u)) = report.crack_timing.collapse {
+        eprintln!(
+            "stopped at t = {time:.5} s: particle {particle} of the bonded body moved {u:.3e} m, \
+             beyond the small-displacement range of its bonds (the body failed); \
+             {} bonds broken",
+            sim.bonded().map_or(0, |b| b.broken())
+        );
+    }
+    let rate = match sim.bonded() {
+        Some(_) => format!("{:.3e} particle-steps/s", report.particle_steps_per_second),
+        None => format!("{:.3e} tet-steps/s", report.tet_steps_per_second),
+    };
     eprintln!(
-        "done: {} steps in {:.2} s ({:.3e} tet-steps/s); outputs in {}",
+        "done: {} steps in {:.2} s ({rate}); outputs in {}",
         report.steps,
         report.wall_seconds,
-        report.tet_steps_per_second,
         out_dir.display()
     );
     Ok(())
@@ -276,6 +288,19 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
             s.max_edge,
             s.worst_quality,
             s.worst_tet
+        );
+    }
+    if let Some(b) = sim.bonded() {
+        let mass: f64 = sim.state.mass.iter().sum();
+        println!(
+            "bonded body `{}`: {} particles (radius {:.4e} m), {} beam bonds, mass {:.6e} kg; \
+             paper 001 Eq. 28 dt_crit {:.4e} s",
+            b.name(),
+            sim.state.len(),
+            b.radii()[0],
+            b.bonds().len(),
+            mass,
+            b.initial_critical_step()
         );
     }
     if let Some(contacts) = sim.contacts() {

@@ -422,3 +422,31 @@ fn contact_scene_gives_identical_outputs_for_1_and_2_threads() {
     assert!(outputs[0].0.len() > 1000, "probes.csv has rows");
     assert!(outputs[0] == outputs[1], "1 and 2 threads differ");
 }
+
+#[test]
+fn bonded_beam_cracks_and_writes_its_crack_pattern_identically_on_1_and_2_threads() {
+    // A 1 m bonded beam loaded suddenly far above its cracking load.
+    let tmp = TempDir::new("bonded");
+    let scene = workspace().join("fixtures/bbm/small_beam.toml");
+    let mut outputs = Vec::new();
+    for threads in [1, 2] {
+        let out = tmp.path().join(format!("out{threads}"));
+        run(&scene, &out, threads);
+        let csv = std::fs::read(out.join("probes.csv")).expect("read probes.csv");
+        let svg = std::fs::read_to_string(out.join("crack.svg")).expect("read crack.svg");
+        outputs.push((csv, svg, summary(&out)));
+    }
+    let bonded = &outputs[0].2["bonded"];
+    let broken = bonded["broken_bonds"].as_u64().expect("broken_bonds");
+    assert!(broken > 0 && broken < bonded["bonds"].as_u64().unwrap());
+    assert!(bonded["first_break_time"].as_f64().expect("a first break") > 0.0);
+    assert_eq!(outputs[0].1.matches("<line").count() as u64, broken);
+    assert!(
+        outputs[0].0 == outputs[1].0,
+        "probes differ between 1 and 2 threads"
+    );
+    assert!(
+        outputs[0].1 == outputs[1].1,
+        "crack patterns differ between 1 and 2 threads"
+    );
+}

@@ -8,7 +8,13 @@
 //!   fixed incidence list (no atomics: bit-identical on any number of threads);
 //! - **tangent** (Eq. 4): K = Σ T K_d Tᵀ and C likewise, as DOF entries (x, y of particle p are
 //!   DOFs 3p, 3p+1, its θ is DOF 3(N + p) + 2, N the number of particles). A broken bond keeps
-//!   zero entries in the pattern so that breaking bonds never forces a new symbolic analysis;
+//!   zero entries in the pattern so that breaking bonds never forces a new symbolic analysis.
+//!   Unbonded contacts enter with their frame at the Taylor mid-point of the step (Eq. 21) and
+//!   always with the sticking k_t0: Eq. 5's k_t(u) drops to zero for a sliding contact, but a
+//!   contact that sticks again within the step then pushes with a stiffness the matrix lacks,
+//!   which a long implicit step integrates explicitly and blows up (measured: rotations of
+//!   10³ rad/s within a step of the benchmark); sliding is left to the force, which caps the
+//!   tangential spring at μF_n;
 //! - **events** (§2.2, §4): after a trial step every intact bond's stress (Eq. 11) is
 //!   computed; a stress above the strength by more than the tolerance ε asks the stepper to
 //!   retake the step with α = (σ_lim − σ_n)/(σ_{n+1} − σ_n) (Eqs. 29–30), as does an unbonded
@@ -46,6 +52,10 @@ pub struct BondSettings {
     pub tolerance: f64,
     /// The nominal step (s), for the Taylor mid-point of Eq. 21.
     pub dt: f64,
+    /// Implicit stepping: only the active contacts (touching at the last commit, or met by a
+    /// trial step and activated) push, so that every contact force has its stiffness in the
+    /// matrix; explicit stepping lets every overlapping pair push.
+    pub implicit: bool,
 }
 
 /// The material of a bonded body: the continuum it represents and its bonds' strength.
@@ -90,6 +100,12 @@ pub struct BondedParticles {
     settings: BondSettings,
     broken: usize,
     broken_log: Vec<(f64, u32)>,
+    /// Whether a trial step activated a contact since the last commit.
+    activated: bool,
+    /// Whether the last check activated a contact.
+    stale: bool,
+    /// Eq. 28's ∆t_crit of the intact body (s).
+    critical_step: f64,
 }
 
 impl BondedParticles {
@@ -138,7 +154,11 @@ impl BondedParticles {
             settings,
             broken: 0,
             broken_log: Vec::new(),
+            activated: false,
+            stale: false,
+            critical_step: 0.0,
         };
+        model.critical_step = model.critical_step_eq28(state);
         model.rebuild_candidates(state);
         model
     }
@@ -257,6 +277,21 @@ impl BondedParticles {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// Eq. 28's ∆t_crit of the body as built, before any bond broke (s).
+    pub fn initial_critical_step(&self) -> f64 {
+        self.critical_step
+    }
+
+    /// The largest displacement of a particle and the particle, if it exceeds `limit` (m):
+    /// the linear (small-displacement) bonds and contacts of this model no longer describe
+    /// a body that has moved that far (a collapsed beam, a flying fragment).
+    pub fn beyond_small_displacement(&self, state: &State, limit: f64) -> Option<(usize, f64)> {
+        (0..self.radius.len())
+            .map(|p| (p, state.displacement(p).norm()))
+            .filter(|(_, u)| *u > limit)
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
     /// Displacement and velocity (x, y, θ) of particle p.
     #[inline]
     fn dofs(state: &State, p: usize) -> (Dof2, Dof2) {
@@ -362,6 +397,42 @@ impl BondedParticles {
             .any(|(a, x)| (x[0] - a[0]).powi(2) + (x[1] - a[1]).powi(2) > limit)
     }
 
+    /// The α of the earliest contact event of a trial step: a touching pair that opened, or a
+    /// pair that started touching, early in the step (before 1 − ε of it). A pair that starts
+    /// touching in an implicit trial step is made active at once (zero tangential history), so
+    /// that the retaken step has it in its matrix: met only in the right-hand side, a contact as
+    /// stiff as a bond is integrated explicitly and a long implicit step overshoots it.
+    fn contact_overshoot(&mut self, state: &State, forces_here: bool) -> Option<f64> {
+        let eps = self.settings.tolerance;
+        let mut earliest: Option<f64> = None;
+        for idx in 0..self.pairs.len() {
+            let p = self.pairs[idx];
+            let frame = self
+                .kinematics(state, p.i as usize, p.j as usize)
+                .frame(p.rest);
+            let (before, now) = (p.overlap, frame.overlap);
+            let alpha = match (p.touching, now > 0.0) {
+                (true, false) => before / (before - now),
+                (false, true) => {
+                    if !forces_here {
+                        let pair = &mut self.pairs[idx];
+                        pair.touching = true;
+                        pair.elastic = 0.0;
+                        pair.slip_reference = frame.slip;
+                        self.activated = true;
+                        self.stale = true;
+                    }
+                    -before / (now - before)
+                }
+                _ => continue,
+            };
+            if alpha < 1.0 - eps {
+                earliest = Some(earliest.map_or(alpha, |e: f64| e.min(alpha)));
+            }
+        }
+        earliest
+    }
+
     /// Global DOF numbers of particle p's x, y and θ in a state of `n` particles.
     #[inline]
     fn dof_numbers(p: u32, n: usize) -> [usize; 3] {
@@ -453,7 +524,8 @@ impl Model for BondedParticles {
                 m[2] += sum[2];
             });
         let law = self.settings.contact;
-        for pair in &self.pairs {
+        let implicit = self.settings.implicit;
+        for pair in self.pairs.iter().filter(|p| p.touching || !implicit) {
             let (i, j) = (pair.i as usize, pair.j as usize);
             let k = self.kinematics(state, i, j);
             if k.frame(pair.rest).overlap <= 0.0 {
@@ -468,10 +540,14 @@ impl Model for BondedParticles {
         }
     }
 
+    /// Gershgorin's bound on the largest eigenvalue of M^{-1/2} K M^{-1/2} (the eigenvalues
+    /// of M⁻¹K, scaled so that rotations and translations compare) and likewise of the
+    /// damping, into [`critical_step`].
     fn stable_dt(&self, state: &State) -> Option<f64> {
         let n = self.radius.len();
         let mut k_rows = vec![[0.0; 3]; n];
         let mut c_rows = vec![[0.0; 3]; n];
+        let inertia = |p: usize| [state.mass[p], state.mass[p], state.spin.inertia[p]];
         for b in self
             .bonds
             .iter()
@@ -481,21 +557,23 @@ impl Model for BondedParticles {
         {
             let k = to_global_matrix(&b.local_stiffness(), b.axis);
             let c = to_global_matrix(&b.local_damping(), b.axis);
-            for (end, p) in [(0, b.i as usize), (1, b.j as usize)] {
+            let (i, j) = (b.i as usize, b.j as usize);
+            let m: Vec<f64> = inertia(i).into_iter().chain(inertia(j)).collect();
+            for (end, p) in [(0, i), (1, j)] {
                 for r in 0..3 {
-                    k_rows[p][r] += k[3 * end + r].iter().map(|v| v.abs()).sum::<f64>();
-                    c_rows[p][r] += c[3 * end + r].iter().map(|v| v.abs()).sum::<f64>();
+                    let row = 3 * end + r;
+                    let scaled = |a: &[[f64; 6]; 6]| -> f64 {
+                        (0..6)
+                            .map(|col| a[row][col].abs() / (m[row] * m[col]).sqrt())
+                            .sum()
+                    };
+                    k_rows[p][r] += scaled(&k);
+                    c_rows[p][r] += scaled(&c);
                 }
             }
         }
-        let (mut omega2, mut rate) = (0.0f64, 0.0f64);
-        for p in 0..n {
-            let m = [state.mass[p], state.mass[p], state.spin.inertia[p]];
-            for r in 0..3 {
-                omega2 = omega2.max(k_rows[p][r] / m[r]);
-                rate = rate.max(c_rows[p][r] / m[r]);
-            }
-        }
+        let omega2 = k_rows.iter().flatten().cloned().fold(0.0, f64::max);
+        let rate = c_rows.iter().flatten().cloned().fold(0.0, f64::max);
         (omega2 > 0.0).then(|| critical_step(omega2, rate))
     }
 
@@ -548,17 +626,17 @@ impl Model for BondedParticles {
                 r: [self.radius[i], self.radius[j]],
             };
             let frame = k.frame(pair.rest);
-            let sticking = !law.forces(pair, &k).sliding;
             let key = (pair.i, pair.j);
-            let stiffness = law.matrix(pair, &frame, k.r, sticking, false);
+            let stiffness = law.matrix(pair, &frame, k.r, true, false);
             Self::add_block(tangent, n, key, &stiffness, false);
-            let damping = law.matrix(pair, &frame, k.r, sticking, true);
+            let damping = law.matrix(pair, &frame, k.r, true, true);
             Self::add_block(tangent, n, key, &damping, true);
         }
         true
     }
 
     fn check_step(&mut self, state: &State, forces_here: bool) -> Option<f64> {
+        self.stale = false;
         if forces_here {
             self.stress_trial.copy_from_slice(&self.stress_eval);
         } else {
@@ -574,30 +652,19 @@ impl Model for BondedParticles {
             .filter(|(b, (&now, _))| now > b.strength * (1.0 + eps))
             .map(|(b, (&now, &before))| (b.strength - before) / (now - before))
             .min_by(f64::total_cmp);
-        let opened = self
-            .pairs
-            .iter()
-            .filter(|p| p.touching)
-            .filter_map(|p| {
-                let now = self
-                    .kinematics(state, p.i as usize, p.j as usize)
-                    .frame(p.rest)
-                    .overlap;
-                (now < 0.0).then_some((p, now))
-            })
-            .filter_map(|(p, now)| {
-                let alpha = p.overlap / (p.overlap - now);
-                (alpha < 1.0 - eps).then_some(alpha)
-            })
-            .min_by(f64::total_cmp);
-        match (bonds, opened) {
+        let contacts = self.contact_overshoot(state, forces_here);
+        match (bonds, contacts) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         }
     }
 
+    fn tangent_stale(&self) -> bool {
+        self.stale
+    }
+
     fn commit_step(&mut self, state: &State) -> bool {
-        let mut changed = false;
+        let mut changed = std::mem::take(&mut self.activated);
         for k in 0..self.bonds.len() {
             if self.intact[k] && self.stress_trial[k] >= self.bonds[k].strength {
                 self.intact[k] = false;

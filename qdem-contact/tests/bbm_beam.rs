@@ -143,6 +143,7 @@ fn lattice_has_the_continuum_modulus_and_poisson_ratio() {
         },
         tolerance: 0.05,
         dt: 1e-3,
+        implicit: true,
     };
     let (mut state, model) =
         BondedParticles::from_packing("block", &packing, &material, settings).unwrap();

@@ -61,6 +61,13 @@ pub trait Model: std::any::Any + Send + Sync {
         None
     }
 
+    /// Whether the last [`Model::check_step`] of an implicit trial step made the model's
+    /// tangent stale (a contact met within the step was activated): the stepper then redoes
+    /// the step with the new tangent, so that the contact is implicit from its first step.
+    fn tangent_stale(&self) -> bool {
+        false
+    }
+
     /// Accepts the step that ended at `state` (after [`Model::check_step`]): applies its
     /// events (breaks bonds, opens and closes contacts) and returns whether the tangent
     /// ([`Model::add_tangent`]) changed, so that an implicit stepper refactorises.

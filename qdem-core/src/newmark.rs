@@ -59,10 +59,14 @@ pub enum TangentUpdate {
     EveryStep,
 }
 
-/// Retakes a step at most this many times (paper 001 Eq. 30) before accepting it.
-const MAX_RETAKES: usize = 8;
-/// The smallest α a retake uses: a step shrinks at most tenfold per retake.
-const MIN_ALPHA: f64 = 0.01;
+/// Retakes a sub-step at most this many times before accepting it: once, as paper 001 §4
+/// recalculates "the last calculated step" once with ∆t·√α (Eq. 30).
+const MAX_RETAKES: usize = 1;
+/// Redoes a sub-step at most this many times when a trial met new contacts (implicit).
+const MAX_REDOS: usize = 4;
+/// The shortest sub-step of the adaptive control, as a fraction of ∆t: a crack that runs
+/// bond after bond would otherwise be resolved one bond per (refactorised) sub-step.
+const MIN_FRACTION: f64 = 1.0 / 16.0;
 
 /// What the adaptive control and the events did (for summaries and the paper's Tables 1–2).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -74,6 +78,8 @@ pub struct StepCounts {
     pub substeps: u64,
     /// Accepted steps at whose end a model's tangent changed (bonds broke, contacts changed).
     pub event_steps: u64,
+    /// Numeric factorisations of the effective matrix (nominal and sub-step), implicit only.
+    pub factorizations: u64,
 }
 
 /// The Newmark-β family: explicit for β = 0, implicit for β > 0, optionally adaptive.
@@ -150,9 +156,10 @@ impl Newmark {
     }
 
     /// The same stepper with the adaptive control of paper 001 Eqs. 29–30: a step that a
-    /// model's [`Model::check_step`] rejects is retaken from its start with ∆t·√α, and the
-    /// remainder of the nominal step follows as further sub-steps (so outputs stay on the
-    /// nominal grid). Off by default.
+    /// model's [`Model::check_step`] rejects is retaken once from its start with ∆t·√α (but
+    /// not shorter than ∆t/16), and the remainder of the nominal step follows as further
+    /// sub-steps, each checked the same way (so outputs stay on the nominal grid). Off by
+    /// default.
     pub fn with_adaptive(mut self, adaptive: bool) -> Newmark {
         self.adaptive = adaptive;
         self
@@ -221,6 +228,7 @@ impl Newmark {
         }
         factor.step = Some(h);
         system.dofs = Some(dofs);
+        self.counts.factorizations += 1;
         Ok(())
     }
 
@@ -288,24 +296,39 @@ impl Newmark {
         span: f64,
     ) -> Result<f64, CoreError> {
         let mut h = span;
-        if self.adaptive {
+        if self.adaptive || self.is_implicit() {
             match &mut self.saved {
                 Some(saved) => saved.as_mut().clone_from(state),
                 None => self.saved = Some(Box::new(state.clone())),
             }
         }
         let forces_here = !self.is_implicit();
-        for retake in 0..=MAX_RETAKES {
+        let (mut retakes, mut redos) = (0, 0);
+        loop {
             self.advance(state, models, h)?;
             let alpha = models
                 .iter_mut()
                 .filter_map(|m| m.check_step(state, forces_here))
                 .min_by(f64::total_cmp);
-            match (alpha, &self.saved) {
-                (Some(alpha), Some(saved)) if self.adaptive && retake < MAX_RETAKES => {
+            let stale = models.iter().any(|m| m.tangent_stale());
+            let Some(saved) = &self.saved else { break };
+            if stale && redos < MAX_REDOS {
+                // Redo with the contacts the trial met in the matrix (an active-set pass).
+                state.clone_from(saved.as_ref());
+                self.system.tangent_current = false;
+                self.system.nominal.step = None;
+                self.system.substep.step = None;
+                redos += 1;
+                continue;
+            }
+            match alpha {
+                Some(alpha)
+                    if self.adaptive && retakes < MAX_RETAKES && h > MIN_FRACTION * self.dt =>
+                {
                     state.clone_from(saved.as_ref());
-                    h *= alpha.clamp(MIN_ALPHA, 1.0).sqrt();
+                    h = (h * alpha.clamp(0.0, 1.0).sqrt()).max(MIN_FRACTION * self.dt);
                     self.counts.retakes += 1;
+                    retakes += 1;
                 }
                 _ => break,
             }
@@ -319,7 +342,6 @@ impl Newmark {
             self.system.tangent_current = false;
             self.system.nominal.step = None;
             self.system.substep.step = None;
-            compute_accelerations(state, models, &mut self.force, &mut self.torque)?;
         }
         Ok(h)
     }

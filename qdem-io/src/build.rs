@@ -9,6 +9,7 @@
 use crate::scene::suggest::did_you_mean;
 use crate::scene::{Integrator, Scene, Selection, TimeStep};
 use nalgebra::Rotation3;
+use qdem_contact::BondedParticles;
 use qdem_contact::DemContacts;
 use qdem_core::rigid_body::tet_mass_properties;
 use qdem_core::{
@@ -168,6 +169,9 @@ impl Simulation {
     /// Reads the meshes and builds every model of `scene`: bodies, then gravity (only if
     /// non-zero), then loads; fixes go into the state.
     pub fn build(scene: Scene) -> Result<Simulation, BuildError> {
+        if let Some(bonded) = scene.bonded.clone() {
+            return crate::bonded_build::build_bonded(scene, &bonded);
+        }
         let core = |source| BuildError::Core {
             scene: scene.path.clone(),
             source,
@@ -240,6 +244,14 @@ impl Simulation {
             BodyKind::Deformable { .. } => self.state.mass[body.particles.clone()].iter().sum(),
             BodyKind::Rigid { center, .. } => self.state.mass[center],
         }
+    }
+
+    /// The bonded-particle model of a `[bonded]` scene.
+    pub fn bonded(&self) -> Option<&BondedParticles> {
+        self.models.iter().find_map(|m| {
+            let m: &dyn std::any::Any = m.as_ref();
+            m.downcast_ref::<BondedParticles>()
+        })
     }
 
     /// The contact model, if the scene has contacts.
@@ -521,6 +533,16 @@ fn missing_group(
 }
 
 /// The candidate particle nearest to `point` (a rigid body's candidates include its centre).
+/// The probe `name` at the particle of `candidates` nearest to `point`.
+pub(crate) fn nearest_particle_in(
+    state: &State,
+    candidates: impl Iterator<Item = usize>,
+    point: Vec3,
+    name: &str,
+) -> ProbePoint {
+    nearest_particle(state, candidates, point, name)
+}
+
 fn nearest_particle(
     state: &State,
     candidates: impl Iterator<Item = usize>,

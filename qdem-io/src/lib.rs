@@ -6,13 +6,16 @@
 //!   messages that name the file, line and key.
 //! - [`build`]: turns a scene into a [`build::Simulation`]: one [`qdem_core::State`] for all
 //!   bodies and only the models the scene needs.
+//!   A `[bonded]` scene builds a 2D beam-bonded body instead (paper 001).
 //! - [`runner`]: the run loop, sampling probes and writing snapshots.
 //! - [`output`]: atomic writers for VTU/PVD, probe CSV and summary JSON.
 //! - [`spectrum`]: dominant frequency of a probe record by FFT.
 //! - [`plot`]: SVG line plots beside the CSVs.
 
+mod bonded_build;
 pub mod build;
 mod contact_build;
+pub mod crack_svg;
 pub mod output;
 pub mod plot;
 pub mod runner;

@@ -6,9 +6,11 @@
 //! The loop is an explicit pipeline: step → probes → snapshot → progress.
 
 use crate::build::{BodyKind, Simulation};
+use crate::crack_svg::write_crack_svg;
 use crate::output::{write_summary, write_vtu, OutputError, ProbeCsv, PvdIndex, VtuGrid};
 use crate::plot::{line_plot_svg, Labels, Series};
 use crate::scene::Integrator;
+use qdem_contact::BondedParticles;
 use qdem_core::{CoreError, Newmark, StaticSteps, Stepper, Vec3, Verlet};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -73,7 +75,46 @@ pub struct RunReport {
     pub probe_rows: usize,
     /// VTU snapshots written.
     pub vtu_files: usize,
+    /// Particle-steps per wall-clock second.
+    pub particle_steps_per_second: f64,
+    /// Wall-clock seconds of the steps before and after the first broken bond, and the
+    /// number of each (bonded scenes; zero otherwise): the t_b, t_u of paper 001 Tables 1–2.
+    pub crack_timing: CrackTiming,
 }
+
+/// Wall time per step before and after cracking starts.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CrackTiming {
+    /// Seconds in steps that began with no bond broken.
+    pub before_seconds: f64,
+    /// Steps that began with no bond broken.
+    pub before_steps: u64,
+    /// Seconds in steps that began with bonds broken.
+    pub after_seconds: f64,
+    /// Steps that began with bonds broken.
+    pub after_steps: u64,
+    /// Time of the first broken bond (s), if any.
+    pub first_break: Option<f64>,
+    /// When the run stopped early because the bonded body moved beyond its
+    /// small-displacement range: (time, particle, displacement).
+    pub collapse: Option<(f64, usize, f64)>,
+}
+
+impl CrackTiming {
+    fn add(&mut self, cracked: bool, seconds: f64) {
+        if cracked {
+            self.after_seconds += seconds;
+            self.after_steps += 1;
+        } else {
+            self.before_seconds += seconds;
+            self.before_steps += 1;
+        }
+    }
+}
+
+/// A bonded run ends early once a particle has moved this many particle spacings: its linear
+/// bonds and contacts are meaningless beyond (the body has collapsed or come apart).
+const COLLAPSE_SPACINGS: f64 = 0.5;
 
 /// Samples that fall due: the first at t = 0, then every `every` seconds (to the nearest step).
 struct Schedule {
@@ -130,15 +171,24 @@ pub fn run(
     let mut stepper = make_stepper(sim).map_err(|source| core_error(sim, source))?;
     let start = Instant::now();
     let mut last_report = start;
+    let mut timing = CrackTiming::default();
     let outcome = (|| -> Result<(), RunError> {
         stepper
             .initialize(&mut sim.state, &mut sim.models)
             .map_err(|source| core_error(sim, source))?;
         for step in 0..=steps {
             if step > 0 {
+                let cracked = sim.bonded().is_some_and(|b| b.broken() > 0);
+                let begin = Instant::now();
                 stepper
                     .step(&mut sim.state, &mut sim.models)
                     .map_err(|source| core_error(sim, source))?;
+                timing.add(cracked, begin.elapsed().as_secs_f64());
+                if let Some((p, u)) = sim.bonded().and_then(|b| {
+                    b.beyond_small_displacement(&sim.state, COLLAPSE_SPACINGS * 2.0 * b.radii()[0])
+                }) {
+                    timing.collapse = Some((sim.state.time, p, u));
+                }
             }
             let (time, dt) = (sim.state.time, sim.dt);
             if probe_schedule.due(time, dt) {
@@ -160,6 +210,9 @@ pub fn run(
                 last_report = Instant::now();
                 progress(&progress_at(step, steps, time, start));
             }
+            if timing.collapse.is_some() {
+                break;
+            }
         }
         Ok(())
     })();
@@ -169,7 +222,15 @@ pub fn run(
     if !names.is_empty() {
         plot_probes(&out_dir.join("probes.svg"), &names, &history)?;
     }
+    if let Some(model) = sim.bonded() {
+        timing.first_break = model.broken_log().first().map(|b| b.0);
+        write_crack_svg(&out_dir.join("crack.svg"), model, &sim.state)?;
+    }
     outcome?;
+    let steps = match timing.collapse {
+        Some(_) => timing.before_steps + timing.after_steps,
+        None => steps,
+    };
     let tet_steps = (sim.tets() as f64) * steps as f64;
     let report = RunReport {
         integrator: stepper.name().to_string(),
@@ -180,8 +241,14 @@ pub fn run(
         tet_steps_per_second: tet_steps / wall_seconds.max(1e-9),
         probe_rows,
         vtu_files: pvd.len(),
+        particle_steps_per_second: sim.state.len() as f64 * steps as f64 / wall_seconds.max(1e-9),
+        crack_timing: timing,
     };
-    write_summary(&out_dir.join("summary.json"), &summary_json(sim, &report))?;
+    let mut summary = summary_json(sim, &report);
+    if let Some(model) = sim.bonded() {
+        summary["bonded"] = bonded_summary(model, &report, stepper.as_ref());
+    }
+    write_summary(&out_dir.join("summary.json"), &summary)?;
     Ok(report)
 }
 
@@ -216,7 +283,10 @@ pub fn make_stepper(sim: &Simulation) -> Result<Box<dyn Stepper>, CoreError> {
             let damping = sim.scene.contact.as_ref().map_or(0.0, |c| c.local_damping);
             Box::new(Verlet::new(sim.dt).with_local_damping(damping))
         }
-        Integrator::Newmark => Box::new(Newmark::new(run.beta, run.gamma, sim.dt)?),
+        Integrator::Newmark => {
+            let adaptive = sim.scene.bonded.as_ref().is_some_and(|b| b.adaptive);
+            Box::new(Newmark::new(run.beta, run.gamma, sim.dt)?.with_adaptive(adaptive))
+        }
         Integrator::Static => Box::new(StaticSteps::new(sim.dt)),
     })
 }
@@ -287,6 +357,39 @@ fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
         ],
     };
     write_vtu(path, &grid)
+}
+
+/// The bonded body's figures: bonds, breaks, the paper's step bound and Table 1–2 timings.
+fn bonded_summary(
+    model: &BondedParticles,
+    report: &RunReport,
+    stepper: &dyn Stepper,
+) -> serde_json::Value {
+    let t = &report.crack_timing;
+    let per = |s: f64, n: u64| if n > 0 { s / n as f64 } else { 0.0 };
+    let counts = stepper.counts();
+    let factor = stepper.factor_stats();
+    json!({
+        "bonds": model.bonds().len(),
+        "broken_bonds": model.broken(),
+        "first_break_time": t.first_break,
+        "touching_pairs": model.touching(),
+        "critical_step_eq28": model.initial_critical_step(),
+        "stopped_at_collapse": t.collapse.map(|(time, particle, u)| json!({
+            "time": time, "particle": particle, "displacement": u,
+        })),
+        "step_before_crack_seconds": per(t.before_seconds, t.before_steps),
+        "step_after_crack_seconds": per(t.after_seconds, t.after_steps),
+        "steps_before_crack": t.before_steps,
+        "steps_after_crack": t.after_steps,
+        "retakes": counts.retakes,
+        "substeps": counts.substeps,
+        "event_steps": counts.event_steps,
+        "factorizations": counts.factorizations,
+        "factor_dofs": factor.map(|f| f.dofs),
+        "factor_nonzeros": factor.map(|f| f.factor_nonzeros),
+        "particle_steps_per_second": report.particle_steps_per_second,
+    })
 }
 
 fn summary_json(sim: &Simulation, report: &RunReport) -> serde_json::Value {

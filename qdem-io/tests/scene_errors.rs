@@ -779,3 +779,78 @@ fn missing_mesh_names_resolved_path() {
         &["/nonexistent/dir/scene.toml: [[body]] \"beam\": mesh file /nonexistent/dir/cantilever.msh does not exist"],
     );
 }
+
+/// A `[bonded]` scene: valid as written, and refused with a message naming the key for a
+/// bad value, a `[[body]]` beside it, a non-Newmark integrator or a `[[fix]]`.
+#[test]
+fn bonded_scenes_parse_and_bad_ones_are_refused_with_the_key() {
+    let good = r#"
+[run]
+t_end = 0.01
+integrator = "newmark"
+beta = 0.25
+dt = 1e-3
+
+[[material]]
+name = "concrete"
+density = 2400.0
+young = 30e9
+poisson = 0.25
+
+[bonded]
+name = "beam"
+material = "concrete"
+size = [3.0, 0.5]
+element_size = 0.05
+strength_mean = 6e6
+top_load = 230e3
+load_ramp = 0.25
+supports = "pinned"
+
+[[probe]]
+name = "mid"
+body = "beam"
+point = [1.5, 0.25, 0.0]
+"#;
+    let scene = qdem_io::scene::Scene::parse(good, std::path::Path::new("beam.toml")).unwrap();
+    let b = scene.bonded.as_ref().unwrap();
+    assert_eq!(b.supports, qdem_io::scene::Supports::Pinned);
+    assert_eq!(b.tolerance, 0.05);
+    assert!(b.adaptive);
+    let cases = [
+        (
+            good.replace("element_size = 0.05", "element_size = -0.05"),
+            "element_size",
+        ),
+        (
+            good.replace("integrator = \"newmark\"", "integrator = \"verlet\""),
+            "newmark",
+        ),
+        (
+            good.replace(
+                "material = \"concrete\"\nsize",
+                "material = \"concret\"\nsize",
+            ),
+            "did you mean \"concrete\"",
+        ),
+        (
+            good.replace("supports = \"pinned\"", "supports = \"clamped\""),
+            "supports",
+        ),
+        (
+            good.replace("load_ramp = 0.25", "load_rmp = 0.25"),
+            "load_ramp",
+        ),
+        (
+            format!("{good}\n[[fix]]\nbody = \"beam\"\nbox = [[0,0,0],[1,1,1]]\n"),
+            "top_load",
+        ),
+    ];
+    for (text, expected) in cases {
+        let error = qdem_io::scene::Scene::parse(&text, std::path::Path::new("beam.toml"))
+            .expect_err(expected)
+            .to_string();
+        assert!(error.contains(expected), "{expected:?} not in: {error}");
+        assert!(error.contains("beam.toml"), "no file in: {error}");
+    }
+}

@@ -1,3 +1,4 @@
+#![allow(dead_code)]
 //! A simply supported bonded beam (paper 001 §5) built in code for the tests.
 
 use qdem_contact::{
@@ -47,6 +48,7 @@ pub fn beam(h: f64, q: f64, mean: f64, std: f64, pin_both: bool, dt: f64) -> Bea
         },
         tolerance: 0.05,
         dt,
+        implicit: false,
     };
     let (mut state, model) =
         BondedParticles::from_packing("beam", &packing, &material, settings).unwrap();

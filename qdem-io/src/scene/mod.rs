@@ -42,8 +42,8 @@ mod validate;
 
 pub use error::{Diagnostic, SceneError};
 pub use schema::{
-    Body, Contact, ContactLawName, Fix, Integrator, Load, Material, Output, Probe, Ramp, Run,
-    Selection, TimeStep, Wall,
+    Body, Bonded, Contact, ContactLawName, Fix, Integrator, Load, Material, Output, PackingName,
+    Probe, Ramp, Run, Selection, Supports, TimeStep, Wall,
 };
 
 use schema::RawScene;
@@ -136,6 +136,8 @@ pub struct Scene {
     pub walls: Vec<Wall>,
     /// `[[probe]]`, in file order.
     pub probes: Vec<Probe>,
+    /// `[bonded]`: a 2D beam-bonded particle body instead of `[[body]]`s.
+    pub bonded: Option<Bonded>,
     /// `[output]` (defaults when absent).
     pub output: Output,
     /// The scene file; relative paths inside the scene are resolved against its directory.

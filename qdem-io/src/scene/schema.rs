@@ -458,7 +458,130 @@ pub(crate) struct RawScene {
     #[serde(default, rename = "wall")]
     pub walls: Vec<Wall>,
     #[serde(default)]
+    pub bonded: Option<Bonded>,
+    #[serde(default)]
     pub output: Output,
+}
+
+/// `[bonded] packing`: how the rectangle is filled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PackingName {
+    /// A triangular lattice.
+    #[default]
+    Regular,
+    /// The lattice with random offsets of up to `jitter` spacings.
+    Random,
+}
+
+/// `[bonded] supports`: how the beam is held.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Supports {
+    /// Simply supported: the end line of particles at each end held vertically, the left one
+    /// nearest mid-height held horizontally.
+    #[default]
+    Simple,
+    /// As `simple`, with the right end's mid-height particle held horizontally too (a pin on
+    /// the centroid at each end: identical to `simple` before cracking, an arch after).
+    Pinned,
+    /// Nothing held.
+    None,
+}
+
+/// `[bonded]`: a 2D beam-bonded particle body (paper 001) filling a rectangle of the x–y
+/// plane, with its supports and a uniform load on its top row. A scene with `[bonded]` has no
+/// `[[body]]` and is integrated with `integrator = "newmark"`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bonded {
+    /// Body name (for probes and messages).
+    pub name: String,
+    /// A `[[material]]`: density, young, poisson of the continuum represented.
+    pub material: String,
+    /// Lower-left corner (m); default the origin.
+    #[serde(default)]
+    pub origin: [f64; 2],
+    /// Width and height (m).
+    pub size: [f64; 2],
+    /// Out-of-plane thickness (m); default 1.
+    #[serde(default = "one")]
+    pub thickness: f64,
+    /// Particle spacing (m).
+    pub element_size: f64,
+    /// `"regular"` (default) or `"random"`.
+    #[serde(default)]
+    pub packing: PackingName,
+    /// Largest random offset in spacings for `packing = "random"`, in [0, 0.25); default 0.1.
+    #[serde(default = "default_jitter")]
+    pub jitter: f64,
+    /// Seed of the random packing.
+    #[serde(default)]
+    pub packing_seed: u64,
+    /// Mean bond strength (Pa).
+    pub strength_mean: f64,
+    /// Standard deviation of the bond strength (Pa); default 0.
+    #[serde(default)]
+    pub strength_std: f64,
+    /// Seed of the strengths.
+    #[serde(default)]
+    pub strength_seed: u64,
+    /// Bond damping ratio ξ_b (Eq. 8), in [0, 1); default 0.
+    #[serde(default)]
+    pub damping_ratio: f64,
+    /// Step as a multiple of the paper's ∆t_crit (Eq. 28): 0.2 for the paper's explicit runs,
+    /// η for implicit ones. Optional; replaces `[run] dt`.
+    #[serde(default)]
+    pub critical_fraction: Option<f64>,
+    /// Retake steps that overshoot a bond's strength or a contact's opening (Eqs. 29–30);
+    /// default true.
+    #[serde(default = "yes")]
+    pub adaptive: bool,
+    /// Relative overshoot ε tolerated before a retake; default 0.05.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// Unbonded contacts: tangential over normal stiffness; default 0.2.
+    #[serde(default = "default_shear_ratio")]
+    pub contact_shear_ratio: f64,
+    /// Unbonded contacts: Coulomb friction; default 0.5.
+    #[serde(default = "default_bbm_friction")]
+    pub friction: f64,
+    /// Unbonded contacts: damping ratio ξ_u (Eq. 6), in [0, 1); default 0.
+    #[serde(default)]
+    pub contact_damping_ratio: f64,
+    /// `"simple"` (default), `"pinned"` or `"none"`.
+    #[serde(default)]
+    pub supports: Supports,
+    /// Uniform downward line load on the top row (N/m); default 0.
+    #[serde(default)]
+    pub top_load: f64,
+    /// Time over which `top_load` rises linearly from zero (s); default 0: applied at once.
+    #[serde(default)]
+    pub load_ramp: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn yes() -> bool {
+    true
+}
+
+fn default_jitter() -> f64 {
+    0.1
+}
+
+fn default_tolerance() -> f64 {
+    0.05
+}
+
+fn default_shear_ratio() -> f64 {
+    0.2
+}
+
+fn default_bbm_friction() -> f64 {
+    0.5
 }
 
 /// Top-level keys that are arrays of tables (`[[name]]`), for messages.

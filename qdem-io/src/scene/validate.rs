@@ -376,7 +376,8 @@ pub(crate) fn validate(
                 ),
             );
         }
-        if beta > 0.0 && run.dt == TimeStep::Auto {
+        let fraction = raw.bonded.as_ref().and_then(|b| b.critical_fraction);
+        if beta > 0.0 && run.dt == TimeStep::Auto && fraction.is_none() {
             c.error(
                 &["run", "dt"],
                 "[run]: implicit Newmark (beta > 0) has no stable-step bound to choose dt from: \
@@ -447,14 +448,19 @@ pub(crate) fn validate(
     let material_names: Vec<&str> = raw.materials.iter().map(|m| m.name.as_str()).collect();
 
     // [[body]]
-    if raw.bodies.is_empty() {
+    if raw.bodies.is_empty() && raw.bonded.is_none() {
         c.error(
             &[],
             "no [[body]] is defined; a scene needs at least one body".to_owned(),
         );
     }
-    let bodies = unique_names(&mut c, "body", raw.bodies.iter().map(|b| b.name.as_str()));
-    let body_names: Vec<&str> = raw.bodies.iter().map(|b| b.name.as_str()).collect();
+    let mut bodies = unique_names(&mut c, "body", raw.bodies.iter().map(|b| b.name.as_str()));
+    let mut body_names: Vec<&str> = raw.bodies.iter().map(|b| b.name.as_str()).collect();
+    if let Some(b) = &raw.bonded {
+        bonded_table(&mut c, &raw, b, &material_names);
+        bodies.insert(b.name.as_str(), body_names.len());
+        body_names.push(b.name.as_str());
+    }
     for (i, b) in raw.bodies.iter().enumerate() {
         let idx = i.to_string();
         let l = label("body", i, Some(&b.name));
@@ -579,9 +585,122 @@ pub(crate) fn validate(
         probes: raw.probes,
         contact: raw.contact,
         walls: raw.walls,
+        bonded: raw.bonded,
         output: raw.output,
         path: path.to_path_buf(),
     })
+}
+
+/// `[bonded]`: ranges, its material, and what a bonded scene cannot have.
+fn bonded_table(
+    c: &mut Checker<'_>,
+    raw: &RawScene,
+    b: &super::schema::Bonded,
+    materials: &[&str],
+) {
+    let l = "[bonded]";
+    let at = |key: &'static str| ["bonded", key];
+    if !materials.contains(&b.material.as_str()) {
+        let mut m = format!("{l}: material {:?} is not defined", b.material);
+        if let Some(s) = did_you_mean(&b.material, materials.iter().copied()) {
+            m.push_str(&format!("; did you mean {s:?}?"));
+        }
+        c.error(&at("material"), m);
+    }
+    if !raw.bodies.is_empty() {
+        c.error(
+            &at("name"),
+            format!(
+                "{l}: a scene with a bonded body has no [[body]] (bonded bodies are 2D); fix: \
+                 remove the [[body]] tables or the [bonded] table"
+            ),
+        );
+    }
+    if raw.run.integrator != Integrator::Newmark {
+        c.error(
+            &["run", "integrator"],
+            format!(
+                "[run]: a bonded body needs integrator = \"newmark\" (its particles rotate); \
+                 use beta = 0 for explicit, beta = 0.25 for implicit"
+            ),
+        );
+    }
+    for (what, list) in [("[[fix]]", raw.fixes.len()), ("[[load]]", raw.loads.len())] {
+        if list > 0 {
+            c.error(
+                &[],
+                format!(
+                    "{what} does not apply to a bonded body; fix: hold it with [bonded] \
+                     supports and load it with [bonded] top_load"
+                ),
+            );
+        }
+    }
+    if c.finite(&at("size"), l, "size", &b.size) && !(b.size[0] > 0.0 && b.size[1] > 0.0) {
+        c.error(
+            &at("size"),
+            format!("{l}: size = {:?}: both must be positive (m)", b.size),
+        );
+    }
+    c.finite(&at("origin"), l, "origin", &b.origin);
+    c.positive(&at("thickness"), l, "thickness", b.thickness, "m");
+    c.positive(&at("element_size"), l, "element_size", b.element_size, "m");
+    c.positive(
+        &at("strength_mean"),
+        l,
+        "strength_mean",
+        b.strength_mean,
+        "Pa",
+    );
+    c.non_negative(&at("strength_std"), l, "strength_std", b.strength_std, "Pa");
+    c.positive(&at("tolerance"), l, "tolerance", b.tolerance, "(relative)");
+    c.non_negative(
+        &at("contact_shear_ratio"),
+        l,
+        "contact_shear_ratio",
+        b.contact_shear_ratio,
+        "",
+    );
+    c.non_negative(&at("friction"), l, "friction", b.friction, "");
+    c.non_negative(
+        &at("top_load"),
+        l,
+        "top_load",
+        b.top_load,
+        "N/m (downwards)",
+    );
+    c.non_negative(&at("load_ramp"), l, "load_ramp", b.load_ramp, "s");
+    if let Some(f) = b.critical_fraction {
+        c.positive(
+            &at("critical_fraction"),
+            l,
+            "critical_fraction",
+            f,
+            "(times ∆t_crit)",
+        );
+    }
+    fraction(
+        c,
+        &at("damping_ratio"),
+        l,
+        "damping_ratio",
+        b.damping_ratio,
+        "a damping ratio",
+    );
+    fraction(
+        c,
+        &at("contact_damping_ratio"),
+        l,
+        "contact_damping_ratio",
+        b.contact_damping_ratio,
+        "a damping ratio",
+    );
+    if !(0.0..0.25).contains(&b.jitter) {
+        c.error(
+            &at("jitter"),
+            format!("{l}: jitter = {}: must be in [0, 0.25) spacings", b.jitter),
+        );
+    }
 }
 
 /// A number in [0, 1).
@@ -820,6 +939,7 @@ pub(crate) fn to_raw(scene: &Scene) -> RawScene {
         probes: scene.probes.clone(),
         contact: scene.contact.clone(),
         walls: scene.walls.clone(),
+        bonded: scene.bonded.clone(),
         output: scene.output.clone(),
     }
 }

@@ -1,0 +1,177 @@
+//! Building a scene's `[bonded]` body (paper 001 §5): the packing of its rectangle, the
+//! [`BondedParticles`] model with seeded strengths, the supports and the top-row line load.
+//!
+//! Supports act on the end lines of the full rows (the particles at the smallest and largest
+//! x): held vertically; the one nearest mid-height of the left end (and for `pinned` of the
+//! right end too) held horizontally. Holding the staggered particles of the other rows as well
+//! would clamp the ends partly. The load is the line load times the body's width, shared
+//! equally by the particles of the top row (all equally spaced), rising linearly over
+//! `load_ramp` seconds.
+//!
+//! The step: `critical_fraction` × ∆t_crit of Eq. 28 when given, else `[run] dt` as for any
+//! scene; an explicit step is always checked against the rigorous bound
+//! ([`qdem_core::Model::stable_dt`]).
+
+use crate::build::{nearest_particle_in, BuildError, Simulation};
+use crate::scene::{Bonded, Integrator, PackingName, Scene, Supports, TimeStep};
+use qdem_contact::{
+    BondSettings, BondedMaterial, BondedParticles, ContactError, Packing, PackingKind, UnbondedLaw,
+};
+use qdem_core::{
+    choose_step, stable_step, CoreError, Dofs, Model, NodalLoad, State, TimeFunction, Vec3,
+};
+
+/// Builds the simulation of a scene whose body is `[bonded]`.
+pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, BuildError> {
+    let contact = |source| BuildError::Contact {
+        scene: scene.path.clone(),
+        source: Box::new(source),
+    };
+    let kind = match bonded.packing {
+        PackingName::Regular => PackingKind::Regular,
+        PackingName::Random => PackingKind::Random {
+            jitter: bonded.jitter,
+            seed: bonded.packing_seed,
+        },
+    };
+    let packing = Packing::rectangle(bonded.origin, bonded.size, bonded.element_size, kind)
+        .ok_or_else(|| {
+            contact(ContactError::TooCoarse {
+                body: bonded.name.clone(),
+                size: bonded.size,
+                element_size: bonded.element_size,
+            })
+        })?;
+    let material = scene.material(&bonded.material).expect("validated scene");
+    let bond_material = BondedMaterial {
+        density: material.density,
+        young: material.young,
+        poisson: material.poisson,
+        thickness: bonded.thickness,
+        damping_ratio: bonded.damping_ratio,
+        strength_mean: bonded.strength_mean,
+        strength_std: bonded.strength_std,
+        seed: bonded.strength_seed,
+    };
+    let mut settings = BondSettings {
+        contact: UnbondedLaw {
+            shear_ratio: bonded.contact_shear_ratio,
+            friction: bonded.friction,
+            damping_ratio: bonded.contact_damping_ratio,
+        },
+        tolerance: bonded.tolerance,
+        dt: 0.0,
+        implicit: scene.run.beta > 0.0,
+    };
+    let (mut state, model) =
+        BondedParticles::from_packing(&bonded.name, &packing, &bond_material, settings)
+            .map_err(contact)?;
+    hold(&mut state, &packing, bonded.supports);
+    let mut models: Vec<Box<dyn Model>> = vec![Box::new(model)];
+    if bonded.top_load > 0.0 {
+        models.push(Box::new(top_load(&packing, bonded)));
+    }
+    let core = |source| BuildError::Core {
+        scene: scene.path.clone(),
+        source,
+    };
+    let dt = bonded_dt(&scene, bonded, &state, &models).map_err(core)?;
+    settings.dt = dt;
+    let model = BondedParticles::from_packing(&bonded.name, &packing, &bond_material, settings)
+        .map_err(contact)?
+        .1;
+    models[0] = Box::new(model);
+    let probes = scene
+        .probes
+        .iter()
+        .map(|p| nearest_particle_in(&state, 0..state.len(), Vec3::from(p.point), &p.name))
+        .collect();
+    let stable_dt = stable_step(&state, &models).unwrap_or((f64::INFINITY, String::new()));
+    Ok(Simulation {
+        scene,
+        state,
+        models,
+        bodies: Vec::new(),
+        probes,
+        stable_dt,
+        dt,
+        warnings: Vec::new(),
+    })
+}
+
+/// The end lines of full rows held vertically, a mid-height particle (or two) horizontally.
+fn hold(state: &mut State, packing: &Packing, supports: Supports) {
+    if supports == Supports::None {
+        return;
+    }
+    let c = &packing.centers;
+    let tol = 0.1 * packing.spacing;
+    let (x_min, x_max) = c
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p[0]), b.max(p[0])));
+    let y_mid = 0.5 * c.iter().fold(f64::MAX, |a, p| a.min(p[1]))
+        + 0.5 * c.iter().fold(f64::MIN, |a, p| a.max(p[1]));
+    let line = |x: f64| -> Vec<usize> {
+        (0..c.len())
+            .filter(|&p| (c[p][0] - x).abs() < tol)
+            .collect()
+    };
+    let (left, right) = (line(x_min), line(x_max));
+    let y = Dofs::parse("y").expect("valid");
+    for &p in left.iter().chain(&right) {
+        state.fix(p, y);
+    }
+    let middle = |ids: &[usize]| {
+        *ids.iter()
+            .min_by(|&&a, &&b| (c[a][1] - y_mid).abs().total_cmp(&(c[b][1] - y_mid).abs()))
+            .expect("a lattice has at least two rows")
+    };
+    let x = Dofs::parse("x").expect("valid");
+    state.fix(middle(&left), x);
+    if supports == Supports::Pinned {
+        state.fix(middle(&right), x);
+    }
+}
+
+/// The line load on the top row.
+fn top_load(packing: &Packing, bonded: &Bonded) -> NodalLoad {
+    let c = &packing.centers;
+    let top = c.iter().fold(f64::MIN, |a, p| a.max(p[1]));
+    let particles = (0..c.len())
+        .filter(|&p| (c[p][1] - top).abs() < 1e-9 * packing.spacing)
+        .map(|p| p as u32)
+        .collect();
+    let total = Vec3::new(0.0, -bonded.top_load * bonded.size[0], 0.0);
+    let factor = if bonded.load_ramp > 0.0 {
+        TimeFunction::new(vec![(0.0, 0.0), (bonded.load_ramp, 1.0)]).expect("increasing times")
+    } else {
+        TimeFunction::constant(1.0)
+    };
+    NodalLoad::new("top_load", particles, total, factor)
+}
+
+/// The step: `critical_fraction` × Eq. 28's ∆t_crit, or `[run] dt`; explicit steps are
+/// refused above the rigorous bound.
+fn bonded_dt(
+    scene: &Scene,
+    bonded: &Bonded,
+    state: &State,
+    models: &[Box<dyn Model>],
+) -> Result<f64, CoreError> {
+    let run = &scene.run;
+    let explicit = run.integrator == Integrator::Newmark && run.beta == 0.0;
+    let requested = match (bonded.critical_fraction, run.dt) {
+        (Some(f), _) => {
+            let model: &dyn std::any::Any = models[0].as_ref();
+            let model: &BondedParticles = model.downcast_ref().expect("the bonded model");
+            Some(f * model.critical_step_eq28(state))
+        }
+        (None, TimeStep::Fixed(dt)) => Some(dt),
+        (None, TimeStep::Auto) => None,
+    };
+    if explicit {
+        choose_step(state, models, requested, run.dt_safety)
+    } else {
+        Ok(requested.expect("validated: implicit runs give dt or critical_fraction"))
+    }
+}
