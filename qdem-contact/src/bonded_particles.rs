@@ -627,9 +627,9 @@ impl Model for BondedParticles {
             };
             let frame = k.frame(pair.rest);
             let key = (pair.i, pair.j);
-            let stiffness = law.matrix(pair, &frame, k.r, true, false);
+            let stiffness = law.matrix(pair, &frame, k.r, false);
             Self::add_block(tangent, n, key, &stiffness, false);
-            let damping = law.matrix(pair, &frame, k.r, true, true);
+            let damping = law.matrix(pair, &frame, k.r, true);
             Self::add_block(tangent, n, key, &damping, true);
         }
         true

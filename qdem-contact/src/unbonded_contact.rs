@@ -10,8 +10,9 @@
 //!   bound and unbound contacts identical");
 //! - tangential: an elastic spring k_t0 on the elastic part e of s, capped by Coulomb's
 //!   |F_t| ≤ μ F_n; past the cap the contact slides and e is reset to the cap. Eq. 5's
-//!   displacement-dependent k_t(u) is this cap written as a stiffness: the tangent is k_t0
-//!   while sticking and 0 while sliding, decided at the Taylor mid-point of the step (Eq. 21);
+//!   displacement-dependent k_t(u) is this cap written as a stiffness (k_t0 + k_t(u) is the
+//!   secant μF_n/|e| while sliding), evaluated with the rest of the force at the state the
+//!   force is asked at; the matrix keeps k_t0 (see [`crate::bonded_particles`]);
 //! - damping c = 2ξ√(k m_r) on the relative normal and tangential velocities (Eq. 6, as
 //!   relative dashpots like the bond's).
 //!
@@ -153,14 +154,13 @@ impl UnbondedLaw {
 
     /// The 6×6 stiffness (or, with `damping`, damping) of a touching pair in global
     /// coordinates over (x_i, y_i, θ_i, x_j, y_j, θ_j): normal k_n n nᵀ on the relative
-    /// displacement, tangential k_t g gᵀ with g the gradient of s; `sticking` chooses k_t0 or 0
-    /// (Eq. 21's k_t(u)).
+    /// displacement, tangential k_t0 g gᵀ with g the gradient of s (the sticking stiffness; see
+    /// [`crate::bonded_particles`] for why a sliding contact keeps it in the matrix).
     pub fn matrix(
         &self,
         pair: &UnbondedPair,
         frame: &PairFrame,
         r: [f64; 2],
-        sticking: bool,
         damping: bool,
     ) -> [[f64; 6]; 6] {
         let kn = pair.normal_stiffness;
@@ -170,7 +170,7 @@ impl UnbondedLaw {
             let z = 2.0 * self.damping_ratio;
             (z * (kn * m).sqrt(), z * (kt * m).sqrt())
         } else {
-            (kn, if sticking { kt } else { 0.0 })
+            (kn, kt)
         };
         let (n, t) = (frame.n, frame.t);
         let gn = [-n[0], -n[1], 0.0, n[0], n[1], 0.0];
@@ -236,21 +236,25 @@ mod tests {
         // δ = 1e-6 (to first order), F_n = 100 N, cap 50 N; k_t s = 2e7 · 1e-7 = 2 N.
         assert!((stick.force[1][1] + 2.0).abs() < 0.01, "{:?}", stick.force);
         assert!(!stick.sliding);
-        let slide = law().forces(&pair(), &kinematics(-1e-6, 1e-5));
+        let k = kinematics(-1e-6, 1e-5);
+        let slide = law().forces(&pair(), &k);
         assert!(slide.sliding);
-        let ft = -slide.force[1][1];
-        // F_n = k_n δ with δ = 1e-6 less the second-order 2.5e-9 of the sideways offset.
-        assert!((ft - 0.5 * 1e8 * (1e-6 - 2.5e-9)).abs() < 0.01, "{ft}");
+        let f = k.frame(0.02);
+        let fj = slide.force[1];
+        let ft = -(fj[0] * f.t[0] + fj[1] * f.t[1]);
+        let fnormal = fj[0] * f.n[0] + fj[1] * f.n[1];
+        assert!((ft - 0.5 * fnormal).abs() < 1e-9 * fnormal, "{ft} {fnormal}");
         // Moments r F_t on both discs.
-        assert!((slide.force[0][2] - 0.01 * slide.force[0][1]).abs() < 1e-6);
+        assert!((slide.force[0][2] - 0.01 * ft).abs() < 1e-12 * ft);
     }
 
     #[test]
+    #[allow(clippy::needless_range_loop)]
     fn matrix_is_the_derivative_of_the_sticking_force() {
         let (p, l) = (pair(), law());
         let k0 = kinematics(-1e-6, 1e-8);
         let frame = k0.frame(p.rest);
-        let m = l.matrix(&p, &frame, k0.r, true, false);
+        let m = l.matrix(&p, &frame, k0.r, false);
         let f0 = l.forces(&p, &k0);
         for col in 0..6 {
             let mut k = k0;

@@ -207,7 +207,7 @@ pub fn check_masses(state: &State) -> Result<(), CoreError> {
             && state.rigid.body_of_member(i).is_none();
         let turns = !state.spin.is_empty()
             && (0..3).any(|axis| !state.spin.fixed[i].contains(axis))
-            && !(state.spin.inertia[i] > 0.0);
+            && state.spin.inertia[i].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater);
         turns || free && state.mass[i].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
     });
     match bad {

@@ -619,10 +619,9 @@ fn bonded_table(
     if raw.run.integrator != Integrator::Newmark {
         c.error(
             &["run", "integrator"],
-            format!(
-                "[run]: a bonded body needs integrator = \"newmark\" (its particles rotate); \
-                 use beta = 0 for explicit, beta = 0.25 for implicit"
-            ),
+            "[run]: a bonded body needs integrator = \"newmark\" (its particles rotate); use \
+             beta = 0 for explicit, beta = 0.25 for implicit"
+                .to_owned(),
         );
     }
     for (what, list) in [("[[fix]]", raw.fixes.len()), ("[[load]]", raw.loads.len())] {
