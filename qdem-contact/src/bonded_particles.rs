@@ -412,7 +412,7 @@ impl BondedParticles {
                 .frame(p.rest);
             let (before, now) = (p.overlap, frame.overlap);
             let alpha = match (p.touching, now > 0.0) {
-                (true, false) => before / (before - now),
+                (true, false) if before > 0.0 => before / (before - now),
                 (false, true) => {
                     if !forces_here {
                         let pair = &mut self.pairs[idx];

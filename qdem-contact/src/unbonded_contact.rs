@@ -243,7 +243,10 @@ mod tests {
         let fj = slide.force[1];
         let ft = -(fj[0] * f.t[0] + fj[1] * f.t[1]);
         let fnormal = fj[0] * f.n[0] + fj[1] * f.n[1];
-        assert!((ft - 0.5 * fnormal).abs() < 1e-9 * fnormal, "{ft} {fnormal}");
+        assert!(
+            (ft - 0.5 * fnormal).abs() < 1e-9 * fnormal,
+            "{ft} {fnormal}"
+        );
         // Moments r F_t on both discs.
         assert!((slide.force[0][2] - 0.01 * ft).abs() < 1e-12 * ft);
     }

@@ -63,7 +63,7 @@ pub enum TangentUpdate {
 /// recalculates "the last calculated step" once with ∆t·√α (Eq. 30).
 const MAX_RETAKES: usize = 1;
 /// Redoes a sub-step at most this many times when a trial met new contacts (implicit).
-const MAX_REDOS: usize = 4;
+const MAX_REDOS: usize = 8;
 /// The shortest sub-step of the adaptive control, as a fraction of ∆t: a crack that runs
 /// bond after bond would otherwise be resolved one bond per (refactorised) sub-step.
 const MIN_FRACTION: f64 = 1.0 / 16.0;
