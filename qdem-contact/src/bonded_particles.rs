@@ -417,8 +417,10 @@ impl BondedParticles {
                     if !forces_here {
                         let pair = &mut self.pairs[idx];
                         pair.touching = true;
+                        // The tangential spring starts from the slip at the step's start (kept
+                        // for every pair at commit), not the trial's end: the retaken step
+                        // starts there.
                         pair.elastic = 0.0;
-                        pair.slip_reference = frame.slip;
                         self.activated = true;
                         self.stale = true;
                     }
