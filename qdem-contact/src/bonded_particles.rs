@@ -277,6 +277,12 @@ impl BondedParticles {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// Sets the nominal step (s) the Taylor mid-point of Eq. 21 uses, once the scene has chosen
+    /// it (from this model's bounds).
+    pub fn set_nominal_step(&mut self, dt: f64) {
+        self.settings.dt = dt;
+    }
+
     /// Eq. 28's ∆t_crit of the body as built, before any bond broke (s).
     pub fn initial_critical_step(&self) -> f64 {
         self.critical_step

@@ -98,17 +98,7 @@ fn clapeyron_holds_at_the_static_answer() {
         .solve(&mut b.state, &mut b.models, 0.0)
         .unwrap();
     let energy = b.models[0].potential_energy(&b.state).unwrap();
-    let top_y = b
-        .packing
-        .centers
-        .iter()
-        .map(|c| c[1])
-        .fold(f64::MIN, f64::max);
-    let top: Vec<usize> = (0..b.state.len())
-        .filter(|&p| (b.packing.centers[p][1] - top_y).abs() < 1e-9)
-        .collect();
-    let per = q * 3.0 / top.len() as f64;
-    let work: f64 = top.iter().map(|&p| -per * b.state.displacement(p)[1]).sum();
+    let work = b.load_work(q);
     assert!(
         (energy / (0.5 * work) - 1.0).abs() < 1e-9,
         "{energy} {work}"
@@ -119,34 +109,17 @@ fn clapeyron_holds_at_the_static_answer() {
 /// `lattice_section`), measured away from the loaded edges.
 #[test]
 fn lattice_has_the_continuum_modulus_and_poisson_ratio() {
-    use qdem_contact::{
-        BondSettings, BondedMaterial, BondedParticles, Packing, PackingKind, UnbondedLaw,
-    };
+    use qdem_contact::{BondedParticles, Packing, PackingKind};
     use qdem_core::{Dofs, NodalLoad, TimeFunction, Vec3};
     let (w, hgt) = (2.0, 0.5);
     let packing = Packing::rectangle([0.0, 0.0], [w, hgt], 0.025, PackingKind::Regular).unwrap();
-    let material = BondedMaterial {
-        density: 2400.0,
-        young: 30e9,
-        poisson: 0.25,
-        thickness: 1.0,
-        damping_ratio: 0.0,
-        strength_mean: f64::INFINITY,
-        strength_std: 0.0,
-        seed: 1,
-    };
-    let settings = BondSettings {
-        contact: UnbondedLaw {
-            shear_ratio: 0.2,
-            friction: 0.5,
-            damping_ratio: 0.0,
-        },
-        tolerance: 0.05,
-        dt: 1e-3,
-        implicit: true,
-    };
-    let (mut state, model) =
-        BondedParticles::from_packing("block", &packing, &material, settings).unwrap();
+    let (mut state, model) = BondedParticles::from_packing(
+        "block",
+        &packing,
+        &bbm::material(f64::INFINITY, 0.0),
+        bbm::settings(1e-3, true),
+    )
+    .unwrap();
     let h = packing.spacing;
     let c = &packing.centers;
     let left: Vec<usize> = (0..c.len()).filter(|&p| c[p][0] < 0.51 * h).collect();

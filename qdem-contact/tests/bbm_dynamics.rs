@@ -10,18 +10,7 @@ use qdem_core::{Newmark, Stepper};
 /// Total energy of the undamped beam under its constant load: kinetic + bond energy − load × u.
 fn energy(b: &bbm::Beam, q: f64) -> f64 {
     let s = &b.state;
-    let top_y = b
-        .packing
-        .centers
-        .iter()
-        .map(|c| c[1])
-        .fold(f64::MIN, f64::max);
-    let top: Vec<usize> = (0..s.len())
-        .filter(|&p| (b.packing.centers[p][1] - top_y).abs() < 1e-9)
-        .collect();
-    let per = q * bbm::LENGTH / top.len() as f64;
-    let work: f64 = top.iter().map(|&p| -per * s.displacement(p)[1]).sum();
-    s.kinetic_energy() + b.models[0].potential_energy(s).unwrap() - work
+    s.kinetic_energy() + b.models[0].potential_energy(s).unwrap() - b.load_work(q)
 }
 
 /// Average acceleration (β = ¼, γ = ½) conserves the energy of a linear undamped system

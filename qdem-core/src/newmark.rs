@@ -106,9 +106,35 @@ struct ImplicitSystem {
     tangent_current: bool,
     entries: Vec<Entry>,
     dofs: Option<FreeDofs>,
+    factors: Factors,
+    rhs: Vec<f64>,
+}
+
+/// The factorisation for the nominal step and the one for the last shorter sub-step.
+#[derive(Debug, Default)]
+struct Factors {
     nominal: Factor,
     substep: Factor,
-    rhs: Vec<f64>,
+}
+
+impl Factors {
+    /// The nominal factorisation, or the sub-step one.
+    fn get(&mut self, nominal: bool) -> &mut Factor {
+        if nominal {
+            &mut self.nominal
+        } else {
+            &mut self.substep
+        }
+    }
+}
+
+impl ImplicitSystem {
+    /// Marks the tangent and both factorisations out of date (a model's tangent changed).
+    fn invalidate(&mut self) {
+        self.tangent_current = false;
+        self.factors.nominal.step = None;
+        self.factors.substep.step = None;
+    }
 }
 
 /// A factorisation of M + γh C + β h² K for one step h.
@@ -209,11 +235,7 @@ impl Newmark {
             scales,
             &mut system.entries,
         )?;
-        let factor = if h == self.dt {
-            &mut system.nominal
-        } else {
-            &mut system.substep
-        };
+        let factor = system.factors.get(h == self.dt);
         factor.step = None;
         if let Err(error) = factor.cholesky.factorize(matrix.as_ref(), "effective") {
             let pivot = factor.cholesky.failed_pivot();
@@ -242,12 +264,9 @@ impl Newmark {
         h: f64,
     ) -> Result<(), CoreError> {
         let nominal = h == self.dt;
-        let factor = if nominal {
-            &self.system.nominal
-        } else {
-            &self.system.substep
-        };
-        if factor.step != Some(h) || self.update == TangentUpdate::EveryStep {
+        if self.system.factors.get(nominal).step != Some(h)
+            || self.update == TangentUpdate::EveryStep
+        {
             self.refactor(state, models, h)?;
         }
         sum_forces(state, models, &mut self.force, &mut self.torque);
@@ -256,12 +275,11 @@ impl Newmark {
         system.rhs.resize(dofs.len(), 0.0);
         let moments = &self.torque[state.rigid.len()..];
         dofs.gather_nodes((&self.force, moments), &mut system.rhs);
-        let factor = if nominal {
-            &mut system.nominal
-        } else {
-            &mut system.substep
-        };
-        factor.cholesky.solve_in_place(&mut system.rhs);
+        system
+            .factors
+            .get(nominal)
+            .cholesky
+            .solve_in_place(&mut system.rhs);
         dofs.scatter_nodes(
             &system.rhs,
             (&mut state.acceleration, &mut state.spin.acceleration),
@@ -315,9 +333,7 @@ impl Newmark {
             if stale && redos < MAX_REDOS {
                 // Redo with the contacts the trial met in the matrix (an active-set pass).
                 state.clone_from(saved.as_ref());
-                self.system.tangent_current = false;
-                self.system.nominal.step = None;
-                self.system.substep.step = None;
+                self.system.invalidate();
                 redos += 1;
                 continue;
             }
@@ -339,9 +355,7 @@ impl Newmark {
         self.counts.substeps += 1;
         if changed {
             self.counts.event_steps += 1;
-            self.system.tangent_current = false;
-            self.system.nominal.step = None;
-            self.system.substep.step = None;
+            self.system.invalidate();
         }
         Ok(h)
     }
@@ -421,7 +435,7 @@ impl Stepper for Newmark {
     }
 
     fn factor_stats(&self) -> Option<&FactorStats> {
-        let cholesky = &self.system.nominal.cholesky;
+        let cholesky = &self.system.factors.nominal.cholesky;
         cholesky.is_factored().then(|| cholesky.stats())
     }
 

@@ -6,7 +6,7 @@ use crate::model::Model;
 use crate::newmark::StepCounts;
 use crate::rigid_body::reduce_member_forces;
 use crate::sparse::FactorStats;
-use crate::state::State;
+use crate::state::{Dofs, State};
 use crate::Vec3;
 use rayon::prelude::*;
 
@@ -119,14 +119,35 @@ pub fn compute_accelerations(
 /// axes. Fails on a non-finite value.
 pub(crate) fn set_spin_accelerations(state: &mut State, moment: &[Vec3]) -> Result<(), CoreError> {
     let spin = &mut state.spin;
-    let (inertia, fixed) = (&spin.inertia, &spin.fixed);
-    let first_bad = spin
-        .acceleration
-        .par_iter_mut()
+    let first_bad = divide_free(
+        &mut spin.acceleration,
+        moment,
+        &spin.inertia,
+        &spin.fixed,
+        |_| false,
+    );
+    non_finite_at(first_bad, state.time)
+}
+
+/// out_i = load_i / inertia_i with the fixed directions zeroed, and zero where `follows(i)`
+/// (members of rigid bodies, which follow their body); in parallel. Returns the first index
+/// with a non-finite result, `usize::MAX` if none.
+fn divide_free(
+    out: &mut [Vec3],
+    load: &[Vec3],
+    inertia: &[f64],
+    fixed: &[Dofs],
+    follows: impl Fn(usize) -> bool + Sync,
+) -> usize {
+    out.par_iter_mut()
         .with_min_len(PARTICLE_CHUNK)
         .enumerate()
         .map(|(i, a)| {
-            let mut acc = moment[i] / inertia[i];
+            if follows(i) {
+                *a = Vec3::zeros();
+                return usize::MAX;
+            }
+            let mut acc = load[i] / inertia[i];
             for axis in 0..3 {
                 if fixed[i].contains(axis) {
                     acc[axis] = 0.0;
@@ -140,13 +161,14 @@ pub(crate) fn set_spin_accelerations(state: &mut State, moment: &[Vec3]) -> Resu
             }
         })
         .min()
-        .unwrap_or(usize::MAX);
+        .unwrap_or(usize::MAX)
+}
+
+/// The error for the first non-finite index `first_bad` of [`divide_free`], if any.
+fn non_finite_at(first_bad: usize, time: f64) -> Result<(), CoreError> {
     match first_bad {
         usize::MAX => Ok(()),
-        particle => Err(CoreError::NonFinite {
-            time: state.time,
-            particle,
-        }),
+        particle => Err(CoreError::NonFinite { time, particle }),
     }
 }
 
@@ -164,39 +186,15 @@ pub(crate) fn refuse_spin(state: &State, stepper: &str) -> Result<(), CoreError>
 /// Sets a = f/m, zero in fixed directions and on members of rigid bodies (which follow their
 /// body). Fails on a non-finite acceleration.
 pub(crate) fn set_accelerations(state: &mut State, force: &[Vec3]) -> Result<(), CoreError> {
-    let (mass, fixed, rigid) = (&state.mass, &state.fixed, &state.rigid);
-    let first_bad = state
-        .acceleration
-        .par_iter_mut()
-        .with_min_len(PARTICLE_CHUNK)
-        .enumerate()
-        .map(|(i, a)| {
-            if rigid.body_of_member(i).is_some() {
-                *a = Vec3::zeros();
-                return usize::MAX;
-            }
-            let mut acc = force[i] / mass[i];
-            for axis in 0..3 {
-                if fixed[i].contains(axis) {
-                    acc[axis] = 0.0;
-                }
-            }
-            *a = acc;
-            if acc.iter().all(|c| c.is_finite()) {
-                usize::MAX
-            } else {
-                i
-            }
-        })
-        .min()
-        .unwrap_or(usize::MAX);
-    match first_bad {
-        usize::MAX => Ok(()),
-        particle => Err(CoreError::NonFinite {
-            time: state.time,
-            particle,
-        }),
-    }
+    let rigid = &state.rigid;
+    let first_bad = divide_free(
+        &mut state.acceleration,
+        force,
+        &state.mass,
+        &state.fixed,
+        |i| rigid.body_of_member(i).is_some(),
+    );
+    non_finite_at(first_bad, state.time)
 }
 
 /// Checks that every particle that is free in some direction, and no member of a rigid body,

@@ -53,20 +53,21 @@ pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, 
         strength_std: bonded.strength_std,
         seed: bonded.strength_seed,
     };
-    let mut settings = BondSettings {
+    let settings = BondSettings {
         contact: UnbondedLaw {
             shear_ratio: bonded.contact_shear_ratio,
             friction: bonded.friction,
             damping_ratio: bonded.contact_damping_ratio,
         },
         tolerance: bonded.tolerance,
-        dt: 0.0,
+        dt: 0.0, // set below, once the step is chosen
         implicit: scene.run.beta > 0.0,
     };
     let (mut state, model) =
         BondedParticles::from_packing(&bonded.name, &packing, &bond_material, settings)
             .map_err(contact)?;
     hold(&mut state, &packing, bonded.supports);
+    let critical = model.initial_critical_step();
     let mut models: Vec<Box<dyn Model>> = vec![Box::new(model)];
     if bonded.top_load > 0.0 {
         models.push(Box::new(top_load(&packing, bonded)));
@@ -75,12 +76,10 @@ pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, 
         scene: scene.path.clone(),
         source,
     };
-    let dt = bonded_dt(&scene, bonded, &state, &models).map_err(core)?;
-    settings.dt = dt;
-    let model = BondedParticles::from_packing(&bonded.name, &packing, &bond_material, settings)
-        .map_err(contact)?
-        .1;
-    models[0] = Box::new(model);
+    let dt = bonded_dt(&scene, bonded, critical, &state, &models).map_err(core)?;
+    let model: &mut dyn std::any::Any = models[0].as_mut();
+    let model: &mut BondedParticles = model.downcast_mut().expect("the bonded model");
+    model.set_nominal_step(dt);
     let probes = scene
         .probes
         .iter()
@@ -150,22 +149,19 @@ fn top_load(packing: &Packing, bonded: &Bonded) -> NodalLoad {
     NodalLoad::new("top_load", particles, total, factor)
 }
 
-/// The step: `critical_fraction` × Eq. 28's ∆t_crit, or `[run] dt`; explicit steps are
-/// refused above the rigorous bound.
+/// The step: `critical_fraction` × Eq. 28's ∆t_crit (`critical`), or `[run] dt`; explicit
+/// steps are refused above the rigorous bound.
 fn bonded_dt(
     scene: &Scene,
     bonded: &Bonded,
+    critical: f64,
     state: &State,
     models: &[Box<dyn Model>],
 ) -> Result<f64, CoreError> {
     let run = &scene.run;
     let explicit = run.integrator == Integrator::Newmark && run.beta == 0.0;
     let requested = match (bonded.critical_fraction, run.dt) {
-        (Some(f), _) => {
-            let model: &dyn std::any::Any = models[0].as_ref();
-            let model: &BondedParticles = model.downcast_ref().expect("the bonded model");
-            Some(f * model.critical_step_eq28(state))
-        }
+        (Some(f), _) => Some(f * critical),
         (None, TimeStep::Fixed(dt)) => Some(dt),
         (None, TimeStep::Auto) => None,
     };

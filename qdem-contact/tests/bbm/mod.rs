@@ -30,28 +30,9 @@ pub struct Beam {
 pub fn beam(h: f64, q: f64, mean: f64, std: f64, pin_both: bool, dt: f64) -> Beam {
     let packing =
         Packing::rectangle([0.0, 0.0], [LENGTH, HEIGHT], h, PackingKind::Regular).unwrap();
-    let material = BondedMaterial {
-        density: 2400.0,
-        young: YOUNG,
-        poisson: POISSON,
-        thickness: 1.0,
-        damping_ratio: 0.0,
-        strength_mean: mean,
-        strength_std: std,
-        seed: 1,
-    };
-    let settings = BondSettings {
-        contact: UnbondedLaw {
-            shear_ratio: 0.2,
-            friction: 0.5,
-            damping_ratio: 0.0,
-        },
-        tolerance: 0.05,
-        dt,
-        implicit: false,
-    };
     let (mut state, model) =
-        BondedParticles::from_packing("beam", &packing, &material, settings).unwrap();
+        BondedParticles::from_packing("beam", &packing, &material(mean, std), settings(dt, false))
+            .unwrap();
     let hs = packing.spacing;
     let y_mid = HEIGHT / 2.0;
     let x_max = packing
@@ -134,7 +115,47 @@ pub fn beam(h: f64, q: f64, mean: f64, std: f64, pin_both: bool, dt: f64) -> Bea
     }
 }
 
+/// Undamped concrete (ρ = 2400 kg/m³, E, ν above, 1 m thick) with strengths N(`mean`, `std`).
+pub fn material(mean: f64, std: f64) -> BondedMaterial {
+    BondedMaterial {
+        density: 2400.0,
+        young: YOUNG,
+        poisson: POISSON,
+        thickness: 1.0,
+        damping_ratio: 0.0,
+        strength_mean: mean,
+        strength_std: std,
+        seed: 1,
+    }
+}
+
+/// Undamped unbonded contacts (k_t0/k_n = 0.2, μ = 0.5), ε = 0.05, nominal step `dt`.
+pub fn settings(dt: f64, implicit: bool) -> BondSettings {
+    BondSettings {
+        contact: UnbondedLaw {
+            shear_ratio: 0.2,
+            friction: 0.5,
+            damping_ratio: 0.0,
+        },
+        tolerance: 0.05,
+        dt,
+        implicit,
+    }
+}
+
 impl Beam {
+    /// Work of the line load `q` (shared equally by the top row) on the current displacement.
+    pub fn load_work(&self, q: f64) -> f64 {
+        let s = &self.state;
+        let c = &self.packing.centers;
+        let top_y = c.iter().map(|c| c[1]).fold(f64::MIN, f64::max);
+        let top: Vec<usize> = (0..s.len())
+            .filter(|&p| (c[p][1] - top_y).abs() < 1e-9)
+            .collect();
+        let per = q * LENGTH / top.len() as f64;
+        top.iter().map(|&p| -per * s.displacement(p)[1]).sum()
+    }
+
     /// Mean vertical displacement of the midspan section (m).
     pub fn midspan_deflection(&self) -> f64 {
         let s = &self.state;
