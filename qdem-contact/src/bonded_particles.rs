@@ -374,6 +374,7 @@ impl BondedParticles {
             center: &center,
             radius: &self.radius,
             body: &body,
+            periodic: None,
         };
         let bonded: HashSet<(u32, u32)> = self
             .bonds

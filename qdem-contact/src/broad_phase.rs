@@ -8,7 +8,14 @@
 //! does not depend on the number of threads. The contact model rebuilds it only when some
 //! sphere has moved more than half the skin since the last build (then no pair outside the list
 //! can have come into contact). Cost O(N log N) per build; there is no O(N²) path.
+//!
+//! Along a periodic axis ([`PeriodicBox`]) the grid spans exactly one period, cells are binned
+//! by the wrapped coordinate, neighbour cells wrap around, and distances are minimum images, so
+//! spheres near opposite boundaries pair through the boundary. A period of fewer than three
+//! cells gets a single cell along that axis (every pair is then compared along it), so no cell
+//! pair is ever visited twice.
 
+use crate::periodic_boundary::PeriodicBox;
 use qdem_core::Vec3;
 use rayon::prelude::*;
 
@@ -20,13 +27,16 @@ pub struct SphereSet<'a> {
     pub radius: &'a [f64],
     /// Owning body of each sphere; spheres of one body never pair.
     pub body: &'a [u32],
+    /// The periodic axes, if any.
+    pub periodic: Option<&'a PeriodicBox>,
 }
 
 /// Integer cell coordinates of every sphere and the grid's key function.
 struct Grid {
     origin: Vec3,
-    inverse_cell: f64,
+    inverse_cell: [f64; 3],
     dims: [u64; 3],
+    period: [Option<f64>; 3],
 }
 
 /// The lower and upper corners of the axis-aligned box around `points` (infinite, inverted
@@ -39,8 +49,15 @@ pub fn bounds<'a>(points: impl IntoIterator<Item = &'a Vec3>) -> (Vec3, Vec3) {
 }
 
 impl Grid {
-    fn new(center: &[Vec3], cell: f64) -> Grid {
-        let (lo, hi) = bounds(center);
+    fn new(center: &[Vec3], cell: f64, periodic: Option<&PeriodicBox>) -> Grid {
+        let (mut lo, mut hi) = bounds(center);
+        let period = [0, 1, 2].map(|k| periodic.and_then(|p| p.length(k)));
+        for k in 0..3 {
+            if let (Some(l), Some(p)) = (period[k], periodic) {
+                lo[k] = p.origin()[k];
+                hi[k] = lo[k] + l;
+            }
+        }
         // Spheres spread over a very large region get larger cells, so that keys fit in u64.
         let mut inverse_cell = 1.0 / cell;
         let cells = |inv: f64| [0, 1, 2].map(|k| ((hi[k] - lo[k]) * inv) as u64 + 1);
@@ -52,17 +69,31 @@ impl Grid {
         {
             inverse_cell *= 0.5;
         }
-        let dims = cells(inverse_cell);
+        let mut dims = cells(inverse_cell);
+        let mut inverse = [inverse_cell; 3];
+        for k in 0..3 {
+            if let Some(l) = period[k] {
+                let whole = (l * inverse_cell).floor() as u64;
+                dims[k] = if whole >= 3 { whole } else { 1 };
+                inverse[k] = dims[k] as f64 / l;
+            }
+        }
         Grid {
             origin: lo,
-            inverse_cell,
+            inverse_cell: inverse,
             dims,
+            period,
         }
     }
 
     fn coords(&self, x: &Vec3) -> [u64; 3] {
-        [0, 1, 2]
-            .map(|k| (((x[k] - self.origin[k]) * self.inverse_cell) as u64).min(self.dims[k] - 1))
+        [0, 1, 2].map(|k| {
+            let mut u = x[k] - self.origin[k];
+            if let Some(l) = self.period[k] {
+                u = u.rem_euclid(l);
+            }
+            ((u * self.inverse_cell[k]) as u64).min(self.dims[k] - 1)
+        })
     }
 
     fn key(&self, c: [u64; 3]) -> u64 {
@@ -78,7 +109,7 @@ pub fn find_pairs(spheres: &SphereSet, skin: f64) -> Vec<(u32, u32)> {
         return Vec::new();
     }
     let r_max = spheres.radius.iter().cloned().fold(0.0, f64::max);
-    let grid = Grid::new(spheres.center, 2.0 * r_max + skin);
+    let grid = Grid::new(spheres.center, 2.0 * r_max + skin, spheres.periodic);
     let mut keyed: Vec<(u64, u32)> = spheres
         .center
         .par_iter()
@@ -123,15 +154,20 @@ pub fn find_pairs(spheres: &SphereSet, skin: f64) -> Vec<(u32, u32)> {
     pairs
 }
 
-/// Keys of the neighbour cells of `c` with a larger key than `c`'s own.
+/// Keys of the neighbour cells of `c` with a larger key than `c`'s own (wrapping around
+/// periodic axes).
 fn forward_neighbours(grid: &Grid, c: [u64; 3]) -> impl Iterator<Item = u64> + '_ {
     let own = grid.key(c);
     (0..27).filter_map(move |m| {
         let offset = [m % 3, (m / 3) % 3, m / 9].map(|o| o as i64 - 1);
         let mut cell = [0u64; 3];
         for k in 0..3 {
-            let v = c[k] as i64 + offset[k];
-            if v < 0 || v >= grid.dims[k] as i64 {
+            let dims = grid.dims[k] as i64;
+            let mut v = c[k] as i64 + offset[k];
+            if grid.period[k].is_some() && dims >= 3 {
+                v = v.rem_euclid(dims);
+            }
+            if v < 0 || v >= dims {
                 return None;
             }
             cell[k] = v as u64;
@@ -148,7 +184,11 @@ fn push_if_near(spheres: &SphereSet, skin: f64, i: u32, j: u32, out: &mut Vec<(u
         return;
     }
     let reach = spheres.radius[iu] + spheres.radius[ju] + skin;
-    if (spheres.center[iu] - spheres.center[ju]).norm_squared() < reach * reach {
+    let mut d = spheres.center[ju] - spheres.center[iu];
+    if let Some(p) = spheres.periodic {
+        d = p.minimum_image(d);
+    }
+    if d.norm_squared() < reach * reach {
         out.push((i.min(j), i.max(j)));
     }
 }
@@ -178,7 +218,25 @@ mod tests {
             let center: Vec<Vec3> = points.iter().map(|p| Vec3::new(p.0, p.1, p.2)).collect();
             let radius: Vec<f64> = points.iter().map(|p| p.3).collect();
             let body: Vec<u32> = points.iter().map(|p| p.4).collect();
-            let set = SphereSet { center: &center, radius: &radius, body: &body };
+            let set = SphereSet { center: &center, radius: &radius, body: &body, periodic: None };
+            prop_assert_eq!(find_pairs(&set, skin), brute_force(&set, skin));
+        }
+
+        #[test]
+        fn the_periodic_grid_finds_exactly_the_brute_force_minimum_image_pairs(
+            points in proptest::collection::vec((-0.2..1.3f64, 0.0..1.0f64, 0.0..0.3f64, 0.01..0.05f64, 0u32..40), 2..300),
+            skin in 0.0..0.05f64,
+            period in 0.25..1.0f64,
+            periodic_y in proptest::bool::ANY,
+        ) {
+            // Spheres partly outside the cell [0, period) along x (as bodies that have not
+            // wrapped yet are); periods from below three cells (one column) to many.
+            let center: Vec<Vec3> = points.iter().map(|p| Vec3::new(p.0, p.1, p.2)).collect();
+            let radius: Vec<f64> = points.iter().map(|p| p.3).collect();
+            let body: Vec<u32> = points.iter().map(|p| p.4).collect();
+            let y = periodic_y.then_some(1.0);
+            let periodic = PeriodicBox::new(Vec3::zeros(), [Some(period), y, None]).unwrap();
+            let set = SphereSet { center: &center, radius: &radius, body: &body, periodic: Some(&periodic) };
             prop_assert_eq!(find_pairs(&set, skin), brute_force(&set, skin));
         }
     }

@@ -17,13 +17,24 @@
 //! The contact point is at x_a + (r_a − δ/2) n; its velocity includes the rigid body's spin,
 //! v + ω × (x_cp − x). Tangential springs grow by the relative displacement over the time since
 //! the previous evaluation, so the model needs no step size.
+//!
+//! With periodic axes ([`DemContacts::with_periodic`]) separations are minimum images, so a
+//! pair touches through the boundary as an original and its ghost would (paper 003 Eq. 1);
+//! the pair keeps the image translation of its second sphere for the moment about that
+//! sphere. With a time delay ([`DemContacts::with_time_delay`]) the force on a sphere from a
+//! ghost beyond the left boundary of the delay axis is scaled by the left ghost scale, and
+//! from one beyond the right boundary by the right one (paper 003 Eqs. 6–7); the average
+//! magnitude of the contact forces through the boundary, F_Ave_current, is measured at every
+//! evaluation, before the scaling, and drives [`TimeDelayedBoundary`].
 
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
 use crate::error::ContactError;
+use crate::periodic_boundary::PeriodicBox;
+use crate::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
 use crate::wall::Wall;
 use qdem_core::stable_step::critical_step;
-use qdem_core::{Model, State, Vec3};
+use qdem_core::{Dofs, Model, State, Vec3};
 use rayon::prelude::*;
 
 /// Marks a sphere that is no part of a rigid body.
@@ -76,7 +87,8 @@ struct SphereNow {
 }
 
 /// Per-contact buffers of a candidate list: who, spring history, and this step's force on
-/// the first partner and contact point.
+/// the first partner, contact point and image translation of the second partner (zero unless
+/// the pair touches through a periodic boundary).
 #[derive(Default)]
 struct ContactList {
     first: Vec<u32>,
@@ -84,6 +96,7 @@ struct ContactList {
     history: Vec<Vec3>,
     force: Vec<Vec3>,
     point: Vec<Vec3>,
+    shift: Vec<Vec3>,
 }
 
 impl ContactList {
@@ -104,6 +117,7 @@ impl ContactList {
         self.history = history;
         self.force = vec![Vec3::zeros(); keys.len()];
         self.point = vec![Vec3::zeros(); keys.len()];
+        self.shift = vec![Vec3::zeros(); keys.len()];
     }
 
     fn len(&self) -> usize {
@@ -119,6 +133,7 @@ pub struct DemContacts {
     body: Vec<u32>,
     rigid: Vec<u32>,
     lever: Vec<f64>,
+    bound_mass: Vec<f64>,
     body_names: Vec<String>,
     materials: usize,
     elasticity: Vec<PairElasticity>,
@@ -137,6 +152,38 @@ pub struct DemContacts {
     wall_start: Vec<u32>,
     sphere_force: Vec<(Vec3, Vec3)>,
     rebuilds: u64,
+    periodic: Option<PeriodicBox>,
+    time_delay: Option<TimeDelay>,
+}
+
+/// A time-delayed periodic boundary along one periodic axis, and its latest state.
+struct TimeDelay {
+    axis: usize,
+    boundary: TimeDelayedBoundary,
+    scales: GhostScales,
+    boundary_force: f64,
+}
+
+/// Ghost scales of an ordinary periodic boundary.
+const UNSCALED: GhostScales = GhostScales {
+    left: 1.0,
+    right: 1.0,
+};
+
+/// Scales of the forces on the first and second sphere of a pair whose second sphere's image
+/// was translated by `shift` along the delay axis: a negative shift means the second sphere
+/// sits near the right boundary and its image beyond the left one, so the first sphere feels
+/// a left ghost and the second (through the image of the first beyond the right boundary) a
+/// right ghost; a positive shift is the mirror case; zero is an ordinary pair.
+#[inline]
+fn pair_scales(shift: f64, scales: &GhostScales) -> (f64, f64) {
+    if shift < 0.0 {
+        (scales.left, scales.right)
+    } else if shift > 0.0 {
+        (scales.right, scales.left)
+    } else {
+        (1.0, 1.0)
+    }
 }
 
 impl DemContacts {
@@ -178,6 +225,7 @@ impl DemContacts {
             .zip(&rigid)
             .map(|(s, &r)| match r {
                 NOT_RIGID => 0.0,
+                b if state.rigid.spin_fixed[b as usize] => 0.0,
                 b => {
                     let arm = state.position[s.particle] - state.position[carrier(s, r)];
                     (arm.norm() + s.radius).powi(2) / state.rigid.inertia[b as usize].min()
@@ -191,6 +239,18 @@ impl DemContacts {
         let wall_elasticity = materials
             .iter()
             .map(|a| PairElasticity::new(*a, None))
+            .collect();
+        // A carrier held in every direction (and, for a rigid body, in rotation) cannot
+        // oscillate: it does not limit the step (infinite mass in the bound below).
+        let held = |s: &ContactSphere, r: u32| {
+            let c = carrier(s, r);
+            state.fixed[c] == Dofs::ALL && (r == NOT_RIGID || state.rigid.spin_fixed[r as usize])
+        };
+        let bound_mass: Vec<f64> = spheres
+            .iter()
+            .zip(&rigid)
+            .zip(&mass)
+            .map(|((s, &r), &m)| if held(s, r) { f64::INFINITY } else { m })
             .collect();
         let now: Vec<SphereNow> = spheres
             .iter()
@@ -209,6 +269,7 @@ impl DemContacts {
             body: spheres.iter().map(|s| s.body as u32).collect(),
             rigid,
             lever,
+            bound_mass,
             body_names,
             materials: materials.len(),
             elasticity,
@@ -227,6 +288,65 @@ impl DemContacts {
             wall_start: Vec::new(),
             sphere_force: vec![(Vec3::zeros(), Vec3::zeros()); spheres.len()],
             rebuilds: 0,
+            periodic: None,
+            time_delay: None,
+        }
+    }
+
+    /// Makes the contacts periodic along the axes of `periodic`; refused when a period is not
+    /// longer than twice the reach of the largest spheres (two radii plus the skin).
+    pub fn with_periodic(mut self, periodic: PeriodicBox) -> Result<DemContacts, ContactError> {
+        let r_max = self.radius.iter().cloned().fold(0.0, f64::max);
+        periodic.check_reach(2.0 * r_max + self.settings.skin)?;
+        self.periodic = Some(periodic);
+        self.built = false;
+        Ok(self)
+    }
+
+    /// Scales the forces from ghosts beyond the boundaries of periodic `axis` by `boundary`'s
+    /// ghost scales (paper 003 §5). Needs [`DemContacts::with_periodic`] along that axis first.
+    pub fn with_time_delay(
+        mut self,
+        axis: usize,
+        boundary: TimeDelayedBoundary,
+    ) -> Result<DemContacts, ContactError> {
+        if self
+            .periodic
+            .as_ref()
+            .and_then(|p| p.length(axis))
+            .is_none()
+        {
+            return Err(ContactError::TimeDelayNotPeriodic {
+                axis: ['x', 'y', 'z'][axis.min(2)],
+            });
+        }
+        self.time_delay = Some(TimeDelay {
+            axis,
+            boundary,
+            scales: UNSCALED,
+            boundary_force: 0.0,
+        });
+        Ok(self)
+    }
+
+    /// The ghost scales (left, right) of the last evaluation and the average magnitude of the
+    /// contact forces through the delayed boundary it measured; `None` without a time delay.
+    pub fn time_delay_state(&self) -> Option<(GhostScales, f64)> {
+        self.time_delay
+            .as_ref()
+            .map(|t| (t.scales, t.boundary_force))
+    }
+
+    /// x_b − x_a, the minimum image when periodic, and the translation of b's image.
+    #[inline]
+    fn separation(&self, a: usize, b: usize) -> (Vec3, Vec3) {
+        let d = self.now[b].center - self.now[a].center;
+        match &self.periodic {
+            Some(p) => {
+                let shift = p.image_shift(&d);
+                (d + shift, shift)
+            }
+            None => (d, Vec3::zeros()),
         }
     }
 
@@ -272,8 +392,7 @@ impl DemContacts {
         for k in 0..self.pairs.len() {
             let (a, b) = (self.pairs.first[k] as usize, self.pairs.second[k] as usize);
             let radius = reduced(self.radius[a], self.radius[b]);
-            let overlap =
-                self.radius[a] + self.radius[b] - (self.now[b].center - self.now[a].center).norm();
+            let overlap = self.radius[a] + self.radius[b] - self.separation(a, b).0.norm();
             if overlap > tolerance * radius {
                 return Err(ContactError::InitialOverlap {
                     a: self.body_names[self.body[a] as usize].clone(),
@@ -355,6 +474,7 @@ impl DemContacts {
             center: &center,
             radius: &self.radius,
             body: &self.body,
+            periodic: self.periodic.as_ref(),
         };
         self.pairs.rebuild(find_pairs(&set, skin));
         let walls = &self.walls;
@@ -415,12 +535,12 @@ impl DemContacts {
         now.velocity + now.spin.cross(&(x - now.center))
     }
 
-    /// Geometry of the pair of spheres a < b: (geometry, contact point, elasticity); `None`
-    /// when apart.
+    /// Geometry of the pair of spheres a < b: (geometry, contact point, elasticity, image
+    /// translation of b); `None` when apart.
     #[inline]
-    fn pair_geometry(&self, a: usize, b: usize) -> Option<(PairGeometry, Vec3, PairElasticity)> {
+    fn pair_geometry(&self, a: usize, b: usize) -> Option<PairContact> {
         let (sa, sb) = (&self.now[a], &self.now[b]);
-        let d = sb.center - sa.center;
+        let (d, shift) = self.separation(a, b);
         let distance_squared = d.norm_squared();
         let reach = sa.radius + sb.radius;
         if distance_squared >= reach * reach || distance_squared == 0.0 {
@@ -430,7 +550,8 @@ impl DemContacts {
         let overlap = reach - distance;
         let normal = d / distance;
         let point = sa.center + (sa.radius - 0.5 * overlap) * normal;
-        let velocity = Self::point_velocity(sa, &point) - Self::point_velocity(sb, &point);
+        let velocity =
+            Self::point_velocity(sa, &point) - Self::point_velocity(sb, &(point - shift));
         let geometry = PairGeometry {
             overlap,
             normal,
@@ -440,17 +561,12 @@ impl DemContacts {
             friction: self.settings.friction,
         };
         let e = self.elasticity[sa.material as usize * self.materials + sb.material as usize];
-        Some((geometry, point, e))
+        Some((geometry, point, e, shift))
     }
 
     /// Geometry of the contact of sphere s with wall w.
     #[inline]
-    fn wall_geometry(
-        &self,
-        state: &State,
-        s: usize,
-        w: usize,
-    ) -> Option<(PairGeometry, Vec3, PairElasticity)> {
+    fn wall_geometry(&self, state: &State, s: usize, w: usize) -> Option<PairContact> {
         let wall = &self.walls[w];
         let sphere = &self.now[s];
         let (overlap, normal) = wall.overlap(&sphere.center, sphere.radius, state.time);
@@ -470,6 +586,7 @@ impl DemContacts {
             geometry,
             point,
             self.wall_elasticity[sphere.material as usize],
+            Vec3::zeros(),
         ))
     }
 
@@ -487,9 +604,10 @@ impl DemContacts {
             .par_iter_mut()
             .zip(list.force.par_iter_mut())
             .zip(list.point.par_iter_mut())
+            .zip(list.shift.par_iter_mut())
             .with_min_len(CONTACT_CHUNK)
             .enumerate()
-            .for_each(|(k, ((history, force), point))| {
+            .for_each(|(k, (((history, force), point), shift))| {
                 let (i, j) = (first[k] as usize, second[k] as usize);
                 let contact = if walls {
                     this.wall_geometry(state, i, j)
@@ -497,9 +615,10 @@ impl DemContacts {
                     this.pair_geometry(i, j)
                 };
                 match contact {
-                    Some((g, x, e)) => {
+                    Some((g, x, e, t)) => {
                         *force = law.force(&g, &e, history, dt);
                         *point = x;
+                        *shift = t;
                     }
                     None => {
                         *history = Vec3::zeros();
@@ -514,13 +633,42 @@ impl DemContacts {
         }) = list;
     }
 
+    /// The average magnitude of the touching pairs' forces through the boundaries of `axis`
+    /// (serial, in pair order, so it does not depend on the thread count).
+    fn boundary_force(&self, axis: usize) -> f64 {
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (f, t) in self.pairs.force.iter().zip(&self.pairs.shift) {
+            if t[axis] != 0.0 && *f != Vec3::zeros() {
+                sum += f.norm();
+                count += 1;
+            }
+        }
+        if count == 0 {
+            0.0
+        } else {
+            sum / count as f64
+        }
+    }
+
+    /// Measures the boundary force and updates the ghost scales of a time-delayed boundary.
+    fn update_time_delay(&mut self, time: f64) {
+        let Some(axis) = self.time_delay.as_ref().map(|t| t.axis) else {
+            return;
+        };
+        let measured = self.boundary_force(axis);
+        let delay = self.time_delay.as_mut().expect("checked above");
+        delay.boundary_force = measured;
+        delay.scales = delay.boundary.update(time, measured);
+    }
+
     /// Per-sphere sums of contact forces, and their moments about the sphere's centre for
-    /// spheres of rigid bodies, in a fixed order.
+    /// spheres of rigid bodies, in a fixed order; forces from delayed ghosts scaled.
     fn gather(&mut self) {
         let (pairs, walls) = (&self.pairs, &self.wall_contacts);
         let (start, incidence, wall_start) =
             (&self.incidence_start, &self.incidence, &self.wall_start);
         let (now, rigid) = (&self.now, &self.rigid);
+        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
         self.sphere_force
             .par_iter_mut()
             .with_min_len(CONTACT_CHUNK)
@@ -530,14 +678,25 @@ impl DemContacts {
                 let spins = rigid[s] != NOT_RIGID;
                 for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
                     let k = (e / 2) as usize;
-                    let fk = if e % 2 == 0 {
-                        pairs.force[k]
+                    let scale = delay.map(|(axis, scales)| {
+                        let (a, b) = pair_scales(pairs.shift[k][axis], &scales);
+                        if e % 2 == 0 {
+                            a
+                        } else {
+                            b
+                        }
+                    });
+                    let (mut fk, center) = if e % 2 == 0 {
+                        (pairs.force[k], now[s].center)
                     } else {
-                        -pairs.force[k]
+                        (-pairs.force[k], now[s].center + pairs.shift[k])
                     };
+                    if let Some(scale) = scale {
+                        fk *= scale;
+                    }
                     f += fk;
                     if spins {
-                        t += (pairs.point[k] - now[s].center).cross(&fk);
+                        t += (pairs.point[k] - center).cross(&fk);
                     }
                 }
                 for k in wall_start[s] as usize..wall_start[s + 1] as usize {
@@ -550,6 +709,10 @@ impl DemContacts {
             });
     }
 }
+
+/// A touching contact: its geometry, contact point, elasticity and the image translation of
+/// its second sphere.
+type PairContact = (PairGeometry, Vec3, PairElasticity, Vec3);
 
 /// r_a r_b / (r_a + r_b).
 #[inline]
@@ -571,6 +734,7 @@ impl Model for DemContacts {
         }
         self.evaluate_list(state, dt, false);
         self.evaluate_list(state, dt, true);
+        self.update_time_delay(state.time);
         self.gather();
         for (s, (f, t)) in self.sphere_force.iter().enumerate() {
             force[self.particle[s] as usize] += f;
@@ -587,7 +751,8 @@ impl Model for DemContacts {
     /// a rigid single sphere, one per sphere for a rigid body with several (all of them may
     /// rest on one wall). k is the stiffest of the normal and tangential springs (Hertz's at an
     /// overlap of [`REFERENCE_OVERLAP`] of the radius), m the carrier's mass, ℓ the lever arm
-    /// of a contact on a rigid body about its centre and I its smallest principal moment.
+    /// of a contact on a rigid body about its centre and I its smallest principal moment (ℓ = 0
+    /// for a body whose rotation is held). Carriers held in every direction are left out.
     fn stable_dt(&self, _state: &State) -> Option<f64> {
         let law = &self.settings.law;
         let zeta = law.damping_ratio();
@@ -606,11 +771,12 @@ impl Model for DemContacts {
             let e = self.wall_elasticity[sphere.material as usize];
             let (kn, kt) = law.stiffness(REFERENCE_OVERLAP * r, r, &e);
             let k = kn.max(kt);
-            let compliance = 1.0 / sphere.mass + self.lever[s];
-            let (w, g) = (
-                k * compliance,
-                2.0 * zeta * (k * sphere.mass).sqrt() * compliance,
-            );
+            let mass = self.bound_mass[s];
+            if mass.is_infinite() {
+                continue;
+            }
+            let compliance = 1.0 / mass + self.lever[s];
+            let (w, g) = (k * compliance, 2.0 * zeta * (k * mass).sqrt() * compliance);
             match self.rigid[s] {
                 NOT_RIGID => worst = (worst.0.max(COORDINATION * w), worst.1.max(COORDINATION * g)),
                 b => {
@@ -632,11 +798,11 @@ impl Model for DemContacts {
         let (p, w) = (&self.pairs, &self.wall_contacts);
         let pairs = (0..p.len()).filter_map(|k| {
             self.pair_geometry(p.first[k] as usize, p.second[k] as usize)
-                .map(|(g, _, e)| law.energy(&g, &e, &p.history[k]))
+                .map(|(g, _, e, _)| law.energy(&g, &e, &p.history[k]))
         });
         let walls = (0..w.len()).filter_map(|k| {
             self.wall_geometry(state, w.first[k] as usize, w.second[k] as usize)
-                .map(|(g, _, e)| law.energy(&g, &e, &w.history[k]))
+                .map(|(g, _, e, _)| law.energy(&g, &e, &w.history[k]))
         });
         Some(pairs.chain(walls).sum())
     }

@@ -81,4 +81,35 @@ pub enum ContactError {
         /// What parry3d said.
         reason: String,
     },
+    /// A period that is not a positive length.
+    #[error("periodic axis {axis}: the period {length} m is not a positive length; fix: give `length` > 0 for every axis in `axes`")]
+    BadPeriod {
+        /// The axis.
+        axis: char,
+        /// The period given (m).
+        length: f64,
+    },
+    /// A periodic box without a periodic axis, or with a non-finite origin.
+    #[error("a periodic box needs at least one periodic axis and a finite origin; fix: set `axes` (e.g. \"y\") and `origin`")]
+    NoPeriodicAxis,
+    /// A period too short for the spheres that interact across it.
+    #[error(
+        "periodic axis {axis}: the period {length} m is not longer than twice the contact reach \
+         {reach:.4} m (two sphere radii plus the skin), so a sphere could touch another and its \
+         image at once; fix: a longer period, or smaller spheres or skin"
+    )]
+    PeriodTooShort {
+        /// The axis.
+        axis: char,
+        /// The period (m).
+        length: f64,
+        /// Largest interaction distance (m).
+        reach: f64,
+    },
+    /// A time delay along an axis that is not periodic.
+    #[error("a time-delayed boundary along {axis} needs that axis periodic; fix: add it to `axes` in [periodic]")]
+    TimeDelayNotPeriodic {
+        /// The axis.
+        axis: char,
+    },
 }

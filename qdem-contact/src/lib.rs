@@ -14,12 +14,18 @@
 //! beam bonds that break), [`unbonded_contact`] (contacts of discs after breakage) and
 //! [`particle_packing`] (lattices of a rectangle and the bond section λ).
 //!
+//! Box tests (paper 003): [`periodic_boundary`] (periodic cells, minimum-image contacts,
+//! bodies wrapped whole), [`time_delayed_boundary`] (Eqs. 2–7: ghost forces scaled by the
+//! neighbour cells' load phase) and [`clump_sample`] (ballast-like stones as rigid clumps with
+//! a grading).
+//!
 //! Rigid bodies are integrated by qdem-core ([`qdem_core::rigid_body`]); their spheres add the
 //! moment of each contact force about the sphere's centre to the body's torque.
 
 pub mod beam_bond;
 pub mod bonded_particles;
 pub mod broad_phase;
+pub mod clump_sample;
 pub mod contact_law;
 pub mod coulomb;
 pub mod dem_contacts;
@@ -28,7 +34,9 @@ pub mod hertz_mindlin;
 pub mod linear_spring;
 pub mod mesh_wall;
 pub mod particle_packing;
+pub mod periodic_boundary;
 pub mod plane_wall;
+pub mod time_delayed_boundary;
 pub mod unbonded_contact;
 pub mod wall;
 
@@ -41,6 +49,8 @@ pub use hertz_mindlin::HertzMindlin;
 pub use linear_spring::LinearSpring;
 pub use mesh_wall::MeshWall;
 pub use particle_packing::{lattice_section, LatticeSection, Packing, PackingKind};
+pub use periodic_boundary::{PeriodicBox, WrapGroup};
 pub use plane_wall::PlaneWall;
+pub use time_delayed_boundary::{GhostScales, LoadCycle, TimeDelayedBoundary};
 pub use unbonded_contact::{UnbondedLaw, UnbondedPair};
 pub use wall::{Wall, WallShape};

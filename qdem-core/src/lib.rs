@@ -52,5 +52,5 @@ pub use state::{Dofs, ParticleSpin, State};
 pub use static_solve::{StaticSolver, StaticSteps};
 pub use stepper::{choose_step, stable_step, Stepper};
 pub use tet_body::TetBody;
-pub use time_function::TimeFunction;
+pub use time_function::{Cyclic, TimeFunction};
 pub use verlet::Verlet;

@@ -95,6 +95,8 @@ pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, 
         stable_dt,
         dt,
         warnings: Vec::new(),
+        granular: None,
+        periodic: None,
     })
 }
 

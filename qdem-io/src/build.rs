@@ -6,15 +6,17 @@
 //! ([`crate::contact_build`]), [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per
 //! load.
 
+use crate::contact_build::ExtraSpheres;
+use crate::granular_build::GranularInfo;
 use crate::scene::suggest::did_you_mean;
 use crate::scene::{Integrator, Scene, Selection, TimeStep};
 use nalgebra::Rotation3;
 use qdem_contact::BondedParticles;
-use qdem_contact::DemContacts;
+use qdem_contact::{DemContacts, PeriodicBox, WrapGroup};
 use qdem_core::rigid_body::tet_mass_properties;
 use qdem_core::{
     choose_step, stable_step, CoreError, Dofs, Gravity, Material, Model, NodalLoad, State, TetBody,
-    Vec3,
+    TimeFunction, Vec3,
 };
 use qdem_mesh::{read_msh, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
@@ -77,6 +79,26 @@ pub enum BuildError {
         extent: f64,
         /// Half that extent.
         limit: f64,
+    },
+    /// A `[granular]` sample or its generation is refused.
+    #[error("{scene}: [granular]: {source}")]
+    Granular {
+        /// The scene file.
+        scene: PathBuf,
+        /// What is wrong.
+        source: qdem_contact::clump_sample::SampleError,
+    },
+    /// A stones file is malformed.
+    #[error(
+        "{path}:{line}: {message} (a stones file is CSV `stone,x,y,z,radius`, one row per sphere)"
+    )]
+    Sample {
+        /// The file.
+        path: PathBuf,
+        /// Line number (1-based; 0 when the file could not be read).
+        line: usize,
+        /// What is wrong.
+        message: String,
     },
     /// A fix or load selects no particle.
     #[error("{scene}: {what} on body `{body}` selects no particle: {fix}")]
@@ -156,6 +178,10 @@ pub struct Simulation {
     pub dt: f64,
     /// Mesh warnings, one line each, naming the file.
     pub warnings: Vec<String>,
+    /// The stones of `[granular]`.
+    pub granular: Option<GranularInfo>,
+    /// The periodic cell of `[periodic]` and the groups of particles that wrap together.
+    pub periodic: Option<(PeriodicBox, Vec<WrapGroup>)>,
 }
 
 /// A body's mesh as read and placed, with its file and its particles' place in the state.
@@ -184,8 +210,43 @@ impl Simulation {
         let mut models: Vec<Box<dyn Model>> = Vec::new();
         let bodies = build_bodies(&scene, &meshes, &mut state, &mut models).map_err(core)?;
         apply_fixes(&scene, &meshes, &mut state)?;
-        fix_rigid_bodies(&bodies, &mut state);
-        if let Some(contacts) = crate::contact_build::build_contacts(&scene, &meshes, &state)? {
+        fix_rigid_bodies(&scene, &bodies, &mut state);
+        let mut extra = ExtraSpheres::default();
+        let granular = match &scene.granular {
+            Some(g) => {
+                let stones = crate::granular_build::stones(&scene, g)?;
+                let material = scene
+                    .materials
+                    .iter()
+                    .position(|m| m.name == g.material)
+                    .expect("validated scene");
+                let (info, spheres) = crate::granular_build::add_stones(
+                    &scene,
+                    g,
+                    &stones,
+                    &mut state,
+                    scene.bodies.len(),
+                    material,
+                )?;
+                extra.spheres = spheres;
+                extra.names = (1..=info.len())
+                    .map(|k| format!("{} stone {k}", g.name))
+                    .collect();
+                Some(info)
+            }
+            None => None,
+        };
+        let periodic = match &scene.periodic {
+            Some(p) => Some((
+                crate::periodic_build::periodic_box(&scene, p)?,
+                crate::periodic_build::wrap_groups(&state, &bodies, granular.as_ref()),
+            )),
+            None => None,
+        };
+        extra.periodic = periodic.as_ref().map(|p| p.0.clone());
+        if let Some(contacts) =
+            crate::contact_build::build_contacts(&scene, &meshes, &state, extra)?
+        {
             models.push(Box::new(contacts));
         }
         if scene.run.gravity.iter().any(|&g| g != 0.0) {
@@ -216,6 +277,8 @@ impl Simulation {
             stable_dt,
             dt,
             warnings,
+            granular,
+            periodic,
         })
     }
 
@@ -366,8 +429,8 @@ fn build_bodies(
 }
 
 /// A rigid body is fixed in every direction any of its particles is fixed in, and its
-/// rotation too when all three are.
-fn fix_rigid_bodies(bodies: &[BodyInfo], state: &mut State) {
+/// rotation too when all three are or a `[[fix]]` on it says `rotation = true`.
+fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], state: &mut State) {
     for body in bodies {
         let BodyKind::Rigid {
             body: b, center, ..
@@ -380,7 +443,11 @@ fn fix_rigid_bodies(bodies: &[BodyInfo], state: &mut State) {
             .clone()
             .fold(Dofs::NONE, |d, i| d.union(state.fixed[i]));
         state.fix(center, dofs);
-        if dofs == Dofs::ALL {
+        let held = scene
+            .fixes
+            .iter()
+            .any(|f| f.body == body.name && f.rotation);
+        if dofs == Dofs::ALL || held {
             state.rigid.spin_fixed[b] = true;
             state.rigid.set_angular_velocity(b, Vec3::zeros());
         }
@@ -417,13 +484,14 @@ fn build_loads(
             .iter()
             .map(|&n| (start + n as usize) as u32)
             .collect();
-        let ramp = load
-            .ramp
-            .time_function()
-            .map_err(|source| BuildError::Core {
-                scene: scene.path.clone(),
-                source,
-            })?;
+        let ramp = match &load.cyclic {
+            Some(c) => TimeFunction::cyclic(c.cycle()),
+            None => load.ramp.time_function(),
+        }
+        .map_err(|source| BuildError::Core {
+            scene: scene.path.clone(),
+            source,
+        })?;
         let total = Vec3::from(load.total_force);
         models.push(Box::new(NodalLoad::new(&what, particles, total, ramp)));
     }

@@ -9,21 +9,32 @@ use crate::scene::{Contact, ContactLawName, Scene};
 use qdem_contact::broad_phase::bounds;
 use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, LinearSpring, MeshWall,
-    PlaneWall, Wall, WallShape,
+    PeriodicBox, PlaneWall, Wall, WallShape,
 };
 use qdem_core::{State, Vec3};
 use qdem_mesh::read_msh;
+
+/// Spheres that do not come from mesh bodies (the stones of `[granular]`), their bodies'
+/// names, and the periodic cell.
+#[derive(Default)]
+pub(crate) struct ExtraSpheres {
+    pub(crate) spheres: Vec<ContactSphere>,
+    pub(crate) names: Vec<String>,
+    pub(crate) periodic: Option<PeriodicBox>,
+}
 
 /// The contact model, or `None` when no body has contact spheres.
 pub(crate) fn build_contacts(
     scene: &Scene,
     meshes: &[PlacedMesh],
     state: &State,
+    extra: ExtraSpheres,
 ) -> Result<Option<DemContacts>, BuildError> {
     let Some(contact) = &scene.contact else {
         return Ok(None);
     };
-    let spheres = contact_spheres(scene, meshes)?;
+    let mut spheres = contact_spheres(scene, meshes)?;
+    spheres.extend(extra.spheres);
     let single_body = spheres.windows(2).all(|w| w[0].body == w[1].body);
     if spheres.is_empty() || (single_body && scene.walls.is_empty()) {
         return Ok(None);
@@ -43,8 +54,16 @@ pub(crate) fn build_contacts(
         skin: contact.skin.unwrap_or(0.25 * r_min),
     };
     let walls = walls(scene, contact)?;
-    let names = scene.bodies.iter().map(|b| b.name.clone()).collect();
+    let names = scene
+        .bodies
+        .iter()
+        .map(|b| b.name.clone())
+        .chain(extra.names)
+        .collect();
     let mut model = DemContacts::new(state, &spheres, names, &materials, settings, walls);
+    if let (Some(cell), Some(periodic)) = (extra.periodic, &scene.periodic) {
+        model = crate::periodic_build::periodic_contacts(scene, periodic, &cell, model)?;
+    }
     model
         .check_initial_overlaps(state, contact.overlap_tolerance)
         .map_err(|source| BuildError::Contact {

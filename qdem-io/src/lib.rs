@@ -6,7 +6,9 @@
 //!   messages that name the file, line and key.
 //! - [`build`]: turns a scene into a [`build::Simulation`]: one [`qdem_core::State`] for all
 //!   bodies and only the models the scene needs.
-//!   A `[bonded]` scene builds a 2D beam-bonded body instead (paper 001).
+//!   A `[bonded]` scene builds a 2D beam-bonded body instead (paper 001). `[granular]` adds a
+//!   sample of rigid stones ([`granular_build`]), `[periodic]` a periodic cell and a
+//!   time-delayed boundary (paper 003).
 //! - [`runner`]: the run loop, sampling probes and writing snapshots.
 //! - [`output`]: atomic writers for VTU/PVD, probe CSV and summary JSON.
 //! - [`spectrum`]: dominant frequency of a probe record by FFT.
@@ -16,7 +18,9 @@ mod bonded_build;
 pub mod build;
 mod contact_build;
 pub mod crack_svg;
+pub mod granular_build;
 pub mod output;
+mod periodic_build;
 pub mod plot;
 pub mod runner;
 pub mod scene;

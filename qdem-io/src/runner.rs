@@ -3,11 +3,18 @@
 //! (`probes.svg`, beside `probes.csv`) at the end. Every output file is written
 //! atomically; a run stopped by an instability still commits the probe rows up to the failure.
 //!
-//! The loop is an explicit pipeline: step → probes → snapshot → progress.
+//! The loop is an explicit pipeline: step → wrap (periodic cells) → probes → snapshot →
+//! progress. A scene with `[granular]` also gets `stones.csv` (the stones' spheres at the end,
+//! the sample format `[granular] sample` reads); one with a time-delayed boundary gets
+//! `boundary.csv` (time, the measured average boundary force, the left and right ghost
+//! scales) at the probe interval.
 
 use crate::build::{BodyKind, Simulation};
 use crate::crack_svg::write_crack_svg;
-use crate::output::{write_summary, write_vtu, OutputError, ProbeCsv, PvdIndex, VtuGrid};
+use crate::granular_build::write_stones_csv;
+use crate::output::{
+    write_atomic, write_summary, write_vtu, OutputError, ProbeCsv, PvdIndex, VtuGrid,
+};
 use crate::plot::{line_plot_svg, Labels, Series};
 use crate::scene::Integrator;
 use qdem_contact::BondedParticles;
@@ -172,6 +179,7 @@ pub fn run(
     let start = Instant::now();
     let mut last_report = start;
     let mut timing = CrackTiming::default();
+    let mut boundary_rows: Vec<[f64; 4]> = Vec::new();
     let outcome = (|| -> Result<(), RunError> {
         stepper
             .initialize(&mut sim.state, &mut sim.models)
@@ -184,6 +192,9 @@ pub fn run(
                     .step(&mut sim.state, &mut sim.models)
                     .map_err(|source| core_error(sim, source))?;
                 timing.add(cracked, begin.elapsed().as_secs_f64());
+                if let Some((cell, groups)) = &sim.periodic {
+                    cell.wrap_bodies(&mut sim.state, groups);
+                }
                 if let Some((p, u)) = sim.bonded().and_then(|b| {
                     b.beyond_small_displacement(&sim.state, COLLAPSE_SPACINGS * 2.0 * b.radii()[0])
                 }) {
@@ -199,6 +210,9 @@ pub fn run(
                     }
                 }
                 csv.row(time, &samples)?;
+                if let Some((scales, force)) = sim.contacts().and_then(|c| c.time_delay_state()) {
+                    boundary_rows.push([time, force, scales.left, scales.right]);
+                }
             }
             if vtu_schedule.due(time, dt) {
                 let file = format!("vtu/state_{:05}.vtu", pvd.len());
@@ -226,6 +240,12 @@ pub fn run(
         timing.first_break = model.broken_log().first().map(|b| b.0);
         write_crack_svg(&out_dir.join("crack.svg"), model, &sim.state)?;
     }
+    if let Some(info) = &sim.granular {
+        write_stones_csv(&out_dir.join("stones.csv"), info, &sim.state)?;
+    }
+    if !boundary_rows.is_empty() {
+        write_boundary_csv(&out_dir.join("boundary.csv"), &boundary_rows)?;
+    }
     outcome?;
     let steps = match timing.collapse {
         Some(_) => timing.before_steps + timing.after_steps,
@@ -248,8 +268,48 @@ pub fn run(
     if let Some(model) = sim.bonded() {
         summary["bonded"] = bonded_summary(model, &report, stepper.as_ref());
     }
+    if let Some(info) = &sim.granular {
+        let spheres = info.radii.len() as f64;
+        summary["granular"] = json!({
+            "name": info.name,
+            "stones": info.len(),
+            "spheres": info.radii.len(),
+            "sphere_steps_per_second": spheres * report.steps as f64 / wall_seconds.max(1e-9),
+        });
+    }
+    if let Some(contacts) = sim.contacts() {
+        summary["contact"] = json!({
+            "spheres": contacts.spheres(),
+            "contacts": contacts.contacts(),
+            "rebuilds": contacts.rebuilds(),
+            "sphere_steps_per_second":
+                contacts.spheres() as f64 * report.steps as f64 / wall_seconds.max(1e-9),
+        });
+    }
+    if let Some((cell, _)) = &sim.periodic {
+        summary["periodic"] = json!({
+            "length": [cell.length(0), cell.length(1), cell.length(2)],
+            "origin": [cell.origin().x, cell.origin().y, cell.origin().z],
+            "time_delay": sim.contacts().and_then(|c| c.time_delay_state()).map(|(s, f)| json!({
+                "last_left_scale": s.left,
+                "last_right_scale": s.right,
+                "last_boundary_force": f,
+            })),
+        });
+    }
     write_summary(&out_dir.join("summary.json"), &summary)?;
     Ok(report)
+}
+
+/// The time-delayed boundary's record: time, F_Ave_current, left and right ghost scales.
+fn write_boundary_csv(path: &Path, rows: &[[f64; 4]]) -> Result<(), OutputError> {
+    write_atomic(path, |w| {
+        writeln!(w, "time,boundary_force,left_scale,right_scale")?;
+        for r in rows {
+            writeln!(w, "{:.9e},{:.9e},{:.9e},{:.9e}", r[0], r[1], r[2], r[3])?;
+        }
+        Ok(())
+    })
 }
 
 /// Displacement of every probe against time, one curve per component.

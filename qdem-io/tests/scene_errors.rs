@@ -854,3 +854,44 @@ point = [1.5, 0.25, 0.0]
         assert!(error.contains("beam.toml"), "no file in: {error}");
     }
 }
+
+#[test]
+fn periodic_and_time_delay_mistakes_are_named() {
+    let periodic = format!("{BASE}\n[periodic]\naxes = \"yy\"\nlength = [0.7]\n");
+    let (_, msg) = error(&periodic);
+    assert_has(&msg, &[PATH, "[periodic]", "axes = \"yy\"", "at most once"]);
+    let periodic = format!("{BASE}\n[periodic]\naxes = \"xy\"\nlength = [0.7]\n");
+    let (_, msg) = error(&periodic);
+    assert_has(&msg, &["[periodic]", "length has 1 entries", "one period per axis"]);
+    let delayed = format!(
+        "{BASE}\n[periodic]\naxes = \"y\"\nlength = [0.7]\n\n[periodic.time_delay]\nbody = \"beam\"\n"
+    );
+    let (_, msg) = error(&delayed);
+    assert_has(&msg, &["[periodic.time_delay]", "carries no [[load]] with `cyclic`"]);
+    let both = with(
+        "ramp = [[0.0, 0.0], [1.0, 1.0]]",
+        "ramp = [[0.0, 0.0], [1.0, 1.0]]\ncyclic = { min = 0.1, max = 1.0, frequency = 0.0 }",
+    );
+    let (_, msg) = error(&both);
+    assert_has(&msg, &["[[load]] #1", "frequency", "either `ramp` or `cyclic`"]);
+}
+
+#[test]
+fn granular_mistakes_are_named() {
+    let granular = format!(
+        "{BASE}\n[granular]\nname = \"ballast\"\nmaterial = \"granit\"\nregion = [[0, 0, 0], [0.3, 0.7, 1.0]]\n"
+    );
+    let (_, msg) = error(&granular);
+    assert_has(
+        &msg,
+        &[
+            "[granular] \"ballast\"",
+            "material \"granit\" is not defined",
+            "add a [contact] table",
+            "needs all of `region`, `count` and `grading`",
+        ],
+    );
+    let rotation = with("dofs = \"xyz\"", "dofs = \"xyz\"\nrotation = true");
+    let (_, msg) = error(&rotation);
+    assert_has(&msg, &["[[fix]] #1", "rotation = true", "is not rigid"]);
+}

@@ -42,8 +42,9 @@ mod validate;
 
 pub use error::{Diagnostic, SceneError};
 pub use schema::{
-    Body, Bonded, Contact, ContactLawName, Fix, Integrator, Load, Material, Output, PackingName,
-    Probe, Ramp, Run, Selection, Supports, TimeStep, Wall,
+    Body, Bonded, Contact, ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load, Material,
+    Output, PackingName, Periodic, Probe, Ramp, Run, Selection, Supports, TimeDelay, TimeStep,
+    Wall,
 };
 
 use schema::RawScene;
@@ -83,12 +84,14 @@ use spans::SpanIndex;
 /// body = "beam"
 /// group = "clamp"             # or box = [[xmin, ymin, zmin], [xmax, ymax, zmax]]
 /// dofs = "xyz"
+/// rotation = false            # optional: also hold a rigid body's rotation
 ///
 /// [[load]]
 /// body = "beam"
 /// group = "tip"
 /// total_force = [0.0, 0.0, -200.0]
-/// ramp = [[0.0, 0.0], [1.0, 1.0]]
+/// ramp = [[0.0, 0.0], [1.0, 1.0]]  # or cyclic = { min = 0.075, max = 1.0, frequency = 3.0,
+///                                  #                phase_deg = 0.0, start = 0.0 }
 ///
 /// [[probe]]
 /// name = "tip"
@@ -108,6 +111,15 @@ use spans::SpanIndex;
 /// normal = [0.0, 0.0, 1.0]    # or mesh = "obstacle.msh" (its boundary surface)
 /// friction = 0.5              # optional, default [contact] friction
 /// velocity = [0.0, 0.0, 0.0]  # m/s, optional
+///
+/// [periodic]                  # optional: see [`Periodic`] (and its time_delay)
+/// axes = "y"
+/// length = [0.7]
+///
+/// [granular]                  # optional: rigid clumps of spheres, see [`Granular`]
+/// name = "ballast"
+/// material = "granite"
+/// sample = "stones.csv"
 ///
 /// [output]
 /// dir = "out"
@@ -138,6 +150,10 @@ pub struct Scene {
     pub probes: Vec<Probe>,
     /// `[bonded]`: a 2D beam-bonded particle body instead of `[[body]]`s.
     pub bonded: Option<Bonded>,
+    /// `[periodic]`: periodic axes and an optional time delay.
+    pub periodic: Option<Periodic>,
+    /// `[granular]`: a sample of rigid stones.
+    pub granular: Option<Granular>,
     /// `[output]` (defaults when absent).
     pub output: Output,
     /// The scene file; relative paths inside the scene are resolved against its directory.
@@ -196,6 +212,12 @@ impl Scene {
     /// `mesh` is kept as is).
     pub fn mesh_path(&self, body: &Body) -> PathBuf {
         self.base_dir().join(&body.mesh)
+    }
+
+    /// The stones file of `[granular] sample`, resolved like [`Scene::mesh_path`].
+    pub fn sample_path(&self) -> Option<PathBuf> {
+        let sample = self.granular.as_ref()?.sample.as_ref()?;
+        Some(self.base_dir().join(sample))
     }
 
     /// The mesh file of a mesh wall, resolved like [`Scene::mesh_path`].

@@ -309,6 +309,9 @@ pub struct Fix {
     pub selection: Selection,
     /// Fixed directions as an `[x, y, z]` mask, from `dofs = "xyz"` (default all three).
     pub dofs: [bool; 3],
+    /// Also hold the rotation of the (rigid) body: `rotation = true`, e.g. a sleeper guided
+    /// vertically by `dofs = "xy"`. Default false.
+    pub rotation: bool,
 }
 
 /// `[[load]]`: a total force shared equally by the selected particles, scaled by a ramp.
@@ -322,6 +325,42 @@ pub struct Load {
     pub total_force: [f64; 3],
     /// Time factor applied to `total_force`.
     pub ramp: Ramp,
+    /// A sinusoidal time factor instead of `ramp`.
+    pub cyclic: Option<CyclicLoad>,
+}
+
+/// `cyclic = { min, max, frequency, phase_deg, start }` of a `[[load]]`: the factor on
+/// `total_force` runs between `min` and `max` at `frequency`, each cycle beginning at the
+/// minimum; `phase_deg` puts the load ahead (positive) of a zero-phase load that begins its
+/// first cycle at `start`. Before its first cycle the factor is `min`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CyclicLoad {
+    /// Factor at the minimum.
+    pub min: f64,
+    /// Factor at the maximum.
+    pub max: f64,
+    /// Hz.
+    pub frequency: f64,
+    /// Phase lead in degrees; default 0.
+    #[serde(default)]
+    pub phase_deg: f64,
+    /// s; default 0.
+    #[serde(default)]
+    pub start: f64,
+}
+
+impl CyclicLoad {
+    /// The core's cycle.
+    pub fn cycle(&self) -> qdem_core::Cyclic {
+        qdem_core::Cyclic {
+            min: self.min,
+            max: self.max,
+            frequency: self.frequency,
+            phase: self.phase_deg.to_radians(),
+            start: self.start,
+        }
+    }
 }
 
 /// A piecewise-linear time factor given by `(t, factor)` points.
@@ -418,6 +457,8 @@ pub(crate) struct RawFix {
     pub bbox: Option<[[f64; 3]; 2]>,
     #[serde(default = "default_dofs")]
     pub dofs: String,
+    #[serde(default)]
+    pub rotation: bool,
 }
 
 fn default_dofs() -> String {
@@ -436,6 +477,8 @@ pub(crate) struct RawLoad {
     pub total_force: [f64; 3],
     #[serde(default)]
     pub ramp: Option<Vec<[f64; 2]>>,
+    #[serde(default)]
+    pub cyclic: Option<CyclicLoad>,
 }
 
 /// The whole file as written.
@@ -460,7 +503,117 @@ pub(crate) struct RawScene {
     #[serde(default)]
     pub bonded: Option<Bonded>,
     #[serde(default)]
+    pub periodic: Option<Periodic>,
+    #[serde(default)]
+    pub granular: Option<Granular>,
+    #[serde(default)]
     pub output: Output,
+}
+
+/// `[periodic]`: periodic boundaries (paper 003 §4) along `axes`, over `length` (one period
+/// per listed axis, from `origin`) or over the `box`.
+///
+/// ```toml
+/// [periodic]
+/// axes = "y"
+/// length = [0.7]            # or box = [[0, 0, 0], [0.3, 0.7, 0.45]]
+/// origin = [0.0, 0.0, 0.0]  # optional
+///
+/// [periodic.time_delay]     # optional: paper 003 §5
+/// body = "sleeper"          # the body whose cyclic [[load]] gives the phase
+/// lag_deg = 90.0            # or sleeper_spacing and speed (m, m/s)
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Periodic {
+    /// The periodic axes, e.g. `"y"` or `"xy"`.
+    pub axes: String,
+    /// One period per listed axis (m), in the order of `axes`.
+    #[serde(default)]
+    pub length: Option<Vec<f64>>,
+    /// The lower corner of the cell (m); default the origin.
+    #[serde(default)]
+    pub origin: Option<[f64; 3]>,
+    /// The cell as a box (lower and upper corner, m): origin and periods at once.
+    #[serde(default, rename = "box")]
+    pub bbox: Option<[[f64; 3]; 2]>,
+    /// A time-delayed boundary.
+    #[serde(default)]
+    pub time_delay: Option<TimeDelay>,
+}
+
+/// `[periodic.time_delay]`: ghost forces scaled by the load phase of the neighbour cells
+/// (paper 003 Eqs. 2–7).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeDelay {
+    /// The body (a sleeper) whose `cyclic` [[load]] sets the phase Φ.
+    pub body: String,
+    /// The delayed axis; default the only periodic axis.
+    #[serde(default)]
+    pub axis: Option<String>,
+    /// Phase lag δ of the neighbour cells (degrees); default 90 (paper 003 Eqs. 4–5).
+    #[serde(default)]
+    pub lag_deg: Option<f64>,
+    /// With `speed`: the lag δ = 360° f s / v of sleepers `sleeper_spacing` apart (m).
+    #[serde(default)]
+    pub sleeper_spacing: Option<f64>,
+    /// With `sleeper_spacing`: the speed of the travelling load (m/s).
+    #[serde(default)]
+    pub speed: Option<f64>,
+}
+
+/// `[granular]`: a sample of rigid stones, each a clump of spheres (paper 003 §3), read from a
+/// `sample` file (the `stones.csv` a run writes; `crop` keeps its stones lying wholly inside a
+/// box) and/or generated loosely in `region` to be deposited under gravity.
+///
+/// ```toml
+/// [granular]
+/// name = "ballast"
+/// material = "granite"
+/// region = [[0, 0, 0.05], [0.3, 0.7, 1.2]]
+/// count = 400
+/// grading = [[0.0224, 0.0], [0.04, 0.5], [0.0625, 1.0]]  # (size m, fraction passing)
+/// spheres_per_stone = [3, 5]
+/// seed = 1
+/// # or: sample = "stones.csv", crop = [[0, 0.7, 0], [0.3, 1.4, 0.45]]
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Granular {
+    /// Name (stones are called `NAME stone K` in messages).
+    pub name: String,
+    /// A `[[material]]` (density and contact elasticity).
+    pub material: String,
+    /// A stones file (CSV `stone,x,y,z,radius`), relative to the scene file.
+    #[serde(default)]
+    pub sample: Option<PathBuf>,
+    /// Keep only the sample's stones whose spheres all lie inside this box (m).
+    #[serde(default)]
+    pub crop: Option<[[f64; 3]; 2]>,
+    /// Generation: the box filled with stones on a loose lattice (m).
+    #[serde(default)]
+    pub region: Option<[[f64; 3]; 2]>,
+    /// Generation: number of stones.
+    #[serde(default)]
+    pub count: Option<usize>,
+    /// Generation: the grading curve, (sieve size m, fraction passing) points.
+    #[serde(default)]
+    pub grading: Option<Vec<[f64; 2]>>,
+    /// Generation: smallest and largest number of spheres per stone; default [3, 5].
+    #[serde(default = "default_spheres_per_stone")]
+    pub spheres_per_stone: [usize; 2],
+    /// Generation: seed; default 1.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+}
+
+fn default_spheres_per_stone() -> [usize; 2] {
+    [3, 5]
+}
+
+fn default_seed() -> u64 {
+    1
 }
 
 /// `[bonded] packing`: how the rectangle is filled.

@@ -6,7 +6,8 @@ use std::path::Path;
 
 use super::error::{Diagnostic, SceneError};
 use super::schema::{
-    ContactLawName, Fix, Integrator, Load, Ramp, RawFix, RawLoad, RawScene, Selection, TimeStep,
+    ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load, Periodic, Ramp, RawFix, RawLoad,
+    RawScene, Selection, TimeStep,
 };
 use super::spans::SpanIndex;
 use super::suggest::did_you_mean;
@@ -448,7 +449,7 @@ pub(crate) fn validate(
     let material_names: Vec<&str> = raw.materials.iter().map(|m| m.name.as_str()).collect();
 
     // [[body]]
-    if raw.bodies.is_empty() && raw.bonded.is_none() {
+    if raw.bodies.is_empty() && raw.bonded.is_none() && raw.granular.is_none() {
         c.error(
             &[],
             "no [[body]] is defined; a scene needs at least one body".to_owned(),
@@ -502,11 +503,23 @@ pub(crate) fn validate(
         );
         let sel = selection(&mut c, "fix", &idx, &l, &f.group, &f.bbox);
         let mask = dofs(&mut c, &["fix", &idx, "dofs"], &l, &f.dofs);
+        let rigid = raw.bodies.iter().any(|b| b.name == f.body && b.rigid);
+        if f.rotation && !rigid {
+            c.error(
+                &["fix", &idx, "rotation"],
+                format!(
+                    "{l}: rotation = true holds a rigid body's rotation, but body {:?} is not \
+                     rigid; fix: set `rigid = true` on the body or drop `rotation`",
+                    f.body
+                ),
+            );
+        }
         if let (Some(selection), Some(dofs)) = (sel, mask) {
             fixes.push(Fix {
                 body: f.body.clone(),
                 selection,
                 dofs,
+                rotation: f.rotation,
             });
         }
     }
@@ -532,12 +545,16 @@ pub(crate) fn validate(
             &ld.total_force,
         );
         let ramp = ramp(&mut c, &idx, &l, &ld.ramp);
+        if let Some(cyclic) = &ld.cyclic {
+            cyclic_load(&mut c, &idx, &l, cyclic, ld.ramp.is_some());
+        }
         if let Some(selection) = sel {
             loads.push(Load {
                 body: ld.body.clone(),
                 selection,
                 total_force: ld.total_force,
                 ramp,
+                cyclic: ld.cyclic,
             });
         }
     }
@@ -559,6 +576,12 @@ pub(crate) fn validate(
     }
 
     contact_tables(&mut c, &raw);
+    if let Some(g) = &raw.granular {
+        granular_table(&mut c, &raw, g, &material_names);
+    }
+    if let Some(p) = &raw.periodic {
+        periodic_table(&mut c, &raw, p);
+    }
 
     // [output]
     c.non_negative(
@@ -586,9 +609,223 @@ pub(crate) fn validate(
         contact: raw.contact,
         walls: raw.walls,
         bonded: raw.bonded,
+        periodic: raw.periodic,
+        granular: raw.granular,
         output: raw.output,
         path: path.to_path_buf(),
     })
+}
+
+/// `cyclic` of a `[[load]]`: finite factors, a positive frequency, not with `ramp`.
+fn cyclic_load(c: &mut Checker<'_>, idx: &str, l: &str, cyclic: &CyclicLoad, has_ramp: bool) {
+    let at = ["load", idx, "cyclic"];
+    let CyclicLoad {
+        min,
+        max,
+        frequency,
+        phase_deg,
+        start,
+    } = *cyclic;
+    c.finite(&at, l, "cyclic", &[min, max, phase_deg, start]);
+    c.positive(&at, l, "cyclic.frequency", frequency, "Hz");
+    if has_ramp {
+        c.error(
+            &at,
+            format!("{l}: give either `ramp` or `cyclic`, not both; drop one"),
+        );
+    }
+}
+
+/// The axes named by `text` ("x", "y", "z" once each), or an error naming the table.
+fn axes_of(c: &mut Checker<'_>, at: &[&str], label: &str, text: &str) -> Option<Vec<usize>> {
+    let mut axes = Vec::new();
+    for ch in text.chars() {
+        match "xyz".find(ch) {
+            Some(k) if !axes.contains(&k) => axes.push(k),
+            _ => {
+                c.error(
+                    at,
+                    format!(
+                        "{label}: axes = {text:?}: give each of x, y, z at most once, e.g. \"y\" \
+                         or \"xy\""
+                    ),
+                );
+                return None;
+            }
+        }
+    }
+    if axes.is_empty() {
+        c.error(
+            at,
+            format!("{label}: axes is empty; name the periodic axes, e.g. \"y\""),
+        );
+        return None;
+    }
+    Some(axes)
+}
+
+/// `[periodic]`: axes, one period each (from `length` or `box`), the time delay's body,
+/// axis and lag.
+fn periodic_table(c: &mut Checker<'_>, raw: &RawScene, p: &Periodic) {
+    let l = "[periodic]";
+    let axes = axes_of(c, &["periodic", "axes"], l, &p.axes);
+    match (&p.length, &p.bbox) {
+        (Some(_), Some(_)) | (None, None) => c.error(
+            &["periodic"],
+            format!("{l}: give the periods as `length` (one per axis) or the cell as `box`, one of the two"),
+        ),
+        (Some(length), None) => {
+            if axes.as_ref().is_some_and(|a| a.len() != length.len()) {
+                c.error(
+                    &["periodic", "length"],
+                    format!(
+                        "{l}: length has {} entries for axes = {:?}; give one period per axis",
+                        length.len(),
+                        p.axes
+                    ),
+                );
+            }
+            for v in length {
+                c.positive(&["periodic", "length"], l, "length", *v, "m");
+            }
+        }
+        (None, Some(b)) => {
+            if let Some(axes) = &axes {
+                for &k in axes {
+                    c.positive(&["periodic", "box"], l, "box extent", b[1][k] - b[0][k], "m");
+                }
+            }
+        }
+    }
+    if p.bbox.is_some() && p.origin.is_some() {
+        c.error(
+            &["periodic", "origin"],
+            format!("{l}: `box` already sets the origin; drop `origin`"),
+        );
+    }
+    let Some(d) = &p.time_delay else { return };
+    let l = "[periodic.time_delay]";
+    let cyclic = raw
+        .loads
+        .iter()
+        .any(|ld| ld.body == d.body && ld.cyclic.is_some());
+    if !cyclic {
+        c.error(
+            &["periodic", "time_delay", "body"],
+            format!(
+                "{l}: body {:?} carries no [[load]] with `cyclic`; the delay follows the phase of \
+                 that load: give the sleeper's [[load]] a `cyclic` factor",
+                d.body
+            ),
+        );
+    }
+    match (&d.axis, &axes) {
+        (Some(a), Some(axes))
+            if a.len() != 1 || !axes.contains(&"xyz".find(a.as_str()).unwrap_or(3)) =>
+        {
+            c.error(
+                &["periodic", "time_delay", "axis"],
+                format!(
+                    "{l}: axis = {a:?} is not one of the periodic axes {:?}",
+                    p.axes
+                ),
+            );
+        }
+        (None, Some(axes)) if axes.len() > 1 => c.error(
+            &["periodic", "time_delay"],
+            format!(
+                "{l}: the cell is periodic along {:?}; say which axis the load travels along \
+                 with `axis`",
+                p.axes
+            ),
+        ),
+        _ => {}
+    }
+    match (d.lag_deg, d.sleeper_spacing, d.speed) {
+        (Some(lag), None, None) => {
+            c.finite(&["periodic", "time_delay", "lag_deg"], l, "lag_deg", &[lag]);
+        }
+        (None, Some(s), Some(v)) => {
+            c.positive(
+                &["periodic", "time_delay", "sleeper_spacing"],
+                l,
+                "sleeper_spacing",
+                s,
+                "m",
+            );
+            c.positive(&["periodic", "time_delay", "speed"], l, "speed", v, "m/s");
+        }
+        (None, None, None) => {}
+        _ => c.error(
+            &["periodic", "time_delay"],
+            format!(
+                "{l}: give the lag as `lag_deg`, or as `sleeper_spacing` with `speed`, not a mix"
+            ),
+        ),
+    }
+}
+
+/// `[granular]`: its material, a sample file or a generation (region, count, grading), a crop.
+fn granular_table(c: &mut Checker<'_>, raw: &RawScene, g: &Granular, materials: &[&str]) {
+    let l = format!("[granular] {:?}", g.name);
+    if !materials.contains(&g.material.as_str()) {
+        c.error(
+            &["granular", "material"],
+            format!(
+                "{l}: material {:?} is not defined (defined materials: {})",
+                g.material,
+                quoted_names(materials.iter().copied())
+            ),
+        );
+    }
+    if raw.contact.is_none() {
+        c.error(
+            &["granular"],
+            format!("{l}: stones touch through contacts: add a [contact] table"),
+        );
+    }
+    if raw.bonded.is_some() {
+        c.error(
+            &["granular"],
+            format!("{l}: a [bonded] scene cannot hold a [granular] sample; drop one"),
+        );
+    }
+    let generates = g.region.is_some() || g.count.is_some() || g.grading.is_some();
+    if !generates && g.sample.is_none() {
+        c.error(
+            &["granular"],
+            format!("{l}: give a `sample` file, or `region`, `count` and `grading` to generate stones (or both: the generated stones go above the sample's)"),
+        );
+    }
+    if generates {
+        if g.region.is_none() || g.count.is_none() || g.grading.is_none() {
+            c.error(
+                &["granular"],
+                format!("{l}: generating stones needs all of `region`, `count` and `grading`"),
+            );
+        }
+        let [lo, hi] = g.spheres_per_stone;
+        if lo == 0 || lo > hi {
+            c.error(
+                &["granular", "spheres_per_stone"],
+                format!(
+                    "{l}: spheres_per_stone = [{lo}, {hi}]: give [min, max] with 1 <= min <= max"
+                ),
+            );
+        }
+    }
+    for (key, b) in [("region", &g.region), ("crop", &g.crop)] {
+        if let Some(b) = b {
+            if c.finite(&["granular", key], &l, key, &b.concat())
+                && (0..3).any(|k| b[1][k] <= b[0][k])
+            {
+                c.error(
+                    &["granular", key],
+                    format!("{l}: {key} = {b:?}: the upper corner must lie above the lower one on every axis"),
+                );
+            }
+        }
+    }
 }
 
 /// `[bonded]`: ranges, its material, and what a bonded scene cannot have.
@@ -766,7 +1003,7 @@ fn contact_tables(c: &mut Checker<'_>, raw: &RawScene) {
         return;
     };
     let l = "[contact]";
-    if radii.is_empty() {
+    if radii.is_empty() && raw.granular.is_none() {
         c.error(
             &["contact"],
             "[contact]: no [[body]] has contact_radius, so nothing can touch: give the bodies \
@@ -918,6 +1155,7 @@ pub(crate) fn to_raw(scene: &Scene) -> RawScene {
                     group,
                     bbox,
                     dofs,
+                    rotation: f.rotation,
                 }
             })
             .collect(),
@@ -932,6 +1170,7 @@ pub(crate) fn to_raw(scene: &Scene) -> RawScene {
                     bbox,
                     total_force: l.total_force,
                     ramp: (!l.ramp.points.is_empty()).then(|| l.ramp.points.clone()),
+                    cyclic: l.cyclic,
                 }
             })
             .collect(),
@@ -939,6 +1178,8 @@ pub(crate) fn to_raw(scene: &Scene) -> RawScene {
         contact: scene.contact.clone(),
         walls: scene.walls.clone(),
         bonded: scene.bonded.clone(),
+        periodic: scene.periodic.clone(),
+        granular: scene.granular.clone(),
         output: scene.output.clone(),
     }
 }
@@ -972,6 +1213,19 @@ pub(crate) fn missing_files(
                 label("body", i, Some(&b.name)),
                 resolved.display(),
                 b.mesh.display().to_string()
+            ),
+        ));
+    }
+    if let Some(sample) = scene.sample_path().filter(|p| !p.is_file()) {
+        let offset = spans.and_then(|s| s.offset(&["granular", "sample"]));
+        out.push(Diagnostic::at(
+            &scene.path,
+            text,
+            offset,
+            format!(
+                "[granular]: sample file {} does not exist (resolved relative to the scene \
+                 file's directory; a run with [granular] writes its stones to stones.csv)",
+                sample.display()
             ),
         ));
     }

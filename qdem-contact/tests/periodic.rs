@@ -1,0 +1,194 @@
+//! Periodic boundaries (paper 003 Eq. 1) and the time-delayed boundary (Eqs. 2–7) on a
+//! compressed, spinning, frictional packing of rigid spheres periodic along x:
+//! - shifting the packing by a fraction of the period gives the same trajectories and contact
+//!   forces (translation invariance);
+//! - a pair touching through the boundary feels the force of the same pair side by side;
+//! - a zero-lag time-delayed boundary is the ordinary periodic boundary bit for bit, and a
+//!   quarter-cycle lag is not.
+
+mod common;
+
+use common::{contacts, rigid_spheres, stepper};
+use qdem_contact::{
+    ContactLaw, ContactSettings, DemContacts, HertzMindlin, LoadCycle, PeriodicBox,
+    TimeDelayedBoundary,
+};
+use qdem_core::{Model, State, Stepper, Vec3};
+
+const R: f64 = 0.005;
+/// Spheres along the periodic axis, and their spacing (below 2R: every neighbour pair
+/// overlaps, the last and the first through the boundary).
+const ROW: usize = 10;
+const SPACING: f64 = 1.96 * R;
+const PERIOD: f64 = ROW as f64 * SPACING;
+
+/// 10 × 3 × 3 spheres, rows along x compressed across the boundary, with deterministic
+/// velocities; every coordinate x shifted by `shift`.
+fn packing(shift: f64) -> (State, Vec<qdem_contact::ContactSphere>) {
+    let mut centers = Vec::new();
+    for k in 0..3 {
+        for j in 0..3 {
+            for i in 0..ROW {
+                let jitter = ((i * 7 + j * 13 + k * 29) % 17) as f64 / 17.0 - 0.5;
+                centers.push(Vec3::new(
+                    (i as f64 + 0.5) * SPACING + 0.02 * R * jitter + shift,
+                    2.2 * R * j as f64 + 0.05 * R * jitter,
+                    2.2 * R * k as f64,
+                ));
+            }
+        }
+    }
+    let (mut state, spheres) = rigid_spheres(&centers, R, 2700.0);
+    for (i, v) in state.velocity.iter_mut().enumerate() {
+        let f = |m: usize| ((i * m) % 101) as f64 / 101.0 - 0.5;
+        *v = 0.02 * Vec3::new(f(37), f(53), f(71));
+    }
+    (state, spheres)
+}
+
+fn model(state: &State, spheres: &[qdem_contact::ContactSphere]) -> DemContacts {
+    let settings = ContactSettings {
+        law: ContactLaw::HertzMindlin(HertzMindlin { damping_ratio: 0.1 }),
+        friction: 0.5,
+        skin: 0.2 * R,
+    };
+    let periodic = PeriodicBox::new(Vec3::zeros(), [Some(PERIOD), None, None]).unwrap();
+    contacts(state, spheres, (5e7, 0.25), settings, Vec::new())
+        .with_periodic(periodic)
+        .unwrap()
+}
+
+/// Steps `model` on `state` `steps` times at a fixed step; returns the state.
+fn run(mut state: State, model: DemContacts, steps: usize) -> (State, Vec<Box<dyn Model>>) {
+    let dt = 0.5 * model.stable_dt(&state).unwrap();
+    let mut models: Vec<Box<dyn Model>> = vec![Box::new(model)];
+    let mut s = stepper(dt, &mut state, &mut models);
+    for _ in 0..steps {
+        s.step(&mut state, &mut models).unwrap();
+    }
+    (state, models)
+}
+
+#[test]
+fn shifting_a_periodic_packing_changes_nothing_but_the_shift() {
+    let steps = 600;
+    let (a, sa) = packing(0.0);
+    let reference = run(a.clone(), model(&a, &sa), steps).0;
+    for fraction in [0.37, -1.61] {
+        let shift = fraction * PERIOD;
+        let (b, sb) = packing(shift);
+        let shifted = run(b.clone(), model(&b, &sb), steps).0;
+        let scale_x = PERIOD;
+        let scale_v = reference
+            .velocity
+            .iter()
+            .map(|v| v.norm())
+            .fold(0.0, f64::max);
+        for i in 0..reference.len() {
+            let dx = shifted.position[i] - Vec3::new(shift, 0.0, 0.0) - reference.position[i];
+            let dv = shifted.velocity[i] - reference.velocity[i];
+            assert!(dx.norm() <= 1e-9 * scale_x, "particle {i}: {dx:?}");
+            assert!(dv.norm() <= 1e-9 * scale_v, "particle {i}: {dv:?}");
+        }
+        for b in 0..reference.rigid.len() {
+            let dw = shifted.rigid.angular_velocity[b] - reference.rigid.angular_velocity[b];
+            assert!(dw.norm() <= 1e-9 * 1e3, "body {b}: {dw:?}");
+        }
+    }
+    // The packing did interact: the rows are no longer evenly spaced.
+    let moved = (0..reference.len())
+        .map(|i| (reference.position[i] - a.position[i]).norm())
+        .fold(0.0, f64::max);
+    assert!(moved > 0.01 * R, "{moved}");
+}
+
+#[test]
+fn a_pair_through_the_boundary_feels_the_force_of_the_pair_side_by_side() {
+    // Spheres at x = 0.2R and L − 1.7R touch through the boundary at a separation of 1.9R;
+    // the same pair side by side without periodicity gives the reference force.
+    let gap = 1.9 * R;
+    let through = [
+        Vec3::new(0.2 * R, 0.0, 0.0),
+        Vec3::new(PERIOD - 1.7 * R, 0.0, 0.0),
+    ];
+    let side = [
+        Vec3::new(0.2 * R, 0.0, 0.0),
+        Vec3::new(0.2 * R - gap, 0.0, 0.0),
+    ];
+    let forces = |centers: &[Vec3], periodic: bool| {
+        let (state, spheres) = rigid_spheres(centers, R, 2700.0);
+        let mut m = model(&state, &spheres);
+        if !periodic {
+            let settings = ContactSettings {
+                law: ContactLaw::HertzMindlin(HertzMindlin { damping_ratio: 0.1 }),
+                friction: 0.5,
+                skin: 0.2 * R,
+            };
+            m = contacts(&state, &spheres, (5e7, 0.25), settings, Vec::new());
+        }
+        let mut f = vec![Vec3::zeros(); state.len()];
+        let mut t = vec![Vec3::zeros(); state.rigid.len()];
+        m.add_forces(&state, &mut f, &mut t);
+        f
+    };
+    let a = forces(&through, true);
+    let b = forces(&side, false);
+    assert!(b[0].x > 0.0, "the left sphere is pushed right: {:?}", b[0]);
+    for i in 0..2 {
+        assert!(
+            (a[i] - b[i]).norm() <= 1e-12 * b[0].norm(),
+            "{:?} {:?}",
+            a[i],
+            b[i]
+        );
+    }
+}
+
+/// The packing run with a time-delayed boundary of lag `lag` (a 100 Hz cycle from t = 0);
+/// also the largest boundary force measured and the largest |left − right| ghost scale
+/// difference over the run.
+fn delayed(lag: f64, steps: usize) -> (State, f64, f64) {
+    let (mut state, sa) = packing(0.0);
+    let cycle = LoadCycle {
+        frequency: 100.0,
+        phase: 0.0,
+        start: 0.0,
+    };
+    let m = model(&state, &sa)
+        .with_time_delay(0, TimeDelayedBoundary::new(cycle, lag))
+        .unwrap();
+    let dt = 0.5 * m.stable_dt(&state).unwrap();
+    let mut models: Vec<Box<dyn Model>> = vec![Box::new(m)];
+    let mut s = stepper(dt, &mut state, &mut models);
+    let (mut force, mut spread) = (0.0f64, 0.0f64);
+    for _ in 0..steps {
+        s.step(&mut state, &mut models).unwrap();
+        let contacts: &dyn std::any::Any = models[0].as_ref();
+        let (scales, f) = contacts
+            .downcast_ref::<DemContacts>()
+            .unwrap()
+            .time_delay_state()
+            .unwrap();
+        force = force.max(f);
+        spread = spread.max((scales.left - scales.right).abs());
+    }
+    (state, force, spread)
+}
+
+#[test]
+fn a_zero_lag_time_delay_is_the_ordinary_periodic_boundary_bit_for_bit() {
+    let steps = 2000;
+    let (a, sa) = packing(0.0);
+    let (ordinary, _) = run(a.clone(), model(&a, &sa), steps);
+    let (zero, force, spread) = delayed(0.0, steps);
+    assert_eq!(zero.position, ordinary.position);
+    assert_eq!(zero.velocity, ordinary.velocity);
+    assert_eq!(zero.rigid.angular_velocity, ordinary.rigid.angular_velocity);
+    // The controller was live: it measured boundary forces, and its scales stayed exactly 1.
+    assert!(force > 0.0, "{force}");
+    assert_eq!(spread, 0.0);
+    // A quarter-cycle lag scales the ghost forces (left ≠ right) and changes the motion.
+    let (quarter, _, spread) = delayed(std::f64::consts::FRAC_PI_2, steps);
+    assert!(spread > 1e-3, "{spread}");
+    assert_ne!(quarter.position, ordinary.position);
+}

@@ -1,0 +1,244 @@
+//! `[granular]`: a sample of rigid stones, each a clump of spheres (paper 003 §3), added to a
+//! simulation after its mesh bodies.
+//!
+//! The stones come from a generation ([`qdem_contact::clump_sample::generate_stones`]: a grading
+//! curve, a loose lattice in a region, a seed), to be deposited under gravity, or from a stones
+//! file: CSV with the header `stone,x,y,z,radius` and one row per sphere, the rows of a stone
+//! together. A run with `[granular]` writes the stones' final spheres to `stones.csv` in that
+//! format ([`write_stones_csv`]), so a deposition run's output is the next run's sample. `crop`
+//! keeps the sample's stones whose spheres all lie inside a box, as paper 003 §3 cuts its
+//! single-sleeper samples out of the middle of its three-sleeper one. A sample and a generation
+//! together give the sample's stones then new ones (deposition in stages: a bed, then the
+//! sleepers laid on it, then the crib ballast poured around them).
+//!
+//! Each stone becomes a centre particle at its centre of mass with its mass (the union of its
+//! spheres at the material's density, [`clump_mass_properties`]) plus one massless member per
+//! sphere, which carries the sphere's contact radius.
+
+use crate::build::BuildError;
+use crate::output::{write_atomic, OutputError};
+use crate::scene::{Granular, Scene};
+use qdem_contact::clump_sample::{
+    clump_mass_properties, generate_stones, Grading, SampleError, SampleSpec, Stone,
+};
+use qdem_contact::ContactSphere;
+use qdem_core::{Dofs, State, Vec3};
+use std::ops::Range;
+use std::path::Path;
+
+/// The stones of a simulation: where they live in the state.
+#[derive(Clone, Debug)]
+pub struct GranularInfo {
+    /// `[granular] name`.
+    pub name: String,
+    /// Per stone: its centre particle and its member particles (one per sphere).
+    pub stones: Vec<(usize, Range<usize>)>,
+    /// Radius of every member particle's sphere, in member order.
+    pub radii: Vec<f64>,
+    /// The first member particle (members are contiguous, stone after stone).
+    pub first_member: usize,
+}
+
+impl GranularInfo {
+    /// Number of stones.
+    pub fn len(&self) -> usize {
+        self.stones.len()
+    }
+
+    /// Whether the sample is empty.
+    pub fn is_empty(&self) -> bool {
+        self.stones.is_empty()
+    }
+}
+
+/// The stones of `granular`: its sample file's, cropped, then the generated ones.
+pub(crate) fn stones(scene: &Scene, granular: &Granular) -> Result<Vec<Stone>, BuildError> {
+    let refused = |source: SampleError| BuildError::Granular {
+        scene: scene.path.clone(),
+        source,
+    };
+    let mut stones = match scene.sample_path() {
+        Some(path) => read_stones_csv(&path)?,
+        None => Vec::new(),
+    };
+    if let Some([lo, hi]) = granular.crop {
+        let inside = |c: &Vec3, r: f64| (0..3).all(|k| c[k] - r >= lo[k] && c[k] + r <= hi[k]);
+        stones.retain(|s| s.centers.iter().zip(&s.radii).all(|(c, &r)| inside(c, r)));
+    }
+    if let (Some([lo, hi]), Some(count), Some(grading)) =
+        (granular.region, granular.count, &granular.grading)
+    {
+        let spec = SampleSpec {
+            region: [Vec3::from(lo), Vec3::from(hi)],
+            count,
+            grading: Grading::new(grading.iter().map(|p| (p[0], p[1])).collect())
+                .map_err(refused)?,
+            spheres_per_stone: granular.spheres_per_stone,
+            seed: granular.seed,
+        };
+        stones.extend(generate_stones(&spec).map_err(refused)?);
+    }
+    Ok(stones)
+}
+
+/// Appends `stones` to `state` as rigid bodies of `density` and returns where they went and
+/// their contact spheres (bodies numbered from `first_body`, material `material`).
+pub(crate) fn add_stones(
+    scene: &Scene,
+    granular: &Granular,
+    stones: &[Stone],
+    state: &mut State,
+    first_body: usize,
+    material: usize,
+) -> Result<(GranularInfo, Vec<ContactSphere>), BuildError> {
+    let density = scene
+        .material(&granular.material)
+        .expect("validated scene")
+        .density;
+    let first_member = state.len();
+    let mut radii = Vec::new();
+    for stone in stones {
+        for (c, &r) in stone.centers.iter().zip(&stone.radii) {
+            push_particle(state, *c, 0.0);
+            radii.push(r);
+        }
+    }
+    let mut info = GranularInfo {
+        name: granular.name.clone(),
+        stones: Vec::with_capacity(stones.len()),
+        radii,
+        first_member,
+    };
+    let mut spheres = Vec::with_capacity(info.radii.len());
+    let mut member = first_member;
+    for (k, stone) in stones.iter().enumerate() {
+        let props =
+            clump_mass_properties(stone, density).map_err(|source| BuildError::Granular {
+                scene: scene.path.clone(),
+                source,
+            })?;
+        let center = state.len();
+        push_particle(state, props.center, props.mass);
+        let members: Range<usize> = member..member + stone.centers.len();
+        let name = format!("{} stone {}", granular.name, k + 1);
+        let ids: Vec<usize> = members.clone().collect();
+        state
+            .add_rigid_body(&name, center, &ids, props.inertia)
+            .map_err(|source| BuildError::Core {
+                scene: scene.path.clone(),
+                source,
+            })?;
+        for p in members.clone() {
+            spheres.push(ContactSphere {
+                particle: p,
+                radius: info.radii[p - first_member],
+                body: first_body + k,
+                material,
+            });
+        }
+        member = members.end;
+        info.stones.push((center, members));
+    }
+    Ok((info, spheres))
+}
+
+fn push_particle(state: &mut State, x: Vec3, mass: f64) {
+    state.reference.push(x);
+    state.position.push(x);
+    state.velocity.push(Vec3::zeros());
+    state.acceleration.push(Vec3::zeros());
+    state.mass.push(mass);
+    state.fixed.push(Dofs::NONE);
+}
+
+/// The header of a stones file.
+pub const STONES_HEADER: &str = "stone,x,y,z,radius";
+
+/// Reads a stones file (see the module docs); every malformed line is refused with its number.
+pub fn read_stones_csv(path: &Path) -> Result<Vec<Stone>, BuildError> {
+    let bad = |line: usize, message: String| BuildError::Sample {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| bad(0, e.to_string()))?;
+    let mut lines = text.lines().enumerate();
+    match lines.next() {
+        Some((_, h)) if h.trim() == STONES_HEADER => {}
+        _ => return Err(bad(1, format!("the first line must be `{STONES_HEADER}`"))),
+    }
+    let mut stones: Vec<Stone> = Vec::new();
+    let mut last_id: Option<u64> = None;
+    for (i, line) in lines {
+        let n = i + 1;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if fields.len() != 5 {
+            return Err(bad(n, format!("expected 5 fields, found {}", fields.len())));
+        }
+        let id: u64 = fields[0]
+            .parse()
+            .map_err(|_| bad(n, format!("stone {:?} is not a whole number", fields[0])))?;
+        let mut v = [0.0; 4];
+        for (k, f) in fields[1..].iter().enumerate() {
+            v[k] = f
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| bad(n, format!("{:?} is not a finite number", f)))?;
+        }
+        if v[3] <= 0.0 {
+            return Err(bad(n, format!("radius {} must be positive", v[3])));
+        }
+        if last_id != Some(id) {
+            if stones.len() as u64 >= 1 && last_id.is_some_and(|l| id < l) {
+                return Err(bad(
+                    n,
+                    format!("stone {id} after stone {}: keep the rows of a stone together, in ascending order", last_id.unwrap_or(0)),
+                ));
+            }
+            stones.push(Stone {
+                centers: Vec::new(),
+                radii: Vec::new(),
+            });
+            last_id = Some(id);
+        }
+        let stone = stones.last_mut().expect("pushed above");
+        stone.centers.push(Vec3::new(v[0], v[1], v[2]));
+        stone.radii.push(v[3]);
+    }
+    if stones.is_empty() {
+        return Err(bad(1, "the file holds no stone".into()));
+    }
+    Ok(stones)
+}
+
+/// Writes the current spheres of every stone to `path` (atomically), in the format
+/// [`read_stones_csv`] reads.
+pub fn write_stones_csv(
+    path: &Path,
+    info: &GranularInfo,
+    state: &State,
+) -> Result<(), OutputError> {
+    write_atomic(path, |w| {
+        writeln!(w, "{STONES_HEADER}")?;
+        for (k, (_, members)) in info.stones.iter().enumerate() {
+            for p in members.clone() {
+                let x = state.position[p];
+                let r = info.radii[p - info.first_member];
+                writeln!(
+                    w,
+                    "{},{:.17e},{:.17e},{:.17e},{:.17e}",
+                    k + 1,
+                    x.x,
+                    x.y,
+                    x.z,
+                    r
+                )?;
+            }
+        }
+        Ok(())
+    })
+}

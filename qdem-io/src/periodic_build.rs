@@ -1,0 +1,127 @@
+//! `[periodic]`: the periodic cell of a scene, the groups of particles that wrap together
+//! (every body whole: paper 003's ghosts are copies of whole particles), and the time-delayed
+//! boundary that follows a sleeper's cyclic load (paper 003 §5).
+
+use crate::build::{BodyInfo, BodyKind, BuildError};
+use crate::granular_build::GranularInfo;
+use crate::scene::{Periodic, Scene};
+use qdem_contact::time_delayed_boundary::lag_from_spacing;
+use qdem_contact::{DemContacts, LoadCycle, PeriodicBox, TimeDelayedBoundary, WrapGroup};
+use qdem_core::{State, Vec3};
+
+/// The axes named in `axes` ("y" → [1]).
+fn axes(text: &str) -> Vec<usize> {
+    text.chars().filter_map(|c| "xyz".find(c)).collect()
+}
+
+/// The periodic cell of `periodic`.
+pub(crate) fn periodic_box(scene: &Scene, periodic: &Periodic) -> Result<PeriodicBox, BuildError> {
+    let mut length = [None; 3];
+    let origin = match (&periodic.length, &periodic.bbox) {
+        (Some(l), _) => {
+            for (&k, &v) in axes(&periodic.axes).iter().zip(l) {
+                length[k] = Some(v);
+            }
+            Vec3::from(periodic.origin.unwrap_or_default())
+        }
+        (None, Some(b)) => {
+            for k in axes(&periodic.axes) {
+                length[k] = Some(b[1][k] - b[0][k]);
+            }
+            Vec3::from(b[0])
+        }
+        (None, None) => unreachable!("validated scene"),
+    };
+    PeriodicBox::new(origin, length).map_err(|source| BuildError::Contact {
+        scene: scene.path.clone(),
+        source: Box::new(source),
+    })
+}
+
+/// One group per body: a deformable body's nodes anchored at the node nearest its centroid, a
+/// rigid body's members anchored at its centre, each stone likewise.
+pub(crate) fn wrap_groups(
+    state: &State,
+    bodies: &[BodyInfo],
+    granular: Option<&GranularInfo>,
+) -> Vec<WrapGroup> {
+    let mut groups = Vec::new();
+    for body in bodies {
+        let mut particles: Vec<usize> = body.particles.clone().collect();
+        let anchor = match body.kind {
+            BodyKind::Rigid { center, .. } => {
+                particles.push(center);
+                center
+            }
+            BodyKind::Deformable { .. } => {
+                let n = particles.len().max(1) as f64;
+                let centroid = particles
+                    .iter()
+                    .fold(Vec3::zeros(), |a, &p| a + state.position[p])
+                    / n;
+                *particles
+                    .iter()
+                    .min_by(|&&a, &&b| {
+                        let da = (state.position[a] - centroid).norm_squared();
+                        let db = (state.position[b] - centroid).norm_squared();
+                        da.total_cmp(&db)
+                    })
+                    .unwrap_or(&body.particles.start)
+            }
+        };
+        groups.push(WrapGroup { anchor, particles });
+    }
+    if let Some(g) = granular {
+        for (center, members) in &g.stones {
+            let mut particles: Vec<usize> = members.clone().collect();
+            particles.push(*center);
+            groups.push(WrapGroup {
+                anchor: *center,
+                particles,
+            });
+        }
+    }
+    groups
+}
+
+/// Adds the periodic cell, and the time delay if asked, to the contact model.
+pub(crate) fn periodic_contacts(
+    scene: &Scene,
+    periodic: &Periodic,
+    cell: &PeriodicBox,
+    contacts: DemContacts,
+) -> Result<DemContacts, BuildError> {
+    let refused = |source| BuildError::Contact {
+        scene: scene.path.clone(),
+        source: Box::new(source),
+    };
+    let contacts = contacts.with_periodic(cell.clone()).map_err(refused)?;
+    let Some(delay) = &periodic.time_delay else {
+        return Ok(contacts);
+    };
+    let cyclic = scene
+        .loads
+        .iter()
+        .find_map(|l| l.cyclic.filter(|_| l.body == delay.body))
+        .expect("validated scene")
+        .cycle();
+    let axis = match &delay.axis {
+        Some(a) => axes(a)[0],
+        None => axes(&periodic.axes)[0],
+    };
+    let lag = match (delay.lag_deg, delay.sleeper_spacing, delay.speed) {
+        (Some(deg), _, _) => deg.to_radians(),
+        (None, Some(spacing), Some(speed)) => lag_from_spacing(cyclic.frequency, spacing, speed),
+        _ => std::f64::consts::FRAC_PI_2,
+    };
+    // The controller's cycles are those of the sleeper's own load, each starting at its
+    // minimum.
+    let cycle = LoadCycle {
+        frequency: cyclic.frequency,
+        phase: 0.0,
+        start: cyclic.first_cycle_start(),
+    };
+    contacts
+        .with_time_delay(axis, TimeDelayedBoundary::new(cycle, lag))
+        .map_err(refused)
+}

@@ -1,0 +1,163 @@
+//! The box tests of paper 003 through the scene format, at the small size of
+//! `fixtures/boxtest/small_*.toml` (coarse stones, one load cycle): the bed and crib
+//! depositions of the three-sleeper box and of the periodic cell, then the three-sleeper box
+//! and the single-sleeper box with fixed walls, ordinary periodic and time-delayed periodic
+//! boundaries. Checked:
+//! - the deposited stones stay inside the box (none below the floor, none through a wall, to
+//!   a tenth of a radius of Hertz overlap) and come to rest;
+//! - every loaded sleeper settles (moves down) by less than the bed under it is deep;
+//! - in the periodic boxes every stone's centre is inside the periodic cell at the end (bodies
+//!   wrap whole) and the time-delayed run records its boundary force and ghost scales.
+//!
+//! Also: a deformable body crossing a periodic boundary is wrapped whole, never torn apart.
+
+mod common;
+
+use common::test_dir;
+use qdem_io::build::Simulation;
+use qdem_io::granular_build::read_stones_csv;
+use qdem_io::runner::run;
+use qdem_io::scene::Scene;
+use std::path::{Path, PathBuf};
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/boxtest")
+}
+
+/// Copies scene `name` into `dir` with its mesh path made absolute, runs it there and returns
+/// the simulation after the run.
+fn run_scene(dir: &Path, name: &str) -> Simulation {
+    let text = std::fs::read_to_string(fixtures().join(format!("small_{name}.toml"))).unwrap();
+    let mesh = fixtures().join("sleeper.msh");
+    let text = text.replace(
+        "mesh = \"sleeper.msh\"",
+        &format!("mesh = {:?}", mesh.display().to_string()),
+    );
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    let scene = Scene::load(&path).unwrap();
+    let out = dir.join(&scene.output.dir);
+    let mut sim = Simulation::build(scene).unwrap();
+    run(&mut sim, &out, &mut |_| {}).unwrap();
+    sim
+}
+
+/// The settlement (m, down positive) of probe `name` at the end of a run.
+fn settlement(sim: &Simulation, name: &str) -> f64 {
+    let p = sim.probes.iter().find(|p| p.name == name).unwrap();
+    -sim.state.displacement(p.particle).z
+}
+
+#[test]
+fn box_tests_deposit_settle_and_wrap() {
+    let dir = test_dir("boxtest");
+    let bed = run_scene(&dir, "deposit_bed");
+    let stones = read_stones_csv(&dir.join("out/boxtest/small/bed/stones.csv")).unwrap();
+    assert_eq!(stones.len(), bed.granular.as_ref().unwrap().len());
+    for s in &stones {
+        for (c, r) in s.centers.iter().zip(&s.radii) {
+            // Walls at z = 0, x = 0, 0.3, y = 0, 2.1; Hertz overlaps stay a few per cent of r.
+            assert!(c.z - r > -0.1 * r, "{c:?} below the floor");
+            assert!(
+                c.x - r > -0.1 * r && c.x + r < 0.3 + 0.1 * r,
+                "{c:?} through a side"
+            );
+            assert!(
+                c.y - r > -0.1 * r && c.y + r < 2.1 + 0.1 * r,
+                "{c:?} through an end"
+            );
+        }
+    }
+    // At rest: the stones' kinetic energy is below a millimetre's worth of their weight.
+    let info = bed.granular.as_ref().unwrap();
+    let weight: f64 = info
+        .stones
+        .iter()
+        .map(|(c, _)| 9.81 * bed.state.mass[*c])
+        .sum();
+    assert!(
+        bed.state.kinetic_energy() < 1e-3 * weight,
+        "{}",
+        bed.state.kinetic_energy()
+    );
+
+    run_scene(&dir, "deposit_crib");
+    let three = run_scene(&dir, "three_sleeper");
+    for name in ["sleeper1", "sleeper2", "sleeper3"] {
+        let s = settlement(&three, name);
+        assert!(s > 0.0 && s < 0.2, "{name}: {s}");
+    }
+    run_scene(&dir, "deposit_cell_bed");
+    run_scene(&dir, "deposit_cell_crib");
+    for case in ["single_fixed", "single_periodic", "single_delayed"] {
+        let sim = run_scene(&dir, case);
+        let s = settlement(&sim, "sleeper2");
+        assert!(s > 0.0 && s < 0.2, "{case}: {s}");
+        if let Some((cell, _)) = &sim.periodic {
+            let origin = cell.origin().y;
+            let length = cell.length(1).unwrap();
+            for (c, _) in &sim.granular.as_ref().unwrap().stones {
+                let y = sim.state.position[*c].y;
+                assert!(
+                    y >= origin && y < origin + length,
+                    "{case}: stone at y = {y}"
+                );
+            }
+        }
+    }
+    let boundary =
+        std::fs::read_to_string(dir.join("out/boxtest/small/single_delayed/boundary.csv")).unwrap();
+    assert!(boundary.starts_with("time,boundary_force,left_scale,right_scale"));
+    assert!(boundary.lines().count() > 100);
+}
+
+#[test]
+fn a_deformable_body_crossing_a_periodic_boundary_stays_whole() {
+    // The contact block (0.1 m cube) flies at 5 m/s along x through a cell of period 0.3 m
+    // from x = -0.15: after 0.06 s it has crossed x = 0.15 and must reappear near x = -0.15,
+    // whole: its extent stays 0.1 m and its tetrahedra keep their volume.
+    let block = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/contact/block.msh");
+    let text = format!(
+        r#"
+[run]
+t_end = 0.06
+[[material]]
+name = "rubber"
+density = 1100.0
+young = 5e6
+poisson = 0.3
+[[body]]
+name = "block"
+mesh = {:?}
+material = "rubber"
+translate = [0.08, 0.0, 0.0]
+velocity = [5.0, 0.0, 0.0]
+[periodic]
+axes = "x"
+length = [0.3]
+origin = [-0.15, 0.0, 0.0]
+"#,
+        block.display().to_string()
+    );
+    let dir = test_dir("periodic-block");
+    let path = dir.join("block.toml");
+    std::fs::write(&path, text).unwrap();
+    let mut sim = Simulation::build(Scene::load(&path).unwrap()).unwrap();
+    run(&mut sim, &dir.join("out"), &mut |_| {}).unwrap();
+    let xs: Vec<f64> = sim.state.position.iter().map(|p| p.x).collect();
+    let (lo, hi) = xs
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+            (l.min(x), h.max(x))
+        });
+    // Travelled 0.3 m: one period, so it is back where it started, whole.
+    assert!((hi - lo - 0.1).abs() < 1e-6, "extent {}", hi - lo);
+    let centre = 0.5 * (lo + hi);
+    assert!((centre - 0.08).abs() < 1e-3, "centre {centre}");
+    // The displacement field stayed continuous: every node moved by the same 0.3 m, less
+    // the wrap, so u = x − X is the same rigid motion everywhere.
+    let u0 = sim.state.displacement(0);
+    for i in 0..sim.state.len() {
+        assert!((sim.state.displacement(i) - u0).norm() < 1e-6);
+    }
+}
