@@ -54,8 +54,8 @@ def run(size, name, seed, out):
 def settlement(out, case, settle, cycles):
     """Settlement (m, positive down) of the middle sleeper after each cycle."""
     with open(os.path.join(out, case, "probes.csv")) as f:
-        rows = [[float(v) for v in r] for r in list(csv.reader(f))[1:]]
-    header = open(os.path.join(out, case, "probes.csv")).readline().strip().split(",")
+        header, *table = list(csv.reader(f))
+    rows = [[float(v) for v in r] for r in table]
     col = header.index("sleeper2.uz")
 
     def uz_at(t):

@@ -164,12 +164,6 @@ struct TimeDelay {
     boundary_force: f64,
 }
 
-/// Ghost scales of an ordinary periodic boundary.
-const UNSCALED: GhostScales = GhostScales {
-    left: 1.0,
-    right: 1.0,
-};
-
 /// Scales of the forces on the first and second sphere of a pair whose second sphere's image
 /// was translated by `shift` along the delay axis: a negative shift means the second sphere
 /// sits near the right boundary and its image beyond the left one, so the first sphere feels
@@ -323,7 +317,7 @@ impl DemContacts {
         self.time_delay = Some(TimeDelay {
             axis,
             boundary,
-            scales: UNSCALED,
+            scales: GhostScales::PERIODIC,
             boundary_force: 0.0,
         });
         Ok(self)
@@ -678,21 +672,15 @@ impl DemContacts {
                 let spins = rigid[s] != NOT_RIGID;
                 for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
                     let k = (e / 2) as usize;
-                    let scale = delay.map(|(axis, scales)| {
-                        let (a, b) = pair_scales(pairs.shift[k][axis], &scales);
-                        if e % 2 == 0 {
-                            a
-                        } else {
-                            b
-                        }
-                    });
-                    let (mut fk, center) = if e % 2 == 0 {
+                    let first = e % 2 == 0;
+                    let (mut fk, center) = if first {
                         (pairs.force[k], now[s].center)
                     } else {
                         (-pairs.force[k], now[s].center + pairs.shift[k])
                     };
-                    if let Some(scale) = scale {
-                        fk *= scale;
+                    if let Some((axis, scales)) = &delay {
+                        let (a, b) = pair_scales(pairs.shift[k][*axis], scales);
+                        fk *= if first { a } else { b };
                     }
                     f += fk;
                     if spins {

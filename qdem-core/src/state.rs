@@ -178,6 +178,19 @@ impl State {
             .collect()
     }
 
+    /// Appends a free particle at `position` (also its reference position) with `velocity`
+    /// and `mass`, and returns its index. A state with particle rotations gets none for it:
+    /// call this before [`State::add_spin`].
+    pub fn push_particle(&mut self, position: Vec3, velocity: Vec3, mass: f64) -> usize {
+        self.reference.push(position);
+        self.position.push(position);
+        self.velocity.push(velocity);
+        self.acceleration.push(Vec3::zeros());
+        self.mass.push(mass);
+        self.fixed.push(Dofs::NONE);
+        self.len() - 1
+    }
+
     /// Number of particles.
     pub fn len(&self) -> usize {
         self.position.len()

@@ -391,13 +391,7 @@ fn build_bodies(
         let kind = if body.rigid {
             let (mass, center, inertia) =
                 tet_mass_properties(&state.reference, &tets, material.density);
-            let c = state.len();
-            state.reference.push(center);
-            state.position.push(center);
-            state.velocity.push(velocity);
-            state.acceleration.push(Vec3::zeros());
-            state.mass.push(mass);
-            state.fixed.push(Dofs::NONE);
+            let c = state.push_particle(center, velocity, mass);
             let members: Vec<usize> = placed.particles.clone().collect();
             let index = state.add_rigid_body(&body.name, c, &members, inertia)?;
             BodyKind::Rigid {

@@ -22,7 +22,7 @@ use qdem_contact::clump_sample::{
     clump_mass_properties, generate_stones, Grading, SampleError, SampleSpec, Stone,
 };
 use qdem_contact::ContactSphere;
-use qdem_core::{Dofs, State, Vec3};
+use qdem_core::{State, Vec3};
 use std::ops::Range;
 use std::path::Path;
 
@@ -99,7 +99,7 @@ pub(crate) fn add_stones(
     let mut radii = Vec::new();
     for stone in stones {
         for (c, &r) in stone.centers.iter().zip(&stone.radii) {
-            push_particle(state, *c, 0.0);
+            state.push_particle(*c, Vec3::zeros(), 0.0);
             radii.push(r);
         }
     }
@@ -117,8 +117,7 @@ pub(crate) fn add_stones(
                 scene: scene.path.clone(),
                 source,
             })?;
-        let center = state.len();
-        push_particle(state, props.center, props.mass);
+        let center = state.push_particle(props.center, Vec3::zeros(), props.mass);
         let members: Range<usize> = member..member + stone.centers.len();
         let name = format!("{} stone {}", granular.name, k + 1);
         let ids: Vec<usize> = members.clone().collect();
@@ -140,15 +139,6 @@ pub(crate) fn add_stones(
         info.stones.push((center, members));
     }
     Ok((info, spheres))
-}
-
-fn push_particle(state: &mut State, x: Vec3, mass: f64) {
-    state.reference.push(x);
-    state.position.push(x);
-    state.velocity.push(Vec3::zeros());
-    state.acceleration.push(Vec3::zeros());
-    state.mass.push(mass);
-    state.fixed.push(Dofs::NONE);
 }
 
 /// The header of a stones file.
@@ -193,7 +183,7 @@ pub fn read_stones_csv(path: &Path) -> Result<Vec<Stone>, BuildError> {
             return Err(bad(n, format!("radius {} must be positive", v[3])));
         }
         if last_id != Some(id) {
-            if stones.len() as u64 >= 1 && last_id.is_some_and(|l| id < l) {
+            if last_id.is_some_and(|l| id < l) {
                 return Err(bad(
                     n,
                     format!("stone {id} after stone {}: keep the rows of a stone together, in ascending order", last_id.unwrap_or(0)),

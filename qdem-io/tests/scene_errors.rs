@@ -862,18 +862,27 @@ fn periodic_and_time_delay_mistakes_are_named() {
     assert_has(&msg, &[PATH, "[periodic]", "axes = \"yy\"", "at most once"]);
     let periodic = format!("{BASE}\n[periodic]\naxes = \"xy\"\nlength = [0.7]\n");
     let (_, msg) = error(&periodic);
-    assert_has(&msg, &["[periodic]", "length has 1 entries", "one period per axis"]);
+    assert_has(
+        &msg,
+        &["[periodic]", "length has 1 entries", "one period per axis"],
+    );
     let delayed = format!(
         "{BASE}\n[periodic]\naxes = \"y\"\nlength = [0.7]\n\n[periodic.time_delay]\nbody = \"beam\"\n"
     );
     let (_, msg) = error(&delayed);
-    assert_has(&msg, &["[periodic.time_delay]", "carries no [[load]] with `cyclic`"]);
+    assert_has(
+        &msg,
+        &["[periodic.time_delay]", "carries no [[load]] with `cyclic`"],
+    );
     let both = with(
         "ramp = [[0.0, 0.0], [1.0, 1.0]]",
         "ramp = [[0.0, 0.0], [1.0, 1.0]]\ncyclic = { min = 0.1, max = 1.0, frequency = 0.0 }",
     );
     let (_, msg) = error(&both);
-    assert_has(&msg, &["[[load]] #1", "frequency", "either `ramp` or `cyclic`"]);
+    assert_has(
+        &msg,
+        &["[[load]] #1", "frequency", "either `ramp` or `cyclic`"],
+    );
 }
 
 #[test]
