@@ -5,16 +5,19 @@ use crate::{bench, progress, verify};
 use qdem_bench::throughput::BenchPlan;
 use qdem_core::Model as _;
 use qdem_io::build::{BodyKind, BuildError, Simulation};
-use qdem_io::runner::{make_stepper, run, RunError};
+use qdem_io::runner::{make_stepper, run_with, RunError, RunOptions};
 use qdem_io::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 use thiserror::Error;
 
 /// Usage text.
 pub const USAGE: &str = "\
 usage:
-  qdem run SCENE [--out DIR] [--threads N]   run a scene; outputs go to DIR (default: the scene's [output] dir)
+  qdem run SCENE [--out DIR] [--threads N] [--resume CHECKPOINT]
+                                             run a scene; outputs go to DIR (default: the scene's [output] dir);
+                                             Ctrl-C or SIGTERM stops it with DIR/checkpoint.qdc, which --resume continues
   qdem check SCENE [--threads N]             validate a scene; print meshes, mass, stable dt, cost estimate
   qdem verify [--json] [--full [--out DIR]]  run the analytical fixtures (--full adds the cantilever meshes,
                                              keeping their outputs and plots in DIR, default out/verify)
@@ -65,6 +68,7 @@ struct Options {
     implicit: bool,
     tets: Option<Vec<usize>>,
     steps: Option<usize>,
+    resume: Option<PathBuf>,
 }
 
 fn parse_list(flag: &str, value: &str) -> Result<Vec<usize>, CliError> {
@@ -102,6 +106,7 @@ fn parse(args: &[String], allowed: &[&str]) -> Result<Options, CliError> {
         };
         match arg.as_str() {
             "--out" => o.out = Some(PathBuf::from(value()?)),
+            "--resume" => o.resume = Some(PathBuf::from(value()?)),
             "--json" => o.json = true,
             "--full" => o.full = true,
             "--implicit" => o.implicit = true,
@@ -160,9 +165,13 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
     };
     match command.as_str() {
         "run" => {
-            let o = parse(rest, &["--out", "--threads"])?;
+            let o = parse(rest, &["--out", "--threads", "--resume"])?;
             set_threads(o.threads.as_deref())?;
-            run_scene(&one_scene(&o, "run")?, o.out.as_deref())
+            run_scene(
+                &one_scene(&o, "run")?,
+                o.out.as_deref(),
+                o.resume.as_deref(),
+            )
         }
         "check" => {
             let o = parse(rest, &["--threads"])?;
@@ -205,7 +214,10 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
     }
 }
 
-fn run_scene(path: &Path, out: Option<&Path>) -> Result<(), CliError> {
+/// Set by the Ctrl-C / SIGTERM handler: the run stops after its current step, checkpointed.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+fn run_scene(path: &Path, out: Option<&Path>, resume: Option<&Path>) -> Result<(), CliError> {
     let scene = Scene::load(path)?;
     let out_dir = match out {
         Some(dir) => dir.to_path_buf(),
@@ -236,7 +248,18 @@ fn run_scene(path: &Path, out: Option<&Path>) -> Result<(), CliError> {
             progress::draw(p, t_end)
         }
     };
-    let report = run(&mut sim, &out_dir, &mut on_progress);
+    // A second signal while the checkpoint is being written is ignored; the handler can
+    // only fail if one is already installed, which this process never does twice.
+    let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed));
+    let options = RunOptions {
+        resume,
+        stop: Some(&STOP),
+        stop_after: None,
+    };
+    if let Some(checkpoint) = resume {
+        eprintln!("resuming from {}", checkpoint.display());
+    }
+    let report = run_with(&mut sim, &out_dir, options, &mut on_progress);
     if show {
         progress::finish();
     }

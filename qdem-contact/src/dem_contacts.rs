@@ -33,8 +33,9 @@ use crate::error::ContactError;
 use crate::periodic_boundary::PeriodicBox;
 use crate::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
 use crate::wall::Wall;
+use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
-use qdem_core::{Dofs, Model, State, Vec3};
+use qdem_core::{CheckpointError, Decoder, Dofs, Encoder, Model, State, Vec3};
 use rayon::prelude::*;
 
 /// Marks a sphere that is no part of a rigid body.
@@ -122,6 +123,47 @@ impl ContactList {
 
     fn len(&self) -> usize {
         self.first.len()
+    }
+
+    /// Writes the list and its per-contact buffers into a checkpoint.
+    fn save(&self, out: &mut Encoder) {
+        out.u32s(&self.first);
+        out.u32s(&self.second);
+        for v in [&self.history, &self.force, &self.point, &self.shift] {
+            out.vec3s(v);
+        }
+    }
+
+    /// Reads back a list whose first partners index `0..firsts` and second partners
+    /// `0..seconds`.
+    fn restore(
+        input: &mut Decoder<'_>,
+        firsts: usize,
+        seconds: usize,
+    ) -> Result<ContactList, CheckpointError> {
+        let first = input.u32s("contact partners")?;
+        let second = input.u32s("contact partners")?;
+        same_count("contact partners", first.len(), second.len())?;
+        if let Some(k) =
+            (0..first.len()).find(|&k| first[k] as usize >= firsts || second[k] as usize >= seconds)
+        {
+            return Err(CheckpointError::Invalid {
+                what: "contact list",
+                detail: format!(
+                    "contact {k} joins {} and {}, beyond the scene's {firsts} spheres",
+                    first[k], second[k]
+                ),
+            });
+        }
+        let n = first.len();
+        Ok(ContactList {
+            first,
+            second,
+            history: input.vec3s_exact(n, "tangential springs")?,
+            force: input.vec3s_exact(n, "contact forces")?,
+            point: input.vec3s_exact(n, "contact points")?,
+            shift: input.vec3s_exact(n, "image translations")?,
+        })
     }
 }
 
@@ -779,6 +821,62 @@ impl Model for DemContacts {
         }
         let (omega_squared, damping_rate) = (2.0 * worst.0, 2.0 * worst.1);
         (omega_squared > 0.0).then(|| critical_step(omega_squared, damping_rate))
+    }
+
+    fn checkpointable(&self) -> bool {
+        true
+    }
+
+    /// The candidate lists with their tangential springs, where and when they were built, and
+    /// the time-delayed boundary's estimates: everything but the sphere centres, which are
+    /// read from the state.
+    fn save(&self, out: &mut Encoder) {
+        out.tag("contact");
+        out.option_f64(self.last_time);
+        out.bool(self.built);
+        out.f64(self.built_time);
+        out.vec3s(&self.built_at);
+        out.u64(self.rebuilds);
+        self.pairs.save(out);
+        self.wall_contacts.save(out);
+        out.bool(self.time_delay.is_some());
+        if let Some(delay) = &self.time_delay {
+            out.f64(delay.scales.left);
+            out.f64(delay.scales.right);
+            out.f64(delay.boundary_force);
+            delay.boundary.save(out);
+        }
+    }
+
+    fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+        input.tag("contact")?;
+        let spheres = self.particle.len();
+        self.last_time = input.option_f64("the last evaluation time")?;
+        self.built = input.bool("the build flag")?;
+        self.built_time = input.f64("the build time")?;
+        self.built_at = input.vec3s("the build positions")?;
+        if self.built {
+            same_count("contact spheres", spheres, self.built_at.len())?;
+        }
+        self.rebuilds = input.u64("the rebuild count")?;
+        self.pairs = ContactList::restore(input, spheres, spheres)?;
+        self.wall_contacts = ContactList::restore(input, spheres, self.walls.len())?;
+        let delayed = input.bool("the time-delay flag")?;
+        same_count(
+            "time-delayed boundaries",
+            self.time_delay.is_some() as usize,
+            delayed as usize,
+        )?;
+        if let Some(delay) = &mut self.time_delay {
+            delay.scales = GhostScales {
+                left: input.f64("the left ghost scale")?,
+                right: input.f64("the right ghost scale")?,
+            };
+            delay.boundary_force = input.f64("the boundary force")?;
+            delay.boundary.restore(input)?;
+        }
+        self.build_incidence();
+        Ok(())
     }
 
     fn potential_energy(&self, state: &State) -> Option<f64> {

@@ -38,6 +38,7 @@
 //! 5. If A(Φ) ≤ 0 or is not finite, or a scale is not finite (a non-finite lag), the scales are
 //!    1. Each scale is clamped to ≥ 0: a negative scale would turn a ghost's push into a pull.
 
+use qdem_core::{CheckpointError, Decoder, Encoder};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
 /// Cycle counts this close below an integer count as that integer, so that a time computed as
@@ -174,6 +175,25 @@ impl TimeDelayedBoundary {
     /// Current estimates (F_min, F_max) for output and tests.
     pub fn extremes(&self) -> (Option<f64>, Option<f64>) {
         (self.current.map(|(_, f_min)| f_min), self.f_max)
+    }
+
+    /// Writes the running estimates (the cycle and its F_min, F_max) into a checkpoint.
+    pub fn save(&self, out: &mut Encoder) {
+        out.bool(self.current.is_some());
+        let (index, f_min) = self.current.unwrap_or((0, 0.0));
+        out.u64(index as u64);
+        out.f64(f_min);
+        out.option_f64(self.f_max);
+    }
+
+    /// Reads back what [`TimeDelayedBoundary::save`] wrote.
+    pub fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+        let known = input.bool("the boundary's cycle flag")?;
+        let index = input.u64("the boundary's cycle")? as i64;
+        let f_min = input.f64("the boundary's F_min")?;
+        self.current = known.then_some((index, f_min));
+        self.f_max = input.option_f64("the boundary's F_max")?;
+        Ok(())
     }
 }
 

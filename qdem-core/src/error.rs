@@ -1,5 +1,6 @@
 //! Errors of the core: bad bodies, bad time functions, bad steps and unstable runs.
 
+use crate::checkpoint::CheckpointError;
 use crate::material::MaterialError;
 use thiserror::Error;
 
@@ -171,4 +172,7 @@ pub enum CoreError {
     /// The sparse linear algebra failed for a reason other than definiteness.
     #[error("sparse factorisation failed: {0}")]
     Sparse(String),
+    /// A checkpoint that cannot be written or read for this scene.
+    #[error("checkpoint: {0}")]
+    Checkpoint(#[from] CheckpointError),
 }

@@ -19,6 +19,11 @@ impl Gravity {
 }
 
 impl Model for Gravity {
+    /// No history: the forces follow from the state alone.
+    fn checkpointable(&self) -> bool {
+        true
+    }
+
     fn name(&self) -> &str {
         "gravity"
     }

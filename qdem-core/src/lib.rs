@@ -15,6 +15,7 @@
 //! with the literal 12-triangle subdomain construction kept as its oracle in
 //! [`tet_subdomain`], and the rigorous explicit step bound in [`stable_step`].
 
+pub mod checkpoint;
 pub mod error;
 pub mod gravity;
 pub mod linear_tet;
@@ -40,6 +41,7 @@ pub type Vec3 = nalgebra::Vector3<f64>;
 /// A 3×3 matrix of f64.
 pub type Mat3 = nalgebra::Matrix3<f64>;
 
+pub use checkpoint::{CheckpointError, Decoder, Encoder};
 pub use error::CoreError;
 pub use gravity::Gravity;
 pub use material::Material;

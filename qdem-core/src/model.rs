@@ -5,6 +5,7 @@
 //! does not need are never built. For implicit and static solves a model also adds its tangent
 //! stiffness and damping into a [`Tangent`] (the optional implicit hook).
 
+use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::sparse::Tangent;
 use crate::state::State;
 use crate::Vec3;
@@ -82,5 +83,25 @@ pub trait Model: std::any::Any + Send + Sync {
     /// (loads, gravity, springs to ground), is empty.
     fn particles(&self) -> Vec<usize> {
         Vec::new()
+    }
+
+    /// Whether [`Model::save`] writes everything the model's future forces depend on beyond
+    /// the [`State`] (its history: tangential springs, broken bonds, running estimates), so
+    /// that a run resumed from a checkpoint continues bit for bit. The default, `false`, makes
+    /// a scene with the model refuse checkpoints; a model without history says `true` and
+    /// keeps the empty [`Model::save`].
+    fn checkpointable(&self) -> bool {
+        false
+    }
+
+    /// Writes the model's history into a checkpoint.
+    fn save(&self, out: &mut Encoder) {
+        let _ = out;
+    }
+
+    /// Reads back what [`Model::save`] wrote, into a model built from the same scene.
+    fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+        let _ = input;
+        Ok(())
     }
 }

@@ -35,6 +35,7 @@
 //! solves); with [`TangentUpdate::EveryStep`] K and C are reassembled at every predicted state
 //! and refactorised, reusing the symbolic analysis. The fixity is read when factorising.
 
+use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::model::Model;
 use crate::sparse::{
@@ -421,6 +422,12 @@ where
         .for_each(update);
 }
 
+fn unsupported_implicit() -> CheckpointError {
+    CheckpointError::Unsupported {
+        what: "the implicit newmark stepper (its factorisation of an earlier state)".to_string(),
+    }
+}
+
 impl Stepper for Newmark {
     fn name(&self) -> &str {
         if self.is_implicit() {
@@ -441,6 +448,36 @@ impl Stepper for Newmark {
 
     fn counts(&self) -> StepCounts {
         self.counts
+    }
+
+    /// The explicit stepper carries nothing from step to step but its counts; the implicit
+    /// one's factorisation of an earlier state is not saved, so it refuses.
+    fn save(&self, out: &mut Encoder) -> Result<(), CheckpointError> {
+        if self.is_implicit() {
+            return Err(unsupported_implicit());
+        }
+        out.tag("newmark");
+        let c = &self.counts;
+        [c.retakes, c.substeps, c.event_steps, c.factorizations]
+            .into_iter()
+            .for_each(|n| out.u64(n));
+        Ok(())
+    }
+
+    fn resume(&mut self, state: &mut State, input: &mut Decoder<'_>) -> Result<(), CoreError> {
+        if self.is_implicit() {
+            return Err(unsupported_implicit().into());
+        }
+        refuse_rigid(state, "newmark")?;
+        check_masses(state)?;
+        input.tag("newmark")?;
+        self.counts = StepCounts {
+            retakes: input.u64("retakes")?,
+            substeps: input.u64("sub-steps")?,
+            event_steps: input.u64("event steps")?,
+            factorizations: input.u64("factorisations")?,
+        };
+        Ok(())
     }
 
     fn initialize(

@@ -30,6 +30,11 @@ impl NodalLoad {
 }
 
 impl Model for NodalLoad {
+    /// No history: the forces follow from the state alone.
+    fn checkpointable(&self) -> bool {
+        true
+    }
+
     fn name(&self) -> &str {
         &self.name
     }

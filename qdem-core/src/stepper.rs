@@ -1,6 +1,7 @@
 //! The [`Stepper`] trait and what every stepper shares: force evaluation into accelerations
 //! with fixity, and the choice of the time step from the models' stable bounds.
 
+use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::model::Model;
 use crate::newmark::StepCounts;
@@ -41,6 +42,27 @@ pub trait Stepper {
     /// Retakes, sub-steps and event steps of an adaptive stepper; zero for the others.
     fn counts(&self) -> StepCounts {
         StepCounts::default()
+    }
+
+    /// Writes what the next step depends on beyond the state and the models (a force buffer
+    /// carried from one step to the next), or refuses: a stepper whose history cannot be
+    /// saved (a factorisation of an earlier state) returns [`CheckpointError::Unsupported`].
+    fn save(&self, out: &mut Encoder) -> Result<(), CheckpointError> {
+        let _ = out;
+        Err(CheckpointError::Unsupported {
+            what: format!("the {} stepper", self.name()),
+        })
+    }
+
+    /// Instead of [`Stepper::initialize`] when a run resumes: reads back what
+    /// [`Stepper::save`] wrote, for a state and models already restored, without evaluating
+    /// any force (which would advance the models' histories).
+    fn resume(&mut self, state: &mut State, input: &mut Decoder<'_>) -> Result<(), CoreError> {
+        let _ = (state, input);
+        Err(CheckpointError::Unsupported {
+            what: format!("the {} stepper", self.name()),
+        }
+        .into())
     }
 }
 

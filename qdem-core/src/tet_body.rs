@@ -251,6 +251,11 @@ fn incidence_lists(tets: &[[u32; 4]]) -> (usize, Vec<u32>, Vec<u32>) {
 }
 
 impl Model for TetBody {
+    /// No history: the forces follow from the state alone.
+    fn checkpointable(&self) -> bool {
+        true
+    }
+
     fn name(&self) -> &str {
         &self.name
     }

@@ -10,6 +10,7 @@
 //! after each. An optional local damping ([`crate::local_damping`]) acts on the summed forces
 //! before they become accelerations.
 
+use crate::checkpoint::{same_count, CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::local_damping;
 use crate::model::Model;
@@ -109,6 +110,24 @@ impl Stepper for Verlet {
             place_members(state);
         }
         self.evaluate(state, models)
+    }
+
+    /// The rigid bodies' torques of the last evaluation, which the next step's first half
+    /// kick uses.
+    fn save(&self, out: &mut Encoder) -> Result<(), CheckpointError> {
+        out.tag("verlet");
+        out.vec3s(&self.torque);
+        Ok(())
+    }
+
+    fn resume(&mut self, state: &mut State, input: &mut Decoder<'_>) -> Result<(), CoreError> {
+        refuse_spin(state, "verlet")?;
+        check_masses(state)?;
+        input.tag("verlet")?;
+        let torque = input.vec3s("rigid-body torques")?;
+        same_count("rigid-body torques", state.rigid.len(), torque.len())?;
+        self.torque = torque;
+        Ok(())
     }
 
     fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {

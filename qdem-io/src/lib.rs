@@ -16,12 +16,14 @@
 
 mod bonded_build;
 pub mod build;
+pub mod checkpoint;
 mod contact_build;
 pub mod crack_svg;
 pub mod granular_build;
 pub mod output;
 mod periodic_build;
 pub mod plot;
+mod run_record;
 pub mod runner;
 pub mod scene;
 pub mod spectrum;

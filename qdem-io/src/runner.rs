@@ -10,17 +10,20 @@
 //! scales) at the probe interval.
 
 use crate::build::{BodyKind, Simulation};
+use crate::checkpoint::{
+    read_checkpoint, scene_fingerprint, write_checkpoint, CheckpointFileError, CHECKPOINT_FILE,
+};
 use crate::crack_svg::write_crack_svg;
 use crate::granular_build::write_stones_csv;
-use crate::output::{
-    write_atomic, write_summary, write_vtu, OutputError, ProbeCsv, PvdIndex, VtuGrid,
-};
+use crate::output::{write_atomic, write_summary, write_vtu, OutputError, ProbeCsv, VtuGrid};
 use crate::plot::{line_plot_svg, Labels, Series};
+use crate::run_record::{check_checkpointable, decode_run, encode_run, RunRecord};
 use crate::scene::Integrator;
 use qdem_contact::BondedParticles;
 use qdem_core::{CoreError, Newmark, StaticSteps, Stepper, Vec3, Verlet};
 use serde_json::json;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 use thiserror::Error;
 
@@ -45,6 +48,36 @@ pub enum RunError {
         scene: PathBuf,
         /// What went wrong.
         source: CoreError,
+    },
+    /// A checkpoint that cannot be resumed from.
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointFileError),
+    /// The run was stopped on request (Ctrl-C, SIGTERM) after writing a checkpoint.
+    #[error(
+        "interrupted at t = {time:.6e} s (step {step}); the run is checkpointed in {checkpoint}: \
+         continue it with `qdem run SCENE --resume {checkpoint}`",
+        checkpoint = checkpoint.display()
+    )]
+    Interrupted {
+        /// Simulated time reached.
+        time: f64,
+        /// The last step done.
+        step: u64,
+        /// The checkpoint written.
+        checkpoint: PathBuf,
+    },
+    /// A run that failed after its last good state was checkpointed.
+    #[error(
+        "{source}\nthe last good state (t = {time:e} s) is saved in {checkpoint}",
+        checkpoint = checkpoint.display()
+    )]
+    Failed {
+        /// Why the run failed.
+        source: Box<RunError>,
+        /// The time of the checkpointed state.
+        time: f64,
+        /// The checkpoint written.
+        checkpoint: PathBuf,
     },
 }
 
@@ -108,7 +141,7 @@ pub struct CrackTiming {
 }
 
 impl CrackTiming {
-    fn add(&mut self, cracked: bool, seconds: f64) {
+    pub(crate) fn add(&mut self, cracked: bool, seconds: f64) {
         if cracked {
             self.after_seconds += seconds;
             self.after_steps += 1;
@@ -123,27 +156,17 @@ impl CrackTiming {
 /// bonds and contacts are meaningless beyond (the body has collapsed or come apart).
 const COLLAPSE_SPACINGS: f64 = 0.5;
 
-/// Samples that fall due: the first at t = 0, then every `every` seconds (to the nearest step).
-struct Schedule {
-    every: f64,
-    next: f64,
-}
-
-impl Schedule {
-    fn new(every: f64) -> Schedule {
-        Schedule { every, next: 0.0 }
-    }
-
-    /// Whether a sample is due at `time`, given the step `dt`; advances past it if so.
-    fn due(&mut self, time: f64, dt: f64) -> bool {
-        if self.every <= 0.0 || time < self.next - 0.5 * dt {
-            return false;
-        }
-        while self.next <= time + 0.5 * dt {
-            self.next += self.every;
-        }
-        true
-    }
+/// How a run starts and when it stops early.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RunOptions<'a> {
+    /// A checkpoint to continue from (`qdem run --resume`), written by a run of the same scene
+    /// into the same output directory.
+    pub resume: Option<&'a Path>,
+    /// Set (by a Ctrl-C or SIGTERM handler) to stop the run after the current step, with a
+    /// checkpoint.
+    pub stop: Option<&'a AtomicBool>,
+    /// Stops as on a stop request once this step is done (a batch slot's last step, a test).
+    pub stop_after: Option<u64>,
 }
 
 /// Runs `sim` to its end time, writing `probes.csv`, `summary.json` and, if asked,
@@ -152,6 +175,21 @@ impl Schedule {
 pub fn run(
     sim: &mut Simulation,
     out_dir: &Path,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<RunReport, RunError> {
+    run_with(sim, out_dir, RunOptions::default(), progress)
+}
+
+/// [`run`], resuming from a checkpoint or stopping on request as `options` say. With
+/// `[output] checkpoint_every`, a resume or a stop request, the scene's models and stepper
+/// must be checkpointable, which is checked before the first step. At every checkpoint the
+/// probe rows so far are published under `probes.csv`; a resumed run keeps the rows the
+/// checkpoint has seen and appends. A run that fails leaves its last good state (at the
+/// latest probe sample) in `checkpoint.qdc` when it can be checkpointed.
+pub fn run_with(
+    sim: &mut Simulation,
+    out_dir: &Path,
+    options: RunOptions<'_>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<RunReport, RunError> {
     let dir_error = |path: &Path| {
@@ -164,67 +202,107 @@ pub fn run(
         std::fs::create_dir_all(&vtu_dir).map_err(dir_error(&vtu_dir))?;
     }
     let names: Vec<String> = sim.probes.iter().map(|p| p.name.clone()).collect();
-    let mut csv = ProbeCsv::create(&out_dir.join("probes.csv"), &names)?;
-    let mut history: Vec<Vec<(f64, f64)>> = vec![Vec::new(); 3 * names.len()];
     let steps = sim.steps();
-    let probe_every = sim
-        .scene
-        .run
-        .probe_every
-        .unwrap_or(sim.scene.run.t_end / 1000.0);
-    let mut probe_schedule = Schedule::new(probe_every);
-    let mut vtu_schedule = Schedule::new(sim.scene.output.vtu_every);
-    let mut pvd = PvdIndex::new();
     let mut stepper = make_stepper(sim).map_err(|source| core_error(sim, source))?;
+    let checkpoint_path = out_dir.join(CHECKPOINT_FILE);
+    let fingerprint = scene_fingerprint(&sim.scene.path);
+    let can_checkpoint = check_checkpointable(sim, stepper.as_ref());
+    if sim.scene.output.checkpoint_every > 0.0 || options.resume.is_some() {
+        if let Err(source) = &can_checkpoint {
+            return Err(core_error(sim, source.clone().into()));
+        }
+    }
+    let mut record = RunRecord::new(sim);
+    let probes_path = out_dir.join("probes.csv");
+    let mut csv = match options.resume {
+        Some(path) => {
+            let body = read_checkpoint(path, fingerprint, &sim.scene.path)?;
+            decode_run(&body, sim, stepper.as_mut(), &mut record)
+                .map_err(|source| core_error(sim, source))?;
+            ProbeCsv::resume(&probes_path, &names, record.probe_rows as usize)?
+        }
+        None => ProbeCsv::create(&probes_path, &names)?,
+    };
+    let first_step = record.next_step;
     let start = Instant::now();
     let mut last_report = start;
-    let mut timing = CrackTiming::default();
-    let mut boundary_rows: Vec<[f64; 4]> = Vec::new();
+    let mut last_good: Option<(f64, Vec<u8>)> = None;
     let outcome = (|| -> Result<(), RunError> {
-        stepper
-            .initialize(&mut sim.state, &mut sim.models)
-            .map_err(|source| core_error(sim, source))?;
-        for step in 0..=steps {
+        if options.resume.is_none() {
+            stepper
+                .initialize(&mut sim.state, &mut sim.models)
+                .map_err(|source| core_error(sim, source))?;
+        }
+        for step in first_step..=steps {
             if step > 0 {
                 let cracked = sim.bonded().is_some_and(|b| b.broken() > 0);
                 let begin = Instant::now();
                 stepper
                     .step(&mut sim.state, &mut sim.models)
                     .map_err(|source| core_error(sim, source))?;
-                timing.add(cracked, begin.elapsed().as_secs_f64());
+                record.timing.add(cracked, begin.elapsed().as_secs_f64());
                 if let Some((cell, groups)) = &sim.periodic {
                     cell.wrap_bodies(&mut sim.state, groups);
                 }
                 if let Some((p, u)) = sim.bonded().and_then(|b| {
                     b.beyond_small_displacement(&sim.state, COLLAPSE_SPACINGS * 2.0 * b.radii()[0])
                 }) {
-                    timing.collapse = Some((sim.state.time, p, u));
+                    record.timing.collapse = Some((sim.state.time, p, u));
                 }
             }
             let (time, dt) = (sim.state.time, sim.dt);
-            if probe_schedule.due(time, dt) {
+            let sampled = record.probes.due(time, dt);
+            if sampled {
                 let samples = probe_samples(sim);
                 for (p, sample) in samples.iter().enumerate() {
-                    for axis in 0..3 {
-                        history[3 * p + axis].push((time, sample[0][axis]));
+                    for (axis, u) in sample[0].iter().enumerate() {
+                        record.history[3 * p + axis].push((time, *u));
                     }
                 }
                 csv.row(time, &samples)?;
+                record.probe_rows += 1;
                 if let Some((scales, force)) = sim.contacts().and_then(|c| c.time_delay_state()) {
-                    boundary_rows.push([time, force, scales.left, scales.right]);
+                    record
+                        .boundary_rows
+                        .push([time, force, scales.left, scales.right]);
                 }
             }
-            if vtu_schedule.due(time, dt) {
-                let file = format!("vtu/state_{:05}.vtu", pvd.len());
+            if record.vtu.due(time, dt) {
+                let file = format!("vtu/state_{:05}.vtu", record.pvd.len());
                 write_snapshot(sim, &out_dir.join(&file))?;
-                pvd.push(time, file);
-                pvd.write(&out_dir.join("results.pvd"))?;
+                record.pvd.push(time, file);
+                record.pvd.write(&out_dir.join("results.pvd"))?;
+            }
+            record.next_step = step + 1;
+            let stop = options.stop.is_some_and(|s| s.load(Ordering::Relaxed))
+                || options.stop_after == Some(step);
+            if record.checkpoints.due(time, dt) || stop {
+                csv.publish()?;
+                let body = encode_run(sim, stepper.as_ref(), &record)
+                    .map_err(|source| core_error(sim, source.into()))?;
+                write_checkpoint(&checkpoint_path, fingerprint, &body)?;
+            } else if sampled && can_checkpoint.is_ok() {
+                let body = encode_run(sim, stepper.as_ref(), &record)
+                    .map_err(|source| core_error(sim, source.into()))?;
+                last_good = Some((time, body));
+            }
+            if stop {
+                return Err(RunError::Interrupted {
+                    time,
+                    step,
+                    checkpoint: checkpoint_path.clone(),
+                });
             }
             if step % 64 == 0 && last_report.elapsed().as_secs_f64() > 0.5 {
                 last_report = Instant::now();
-                progress(&progress_at(step, steps, time, start));
+                progress(&progress_at(
+                    step - first_step,
+                    steps - first_step,
+                    time,
+                    start,
+                ));
             }
-            if timing.collapse.is_some() {
+            if record.timing.collapse.is_some() {
                 break;
             }
         }
@@ -233,8 +311,20 @@ pub fn run(
     let wall_seconds = start.elapsed().as_secs_f64();
     let probe_rows = csv.num_rows();
     csv.finish()?;
+    let outcome = match (outcome, last_good) {
+        (Err(source @ RunError::Core { .. }), Some((time, body))) => {
+            write_checkpoint(&checkpoint_path, fingerprint, &body)?;
+            Err(RunError::Failed {
+                source: Box::new(source),
+                time,
+                checkpoint: checkpoint_path.clone(),
+            })
+        }
+        (outcome, _) => outcome,
+    };
+    let mut timing = record.timing;
     if !names.is_empty() {
-        plot_probes(&out_dir.join("probes.svg"), &names, &history)?;
+        plot_probes(&out_dir.join("probes.svg"), &names, &record.history)?;
     }
     if let Some(model) = sim.bonded() {
         timing.first_break = model.broken_log().first().map(|b| b.0);
@@ -243,15 +333,16 @@ pub fn run(
     if let Some(info) = &sim.granular {
         write_stones_csv(&out_dir.join("stones.csv"), info, &sim.state)?;
     }
-    if !boundary_rows.is_empty() {
-        write_boundary_csv(&out_dir.join("boundary.csv"), &boundary_rows)?;
+    if !record.boundary_rows.is_empty() {
+        write_boundary_csv(&out_dir.join("boundary.csv"), &record.boundary_rows)?;
     }
     outcome?;
     let steps = match timing.collapse {
         Some(_) => timing.before_steps + timing.after_steps,
         None => steps,
     };
-    let tet_steps = (sim.tets() as f64) * steps as f64;
+    let stepped = steps.saturating_sub(first_step.saturating_sub(1)) as f64;
+    let tet_steps = (sim.tets() as f64) * stepped;
     let report = RunReport {
         integrator: stepper.name().to_string(),
         steps,
@@ -260,11 +351,14 @@ pub fn run(
         wall_seconds,
         tet_steps_per_second: tet_steps / wall_seconds.max(1e-9),
         probe_rows,
-        vtu_files: pvd.len(),
-        particle_steps_per_second: sim.state.len() as f64 * steps as f64 / wall_seconds.max(1e-9),
+        vtu_files: record.pvd.len(),
+        particle_steps_per_second: sim.state.len() as f64 * stepped / wall_seconds.max(1e-9),
         crack_timing: timing,
     };
     let mut summary = summary_json(sim, &report);
+    if options.resume.is_some() {
+        summary["resumed_at_step"] = json!(first_step.saturating_sub(1));
+    }
     if let Some(model) = sim.bonded() {
         summary["bonded"] = bonded_summary(model, &report, stepper.as_ref());
     }
@@ -274,7 +368,7 @@ pub fn run(
             "name": info.name,
             "stones": info.len(),
             "spheres": info.radii.len(),
-            "sphere_steps_per_second": spheres * report.steps as f64 / wall_seconds.max(1e-9),
+            "sphere_steps_per_second": spheres * stepped / wall_seconds.max(1e-9),
         });
     }
     if let Some(contacts) = sim.contacts() {
@@ -283,7 +377,7 @@ pub fn run(
             "contacts": contacts.contacts(),
             "rebuilds": contacts.rebuilds(),
             "sphere_steps_per_second":
-                contacts.spheres() as f64 * report.steps as f64 / wall_seconds.max(1e-9),
+                contacts.spheres() as f64 * stepped / wall_seconds.max(1e-9),
         });
     }
     if let Some((cell, _)) = &sim.periodic {

@@ -216,6 +216,37 @@ impl AtomicFile {
         Ok(())
     }
 
+    /// Makes what has been written so far visible under the target path, atomically, and goes
+    /// on writing: the content is flushed, copied to a second temporary file
+    /// `.NAME.publish-<pid>`, synced and renamed over the target. A run publishes its
+    /// row-by-row outputs this way when it writes a checkpoint, so that the files on disk
+    /// always hold at least what the latest checkpoint has seen.
+    ///
+    /// # Errors
+    /// [`OutputError::Io`] if flushing, copying, syncing or renaming fails; the target is
+    /// then untouched.
+    pub fn publish(&mut self) -> Result<(), OutputError> {
+        if let Err(source) = self.writer().flush() {
+            return Err(self.error(IoStage::Write, source));
+        }
+        let copy = self.temp.with_file_name(
+            self.temp
+                .file_name()
+                .expect("a temporary path has a file name")
+                .to_string_lossy()
+                .replacen(".tmp-", ".publish-", 1),
+        );
+        let result = fs::copy(&self.temp, &copy)
+            .and_then(|_| File::open(&copy)?.sync_all())
+            .and_then(|_| fs::rename(&copy, &self.path));
+        if let Err(source) = result {
+            let _ = fs::remove_file(&copy);
+            return Err(self.error(IoStage::Rename, source));
+        }
+        sync_parent_dir(&self.path);
+        Ok(())
+    }
+
     /// Removes the temporary file (the writer is already closed) and builds the error.
     fn fail(&self, stage: IoStage, source: io::Error) -> OutputError {
         let _ = fs::remove_file(&self.temp);

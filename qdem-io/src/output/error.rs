@@ -112,4 +112,15 @@ pub enum OutputError {
         /// The offending value.
         value: f64,
     },
+    /// An output of an earlier run that a resumed run cannot continue.
+    #[error(
+        "cannot continue `{path}` from the checkpoint: {reason}; resume into the output \
+         directory the checkpoint was written in, or run the scene from the start"
+    )]
+    Resume {
+        /// The output file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
 }

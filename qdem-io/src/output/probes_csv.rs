@@ -153,6 +153,59 @@ impl ProbeCsv {
         Ok(())
     }
 
+    /// Continues the file at `path` written by an earlier run of the same probes: the header
+    /// and its first `rows` rows are kept (rows after them, written by a run that went on
+    /// past the checkpoint being resumed, are dropped: the resumed run writes them again)
+    /// and new rows follow.
+    ///
+    /// # Errors
+    /// [`OutputError::Resume`] if the file cannot be read, has another header or fewer than
+    /// `rows` rows; the errors of [`ProbeCsv::create`].
+    pub fn resume(path: &Path, probe_names: &[String], rows: usize) -> Result<Self, OutputError> {
+        let resume_error = |reason: String| OutputError::Resume {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| resume_error(e.to_string()))?;
+        let mut csv = Self::create(path, probe_names)?;
+        let mut lines = text.lines();
+        let header = lines.next().unwrap_or("");
+        let expected: String = std::iter::once("t".to_string())
+            .chain(
+                probe_names
+                    .iter()
+                    .flat_map(|n| PROBE_COLUMNS.iter().map(move |c| format!("{n}.{c}"))),
+            )
+            .collect::<Vec<_>>()
+            .join(",");
+        if header != expected {
+            return Err(resume_error(format!(
+                "its header `{header}` is not that of the scene's probes `{expected}`"
+            )));
+        }
+        let kept: Vec<&str> = lines.take(rows).collect();
+        if kept.len() < rows {
+            return Err(resume_error(format!(
+                "it has {} rows but the checkpoint was taken after {rows}",
+                kept.len()
+            )));
+        }
+        let result = kept
+            .iter()
+            .try_for_each(|line| writeln!(csv.file.writer(), "{line}"));
+        result.map_err(|source| csv.file.error(IoStage::Write, source))?;
+        csv.num_rows = rows;
+        Ok(csv)
+    }
+
+    /// Makes the rows written so far visible under the file's name ([`AtomicFile::publish`]).
+    ///
+    /// # Errors
+    /// [`OutputError::Io`] if that fails.
+    pub fn publish(&mut self) -> Result<(), OutputError> {
+        self.file.publish()
+    }
+
     /// Flushes, syncs and renames the file into place.
     ///
     /// # Errors

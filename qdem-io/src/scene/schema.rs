@@ -424,6 +424,11 @@ pub struct Output {
     /// Simulated time between VTU snapshots, s; 0 (the default) writes none.
     #[serde(default)]
     pub vtu_every: f64,
+    /// Simulated time between checkpoints (`checkpoint.qdc` in the output directory, which
+    /// `qdem run --resume` continues from), s; 0 (the default) writes one only when the run
+    /// is interrupted (Ctrl-C, SIGTERM) or becomes unstable.
+    #[serde(default)]
+    pub checkpoint_every: f64,
 }
 
 impl Output {
@@ -438,6 +443,7 @@ impl Default for Output {
         Output {
             dir: default_out_dir(),
             vtu_every: 0.0,
+            checkpoint_every: 0.0,
         }
     }
 }

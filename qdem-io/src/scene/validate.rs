@@ -591,6 +591,13 @@ pub(crate) fn validate(
         raw.output.vtu_every,
         "seconds",
     );
+    c.non_negative(
+        &["output", "checkpoint_every"],
+        "[output]",
+        "checkpoint_every",
+        raw.output.checkpoint_every,
+        "seconds",
+    );
 
     if !c.found.is_empty() {
         let mut found = c.found;
