@@ -82,6 +82,21 @@ pub enum CoreError {
         /// First offending particle.
         particle: usize,
     },
+    /// A tetrahedron turned inside out.
+    #[error(
+        "body `{body}`: tetrahedron {tet} turned inside out at t = {time:.6e} s (det F = \
+         {det:.3e}, must stay positive): the deformation there is more than its mesh can carry"
+    )]
+    Inverted {
+        /// Body name.
+        body: String,
+        /// Tetrahedron index within the body.
+        tet: usize,
+        /// det F, the ratio of its current to its reference volume.
+        det: f64,
+        /// Simulated time.
+        time: f64,
+    },
     /// Newmark parameters outside the range of paper 001 Eq. 16.
     #[error(
         "newmark: beta = {beta} and gamma = {gamma} are outside 0 <= gamma <= 1, \

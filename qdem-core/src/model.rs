@@ -85,6 +85,14 @@ pub trait Model: std::any::Any + Send + Sync {
         Vec::new()
     }
 
+    /// After a step: a physical impossibility the model met at its last force evaluation at
+    /// `state` (a tetrahedron turned inside out), which stops the run; `None` when all is
+    /// well.
+    fn failure(&self, state: &State) -> Option<crate::CoreError> {
+        let _ = state;
+        None
+    }
+
     /// Whether [`Model::save`] writes everything the model's future forces depend on beyond
     /// the [`State`] (its history: tangential springs, broken bonds, running estimates), so
     /// that a run resumed from a checkpoint continues bit for bit. The default, `false`, makes

@@ -47,6 +47,8 @@ pub struct TetBody {
     tet_forces: Vec<Vec3>,
     omega_squared: f64,
     damping_rate: f64,
+    /// The first tetrahedron found inverted at the last force evaluation.
+    inverted: Option<usize>,
 }
 
 impl TetBody {
@@ -116,6 +118,7 @@ impl TetBody {
             incidence,
             omega_squared,
             damping_rate,
+            inverted: None,
         })
     }
 
@@ -162,11 +165,13 @@ impl TetBody {
     fn compute_tet_forces<const VISCOUS: bool>(&mut self, state: &State) {
         let (elastic, viscous) = (self.pair(), self.vpair());
         let (tets, dm_inv) = (&self.tets, &self.dm_inv);
-        self.tet_forces
+        let inverted = self
+            .tet_forces
             .par_chunks_mut(4 * TET_CHUNK)
             .enumerate()
-            .for_each(|(chunk, out)| {
+            .map(|(chunk, out)| {
                 let start = chunk * TET_CHUNK;
+                let mut first_inverted = usize::MAX;
                 for (local, f) in out.chunks_exact_mut(4).enumerate() {
                     let e = start + local;
                     let tet = &tets[e];
@@ -174,8 +179,20 @@ impl TetBody {
                     let v = VISCOUS.then(|| tet.map(|n| state.velocity[n as usize]));
                     let (t, cof) = tet_stress(&x, v.as_ref(), &dm_inv[e], elastic, viscous);
                     f.copy_from_slice(&vertex_forces(&t, &cof));
+                    // 6 × the current volume; B = FFᵀ cannot tell an inverted tetrahedron
+                    // from its mirror image, so the sign is checked here.
+                    let six_volume = (x[1] - x[0]).dot(&cof.column(0));
+                    let positive =
+                        six_volume.partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater);
+                    if !positive && first_inverted == usize::MAX {
+                        first_inverted = e;
+                    }
                 }
-            });
+                first_inverted
+            })
+            .min()
+            .unwrap_or(usize::MAX);
+        self.inverted = (inverted != usize::MAX).then_some(inverted);
     }
 
     /// Stage 2: per-particle sums over the incidence list, in a fixed order (Eq. 11).
@@ -254,6 +271,17 @@ impl Model for TetBody {
     /// No history: the forces follow from the state alone.
     fn checkpointable(&self) -> bool {
         true
+    }
+
+    fn failure(&self, state: &State) -> Option<CoreError> {
+        let tet = self.inverted?;
+        let x = self.tets[tet].map(|n| state.position[n as usize]);
+        Some(CoreError::Inverted {
+            body: self.name.clone(),
+            tet,
+            det: (edge_matrix(&x) * self.dm_inv[tet]).determinant(),
+            time: state.time,
+        })
     }
 
     fn name(&self) -> &str {

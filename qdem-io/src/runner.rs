@@ -20,7 +20,8 @@ use crate::plot::{line_plot_svg, Labels, Series};
 use crate::run_record::{check_checkpointable, decode_run, encode_run, RunRecord};
 use crate::scene::Integrator;
 use qdem_contact::BondedParticles;
-use qdem_core::{CoreError, Newmark, StaticSteps, Stepper, Vec3, Verlet};
+use qdem_core::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
+use qdem_core::{stable_step, CoreError, Newmark, StaticSteps, Stepper, Vec3, Verlet};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -49,6 +50,30 @@ pub enum RunError {
         /// What went wrong.
         source: CoreError,
     },
+    /// The run went unstable.
+    #[error(
+        "{scene}: the run became unstable at step {step} (t = {time:.6e} s): {detail}. The step \
+         was dt = {dt:.4e} s; the stable bound at this state is {bound:.4e} s (set by \
+         {limiter}): {advice}",
+        scene = scene.display(),
+        advice = unstable_advice(dt, bound)
+    )]
+    Unstable {
+        /// The scene file.
+        scene: PathBuf,
+        /// The step that failed.
+        step: u64,
+        /// Simulated time after it.
+        time: f64,
+        /// What went wrong, and where (particle, body, element).
+        detail: String,
+        /// The step size.
+        dt: f64,
+        /// The stable bound at this state.
+        bound: f64,
+        /// The model that sets it.
+        limiter: String,
+    },
     /// A checkpoint that cannot be resumed from.
     #[error(transparent)]
     Checkpoint(#[from] CheckpointFileError),
@@ -68,7 +93,7 @@ pub enum RunError {
     },
     /// A run that failed after its last good state was checkpointed.
     #[error(
-        "{source}\nthe last good state (t = {time:e} s) is saved in {checkpoint}",
+        "{source}\nthe last good state (t = {time:.6e} s) is saved in {checkpoint}",
         checkpoint = checkpoint.display()
     )]
     Failed {
@@ -227,6 +252,7 @@ pub fn run_with(
     let start = Instant::now();
     let mut last_report = start;
     let mut last_good: Option<(f64, Vec<u8>)> = None;
+    let mut energy = EnergyGrowth::new();
     let outcome = (|| -> Result<(), RunError> {
         if options.resume.is_none() {
             stepper
@@ -237,9 +263,8 @@ pub fn run_with(
             if step > 0 {
                 let cracked = sim.bonded().is_some_and(|b| b.broken() > 0);
                 let begin = Instant::now();
-                stepper
-                    .step(&mut sim.state, &mut sim.models)
-                    .map_err(|source| core_error(sim, source))?;
+                let stepped = stepper.step(&mut sim.state, &mut sim.models);
+                check_stability(sim, stepped, step, &mut energy)?;
                 record.timing.add(cracked, begin.elapsed().as_secs_f64());
                 if let Some((cell, groups)) = &sim.periodic {
                     cell.wrap_bodies(&mut sim.state, groups);
@@ -312,7 +337,7 @@ pub fn run_with(
     let probe_rows = csv.num_rows();
     csv.finish()?;
     let outcome = match (outcome, last_good) {
-        (Err(source @ RunError::Core { .. }), Some((time, body))) => {
+        (Err(source @ (RunError::Core { .. } | RunError::Unstable { .. })), Some((time, body))) => {
             write_checkpoint(&checkpoint_path, fingerprint, &body)?;
             Err(RunError::Failed {
                 source: Box::new(source),
@@ -393,6 +418,63 @@ pub fn run_with(
     }
     write_summary(&out_dir.join("summary.json"), &summary)?;
     Ok(report)
+}
+
+/// Stops the run after a failed step (a non-finite acceleration), a step that left a model
+/// in an impossible state (an inverted tetrahedron), or runaway kinetic energy, with the
+/// diagnosis and the stable step at this state; passes other stepper errors on.
+fn check_stability(
+    sim: &Simulation,
+    stepped: Result<(), CoreError>,
+    step: u64,
+    energy: &mut EnergyGrowth,
+) -> Result<(), RunError> {
+    let failure = match stepped {
+        Err(CoreError::NonFinite { particle, .. }) => {
+            Some(format!("particle {particle} has a non-finite acceleration"))
+        }
+        Err(source) => return Err(core_error(sim, source)),
+        Ok(()) => sim
+            .models
+            .iter()
+            .find_map(|m| m.failure(&sim.state))
+            .map(|e| e.to_string()),
+    };
+    let failure = failure.or_else(|| {
+        energy.observe(sim.state.kinetic_energy()).map(|growth| {
+            format!(
+                "the kinetic energy grew by more than {:.0}% at each of the last {GROWTH_STEPS} \
+                 steps (x{growth:.2e} in all), the signature of an unstable step",
+                100.0 * (GROWTH_PER_STEP - 1.0)
+            )
+        })
+    });
+    let Some(detail) = failure else {
+        return Ok(());
+    };
+    let (bound, limiter) =
+        stable_step(&sim.state, &sim.models).unwrap_or((f64::INFINITY, "nothing".to_string()));
+    Err(RunError::Unstable {
+        scene: sim.scene.path.clone(),
+        step,
+        time: sim.state.time,
+        detail,
+        dt: sim.dt,
+        bound,
+        limiter,
+    })
+}
+
+/// What to do about an instability, given the step and its bound.
+fn unstable_advice(dt: &f64, bound: &f64) -> String {
+    if dt > bound {
+        format!("the step is above the bound: use dt = \"auto\" or dt <= {bound:.4e} s")
+    } else {
+        "the step is within the bound, so the cause is physical: a load or a contact \
+         stiffness too large for the mesh there (reduce it or refine the mesh), or a contact \
+         pushing a vertex through its body (finer contact spheres)"
+            .to_string()
+    }
 }
 
 /// The time-delayed boundary's record: time, F_Ave_current, left and right ghost scales.
