@@ -34,8 +34,9 @@ use crate::broad_phase::{find_pairs, SphereSet};
 use crate::error::ContactError;
 use crate::particle_packing::{lattice_section, Packing, SplitMix64};
 use crate::unbonded_contact::{PairKinematics, UnbondedLaw, UnbondedPair};
+use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
-use qdem_core::{Model, State, Tangent, Vec3};
+use qdem_core::{CheckpointError, Decoder, Encoder, Model, State, Tangent, Vec3};
 use rayon::prelude::*;
 use std::collections::HashSet;
 
@@ -484,9 +485,116 @@ impl BondedParticles {
     }
 }
 
+/// Writes the unbonded pairs with their committed contact state.
+fn save_pairs(pairs: &[UnbondedPair], out: &mut Encoder) {
+    out.u32s(&pairs.iter().flat_map(|p| [p.i, p.j]).collect::<Vec<_>>());
+    let values: Vec<f64> = pairs
+        .iter()
+        .flat_map(|p| {
+            [
+                p.rest,
+                p.normal_stiffness,
+                p.reduced_mass,
+                p.elastic,
+                p.slip_reference,
+                p.overlap,
+            ]
+        })
+        .collect();
+    out.f64s(&values);
+    out.bools(&pairs.iter().map(|p| p.touching).collect::<Vec<_>>());
+}
+
+/// Reads back the pairs of [`save_pairs`] for `particles` discs.
+fn restore_pairs(
+    input: &mut Decoder<'_>,
+    particles: usize,
+) -> Result<Vec<UnbondedPair>, CheckpointError> {
+    let ends = input.u32s("unbonded pairs")?;
+    let values = input.f64s("unbonded pair states")?;
+    let touching = input.bools("unbonded contact flags")?;
+    let n = touching.len();
+    same_count("unbonded pair ends", 2 * n, ends.len())?;
+    same_count("unbonded pair values", 6 * n, values.len())?;
+    if let Some(&bad) = ends.iter().find(|&&e| e as usize >= particles) {
+        return Err(CheckpointError::Invalid {
+            what: "unbonded pair",
+            detail: format!("disc {bad} is beyond the scene's {particles}"),
+        });
+    }
+    Ok((0..n)
+        .map(|k| {
+            let v = &values[6 * k..6 * k + 6];
+            UnbondedPair {
+                i: ends[2 * k],
+                j: ends[2 * k + 1],
+                rest: v[0],
+                normal_stiffness: v[1],
+                reduced_mass: v[2],
+                touching: touching[k],
+                elastic: v[3],
+                slip_reference: v[4],
+                overlap: v[5],
+            }
+        })
+        .collect())
+}
+
 impl Model for BondedParticles {
     fn name(&self) -> &str {
         &self.name
+    }
+
+    fn checkpointable(&self) -> bool {
+        true
+    }
+
+    /// The bonds left intact, their stresses, the unbonded pairs with their committed
+    /// contact state, the broad phase's reference positions and the breakage log.
+    fn save(&self, out: &mut Encoder) {
+        out.tag("bonded particles");
+        out.bools(&self.intact);
+        for stress in [
+            &self.stress_eval,
+            &self.stress_trial,
+            &self.stress_committed,
+        ] {
+            out.f64s(stress);
+        }
+        save_pairs(&self.pairs, out);
+        out.f64s(&self.grid_reference.concat());
+        out.u64(self.broken as u64);
+        out.f64s(&self.broken_log.iter().map(|b| b.0).collect::<Vec<_>>());
+        out.u32s(&self.broken_log.iter().map(|b| b.1).collect::<Vec<_>>());
+        out.bool(self.activated);
+        out.bool(self.stale);
+    }
+
+    fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+        input.tag("bonded particles")?;
+        let bonds = self.bonds.len();
+        self.intact = input.bools("intact bonds")?;
+        same_count("bonds", bonds, self.intact.len())?;
+        for stress in [
+            &mut self.stress_eval,
+            &mut self.stress_trial,
+            &mut self.stress_committed,
+        ] {
+            *stress = input.f64s("bond stresses")?;
+            same_count("bond stresses", bonds, stress.len())?;
+        }
+        self.pairs = restore_pairs(input, self.radius.len())?;
+        self.pair_index = self.pairs.iter().map(|p| (p.i, p.j)).collect();
+        let grid = input.f64s("the broad phase's positions")?;
+        self.grid_reference = grid.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+        self.broken = input.u64("the broken-bond count")? as usize;
+        let times = input.f64s("the breakage log")?;
+        let which = input.u32s("the breakage log")?;
+        same_count("breakage log entries", times.len(), which.len())?;
+        self.broken_log = times.into_iter().zip(which).collect();
+        self.activated = input.bool("the activation flag")?;
+        self.stale = input.bool("the stale flag")?;
+        Ok(())
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
