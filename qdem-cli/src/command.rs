@@ -5,7 +5,7 @@ use crate::{bench, progress, verify};
 use qdem_bench::throughput::BenchPlan;
 use qdem_core::Model as _;
 use qdem_io::build::{BodyKind, BuildError, Simulation};
-use qdem_io::runner::{make_stepper, run_with, RunError, RunOptions};
+use qdem_io::runner::{checkpoint_support, make_stepper, run_with, RunError, RunOptions};
 use qdem_io::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -349,6 +349,10 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
         sim.steps(),
         sim.scene.run.t_end
     );
+    match checkpoint_support(&sim) {
+        Ok(()) => println!("checkpoints: supported (`checkpoint_every`, Ctrl-C, --resume)"),
+        Err(why) => println!("checkpoints: not supported: {why}"),
+    }
     let per_step = measure_step_cost(&mut sim, 20)?;
     let total = per_step * sim.steps() as f64;
     println!(

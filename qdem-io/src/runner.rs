@@ -511,6 +511,13 @@ fn plot_probes(
     line_plot_svg(path, &labels, &series)
 }
 
+/// Whether runs of `sim` can be checkpointed and resumed, or the model or stepper that
+/// cannot.
+pub fn checkpoint_support(sim: &Simulation) -> Result<(), CoreError> {
+    let stepper = make_stepper(sim)?;
+    Ok(check_checkpointable(sim, stepper.as_ref())?)
+}
+
 /// The scene's stepper with the simulation's step.
 pub fn make_stepper(sim: &Simulation) -> Result<Box<dyn Stepper>, CoreError> {
     let run = &sim.scene.run;
