@@ -422,12 +422,6 @@ where
         .for_each(update);
 }
 
-fn unsupported_implicit() -> CheckpointError {
-    CheckpointError::Unsupported {
-        what: "the implicit newmark stepper (its factorisation of an earlier state)".to_string(),
-    }
-}
-
 impl Stepper for Newmark {
     fn name(&self) -> &str {
         if self.is_implicit() {
@@ -450,33 +444,52 @@ impl Stepper for Newmark {
         self.counts
     }
 
-    /// The explicit stepper carries nothing from step to step but its counts; the implicit
-    /// one's factorisation of an earlier state is not saved, so it refuses.
+    /// The counts and, for the implicit stepper, the tangent it factorised and the steps its
+    /// factorisations are for, so that a resumed run factorises the same matrices again.
     fn save(&self, out: &mut Encoder) -> Result<(), CheckpointError> {
-        if self.is_implicit() {
-            return Err(unsupported_implicit());
-        }
         out.tag("newmark");
         let c = &self.counts;
         [c.retakes, c.substeps, c.event_steps, c.factorizations]
             .into_iter()
             .for_each(|n| out.u64(n));
+        if self.is_implicit() {
+            let system = &self.system;
+            out.bool(system.tangent_current);
+            system.tangent.save(out);
+            out.option_f64(system.factors.nominal.step);
+            out.option_f64(system.factors.substep.step);
+        }
         Ok(())
     }
 
-    fn resume(&mut self, state: &mut State, input: &mut Decoder<'_>) -> Result<(), CoreError> {
-        if self.is_implicit() {
-            return Err(unsupported_implicit().into());
-        }
+    fn resume(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        input: &mut Decoder<'_>,
+    ) -> Result<(), CoreError> {
         refuse_rigid(state, "newmark")?;
         check_masses(state)?;
         input.tag("newmark")?;
-        self.counts = StepCounts {
+        let counts = StepCounts {
             retakes: input.u64("retakes")?,
             substeps: input.u64("sub-steps")?,
             event_steps: input.u64("event steps")?,
             factorizations: input.u64("factorisations")?,
         };
+        if self.is_implicit() {
+            self.system.tangent_current = input.bool("the tangent flag")?;
+            let dofs = 3 * state.len() + 3 * state.spin.len();
+            self.system.tangent.restore(input, dofs)?;
+            let steps = [
+                input.option_f64("a factorised step")?,
+                input.option_f64("a factorised step")?,
+            ];
+            for h in steps.into_iter().flatten() {
+                self.refactor(state, models, h)?;
+            }
+        }
+        self.counts = counts;
         Ok(())
     }
 

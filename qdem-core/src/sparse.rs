@@ -18,6 +18,7 @@
 //!   move rigidly (a singular stiffness), and [`explain_failure`] turns a failed factorisation
 //!   into a message naming the particle of the failing pivot, its body and the free bodies.
 
+use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::model::Model;
 use crate::state::{Dofs, State};
@@ -96,6 +97,44 @@ impl Tangent {
     /// The stored stiffness entries (lower triangle, global DOFs, duplicates not summed).
     pub fn stiffness_entries(&self) -> &[Entry] {
         &self.stiffness
+    }
+
+    /// Writes the entries into a checkpoint (an implicit stepper's factorised tangent).
+    pub(crate) fn save(&self, out: &mut Encoder) {
+        for list in [&self.stiffness, &self.damping] {
+            out.u64(list.len() as u64);
+            for e in list {
+                out.u64(e.row as u64);
+                out.u64(e.col as u64);
+                out.f64(e.val);
+            }
+        }
+    }
+
+    /// Reads back what [`Tangent::save`] wrote, for `dofs` degrees of freedom.
+    pub(crate) fn restore(
+        &mut self,
+        input: &mut Decoder<'_>,
+        dofs: usize,
+    ) -> Result<(), CheckpointError> {
+        for list in [&mut self.stiffness, &mut self.damping] {
+            let n = input.u64("tangent entries")?;
+            list.clear();
+            for _ in 0..n {
+                let (row, col) = (input.u64("a tangent row")?, input.u64("a tangent column")?);
+                let val = input.f64("a tangent value")?;
+                if row >= dofs as u64 || col > row {
+                    return Err(CheckpointError::Invalid {
+                        what: "tangent",
+                        detail: format!(
+                            "entry ({row}, {col}) outside the lower triangle of {dofs} DOFs"
+                        ),
+                    });
+                }
+                list.push(Triplet::new(row as usize, col as usize, val));
+            }
+        }
+        Ok(())
     }
 }
 

@@ -45,8 +45,8 @@ pub trait Stepper {
     }
 
     /// Writes what the next step depends on beyond the state and the models (a force buffer
-    /// carried from one step to the next), or refuses: a stepper whose history cannot be
-    /// saved (a factorisation of an earlier state) returns [`CheckpointError::Unsupported`].
+    /// carried from one step to the next, the tangent of a reused factorisation), or refuses
+    /// with [`CheckpointError::Unsupported`] (the default).
     fn save(&self, out: &mut Encoder) -> Result<(), CheckpointError> {
         let _ = out;
         Err(CheckpointError::Unsupported {
@@ -57,8 +57,13 @@ pub trait Stepper {
     /// Instead of [`Stepper::initialize`] when a run resumes: reads back what
     /// [`Stepper::save`] wrote, for a state and models already restored, without evaluating
     /// any force (which would advance the models' histories).
-    fn resume(&mut self, state: &mut State, input: &mut Decoder<'_>) -> Result<(), CoreError> {
-        let _ = (state, input);
+    fn resume(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        input: &mut Decoder<'_>,
+    ) -> Result<(), CoreError> {
+        let _ = (state, models, input);
         Err(CheckpointError::Unsupported {
             what: format!("the {} stepper", self.name()),
         }

@@ -120,7 +120,12 @@ impl Stepper for Verlet {
         Ok(())
     }
 
-    fn resume(&mut self, state: &mut State, input: &mut Decoder<'_>) -> Result<(), CoreError> {
+    fn resume(
+        &mut self,
+        state: &mut State,
+        _models: &mut [Box<dyn Model>],
+        input: &mut Decoder<'_>,
+    ) -> Result<(), CoreError> {
         refuse_spin(state, "verlet")?;
         check_masses(state)?;
         input.tag("verlet")?;

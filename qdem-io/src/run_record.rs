@@ -140,7 +140,8 @@ pub(crate) fn check_checkpointable(
     stepper.save(&mut Encoder::new())
 }
 
-/// The checkpoint body of a run: the record, the state, the stepper, every model.
+/// The checkpoint body of a run: the record, the state, every model, the stepper (whose
+/// resumption may refactorise with the models' restored tangents).
 pub(crate) fn encode_run(
     sim: &Simulation,
     stepper: &dyn Stepper,
@@ -149,16 +150,16 @@ pub(crate) fn encode_run(
     let mut out = Encoder::new();
     record.save(&mut out);
     sim.state.save(&mut out);
-    stepper.save(&mut out)?;
     for m in &sim.models {
         out.tag(&format!("model {}", m.name()));
         m.save(&mut out);
     }
+    stepper.save(&mut out)?;
     Ok(out.into_bytes())
 }
 
 /// Restores a run encoded by [`encode_run`] into a freshly built `sim`, its stepper and a
-/// fresh record; the stepper is resumed rather than initialised.
+/// fresh record; the stepper is resumed, after the models, rather than initialised.
 pub(crate) fn decode_run(
     body: &[u8],
     sim: &mut Simulation,
@@ -168,11 +169,11 @@ pub(crate) fn decode_run(
     let mut input = Decoder::new(body);
     record.restore(&mut input)?;
     sim.state.restore(&mut input)?;
-    stepper.resume(&mut sim.state, &mut input)?;
     for m in sim.models.iter_mut() {
         input.tag(&format!("model {}", m.name()))?;
         m.restore(&mut input)?;
     }
+    stepper.resume(&mut sim.state, &mut sim.models, &mut input)?;
     if !input.is_done() {
         return Err(CheckpointError::Invalid {
             what: "end",

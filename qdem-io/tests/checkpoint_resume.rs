@@ -316,14 +316,29 @@ fn a_resumed_cracking_bonded_beam_equals_the_uninterrupted_one() {
 }
 
 #[test]
+fn a_resumed_implicit_bonded_beam_equals_the_uninterrupted_one() {
+    let dir = test_dir("ckpt-implicit-scene");
+    let scene = bonded_scene(&dir, "beta = 0.25", 0.0);
+    let steps = build(&scene).steps();
+    let files = ["probes.csv", "crack.svg", "probes.svg"];
+    resume_equals_uninterrupted("ckpt-implicit", &scene, steps / 2, &files);
+}
+
+#[test]
 fn a_scene_that_cannot_be_checkpointed_is_refused_before_the_first_step() {
-    let dir = test_dir("ckpt-implicit");
-    let scene = bonded_scene(&dir, "beta = 0.25", 0.001);
+    let dir = test_dir("ckpt-static");
+    let text = std::fs::read_to_string(cantilever_scene(&dir))
+        .unwrap()
+        .replace("integrator = \"verlet\"", "integrator = \"static\"")
+        .replace("dt = \"auto\"", "dt = 0.001")
+        .replace("[output]\n", "[output]\ncheckpoint_every = 0.005\n");
+    let scene = dir.join("static.toml");
+    std::fs::write(&scene, text).unwrap();
     let mut sim = build(&scene);
     let error = run(&mut sim, &dir.join("out"), RunOptions::default()).unwrap_err();
     let message = error.to_string();
     assert!(
-        message.contains("implicit newmark stepper") && message.contains("cannot be checkpointed"),
+        message.contains("static stepper") && message.contains("cannot be checkpointed"),
         "{message}"
     );
     assert_eq!(sim.state.time, 0.0, "no step may be taken");
