@@ -31,8 +31,15 @@ impl Schedule {
         if self.every <= 0.0 || time < self.next - 0.5 * dt {
             return false;
         }
-        while self.next <= time + 0.5 * dt {
-            self.next += self.every;
+        // An interval far below the step (a checkpoint at every step) skips ahead at once,
+        // and one below the rounding of `next` still advances it.
+        let horizon = time + 0.5 * dt;
+        let behind = (horizon - self.next) / self.every;
+        if behind > 64.0 {
+            self.next += behind.floor() * self.every;
+        }
+        while self.next <= horizon {
+            self.next = (self.next + self.every).max(self.next.next_up());
         }
         true
     }
@@ -124,6 +131,22 @@ impl RunRecord {
         t.after_seconds = input.f64("the crack timing")?;
         t.after_steps = input.u64("the crack timing")?;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Schedule;
+
+    #[test]
+    fn a_schedule_is_due_once_per_interval_and_at_every_step_when_the_interval_is_tiny() {
+        let mut every_tenth = Schedule::new(0.1);
+        let due = (0..=100).filter(|&n| every_tenth.due(n as f64 * 0.01, 0.01)).count();
+        assert_eq!(due, 11);
+        let mut tiny = Schedule::after_start(1e-300);
+        assert!((1..=1000).all(|n| tiny.due(n as f64 * 1e-3, 1e-3)));
+        let mut never = Schedule::new(0.0);
+        assert!(!never.due(0.0, 1e-3));
     }
 }
 
