@@ -134,22 +134,6 @@ impl RunRecord {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::Schedule;
-
-    #[test]
-    fn a_schedule_is_due_once_per_interval_and_at_every_step_when_the_interval_is_tiny() {
-        let mut every_tenth = Schedule::new(0.1);
-        let due = (0..=100).filter(|&n| every_tenth.due(n as f64 * 0.01, 0.01)).count();
-        assert_eq!(due, 11);
-        let mut tiny = Schedule::after_start(1e-300);
-        assert!((1..=1000).all(|n| tiny.due(n as f64 * 1e-3, 1e-3)));
-        let mut never = Schedule::new(0.0);
-        assert!(!never.due(0.0, 1e-3));
-    }
-}
-
 /// Fails, naming the first model or the stepper that cannot be checkpointed.
 pub(crate) fn check_checkpointable(
     sim: &Simulation,
@@ -205,4 +189,20 @@ pub(crate) fn decode_run(
         .into());
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Schedule;
+
+    #[test]
+    fn a_schedule_is_due_once_per_interval_and_at_every_step_when_the_interval_is_tiny() {
+        let mut every_tenth = Schedule::new(0.1);
+        let due = (0..=100).filter(|&n| every_tenth.due(n as f64 * 0.01, 0.01)).count();
+        assert_eq!(due, 11);
+        let mut tiny = Schedule::after_start(1e-300);
+        assert!((1..=1000).all(|n| tiny.due(n as f64 * 1e-3, 1e-3)));
+        let mut never = Schedule::new(0.0);
+        assert!(!never.due(0.0, 1e-3));
+    }
 }
