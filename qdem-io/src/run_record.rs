@@ -198,7 +198,9 @@ mod tests {
     #[test]
     fn a_schedule_is_due_once_per_interval_and_at_every_step_when_the_interval_is_tiny() {
         let mut every_tenth = Schedule::new(0.1);
-        let due = (0..=100).filter(|&n| every_tenth.due(n as f64 * 0.01, 0.01)).count();
+        let due = (0..=100)
+            .filter(|&n| every_tenth.due(n as f64 * 0.01, 0.01))
+            .count();
         assert_eq!(due, 11);
         let mut tiny = Schedule::after_start(1e-300);
         assert!((1..=1000).all(|n| tiny.due(n as f64 * 1e-3, 1e-3)));

@@ -234,6 +234,33 @@ pub enum MeshError {
         volume6: f64,
     },
 
+    /// The physical groups would hold more node entries than
+    /// [`crate::MAX_GROUP_ENTRIES_PER_NODE`] per mesh node: elements that are in very many
+    /// physical groups (corrupt or hostile physical tags).
+    #[error(
+        "{}: the physical groups would hold up to {entries} node entries, more than the \
+         {limit} accepted for a mesh of {nodes} nodes (element {element_id} is in {groups} \
+         physical groups); fix: give each element (each entity in $Entities) only the physical \
+         groups it belongs to, and re-export the mesh from gmsh",
+        .file.display()
+    )]
+    TooManyGroupEntries {
+        /// The file.
+        file: PathBuf,
+        /// The total size of the node sets before duplicates between sets are merged (an upper
+        /// bound).
+        entries: u64,
+        /// The limit: [`crate::MAX_GROUP_ENTRIES_PER_NODE`] times the number of nodes, and at
+        /// least 2^20.
+        limit: u64,
+        /// The number of mesh nodes (those used by a tetrahedron).
+        nodes: usize,
+        /// An element of the list of physical groups that contributes most.
+        element_id: u64,
+        /// The number of physical groups that element is in.
+        groups: usize,
+    },
+
     /// The file holds no linear tetrahedra.
     #[error(
         "no tetrahedra (type 4) in {}: mesh the volume (gmsh -3), and if Mesh.SaveAll = 0 put \

@@ -14,8 +14,10 @@
 //! - keeps exact duplicate tetrahedra once (MSH 2.2 repeats an element per physical group).
 //!
 //! The reader never panics: counts are checked against the bytes left before anything is
-//! allocated, and every error names the file and the line (ASCII) or byte offset (binary) or
-//! element id, and ends with a fix.
+//! allocated, the physical groups' node sets are bounded ([`MAX_GROUP_ENTRIES_PER_NODE`]), so
+//! work and memory grow about linearly with the file's size (see `docs/fuzzing.md`), and every
+//! error names the file and the line (ASCII) or byte offset (binary) or element id, and ends
+//! with a fix.
 //!
 //! ```no_run
 //! use std::path::Path;
@@ -59,7 +61,7 @@ pub use msh::{parse_msh, read_msh};
 pub use quality::{max_edge, radius_ratio, signed_volume6, MeshStats, TET_EDGES};
 pub use reorder::NodeGraph;
 pub use surface::TET_FACES_OUTWARD;
-pub use validate::DEGENERATE_TOL;
+pub use validate::{DEGENERATE_TOL, MAX_GROUP_ENTRIES_PER_NODE};
 
 /// A linear tetrahedral mesh with physical groups as node sets.
 #[derive(Debug, Clone, PartialEq, Default)]

@@ -14,6 +14,15 @@ use crate::{PhysicalGroup, TetMesh};
 /// A tetrahedron is degenerate when `|6V| <= DEGENERATE_TOL * (longest edge)^3`.
 pub const DEGENERATE_TOL: f64 = 1e-12;
 
+/// The physical groups of a mesh may hold at most this many node entries per mesh node, all
+/// groups together (2^20 entries for a mesh of up to 16384 nodes). A node of a real mesh is in a
+/// handful of groups (its volume, a boundary surface, a curve, a point); a file whose elements
+/// are each in thousands of groups would otherwise make node sets quadratic in its size.
+pub const MAX_GROUP_ENTRIES_PER_NODE: usize = 64;
+
+/// The node-entry limit of the physical groups of a small mesh (4 MiB of node indices).
+const MIN_GROUP_ENTRY_LIMIT: u64 = 1 << 20;
+
 const NONE: u32 = u32::MAX;
 
 /// File node id to index in the raw node list.
@@ -188,7 +197,7 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
         });
     }
 
-    let groups = groups(&raw, &map, &new_index, file, &mut warnings)?;
+    let groups = groups(&raw, &map, &new_index, nodes.len(), file, &mut warnings)?;
     Ok((
         TetMesh {
             nodes,
@@ -200,10 +209,16 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
 }
 
 /// Physical groups as sorted node sets (new indices), sorted by (dim, tag).
+///
+/// The nodes are gathered per source (list of groups) first, so that an element in many
+/// groups is walked once, and the total size of the sets is checked against
+/// [`MAX_GROUP_ENTRIES_PER_NODE`] before they are filled: the work and memory stay
+/// proportional to the file.
 fn groups(
     raw: &RawMesh,
     map: &IdMap,
     new_index: &[u32],
+    mesh_nodes: usize,
     file: &Path,
     warnings: &mut Vec<MeshWarning>,
 ) -> Result<Vec<PhysicalGroup>, MeshError> {
@@ -213,26 +228,22 @@ fn groups(
     keys.sort_unstable();
     keys.dedup();
     let slot: HashMap<(u8, i32), usize> = keys.iter().enumerate().map(|(k, &g)| (g, k)).collect();
-    let src_slots: Vec<Vec<usize>> = raw
-        .sources
-        .iter()
-        .map(|s| s.iter().map(|g| slot[g]).collect())
-        .collect();
-    let mut sets: Vec<Vec<u32>> = vec![Vec::new(); keys.len()];
 
-    // All tetrahedra, dropped duplicates included (same nodes, maybe other groups).
+    // The node set of each source. All tetrahedra, dropped duplicates included (same nodes,
+    // maybe other groups).
+    let mut per_source: Vec<Vec<u32>> = vec![Vec::new(); raw.sources.len()];
     for t in &raw.tets {
-        for &g in &src_slots[t.src as usize] {
-            for &id in &t.nodes {
-                // Resolved above: every tetrahedron's nodes exist and are used.
-                if let Some(k) = map.get(id) {
-                    sets[g].push(new_index[k as usize]);
-                }
+        if raw.sources[t.src as usize].is_empty() {
+            continue;
+        }
+        for &id in &t.nodes {
+            // Resolved above: every tetrahedron's nodes exist and are used.
+            if let Some(k) = map.get(id) {
+                per_source[t.src as usize].push(new_index[k as usize]);
             }
         }
     }
     for e in &raw.others {
-        let slots = &src_slots[e.src as usize];
         for &id in &raw.other_nodes[e.start..e.start + e.len] {
             let k = map.get(id).ok_or_else(|| MeshError::UndefinedNode {
                 file: file.to_path_buf(),
@@ -241,22 +252,58 @@ fn groups(
             })?;
             let n = new_index[k as usize];
             if n != NONE {
-                for &g in slots {
-                    sets[g].push(n);
-                }
+                per_source[e.src as usize].push(n);
             }
         }
     }
+    for set in &mut per_source {
+        set.sort_unstable();
+        set.dedup();
+    }
 
+    // Each group gets the set of every source it is in: bound the total before filling.
+    let size = |s: usize| (raw.sources[s].len() as u64).saturating_mul(per_source[s].len() as u64);
+    let entries = (0..raw.sources.len()).fold(0u64, |sum, s| sum.saturating_add(size(s)));
+    let limit = (MAX_GROUP_ENTRIES_PER_NODE as u64)
+        .saturating_mul(mesh_nodes as u64)
+        .max(MIN_GROUP_ENTRY_LIMIT);
+    if entries > limit {
+        let worst = (0..raw.sources.len()).max_by_key(|&s| size(s)).unwrap_or(0);
+        let element_id = raw
+            .tets
+            .iter()
+            .map(|t| (t.src, t.id))
+            .chain(raw.others.iter().map(|e| (e.src, e.id)))
+            .find(|&(src, _)| src as usize == worst)
+            .map_or(0, |(_, id)| id);
+        return Err(MeshError::TooManyGroupEntries {
+            file: file.to_path_buf(),
+            entries,
+            limit,
+            nodes: mesh_nodes,
+            element_id,
+            groups: raw.sources[worst].len(),
+        });
+    }
+    let mut sets: Vec<Vec<u32>> = vec![Vec::new(); keys.len()];
+    for (groups, set) in raw.sources.iter().zip(&per_source) {
+        for g in groups {
+            sets[slot[g]].extend_from_slice(set);
+        }
+    }
+
+    // The first name given to a group wins.
+    let mut names: HashMap<(u8, i32), &str> = HashMap::with_capacity(raw.names.len());
+    for (dim, tag, name) in &raw.names {
+        names.entry((*dim, *tag)).or_insert(name.as_str());
+    }
     let mut out = Vec::with_capacity(keys.len());
     for ((dim, tag), mut nodes) in keys.into_iter().zip(sets) {
         nodes.sort_unstable();
         nodes.dedup();
-        let name = raw
-            .names
-            .iter()
-            .find(|&&(d, t, _)| d == dim && t == tag)
-            .map_or_else(|| format!("{dim}:{tag}"), |(_, _, n)| n.clone());
+        let name = names
+            .get(&(dim, tag))
+            .map_or_else(|| format!("{dim}:{tag}"), |n| (*n).to_string());
         if nodes.is_empty() {
             warnings.push(MeshWarning::EmptyGroup {
                 name: name.clone(),

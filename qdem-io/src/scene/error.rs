@@ -76,6 +76,79 @@ pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
     )
 }
 
+/// Diagnostics for many `(offset, message)` pairs, in the given order, with their positions
+/// found in one pass over `text` (in offset order): `line_col` for each would cost a pass per
+/// diagnostic, quadratic for a large file with many problems.
+pub(crate) fn located(
+    path: &Path,
+    text: Option<&str>,
+    items: Vec<(Option<usize>, String)>,
+) -> Vec<Diagnostic> {
+    let mut positions: Vec<Option<(usize, usize)>> = vec![None; items.len()];
+    if let Some(text) = text {
+        let mut order: Vec<usize> = (0..items.len()).filter(|&k| items[k].0.is_some()).collect();
+        order.sort_by_key(|&k| items[k].0);
+        let mut sweep = Sweep::new(text);
+        for k in order {
+            positions[k] = items[k].0.map(|offset| sweep.line_col(offset));
+        }
+    }
+    items
+        .into_iter()
+        .zip(positions)
+        .map(|((_, message), position)| Diagnostic {
+            path: path.to_path_buf(),
+            line: position.map(|p| p.0),
+            column: position.map(|p| p.1),
+            message,
+        })
+        .collect()
+}
+
+/// [`line_col`] for non-decreasing offsets, each in time proportional to the distance from the
+/// previous one.
+struct Sweep<'a> {
+    text: &'a str,
+    /// The last offset asked for (a char boundary), its line, its line's start and its column.
+    offset: usize,
+    line: usize,
+    line_start: usize,
+    column: usize,
+}
+
+impl<'a> Sweep<'a> {
+    fn new(text: &'a str) -> Self {
+        Sweep {
+            text,
+            offset: 0,
+            line: 1,
+            line_start: 0,
+            column: 1,
+        }
+    }
+
+    fn line_col(&mut self, offset: usize) -> (usize, usize) {
+        let mut offset = offset.min(self.text.len());
+        while !self.text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        if offset < self.offset {
+            return line_col(self.text, offset);
+        }
+        let between = &self.text[self.offset..offset];
+        match between.rfind('\n') {
+            Some(last) => {
+                self.line += between.matches('\n').count();
+                self.line_start = self.offset + last + 1;
+                self.column = self.text[self.line_start..offset].chars().count() + 1;
+            }
+            None => self.column += between.chars().count(),
+        }
+        self.offset = offset;
+        (self.line, self.column)
+    }
+}
+
 /// Why a scene could not be loaded.
 ///
 /// Every message starts with the scene path (and `:line:column` where known).
@@ -330,6 +403,26 @@ mod tests {
         assert_eq!(line_col(text, 8), (3, 1));
         assert_eq!(line_col(text, 6), (2, 3)); // inside é: backs up to its start
         assert_eq!(line_col(text, 99), (3, 2));
+    }
+
+    #[test]
+    fn one_pass_positions_match_line_col() {
+        let text = "ab\ncdé\nf\n\nxyz";
+        let offsets = [7, 0, 99, 3, 6, 12, 8, 10, 3];
+        let items: Vec<(Option<usize>, String)> = offsets
+            .iter()
+            .map(|&o| (Some(o), format!("at {o}")))
+            .chain([(None, "nowhere".to_owned())])
+            .collect();
+        let ds = located(Path::new("s.toml"), Some(text), items);
+        for (d, &o) in ds.iter().zip(&offsets) {
+            let (l, c) = line_col(text, o);
+            assert_eq!((d.line, d.column), (Some(l), Some(c)), "offset {o}");
+            assert_eq!(d.message, format!("at {o}"));
+        }
+        assert_eq!((ds[9].line, ds[9].column), (None, None));
+        let ds = located(Path::new("s.toml"), None, vec![(Some(3), "x".to_owned())]);
+        assert_eq!((ds[0].line, ds[0].column), (None, None));
     }
 
     #[test]

@@ -1,10 +1,10 @@
 //! Semantic validation: everything serde cannot check. Every problem is collected (not just
 //! the first) and reported in file order, each naming its table and saying how to fix it.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
-use super::error::{Diagnostic, SceneError};
+use super::error::{located, Diagnostic, SceneError};
 use super::schema::{
     ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load, Periodic, Ramp, RawFix, RawLoad,
     RawScene, Selection, TimeStep,
@@ -13,28 +13,69 @@ use super::spans::SpanIndex;
 use super::suggest::did_you_mean;
 use super::Scene;
 
+/// The most edit-distance cells (characters of the word times characters of the candidates)
+/// that "did you mean" suggestions may cost in one scene: plenty for any real scene, and a bound
+/// for a huge one with thousands of undefined references (whose messages then go without
+/// suggestions).
+const SUGGESTION_BUDGET: usize = 20_000_000;
+
+/// The most names listed in a "defined bodies: ..." message; the rest are counted.
+const MAX_LISTED_NAMES: usize = 20;
+
 /// Collects located problems.
 struct Checker<'a> {
-    path: &'a Path,
     text: Option<&'a str>,
     spans: Option<&'a SpanIndex>,
-    found: Vec<(Option<usize>, Diagnostic)>,
+    /// Problems as (byte offset, message); positions are resolved once, at the end.
+    found: Vec<(Option<usize>, String)>,
+    /// Byte offsets of the starts of the text's lines.
+    line_starts: Vec<usize>,
+    /// What is left of [`SUGGESTION_BUDGET`].
+    suggestion_budget: usize,
 }
 
-impl Checker<'_> {
+impl<'a> Checker<'a> {
+    fn new(text: Option<&'a str>, spans: Option<&'a SpanIndex>) -> Self {
+        let line_starts = text.map_or_else(Vec::new, |t| {
+            std::iter::once(0)
+                .chain(t.match_indices('\n').map(|(k, _)| k + 1))
+                .collect()
+        });
+        Checker {
+            text,
+            spans,
+            found: Vec::new(),
+            line_starts,
+            suggestion_budget: SUGGESTION_BUDGET,
+        }
+    }
+
     fn offset(&self, at: &[&str]) -> Option<usize> {
         self.spans.and_then(|s| s.offset(at))
     }
 
     fn line_of(&self, at: &[&str]) -> Option<usize> {
         let offset = self.offset(at)?;
-        Some(super::error::line_col(self.text?, offset).0)
+        self.text
+            .map(|_| self.line_starts.partition_point(|&start| start <= offset))
     }
 
     fn error(&mut self, at: &[&str], message: String) {
         let offset = self.offset(at);
-        let d = Diagnostic::at(self.path, self.text, offset, message);
-        self.found.push((offset, d));
+        self.found.push((offset, message));
+    }
+
+    /// [`did_you_mean`] within the scene's [`SUGGESTION_BUDGET`].
+    fn suggest<'n>(&mut self, word: &str, candidates: &[&'n str]) -> Option<&'n str> {
+        let cells = candidates
+            .iter()
+            .fold(0usize, |sum, c| sum.saturating_add(c.len() + 1))
+            .saturating_mul(word.len() + 1);
+        if cells > self.suggestion_budget {
+            return None;
+        }
+        self.suggestion_budget -= cells;
+        did_you_mean(word, candidates.iter().copied())
     }
 
     /// Check that every component is finite; true when they all are.
@@ -94,11 +135,17 @@ fn label(table: &str, index: usize, name: Option<&str>) -> String {
     }
 }
 
-fn quoted_names<'a>(names: impl Iterator<Item = &'a str>) -> String {
-    names
+/// `"a", "b", "c"`, at most [`MAX_LISTED_NAMES`] of them, then `… and N more`.
+fn quoted_names<'a>(names: impl ExactSizeIterator<Item = &'a str>) -> String {
+    let total = names.len();
+    let mut listed: Vec<String> = names
+        .take(MAX_LISTED_NAMES)
         .map(|n| format!("{n:?}"))
-        .collect::<Vec<_>>()
-        .join(", ")
+        .collect();
+    if total > listed.len() {
+        listed.push(format!("… and {} more", total - listed.len()));
+    }
+    listed.join(", ")
 }
 
 /// Check names: non-empty and unique within their table.
@@ -148,7 +195,7 @@ fn body_ref(
         return;
     }
     let mut m = format!("{owner}: body {body:?} is not defined");
-    if let Some(s) = did_you_mean(body, body_names.iter().copied()) {
+    if let Some(s) = c.suggest(body, body_names) {
         m.push_str(&format!("; did you mean {s:?}?"));
     }
     if body_names.is_empty() {
@@ -328,12 +375,7 @@ pub(crate) fn validate(
     text: Option<&str>,
     spans: Option<&SpanIndex>,
 ) -> Result<Scene, SceneError> {
-    let mut c = Checker {
-        path,
-        text,
-        spans,
-        found: Vec::new(),
-    };
+    let mut c = Checker::new(text, spans);
 
     // [run]
     let run = &raw.run;
@@ -473,7 +515,7 @@ pub(crate) fn validate(
         }
         if !materials.contains_key(b.material.as_str()) {
             let mut m = format!("{l}: material {:?} is not defined", b.material);
-            if let Some(s) = did_you_mean(&b.material, material_names.iter().copied()) {
+            if let Some(s) = c.suggest(&b.material, &material_names) {
                 m.push_str(&format!("; did you mean {s:?}?"));
             }
             if material_names.is_empty() {
@@ -489,6 +531,12 @@ pub(crate) fn validate(
     }
 
     // [[fix]]
+    let rigid_bodies: HashSet<&str> = raw
+        .bodies
+        .iter()
+        .filter(|b| b.rigid)
+        .map(|b| b.name.as_str())
+        .collect();
     let mut fixes = Vec::with_capacity(raw.fixes.len());
     for (i, f) in raw.fixes.iter().enumerate() {
         let idx = i.to_string();
@@ -503,7 +551,7 @@ pub(crate) fn validate(
         );
         let sel = selection(&mut c, "fix", &idx, &l, &f.group, &f.bbox);
         let mask = dofs(&mut c, &["fix", &idx, "dofs"], &l, &f.dofs);
-        let rigid = raw.bodies.iter().any(|b| b.name == f.body && b.rigid);
+        let rigid = rigid_bodies.contains(f.body.as_str());
         if f.rotation && !rigid {
             c.error(
                 &["fix", &idx, "rotation"],
@@ -602,9 +650,7 @@ pub(crate) fn validate(
     if !c.found.is_empty() {
         let mut found = c.found;
         found.sort_by_key(|(offset, _)| offset.unwrap_or(usize::MAX));
-        return Err(SceneError::Invalid(
-            found.into_iter().map(|(_, d)| d).collect(),
-        ));
+        return Err(SceneError::Invalid(located(path, text, found)));
     }
     Ok(Scene {
         run: raw.run,
@@ -846,7 +892,7 @@ fn bonded_table(
     let at = |key: &'static str| ["bonded", key];
     if !materials.contains(&b.material.as_str()) {
         let mut m = format!("{l}: material {:?} is not defined", b.material);
-        if let Some(s) = did_you_mean(&b.material, materials.iter().copied()) {
+        if let Some(s) = c.suggest(&b.material, materials) {
             m.push_str(&format!("; did you mean {s:?}?"));
         }
         c.error(&at("material"), m);
@@ -1210,9 +1256,7 @@ pub(crate) fn missing_files(
         } else {
             "does not exist"
         };
-        out.push(Diagnostic::at(
-            &scene.path,
-            text,
+        out.push((
             offset,
             format!(
                 "{}: mesh file {} {what} (mesh = {:?} is resolved relative to the scene file's \
@@ -1225,9 +1269,7 @@ pub(crate) fn missing_files(
     }
     if let Some(sample) = scene.sample_path().filter(|p| !p.is_file()) {
         let offset = spans.and_then(|s| s.offset(&["granular", "sample"]));
-        out.push(Diagnostic::at(
-            &scene.path,
-            text,
+        out.push((
             offset,
             format!(
                 "[granular]: sample file {} does not exist (resolved relative to the scene \
@@ -1244,9 +1286,7 @@ pub(crate) fn missing_files(
         }
         let idx = i.to_string();
         let offset = spans.and_then(|s| s.offset(&["wall", &idx, "mesh"]));
-        out.push(Diagnostic::at(
-            &scene.path,
-            text,
+        out.push((
             offset,
             format!(
                 "{}: mesh file {} does not exist (resolved relative to the scene file's \
@@ -1256,5 +1296,5 @@ pub(crate) fn missing_files(
             ),
         ));
     }
-    out
+    located(&scene.path, text, out)
 }
