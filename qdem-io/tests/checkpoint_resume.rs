@@ -8,37 +8,22 @@
 
 mod common;
 
-use common::test_dir;
+use common::{fixture, short_cantilever, test_dir};
 use qdem_io::build::Simulation;
 use qdem_io::checkpoint::CHECKPOINT_FILE;
 use qdem_io::runner::{run_with, RunError, RunOptions};
 use qdem_io::scene::Scene;
 use std::path::{Path, PathBuf};
 
-fn fixture(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../fixtures")
-        .join(rel)
-}
-
-/// The cantilever on its coarse mesh, shortened to 0.02 s (5,300 steps) of its load ramp.
+/// The short cantilever (5,300 steps), sampled every 1 ms, a VTU every 5 ms.
 fn cantilever_scene(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string(fixture("cantilever/cantilever_lc100.toml"))
-        .unwrap()
-        .replace("t_end = 3.0", "t_end = 0.02")
-        .replace("probe_every = 1e-4", "probe_every = 1e-3")
-        .replace("[0.0, 0.0], [1.0, 1.0]", "[0.0, 0.0], [0.01, 1.0]")
-        .replace(
-            "mesh = \"cantilever_lc100.msh\"",
-            &format!(
-                "mesh = \"{}\"",
-                fixture("cantilever/cantilever_lc100.msh").display()
-            ),
-        );
-    let path = dir.join("cantilever.toml");
-    let text = text.replace("vtu_every = 0.05", "vtu_every = 0.005");
-    std::fs::write(&path, text).unwrap();
-    path
+    short_cantilever(
+        dir,
+        &[
+            ("probe_every = 1e-4", "probe_every = 1e-3"),
+            ("vtu_every = 0.05", "vtu_every = 0.005"),
+        ],
+    )
 }
 
 /// A rigid sleeper dropped onto 40 falling clumps in a cell periodic along y, its ghosts

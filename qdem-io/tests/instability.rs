@@ -5,37 +5,17 @@
 
 mod common;
 
-use common::test_dir;
+use common::{short_cantilever, test_dir};
 use qdem_io::build::Simulation;
 use qdem_io::checkpoint::{read_checkpoint, scene_fingerprint, CHECKPOINT_FILE};
 use qdem_io::runner::{run, RunError};
 use qdem_io::scene::Scene;
 use std::path::{Path, PathBuf};
 
-fn fixture(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../fixtures")
-        .join(rel)
-}
-
-/// The coarse cantilever for 0.02 s, its tip load `tip_force` (N, downwards) ramped on over
-/// 0.01 s.
+/// The short cantilever with its tip load `tip_force` (N, downwards).
 fn cantilever(dir: &Path, tip_force: f64) -> PathBuf {
-    let text = std::fs::read_to_string(fixture("cantilever/cantilever_lc100.toml"))
-        .unwrap()
-        .replace("t_end = 3.0", "t_end = 0.02")
-        .replace("[0.0, 0.0], [1.0, 1.0]", "[0.0, 0.0], [0.01, 1.0]")
-        .replace("-200.0]", &format!("{:?}]", -tip_force))
-        .replace(
-            "mesh = \"cantilever_lc100.msh\"",
-            &format!(
-                "mesh = \"{}\"",
-                fixture("cantilever/cantilever_lc100.msh").display()
-            ),
-        );
-    let path = dir.join("cantilever.toml");
-    std::fs::write(&path, text).unwrap();
-    path
+    let force = format!("{:?}]", -tip_force);
+    short_cantilever(dir, &[("-200.0]", force.as_str())])
 }
 
 /// Runs the scene with its step scaled by `dt_factor`; returns the error and the checkpoint.
