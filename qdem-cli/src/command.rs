@@ -19,6 +19,9 @@ usage:
                                              run a scene; outputs go to DIR (default: the scene's [output] dir);
                                              Ctrl-C or SIGTERM stops it with DIR/checkpoint.qdc, which --resume continues
   qdem check SCENE [--threads N]             validate a scene; print meshes, mass, stable dt, cost estimate
+  qdem analyze SCENE [--out DIR] [--from T] [--to T] [--bandwidth HZ] [--fmax HZ]
+                                             spectra (Parzen window, default 20 Hz) and mobility of a finished
+                                             run's probes into DIR/analysis (default: the scene's [output] dir)
   qdem verify [--json] [--full [--out DIR]]  run the analytical fixtures (--full adds the cantilever meshes,
                                              keeping their outputs and plots in DIR, default out/verify)
   qdem bench [--json] [--tets N,N,..] [--threads N,N,..] [--steps N]
@@ -47,6 +50,9 @@ pub enum CliError {
     /// A verification fixture that failed to run or missed its tolerance.
     #[error("{0}")]
     Verify(String),
+    /// An analysis that could not be made.
+    #[error(transparent)]
+    Analyze(#[from] qdem_io::analyze::AnalyzeError),
     /// The thread pool could not be set up.
     #[error("cannot start {threads} threads: {message}")]
     Threads {
@@ -69,6 +75,17 @@ struct Options {
     tets: Option<Vec<usize>>,
     steps: Option<usize>,
     resume: Option<PathBuf>,
+    analyze: qdem_io::analyze::AnalyzeOptions,
+}
+
+/// A finite non-negative number of seconds or hertz.
+fn parse_number(flag: &str, value: &str) -> Result<f64, CliError> {
+    value
+        .trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .ok_or_else(|| CliError::Usage(format!("{flag} takes a number >= 0, got `{value}`")))
 }
 
 fn parse_list(flag: &str, value: &str) -> Result<Vec<usize>, CliError> {
@@ -113,6 +130,10 @@ fn parse(args: &[String], allowed: &[&str]) -> Result<Options, CliError> {
             "--steps" => o.steps = Some(parse_list(arg, &value()?)?[0]),
             "--tets" => o.tets = Some(parse_list(arg, &value()?)?),
             "--threads" => o.threads = Some(parse_list(arg, &value()?)?),
+            "--from" => o.analyze.from = Some(parse_number(arg, &value()?)?),
+            "--to" => o.analyze.to = Some(parse_number(arg, &value()?)?),
+            "--bandwidth" => o.analyze.bandwidth = parse_number(arg, &value()?)?,
+            "--fmax" => o.analyze.max_frequency = parse_number(arg, &value()?)?,
             _ => unreachable!("every allowed option is matched"),
         }
     }
@@ -178,6 +199,10 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
             set_threads(o.threads.as_deref())?;
             check_scene(&one_scene(&o, "check")?)
         }
+        "analyze" => {
+            let o = parse(rest, &["--out", "--from", "--to", "--bandwidth", "--fmax"])?;
+            analyze_run(&one_scene(&o, "analyze")?, o.out.as_deref(), &o.analyze)
+        }
         "verify" => {
             let o = parse(rest, &["--json", "--full", "--out"])?;
             no_positional(&o, "verify")?;
@@ -212,6 +237,38 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
         }
         other => Err(CliError::Usage(format!("unknown command `{other}`"))),
     }
+}
+
+fn analyze_run(
+    path: &Path,
+    out: Option<&Path>,
+    options: &qdem_io::analyze::AnalyzeOptions,
+) -> Result<(), CliError> {
+    let scene = Scene::load(path)?;
+    let out_dir = match out {
+        Some(dir) => dir.to_path_buf(),
+        None => scene.base_dir().join(&scene.output.dir),
+    };
+    let a = qdem_io::analyze::analyze(&scene, &out_dir, options)?;
+    println!(
+        "analysed {} rows every {:.4e} s ({:.4} s, frequency step {:.3} Hz), Parzen bandwidth {} Hz",
+        a.rows,
+        a.dt,
+        a.dt * (a.rows - 1) as f64,
+        1.0 / (a.dt * a.rows as f64),
+        options.bandwidth
+    );
+    for p in &a.peaks {
+        println!(
+            "probe `{}`: largest smoothed vertical-acceleration amplitude above 20 Hz at {:.1} Hz ({:.3e} m/s)",
+            p.probe, p.frequency, p.amplitude
+        );
+    }
+    if !a.mobility {
+        println!("no `series` load in the scene: mobility not computed");
+    }
+    println!("spectra, mobility and plots in {}", a.dir.display());
+    Ok(())
 }
 
 /// Set by the Ctrl-C / SIGTERM handler: the run stops after its current step, checkpointed.
@@ -353,7 +410,7 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
         Ok(()) => println!("checkpoints: supported (`checkpoint_every`, Ctrl-C, --resume)"),
         Err(why) => println!("checkpoints: not supported: {why}"),
     }
-    let per_step = measure_step_cost(&mut sim, 20)?;
+    let (per_step, stepped) = measure_step_cost(&mut sim, 20)?;
     let total = per_step * sim.steps() as f64;
     println!(
         "measured {:.3e} s/step on {} threads ({:.3e} tet-steps/s): estimated run time {} (outputs not counted)",
@@ -362,14 +419,53 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
         sim.tets() as f64 / per_step,
         progress::clock(total)
     );
+    print_force_split(&mut sim, &stepped, per_step, 10);
     Ok(())
+}
+
+/// Where a step's time goes: each model's force evaluation timed over `n` calls on the state
+/// the cost measurement left, as a share of the measured step; models under 1% are summed.
+fn print_force_split(sim: &mut Simulation, state: &qdem_core::State, per_step: f64, n: usize) {
+    let mut force = vec![qdem_core::Vec3::zeros(); state.len()];
+    let mut torque = vec![qdem_core::Vec3::zeros(); state.rigid.len() + state.spin.len()];
+    let mut rest = 0.0;
+    let mut forces = 0.0;
+    println!("time per step by model (force evaluation, {n} calls each):");
+    for model in sim.models.iter_mut() {
+        let start = Instant::now();
+        for _ in 0..n {
+            model.add_forces(state, &mut force, &mut torque);
+        }
+        let seconds = start.elapsed().as_secs_f64() / n as f64;
+        forces += seconds;
+        if seconds < 0.01 * per_step {
+            rest += seconds;
+            continue;
+        }
+        println!(
+            "  {:<24} {seconds:.3e} s ({:.1}%)",
+            model.name(),
+            100.0 * seconds / per_step
+        );
+    }
+    println!(
+        "  {:<24} {rest:.3e} s ({:.1}%)",
+        "other models",
+        100.0 * rest / per_step
+    );
+    let integrate = (per_step - forces).max(0.0);
+    println!(
+        "  {:<24} {integrate:.3e} s ({:.1}%)",
+        "integration and checks",
+        100.0 * integrate / per_step
+    );
 }
 
 /// Wall seconds per step of the scene's own stepper, measured over `n` steps on a copy of the
 /// state; for implicit and static scenes also prints the sparse system's size, non-zeros,
 /// Cholesky fill and factorisation time from the stepper's one factorisation (in
 /// `initialize`, which is not timed).
-fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<f64, CliError> {
+fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<(f64, qdem_core::State), CliError> {
     let run_error = |source| RunError::Core {
         scene: sim.scene.path.clone(),
         source,
@@ -396,5 +492,5 @@ fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<f64, CliError> {
             .step(&mut state, &mut sim.models)
             .map_err(run_error)?;
     }
-    Ok(start.elapsed().as_secs_f64() / n as f64)
+    Ok((start.elapsed().as_secs_f64() / n as f64, state))
 }

@@ -97,6 +97,7 @@ pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, 
         warnings: Vec::new(),
         granular: None,
         periodic: None,
+        ballast: None,
     })
 }
 

@@ -6,6 +6,7 @@
 //! ([`crate::contact_build`]), [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per
 //! load.
 
+use crate::ballast_build::{place_ballast, BallastInfo};
 use crate::contact_build::ExtraSpheres;
 use crate::granular_build::GranularInfo;
 use crate::scene::suggest::did_you_mean;
@@ -100,6 +101,37 @@ pub enum BuildError {
         /// What is wrong.
         message: String,
     },
+    /// `[ballast]` stones cannot be made or placed.
+    #[error("{scene}: [ballast]: {message}")]
+    Ballast {
+        /// The scene file.
+        scene: PathBuf,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+    /// A load's series file is malformed.
+    #[error(
+        "{path}:{line}: {message} (a series file is CSV with a header row, time in s in the \
+         first column, rows in non-decreasing time)"
+    )]
+    Series {
+        /// The file.
+        path: PathBuf,
+        /// Line number (1-based; 0 when the file could not be read).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// `[run] start_from` cannot be used.
+    #[error("{scene}: [run] start_from {checkpoint}: {message}")]
+    StartFrom {
+        /// The scene file.
+        scene: PathBuf,
+        /// The checkpoint.
+        checkpoint: PathBuf,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
     /// A fix or load selects no particle.
     #[error("{scene}: {what} on body `{body}` selects no particle: {fix}")]
     EmptySelection {
@@ -182,6 +214,8 @@ pub struct Simulation {
     pub granular: Option<GranularInfo>,
     /// The periodic cell of `[periodic]` and the groups of particles that wrap together.
     pub periodic: Option<(PeriodicBox, Vec<WrapGroup>)>,
+    /// The stones of `[ballast]`.
+    pub ballast: Option<BallastInfo>,
 }
 
 /// A body's mesh as read and placed, with its file and its particles' place in the state.
@@ -202,7 +236,7 @@ impl Simulation {
             scene: scene.path.clone(),
             source,
         };
-        let (meshes, warnings) = read_meshes(&scene)?;
+        let (meshes, warnings, ballast) = read_meshes(&scene)?;
         let reference = meshes
             .iter()
             .flat_map(|m| m.mesh.nodes.iter().map(|p| Vec3::from(*p)));
@@ -212,6 +246,12 @@ impl Simulation {
         apply_fixes(&scene, &meshes, &mut state)?;
         fix_rigid_bodies(&scene, &bodies, &mut state);
         let mut extra = ExtraSpheres::default();
+        if let Some(info) = &ballast {
+            extra.spheres.clone_from(&info.spheres);
+            extra.names = (1..=info.stones.len())
+                .map(|k| format!("{} stone {k}", info.name))
+                .collect();
+        }
         let granular = match &scene.granular {
             Some(g) => {
                 let stones = crate::granular_build::stones(&scene, g)?;
@@ -225,13 +265,13 @@ impl Simulation {
                     g,
                     &stones,
                     &mut state,
-                    scene.bodies.len(),
+                    scene.bodies.len() + extra.names.len(),
                     material,
                 )?;
-                extra.spheres = spheres;
-                extra.names = (1..=info.len())
-                    .map(|k| format!("{} stone {k}", g.name))
-                    .collect();
+                extra.spheres.extend(spheres);
+                extra
+                    .names
+                    .extend((1..=info.len()).map(|k| format!("{} stone {k}", g.name)));
                 Some(info)
             }
             None => None,
@@ -239,7 +279,12 @@ impl Simulation {
         let periodic = match &scene.periodic {
             Some(p) => Some((
                 crate::periodic_build::periodic_box(&scene, p)?,
-                crate::periodic_build::wrap_groups(&state, &bodies, granular.as_ref()),
+                crate::periodic_build::wrap_groups(
+                    &state,
+                    &bodies,
+                    granular.as_ref(),
+                    ballast.as_ref(),
+                ),
             )),
             None => None,
         };
@@ -253,19 +298,10 @@ impl Simulation {
             models.push(Box::new(Gravity::new(Vec3::from(scene.run.gravity))));
         }
         build_loads(&scene, &meshes, &mut models)?;
-        let probes = scene
-            .probes
-            .iter()
-            .map(|p| {
-                let body = &bodies[body_index(&scene, &p.body)];
-                let center = match body.kind {
-                    BodyKind::Rigid { center, .. } => Some(center),
-                    BodyKind::Deformable { .. } => None,
-                };
-                let candidates = body.particles.clone().chain(center);
-                nearest_particle(&state, candidates, Vec3::from(p.point), &p.name)
-            })
-            .collect();
+        if let Some(file) = &scene.run.start_from {
+            crate::start_from::restore_state(&scene, file, &mut state, periodic.as_ref())?;
+        }
+        let probes = resolve_probes(&scene, &bodies, &state);
         let stable_dt = stable_step(&state, &models).unwrap_or((f64::INFINITY, String::new()));
         let dt = choose_dt(&scene, &state, &models).map_err(core)?;
         Ok(Simulation {
@@ -279,6 +315,7 @@ impl Simulation {
             warnings,
             granular,
             periodic,
+            ballast,
         })
     }
 
@@ -326,9 +363,30 @@ impl Simulation {
     }
 }
 
+/// Each probe at the particle of its body nearest its point at the start of the run (after
+/// `start_from`, the settled positions).
+fn resolve_probes(scene: &Scene, bodies: &[BodyInfo], state: &State) -> Vec<ProbePoint> {
+    scene
+        .probes
+        .iter()
+        .map(|p| {
+            let body = &bodies[body_index(scene, &p.body)];
+            let center = match body.kind {
+                BodyKind::Rigid { center, .. } => Some(center),
+                BodyKind::Deformable { .. } => None,
+            };
+            let candidates = body.particles.clone().chain(center);
+            nearest_particle(state, candidates, Vec3::from(p.point), &p.name)
+        })
+        .collect()
+}
+
+/// The placed meshes, mesh warnings and `[ballast]` stones of a scene.
+type ReadMeshes = (Vec<PlacedMesh>, Vec<String>, Option<BallastInfo>);
+
 /// Reads (and reorders, unless the body says not to) every body's mesh, laying the bodies'
-/// particles out one after another.
-fn read_meshes(scene: &Scene) -> Result<(Vec<PlacedMesh>, Vec<String>), BuildError> {
+/// particles out one after another, then the `[ballast]` stones as one more mesh.
+fn read_meshes(scene: &Scene) -> Result<ReadMeshes, BuildError> {
     let mut warnings = Vec::new();
     let mut meshes: Vec<PlacedMesh> = Vec::new();
     for body in &scene.bodies {
@@ -351,7 +409,15 @@ fn read_meshes(scene: &Scene) -> Result<(Vec<PlacedMesh>, Vec<String>), BuildErr
             particles,
         });
     }
-    Ok((meshes, warnings))
+    let mut ballast = None;
+    if let Some(b) = &scene.ballast {
+        let start = meshes.last().map_or(0, |m| m.particles.end);
+        let (placed, info, stone_warnings) = place_ballast(scene, b, start, scene.bodies.len())?;
+        meshes.push(placed);
+        warnings.extend(stone_warnings);
+        ballast = Some(info);
+    }
+    Ok((meshes, warnings, ballast))
 }
 
 /// Rotates the nodes about their centroid by `degrees` about x, then y, then z, then
@@ -419,6 +485,25 @@ fn build_bodies(
             mesh: placed.path.clone(),
         });
     }
+    if let (Some(b), Some(placed)) = (&scene.ballast, meshes.get(scene.bodies.len())) {
+        let material = core_material(scene.material(&b.material).expect("validated scene"));
+        let tets = offset_tets(&placed.mesh, placed.particles.start);
+        let stones = TetBody::new(&b.name, &state.reference, tets, material)?;
+        stones.lump_mass(&mut state.mass);
+        models.push(Box::new(stones));
+        for i in placed.particles.clone() {
+            state.velocity[i] = Vec3::from(b.velocity);
+        }
+        bodies.push(BodyInfo {
+            name: b.name.clone(),
+            particles: placed.particles.clone(),
+            kind: BodyKind::Deformable {
+                model: models.len() - 1,
+            },
+            stats: placed.mesh.stats(),
+            mesh: placed.path.clone(),
+        });
+    }
     Ok(bodies)
 }
 
@@ -478,9 +563,13 @@ fn build_loads(
             .iter()
             .map(|&n| (start + n as usize) as u32)
             .collect();
-        let ramp = match &load.cyclic {
-            Some(c) => TimeFunction::cyclic(c.cycle()),
-            None => load.ramp.time_function(),
+        let ramp = match (&load.cyclic, &load.series) {
+            (Some(c), _) => TimeFunction::cyclic(c.cycle()),
+            (None, Some(series)) => TimeFunction::new(crate::load_series::read_series(
+                &scene.resolve(&series.file),
+                &series.column,
+            )?),
+            (None, None) => load.ramp.time_function(),
         }
         .map_err(|source| BuildError::Core {
             scene: scene.path.clone(),
@@ -518,12 +607,20 @@ fn choose_dt(scene: &Scene, state: &State, models: &[Box<dyn Model>]) -> Result<
     })
 }
 
-/// Index of a body that the validated scene guarantees to exist.
+/// Index of a body that the validated scene guarantees to exist (the `[ballast]` comes after
+/// the `[[body]]`s).
 pub(crate) fn body_index(scene: &Scene, name: &str) -> usize {
     scene
         .bodies
         .iter()
         .position(|b| b.name == name)
+        .or_else(|| {
+            scene
+                .ballast
+                .as_ref()
+                .filter(|b| b.name == name)
+                .map(|_| scene.bodies.len())
+        })
         .expect("validated scene")
 }
 
@@ -612,7 +709,7 @@ fn nearest_particle(
     name: &str,
 ) -> ProbePoint {
     let (particle, distance) = candidates
-        .map(|i| (i, (state.reference[i] - point).norm()))
+        .map(|i| (i, (state.position[i] - point).norm()))
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .expect("a body has particles");
     ProbePoint {

@@ -13,13 +13,22 @@
 //! - [`output`]: atomic writers for VTU/PVD, probe CSV and summary JSON.
 //! - [`spectrum`]: dominant frequency of a probe record by FFT.
 //! - [`plot`]: SVG line plots beside the CSVs.
+//! - `[ballast]` ([`ballast_build`]): deformable stones laid out for deposition (paper 000 §4);
+//!   `[run] start_from` begins a run from another scene's checkpoint; a `[[load]]` may follow
+//!   a CSV time series.
+//! - [`analyze`]: Parzen-smoothed linear spectra and mobility of a run's sensors
+//!   ([`linear_spectrum`], paper 000 §4.2).
 
+pub mod analyze;
+pub mod ballast_build;
 mod bonded_build;
 pub mod build;
 pub mod checkpoint;
 mod contact_build;
 pub mod crack_svg;
 pub mod granular_build;
+pub mod linear_spectrum;
+mod load_series;
 pub mod output;
 mod periodic_build;
 pub mod plot;
@@ -27,3 +36,4 @@ mod run_record;
 pub mod runner;
 pub mod scene;
 pub mod spectrum;
+mod start_from;

@@ -2,6 +2,7 @@
 //! (every body whole: paper 003's ghosts are copies of whole particles), and the time-delayed
 //! boundary that follows a sleeper's cyclic load (paper 003 §5).
 
+use crate::ballast_build::BallastInfo;
 use crate::build::{BodyInfo, BodyKind, BuildError};
 use crate::granular_build::GranularInfo;
 use crate::scene::{Periodic, Scene};
@@ -39,37 +40,30 @@ pub(crate) fn periodic_box(scene: &Scene, periodic: &Periodic) -> Result<Periodi
 }
 
 /// One group per body: a deformable body's nodes anchored at the node nearest its centroid, a
-/// rigid body's members anchored at its centre, each stone likewise.
+/// rigid body's members anchored at its centre, each rigid stone at its centre and each ballast
+/// stone (not the ballast as a whole) like a deformable body.
 pub(crate) fn wrap_groups(
     state: &State,
     bodies: &[BodyInfo],
     granular: Option<&GranularInfo>,
+    ballast: Option<&BallastInfo>,
 ) -> Vec<WrapGroup> {
     let mut groups = Vec::new();
     for body in bodies {
-        let mut particles: Vec<usize> = body.particles.clone().collect();
-        let anchor = match body.kind {
+        if ballast.is_some_and(|b| b.name == body.name) {
+            continue;
+        }
+        groups.push(match body.kind {
             BodyKind::Rigid { center, .. } => {
+                let mut particles: Vec<usize> = body.particles.clone().collect();
                 particles.push(center);
-                center
+                WrapGroup {
+                    anchor: center,
+                    particles,
+                }
             }
-            BodyKind::Deformable { .. } => {
-                let n = particles.len().max(1) as f64;
-                let centroid = particles
-                    .iter()
-                    .fold(Vec3::zeros(), |a, &p| a + state.position[p])
-                    / n;
-                *particles
-                    .iter()
-                    .min_by(|&&a, &&b| {
-                        let da = (state.position[a] - centroid).norm_squared();
-                        let db = (state.position[b] - centroid).norm_squared();
-                        da.total_cmp(&db)
-                    })
-                    .unwrap_or(&body.particles.start)
-            }
-        };
-        groups.push(WrapGroup { anchor, particles });
+            BodyKind::Deformable { .. } => deformable_group(state, body.particles.clone()),
+        });
     }
     if let Some(g) = granular {
         for (center, members) in &g.stones {
@@ -81,7 +75,29 @@ pub(crate) fn wrap_groups(
             });
         }
     }
+    if let Some(b) = ballast {
+        groups.extend(b.stones.iter().map(|s| deformable_group(state, s.clone())));
+    }
     groups
+}
+
+/// The particles of a deformable body, anchored at the one nearest their centroid.
+fn deformable_group(state: &State, range: std::ops::Range<usize>) -> WrapGroup {
+    let particles: Vec<usize> = range.clone().collect();
+    let n = particles.len().max(1) as f64;
+    let centroid = particles
+        .iter()
+        .fold(Vec3::zeros(), |a, &p| a + state.position[p])
+        / n;
+    let anchor = *particles
+        .iter()
+        .min_by(|&&a, &&b| {
+            let da = (state.position[a] - centroid).norm_squared();
+            let db = (state.position[b] - centroid).norm_squared();
+            da.total_cmp(&db)
+        })
+        .unwrap_or(&range.start);
+    WrapGroup { anchor, particles }
 }
 
 /// Adds the periodic cell, and the time delay if asked, to the contact model.

@@ -103,7 +103,13 @@ impl RunRecord {
         out.u64(t.after_steps);
     }
 
-    fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+    /// Reads a record written by `save`; `fixed_histories` says that the number of probe
+    /// histories must match this record's (false only to read past a record).
+    fn restore(
+        &mut self,
+        input: &mut Decoder<'_>,
+        fixed_histories: bool,
+    ) -> Result<(), CheckpointError> {
         input.tag("run")?;
         self.next_step = input.u64("the next step")?;
         for s in [&mut self.probes, &mut self.vtu, &mut self.checkpoints] {
@@ -115,7 +121,11 @@ impl RunRecord {
         }
         self.probe_rows = input.u64("the probe rows")?;
         let series = input.u64("the probe histories")? as usize;
-        same_count("probe histories", self.history.len(), series)?;
+        if fixed_histories {
+            same_count("probe histories", self.history.len(), series)?;
+        } else {
+            self.history = vec![Vec::new(); series];
+        }
         for h in self.history.iter_mut() {
             let flat = input.f64s("a probe history")?;
             *h = flat.chunks_exact(2).map(|p| (p[0], p[1])).collect();
@@ -132,6 +142,23 @@ impl RunRecord {
         t.after_steps = input.u64("the crack timing")?;
         Ok(())
     }
+}
+
+/// Reads past the run record at the start of a checkpoint body, leaving `input` at the state
+/// (for `[run] start_from`, which takes only the state).
+pub(crate) fn skip_record(input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+    let mut record = RunRecord {
+        next_step: 0,
+        probes: Schedule::new(0.0),
+        vtu: Schedule::new(0.0),
+        checkpoints: Schedule::new(0.0),
+        pvd: PvdIndex::new(),
+        probe_rows: 0,
+        history: Vec::new(),
+        boundary_rows: Vec::new(),
+        timing: CrackTiming::default(),
+    };
+    record.restore(input, false)
 }
 
 /// Fails, naming the first model or the stepper that cannot be checkpointed.
@@ -174,7 +201,7 @@ pub(crate) fn decode_run(
     record: &mut RunRecord,
 ) -> Result<(), CoreError> {
     let mut input = Decoder::new(body);
-    record.restore(&mut input)?;
+    record.restore(&mut input, true)?;
     sim.state.restore(&mut input)?;
     for m in sim.models.iter_mut() {
         input.tag(&format!("model {}", m.name()))?;

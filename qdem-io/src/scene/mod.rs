@@ -42,9 +42,9 @@ mod validate;
 
 pub use error::{Diagnostic, SceneError};
 pub use schema::{
-    Body, Bonded, Contact, ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load, Material,
-    Output, PackingName, Periodic, Probe, Ramp, Run, Selection, Supports, TimeDelay, TimeStep,
-    Wall,
+    Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load,
+    Material, Output, PackingName, Periodic, Probe, Ramp, Run, Selection, Series, Supports,
+    TimeDelay, TimeStep, Wall,
 };
 
 use schema::RawScene;
@@ -154,6 +154,8 @@ pub struct Scene {
     pub periodic: Option<Periodic>,
     /// `[granular]`: a sample of rigid stones.
     pub granular: Option<Granular>,
+    /// `[ballast]`: deformable stones.
+    pub ballast: Option<Ballast>,
     /// `[output]` (defaults when absent).
     pub output: Output,
     /// The scene file; relative paths inside the scene are resolved against its directory.
@@ -218,6 +220,12 @@ impl Scene {
     pub fn sample_path(&self) -> Option<PathBuf> {
         let sample = self.granular.as_ref()?.sample.as_ref()?;
         Some(self.base_dir().join(sample))
+    }
+
+    /// A file named in the scene (a stone mesh, a load series, a checkpoint to start from),
+    /// resolved like [`Scene::mesh_path`].
+    pub fn resolve(&self, file: &Path) -> PathBuf {
+        self.base_dir().join(file)
     }
 
     /// The mesh file of a mesh wall, resolved like [`Scene::mesh_path`].

@@ -44,6 +44,11 @@ pub struct Run {
     /// Newmark γ (paper 001 Eq. 14), for `integrator = "newmark"`; default ½.
     #[serde(default = "default_gamma")]
     pub gamma: f64,
+    /// Start from the state in this checkpoint (written by another scene with the same bodies,
+    /// e.g. a deposition run), relative to the scene file: positions, velocities and reference
+    /// positions are taken from it, time restarts at 0, contact histories start empty.
+    #[serde(default)]
+    pub start_from: Option<PathBuf>,
 }
 
 fn default_beta() -> f64 {
@@ -327,6 +332,30 @@ pub struct Load {
     pub ramp: Ramp,
     /// A sinusoidal time factor instead of `ramp`.
     pub cyclic: Option<CyclicLoad>,
+    /// A time series read from a CSV file instead of `ramp`.
+    pub series: Option<Series>,
+}
+
+/// `series = { file, column }` of a `[[load]]`: the time factor on `total_force` is the named
+/// column of a CSV file whose first column is time (s), linearly interpolated between rows and
+/// held before the first and after the last. With `total_force = [0, 0, -1]` a column in
+/// newtons is a downward force; with `[0, 0, -A]` a column in pascals is a pressure on the
+/// area A (m²).
+///
+/// ```toml
+/// [[load]]
+/// body = "sleeper"
+/// box = [[0.49, -0.2, 0.15], [0.64, 0.2, 0.2]]
+/// total_force = [0.0, 0.0, -1.0]
+/// series = { file = "train.csv", column = "Rp1" }
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Series {
+    /// The CSV file, relative to the scene file; a header row names the columns.
+    pub file: PathBuf,
+    /// The column to read.
+    pub column: String,
 }
 
 /// `cyclic = { min, max, frequency, phase_deg, start }` of a `[[load]]`: the factor on
@@ -485,6 +514,8 @@ pub(crate) struct RawLoad {
     pub ramp: Option<Vec<[f64; 2]>>,
     #[serde(default)]
     pub cyclic: Option<CyclicLoad>,
+    #[serde(default)]
+    pub series: Option<Series>,
 }
 
 /// The whole file as written.
@@ -513,7 +544,58 @@ pub(crate) struct RawScene {
     #[serde(default)]
     pub granular: Option<Granular>,
     #[serde(default)]
+    pub ballast: Option<Ballast>,
+    #[serde(default)]
     pub output: Output,
+}
+
+/// `[ballast]`: deformable ballast stones (paper 000 §4): copies of gmsh stone meshes, each a
+/// QDEM body with contact spheres at its surface vertices, scaled to a grading curve, turned at
+/// random and laid on a loose lattice in `region` to be deposited under gravity. Together the
+/// stones are one body called `name` (for probes, fixes, loads and output); in contact each
+/// stone is its own body.
+///
+/// ```toml
+/// [ballast]
+/// name = "ballast"
+/// material = "granite"
+/// meshes = ["stones/coarse/stone_00.msh", "stones/coarse/stone_01.msh"]
+/// contact_radius = 0.012
+/// count = 300
+/// region = [[-2.3, 0.0, 0.0], [2.3, 0.6, 1.0]]
+/// exclude = [[-1.1, 0.15, 0.25], [1.1, 0.45, 1.0]]   # optional: keep clear (a sleeper)
+/// grading = [[0.04, 0.0], [0.05, 0.5], [0.063, 1.0]]  # optional (sieve size m, passing)
+/// seed = 1
+/// velocity = [0.0, 0.0, -2.0]                           # optional (m/s)
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ballast {
+    /// Name of the ballast body (stones are `NAME stone K` in messages).
+    pub name: String,
+    /// A `[[material]]`.
+    pub material: String,
+    /// Stone shapes: tetrahedral gmsh meshes, relative to the scene file.
+    pub meshes: Vec<PathBuf>,
+    /// Radius of the contact spheres at the stones' surface vertices, m (after scaling).
+    pub contact_radius: f64,
+    /// Number of stones.
+    pub count: usize,
+    /// The box filled with stones, bottom layer first (m).
+    pub region: [[f64; 3]; 2],
+    /// A box no stone may reach into (m).
+    #[serde(default)]
+    pub exclude: Option<[[f64; 3]; 2]>,
+    /// Grading curve, (sieve size m, fraction passing) points; a stone's sieve size is the
+    /// middle extent of its bounding box. Without one the meshes keep their size.
+    #[serde(default)]
+    pub grading: Option<Vec<[f64; 2]>>,
+    /// Seed of the shapes, sizes, turns and lattice jitter; default 1.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Initial velocity of every stone (m/s), e.g. downward to shorten the fall; default 0.
+    #[serde(default)]
+    pub velocity: [f64; 3],
 }
 
 /// `[periodic]`: periodic boundaries (paper 003 §4) along `axes`, over `length` (one period

@@ -6,8 +6,8 @@ use std::path::Path;
 
 use super::error::{located, Diagnostic, SceneError};
 use super::schema::{
-    ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load, Periodic, Ramp, RawFix, RawLoad,
-    RawScene, Selection, TimeStep,
+    Ballast, ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load, Periodic, Ramp, RawFix,
+    RawLoad, RawScene, Selection, Series, TimeStep,
 };
 use super::spans::SpanIndex;
 use super::suggest::did_you_mean;
@@ -491,7 +491,11 @@ pub(crate) fn validate(
     let material_names: Vec<&str> = raw.materials.iter().map(|m| m.name.as_str()).collect();
 
     // [[body]]
-    if raw.bodies.is_empty() && raw.bonded.is_none() && raw.granular.is_none() {
+    if raw.bodies.is_empty()
+        && raw.bonded.is_none()
+        && raw.granular.is_none()
+        && raw.ballast.is_none()
+    {
         c.error(
             &[],
             "no [[body]] is defined; a scene needs at least one body".to_owned(),
@@ -501,6 +505,20 @@ pub(crate) fn validate(
     let mut body_names: Vec<&str> = raw.bodies.iter().map(|b| b.name.as_str()).collect();
     if let Some(b) = &raw.bonded {
         bonded_table(&mut c, &raw, b, &material_names);
+        bodies.insert(b.name.as_str(), body_names.len());
+        body_names.push(b.name.as_str());
+    }
+    if let Some(b) = &raw.ballast {
+        ballast_table(&mut c, &raw, b, &material_names);
+        if bodies.contains_key(b.name.as_str()) {
+            c.error(
+                &["ballast", "name"],
+                format!(
+                    "[ballast] {:?}: a [[body]] has the same name; rename one",
+                    b.name
+                ),
+            );
+        }
         bodies.insert(b.name.as_str(), body_names.len());
         body_names.push(b.name.as_str());
     }
@@ -596,6 +614,15 @@ pub(crate) fn validate(
         if let Some(cyclic) = &ld.cyclic {
             cyclic_load(&mut c, &idx, &l, cyclic, ld.ramp.is_some());
         }
+        if let Some(series) = &ld.series {
+            series_load(
+                &mut c,
+                &idx,
+                &l,
+                series,
+                ld.ramp.is_some() || ld.cyclic.is_some(),
+            );
+        }
         if let Some(selection) = sel {
             loads.push(Load {
                 body: ld.body.clone(),
@@ -603,6 +630,7 @@ pub(crate) fn validate(
                 total_force: ld.total_force,
                 ramp,
                 cyclic: ld.cyclic,
+                series: ld.series.clone(),
             });
         }
     }
@@ -664,6 +692,7 @@ pub(crate) fn validate(
         bonded: raw.bonded,
         periodic: raw.periodic,
         granular: raw.granular,
+        ballast: raw.ballast,
         output: raw.output,
         path: path.to_path_buf(),
     })
@@ -686,6 +715,82 @@ fn cyclic_load(c: &mut Checker<'_>, idx: &str, l: &str, cyclic: &CyclicLoad, has
             &at,
             format!("{l}: give either `ramp` or `cyclic`, not both; drop one"),
         );
+    }
+}
+
+/// `series` of a `[[load]]`: a file and a column, not with `ramp` or `cyclic`.
+fn series_load(c: &mut Checker<'_>, idx: &str, l: &str, series: &Series, other: bool) {
+    let at = ["load", idx, "series"];
+    if series.column.trim().is_empty() {
+        c.error(
+            &at,
+            format!("{l}: series.column is empty; name a column of the CSV header"),
+        );
+    }
+    if other {
+        c.error(
+            &at,
+            format!("{l}: give one time factor: `ramp`, `cyclic` or `series`; drop the others"),
+        );
+    }
+}
+
+/// `[ballast]`: its material, meshes, count, radius, boxes and that it can touch.
+fn ballast_table(c: &mut Checker<'_>, raw: &RawScene, b: &Ballast, materials: &[&str]) {
+    let l = format!("[ballast] {:?}", b.name);
+    if !materials.contains(&b.material.as_str()) {
+        c.error(
+            &["ballast", "material"],
+            format!(
+                "{l}: material {:?} is not defined (defined materials: {})",
+                b.material,
+                quoted_names(materials.iter().copied())
+            ),
+        );
+    }
+    if raw.contact.is_none() {
+        c.error(
+            &["ballast"],
+            format!("{l}: stones touch through contacts: add a [contact] table"),
+        );
+    }
+    if raw.bonded.is_some() {
+        c.error(
+            &["ballast"],
+            format!("{l}: a [bonded] scene cannot hold ballast; drop one"),
+        );
+    }
+    if b.meshes.is_empty() {
+        c.error(
+            &["ballast", "meshes"],
+            format!("{l}: meshes is empty; list the stone meshes (gmsh files)"),
+        );
+    }
+    if b.count == 0 {
+        c.error(
+            &["ballast", "count"],
+            format!("{l}: count must be at least 1"),
+        );
+    }
+    c.finite(&["ballast", "velocity"], &l, "velocity", &b.velocity);
+    c.positive(
+        &["ballast", "contact_radius"],
+        &l,
+        "contact_radius",
+        b.contact_radius,
+        "m",
+    );
+    for (key, bx) in [("region", Some(&b.region)), ("exclude", b.exclude.as_ref())] {
+        if let Some(bx) = bx {
+            if c.finite(&["ballast", key], &l, key, &bx.concat())
+                && (0..3).any(|k| bx[1][k] <= bx[0][k])
+            {
+                c.error(
+                    &["ballast", key],
+                    format!("{l}: {key} = {bx:?}: the upper corner must lie above the lower one on every axis"),
+                );
+            }
+        }
     }
 }
 
@@ -1056,7 +1161,7 @@ fn contact_tables(c: &mut Checker<'_>, raw: &RawScene) {
         return;
     };
     let l = "[contact]";
-    if radii.is_empty() && raw.granular.is_none() {
+    if radii.is_empty() && raw.granular.is_none() && raw.ballast.is_none() {
         c.error(
             &["contact"],
             "[contact]: no [[body]] has contact_radius, so nothing can touch: give the bodies \
@@ -1224,6 +1329,7 @@ pub(crate) fn to_raw(scene: &Scene) -> RawScene {
                     total_force: l.total_force,
                     ramp: (!l.ramp.points.is_empty()).then(|| l.ramp.points.clone()),
                     cyclic: l.cyclic,
+                    series: l.series.clone(),
                 }
             })
             .collect(),
@@ -1233,6 +1339,7 @@ pub(crate) fn to_raw(scene: &Scene) -> RawScene {
         bonded: scene.bonded.clone(),
         periodic: scene.periodic.clone(),
         granular: scene.granular.clone(),
+        ballast: scene.ballast.clone(),
         output: scene.output.clone(),
     }
 }
@@ -1278,6 +1385,7 @@ pub(crate) fn missing_files(
             ),
         ));
     }
+    out.extend(named_files(scene, spans));
     for (i, w) in scene.walls.iter().enumerate() {
         let Some(mesh) = &w.mesh else { continue };
         let resolved = scene.wall_mesh_path(mesh);
@@ -1297,4 +1405,48 @@ pub(crate) fn missing_files(
         ));
     }
     located(&scene.path, text, out)
+}
+
+/// The ballast's stone meshes, the loads' series files and the checkpoint to start from that
+/// do not exist.
+fn named_files(scene: &Scene, spans: Option<&SpanIndex>) -> Vec<(Option<usize>, String)> {
+    let mut files: Vec<(Vec<String>, String, &Path, &str)> = Vec::new();
+    if let Some(b) = &scene.ballast {
+        for (i, mesh) in b.meshes.iter().enumerate() {
+            let at = vec!["ballast".to_string(), "meshes".to_string()];
+            files.push((at, format!("[ballast]: stone mesh #{}", i + 1), mesh, ""));
+        }
+    }
+    for (i, l) in scene.loads.iter().enumerate() {
+        if let Some(series) = &l.series {
+            let at = vec!["load".to_string(), i.to_string(), "series".to_string()];
+            files.push((
+                at,
+                format!("{}: series file", label("load", i, None)),
+                &series.file,
+                "",
+            ));
+        }
+    }
+    if let Some(start) = &scene.run.start_from {
+        let at = vec!["run".to_string(), "start_from".to_string()];
+        let hint = "; run the scene that writes it first (its [output] dir holds checkpoint.qdc \
+                    when it has `checkpoint_every`)";
+        files.push((at, "[run] start_from: checkpoint".to_string(), start, hint));
+    }
+    files
+        .into_iter()
+        .filter(|(_, _, file, _)| !scene.resolve(file).is_file())
+        .map(|(at, what, file, hint)| {
+            let at: Vec<&str> = at.iter().map(String::as_str).collect();
+            (
+                spans.and_then(|s| s.offset(&at)),
+                format!(
+                    "{what} {} does not exist (resolved relative to the scene file's \
+                     directory){hint}",
+                    scene.resolve(file).display()
+                ),
+            )
+        })
+        .collect()
 }
