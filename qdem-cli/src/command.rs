@@ -459,6 +459,13 @@ fn print_force_split(sim: &mut Simulation, state: &qdem_core::State, per_step: f
         "integration and checks",
         100.0 * integrate / per_step
     );
+    if let Some(c) = sim.contacts() {
+        println!(
+            "  contacts after the measured steps: {} candidate pairs and wall candidates, {} touching",
+            c.candidates(),
+            c.contacts()
+        );
+    }
 }
 
 /// Wall seconds per step of the scene's own stepper, measured over `n` steps on a copy of the

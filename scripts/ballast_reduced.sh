@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The reduced ballasted track end to end (paper 000 §4; docs/ballast.md):
+#   1. the ballast layer and sleeper formed by free fall (reduced_deposit.toml, checkpointed),
+#   2. two bogies passing over the settled track (reduced_load.toml, start_from step 1),
+#   3. spectra (Parzen, 20 Hz) and mobility of the sensors (qdem analyze),
+# and with --friction-study also step 2 and 3 with friction 1.73 (reduced_load_mu173.toml).
+# Outputs: out/ballast/reduced_{deposit,load,load_mu173}/ (probes.csv, vtu/, analysis/*.csv|svg).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release -p qdem-cli
+qdem=target/release/qdem
+dir=fixtures/ballast
+if [ ! -f out/ballast/reduced_deposit/checkpoint.qdc ] || [ "${1:-}" = "--redeposit" ]; then
+    $qdem run $dir/reduced_deposit.toml
+fi
+runs=(reduced_load)
+if [ "${1:-}" = "--friction-study" ]; then
+    runs+=(reduced_load_mu173)
+fi
+for run in "${runs[@]}"; do
+    $qdem run $dir/$run.toml
+    $qdem analyze $dir/$run.toml --from 0.06
+done
