@@ -212,6 +212,36 @@ fn a_run_starts_from_another_scenes_checkpoint_and_refuses_one_of_other_bodies()
     }
 }
 
+#[test]
+fn missing_stone_meshes_series_files_and_checkpoints_are_named_before_anything_runs() {
+    let dir = test_dir("ballast-missing");
+    let edits = [
+        ("stone_00.msh", "stone_99.msh"),
+        (
+            "[[material]]",
+            "start_from = \"nowhere/checkpoint.qdc\"\n[[material]]",
+        ),
+    ];
+    let path = stones_scene(&dir, "a.toml", &edits);
+    let message = Scene::load(&path).err().unwrap().to_string();
+    assert!(
+        message.contains("stone mesh #1") && message.contains("stone_99.msh"),
+        "{message}"
+    );
+    assert!(
+        message.contains("nowhere/checkpoint.qdc")
+            && message.contains("run the scene that writes it first"),
+        "{message}"
+    );
+    let series = series_scene(&dir, "time,Rp1\n0,1\n");
+    std::fs::remove_file(dir.join("series.csv")).unwrap();
+    let message = Scene::load(&series).err().unwrap().to_string();
+    assert!(
+        message.contains("series file") && message.contains("series.csv"),
+        "{message}"
+    );
+}
+
 /// The sleeper alone with a `series` load read from `series.csv` in `dir`.
 fn series_scene(dir: &Path, series: &str) -> PathBuf {
     std::fs::write(dir.join("series.csv"), series).unwrap();
