@@ -17,14 +17,15 @@
 //! runs over all their tetrahedra in parallel); in contact each stone is its own body, so its
 //! spheres never touch each other, and a periodic cell wraps each stone whole.
 
-use crate::build::{BuildError, PlacedMesh};
+use crate::build::{read_mesh, BuildError, PlacedMesh};
 use crate::scene::{Ballast, Scene};
 use nalgebra::UnitQuaternion;
+use qdem_contact::broad_phase::bounds;
 use qdem_contact::clump_sample::Grading;
 use qdem_contact::particle_packing::SplitMix64;
 use qdem_contact::ContactSphere;
 use qdem_core::{Mat3, Vec3};
-use qdem_mesh::{read_msh, TetMesh};
+use qdem_mesh::TetMesh;
 use std::ops::Range;
 use std::path::PathBuf;
 
@@ -143,14 +144,10 @@ fn read_shapes(scene: &Scene, ballast: &Ballast) -> Result<(Vec<Shape>, Vec<Stri
     let mut warnings = Vec::new();
     for file in &ballast.meshes {
         let path = scene.resolve(file);
-        let (mut mesh, mesh_warnings) = read_msh(&path)?;
-        warnings.extend(
-            mesh_warnings
-                .iter()
-                .map(|w| format!("{}: {w}", path.display())),
-        );
+        let mut mesh = read_mesh(&path, &mut warnings)?;
         mesh.reorder_for_locality();
-        let (lo, hi) = bounding_box(&mesh);
+        let nodes: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
+        let (lo, hi) = bounds(&nodes);
         let extents = hi - lo;
         let mut axes = [0, 1, 2];
         axes.sort_by(|&a, &b| extents[b].total_cmp(&extents[a]));
@@ -172,14 +169,6 @@ fn read_shapes(scene: &Scene, ballast: &Ballast) -> Result<(Vec<Shape>, Vec<Stri
         });
     }
     Ok((shapes, warnings))
-}
-
-/// Lower and upper corners of the bounding box of a mesh's nodes.
-fn bounding_box(mesh: &TetMesh) -> (Vec3, Vec3) {
-    mesh.nodes.iter().fold(
-        (Vec3::repeat(f64::MAX), Vec3::repeat(f64::MIN)),
-        |(lo, hi), p| (lo.inf(&Vec3::from(*p)), hi.sup(&Vec3::from(*p))),
-    )
 }
 
 /// No turn, or half a turn about x, y or z: each keeps a laid-out stone's bounding box.

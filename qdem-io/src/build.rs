@@ -21,7 +21,7 @@ use qdem_core::{
 };
 use qdem_mesh::{read_msh, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// Why a scene could not be turned into a simulation.
@@ -391,12 +391,7 @@ fn read_meshes(scene: &Scene) -> Result<ReadMeshes, BuildError> {
     let mut meshes: Vec<PlacedMesh> = Vec::new();
     for body in &scene.bodies {
         let path = scene.mesh_path(body);
-        let (mut mesh, mesh_warnings) = read_msh(&path)?;
-        warnings.extend(
-            mesh_warnings
-                .iter()
-                .map(|w| format!("{}: {w}", path.display())),
-        );
+        let mut mesh = read_mesh(&path, &mut warnings)?;
         if body.reorder {
             mesh.reorder_for_locality();
         }
@@ -418,6 +413,17 @@ fn read_meshes(scene: &Scene) -> Result<ReadMeshes, BuildError> {
         ballast = Some(info);
     }
     Ok((meshes, warnings, ballast))
+}
+
+/// Reads the mesh at `path`, adding its warnings, each naming the file, to `warnings`.
+pub(crate) fn read_mesh(path: &Path, warnings: &mut Vec<String>) -> Result<TetMesh, MeshError> {
+    let (mesh, mesh_warnings) = read_msh(path)?;
+    warnings.extend(
+        mesh_warnings
+            .iter()
+            .map(|w| format!("{}: {w}", path.display())),
+    );
+    Ok(mesh)
 }
 
 /// Rotates the nodes about their centroid by `degrees` about x, then y, then z, then

@@ -738,28 +738,7 @@ fn series_load(c: &mut Checker<'_>, idx: &str, l: &str, series: &Series, other: 
 /// `[ballast]`: its material, meshes, count, radius, boxes and that it can touch.
 fn ballast_table(c: &mut Checker<'_>, raw: &RawScene, b: &Ballast, materials: &[&str]) {
     let l = format!("[ballast] {:?}", b.name);
-    if !materials.contains(&b.material.as_str()) {
-        c.error(
-            &["ballast", "material"],
-            format!(
-                "{l}: material {:?} is not defined (defined materials: {})",
-                b.material,
-                quoted_names(materials.iter().copied())
-            ),
-        );
-    }
-    if raw.contact.is_none() {
-        c.error(
-            &["ballast"],
-            format!("{l}: stones touch through contacts: add a [contact] table"),
-        );
-    }
-    if raw.bonded.is_some() {
-        c.error(
-            &["ballast"],
-            format!("{l}: a [bonded] scene cannot hold ballast; drop one"),
-        );
-    }
+    stone_table(c, raw, "ballast", &l, &b.material, materials, "ballast");
     if b.meshes.is_empty() {
         c.error(
             &["ballast", "meshes"],
@@ -782,15 +761,54 @@ fn ballast_table(c: &mut Checker<'_>, raw: &RawScene, b: &Ballast, materials: &[
     );
     for (key, bx) in [("region", Some(&b.region)), ("exclude", b.exclude.as_ref())] {
         if let Some(bx) = bx {
-            if c.finite(&["ballast", key], &l, key, &bx.concat())
-                && (0..3).any(|k| bx[1][k] <= bx[0][k])
-            {
-                c.error(
-                    &["ballast", key],
-                    format!("{l}: {key} = {bx:?}: the upper corner must lie above the lower one on every axis"),
-                );
-            }
+            box_corners(c, "ballast", &l, key, bx);
         }
+    }
+}
+
+/// What `[granular]` and `[ballast]` share: a defined material, a `[contact]` table, no
+/// `[bonded]` body (`holds` names what a bonded scene cannot hold).
+fn stone_table(
+    c: &mut Checker<'_>,
+    raw: &RawScene,
+    table: &str,
+    l: &str,
+    material: &str,
+    materials: &[&str],
+    holds: &str,
+) {
+    if !materials.contains(&material) {
+        c.error(
+            &[table, "material"],
+            format!(
+                "{l}: material {material:?} is not defined (defined materials: {})",
+                quoted_names(materials.iter().copied())
+            ),
+        );
+    }
+    if raw.contact.is_none() {
+        c.error(
+            &[table],
+            format!("{l}: stones touch through contacts: add a [contact] table"),
+        );
+    }
+    if raw.bonded.is_some() {
+        c.error(
+            &[table],
+            format!("{l}: a [bonded] scene cannot hold {holds}; drop one"),
+        );
+    }
+}
+
+/// A box `key` of `table`: finite corners, the upper above the lower on every axis.
+fn box_corners(c: &mut Checker<'_>, table: &str, l: &str, key: &str, b: &[[f64; 3]; 2]) {
+    if c.finite(&[table, key], l, key, &b.concat()) && (0..3).any(|k| b[1][k] <= b[0][k]) {
+        c.error(
+            &[table, key],
+            format!(
+                "{l}: {key} = {b:?}: the upper corner must lie above the lower one on every axis"
+            ),
+        );
     }
 }
 
@@ -926,28 +944,15 @@ fn periodic_table(c: &mut Checker<'_>, raw: &RawScene, p: &Periodic) {
 /// `[granular]`: its material, a sample file or a generation (region, count, grading), a crop.
 fn granular_table(c: &mut Checker<'_>, raw: &RawScene, g: &Granular, materials: &[&str]) {
     let l = format!("[granular] {:?}", g.name);
-    if !materials.contains(&g.material.as_str()) {
-        c.error(
-            &["granular", "material"],
-            format!(
-                "{l}: material {:?} is not defined (defined materials: {})",
-                g.material,
-                quoted_names(materials.iter().copied())
-            ),
-        );
-    }
-    if raw.contact.is_none() {
-        c.error(
-            &["granular"],
-            format!("{l}: stones touch through contacts: add a [contact] table"),
-        );
-    }
-    if raw.bonded.is_some() {
-        c.error(
-            &["granular"],
-            format!("{l}: a [bonded] scene cannot hold a [granular] sample; drop one"),
-        );
-    }
+    stone_table(
+        c,
+        raw,
+        "granular",
+        &l,
+        &g.material,
+        materials,
+        "a [granular] sample",
+    );
     let generates = g.region.is_some() || g.count.is_some() || g.grading.is_some();
     if !generates && g.sample.is_none() {
         c.error(
@@ -974,14 +979,7 @@ fn granular_table(c: &mut Checker<'_>, raw: &RawScene, g: &Granular, materials: 
     }
     for (key, b) in [("region", &g.region), ("crop", &g.crop)] {
         if let Some(b) = b {
-            if c.finite(&["granular", key], &l, key, &b.concat())
-                && (0..3).any(|k| b[1][k] <= b[0][k])
-            {
-                c.error(
-                    &["granular", key],
-                    format!("{l}: {key} = {b:?}: the upper corner must lie above the lower one on every axis"),
-                );
-            }
+            box_corners(c, "granular", &l, key, b);
         }
     }
 }
