@@ -16,7 +16,7 @@ fn static_deflection_converges_to_timoshenko() {
     let q = 10e3;
     let mut errors = Vec::new();
     for h in [0.05, 0.025, 0.01] {
-        let mut b = beam(h, q, f64::INFINITY, 0.0, false, 1e-3);
+        let mut b = beam(h, q, f64::INFINITY, 0.0, false);
         StaticSolver::new()
             .solve(&mut b.state, &mut b.models, 0.0)
             .unwrap();
@@ -46,10 +46,10 @@ fn static_deflection_converges_to_timoshenko() {
 fn first_crack_is_at_bottom_midspan_between_the_bracketing_loads() {
     let strength = 6e6;
     let h = 0.01;
-    let probe = beam(h, 1.0, strength, 0.0, false, 1e-3);
+    let probe = beam(h, 1.0, strength, 0.0, false);
     let q_crit = cracking_load(strength, probe.span);
     for (factor, breaks) in [(0.97, false), (1.03, true)] {
-        let mut b = beam(h, factor * q_crit, strength, 0.0, false, 1e-3);
+        let mut b = beam(h, factor * q_crit, strength, 0.0, false);
         StaticSolver::new()
             .solve(&mut b.state, &mut b.models, 0.0)
             .unwrap();
@@ -93,7 +93,7 @@ fn first_crack_is_at_bottom_midspan_between_the_bracketing_loads() {
 #[test]
 fn clapeyron_holds_at_the_static_answer() {
     let q = 50e3;
-    let mut b = beam(0.05, q, f64::INFINITY, 0.0, false, 1e-3);
+    let mut b = beam(0.05, q, f64::INFINITY, 0.0, false);
     StaticSolver::new()
         .solve(&mut b.state, &mut b.models, 0.0)
         .unwrap();
@@ -117,7 +117,7 @@ fn lattice_has_the_continuum_modulus_and_poisson_ratio() {
         "block",
         &packing,
         &bbm::material(f64::INFINITY, 0.0),
-        bbm::settings(1e-3, true),
+        bbm::settings(true),
     )
     .unwrap();
     let h = packing.spacing;

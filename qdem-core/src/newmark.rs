@@ -13,26 +13,30 @@
 //!   a_{n+1} = M⁻¹ f(t_{n+1}, x̃, ṽ), the viscous force seeing the predicted velocity ṽ. For
 //!   γ = ½, ṽ is the half-step velocity and the scheme is [`crate::Verlet`], operation for
 //!   operation; it is stable for ∆t ≤ [`crate::stable_step()`].
-//! - **β > 0** (implicit): the incremental internal-force form of Eqs. 19–20,
-//!   f(x̃ + β∆t² a, ṽ + γ∆t a) ≈ f(x̃, ṽ) − (β∆t² K + γ∆t C) a, turns Eq. 15 into Eq. 26,
+//! - **β > 0** (implicit): Eq. 26 linearises the internal force at the step's start,
+//!   f(x_{n+1}, v_{n+1}) ≈ f(x_n, ·) − K (x_{n+1} − x_n) − C v_{n+1}, and reads
 //!
-//!   (M + γ∆t C + β∆t² K) a_{n+1} = f(t_{n+1}, x̃, ṽ),
+//!   (M + γ∆t C + β∆t² K) a_{n+1} = f_ext(t_{n+1}) − f_int(x_n) − K (x̃ − x_n) − C ṽ
 //!
-//!   whose right-hand side is Eq. 26's f_n − K a_n − C b_n (a_n = x̃ − x_n, b_n = ṽ of Eq. 22)
-//!   with the internal force evaluated by the models themselves at the predicted state, so a
-//!   force that is not K·u (the geometrically non-linear QDEM kernel, contacts) is handled. One
-//!   linear solve is one Newton iteration from the predictor: exact for a linear force, and
-//!   otherwise in error by the neglected non-linearity of the step's increment (of the order of
-//!   the strain times the increment for the QDEM kernel), which small-strain runs can ignore.
-//!   Equilibria (a = v = 0) are exactly those of the models' non-linear force, whatever the
-//!   tangent. Average acceleration (β = ¼, γ = ½) is unconditionally stable and conserves
-//!   energy for linear systems.
+//!   (its f_n − K a_n − C b_n with a_n = x̃ − x_n, b_n = ṽ of Eq. 22). It is solved as one
+//!   Newton iteration from the held state x = x_n, a⁰ = −(x̃ − x_n)/(β∆t²), v⁰ = ṽ + γ∆t a⁰
+//!   ([`hold`]): the models give f(t_{n+1}, x_n, v⁰) themselves, so a force that is not K·u
+//!   (the geometrically non-linear QDEM kernel, contacts) enters at a state the body has
+//!   actually been in, and (M + γ∆t C + β∆t² K) δa = f − M a⁰ gives a_{n+1} = a⁰ + δa. This is
+//!   exact for a linear force; otherwise it errs by the non-linearity over the step's own
+//!   increment. Linearising at the predictor x̃ instead (the same for a linear force) breaks
+//!   down when ∆t is far above the stable explicit step: for a mode with ω∆t ≫ 1 the
+//!   predictor's ¼∆t² a_n moves it by (ω∆t)²/4 times its amplitude, and a contact or a
+//!   Coulomb cap evaluated there is meaningless (measured: the bonded beam at ∆t = 5 ms came
+//!   apart once cracking made contacts). Equilibria (a = v = 0) are exactly those of the
+//!   models' non-linear force, whatever the tangent. Average acceleration (β = ¼, γ = ½) is
+//!   unconditionally stable and conserves energy for linear systems.
 //!
 //! Constraints (Eqs. 23, 27) are eliminated: fixed DOFs are left out of the system
 //! ([`FreeDofs`]) and keep zero velocity and acceleration. The effective matrix is factorised by
 //! [`SparseCholesky`]: with [`TangentUpdate::Fixed`] once, at [`Stepper::initialize`] (exact for
 //! a linear small-strain run; each step then costs one force evaluation and two triangular
-//! solves); with [`TangentUpdate::EveryStep`] K and C are reassembled at every predicted state
+//! solves); with [`TangentUpdate::EveryStep`] K and C are reassembled at every step's start
 //! and refactorised, reusing the symbolic analysis. The fixity is read when factorising.
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
@@ -56,7 +60,7 @@ pub enum TangentUpdate {
     /// tangent ([`Model::commit_step`]: bonds broken, contacts made or lost).
     #[default]
     Fixed,
-    /// Every step, with K and C at the predicted state (large displacements or rotations).
+    /// Every step, with K and C at the step's start (large displacements or rotations).
     EveryStep,
 }
 
@@ -255,10 +259,12 @@ impl Newmark {
         Ok(())
     }
 
-    /// Solves Eq. 26 for a_{n+1} with the right-hand side f(t_{n+1}, x̃, ṽ) at the predicted
-    /// state, refactorising first if no factorisation for the step `h` is current, and writes
-    /// it into the state's accelerations (zero in fixed directions).
-    fn solve_accelerations(
+    /// One implicit step of length `h` (Eq. 26, linearised at the step's start): refactorises
+    /// first if no factorisation for `h` is current (the tangent at x_n, Eq. 21's mid-point
+    /// taken from there), holds the positions at x_n with the acceleration a⁰ that keeps them
+    /// there ([`hold`]), evaluates the models' force f(t_{n+1}, x_n, v⁰), solves
+    /// (M + γhC + βh²K) δa = f − M a⁰ and moves by δa ([`apply_increment`]).
+    fn implicit_step(
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
@@ -270,21 +276,22 @@ impl Newmark {
         {
             self.refactor(state, models, h)?;
         }
+        let (beta, gamma) = (self.beta, self.gamma);
+        hold(state, h, beta, gamma);
         sum_forces(state, models, &mut self.force, &mut self.torque);
+        let moments = &mut self.torque[state.rigid.len()..];
+        subtract_inertia(state, &mut self.force, moments);
         let system = &mut self.system;
         let dofs = system.dofs.as_ref().expect("factorised before stepping");
         system.rhs.resize(dofs.len(), 0.0);
-        let moments = &self.torque[state.rigid.len()..];
         dofs.gather_nodes((&self.force, moments), &mut system.rhs);
         system
             .factors
             .get(nominal)
             .cholesky
             .solve_in_place(&mut system.rhs);
-        dofs.scatter_nodes(
-            &system.rhs,
-            (&mut state.acceleration, &mut state.spin.acceleration),
-        );
+        dofs.scatter_nodes(&system.rhs, (&mut self.force, moments));
+        apply_increment(state, (&self.force, moments), h, beta, gamma);
         check_finite(state)
     }
 
@@ -295,13 +302,12 @@ impl Newmark {
         models: &mut [Box<dyn Model>],
         h: f64,
     ) -> Result<(), CoreError> {
+        if self.is_implicit() {
+            return self.implicit_step(state, models, h);
+        }
         let (beta, gamma) = (self.beta, self.gamma);
         predict(state, h, beta, gamma);
-        if self.is_implicit() {
-            self.solve_accelerations(state, models, h)?;
-        } else {
-            compute_accelerations(state, models, &mut self.force, &mut self.torque)?;
-        }
+        compute_accelerations(state, models, &mut self.force, &mut self.torque)?;
         correct(state, h, beta, gamma);
         Ok(())
     }
@@ -398,6 +404,82 @@ pub fn correct(state: &mut State, dt: f64, beta: f64, gamma: f64) {
         *v += cv * a;
     };
     for_each_dof(state, update);
+}
+
+/// The start of an implicit step (Eq. 26 linearised at x_n): the acceleration
+/// a⁰ = −(x̃ − x_n)/(β∆t²) = −(v_n + (½ − β)∆t a_n)/(β∆t) that leaves the positions at x_n,
+/// the velocity v⁰ = ṽ + γ∆t a⁰ that goes with it, t ← t + ∆t; rotations likewise.
+fn hold(state: &mut State, dt: f64, beta: f64, gamma: f64) {
+    let (ca, cv) = ((0.5 - beta) * dt, (1.0 - gamma) * dt);
+    let update = |(v, a): (&mut Vec3, &mut Vec3)| {
+        let held = -(*v + ca * *a) / (beta * dt);
+        *v += cv * *a + gamma * dt * held;
+        *a = held;
+    };
+    state
+        .velocity
+        .par_iter_mut()
+        .zip(state.acceleration.par_iter_mut())
+        .with_min_len(PARTICLE_CHUNK)
+        .for_each(update);
+    let spin = &mut state.spin;
+    spin.velocity
+        .par_iter_mut()
+        .zip(spin.acceleration.par_iter_mut())
+        .with_min_len(PARTICLE_CHUNK)
+        .for_each(update);
+    state.time += dt;
+}
+
+/// The residual of Eq. 15 at the held state: force ← f − M a⁰, moment ← m − J α⁰.
+fn subtract_inertia(state: &State, force: &mut [Vec3], moment: &mut [Vec3]) {
+    let residual = |((f, a), m): ((&mut Vec3, &Vec3), &f64)| *f -= *m * a;
+    force
+        .par_iter_mut()
+        .zip(state.acceleration.par_iter())
+        .zip(state.mass.par_iter())
+        .with_min_len(PARTICLE_CHUNK)
+        .for_each(residual);
+    let spin = &state.spin;
+    moment
+        .par_iter_mut()
+        .zip(spin.acceleration.par_iter())
+        .zip(spin.inertia.par_iter())
+        .with_min_len(PARTICLE_CHUNK)
+        .for_each(residual);
+}
+
+/// Adds the solved increment δa: x ← x + β∆t² δa, v ← v + γ∆t δa, a ← a + δa, translations
+/// and rotations.
+fn apply_increment(
+    state: &mut State,
+    increment: (&[Vec3], &[Vec3]),
+    dt: f64,
+    beta: f64,
+    gamma: f64,
+) {
+    let (cx, cv) = (beta * dt * dt, gamma * dt);
+    let update = |(((x, v), a), d): (((&mut Vec3, &mut Vec3), &mut Vec3), &Vec3)| {
+        *x += cx * d;
+        *v += cv * d;
+        *a += d;
+    };
+    state
+        .position
+        .par_iter_mut()
+        .zip(state.velocity.par_iter_mut())
+        .zip(state.acceleration.par_iter_mut())
+        .zip(increment.0.par_iter())
+        .with_min_len(PARTICLE_CHUNK)
+        .for_each(update);
+    let spin = &mut state.spin;
+    spin.angle
+        .par_iter_mut()
+        .zip(spin.velocity.par_iter_mut())
+        .zip(spin.acceleration.par_iter_mut())
+        .zip(increment.1.par_iter())
+        .with_min_len(PARTICLE_CHUNK)
+        .for_each(update);
 }
 
 /// Applies `update` to every (position, velocity, acceleration) triple, translations and

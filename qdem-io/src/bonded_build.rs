@@ -60,7 +60,6 @@ pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, 
             damping_ratio: bonded.contact_damping_ratio,
         },
         tolerance: bonded.tolerance,
-        dt: 0.0, // set below, once the step is chosen
         implicit: scene.run.beta > 0.0,
     };
     let (mut state, model) =
@@ -77,9 +76,6 @@ pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, 
         source,
     };
     let dt = bonded_dt(&scene, bonded, critical, &state, &models).map_err(core)?;
-    let model: &mut dyn std::any::Any = models[0].as_mut();
-    let model: &mut BondedParticles = model.downcast_mut().expect("the bonded model");
-    model.set_nominal_step(dt);
     let probes = scene
         .probes
         .iter()

@@ -27,11 +27,11 @@ pub struct Beam {
 /// vertically, the left (and with `pin_both` the right) one nearest mid-height held
 /// horizontally too. (Holding both zig-zag end particles of every row would clamp the ends
 /// partly.)
-pub fn beam(h: f64, q: f64, mean: f64, std: f64, pin_both: bool, dt: f64) -> Beam {
+pub fn beam(h: f64, q: f64, mean: f64, std: f64, pin_both: bool) -> Beam {
     let packing =
         Packing::rectangle([0.0, 0.0], [LENGTH, HEIGHT], h, PackingKind::Regular).unwrap();
     let (mut state, model) =
-        BondedParticles::from_packing("beam", &packing, &material(mean, std), settings(dt, false))
+        BondedParticles::from_packing("beam", &packing, &material(mean, std), settings(false))
             .unwrap();
     let hs = packing.spacing;
     let y_mid = HEIGHT / 2.0;
@@ -129,8 +129,8 @@ pub fn material(mean: f64, std: f64) -> BondedMaterial {
     }
 }
 
-/// Undamped unbonded contacts (k_t0/k_n = 0.2, μ = 0.5), ε = 0.05, nominal step `dt`.
-pub fn settings(dt: f64, implicit: bool) -> BondSettings {
+/// Undamped unbonded contacts (k_t0/k_n = 0.2, μ = 0.5), ε = 0.05.
+pub fn settings(implicit: bool) -> BondSettings {
     BondSettings {
         contact: UnbondedLaw {
             shear_ratio: 0.2,
@@ -138,7 +138,6 @@ pub fn settings(dt: f64, implicit: bool) -> BondSettings {
             damping_ratio: 0.0,
         },
         tolerance: 0.05,
-        dt,
         implicit,
     }
 }
