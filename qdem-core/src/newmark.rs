@@ -13,24 +13,27 @@
 //!   a_{n+1} = M⁻¹ f(t_{n+1}, x̃, ṽ), the viscous force seeing the predicted velocity ṽ. For
 //!   γ = ½, ṽ is the half-step velocity and the scheme is [`crate::Verlet`], operation for
 //!   operation; it is stable for ∆t ≤ [`crate::stable_step()`].
-//! - **β > 0** (implicit): Eq. 26 linearises the internal force at the step's start,
-//!   f(x_{n+1}, v_{n+1}) ≈ f(x_n, ·) − K (x_{n+1} − x_n) − C v_{n+1}, and reads
+//! - **β > 0** (implicit): Eq. 26 linearises the force at the step's start,
+//!   f(x_{n+1}, v_{n+1}) ≈ f(x_n, v_n) − K (x_{n+1} − x_n) − C (v_{n+1} − v_n), and reads
 //!
-//!   (M + γ∆t C + β∆t² K) a_{n+1} = f_ext(t_{n+1}) − f_int(x_n) − K (x̃ − x_n) − C ṽ
+//!   (M + γ∆t C + β∆t² K) a_{n+1} = f(t_{n+1}, x_n, v_n) − K (x̃ − x_n) − C (ṽ − v_n)
 //!
-//!   (its f_n − K a_n − C b_n with a_n = x̃ − x_n, b_n = ṽ of Eq. 22). It is solved as one
-//!   Newton iteration from the held state x = x_n, a⁰ = −(x̃ − x_n)/(β∆t²), v⁰ = ṽ + γ∆t a⁰
-//!   ([`hold`]): the models give f(t_{n+1}, x_n, v⁰) themselves, so a force that is not K·u
-//!   (the geometrically non-linear QDEM kernel, contacts) enters at a state the body has
-//!   actually been in, and (M + γ∆t C + β∆t² K) δa = f − M a⁰ gives a_{n+1} = a⁰ + δa. This is
-//!   exact for a linear force; otherwise it errs by the non-linearity over the step's own
-//!   increment. Linearising at the predictor x̃ instead (the same for a linear force) breaks
-//!   down when ∆t is far above the stable explicit step: for a mode with ω∆t ≫ 1 the
-//!   predictor's ¼∆t² a_n moves it by (ω∆t)²/4 times its amplitude, and a contact or a
-//!   Coulomb cap evaluated there is meaningless (measured: the bonded beam at ∆t = 5 ms came
-//!   apart once cracking made contacts). Equilibria (a = v = 0) are exactly those of the
-//!   models' non-linear force, whatever the tangent. Average acceleration (β = ¼, γ = ½) is
-//!   unconditionally stable and conserves energy for linear systems.
+//!   (its f_n − K a_n − C b_n with a_n = x̃ − x_n, b_n = ṽ of Eq. 22, the damping of f_n
+//!   included in f). It is solved as one Newton iteration from the held state: positions x_n
+//!   with a⁰ = −(x̃ − x_n)/(β∆t²), velocities v_n and the damping's share of the
+//!   jump to v⁰ = ṽ + γ∆t a⁰ added as −C (v⁰ − v_n); (M + γ∆t C + β∆t² K) δa = f − M a⁰ −
+//!   C (v⁰ − v_n) gives a_{n+1} = a⁰ + δa. The models give f at a state the body has actually
+//!   been in, so a force that is not K·u + C·v (the geometrically non-linear QDEM kernel,
+//!   contacts that open, Coulomb caps, dashpots that act one way) is evaluated where it makes
+//!   sense. This is exact for a linear force; otherwise it errs by the non-linearity over the
+//!   step's own increment. Linearising at the predictor (x̃, ṽ) instead, the same for a linear
+//!   force, breaks down when ∆t is far above the stable explicit step: for a mode with
+//!   ω∆t ≫ 1 the predictor's ¼∆t² a_n moves it by (ω∆t)²/4 times its amplitude, and the held
+//!   velocity v⁰ is −v_n for β = ¼, γ = ½ (tests `implicit_step_linearises_*`; the bonded
+//!   beam at ∆t = 5 ms came apart within two steps of its first break). Equilibria (a = v = 0)
+//!   are exactly those of the models' non-linear force, whatever the tangent. Average
+//!   acceleration (β = ¼, γ = ½) is unconditionally stable and conserves energy for linear
+//!   systems.
 //!
 //! Constraints (Eqs. 23, 27) are eliminated: fixed DOFs are left out of the system
 //! ([`FreeDofs`]) and keep zero velocity and acceleration. The effective matrix is factorised by
@@ -113,6 +116,8 @@ struct ImplicitSystem {
     dofs: Option<FreeDofs>,
     factors: Factors,
     rhs: Vec<f64>,
+    /// v⁰ − v_n of the held state, translations then rotations ([`hold`]).
+    velocity_change: (Vec<Vec3>, Vec<Vec3>),
 }
 
 /// The factorisation for the nominal step and the one for the last shorter sub-step.
@@ -260,10 +265,10 @@ impl Newmark {
     }
 
     /// One implicit step of length `h` (Eq. 26, linearised at the step's start): refactorises
-    /// first if no factorisation for `h` is current (the tangent at x_n, Eq. 21's mid-point
-    /// taken from there), holds the positions at x_n with the acceleration a⁰ that keeps them
-    /// there ([`hold`]), evaluates the models' force f(t_{n+1}, x_n, v⁰), solves
-    /// (M + γhC + βh²K) δa = f − M a⁰ and moves by δa ([`apply_increment`]).
+    /// first if no factorisation for `h` is current (the tangent at x_n), holds the positions
+    /// at x_n with the acceleration a⁰ that keeps them there ([`hold`]), evaluates the models'
+    /// force f(t_{n+1}, x_n, v_n), solves (M + γhC + βh²K) δa = f − M a⁰ − C (v⁰ − v_n) and
+    /// moves by δa ([`apply_increment`]).
     fn implicit_step(
         &mut self,
         state: &mut State,
@@ -277,11 +282,18 @@ impl Newmark {
             self.refactor(state, models, h)?;
         }
         let (beta, gamma) = (self.beta, self.gamma);
-        hold(state, h, beta, gamma);
+        let system = &mut self.system;
+        let change = &mut system.velocity_change;
+        change.0.resize(state.len(), Vec3::zeros());
+        change.1.resize(state.spin.len(), Vec3::zeros());
+        hold(state, h, beta, gamma, (&mut change.0, &mut change.1));
         sum_forces(state, models, &mut self.force, &mut self.torque);
         let moments = &mut self.torque[state.rigid.len()..];
         subtract_inertia(state, &mut self.force, moments);
-        let system = &mut self.system;
+        let change = (&change.0[..], &change.1[..]);
+        system
+            .tangent
+            .subtract_damping_times(change, (&mut self.force, moments));
         let dofs = system.dofs.as_ref().expect("factorised before stepping");
         system.rhs.resize(dofs.len(), 0.0);
         dofs.gather_nodes((&self.force, moments), &mut system.rhs);
@@ -291,7 +303,7 @@ impl Newmark {
             .cholesky
             .solve_in_place(&mut system.rhs);
         dofs.scatter_nodes(&system.rhs, (&mut self.force, moments));
-        apply_increment(state, (&self.force, moments), h, beta, gamma);
+        apply_increment(state, (&self.force, moments), change, h, beta, gamma);
         check_finite(state)
     }
 
@@ -406,26 +418,29 @@ pub fn correct(state: &mut State, dt: f64, beta: f64, gamma: f64) {
     for_each_dof(state, update);
 }
 
-/// The start of an implicit step (Eq. 26 linearised at x_n): the acceleration
+/// The start of an implicit step (Eq. 26 linearised at x_n, v_n): the acceleration
 /// a⁰ = −(x̃ − x_n)/(β∆t²) = −(v_n + (½ − β)∆t a_n)/(β∆t) that leaves the positions at x_n,
-/// the velocity v⁰ = ṽ + γ∆t a⁰ that goes with it, t ← t + ∆t; rotations likewise.
-fn hold(state: &mut State, dt: f64, beta: f64, gamma: f64) {
+/// and into `change` the v⁰ − v_n = (1 − γ)∆t a_n + γ∆t a⁰ that goes with it (−2v_n for
+/// β = ¼, γ = ½); the velocities stay v_n, t ← t + ∆t; rotations likewise.
+fn hold(state: &mut State, dt: f64, beta: f64, gamma: f64, change: (&mut [Vec3], &mut [Vec3])) {
     let (ca, cv) = ((0.5 - beta) * dt, (1.0 - gamma) * dt);
-    let update = |(v, a): (&mut Vec3, &mut Vec3)| {
+    let update = |((v, a), dv): ((&Vec3, &mut Vec3), &mut Vec3)| {
         let held = -(*v + ca * *a) / (beta * dt);
-        *v += cv * *a + gamma * dt * held;
+        *dv = cv * *a + gamma * dt * held;
         *a = held;
     };
     state
         .velocity
-        .par_iter_mut()
+        .par_iter()
         .zip(state.acceleration.par_iter_mut())
+        .zip(change.0.par_iter_mut())
         .with_min_len(PARTICLE_CHUNK)
         .for_each(update);
     let spin = &mut state.spin;
     spin.velocity
-        .par_iter_mut()
+        .par_iter()
         .zip(spin.acceleration.par_iter_mut())
+        .zip(change.1.par_iter_mut())
         .with_min_len(PARTICLE_CHUNK)
         .for_each(update);
     state.time += dt;
@@ -449,19 +464,21 @@ fn subtract_inertia(state: &State, force: &mut [Vec3], moment: &mut [Vec3]) {
         .for_each(residual);
 }
 
-/// Adds the solved increment δa: x ← x + β∆t² δa, v ← v + γ∆t δa, a ← a + δa, translations
-/// and rotations.
+/// Adds the solved increment δa to the held state: x ← x + β∆t² δa, v ← v + (v⁰ − v_n) + γ∆t δa,
+/// a ← a + δa, translations and rotations.
 fn apply_increment(
     state: &mut State,
     increment: (&[Vec3], &[Vec3]),
+    change: (&[Vec3], &[Vec3]),
     dt: f64,
     beta: f64,
     gamma: f64,
 ) {
     let (cx, cv) = (beta * dt * dt, gamma * dt);
-    let update = |(((x, v), a), d): (((&mut Vec3, &mut Vec3), &mut Vec3), &Vec3)| {
+    type Dof<'a> = (((&'a mut Vec3, &'a mut Vec3), &'a mut Vec3), &'a Vec3);
+    let update = |((((x, v), a), d), dv): (Dof<'_>, &Vec3)| {
         *x += cx * d;
-        *v += cv * d;
+        *v += dv + cv * d;
         *a += d;
     };
     state
@@ -470,6 +487,7 @@ fn apply_increment(
         .zip(state.velocity.par_iter_mut())
         .zip(state.acceleration.par_iter_mut())
         .zip(increment.0.par_iter())
+        .zip(change.0.par_iter())
         .with_min_len(PARTICLE_CHUNK)
         .for_each(update);
     let spin = &mut state.spin;
@@ -478,6 +496,7 @@ fn apply_increment(
         .zip(spin.velocity.par_iter_mut())
         .zip(spin.acceleration.par_iter_mut())
         .zip(increment.1.par_iter())
+        .zip(change.1.par_iter())
         .with_min_len(PARTICLE_CHUNK)
         .for_each(update);
 }

@@ -94,6 +94,34 @@ impl Tangent {
         }
     }
 
+    /// Subtracts C x from `y`; x and y run over the generalised nodes (particles, then their
+    /// rotations) as [`FreeDofs::gather_nodes`] reads them, and each stored lower-triangle
+    /// entry acts on both sides. Sequential, so the sum is the same on any number of threads.
+    pub fn subtract_damping_times(&self, x: (&[Vec3], &[Vec3]), y: (&mut [Vec3], &mut [Vec3])) {
+        let n = x.0.len();
+        let value = |dof: usize| {
+            let node = dof / 3;
+            let v = if node < n { &x.0[node] } else { &x.1[node - n] };
+            v[dof % 3]
+        };
+        let (particles, rotations) = y;
+        let mut subtract = |dof: usize, amount: f64| {
+            let node = dof / 3;
+            let v = if node < n {
+                &mut particles[node]
+            } else {
+                &mut rotations[node - n]
+            };
+            v[dof % 3] -= amount;
+        };
+        for e in &self.damping {
+            subtract(e.row, e.val * value(e.col));
+            if e.row != e.col {
+                subtract(e.col, e.val * value(e.row));
+            }
+        }
+    }
+
     /// The stored stiffness entries (lower triangle, global DOFs, duplicates not summed).
     pub fn stiffness_entries(&self) -> &[Entry] {
         &self.stiffness

@@ -192,3 +192,53 @@ fn implicit_step_linearises_a_one_sided_contact_where_the_body_is() {
         assert!(drift < 1e-6, "step {step}: energy drift {drift:e}");
     }
 }
+
+/// A dashpot that only resists motion towards −x (as a contact's normal damping resists only
+/// approach), and a constant push F towards −x.
+struct OneSidedDashpot {
+    c: f64,
+    push: f64,
+}
+
+impl Model for OneSidedDashpot {
+    fn name(&self) -> &str {
+        "one-sided dashpot"
+    }
+
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
+        force[0].x += self.c * (-state.velocity[0].x).max(0.0) - self.push;
+    }
+
+    fn add_tangent(&self, _state: &State, tangent: &mut Tangent) -> bool {
+        tangent.add_damping(0, 0, &(qdem_core::Mat3::identity() * self.c));
+        true
+    }
+}
+
+/// Pushed through the dashpot from rest near its terminal velocity −F/c, the mass always moves
+/// towards −x, so the dashpot acts throughout and the motion is linear: average acceleration
+/// must give the trapezoidal recurrence (m/∆t + c/2) v_{n+1} = (m/∆t − c/2) v_n − F, even at
+/// c∆t/m = 1000. The implicit step linearises the force at v_n; at the held velocity of the
+/// predictor form (−v_n for β = ¼, γ = ½) the dashpot would see the mass moving away.
+#[test]
+fn implicit_step_linearises_a_one_sided_dashpot_at_the_velocity_the_body_has() {
+    let (m, c, push) = (1.0, 1e3, 1e3);
+    let terminal = -push / c;
+    let mut state = State::at_rest(vec![Vec3::zeros()]);
+    state.mass[0] = m;
+    state.velocity[0].x = 0.9 * terminal;
+    let mut models: Vec<Box<dyn Model>> = vec![Box::new(OneSidedDashpot { c, push })];
+    let dt = 1000.0 * m / c;
+    let mut stepper = Newmark::average_acceleration(dt);
+    stepper.initialize(&mut state, &mut models).unwrap();
+    let mut expected = state.velocity[0].x;
+    for step in 0..50 {
+        stepper.step(&mut state, &mut models).unwrap();
+        expected = ((m / dt - 0.5 * c) * expected - push) / (m / dt + 0.5 * c);
+        let v = state.velocity[0].x;
+        assert!(
+            (v - expected).abs() <= 1e-9 * terminal.abs(),
+            "step {step}: v = {v:e}, trapezoidal recurrence {expected:e}"
+        );
+    }
+}
