@@ -46,7 +46,8 @@ use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::model::Model;
 use crate::sparse::{
-    assemble, explain_failure, Entry, FactorStats, FreeDofs, Scales, SparseCholesky, Tangent,
+    assemble, explain_failure, DampingRows, Entry, FactorStats, FreeDofs, Scales, SparseCholesky,
+    Tangent,
 };
 use crate::state::State;
 use crate::stepper::{
@@ -118,6 +119,8 @@ struct ImplicitSystem {
     rhs: Vec<f64>,
     /// v⁰ − v_n of the held state, translations then rotations ([`hold`]).
     velocity_change: (Vec<Vec3>, Vec<Vec3>),
+    /// The tangent's damping by rows, for C (v⁰ − v_n).
+    damping: DampingRows,
 }
 
 /// The factorisation for the nominal step and the one for the last shorter sub-step.
@@ -237,6 +240,8 @@ impl Newmark {
             collect_tangent(state, models, &mut system.tangent)?;
             system.tangent_current = true;
         }
+        let nodes = state.len() + state.spin.len();
+        system.damping.build(&system.tangent, 3 * nodes);
         let dofs = FreeDofs::new(&state.node_fixity());
         let matrix = assemble(
             &system.tangent,
@@ -292,8 +297,8 @@ impl Newmark {
         subtract_inertia(state, &mut self.force, moments);
         let change = (&change.0[..], &change.1[..]);
         system
-            .tangent
-            .subtract_damping_times(change, (&mut self.force, moments));
+            .damping
+            .subtract_times(change, (&mut self.force, moments));
         let dofs = system.dofs.as_ref().expect("factorised before stepping");
         system.rhs.resize(dofs.len(), 0.0);
         dofs.gather_nodes((&self.force, moments), &mut system.rhs);

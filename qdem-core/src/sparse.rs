@@ -22,6 +22,7 @@ use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::model::Model;
 use crate::state::{Dofs, State};
+use crate::stepper::PARTICLE_CHUNK;
 use crate::{Mat3, Vec3};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError;
@@ -31,11 +32,90 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
 use faer::{Conj, MatMut, Side};
 use nalgebra::{Matrix6, SMatrix, SymmetricEigen, Vector6};
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::time::Instant;
 
 /// One stored matrix entry (row, column, value).
 pub type Entry = Triplet<usize, usize, f64>;
+
+/// The damping C of a [`Tangent`] as whole rows (each stored lower-triangle entry on both
+/// sides, duplicates kept, in the tangent's order), so that C x runs row by row in parallel and
+/// still sums every row in the same order on any number of threads.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct DampingRows {
+    start: Vec<usize>,
+    col: Vec<usize>,
+    val: Vec<f64>,
+}
+
+impl DampingRows {
+    /// Rebuilds the rows of `tangent`'s damping over `dofs` degrees of freedom.
+    pub(crate) fn build(&mut self, tangent: &Tangent, dofs: usize) {
+        self.start.clear();
+        self.start.resize(dofs + 1, 0);
+        for e in &tangent.damping {
+            self.start[e.row + 1] += 1;
+            if e.row != e.col {
+                self.start[e.col + 1] += 1;
+            }
+        }
+        for i in 0..dofs {
+            self.start[i + 1] += self.start[i];
+        }
+        let mut next = self.start[..dofs].to_vec();
+        self.col.resize(self.start[dofs], 0);
+        self.val.resize(self.start[dofs], 0.0);
+        let mut put = |row: usize, col: usize, val: f64| {
+            self.col[next[row]] = col;
+            self.val[next[row]] = val;
+            next[row] += 1;
+        };
+        for e in &tangent.damping {
+            put(e.row, e.col, e.val);
+            if e.row != e.col {
+                put(e.col, e.row, e.val);
+            }
+        }
+    }
+
+    /// Subtracts C x from `y`; x and y run over the generalised nodes (particles, then their
+    /// rotations) as [`FreeDofs::gather_nodes`] reads them.
+    pub(crate) fn subtract_times(&self, x: (&[Vec3], &[Vec3]), y: (&mut [Vec3], &mut [Vec3])) {
+        if self.val.is_empty() {
+            return;
+        }
+        let n = x.0.len();
+        let value = |dof: usize| {
+            let node = dof / 3;
+            let v = if node < n { &x.0[node] } else { &x.1[node - n] };
+            v[dof % 3]
+        };
+        let row = |dof: usize| -> f64 {
+            let range = self.start[dof]..self.start[dof + 1];
+            self.col[range.clone()]
+                .iter()
+                .zip(&self.val[range])
+                .map(|(&c, &v)| v * value(c))
+                .sum()
+        };
+        let update = |offset: usize| {
+            move |(node, out): (usize, &mut Vec3)| {
+                for c in 0..3 {
+                    out[c] -= row(3 * (offset + node) + c);
+                }
+            }
+        };
+        y.0.par_iter_mut()
+            .enumerate()
+            .with_min_len(PARTICLE_CHUNK)
+            .for_each(update(0));
+        y.1.par_iter_mut()
+            .enumerate()
+            .with_min_len(PARTICLE_CHUNK)
+            .for_each(update(n));
+    }
+}
 
 /// Marker in [`FreeDofs`] for a fixed DOF.
 const FIXED: usize = usize::MAX;
@@ -91,34 +171,6 @@ impl Tangent {
     pub fn add_damping_entry(&mut self, row: usize, col: usize, value: f64) {
         if row >= col {
             self.damping.push(Triplet::new(row, col, value));
-        }
-    }
-
-    /// Subtracts C x from `y`; x and y run over the generalised nodes (particles, then their
-    /// rotations) as [`FreeDofs::gather_nodes`] reads them, and each stored lower-triangle
-    /// entry acts on both sides. Sequential, so the sum is the same on any number of threads.
-    pub fn subtract_damping_times(&self, x: (&[Vec3], &[Vec3]), y: (&mut [Vec3], &mut [Vec3])) {
-        let n = x.0.len();
-        let value = |dof: usize| {
-            let node = dof / 3;
-            let v = if node < n { &x.0[node] } else { &x.1[node - n] };
-            v[dof % 3]
-        };
-        let (particles, rotations) = y;
-        let mut subtract = |dof: usize, amount: f64| {
-            let node = dof / 3;
-            let v = if node < n {
-                &mut particles[node]
-            } else {
-                &mut rotations[node - n]
-            };
-            v[dof % 3] -= amount;
-        };
-        for e in &self.damping {
-            subtract(e.row, e.val * value(e.col));
-            if e.row != e.col {
-                subtract(e.col, e.val * value(e.row));
-            }
         }
     }
 
