@@ -239,9 +239,8 @@ impl Newmark {
         if !system.tangent_current || self.update == TangentUpdate::EveryStep {
             collect_tangent(state, models, &mut system.tangent)?;
             system.tangent_current = true;
+            system.damping.build(&system.tangent, node_dofs(state));
         }
-        let nodes = state.len() + state.spin.len();
-        system.damping.build(&system.tangent, 3 * nodes);
         let dofs = FreeDofs::new(&state.node_fixity());
         let matrix = assemble(
             &system.tangent,
@@ -400,6 +399,11 @@ pub(crate) fn collect_tangent(
     }
 }
 
+/// Number of DOFs of the generalised nodes (particles, then their rotations), 3 each.
+fn node_dofs(state: &State) -> usize {
+    3 * (state.len() + state.spin.len())
+}
+
 /// The predictor of Eqs. 13–14 (the a_n, b_n of Eq. 22): x ← x + ∆t (v + (½ − β)∆t a),
 /// v ← v + (1 − γ)∆t a, t ← t + ∆t; the same for the particles' rotations.
 pub fn predict(state: &mut State, dt: f64, beta: f64, gamma: f64) {
@@ -434,39 +438,30 @@ fn hold(state: &mut State, dt: f64, beta: f64, gamma: f64, change: (&mut [Vec3],
         *dv = cv * *a + gamma * dt * held;
         *a = held;
     };
-    state
-        .velocity
-        .par_iter()
-        .zip(state.acceleration.par_iter_mut())
-        .zip(change.0.par_iter_mut())
-        .with_min_len(PARTICLE_CHUNK)
-        .for_each(update);
-    let spin = &mut state.spin;
-    spin.velocity
-        .par_iter()
-        .zip(spin.acceleration.par_iter_mut())
-        .zip(change.1.par_iter_mut())
-        .with_min_len(PARTICLE_CHUNK)
-        .for_each(update);
+    for ((_, v, a), dv) in dof_sets(state).into_iter().zip([change.0, change.1]) {
+        v.par_iter()
+            .zip(a.par_iter_mut())
+            .zip(dv.par_iter_mut())
+            .with_min_len(PARTICLE_CHUNK)
+            .for_each(update);
+    }
     state.time += dt;
 }
 
 /// The residual of Eq. 15 at the held state: force ← f − M a⁰, moment ← m − J α⁰.
 fn subtract_inertia(state: &State, force: &mut [Vec3], moment: &mut [Vec3]) {
     let residual = |((f, a), m): ((&mut Vec3, &Vec3), &f64)| *f -= *m * a;
-    force
-        .par_iter_mut()
-        .zip(state.acceleration.par_iter())
-        .zip(state.mass.par_iter())
-        .with_min_len(PARTICLE_CHUNK)
-        .for_each(residual);
-    let spin = &state.spin;
-    moment
-        .par_iter_mut()
-        .zip(spin.acceleration.par_iter())
-        .zip(spin.inertia.par_iter())
-        .with_min_len(PARTICLE_CHUNK)
-        .for_each(residual);
+    let sets = [
+        (force, &state.acceleration, &state.mass),
+        (moment, &state.spin.acceleration, &state.spin.inertia),
+    ];
+    for (f, a, m) in sets {
+        f.par_iter_mut()
+            .zip(a.par_iter())
+            .zip(m.par_iter())
+            .with_min_len(PARTICLE_CHUNK)
+            .for_each(residual);
+    }
 }
 
 /// Adds the solved increment δa to the held state: x ← x + β∆t² δa, v ← v + (v⁰ − v_n) + γ∆t δa,
@@ -486,24 +481,16 @@ fn apply_increment(
         *v += dv + cv * d;
         *a += d;
     };
-    state
-        .position
-        .par_iter_mut()
-        .zip(state.velocity.par_iter_mut())
-        .zip(state.acceleration.par_iter_mut())
-        .zip(increment.0.par_iter())
-        .zip(change.0.par_iter())
-        .with_min_len(PARTICLE_CHUNK)
-        .for_each(update);
-    let spin = &mut state.spin;
-    spin.angle
-        .par_iter_mut()
-        .zip(spin.velocity.par_iter_mut())
-        .zip(spin.acceleration.par_iter_mut())
-        .zip(increment.1.par_iter())
-        .zip(change.1.par_iter())
-        .with_min_len(PARTICLE_CHUNK)
-        .for_each(update);
+    let extra = [(increment.0, change.0), (increment.1, change.1)];
+    for ((x, v, a), (d, dv)) in dof_sets(state).into_iter().zip(extra) {
+        x.par_iter_mut()
+            .zip(v.par_iter_mut())
+            .zip(a.par_iter_mut())
+            .zip(d.par_iter())
+            .zip(dv.par_iter())
+            .with_min_len(PARTICLE_CHUNK)
+            .for_each(update);
+    }
 }
 
 /// Applies `update` to every (position, velocity, acceleration) triple, translations and
@@ -512,20 +499,30 @@ fn for_each_dof<F>(state: &mut State, update: F)
 where
     F: Fn(((&mut Vec3, &mut Vec3), &Vec3)) + Sync + Send + Copy,
 {
-    state
-        .position
-        .par_iter_mut()
-        .zip(state.velocity.par_iter_mut())
-        .zip(state.acceleration.par_iter())
-        .with_min_len(PARTICLE_CHUNK)
-        .for_each(update);
+    for (x, v, a) in dof_sets(state) {
+        x.par_iter_mut()
+            .zip(v.par_iter_mut())
+            .zip(a.par_iter())
+            .with_min_len(PARTICLE_CHUNK)
+            .for_each(update);
+    }
+}
+
+/// The (position, velocity, acceleration) arrays of the translations, then of the particles'
+/// rotations.
+type DofSet<'a> = (&'a mut [Vec3], &'a mut [Vec3], &'a mut [Vec3]);
+
+/// The two sets of generalised DOFs of `state`: translations, then rotations.
+fn dof_sets(state: &mut State) -> [DofSet<'_>; 2] {
     let spin = &mut state.spin;
-    spin.angle
-        .par_iter_mut()
-        .zip(spin.velocity.par_iter_mut())
-        .zip(spin.acceleration.par_iter())
-        .with_min_len(PARTICLE_CHUNK)
-        .for_each(update);
+    [
+        (
+            &mut state.position,
+            &mut state.velocity,
+            &mut state.acceleration,
+        ),
+        (&mut spin.angle, &mut spin.velocity, &mut spin.acceleration),
+    ]
 }
 
 impl Stepper for Newmark {
@@ -585,8 +582,9 @@ impl Stepper for Newmark {
         };
         if self.is_implicit() {
             self.system.tangent_current = input.bool("the tangent flag")?;
-            let dofs = 3 * state.len() + 3 * state.spin.len();
+            let dofs = node_dofs(state);
             self.system.tangent.restore(input, dofs)?;
+            self.system.damping.build(&self.system.tangent, dofs);
             let steps = [
                 input.option_f64("a factorised step")?,
                 input.option_f64("a factorised step")?,
