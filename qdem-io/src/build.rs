@@ -89,6 +89,17 @@ pub enum BuildError {
         /// What is wrong.
         source: qdem_contact::clump_sample::SampleError,
     },
+    /// A body's `rest_on` finds no stone beneath it.
+    #[error(
+        "{scene}: body `{body}`: rest_on: no stone lies beneath its contact spheres, so it has \
+         nothing to rest on; fix: translate the body over the sample, or drop rest_on"
+    )]
+    RestOn {
+        /// The scene file.
+        scene: PathBuf,
+        /// The body.
+        body: String,
+    },
     /// A stones file is malformed.
     #[error(
         "{path}:{line}: {message} (a stones file is CSV `stone,x,y,z,radius`, one row per sphere)"
@@ -236,7 +247,16 @@ impl Simulation {
             scene: scene.path.clone(),
             source,
         };
-        let (meshes, warnings, ballast) = read_meshes(&scene)?;
+        let (mut meshes, warnings, ballast) = read_meshes(&scene)?;
+        let stones = match &scene.granular {
+            Some(g) => crate::granular_build::stones(&scene, g)?,
+            None => Vec::new(),
+        };
+        let periodic_box = match &scene.periodic {
+            Some(p) => Some(crate::periodic_build::periodic_box(&scene, p)?),
+            None => None,
+        };
+        crate::rest_on::rest_bodies(&scene, &mut meshes, &stones, periodic_box.as_ref())?;
         let reference = meshes
             .iter()
             .flat_map(|m| m.mesh.nodes.iter().map(|p| Vec3::from(*p)));
@@ -254,7 +274,6 @@ impl Simulation {
         }
         let granular = match &scene.granular {
             Some(g) => {
-                let stones = crate::granular_build::stones(&scene, g)?;
                 let material = scene
                     .materials
                     .iter()
@@ -276,9 +295,9 @@ impl Simulation {
             }
             None => None,
         };
-        let periodic = match &scene.periodic {
+        let periodic = match periodic_box {
             Some(p) => Some((
-                crate::periodic_build::periodic_box(&scene, p)?,
+                p,
                 crate::periodic_build::wrap_groups(
                     &state,
                     &bodies,

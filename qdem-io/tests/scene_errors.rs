@@ -900,6 +900,16 @@ fn granular_mistakes_are_named() {
             "needs all of `region`, `count` and `grading`",
         ],
     );
+    let rest = with("reorder = true", "reorder = true\nrest_on = \"ballast\"");
+    let (_, msg) = error(&rest);
+    assert_has(
+        &msg,
+        &[
+            "scene.toml:22:11: [[body]] \"beam\"",
+            "rest_on = \"ballast\" needs a [granular] sample of that name",
+            "rest_on needs the body's contact_radius",
+        ],
+    );
     let rotation = with("dofs = \"xyz\"", "dofs = \"xyz\"\nrotation = true");
     let (_, msg) = error(&rotation);
     assert_has(&msg, &["[[fix]] #1", "rotation = true", "is not rigid"]);

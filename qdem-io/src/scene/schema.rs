@@ -219,6 +219,11 @@ pub struct Body {
     /// Initial velocity of every particle of the body (m/s); default zero.
     #[serde(default)]
     pub velocity: [f64; 3],
+    /// Name of the `[granular]` sample to lay the body on: after `translate` it is lowered
+    /// along −z until its contact spheres touch the stones beneath (`rest_on.rs`); default
+    /// none (the body stays where `translate` puts it).
+    #[serde(default)]
+    pub rest_on: Option<String>,
 }
 
 /// `[contact].law`: the contact law between spheres of different bodies and against walls.

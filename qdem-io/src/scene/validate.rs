@@ -941,6 +941,35 @@ fn periodic_table(c: &mut Checker<'_>, raw: &RawScene, p: &Periodic) {
     }
 }
 
+/// `[[body]] rest_on`: a `[granular]` of that name, and contact spheres to rest with.
+fn rest_on_key(
+    c: &mut Checker<'_>,
+    raw: &RawScene,
+    idx: &str,
+    l: &str,
+    has_spheres: bool,
+    sample: &str,
+) {
+    let at = ["body", idx, "rest_on"];
+    match &raw.granular {
+        Some(g) if g.name == sample => {}
+        Some(g) => c.error(
+            &at,
+            format!("{l}: rest_on = {sample:?} names no sample; the [granular] sample is {:?}", g.name),
+        ),
+        None => c.error(
+            &at,
+            format!("{l}: rest_on = {sample:?} needs a [granular] sample of that name to rest on; add one or drop rest_on"),
+        ),
+    }
+    if !has_spheres {
+        c.error(
+            &at,
+            format!("{l}: rest_on needs the body's contact_radius (its contact spheres are what rest on the stones)"),
+        );
+    }
+}
+
 /// `[granular]`: its material, a sample file or a generation (region, count, grading), a crop.
 fn granular_table(c: &mut Checker<'_>, raw: &RawScene, g: &Granular, materials: &[&str]) {
     let l = format!("[granular] {:?}", g.name);
@@ -1130,6 +1159,9 @@ fn contact_tables(c: &mut Checker<'_>, raw: &RawScene) {
             &b.rotate_deg,
         );
         c.finite(&["body", &idx, "velocity"], &l, "velocity", &b.velocity);
+        if let Some(sample) = &b.rest_on {
+            rest_on_key(c, raw, &idx, &l, b.contact_radius.is_some(), sample);
+        }
         if b.rigid && run.integrator != Integrator::Verlet {
             c.error(
                 &["body", &idx, "rigid"],
