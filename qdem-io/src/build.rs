@@ -295,18 +295,15 @@ impl Simulation {
             }
             None => None,
         };
-        let periodic = match periodic_box {
-            Some(p) => Some((
-                p,
-                crate::periodic_build::wrap_groups(
-                    &state,
-                    &bodies,
-                    granular.as_ref(),
-                    ballast.as_ref(),
-                ),
-            )),
-            None => None,
-        };
+        let periodic = periodic_box.map(|p| {
+            let groups = crate::periodic_build::wrap_groups(
+                &state,
+                &bodies,
+                granular.as_ref(),
+                ballast.as_ref(),
+            );
+            (p, groups)
+        });
         extra.periodic = periodic.as_ref().map(|p| p.0.clone());
         if let Some(contacts) =
             crate::contact_build::build_contacts(&scene, &meshes, &state, extra)?

@@ -31,19 +31,20 @@ pub(crate) fn rest_bodies(
         if body.rest_on.is_none() {
             continue;
         }
-        let radius = body.contact_radius.expect("validated: rest_on needs contact_radius");
+        let radius = body
+            .contact_radius
+            .expect("validated: rest_on needs contact_radius");
         let spheres: Vec<Vec3> = placed
             .mesh
             .surface_nodes()
             .iter()
             .map(|&n| Vec3::from(placed.mesh.nodes[n as usize]))
             .collect();
-        let drop = resting_drop(&spheres, radius, stones, periodic).ok_or_else(|| {
-            BuildError::RestOn {
+        let drop =
+            resting_drop(&spheres, radius, stones, periodic).ok_or_else(|| BuildError::RestOn {
                 scene: scene.path.clone(),
                 body: body.name.clone(),
-            }
-        })?;
+            })?;
         for p in &mut placed.mesh.nodes {
             p[2] -= drop;
         }
