@@ -7,7 +7,11 @@
 //! together. A run with `[granular]` writes the stones' final spheres to `stones.csv` in that
 //! format ([`write_stones_csv`]), so a deposition run's output is the next run's sample. `crop`
 //! keeps the sample's stones whose spheres all lie inside a box, as paper 003 §3 cuts its
-//! single-sleeper samples out of the middle of its three-sleeper one. A sample and a generation
+//! single-sleeper samples out of the middle of its three-sleeper one. A sphere may cross a
+//! face of the box by [`CROP_TOLERANCE`] of its radius: a stone resting on a wall overlaps it
+//! by its contact overlap (up to 0.3% of the radius in the box-test deposits), and a crop box
+//! drawn on the walls must keep it — refusing it took the whole bottom layer and the stones
+//! along the side walls out of every cropped sample, and the sample collapsed into the gap. A sample and a generation
 //! together give the sample's stones then new ones (deposition in stages: a bed, then the
 //! sleepers laid on it, then the crib ballast poured around them).
 //!
@@ -51,6 +55,17 @@ impl GranularInfo {
     }
 }
 
+/// How far, as a fraction of its radius, a sphere may cross a face of the `crop` box and still
+/// count as inside (module docs): three times the largest wall overlap of a deposit.
+pub const CROP_TOLERANCE: f64 = 0.01;
+
+/// Whether a sphere (centre `c`, radius `r`) lies inside the box `lo`–`hi` up to
+/// [`CROP_TOLERANCE`].
+fn inside_crop(lo: &[f64; 3], hi: &[f64; 3], c: &Vec3, r: f64) -> bool {
+    let slack = CROP_TOLERANCE * r;
+    (0..3).all(|k| c[k] - r >= lo[k] - slack && c[k] + r <= hi[k] + slack)
+}
+
 /// The stones of `granular`: its sample file's, cropped, then the generated ones.
 pub(crate) fn stones(scene: &Scene, granular: &Granular) -> Result<Vec<Stone>, BuildError> {
     let refused = |source: SampleError| BuildError::Granular {
@@ -62,8 +77,12 @@ pub(crate) fn stones(scene: &Scene, granular: &Granular) -> Result<Vec<Stone>, B
         None => Vec::new(),
     };
     if let Some([lo, hi]) = granular.crop {
-        let inside = |c: &Vec3, r: f64| (0..3).all(|k| c[k] - r >= lo[k] && c[k] + r <= hi[k]);
-        stones.retain(|s| s.centers.iter().zip(&s.radii).all(|(c, &r)| inside(c, r)));
+        stones.retain(|s| {
+            s.centers
+                .iter()
+                .zip(&s.radii)
+                .all(|(c, &r)| inside_crop(&lo, &hi, c, r))
+        });
     }
     if let (Some([lo, hi]), Some(count), Some(grading)) =
         (granular.region, granular.count, &granular.grading)
@@ -231,4 +250,49 @@ pub fn write_stones_csv(
         }
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LO: [f64; 3] = [0.0, 0.0, 0.0];
+    const HI: [f64; 3] = [1.0, 1.0, 1.0];
+
+    #[test]
+    fn a_stone_resting_on_a_wall_of_the_crop_box_is_kept() {
+        // r = 0.1 pressed 0.3% of r into the floor, as the deposits' stones rest on it.
+        let r = 0.1;
+        assert!(inside_crop(
+            &LO,
+            &HI,
+            &Vec3::new(0.5, 0.5, r - 0.003 * r),
+            r
+        ));
+        assert!(inside_crop(
+            &LO,
+            &HI,
+            &Vec3::new(1.0 - r + 0.003 * r, 0.5, 0.5),
+            r
+        ));
+    }
+
+    #[test]
+    fn a_stone_across_a_face_of_the_crop_box_is_dropped() {
+        // Crossing by 5% of r is no contact overlap, and a stone astride a cut is outside.
+        let r = 0.1;
+        assert!(!inside_crop(
+            &LO,
+            &HI,
+            &Vec3::new(0.5, 0.5, r - 0.05 * r),
+            r
+        ));
+        assert!(!inside_crop(&LO, &HI, &Vec3::new(0.5, 1.0, 0.5), r));
+        assert!(!inside_crop(
+            &LO,
+            &HI,
+            &Vec3::new(0.5, 0.5, 1.0 - 0.5 * r),
+            r
+        ));
+    }
 }
