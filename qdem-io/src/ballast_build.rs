@@ -128,6 +128,7 @@ pub(crate) fn place_ballast(
         particles: start..start + mesh.nodes.len(),
         mesh,
         path: ballast_path(scene, ballast),
+        rotation: nalgebra::UnitQuaternion::identity(),
     };
     Ok((placed, info, warnings))
 }

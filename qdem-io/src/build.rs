@@ -11,7 +11,7 @@ use crate::contact_build::ExtraSpheres;
 use crate::granular_build::GranularInfo;
 use crate::scene::suggest::did_you_mean;
 use crate::scene::{Integrator, Scene, Selection, TimeStep};
-use nalgebra::Rotation3;
+use nalgebra::{Rotation3, UnitQuaternion};
 use qdem_contact::BondedParticles;
 use qdem_contact::{DemContacts, PeriodicBox, WrapGroup};
 use qdem_core::rigid_body::tet_mass_properties;
@@ -100,6 +100,32 @@ pub enum BuildError {
         /// The body.
         body: String,
     },
+    /// A body's `pose_from` file has no row for it.
+    #[error(
+        "{scene}: body `{body}`: pose_from: {path} has no pose for a body of that name; fix: \
+         name the body as in the run that wrote the file, or drop pose_from"
+    )]
+    PoseMissing {
+        /// The scene file.
+        scene: PathBuf,
+        /// The body.
+        body: String,
+        /// The poses file.
+        path: PathBuf,
+    },
+    /// A poses file is malformed.
+    #[error(
+        "{path}:{line}: {message} (a poses file is CSV `body,x,y,z,qw,qx,qy,qz`, one row per \
+         rigid body, as a run writes it)"
+    )]
+    Poses {
+        /// The file.
+        path: PathBuf,
+        /// Line number (1-based; 0 when the file could not be read).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
     /// A stones file is malformed.
     #[error(
         "{path}:{line}: {message} (a stones file is CSV `stone,x,y,z,radius`, one row per sphere)"
@@ -174,6 +200,10 @@ pub enum BodyKind {
         center: usize,
         /// Its tetrahedra, as state particle indices.
         tets: Vec<[u32; 4]>,
+        /// Orientation its principal frame had in the body's design placement (after
+        /// `rotate_deg` and `translate`, before `pose_from`): the pose written to `poses.csv`
+        /// is measured from it ([`crate::pose_from`]).
+        design_frame: UnitQuaternion<f64>,
     },
 }
 
@@ -234,6 +264,8 @@ pub(crate) struct PlacedMesh {
     pub(crate) mesh: TetMesh,
     pub(crate) path: PathBuf,
     pub(crate) particles: Range<usize>,
+    /// The rotation `pose_from` gave the mesh from its design placement (identity without).
+    pub(crate) rotation: UnitQuaternion<f64>,
 }
 
 impl Simulation {
@@ -256,6 +288,7 @@ impl Simulation {
             Some(p) => Some(crate::periodic_build::periodic_box(&scene, p)?),
             None => None,
         };
+        crate::pose_from::pose_bodies(&scene, &mut meshes)?;
         crate::rest_on::rest_bodies(&scene, &mut meshes, &stones, periodic_box.as_ref())?;
         let reference = meshes
             .iter()
@@ -418,6 +451,7 @@ fn read_meshes(scene: &Scene) -> Result<ReadMeshes, BuildError> {
             mesh,
             path,
             particles,
+            rotation: UnitQuaternion::identity(),
         });
     }
     let mut ballast = None;
@@ -486,6 +520,7 @@ fn build_bodies(
                 body: index,
                 center: c,
                 tets,
+                design_frame: placed.rotation.inverse() * state.rigid.orientation[index],
             }
         } else {
             let core = core_material(material);

@@ -32,6 +32,7 @@ mod load_series;
 pub mod output;
 mod periodic_build;
 pub mod plot;
+pub mod pose_from;
 mod rest_on;
 mod run_record;
 pub mod runner;

@@ -7,7 +7,8 @@
 //! progress. A scene with `[granular]` also gets `stones.csv` (the stones' spheres at the end,
 //! the sample format `[granular] sample` reads); one with a time-delayed boundary gets
 //! `boundary.csv` (time, the measured average boundary force, the left and right ghost
-//! scales) at the probe interval.
+//! scales) at the probe interval; one with rigid `[[body]]`s gets `poses.csv` (where each
+//! ended, the file `[[body]] pose_from` reads: [`crate::pose_from`]).
 
 use crate::build::{BodyKind, Simulation};
 use crate::checkpoint::{
@@ -17,6 +18,7 @@ use crate::crack_svg::write_crack_svg;
 use crate::granular_build::write_stones_csv;
 use crate::output::{write_atomic, write_summary, write_vtu, OutputError, ProbeCsv, VtuGrid};
 use crate::plot::{line_plot_svg, Labels, Series};
+use crate::pose_from::{poses, write_poses_csv};
 use crate::run_record::{check_checkpointable, decode_run, encode_run, RunRecord};
 use crate::scene::Integrator;
 use qdem_contact::BondedParticles;
@@ -371,6 +373,10 @@ pub fn run_with(
     }
     if let Some(info) = &sim.granular {
         write_stones_csv(&out_dir.join("stones.csv"), info, &sim.state)?;
+    }
+    let poses = poses(sim);
+    if !poses.is_empty() {
+        write_poses_csv(&out_dir.join("poses.csv"), &poses)?;
     }
     if !record.boundary_rows.is_empty() {
         write_boundary_csv(&out_dir.join("boundary.csv"), &record.boundary_rows)?;

@@ -910,6 +910,18 @@ fn granular_mistakes_are_named() {
             "rest_on needs the body's contact_radius",
         ],
     );
+    let posed = with(
+        "reorder = true",
+        "reorder = true\nrest_on = \"ballast\"\npose_from = \"poses.csv\"",
+    );
+    let (_, msg) = error(&posed);
+    assert_has(
+        &msg,
+        &[
+            "pose_from places rigid bodies only",
+            "pose_from and rest_on both place the body; keep one",
+        ],
+    );
     let rotation = with("dofs = \"xyz\"", "dofs = \"xyz\"\nrotation = true");
     let (_, msg) = error(&rotation);
     assert_has(&msg, &["[[fix]] #1", "rotation = true", "is not rigid"]);

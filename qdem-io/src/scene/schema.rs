@@ -224,6 +224,10 @@ pub struct Body {
     /// none (the body stays where `translate` puts it).
     #[serde(default)]
     pub rest_on: Option<String>,
+    /// A `poses.csv` written by an earlier run (relative to the scene file): a rigid body is
+    /// placed where that run left its body of the same name (`pose_from.rs`); default none.
+    #[serde(default)]
+    pub pose_from: Option<PathBuf>,
 }
 
 /// `[contact].law`: the contact law between spheres of different bodies and against walls.
@@ -681,7 +685,8 @@ pub struct Granular {
     /// A stones file (CSV `stone,x,y,z,radius`), relative to the scene file.
     #[serde(default)]
     pub sample: Option<PathBuf>,
-    /// Keep only the sample's stones whose spheres all lie inside this box (m).
+    /// Keep only the sample's stones whose spheres all lie inside this box (m), up to
+    /// `CROP_TOLERANCE` of a radius (a stone resting on a wall of the box stays).
     #[serde(default)]
     pub crop: Option<[[f64; 3]; 2]>,
     /// Generation: the box filled with stones on a loose lattice (m).

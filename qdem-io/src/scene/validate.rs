@@ -6,8 +6,8 @@ use std::path::Path;
 
 use super::error::{located, Diagnostic, SceneError};
 use super::schema::{
-    Ballast, ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load, Periodic, Ramp, RawFix,
-    RawLoad, RawScene, Selection, Series, TimeStep,
+    Ballast, Body, ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load, Periodic, Ramp,
+    RawFix, RawLoad, RawScene, Selection, Series, TimeStep,
 };
 use super::spans::SpanIndex;
 use super::suggest::did_you_mean;
@@ -970,6 +970,24 @@ fn rest_on_key(
     }
 }
 
+/// `[[body]] pose_from`: a rigid body (a deformable one's shape would be lost), not also laid
+/// with `rest_on`.
+fn pose_from_key(c: &mut Checker<'_>, idx: &str, l: &str, b: &Body) {
+    let at = ["body", idx, "pose_from"];
+    if !b.rigid {
+        c.error(
+            &at,
+            format!("{l}: pose_from places rigid bodies only (a poses file holds no shape); set rigid = true or drop pose_from"),
+        );
+    }
+    if b.rest_on.is_some() {
+        c.error(
+            &at,
+            format!("{l}: pose_from and rest_on both place the body; keep one"),
+        );
+    }
+}
+
 /// `[granular]`: its material, a sample file or a generation (region, count, grading), a crop.
 fn granular_table(c: &mut Checker<'_>, raw: &RawScene, g: &Granular, materials: &[&str]) {
     let l = format!("[granular] {:?}", g.name);
@@ -1161,6 +1179,9 @@ fn contact_tables(c: &mut Checker<'_>, raw: &RawScene) {
         c.finite(&["body", &idx, "velocity"], &l, "velocity", &b.velocity);
         if let Some(sample) = &b.rest_on {
             rest_on_key(c, raw, &idx, &l, b.contact_radius.is_some(), sample);
+        }
+        if b.pose_from.is_some() {
+            pose_from_key(c, &idx, &l, b);
         }
         if b.rigid && run.integrator != Integrator::Verlet {
             c.error(
