@@ -37,6 +37,13 @@
 //!    the ratio stays consistent with the fitted sinusoid.
 //! 5. If A(Φ) ≤ 0 or is not finite, or a scale is not finite (a non-finite lag), the scales are
 //!    1. Each scale is clamped to ≥ 0: a negative scale would turn a ghost's push into a pull.
+//! 6. Each scale is at most a limit ([`TimeDelayedBoundary::with_scale_limit`]), the load's
+//!    max/min ratio in a scene. The paper's premise is that the boundary forces follow the
+//!    sleeper load (its Fig. 13), so a neighbour's force is at most L_max/L_min times this
+//!    cell's. Without the cap, a cycle whose first data point F_min is near zero (the boundary
+//!    contacts relaxed at the minimum load) gets scales of hundreds towards its end, where
+//!    A(Φ) → F_min, and the ghosts' pushes blow the sample apart: in the seed-1 box-test study
+//!    F_current fell to 0.015 N, the scales rose to 1,086 and an acceleration became infinite.
 
 use qdem_core::{CheckpointError, Decoder, Encoder};
 use std::f64::consts::{FRAC_PI_2, TAU};
@@ -120,6 +127,8 @@ pub struct TimeDelayedBoundary {
     /// The current cycle's index and F_min (its first data point).
     current: Option<(i64, f64)>,
     f_max: Option<f64>,
+    /// Rule 6's cap on either scale.
+    limit: f64,
 }
 
 impl TimeDelayedBoundary {
@@ -131,6 +140,16 @@ impl TimeDelayedBoundary {
             lag,
             current: None,
             f_max: None,
+            limit: f64::INFINITY,
+        }
+    }
+
+    /// The same controller with both scales capped at `limit` (rule 6; ≥ 1, so a zero lag
+    /// still gives exactly the ordinary boundary).
+    pub fn with_scale_limit(self, limit: f64) -> TimeDelayedBoundary {
+        TimeDelayedBoundary {
+            limit: limit.max(1.0),
+            ..self
         }
     }
 
@@ -150,7 +169,7 @@ impl TimeDelayedBoundary {
             self.f_max = Some(estimate_max(f_current, f_min, phi));
         }
         match self.f_max {
-            Some(f_max) => ghost_scales(f_max, f_min, phi, self.lag),
+            Some(f_max) => ghost_scales(f_max, f_min, phi, self.lag, self.limit),
             None => GhostScales::PERIODIC,
         }
     }
@@ -197,9 +216,10 @@ impl TimeDelayedBoundary {
     }
 }
 
-/// Rules 4–5: s = 1 + (f_max − f_min)/2 · (sin(Φ ∓ δ) − sin Φ)/A(Φ) = A(Φ ∓ δ)/A(Φ) (Eqs. 4–7),
-/// exactly 1 for δ = 0, clamped to ≥ 0; both 1 where A(Φ) ≤ 0 or a value is not finite.
-fn ghost_scales(f_max: f64, f_min: f64, phi: f64, lag: f64) -> GhostScales {
+/// Rules 4–6: s = 1 + (f_max − f_min)/2 · (sin(Φ ∓ δ) − sin Φ)/A(Φ) = A(Φ ∓ δ)/A(Φ) (Eqs. 4–7),
+/// exactly 1 for δ = 0, clamped to [0, `limit`]; both 1 where A(Φ) ≤ 0 or a value is not
+/// finite.
+fn ghost_scales(f_max: f64, f_min: f64, phi: f64, lag: f64, limit: f64) -> GhostScales {
     let current = average_force(f_max, f_min, phi);
     if !(current > 0.0 && current.is_finite()) {
         return GhostScales::PERIODIC;
@@ -212,8 +232,8 @@ fn ghost_scales(f_max: f64, f_min: f64, phi: f64, lag: f64) -> GhostScales {
         return GhostScales::PERIODIC;
     }
     GhostScales {
-        left: left.max(0.0),
-        right: right.max(0.0),
+        left: left.clamp(0.0, limit),
+        right: right.clamp(0.0, limit),
     }
 }
 
@@ -415,23 +435,33 @@ mod tests {
     #[test]
     fn scales_are_clamped_and_guarded() {
         // f_max = 30, f_min = 10 at Φ = π/2 with δ = π: left/right A(−π/2)/A(π/2) = 10/30 ≥ 0.
-        let s = ghost_scales(30.0, 10.0, FRAC_PI_2, PI);
+        let s = ghost_scales(30.0, 10.0, FRAC_PI_2, PI, f64::INFINITY);
         assert!(close(s.left, 1.0 / 3.0, 1e-12) && close(s.right, 1.0 / 3.0, 1e-12));
         // f_max = 30, f_min = −10 (a fit gone wrong): A(π/2) = 30, A(−π/2) = −10 → −1/3 → 0.
-        let s = ghost_scales(30.0, -10.0, FRAC_PI_2, PI);
+        let s = ghost_scales(30.0, -10.0, FRAC_PI_2, PI, f64::INFINITY);
         assert_eq!((s.left, s.right), (0.0, 0.0));
         // A(Φ) ≤ 0 or not finite, or a NaN lag: ordinary boundary.
         assert_eq!(
-            ghost_scales(30.0, -10.0, -FRAC_PI_2, 1.0),
+            ghost_scales(30.0, -10.0, -FRAC_PI_2, 1.0, f64::INFINITY),
             GhostScales::PERIODIC
         );
         assert_eq!(
-            ghost_scales(f64::INFINITY, 10.0, 0.0, 1.0),
+            ghost_scales(f64::INFINITY, 10.0, 0.0, 1.0, f64::INFINITY),
             GhostScales::PERIODIC
         );
         assert_eq!(
-            ghost_scales(30.0, 10.0, 0.0, f64::NAN),
+            ghost_scales(30.0, 10.0, 0.0, f64::NAN, f64::INFINITY),
             GhostScales::PERIODIC
+        );
+        // F_min = 0.1 N, F_max = 150 N near a cycle's end (Φ = 3π/2 − 0.1), δ = π/2:
+        // A(Φ) = 75.05 − 74.95 cos 0.1 = 0.474 N against A(Φ ∓ δ) = 75.05 ± 74.95 sin 0.1 =
+        // 82.5 and 67.6 N: scales 174 and 142, capped at the load ratio 40/3.
+        let s = ghost_scales(150.0, 0.1, 1.5 * PI - 0.1, FRAC_PI_2, 40.0 / 3.0);
+        assert_eq!((s.left, s.right), (40.0 / 3.0, 40.0 / 3.0));
+        let free = ghost_scales(150.0, 0.1, 1.5 * PI - 0.1, FRAC_PI_2, f64::INFINITY);
+        assert!(
+            close(free.left, 173.9586, 1e-6) && close(free.right, 142.4159, 1e-6),
+            "{free:?}"
         );
     }
 }

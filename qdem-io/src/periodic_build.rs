@@ -137,7 +137,11 @@ pub(crate) fn periodic_contacts(
         phase: 0.0,
         start: cyclic.first_cycle_start(),
     };
-    contacts
-        .with_time_delay(axis, TimeDelayedBoundary::new(cycle, lag))
-        .map_err(refused)
+    // Rule 6 of the controller: no ghost pushes more than the load's max/min ratio harder.
+    let limit = match cyclic.max / cyclic.min {
+        r if r.is_finite() => r.abs(),
+        _ => f64::INFINITY,
+    };
+    let boundary = TimeDelayedBoundary::new(cycle, lag).with_scale_limit(limit);
+    contacts.with_time_delay(axis, boundary).map_err(refused)
 }
