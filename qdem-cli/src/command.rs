@@ -329,9 +329,11 @@ fn run_scene(path: &Path, out: Option<&Path>, resume: Option<&Path>) -> Result<(
             sim.bonded().map_or(0, |b| b.broken())
         );
     }
-    let rate = match sim.bonded() {
-        Some(_) => format!("{:.3e} particle-steps/s", report.particle_steps_per_second),
-        None => format!("{:.3e} tet-steps/s", report.tet_steps_per_second),
+    // Particles are what a bonded or a stone run steps; its tetrahedra, if any, are few.
+    let rate = if sim.bonded().is_some() || sim.granular.is_some() {
+        format!("{:.3e} particle-steps/s", report.particle_steps_per_second)
+    } else {
+        format!("{:.3e} tet-steps/s", report.tet_steps_per_second)
     };
     eprintln!(
         "done: {} steps in {:.2} s ({rate}); outputs in {}",
