@@ -20,6 +20,7 @@
 //! sphere, which carries the sphere's contact radius.
 
 use crate::build::BuildError;
+use crate::csv_rows::{finite, read_text, rows};
 use crate::output::{write_atomic, OutputError};
 use crate::scene::{Granular, Scene};
 use qdem_contact::clump_sample::{
@@ -170,34 +171,14 @@ pub fn read_stones_csv(path: &Path) -> Result<Vec<Stone>, BuildError> {
         line,
         message,
     };
-    let text = std::fs::read_to_string(path).map_err(|e| bad(0, e.to_string()))?;
-    let mut lines = text.lines().enumerate();
-    match lines.next() {
-        Some((_, h)) if h.trim() == STONES_HEADER => {}
-        _ => return Err(bad(1, format!("the first line must be `{STONES_HEADER}`"))),
-    }
+    let text = read_text(path, STONES_HEADER, &bad)?;
     let mut stones: Vec<Stone> = Vec::new();
     let mut last_id: Option<u64> = None;
-    for (i, line) in lines {
-        let n = i + 1;
-        if line.trim().is_empty() {
-            continue;
-        }
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        if fields.len() != 5 {
-            return Err(bad(n, format!("expected 5 fields, found {}", fields.len())));
-        }
+    for (n, fields) in rows(&text, 5, &bad)? {
         let id: u64 = fields[0]
             .parse()
             .map_err(|_| bad(n, format!("stone {:?} is not a whole number", fields[0])))?;
-        let mut v = [0.0; 4];
-        for (k, f) in fields[1..].iter().enumerate() {
-            v[k] = f
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| bad(n, format!("{:?} is not a finite number", f)))?;
-        }
+        let v: [f64; 4] = finite(&fields[1..], n, &bad)?;
         if v[3] <= 0.0 {
             return Err(bad(n, format!("radius {} must be positive", v[3])));
         }

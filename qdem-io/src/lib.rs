@@ -26,6 +26,7 @@ pub mod build;
 pub mod checkpoint;
 mod contact_build;
 pub mod crack_svg;
+mod csv_rows;
 pub mod granular_build;
 pub mod linear_spectrum;
 mod load_series;

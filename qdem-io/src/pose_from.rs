@@ -23,6 +23,7 @@
 //! that stop it before it reaches the bed again.
 
 use crate::build::{BodyKind, BuildError, PlacedMesh, Simulation};
+use crate::csv_rows::{finite, read_text, rows};
 use crate::output::{write_atomic, OutputError};
 use crate::scene::Scene;
 use nalgebra::{Quaternion, UnitQuaternion};
@@ -77,33 +78,14 @@ pub fn read_poses_csv(path: &Path) -> Result<Vec<Pose>, BuildError> {
         line,
         message,
     };
-    let text = std::fs::read_to_string(path).map_err(|e| bad(0, e.to_string()))?;
-    let mut lines = text.lines().enumerate();
-    match lines.next() {
-        Some((_, h)) if h.trim() == POSES_HEADER => {}
-        _ => return Err(bad(1, format!("the first line must be `{POSES_HEADER}`"))),
-    }
+    let text = read_text(path, POSES_HEADER, &bad)?;
     let mut poses = Vec::new();
-    for (i, line) in lines.filter(|(_, l)| !l.trim().is_empty()) {
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        if fields.len() != 8 {
-            return Err(bad(
-                i + 1,
-                format!("expected 8 fields, found {}", fields.len()),
-            ));
-        }
-        let mut v = [0.0; 7];
-        for (k, f) in fields[1..].iter().enumerate() {
-            v[k] = f
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| bad(i + 1, format!("{f:?} is not a finite number")))?;
-        }
+    for (n, fields) in rows(&text, 8, &bad)? {
+        let v: [f64; 7] = finite(&fields[1..], n, &bad)?;
         let q = Quaternion::new(v[3], v[4], v[5], v[6]);
         if (q.norm() - 1.0).abs() > 1e-9 {
             return Err(bad(
-                i + 1,
+                n,
                 format!(
                     "the rotation ({}, {}, {}, {}) is no unit quaternion",
                     v[3], v[4], v[5], v[6]
