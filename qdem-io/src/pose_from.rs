@@ -12,7 +12,7 @@
 //!
 //! x′ = c + Q (x − c_d),
 //!
-//! c_d the design placement's centre of mass ([`pose_bodies`]). Q is kept against the design
+//! c_d the design placement's centre of mass. Q is kept against the design
 //! placement, not the run's start, so poses chain through any number of runs: a run whose
 //! body started at pose Q_p and whose principal frame has turned from q(0) to q(t) writes
 //! Q = q(t) q(0)⁻¹ Q_p ([`crate::build::BodyKind::Rigid`] keeps Q_p⁻¹ q(0) as its design

@@ -1,10 +1,11 @@
 //! `[[body]] rest_on`: a body laid on a granular sample, as a sleeper section is laid on its
 //! ballast bed in the box tests of paper 003 §2.
 //!
-//! A deposition run writes only its stones (`stones.csv`), not where the sleeper lay; so the
-//! deposition lays the sleeper on the bed this way, and each run after it places the sleeper
-//! above the stones at its design height again and lowers it straight down (along −z) until
-//! its first contact sphere touches a stone's sphere. A
+//! The box-test depositions lay their sleepers on the bed this way: from its design height
+//! the body is lowered straight down (along −z) until its first contact sphere touches a
+//! stone's sphere. (The loading scenes start the sleepers where the deposition left them,
+//! [`crate::pose_from`]: crib stones nestled against the sides of a sleeper that settled
+//! would stop it here before it reached the bed.) A
 //! body sphere b (radius r_b) touches a stone sphere s (radius r_s) beneath it, at horizontal
 //! distance h < r_b + r_s, once it has come down by
 //!
