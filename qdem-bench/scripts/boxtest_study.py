@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """The box-test study of paper 003: for each of 3 samples (seeds 1, 2, 3), deposit the
-three-sleeper sample (bed, then sleepers and crib) and a periodic single-sleeper one, then
-run the three-sleeper box, the single-sleeper box with fixed walls (the three-sleeper
-sample's middle third) and with ordinary and time-delayed periodic boundaries (the periodic
-sample); collect the middle sleeper's settlement after every load cycle.
+sample of the periodic single-sleeper cell (bed, then the sleeper and the crib), then load
+it in the three-sleeper box (the cell's sample three times along y), in the single-sleeper
+box with fixed walls, and with ordinary and time-delayed periodic boundaries; collect the
+middle sleeper's settlement after every load cycle. All four cases of a seed load the same
+middle sample from the same sleeper pose.
 
     cargo build --release -p qdem-cli
     python3 qdem-bench/scripts/boxtest_study.py [--size study|small] [--seeds 1,2,3]
@@ -111,7 +112,7 @@ def main():
     for seed in seeds:
         out = os.path.join(base, f"{args.size}_seed{seed}")
         os.makedirs(out, exist_ok=True)
-        for name in ["deposit_bed", "deposit_crib", "deposit_cell_bed", "deposit_cell_crib"] + CASES:
+        for name in ["deposit_cell_bed", "deposit_cell_crib"] + CASES:
             s = run(args.size, name, seed, out)
             runs.append(dict(seed=seed, run=name, particles=s["particles"],
                              stones=s["granular"]["stones"], spheres=s["contact"]["spheres"],

@@ -100,15 +100,15 @@ pub enum BuildError {
         /// The body.
         body: String,
     },
-    /// A body's `pose_from` file has no row for it.
+    /// A body's `pose_from` file has no row for it (or for its `pose_body`).
     #[error(
-        "{scene}: body `{body}`: pose_from: {path} has no pose for a body of that name; fix: \
-         name the body as in the run that wrote the file, or drop pose_from"
+        "{scene}: pose_from: {path} has no pose for a body `{body}`; fix: name the body (or \
+         its pose_body) as in the run that wrote the file, or drop pose_from"
     )]
     PoseMissing {
         /// The scene file.
         scene: PathBuf,
-        /// The body.
+        /// The body whose pose was looked for.
         body: String,
         /// The poses file.
         path: PathBuf,

@@ -5,7 +5,11 @@
 //! curve, a loose lattice in a region, a seed), to be deposited under gravity, or from a stones
 //! file: CSV with the header `stone,x,y,z,radius` and one row per sphere, the rows of a stone
 //! together. A run with `[granular]` writes the stones' final spheres to `stones.csv` in that
-//! format ([`write_stones_csv`]), so a deposition run's output is the next run's sample. `crop`
+//! format ([`write_stones_csv`]), so a deposition run's output is the next run's sample.
+//! `copies` places the sample once per translation: a sample deposited in a periodic cell,
+//! repeated by whole periods, is the packing of a box several cells long whose every cell holds
+//! the same stones (the three-sleeper box test built around the single-sleeper cell's
+//! sample, so that both load the same ballast). `crop`
 //! keeps the sample's stones whose spheres all lie inside a box, as paper 003 §3 cuts its
 //! single-sleeper samples out of the middle of its three-sleeper one. A sphere may cross a
 //! face of the box by [`CROP_TOLERANCE`] of its radius: a stone resting on a wall overlaps it
@@ -67,14 +71,27 @@ fn inside_crop(lo: &[f64; 3], hi: &[f64; 3], c: &Vec3, r: f64) -> bool {
     (0..3).all(|k| c[k] - r >= lo[k] - slack && c[k] + r <= hi[k] + slack)
 }
 
-/// The stones of `granular`: its sample file's, cropped, then the generated ones.
+/// `stones` placed once per translation of `copies`, copy after copy.
+fn copied(stones: &[Stone], copies: &[[f64; 3]]) -> Vec<Stone> {
+    copies
+        .iter()
+        .flat_map(|&t| {
+            stones.iter().map(move |s| Stone {
+                centers: s.centers.iter().map(|c| c + Vec3::from(t)).collect(),
+                radii: s.radii.clone(),
+            })
+        })
+        .collect()
+}
+
+/// The stones of `granular`: its sample file's, copied and cropped, then the generated ones.
 pub(crate) fn stones(scene: &Scene, granular: &Granular) -> Result<Vec<Stone>, BuildError> {
     let refused = |source: SampleError| BuildError::Granular {
         scene: scene.path.clone(),
         source,
     };
     let mut stones = match scene.sample_path() {
-        Some(path) => read_stones_csv(&path)?,
+        Some(path) => copied(&read_stones_csv(&path)?, &granular.copies),
         None => Vec::new(),
     };
     if let Some([lo, hi]) = granular.crop {
@@ -256,6 +273,43 @@ mod tests {
             &Vec3::new(1.0 - r + 0.003 * r, 0.5, 0.5),
             r
         ));
+    }
+
+    #[test]
+    fn copies_repeat_a_periodic_cell_and_the_crop_drops_the_stones_astride_the_ends() {
+        // A cell y in [0.7, 1.4): one stone inside, one astride its upper face (its image
+        // astride the lower face belongs to the cell too). Three copies a period apart fill
+        // y in [0, 2.1); the crop keeps the astride stone at the two inner faces only.
+        let inside = Stone {
+            centers: vec![Vec3::new(0.1, 1.0, 0.1), Vec3::new(0.15, 1.0, 0.1)],
+            radii: vec![0.05, 0.04],
+        };
+        let astride = Stone {
+            centers: vec![Vec3::new(0.1, 1.39, 0.1)],
+            radii: vec![0.05],
+        };
+        let copies = [[0.0, -0.7, 0.0], [0.0, 0.0, 0.0], [0.0, 0.7, 0.0]];
+        let all = copied(&[inside.clone(), astride], &copies);
+        let ys: Vec<f64> = all.iter().map(|s| s.centers[0].y).collect();
+        let want = [0.3, 0.69, 1.0, 1.39, 1.7, 2.09];
+        assert!(
+            ys.iter().zip(want).all(|(y, w)| (y - w).abs() < 1e-12),
+            "{ys:?}"
+        );
+        assert_eq!(all[4].radii, inside.radii);
+        let d = all[4].centers[1] - all[4].centers[0];
+        assert!((d - Vec3::new(0.05, 0.0, 0.0)).norm() < 1e-12, "{d:?}");
+        let (lo, hi) = ([0.0, 0.0, 0.0], [0.3, 2.1, 0.45]);
+        let kept = all
+            .iter()
+            .filter(|s| {
+                s.centers
+                    .iter()
+                    .zip(&s.radii)
+                    .all(|(c, &r)| inside_crop(&lo, &hi, c, r))
+            })
+            .count();
+        assert_eq!(kept, 5);
     }
 
     #[test]

@@ -12,7 +12,11 @@
 //!
 //! x′ = c + Q (x − c_d),
 //!
-//! c_d the design placement's centre of mass. Q is kept against the design
+//! c_d the design placement's centre of mass. `pose_body` takes another body's row instead
+//! and `pose_shift` s moves its centre, x′ = c + s + Q (x − c_d): the three sleepers of a box
+//! three cells long placed from the one sleeper of a periodic cell, a period apart (the body
+//! turns by Q from its *own* design placement, so the two bodies must share a mesh and design
+//! orientation for the copy to be exact). Q is kept against the design
 //! placement, not the run's start, so poses chain through any number of runs: a run whose
 //! body started at pose Q_p and whose principal frame has turned from q(0) to q(t) writes
 //! Q = q(t) q(0)⁻¹ Q_p ([`crate::build::BodyKind::Rigid`] keeps Q_p⁻¹ q(0) as its design
@@ -53,18 +57,20 @@ pub(crate) fn pose_bodies(scene: &Scene, meshes: &mut [PlacedMesh]) -> Result<()
             continue;
         };
         let path = scene.resolve(file);
+        let source = body.pose_body.as_ref().unwrap_or(&body.name);
         let pose = read_poses_csv(&path)?
             .into_iter()
-            .find(|p| p.body == body.name)
+            .find(|p| &p.body == source)
             .ok_or_else(|| BuildError::PoseMissing {
                 scene: scene.path.clone(),
-                body: body.name.clone(),
+                body: source.clone(),
                 path: path.clone(),
             })?;
+        let center = pose.center + Vec3::from(body.pose_shift);
         let nodes: Vec<Vec3> = placed.mesh.nodes.iter().map(|&p| Vec3::from(p)).collect();
         let (_, design_center, _) = tet_mass_properties(&nodes, &placed.mesh.tets, 1.0);
         for (p, x) in placed.mesh.nodes.iter_mut().zip(&nodes) {
-            *p = (pose.center + pose.rotation * (x - design_center)).into();
+            *p = (center + pose.rotation * (x - design_center)).into();
         }
         placed.rotation = pose.rotation;
     }

@@ -1,10 +1,13 @@
 //! The box tests of paper 003 through the scene format, at the small size of
 //! `fixtures/boxtest/small_*.toml` (coarse stones, one load cycle): the bed and crib
-//! depositions of the three-sleeper box and of the periodic cell, then the three-sleeper box
-//! and the single-sleeper box with fixed walls, ordinary periodic and time-delayed periodic
-//! boundaries. Checked:
-//! - the deposited stones stay inside the box (none below the floor, none through a wall, to
-//!   a tenth of a radius of Hertz overlap) and come to rest;
+//! depositions of the periodic cell, then the three-sleeper box (the cell's sample three
+//! times) and the single-sleeper box with fixed walls, ordinary periodic and time-delayed
+//! periodic boundaries. Checked:
+//! - the deposited stones stay inside the cell (none below the floor, none through a side
+//!   wall, to a tenth of a radius of Hertz overlap, every centre inside the periodic cell)
+//!   and come to rest;
+//! - the three-sleeper box holds three copies of the cell's sample less the stones astride
+//!   its two end walls;
 //! - every loaded sleeper settles (moves down) by less than the bed under it is deep;
 //! - in the periodic boxes every stone's centre is inside the periodic cell at the end (bodies
 //!   wrap whole) and the time-delayed run records its boundary force and ghost scales.
@@ -14,6 +17,7 @@
 mod common;
 
 use common::test_dir;
+use qdem_core::Vec3;
 use qdem_io::build::Simulation;
 use qdem_io::granular_build::read_stones_csv;
 use qdem_io::runner::run;
@@ -24,9 +28,8 @@ fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/boxtest")
 }
 
-/// Copies scene `name` into `dir` with its mesh path made absolute, runs it there and returns
-/// the simulation after the run.
-fn run_scene(dir: &Path, name: &str) -> Simulation {
+/// Copies scene `name` into `dir` with its mesh path made absolute and builds it there.
+fn build_scene(dir: &Path, name: &str) -> Simulation {
     let text = std::fs::read_to_string(fixtures().join(format!("small_{name}.toml"))).unwrap();
     let mesh = fixtures().join("sleeper.msh");
     let text = text.replace(
@@ -35,11 +38,25 @@ fn run_scene(dir: &Path, name: &str) -> Simulation {
     );
     let path = dir.join(format!("{name}.toml"));
     std::fs::write(&path, text).unwrap();
-    let scene = Scene::load(&path).unwrap();
-    let out = dir.join(&scene.output.dir);
-    let mut sim = Simulation::build(scene).unwrap();
+    Simulation::build(Scene::load(&path).unwrap()).unwrap()
+}
+
+/// Builds scene `name` in `dir` (see [`build_scene`]), runs it there and returns the
+/// simulation after the run.
+fn run_scene(dir: &Path, name: &str) -> Simulation {
+    let mut sim = build_scene(dir, name);
+    let out = dir.join(&sim.scene.output.dir);
     run(&mut sim, &out, &mut |_| {}).unwrap();
     sim
+}
+
+/// The centres of mass of the stones.
+fn stone_centers(sim: &Simulation) -> Vec<Vec3> {
+    let info = sim.granular.as_ref().unwrap();
+    info.stones
+        .iter()
+        .map(|(c, _)| sim.state.position[*c])
+        .collect()
 }
 
 /// The settlement (m, down positive) of probe `name` at the end of a run.
@@ -48,26 +65,37 @@ fn settlement(sim: &Simulation, name: &str) -> f64 {
     -sim.state.displacement(p.particle).z
 }
 
+/// Every stone's centre is inside the periodic cell along y.
+fn assert_wrapped(sim: &Simulation, case: &str) {
+    let (cell, _) = sim.periodic.as_ref().unwrap();
+    let origin = cell.origin().y;
+    let length = cell.length(1).unwrap();
+    for (c, _) in &sim.granular.as_ref().unwrap().stones {
+        let y = sim.state.position[*c].y;
+        assert!(
+            y >= origin && y < origin + length,
+            "{case}: stone at y = {y}"
+        );
+    }
+}
+
 #[test]
 fn box_tests_deposit_settle_and_wrap() {
     let dir = test_dir("boxtest");
-    let bed = run_scene(&dir, "deposit_bed");
-    let stones = read_stones_csv(&dir.join("out/boxtest/small/bed/stones.csv")).unwrap();
+    let bed = run_scene(&dir, "deposit_cell_bed");
+    let stones = read_stones_csv(&dir.join("out/boxtest/small/cell_bed/stones.csv")).unwrap();
     assert_eq!(stones.len(), bed.granular.as_ref().unwrap().len());
     for s in &stones {
         for (c, r) in s.centers.iter().zip(&s.radii) {
-            // Walls at z = 0, x = 0, 0.3, y = 0, 2.1; Hertz overlaps stay a few per cent of r.
+            // Walls at z = 0, x = 0, 0.3; Hertz overlaps stay a few per cent of r.
             assert!(c.z - r > -0.1 * r, "{c:?} below the floor");
             assert!(
                 c.x - r > -0.1 * r && c.x + r < 0.3 + 0.1 * r,
                 "{c:?} through a side"
             );
-            assert!(
-                c.y - r > -0.1 * r && c.y + r < 2.1 + 0.1 * r,
-                "{c:?} through an end"
-            );
         }
     }
+    assert_wrapped(&bed, "deposit_cell_bed");
     // At rest: the stones' kinetic energy is below a millimetre's worth of their weight.
     let info = bed.granular.as_ref().unwrap();
     let weight: f64 = info
@@ -81,28 +109,37 @@ fn box_tests_deposit_settle_and_wrap() {
         bed.state.kinetic_energy()
     );
 
-    run_scene(&dir, "deposit_crib");
+    run_scene(&dir, "deposit_cell_crib");
+    // One sample for all four cases: the fixed box's stones are the middle third of the
+    // three-sleeper box's, which holds the periodic cell's sample three times less the stones
+    // astride its two end walls.
+    let fixed = stone_centers(&build_scene(&dir, "single_fixed"));
+    let cell = stone_centers(&build_scene(&dir, "single_periodic"));
+    let three = stone_centers(&build_scene(&dir, "three_sleeper"));
+    for c in &fixed {
+        assert!(
+            three.iter().any(|t| (t - c).norm() < 1e-12),
+            "fixed-wall stone at {c:?} is not in the three-sleeper box"
+        );
+    }
+    assert!(
+        fixed.len() < cell.len() && 3 * fixed.len() <= three.len() && three.len() < 3 * cell.len(),
+        "stones: fixed {}, cell {}, three-sleeper {}",
+        fixed.len(),
+        cell.len(),
+        three.len()
+    );
     let three = run_scene(&dir, "three_sleeper");
     for name in ["sleeper1", "sleeper2", "sleeper3"] {
         let s = settlement(&three, name);
         assert!(s > 0.0 && s < 0.2, "{name}: {s}");
     }
-    run_scene(&dir, "deposit_cell_bed");
-    run_scene(&dir, "deposit_cell_crib");
     for case in ["single_fixed", "single_periodic", "single_delayed"] {
         let sim = run_scene(&dir, case);
         let s = settlement(&sim, "sleeper2");
         assert!(s > 0.0 && s < 0.2, "{case}: {s}");
-        if let Some((cell, _)) = &sim.periodic {
-            let origin = cell.origin().y;
-            let length = cell.length(1).unwrap();
-            for (c, _) in &sim.granular.as_ref().unwrap().stones {
-                let y = sim.state.position[*c].y;
-                assert!(
-                    y >= origin && y < origin + length,
-                    "{case}: stone at y = {y}"
-                );
-            }
+        if sim.periodic.is_some() {
+            assert_wrapped(&sim, case);
         }
     }
     let boundary =

@@ -922,6 +922,26 @@ fn granular_mistakes_are_named() {
             "pose_from and rest_on both place the body; keep one",
         ],
     );
+    let options = with(
+        "reorder = true",
+        "reorder = true\npose_body = \"sleeper2\"\npose_shift = [0.0, 0.7, 0.0]",
+    );
+    let (_, msg) = error(&options);
+    assert_has(
+        &msg,
+        &[
+            "pose_body chooses a pose of a `pose_from` file; give pose_from or drop pose_body",
+            "pose_shift chooses a pose",
+        ],
+    );
+    let copies = format!(
+        "{BASE}\n[granular]\nname = \"ballast\"\nmaterial = \"concrete\"\nregion = [[0, 0, 0], [0.3, 0.7, 1.0]]\ncount = 10\ngrading = [[0.05, 0.0], [0.1, 1.0]]\ncopies = [[0.0, 0.7, 0.0]]\n"
+    );
+    let (_, msg) = error(&copies);
+    assert_has(
+        &msg,
+        &["copies repeats the stones of a `sample` file; give one or drop copies"],
+    );
     let rotation = with("dofs = \"xyz\"", "dofs = \"xyz\"\nrotation = true");
     let (_, msg) = error(&rotation);
     assert_has(&msg, &["[[fix]] #1", "rotation = true", "is not rigid"]);

@@ -228,6 +228,15 @@ pub struct Body {
     /// placed where that run left its body of the same name (`pose_from.rs`); default none.
     #[serde(default)]
     pub pose_from: Option<PathBuf>,
+    /// With `pose_from`: take the pose of this body of the poses file instead of the body of
+    /// the same name (the sleepers of a three-sleeper box placed from the one sleeper of a
+    /// periodic cell); default the body's own name.
+    #[serde(default)]
+    pub pose_body: Option<String>,
+    /// With `pose_from`: added to the pose's centre of mass (m), e.g. one period along a
+    /// periodic axis; default zero.
+    #[serde(default)]
+    pub pose_shift: [f64; 3],
 }
 
 /// `[contact].law`: the contact law between spheres of different bodies and against walls.
@@ -674,6 +683,8 @@ pub struct TimeDelay {
 /// spheres_per_stone = [3, 5]
 /// seed = 1
 /// # or: sample = "stones.csv", crop = [[0, 0.7, 0], [0.3, 1.4, 0.45]]
+/// # a periodic cell's sample repeated along y:
+/// # sample = "stones.csv", copies = [[0, -0.7, 0], [0, 0, 0], [0, 0.7, 0]]
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -685,6 +696,11 @@ pub struct Granular {
     /// A stones file (CSV `stone,x,y,z,radius`), relative to the scene file.
     #[serde(default)]
     pub sample: Option<PathBuf>,
+    /// The sample's stones placed once per translation (m), before `crop`: a sample deposited
+    /// in a periodic cell, repeated by whole periods, fills a box several cells long with the
+    /// cell's packing; default one copy where the file puts it.
+    #[serde(default = "default_copies")]
+    pub copies: Vec<[f64; 3]>,
     /// Keep only the sample's stones whose spheres all lie inside this box (m), up to
     /// `CROP_TOLERANCE` of a radius (a stone resting on a wall of the box stays).
     #[serde(default)]
@@ -704,6 +720,10 @@ pub struct Granular {
     /// Generation: seed; default 1.
     #[serde(default = "default_seed")]
     pub seed: u64,
+}
+
+fn default_copies() -> Vec<[f64; 3]> {
+    vec![[0.0; 3]]
 }
 
 fn default_spheres_per_stone() -> [usize; 2] {

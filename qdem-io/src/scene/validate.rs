@@ -988,6 +988,24 @@ fn pose_from_key(c: &mut Checker<'_>, idx: &str, l: &str, b: &Body) {
     }
 }
 
+/// `[[body]] pose_body`, `pose_shift`: say which pose of a `pose_from` file, and where.
+fn pose_options(c: &mut Checker<'_>, idx: &str, l: &str, b: &Body) {
+    if b.pose_from.is_none() {
+        for (key, given) in [
+            ("pose_body", b.pose_body.is_some()),
+            ("pose_shift", b.pose_shift != [0.0; 3]),
+        ] {
+            if given {
+                c.error(
+                    &["body", idx, key],
+                    format!("{l}: {key} chooses a pose of a `pose_from` file; give pose_from or drop {key}"),
+                );
+            }
+        }
+    }
+    c.finite(&["body", idx, "pose_shift"], l, "pose_shift", &b.pose_shift);
+}
+
 /// `[granular]`: its material, a sample file or a generation (region, count, grading), a crop.
 fn granular_table(c: &mut Checker<'_>, raw: &RawScene, g: &Granular, materials: &[&str]) {
     let l = format!("[granular] {:?}", g.name);
@@ -1028,6 +1046,27 @@ fn granular_table(c: &mut Checker<'_>, raw: &RawScene, g: &Granular, materials: 
         if let Some(b) = b {
             box_corners(c, "granular", &l, key, b);
         }
+    }
+    copies_key(c, &l, g);
+}
+
+/// `[granular] copies`: translations of a sample file's stones, at least one.
+fn copies_key(c: &mut Checker<'_>, l: &str, g: &Granular) {
+    let at = ["granular", "copies"];
+    if g.copies.is_empty() {
+        c.error(
+            &at,
+            format!("{l}: copies = [] places no stone; give at least one translation, [[0, 0, 0]] for the sample where it is"),
+        );
+    }
+    if g.sample.is_none() && g.copies != [[0.0; 3]] {
+        c.error(
+            &at,
+            format!("{l}: copies repeats the stones of a `sample` file; give one or drop copies"),
+        );
+    }
+    for t in &g.copies {
+        c.finite(&at, l, "copies", t);
     }
 }
 
@@ -1183,6 +1222,7 @@ fn contact_tables(c: &mut Checker<'_>, raw: &RawScene) {
         if b.pose_from.is_some() {
             pose_from_key(c, &idx, &l, b);
         }
+        pose_options(c, &idx, &l, b);
         if b.rigid && run.integrator != Integrator::Verlet {
             c.error(
                 &["body", &idx, "rigid"],
