@@ -8,16 +8,16 @@
 //! format ([`write_stones_csv`]), so a deposition run's output is the next run's sample.
 //! `copies` places the sample once per translation: a sample deposited in a periodic cell,
 //! repeated by whole periods, is the packing of a box several cells long whose every cell holds
-//! the same stones (the three-sleeper box test built around the single-sleeper cell's
-//! sample, so that both load the same ballast). `crop`
-//! keeps the sample's stones whose spheres all lie inside a box, as paper 003 §3 cuts its
-//! single-sleeper samples out of the middle of its three-sleeper one. A sphere may cross a
-//! face of the box by [`CROP_TOLERANCE`] of its radius: a stone resting on a wall overlaps it
-//! by its contact overlap (up to 0.3% of the radius in the box-test deposits), and a crop box
-//! drawn on the walls must keep it — refusing it took the whole bottom layer and the stones
-//! along the side walls out of every cropped sample, and the sample collapsed into the gap. A sample and a generation
-//! together give the sample's stones then new ones (deposition in stages: a bed, then the
-//! sleepers laid on it, then the crib ballast poured around them).
+//! the same stones (the three-sleeper box test built around the single-sleeper cell's sample,
+//! so that both load the same ballast). `crop` then keeps the stones whose spheres all lie
+//! inside a box, as paper 003 §3 cuts its single-sleeper samples out of the middle of its
+//! three-sleeper one. A sphere may cross a face of the box by [`CROP_TOLERANCE`] of its
+//! radius: a stone resting on a wall overlaps it by its contact overlap (up to 0.3% of the
+//! radius in the box-test deposits), and a crop box drawn on the walls must keep it — refusing
+//! it took the whole bottom layer and the stones along the side walls out of every cropped
+//! sample, and the sample collapsed into the gap. A sample and a generation together give the
+//! sample's stones then new ones (deposition in stages: a bed, then the sleepers laid on it,
+//! then the crib ballast poured around them).
 //!
 //! Each stone becomes a centre particle at its centre of mass with its mass (the union of its
 //! spheres at the material's density, [`clump_mass_properties`]) plus one massless member per
