@@ -222,6 +222,19 @@ fn pair_scales(shift: f64, scales: &GhostScales) -> (f64, f64) {
     }
 }
 
+/// Whether the segment from a to b (coordinates relative to a plane) crosses the plane, or,
+/// with a `period`, one of its copies a whole number of periods away.
+#[inline]
+fn crosses(a: f64, b: f64, period: Option<f64>) -> bool {
+    match period {
+        Some(l) => {
+            let below = (a / l).floor() * l;
+            b < below || b >= below + l
+        }
+        None => (a < 0.0) != (b < 0.0),
+    }
+}
+
 impl DemContacts {
     /// Contacts between `spheres` (of bodies `body_names`, with elastic constants (E, ν) per
     /// material) and against `walls`, at the state's current configuration.
@@ -371,6 +384,35 @@ impl DemContacts {
         self.time_delay
             .as_ref()
             .map(|t| (t.scales, t.boundary_force))
+    }
+
+    /// The average magnitude of the touching pairs' forces across the plane x[axis] = `at`
+    /// (serial, in pair order): a pair crosses it when its two sphere centres, the second at
+    /// the image it touches, lie on either side. In a periodic cell the plane repeats every
+    /// period, so a section at a cell face measures what the boundary force does; in a box
+    /// several cells long it measures the force through an inner face (paper 003's premise
+    /// for Eqs. 4–5 is a statement about that force).
+    pub fn section_force(&self, axis: usize, at: f64) -> f64 {
+        let period = self.periodic.as_ref().and_then(|p| p.length(axis));
+        let (mut sum, mut count) = (0.0, 0usize);
+        for k in 0..self.pairs.len() {
+            let f = self.pairs.force[k];
+            if f == Vec3::zeros() {
+                continue;
+            }
+            let (i, j) = (self.pairs.first[k] as usize, self.pairs.second[k] as usize);
+            let a = self.now[i].center[axis] - at;
+            let b = self.now[j].center[axis] + self.pairs.shift[k][axis] - at;
+            if crosses(a, b, period) {
+                sum += f.norm();
+                count += 1;
+            }
+        }
+        if count == 0 {
+            0.0
+        } else {
+            sum / count as f64
+        }
     }
 
     /// x_b − x_a, the minimum image when periodic, and the translation of b's image.

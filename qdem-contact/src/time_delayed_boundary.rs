@@ -44,6 +44,22 @@
 //!    contacts relaxed at the minimum load) gets scales of hundreds towards its end, where
 //!    A(Φ) → F_min, and the ghosts' pushes blow the sample apart: in the seed-1 box-test study
 //!    F_current fell to 0.015 N, the scales rose to 1,086 and an acceleration became infinite.
+//! 7. Optionally (shared faces, [`TimeDelayedBoundary::with_shared_faces`]; not in paper
+//!    003), both sides take one scale, [`GhostScales::shared`].
+//!
+//! # Shared faces (qdem's variant)
+//! Eqs. 6–7 scale the two ends of one pair through the boundary differently: the sphere near
+//! the left face feels s_left · f, its partner near the right face s_right · f, so the pair's
+//! action is not its reaction and the boundary pushes the sample as a whole by
+//! (s_left − s_right) f per pair, back and forth over a cycle. In a box of several cells a face
+//! is shared by two cells and one set of pairs carries its force both ways; measured in the
+//! box-test study (`docs/boxtest.md`), the force through each face of the middle cell follows
+//! both cells' loads (it peaks between their peaks) and swings less than a periodic cell's.
+//! With shared faces each face is taken to carry the mean of its two cells' Eq. 2 forces,
+//! (A(Φ) + A(Φ ∓ δ))/2, and the cell's one set of boundary pairs, standing for both faces, is
+//! scaled by their mean over A(Φ): s = (2A(Φ) + A(Φ − δ) + A(Φ + δ))/(4A(Φ)) on both
+//! spheres. For δ = π/2 the swing of the boundary force about its mean is halved; for δ = 0
+//! s is exactly 1.
 
 use qdem_core::{CheckpointError, Decoder, Encoder};
 use std::f64::consts::{FRAC_PI_2, TAU};
@@ -117,6 +133,15 @@ impl GhostScales {
         left: 1.0,
         right: 1.0,
     };
+
+    /// Shared faces: both sides at s = (1 + (s_left + s_right)/2)/2, i.e.
+    /// (2A(Φ) + A(Φ − δ) + A(Φ + δ))/(4A(Φ)): each face carries the mean of its two cells'
+    /// Eq. 2 forces, and the cell's one set of boundary pairs stands for both faces. Exactly 1
+    /// where both scales are 1.
+    pub fn shared(self) -> GhostScales {
+        let s = 0.5 * (1.0 + 0.5 * (self.left + self.right));
+        GhostScales { left: s, right: s }
+    }
 }
 
 /// The controller's state: the load cycle, the lag and the current cycle's extremes.
@@ -129,6 +154,8 @@ pub struct TimeDelayedBoundary {
     f_max: Option<f64>,
     /// Rule 6's cap on either scale.
     limit: f64,
+    /// Rule 7: one scale for both sides of the boundary ([`GhostScales::shared`]).
+    shared: bool,
 }
 
 impl TimeDelayedBoundary {
@@ -141,6 +168,16 @@ impl TimeDelayedBoundary {
             current: None,
             f_max: None,
             limit: f64::INFINITY,
+            shared: false,
+        }
+    }
+
+    /// The same controller with shared faces (rule 7): a pair through the boundary pushes
+    /// both its spheres with one scale, so its action equals its reaction.
+    pub fn with_shared_faces(self) -> TimeDelayedBoundary {
+        TimeDelayedBoundary {
+            shared: true,
+            ..self
         }
     }
 
@@ -154,7 +191,7 @@ impl TimeDelayedBoundary {
     }
 
     /// Takes the measured F_current (average magnitude of the contact forces across both
-    /// boundaries) at time `time` and returns the ghost scales, by rules 1–5 of the module docs.
+    /// boundaries) at time `time` and returns the ghost scales, by rules 1–7 of the module docs.
     /// Call once per force evaluation, in time order.
     pub fn update(&mut self, time: f64, f_current: f64) -> GhostScales {
         let (Some(phi), Some(index)) = (self.cycle.phase_at(time), self.cycle.cycle_at(time))
@@ -168,9 +205,14 @@ impl TimeDelayedBoundary {
         if 1.0 + phi.sin() >= 0.5 {
             self.f_max = Some(estimate_max(f_current, f_min, phi));
         }
-        match self.f_max {
-            Some(f_max) => ghost_scales(f_max, f_min, phi, self.lag, self.limit),
-            None => GhostScales::PERIODIC,
+        let Some(f_max) = self.f_max else {
+            return GhostScales::PERIODIC;
+        };
+        let scales = ghost_scales(f_max, f_min, phi, self.lag, self.limit);
+        if self.shared {
+            scales.shared()
+        } else {
+            scales
         }
     }
 
@@ -256,6 +298,21 @@ mod tests {
 
     fn close(a: f64, b: f64, tol: f64) -> bool {
         (a - b).abs() <= tol * b.abs().max(1.0)
+    }
+
+    #[test]
+    fn shared_faces_scale_both_sides_by_the_mean_of_the_two_faces() {
+        // f_max = 30, f_min = 10, δ = π/2. At Φ = 0: A = 20, A(−π/2) = 10, A(π/2) = 30, so
+        // s_left = 0.5, s_right = 1.5 and the shared scale (2·20 + 10 + 30)/(4·20) = 1.
+        // At the peak Φ = π/2: A = 30, both neighbours at 20: (60 + 40)/120 = 5/6.
+        let at = |phi: f64| ghost_scales(30.0, 10.0, phi, FRAC_PI_2, f64::INFINITY);
+        let zero = at(0.0);
+        assert!(close(zero.left, 0.5, 1e-15) && close(zero.right, 1.5, 1e-15));
+        let shared = zero.shared();
+        assert!(close(shared.left, 1.0, 1e-15) && shared.left == shared.right);
+        let peak = at(FRAC_PI_2).shared();
+        assert!(close(peak.left, 5.0 / 6.0, 1e-15) && peak.left == peak.right);
+        assert_eq!(GhostScales::PERIODIC.shared(), GhostScales::PERIODIC);
     }
 
     #[test]

@@ -142,6 +142,9 @@ pub(crate) fn periodic_contacts(
         r if r.is_finite() => r.abs(),
         _ => f64::INFINITY,
     };
-    let boundary = TimeDelayedBoundary::new(cycle, lag).with_scale_limit(limit);
+    let mut boundary = TimeDelayedBoundary::new(cycle, lag).with_scale_limit(limit);
+    if delay.shared_faces {
+        boundary = boundary.with_shared_faces();
+    }
     contacts.with_time_delay(axis, boundary).map_err(refused)
 }

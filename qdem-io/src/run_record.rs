@@ -59,6 +59,8 @@ pub(crate) struct RunRecord {
     pub history: Vec<Vec<(f64, f64)>>,
     /// The time-delayed boundary's rows for `boundary.csv`.
     pub boundary_rows: Vec<[f64; 4]>,
+    /// `sections.csv`'s rows, flat: the time, then each `[[section]]`'s force.
+    pub section_rows: Vec<f64>,
     pub timing: CrackTiming,
 }
 
@@ -75,6 +77,7 @@ impl RunRecord {
             probe_rows: 0,
             history: vec![Vec::new(); 3 * sim.probes.len()],
             boundary_rows: Vec::new(),
+            section_rows: Vec::new(),
             timing: CrackTiming::default(),
         }
     }
@@ -96,6 +99,7 @@ impl RunRecord {
             out.f64s(&series.iter().flat_map(|&(t, u)| [t, u]).collect::<Vec<_>>());
         }
         out.f64s(&self.boundary_rows.concat());
+        out.f64s(&self.section_rows);
         let t = &self.timing;
         out.f64(t.before_seconds);
         out.u64(t.before_steps);
@@ -135,6 +139,7 @@ impl RunRecord {
             .chunks_exact(4)
             .map(|r| [r[0], r[1], r[2], r[3]])
             .collect();
+        self.section_rows = input.f64s("the section rows")?;
         let t = &mut self.timing;
         t.before_seconds = input.f64("the crack timing")?;
         t.before_steps = input.u64("the crack timing")?;
@@ -156,6 +161,7 @@ pub(crate) fn skip_record(input: &mut Decoder<'_>) -> Result<(), CheckpointError
         probe_rows: 0,
         history: Vec::new(),
         boundary_rows: Vec::new(),
+        section_rows: Vec::new(),
         timing: CrackTiming::default(),
     };
     record.restore(input, false)

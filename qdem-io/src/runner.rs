@@ -7,7 +7,8 @@
 //! progress. A scene with `[granular]` also gets `stones.csv` (the stones' spheres at the end,
 //! the sample format `[granular] sample` reads); one with a time-delayed boundary gets
 //! `boundary.csv` (time, the measured average boundary force, the left and right ghost
-//! scales) at the probe interval; one with rigid `[[body]]`s gets `poses.csv` (where each
+//! scales) at the probe interval, and one with `[[section]]`s `sections.csv` (time, the
+//! average contact force across each section plane); one with rigid `[[body]]`s gets `poses.csv` (where each
 //! ended, the file `[[body]] pose_from` reads: [`crate::pose_from`]).
 
 use crate::build::{BodyKind, Simulation};
@@ -299,6 +300,7 @@ pub fn run_with(
                         .boundary_rows
                         .push([time, force, scales.left, scales.right]);
                 }
+                record_sections(sim, time, &mut record.section_rows);
             }
             if record.vtu.due(time, dt) {
                 let file = format!("vtu/state_{:05}.vtu", record.pvd.len());
@@ -380,6 +382,9 @@ pub fn run_with(
     }
     if !record.boundary_rows.is_empty() {
         write_boundary_csv(&out_dir.join("boundary.csv"), &record.boundary_rows)?;
+    }
+    if !record.section_rows.is_empty() {
+        write_sections_csv(&out_dir.join("sections.csv"), sim, &record.section_rows)?;
     }
     outcome?;
     let steps = match timing.collapse {
@@ -503,6 +508,35 @@ fn write_boundary_csv(path: &Path, rows: &[[f64; 4]]) -> Result<(), OutputError>
         writeln!(w, "time,boundary_force,left_scale,right_scale")?;
         for r in rows {
             writeln!(w, "{:.9e},{:.9e},{:.9e},{:.9e}", r[0], r[1], r[2], r[3])?;
+        }
+        Ok(())
+    })
+}
+
+/// Appends a row of `sections.csv`: the time and each `[[section]]`'s average contact force.
+fn record_sections(sim: &Simulation, time: f64, rows: &mut Vec<f64>) {
+    let Some(contacts) = sim.contacts() else {
+        return;
+    };
+    if sim.scene.sections.is_empty() {
+        return;
+    }
+    rows.push(time);
+    for s in &sim.scene.sections {
+        let axis = "xyz".find(&s.axis).expect("validated: x, y or z");
+        rows.push(contacts.section_force(axis, s.at));
+    }
+}
+
+/// The sections' record: time, then the average magnitude of the contact forces across each
+/// `[[section]]` plane (N), one column per section named after it.
+fn write_sections_csv(path: &Path, sim: &Simulation, rows: &[f64]) -> Result<(), OutputError> {
+    let names: Vec<&str> = sim.scene.sections.iter().map(|s| s.name.as_str()).collect();
+    write_atomic(path, |w| {
+        writeln!(w, "time,{}", names.join(","))?;
+        for row in rows.chunks_exact(names.len() + 1) {
+            let cells: Vec<String> = row.iter().map(|v| format!("{v:.9e}")).collect();
+            writeln!(w, "{}", cells.join(","))?;
         }
         Ok(())
     })

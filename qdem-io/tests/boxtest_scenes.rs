@@ -2,12 +2,13 @@
 //! `fixtures/boxtest/small_*.toml` (coarse stones, one load cycle): the bed and crib
 //! depositions of the periodic cell, then the three-sleeper box (the cell's sample three
 //! times) and the single-sleeper box with fixed walls, ordinary periodic and time-delayed
-//! periodic boundaries. Checked:
+//! periodic boundaries (paper 003's and with shared faces). Checked:
 //! - the deposited stones stay inside the cell (none below the floor, none through a side
 //!   wall, to a tenth of a radius of Hertz overlap, every centre inside the periodic cell)
 //!   and come to rest;
 //! - the three-sleeper box holds three copies of the cell's sample less the stones astride
-//!   its two end walls;
+//!   its two end walls, and at the start the contact force through its inner faces
+//!   (`sections.csv`) is the force through the periodic cell's face;
 //! - every loaded sleeper settles (moves down) by less than the bed under it is deep;
 //! - in the periodic boxes every stone's centre is inside the periodic cell at the end (bodies
 //!   wrap whole) and the time-delayed run records its boundary force and ghost scales.
@@ -110,7 +111,7 @@ fn box_tests_deposit_settle_and_wrap() {
     );
 
     run_scene(&dir, "deposit_cell_crib");
-    // One sample for all four cases: the fixed box's stones are the middle third of the
+    // One sample for all the cases: the fixed box's stones are the middle third of the
     // three-sleeper box's, which holds the periodic cell's sample three times less the stones
     // astride its two end walls.
     let fixed = stone_centers(&build_scene(&dir, "single_fixed"));
@@ -134,7 +135,12 @@ fn box_tests_deposit_settle_and_wrap() {
         let s = settlement(&three, name);
         assert!(s > 0.0 && s < 0.2, "{name}: {s}");
     }
-    for case in ["single_fixed", "single_periodic", "single_delayed"] {
+    for case in [
+        "single_fixed",
+        "single_periodic",
+        "single_delayed",
+        "single_shared",
+    ] {
         let sim = run_scene(&dir, case);
         let s = settlement(&sim, "sleeper2");
         assert!(s > 0.0 && s < 0.2, "{case}: {s}");
@@ -146,6 +152,22 @@ fn box_tests_deposit_settle_and_wrap() {
         std::fs::read_to_string(dir.join("out/boxtest/small/single_delayed/boundary.csv")).unwrap();
     assert!(boundary.starts_with("time,boundary_force,left_scale,right_scale"));
     assert!(boundary.lines().count() > 100);
+    // The three-sleeper box's middle third is the cell's sample: at t = 0 the same pairs
+    // cross its inner faces as cross the periodic cell's face.
+    let first_row = |case: &str| -> Vec<f64> {
+        let path = dir.join(format!("out/boxtest/small/{case}/sections.csv"));
+        let text = std::fs::read_to_string(path).unwrap();
+        let row = text.lines().nth(1).unwrap();
+        row.split(',').map(|v| v.parse().unwrap()).collect()
+    };
+    let (three, cell) = (first_row("three_sleeper"), first_row("single_periodic"));
+    assert!(cell[1] > 0.0, "no contact through the cell face: {cell:?}");
+    for face in &three[1..] {
+        assert!(
+            (face - cell[1]).abs() <= 1e-9 * cell[1],
+            "{three:?} {cell:?}"
+        );
+    }
 }
 
 #[test]

@@ -89,6 +89,11 @@ name = "sleeper"
 body = "sleeper"
 point = [0.15, 1.05, 0.55]
 
+[[section]]
+name = "face"
+axis = "y"
+at = 0.7
+
 [[wall]]
 point = [0.0, 0.0, 0.0]
 normal = [0.0, 0.0, 1.0]
@@ -217,7 +222,13 @@ fn a_resumed_periodic_contact_run_equals_the_uninterrupted_one() {
     let scene = boxtest_scene(&dir);
     let sim = build(&scene);
     let steps = sim.steps();
-    let files = ["probes.csv", "boundary.csv", "stones.csv", "probes.svg"];
+    let files = [
+        "probes.csv",
+        "boundary.csv",
+        "sections.csv",
+        "stones.csv",
+        "probes.svg",
+    ];
     let dir = resume_equals_uninterrupted("ckpt-boxtest", &scene, steps * 3 / 4, &files);
     // The boundary's estimates were live at the checkpoint (t = 0.3 s): ghost scales other
     // than 1 both before and after it.

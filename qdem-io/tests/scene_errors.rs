@@ -946,3 +946,20 @@ fn granular_mistakes_are_named() {
     let (_, msg) = error(&rotation);
     assert_has(&msg, &["[[fix]] #1", "rotation = true", "is not rigid"]);
 }
+
+#[test]
+fn a_section_needs_one_axis_a_finite_plane_and_contacts() {
+    let bad = with(
+        "[output]",
+        "[[section]]\nname = \"face\"\naxis = \"xy\"\nat = nan\n\n[output]",
+    );
+    let (_, msg) = error(&bad);
+    assert_has(
+        &msg,
+        &[
+            "scene.toml:41:8: [[section]] \"face\": axis = \"xy\": name the one axis",
+            "[[section]] \"face\": `at` must be a finite number, not NaN",
+            "measures contact forces, but the scene has no [contact]",
+        ],
+    );
+}

@@ -43,8 +43,8 @@ mod validate;
 pub use error::{Diagnostic, SceneError};
 pub use schema::{
     Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load,
-    Material, Output, PackingName, Periodic, Probe, Ramp, Run, Selection, Series, Supports,
-    TimeDelay, TimeStep, Wall,
+    Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section, Selection, Series,
+    Supports, TimeDelay, TimeStep, Wall,
 };
 
 use schema::RawScene;
@@ -148,6 +148,8 @@ pub struct Scene {
     pub walls: Vec<Wall>,
     /// `[[probe]]`, in file order.
     pub probes: Vec<Probe>,
+    /// `[[section]]`, in file order.
+    pub sections: Vec<Section>,
     /// `[bonded]`: a 2D beam-bonded particle body instead of `[[body]]`s.
     pub bonded: Option<Bonded>,
     /// `[periodic]`: periodic axes and an optional time delay.

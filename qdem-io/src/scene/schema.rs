@@ -461,6 +461,28 @@ pub struct Probe {
     pub point: [f64; 3],
 }
 
+/// `[[section]]`: a plane x[axis] = `at` across which the average magnitude of the contact
+/// forces of touching sphere pairs is written to `sections.csv` at every probe time (the
+/// force through a cell face of a box test, paper 003 §5; in a periodic cell the plane
+/// repeats every period).
+///
+/// ```toml
+/// [[section]]
+/// name = "left"
+/// axis = "y"
+/// at = 0.7
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Section {
+    /// Unique name (the CSV column).
+    pub name: String,
+    /// The axis the plane is normal to: "x", "y" or "z".
+    pub axis: String,
+    /// The plane's coordinate along `axis` (m).
+    pub at: f64,
+}
+
 /// `[output]`: where and how often to write results.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -551,6 +573,8 @@ pub(crate) struct RawScene {
     pub loads: Vec<RawLoad>,
     #[serde(default, rename = "probe")]
     pub probes: Vec<Probe>,
+    #[serde(default, rename = "section")]
+    pub sections: Vec<Section>,
     #[serde(default)]
     pub contact: Option<Contact>,
     #[serde(default, rename = "wall")]
@@ -628,6 +652,7 @@ pub struct Ballast {
 /// [periodic.time_delay]     # optional: paper 003 §5
 /// body = "sleeper"          # the body whose cyclic [[load]] gives the phase
 /// lag_deg = 90.0            # or sleeper_spacing and speed (m, m/s)
+/// shared_faces = false      # true: one scale for both sides of a pair (qdem's variant)
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -667,6 +692,11 @@ pub struct TimeDelay {
     /// With `sleeper_spacing`: the speed of the travelling load (m/s).
     #[serde(default)]
     pub speed: Option<f64>,
+    /// Shared faces (qdem's variant, not paper 003's Eqs. 6–7): both spheres of a pair
+    /// through the boundary scaled alike, by the mean of the two faces' predicted forces, so
+    /// the pair's action equals its reaction; default false.
+    #[serde(default)]
+    pub shared_faces: bool,
 }
 
 /// `[granular]`: a sample of rigid stones, each a clump of spheres (paper 003 §3), read from a
@@ -856,4 +886,6 @@ fn default_bbm_friction() -> f64 {
 }
 
 /// Top-level keys that are arrays of tables (`[[name]]`), for messages.
-pub(crate) const ARRAY_TABLES: &[&str] = &["material", "body", "fix", "load", "probe", "wall"];
+pub(crate) const ARRAY_TABLES: &[&str] = &[
+    "material", "body", "fix", "load", "probe", "section", "wall",
+];

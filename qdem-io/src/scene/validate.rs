@@ -651,6 +651,7 @@ pub(crate) fn validate(
         c.finite(&["probe", &idx, "point"], &l, "point", &p.point);
     }
 
+    section_tables(&mut c, &raw);
     contact_tables(&mut c, &raw);
     if let Some(g) = &raw.granular {
         granular_table(&mut c, &raw, g, &material_names);
@@ -687,6 +688,7 @@ pub(crate) fn validate(
         fixes,
         loads,
         probes: raw.probes,
+        sections: raw.sections,
         contact: raw.contact,
         walls: raw.walls,
         bonded: raw.bonded,
@@ -813,6 +815,35 @@ fn box_corners(c: &mut Checker<'_>, table: &str, l: &str, key: &str, b: &[[f64; 
 }
 
 /// The axes named by `text` ("x", "y", "z" once each), or an error naming the table.
+/// `[[section]]`: unique names, one axis, a finite plane, and contacts to measure.
+fn section_tables(c: &mut Checker<'_>, raw: &RawScene) {
+    unique_names(c, "section", raw.sections.iter().map(|s| s.name.as_str()));
+    for (i, s) in raw.sections.iter().enumerate() {
+        let idx = i.to_string();
+        let l = label("section", i, Some(&s.name));
+        if !matches!(s.axis.as_str(), "x" | "y" | "z") {
+            c.error(
+                &["section", &idx, "axis"],
+                format!(
+                    "{l}: axis = {:?}: name the one axis the plane is normal to, \"x\", \"y\" \
+                     or \"z\"",
+                    s.axis
+                ),
+            );
+        }
+        c.finite(&["section", &idx, "at"], &l, "at", &[s.at]);
+        if raw.contact.is_none() {
+            c.error(
+                &["section", &idx],
+                format!(
+                    "{l} measures contact forces, but the scene has no [contact]; add one or \
+                     remove the section"
+                ),
+            );
+        }
+    }
+}
+
 fn axes_of(c: &mut Checker<'_>, at: &[&str], label: &str, text: &str) -> Option<Vec<usize>> {
     let mut axes = Vec::new();
     for ch in text.chars() {
@@ -1425,6 +1456,7 @@ pub(crate) fn to_raw(scene: &Scene) -> RawScene {
             })
             .collect(),
         probes: scene.probes.clone(),
+        sections: scene.sections.clone(),
         contact: scene.contact.clone(),
         walls: scene.walls.clone(),
         bonded: scene.bonded.clone(),
