@@ -2,16 +2,17 @@
 """The box-test study of paper 003: for each of 3 samples (seeds 1, 2, 3), deposit the
 sample of the periodic single-sleeper cell (bed, then the sleeper and the crib), then load
 it in the three-sleeper box (the cell's sample three times along y), in the single-sleeper
-box with fixed walls, and with ordinary and time-delayed periodic boundaries; collect the
-middle sleeper's settlement after every load cycle. All four cases of a seed load the same
-middle sample from the same sleeper pose.
+box with fixed walls, and with ordinary and time-delayed periodic boundaries (paper 003's
+Eqs. 6-7, and qdem's shared faces); collect the middle sleeper's settlement after every load
+cycle. All five cases of a seed load the same middle sample from the same sleeper pose.
 
     cargo build --release -p qdem-cli
     python3 qdem-bench/scripts/boxtest_study.py [--size study|small] [--seeds 1,2,3]
 
 Writes out/boxtest_study/settlement.csv (case, seed, cycle, settlement), settlement.svg,
 runs.json (particles, steps, wall time, sphere-steps/s of every run) and the tables between
-<!-- boxtest:begin --> and <!-- boxtest:end --> in docs/boxtest.md. Settlement is the
+<!-- boxtest:begin --> and <!-- boxtest:end --> in docs/boxtest.md, then (study size) runs
+boxtest_faces.py: the force through the middle cell's faces over a cycle. Settlement is the
 sleeper's downward displacement at the end of each cycle (its load back at the minimum)
 relative to the start of the cycles (after the settling time under the minimum load).
 """
@@ -26,11 +27,12 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FIXTURES = os.path.join(ROOT, "fixtures", "boxtest")
 QDEM = os.path.join(ROOT, "target", "release", "qdem")
-CASES = ["three_sleeper", "single_fixed", "single_periodic", "single_delayed"]
+CASES = ["three_sleeper", "single_fixed", "single_periodic", "single_delayed", "single_shared"]
 LABELS = {"three_sleeper": "three-sleeper (middle)", "single_fixed": "single, fixed walls",
-          "single_periodic": "single, periodic", "single_delayed": "single, time-delayed"}
+          "single_periodic": "single, periodic", "single_delayed": "single, time-delayed",
+          "single_shared": "single, time-delayed, shared faces"}
 COLOURS = {"three_sleeper": "#000000", "single_fixed": "#1f77b4",
-           "single_periodic": "#ff7f0e", "single_delayed": "#2ca02c"}
+           "single_periodic": "#ff7f0e", "single_delayed": "#2ca02c", "single_shared": "#d62728"}
 
 
 def scene_for(size, name, seed, out):
@@ -139,19 +141,21 @@ def main():
                       "<!-- boxtest:begin -->\n" + table + "\n<!-- boxtest:end -->", text, flags=re.S)
         open(doc, "w").write(text)
         os.replace(os.path.join(base, "settlement.svg"), os.path.join(ROOT, "docs", "boxtest_settlement.svg"))
+        faces = os.path.join(os.path.dirname(os.path.abspath(__file__)), "boxtest_faces.py")
+        subprocess.run([sys.executable, faces, "--seeds", args.seeds], check=True)
     return 0
 
 
 def tables(series, runs, seeds):
     last = {(c, s): v[-1] for c, s, v in series}
-    lines = ["| sample | three-sleeper (mm) | fixed walls (mm) | periodic (mm) | time-delayed (mm) | order fixed < periodic < delayed | closest to three-sleeper |",
-             "| --- | --- | --- | --- | --- | --- | --- |"]
+    lines = ["| sample | three-sleeper (mm) | fixed walls (mm) | periodic (mm) | time-delayed (mm) | time-delayed, shared faces (mm) | order fixed < periodic < delayed (paper / shared) | closest to three-sleeper |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for s in seeds:
         ref = last[("three_sleeper", s)]
         vals = [last[(c, s)] for c in CASES[1:]]
         errs = {c: last[(c, s)] - ref for c in CASES[1:]}
         closest = min(errs, key=lambda c: abs(errs[c]))
-        order = "yes" if vals[0] < vals[1] < vals[2] else "no"
+        order = "/".join("yes" if vals[0] < vals[1] < v else "no" for v in vals[2:])
         cells = " | ".join(f"{1000 * v:.2f} ({1000 * errs[c]:+.2f})" for c, v in zip(CASES[1:], vals))
         lines.append(f"| {s} | {1000 * ref:.2f} | {cells} | {order} | {LABELS[closest]} |")
     lines += ["", "(in brackets: the error against the three-sleeper box's middle sleeper)", "",
