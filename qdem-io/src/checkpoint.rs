@@ -184,7 +184,7 @@ mod tests {
             read_checkpoint(&path, 42, scene),
             Err(CheckpointFileError::Version {
                 found: 9,
-                expected: 1,
+                expected: FORMAT_VERSION,
                 ..
             })
         ));
