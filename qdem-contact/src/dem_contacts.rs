@@ -394,16 +394,20 @@ impl DemContacts {
     /// for Eqs. 4–5 is a statement about that force).
     pub fn section_force(&self, axis: usize, at: f64) -> f64 {
         let period = self.periodic.as_ref().and_then(|p| p.length(axis));
-        let (mut sum, mut count) = (0.0, 0usize);
-        for k in 0..self.pairs.len() {
-            let f = self.pairs.force[k];
-            if f == Vec3::zeros() {
-                continue;
-            }
+        self.mean_pair_force(|k| {
             let (i, j) = (self.pairs.first[k] as usize, self.pairs.second[k] as usize);
             let a = self.now[i].center[axis] - at;
             let b = self.now[j].center[axis] + self.pairs.shift[k][axis] - at;
-            if crosses(a, b, period) {
+            crosses(a, b, period)
+        })
+    }
+
+    /// The average magnitude of the forces of the touching pairs k for which `counted(k)`
+    /// (serial, in pair order, so it does not depend on the thread count); 0 without any.
+    fn mean_pair_force(&self, counted: impl Fn(usize) -> bool) -> f64 {
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (k, f) in self.pairs.force.iter().enumerate() {
+            if *f != Vec3::zeros() && counted(k) {
                 sum += f.norm();
                 count += 1;
             }
@@ -711,21 +715,9 @@ impl DemContacts {
         }) = list;
     }
 
-    /// The average magnitude of the touching pairs' forces through the boundaries of `axis`
-    /// (serial, in pair order, so it does not depend on the thread count).
+    /// The average magnitude of the touching pairs' forces through the boundaries of `axis`.
     fn boundary_force(&self, axis: usize) -> f64 {
-        let (mut sum, mut count) = (0.0, 0usize);
-        for (f, t) in self.pairs.force.iter().zip(&self.pairs.shift) {
-            if t[axis] != 0.0 && *f != Vec3::zeros() {
-                sum += f.norm();
-                count += 1;
-            }
-        }
-        if count == 0 {
-            0.0
-        } else {
-            sum / count as f64
-        }
+        self.mean_pair_force(|k| self.pairs.shift[k][axis] != 0.0)
     }
 
     /// Measures the boundary force and updates the ghost scales of a time-delayed boundary.
