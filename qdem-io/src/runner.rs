@@ -8,8 +8,8 @@
 //! the sample format `[granular] sample` reads); one with a time-delayed boundary gets
 //! `boundary.csv` (time, the measured average boundary force, the left and right ghost
 //! scales) at the probe interval, and one with `[[section]]`s `sections.csv` (time, the
-//! average contact force across each section plane); one with rigid `[[body]]`s gets `poses.csv` (where each
-//! ended, the file `[[body]] pose_from` reads: [`crate::pose_from`]).
+//! average contact force across each section plane); one with rigid `[[body]]`s gets
+//! `poses.csv` (where each ended, the file `[[body]] pose_from` reads: [`crate::pose_from`]).
 
 use crate::build::{BodyKind, Simulation};
 use crate::checkpoint::{

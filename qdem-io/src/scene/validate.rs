@@ -814,7 +814,6 @@ fn box_corners(c: &mut Checker<'_>, table: &str, l: &str, key: &str, b: &[[f64; 
     }
 }
 
-/// The axes named by `text` ("x", "y", "z" once each), or an error naming the table.
 /// `[[section]]`: unique names, one axis, a finite plane, and contacts to measure.
 fn section_tables(c: &mut Checker<'_>, raw: &RawScene) {
     unique_names(c, "section", raw.sections.iter().map(|s| s.name.as_str()));
@@ -844,6 +843,7 @@ fn section_tables(c: &mut Checker<'_>, raw: &RawScene) {
     }
 }
 
+/// The axes named by `text` ("x", "y", "z" once each), or an error naming the table.
 fn axes_of(c: &mut Checker<'_>, at: &[&str], label: &str, text: &str) -> Option<Vec<usize>> {
     let mut axes = Vec::new();
     for ch in text.chars() {
