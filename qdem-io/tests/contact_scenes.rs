@@ -5,11 +5,13 @@
 //!   slides with a = g (sin θ − μ cos θ).
 //! - The same block given a velocity on the triangulated floor `ramp.msh` decelerates at μ g
 //!   until it stops after v₀²/(2 μ g).
+//! - Without the plane nothing can touch: no contact model is built, and a `[[section]]`
+//!   records zero force.
 
 use qdem_core::Vec3;
 use qdem_io::build::{BodyKind, Simulation};
 use qdem_io::runner::make_stepper;
-use qdem_io::scene::{Scene, Wall};
+use qdem_io::scene::{Scene, Section, Wall};
 use std::path::{Path, PathBuf};
 
 fn fixture(name: &str) -> PathBuf {
@@ -87,9 +89,25 @@ fn a_lone_body_without_walls_gets_no_contact_model() {
     scene.walls.clear();
     // Nothing bounds the step of a lone rigid body: the scene must give one.
     scene.run.dt = qdem_io::scene::TimeStep::Fixed(1e-4);
-    let alone = Simulation::build(scene).unwrap();
+    scene.run.t_end = 2e-3;
+    scene.sections.push(Section {
+        name: "mid".into(),
+        axis: "x".into(),
+        at: 0.0,
+    });
+    let mut alone = Simulation::build(scene).unwrap();
     assert!(
         alone.contacts().is_none(),
         "one body and no wall: nothing can touch"
     );
+    // A section there measures no contact force: sections.csv holds zeros.
+    let out = std::env::temp_dir().join(format!("qdem-lone-section-{}", std::process::id()));
+    qdem_io::runner::run(&mut alone, &out, &mut |_| {}).unwrap();
+    let text = std::fs::read_to_string(out.join("sections.csv")).unwrap();
+    let rows: Vec<&str> = text.lines().collect();
+    assert_eq!(rows[0], "time,mid");
+    assert!(rows.len() > 2, "{text}");
+    for row in &rows[1..] {
+        assert_eq!(row.split(',').nth(1), Some("0.000000000e0"), "{text}");
+    }
 }
