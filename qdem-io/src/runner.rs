@@ -519,10 +519,11 @@ fn record_sections(sim: &Simulation, time: f64, rows: &mut Vec<f64>) {
     if sim.scene.sections.is_empty() {
         return;
     }
+    let contacts = sim.contacts();
     rows.push(time);
     for s in &sim.scene.sections {
         let axis = "xyz".find(&s.axis).expect("validated: x, y or z");
-        rows.push(sim.contacts().map_or(0.0, |c| c.section_force(axis, s.at)));
+        rows.push(contacts.map_or(0.0, |c| c.section_force(axis, s.at)));
     }
 }
 
