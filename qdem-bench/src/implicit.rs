@@ -4,7 +4,7 @@
 //! factorisation (force evaluation + solve + update), on a structured block clamped on one face.
 
 use crate::throughput::{block_mesh, body_on, Ordering};
-use qdem_core::sparse::{assemble, FreeDofs, Scales, SparseCholesky};
+use qdem_core::sparse::{Assembler, FreeDofs, Scales, SparseCholesky};
 use qdem_core::{CoreError, Dofs, Model, Newmark, Stepper, Tangent};
 use std::time::Instant;
 
@@ -55,10 +55,11 @@ pub fn measure_implicit(tets: usize, threads: usize) -> Result<ImplicitResult, C
             damping: 0.5 * dt,
             stiffness: 0.25 * dt * dt,
         };
-        let matrix = assemble(&tangent, &state.mass, &dofs, scales, &mut Vec::new())?;
+        let mut assembler = Assembler::new();
+        let matrix = assembler.assemble(&tangent, &state.mass, &dofs, scales)?;
         let assembly_seconds = start.elapsed().as_secs_f64();
         let mut cholesky = SparseCholesky::new();
-        cholesky.factorize(matrix.as_ref(), "benchmark system")?;
+        cholesky.factorize(matrix, "benchmark system")?;
         let stats = cholesky.stats().clone();
         let mut rhs = vec![1.0; dofs.len()];
         let start = Instant::now();

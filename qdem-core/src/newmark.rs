@@ -46,8 +46,7 @@ use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::model::Model;
 use crate::sparse::{
-    assemble, explain_failure, DampingRows, Entry, FactorStats, FreeDofs, Scales, SparseCholesky,
-    Tangent,
+    explain_failure, Assembler, DampingRows, FactorStats, FreeDofs, Scales, SparseCholesky, Tangent,
 };
 use crate::state::State;
 use crate::stepper::{
@@ -113,7 +112,7 @@ pub struct Newmark {
 struct ImplicitSystem {
     tangent: Tangent,
     tangent_current: bool,
-    entries: Vec<Entry>,
+    assembler: Assembler,
     dofs: Option<FreeDofs>,
     factors: Factors,
     rhs: Vec<f64>,
@@ -242,16 +241,13 @@ impl Newmark {
             system.damping.build(&system.tangent, node_dofs(state));
         }
         let dofs = FreeDofs::new(&state.node_fixity());
-        let matrix = assemble(
-            &system.tangent,
-            &state.node_mass(),
-            &dofs,
-            scales,
-            &mut system.entries,
-        )?;
+        let matrix =
+            system
+                .assembler
+                .assemble(&system.tangent, &state.node_mass(), &dofs, scales)?;
         let factor = system.factors.get(h == self.dt);
         factor.step = None;
-        if let Err(error) = factor.cholesky.factorize(matrix.as_ref(), "effective") {
+        if let Err(error) = factor.cholesky.factorize(matrix, "effective") {
             let pivot = factor.cholesky.failed_pivot();
             return Err(explain_failure(
                 error,

@@ -174,6 +174,15 @@ impl Tangent {
         }
     }
 
+    /// Appends ready stiffness and damping entries (global DOFs, on or below the diagonal,
+    /// as [`Tangent::add_stiffness_entry`] keeps them): for models that keep their entries
+    /// between assemblies.
+    pub fn extend(&mut self, stiffness: &[Entry], damping: &[Entry]) {
+        debug_assert!(stiffness.iter().chain(damping).all(|e| e.row >= e.col));
+        self.stiffness.extend_from_slice(stiffness);
+        self.damping.extend_from_slice(damping);
+    }
+
     /// The stored stiffness entries (lower triangle, global DOFs, duplicates not summed).
     pub fn stiffness_entries(&self) -> &[Entry] {
         &self.stiffness
@@ -343,32 +352,144 @@ pub struct Scales {
 
 /// Assembles s_M M + s_C C + s_K K over the free DOFs, lower triangle, duplicates summed
 /// (the left-hand side of paper 001 Eq. 26 with s = (1, γ∆t, β∆t²)). A term with a zero factor
-/// is left out of the pattern. `entries` is scratch space owned by the caller.
-pub fn assemble(
-    tangent: &Tangent,
-    mass: &[f64],
-    dofs: &FreeDofs,
+/// is left out of the pattern.
+///
+/// The compressed-column pattern is kept between calls, and so is the slot of every entry
+/// of the tangent in it: while the models add the same entries (the bonded beam keeps its
+/// broken bonds' zero entries so that its pattern holds), assembling is one pass that adds
+/// each value into its slot; an entry the pattern lacks rebuilds it from triplets. Every
+/// slot sums its entries in the tangent's order (stiffness, damping, mass) either way, so
+/// the values do not depend on which path ran.
+#[derive(Clone, Debug, Default)]
+pub struct Assembler {
+    matrix: Option<SparseColMat<usize, f64>>,
+    /// The slot of each stiffness, damping and mass entry at the last assembly ([`FIXED`]
+    /// for an entry of a fixed DOF).
+    slots: [Vec<usize>; 3],
+}
+
+impl Assembler {
+    /// An assembler with no pattern yet.
+    pub fn new() -> Assembler {
+        Assembler::default()
+    }
+
+    /// The assembled matrix of `tangent` and the lumped `mass` (one per generalised node)
+    /// over `dofs`, scaled by `scales`.
+    pub fn assemble(
+        &mut self,
+        tangent: &Tangent,
+        mass: &[f64],
+        dofs: &FreeDofs,
+        scales: Scales,
+    ) -> Result<SparseColMatRef<'_, usize, f64>, CoreError> {
+        let terms = Terms {
+            tangent,
+            mass,
+            dofs,
+            scales,
+        };
+        let fits = match &mut self.matrix {
+            Some(matrix) if matrix.nrows() == dofs.len() => terms.fill(matrix, &mut self.slots),
+            _ => false,
+        };
+        if !fits {
+            let mut matrix = terms.pattern()?;
+            let filled = terms.fill(&mut matrix, &mut self.slots);
+            debug_assert!(filled, "a pattern built from the entries holds them");
+            self.matrix = Some(matrix);
+        }
+        Ok(self.matrix.as_ref().expect("assembled above").as_ref())
+    }
+}
+
+/// The entries of one assembly: s_K K, s_C C and s_M M over the free DOFs.
+struct Terms<'a> {
+    tangent: &'a Tangent,
+    mass: &'a [f64],
+    dofs: &'a FreeDofs,
     scales: Scales,
-    entries: &mut Vec<Entry>,
-) -> Result<SparseColMat<usize, f64>, CoreError> {
-    entries.clear();
-    let terms = [
-        (&tangent.stiffness, scales.stiffness),
-        (&tangent.damping, scales.damping),
-    ];
-    for (list, scale) in terms.into_iter().filter(|t| t.1 != 0.0) {
-        entries.extend(list.iter().filter_map(|e| {
-            let (row, col) = (dofs.index(e.row)?, dofs.index(e.col)?);
-            Some(Triplet::new(row, col, scale * e.val))
-        }));
+}
+
+impl Terms<'_> {
+    /// Calls `add(list, k, row, column, value)` for the k-th entry of each list (stiffness,
+    /// damping, mass) whose factor is not zero, with system indices, or [`FIXED`] as the row
+    /// of an entry of a fixed DOF.
+    fn for_each(&self, mut add: impl FnMut(usize, usize, usize, usize, f64) -> bool) -> bool {
+        let s = self.scales;
+        let lists = [
+            (&self.tangent.stiffness, s.stiffness),
+            (&self.tangent.damping, s.damping),
+        ];
+        for (list, (entries, scale)) in lists.into_iter().enumerate() {
+            if scale == 0.0 {
+                continue;
+            }
+            for (k, e) in entries.iter().enumerate() {
+                let (row, col) = match (self.dofs.index(e.row), self.dofs.index(e.col)) {
+                    (Some(row), Some(col)) => (row, col),
+                    _ => (FIXED, FIXED),
+                };
+                if !add(list, k, row, col, scale * e.val) {
+                    return false;
+                }
+            }
+        }
+        if s.mass != 0.0 {
+            for dof in 0..3 * self.mass.len() {
+                let i = self.dofs.index(dof).unwrap_or(FIXED);
+                if !add(2, dof, i, i, s.mass * self.mass[dof / 3]) {
+                    return false;
+                }
+            }
+        }
+        true
     }
-    if scales.mass != 0.0 {
-        entries.extend((0..3 * mass.len()).filter_map(|dof| {
-            let i = dofs.index(dof)?;
-            Some(Triplet::new(i, i, scales.mass * mass[dof / 3]))
-        }));
+
+    /// A matrix with the pattern of these entries (built from triplets).
+    fn pattern(&self) -> Result<SparseColMat<usize, f64>, CoreError> {
+        let mut entries = Vec::new();
+        self.for_each(|_, _, row, col, val| {
+            if row != FIXED {
+                entries.push(Triplet::new(row, col, val));
+            }
+            true
+        });
+        let n = self.dofs.len();
+        SparseColMat::try_new_from_triplets(n, n, &entries).map_err(sparse_error)
     }
-    SparseColMat::try_new_from_triplets(dofs.len(), dofs.len(), entries).map_err(sparse_error)
+
+    /// Sums the entries into `matrix`'s values through their slots, found again (binary
+    /// search in the column) where the last assembly's slot no longer fits; false if an entry
+    /// has no place in the pattern.
+    fn fill(&self, matrix: &mut SparseColMat<usize, f64>, slots: &mut [Vec<usize>; 3]) -> bool {
+        let (pattern, values) = matrix.parts_mut();
+        let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
+        values.fill(0.0);
+        self.for_each(|list, k, row, col, val| {
+            let cached = &mut slots[list];
+            if cached.len() <= k {
+                cached.resize(k + 1, FIXED);
+            }
+            if row == FIXED {
+                cached[k] = FIXED;
+                return true;
+            }
+            let column = col_ptr[col]..col_ptr[col + 1];
+            let slot = cached[k];
+            let slot = if column.contains(&slot) && row_idx[slot] == row {
+                slot
+            } else {
+                match row_idx[column.clone()].binary_search(&row) {
+                    Ok(offset) => column.start + offset,
+                    Err(_) => return false,
+                }
+            };
+            cached[k] = slot;
+            values[slot] += val;
+            true
+        })
+    }
 }
 
 /// Size, sparsity and cost of the last factorisation (for `qdem check`).
@@ -390,10 +511,12 @@ pub struct FactorStats {
     pub factorizations: usize,
 }
 
-/// The symbolic analysis of one sparsity pattern, with the scratch space its solves need.
+/// The symbolic analysis of one sparsity pattern, with the scratch space its numeric
+/// factorisations and its solves need.
 struct Analysis {
     pattern: SymbolicSparseColMat<usize>,
     symbolic: SymbolicCholesky<usize>,
+    factor_scratch: MemBuffer,
     solve_scratch: MemBuffer,
 }
 
@@ -450,10 +573,9 @@ impl SparseCholesky {
         self.factored = false;
         self.failed_pivot = None;
         self.analyse(a)?;
-        let symbolic = &self.analysis.as_ref().expect("analysed above").symbolic;
+        let analysis = self.analysis.as_mut().expect("analysed above");
+        let symbolic = &analysis.symbolic;
         let par = faer::get_global_parallelism();
-        let mut scratch =
-            MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
         self.values.resize(symbolic.len_val(), 0.0);
         let start = Instant::now();
         let result = symbolic.factorize_numeric_llt(
@@ -462,7 +584,7 @@ impl SparseCholesky {
             Side::Lower,
             Default::default(),
             par,
-            MemStack::new(&mut scratch),
+            MemStack::new(&mut analysis.factor_scratch),
             Default::default(),
         );
         if let Err(error) = result {
@@ -507,12 +629,14 @@ impl SparseCholesky {
             analyses: self.stats.analyses + 1,
             factorizations: self.stats.factorizations,
         };
-        let solve_scratch = MemBuffer::new(
-            symbolic.solve_in_place_scratch::<f64>(1, faer::get_global_parallelism()),
-        );
+        let par = faer::get_global_parallelism();
+        let factor_scratch =
+            MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
+        let solve_scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
         self.analysis = Some(Analysis {
             pattern: pattern.to_owned().map_err(sparse_error)?,
             symbolic,
+            factor_scratch,
             solve_scratch,
         });
         Ok(())
@@ -758,4 +882,106 @@ fn free_rigid_modes(
 /// Maps a faer error to a core error.
 fn sparse_error(e: impl std::fmt::Debug) -> CoreError {
     CoreError::Sparse(format!("{e:?}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The dense lower triangle of s_M M + s_C C + s_K K, summed entry by entry.
+    fn dense(tangent: &Tangent, mass: &[f64], dofs: &FreeDofs, s: Scales) -> Vec<Vec<f64>> {
+        let n = dofs.len();
+        let mut a = vec![vec![0.0; n]; n];
+        for (list, scale) in [
+            (&tangent.stiffness, s.stiffness),
+            (&tangent.damping, s.damping),
+        ] {
+            for e in list {
+                if let (Some(r), Some(c)) = (dofs.index(e.row), dofs.index(e.col)) {
+                    a[r][c] += scale * e.val;
+                }
+            }
+        }
+        for dof in 0..3 * mass.len() {
+            if let Some(i) = dofs.index(dof) {
+                a[i][i] += s.mass * mass[dof / 3];
+            }
+        }
+        a
+    }
+
+    /// The matrix's stored lower triangle as a dense one.
+    fn stored(m: SparseColMatRef<'_, usize, f64>) -> Vec<Vec<f64>> {
+        let mut a = vec![vec![0.0; m.nrows()]; m.nrows()];
+        for c in 0..m.ncols() {
+            for (r, v) in m.row_idx_of_col(c).zip(m.val_of_col(c)) {
+                a[r][c] += v;
+            }
+        }
+        a
+    }
+
+    fn assert_close(a: &[Vec<f64>], b: &[Vec<f64>]) {
+        for (ra, rb) in a.iter().zip(b) {
+            for (x, y) in ra.iter().zip(rb) {
+                assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()), "{x} vs {y}");
+            }
+        }
+    }
+
+    /// A chain of 4 particles with a fixed one: coupled blocks, duplicates and fixed DOFs.
+    fn chain(stiffness: f64) -> Tangent {
+        let mut t = Tangent::new();
+        for p in 0..3 {
+            let k = Mat3::from_fn(|r, c| stiffness * (1.0 + r as f64 + 0.5 * c as f64));
+            let k = k + k.transpose();
+            t.add_stiffness(p, p, &k);
+            t.add_stiffness(p + 1, p + 1, &k);
+            t.add_stiffness(p + 1, p, &(-k));
+            t.add_damping(p, p, &(0.1 * k));
+            t.add_damping(p + 1, p, &(-0.1 * k));
+        }
+        t
+    }
+
+    #[test]
+    fn reassembly_through_the_kept_pattern_matches_a_fresh_assembly() {
+        let mass = [2.0, 3.0, 4.0, 5.0];
+        let dofs = FreeDofs::new(&[Dofs::ALL, Dofs::NONE, Dofs::NONE, Dofs::NONE]);
+        let s = Scales {
+            mass: 1.0,
+            damping: 0.5,
+            stiffness: 0.25,
+        };
+        let mut assembler = Assembler::new();
+        let first = chain(1.0);
+        assert_close(
+            &stored(assembler.assemble(&first, &mass, &dofs, s).unwrap()),
+            &dense(&first, &mass, &dofs, s),
+        );
+        // New values at the same entries: filled through the kept slots.
+        let second = chain(7.0);
+        let kept = stored(assembler.assemble(&second, &mass, &dofs, s).unwrap());
+        assert_close(&kept, &dense(&second, &mass, &dofs, s));
+        assert_close(
+            &kept,
+            &stored(Assembler::new().assemble(&second, &mass, &dofs, s).unwrap()),
+        );
+        // An entry outside the pattern (particles 1 and 3) rebuilds it.
+        let mut third = chain(7.0);
+        third.add_stiffness(3, 1, &Mat3::from_element(0.3));
+        let rebuilt = assembler.assemble(&third, &mass, &dofs, s).unwrap();
+        assert_eq!(
+            rebuilt.compute_nnz(),
+            kept_nnz(&second, &mass, &dofs, s) + 9
+        );
+        assert_close(&stored(rebuilt), &dense(&third, &mass, &dofs, s));
+    }
+
+    fn kept_nnz(t: &Tangent, mass: &[f64], dofs: &FreeDofs, s: Scales) -> usize {
+        Assembler::new()
+            .assemble(t, mass, dofs, s)
+            .unwrap()
+            .compute_nnz()
+    }
 }

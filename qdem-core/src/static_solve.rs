@@ -19,8 +19,8 @@ use crate::error::CoreError;
 use crate::model::Model;
 use crate::newmark::collect_tangent;
 use crate::sparse::{
-    assemble, explain_failure, unconstrained_bodies, FactorStats, FreeDofs, Scales, SparseCholesky,
-    Tangent, FIX_HINT,
+    explain_failure, unconstrained_bodies, Assembler, FactorStats, FreeDofs, Scales,
+    SparseCholesky, Tangent, FIX_HINT,
 };
 use crate::state::State;
 use crate::stepper::{refuse_rigid, sum_forces, Stepper};
@@ -104,8 +104,9 @@ impl StaticSolver {
             stiffness: 1.0,
         };
         let mass = state.node_mass();
-        let matrix = assemble(&tangent, &mass, &dofs, scales, &mut Vec::new())?;
-        if let Err(error) = self.cholesky.factorize(matrix.as_ref(), "stiffness") {
+        let mut assembler = Assembler::new();
+        let matrix = assembler.assemble(&tangent, &mass, &dofs, scales)?;
+        if let Err(error) = self.cholesky.factorize(matrix, "stiffness") {
             let pivot = self.cholesky.failed_pivot();
             return Err(explain_failure(
                 error, pivot, &dofs, state, models, &tangent,
