@@ -37,6 +37,7 @@
 //! moved more than half the skin.
 
 use crate::beam_bond::{to_global_matrix, BeamBond, Dof2};
+use crate::bond_tangent::{pair_dofs, BondTangent};
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::error::ContactError;
 use crate::particle_packing::{lattice_section, Packing, SplitMix64};
@@ -92,6 +93,8 @@ pub struct BondedParticles {
     radius: Vec<f64>,
     bonds: Vec<BeamBond>,
     intact: Vec<bool>,
+    /// The bonds' tangent entries (zero for broken bonds).
+    bond_tangent: BondTangent,
     /// Per particle, the (bond, end) pairs touching it, in bond order (CSR).
     incidence_start: Vec<usize>,
     incidence: Vec<(u32, u8)>,
@@ -146,6 +149,7 @@ impl BondedParticles {
             name: name.to_string(),
             radius,
             intact: vec![true; m],
+            bond_tangent: BondTangent::new(&bonds, &vec![true; m], state.len()),
             incidence_start: count,
             incidence,
             bond_force: vec![[[0.0; 3]; 2]; m],
@@ -442,13 +446,6 @@ impl BondedParticles {
         earliest
     }
 
-    /// Global DOF numbers of particle p's x, y and θ in a state of `n` particles.
-    #[inline]
-    fn dof_numbers(p: u32, n: usize) -> [usize; 3] {
-        let p = p as usize;
-        [3 * p, 3 * p + 1, 3 * (n + p) + 2]
-    }
-
     /// Adds a 6×6 global matrix of pair (i, j) to the tangent.
     fn add_block(
         tangent: &mut Tangent,
@@ -457,8 +454,7 @@ impl BondedParticles {
         a: &[[f64; 6]; 6],
         damping: bool,
     ) {
-        let [di, dj] = [Self::dof_numbers(i, n), Self::dof_numbers(j, n)];
-        let dofs = [di[0], di[1], di[2], dj[0], dj[1], dj[2]];
+        let dofs = pair_dofs((i, j), n);
         for (r, row) in a.iter().enumerate() {
             for (c, value) in row.iter().enumerate() {
                 let (dr, dc) = (dofs[r], dofs[c]);
@@ -563,6 +559,7 @@ impl Model for BondedParticles {
         let bonds = self.bonds.len();
         self.intact = input.bools("intact bonds")?;
         same_count("bonds", bonds, self.intact.len())?;
+        self.bond_tangent = BondTangent::new(&self.bonds, &self.intact, self.bond_tangent.nodes());
         for stress in [
             &mut self.stress_eval,
             &mut self.stress_trial,
@@ -708,16 +705,10 @@ impl Model for BondedParticles {
 
     fn add_tangent(&self, state: &State, tangent: &mut Tangent) -> bool {
         let n = state.len();
-        for (b, &intact) in self.bonds.iter().zip(&self.intact) {
-            let pair = (b.i, b.j);
-            if intact {
-                let k = to_global_matrix(&b.local_stiffness(), b.axis);
-                let c = to_global_matrix(&b.local_damping(), b.axis);
-                Self::add_block(tangent, n, pair, &k, false);
-                Self::add_block(tangent, n, pair, &c, true);
-            } else {
-                Self::add_block(tangent, n, pair, &[[0.0; 6]; 6], false);
-            }
+        if self.bond_tangent.nodes() == n {
+            self.bond_tangent.add_to(tangent);
+        } else {
+            BondTangent::new(&self.bonds, &self.intact, n).add_to(tangent);
         }
         let law = self.settings.contact;
         for pair in self.pairs.iter().filter(|p| p.touching) {
@@ -766,6 +757,7 @@ impl Model for BondedParticles {
         for k in 0..self.bonds.len() {
             if self.intact[k] && self.stress_trial[k] >= self.bonds[k].strength {
                 self.intact[k] = false;
+                self.bond_tangent.remove(k);
                 self.broken += 1;
                 self.broken_log.push((state.time, k as u32));
                 changed = true;

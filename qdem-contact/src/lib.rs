@@ -23,6 +23,7 @@
 //! moment of each contact force about the sphere's centre to the body's torque.
 
 pub mod beam_bond;
+mod bond_tangent;
 pub mod bonded_particles;
 pub mod broad_phase;
 pub mod clump_sample;
