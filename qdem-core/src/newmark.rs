@@ -335,7 +335,7 @@ impl Newmark {
         let mut h = span;
         if self.adaptive || self.is_implicit() {
             match &mut self.saved {
-                Some(saved) => saved.as_mut().clone_from(state),
+                Some(saved) => saved.copy_motion_from(state),
                 None => self.saved = Some(Box::new(state.clone())),
             }
         }
@@ -351,7 +351,7 @@ impl Newmark {
             let Some(saved) = &self.saved else { break };
             if stale && redos < MAX_REDOS {
                 // Redo with the contacts the trial met in the matrix (an active-set pass).
-                state.clone_from(saved.as_ref());
+                state.copy_motion_from(saved);
                 self.system.invalidate();
                 redos += 1;
                 continue;
@@ -360,7 +360,7 @@ impl Newmark {
                 Some(alpha)
                     if self.adaptive && retakes < MAX_RETAKES && h > MIN_FRACTION * self.dt =>
                 {
-                    state.clone_from(saved.as_ref());
+                    state.copy_motion_from(saved);
                     h = (h * alpha.clamp(0.0, 1.0).sqrt()).max(MIN_FRACTION * self.dt);
                     self.counts.retakes += 1;
                     retakes += 1;

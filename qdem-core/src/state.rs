@@ -201,6 +201,23 @@ impl State {
         self.position.is_empty()
     }
 
+    /// Copies what a step changes from `source`, a state of the same particles: the time, the
+    /// positions, velocities and accelerations, the rigid bodies' rotations and the
+    /// particles' rotational DOFs (not the reference, masses or fixity). For saving a state
+    /// before a step that may be retaken, and restoring it, without copying (or allocating)
+    /// the parts no step changes.
+    pub fn copy_motion_from(&mut self, source: &State) {
+        self.time = source.time;
+        self.position.clone_from(&source.position);
+        self.velocity.clone_from(&source.velocity);
+        self.acceleration.clone_from(&source.acceleration);
+        self.rigid.clone_from(&source.rigid);
+        let (spin, from) = (&mut self.spin, &source.spin);
+        spin.angle.clone_from(&from.angle);
+        spin.velocity.clone_from(&from.velocity);
+        spin.acceleration.clone_from(&from.acceleration);
+    }
+
     /// Displacement x − X of particle `i`.
     #[inline]
     pub fn displacement(&self, i: usize) -> Vec3 {
@@ -243,6 +260,31 @@ impl State {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn copying_the_motion_restores_everything_a_step_changes() {
+        let mut saved = State::at_rest(vec![Vec3::zeros(), Vec3::x()]);
+        saved.add_spin(vec![1.0, 1.0], Dofs::NONE);
+        let mut state = saved.clone();
+        state.time = 0.5;
+        for (k, v) in [
+            &mut state.position,
+            &mut state.velocity,
+            &mut state.acceleration,
+        ]
+        .into_iter()
+        .chain([
+            &mut state.spin.angle,
+            &mut state.spin.velocity,
+            &mut state.spin.acceleration,
+        ])
+        .enumerate()
+        {
+            v[1] = Vec3::repeat(k as f64 + 1.0);
+        }
+        state.copy_motion_from(&saved);
+        assert_eq!(state, saved);
+    }
 
     #[test]
     fn dofs_parse_accepts_subsets_and_rejects_bad_text() {
