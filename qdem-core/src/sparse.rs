@@ -913,10 +913,13 @@ mod tests {
     /// The matrix's stored lower triangle as a dense one.
     fn stored(m: SparseColMatRef<'_, usize, f64>) -> Vec<Vec<f64>> {
         let mut a = vec![vec![0.0; m.nrows()]; m.nrows()];
-        for c in 0..m.ncols() {
-            for (r, v) in m.row_idx_of_col(c).zip(m.val_of_col(c)) {
-                a[r][c] += v;
-            }
+        let entries = (0..m.ncols()).flat_map(|c| {
+            m.row_idx_of_col(c)
+                .zip(m.val_of_col(c))
+                .map(move |e| (e, c))
+        });
+        for ((r, v), c) in entries {
+            a[r][c] += v;
         }
         a
     }
