@@ -99,6 +99,8 @@ pub struct BondedParticles {
     incidence_start: Vec<usize>,
     incidence: Vec<(u32, u8)>,
     bond_force: Vec<[Dof2; 2]>,
+    /// Displacement and velocity (x, y, θ) of every particle, packed for the bond loop.
+    motion: Vec<(Dof2, Dof2)>,
     stress_eval: Vec<f64>,
     stress_trial: Vec<f64>,
     stress_committed: Vec<f64>,
@@ -113,6 +115,9 @@ pub struct BondedParticles {
     activated: bool,
     /// Whether the last check activated a contact.
     stale: bool,
+    /// Whether a bond's trial stress reached its strength at the last check (it breaks on
+    /// commit): saves the commit a pass over every bond at the steps where none breaks.
+    breaking: bool,
     /// Eq. 28's ∆t_crit of the intact body (s).
     critical_step: f64,
 }
@@ -153,6 +158,7 @@ impl BondedParticles {
             incidence_start: count,
             incidence,
             bond_force: vec![[[0.0; 3]; 2]; m],
+            motion: vec![([0.0; 3], [0.0; 3]); n],
             stress_eval: vec![0.0; m],
             stress_trial: vec![0.0; m],
             stress_committed: vec![0.0; m],
@@ -166,6 +172,7 @@ impl BondedParticles {
             broken_log: Vec::new(),
             activated: false,
             stale: false,
+            breaking: false,
             critical_step: 0.0,
         };
         model.critical_step = model.critical_step_eq28(state);
@@ -446,6 +453,32 @@ impl BondedParticles {
         earliest
     }
 
+    /// Breaks every intact bond whose trial stress reached its strength (§2.2): its tangent
+    /// entries go to zero and its two particles become an unbonded candidate pair. Whether
+    /// one broke.
+    fn break_bonds(&mut self, state: &State) -> bool {
+        let before = self.broken;
+        for k in 0..self.bonds.len() {
+            if !(self.intact[k] && self.stress_trial[k] >= self.bonds[k].strength) {
+                continue;
+            }
+            self.intact[k] = false;
+            self.bond_tangent.remove(k);
+            self.broken += 1;
+            self.broken_log.push((state.time, k as u32));
+            let b = self.bonds[k];
+            let key = (b.i.min(b.j), b.i.max(b.j));
+            if self.pair_index.insert(key) {
+                let rest = b
+                    .length
+                    .min(self.radius[b.i as usize] + self.radius[b.j as usize]);
+                let pair = self.candidate(state, key.0, key.1, rest, b.stiffness[0]);
+                self.pairs.push(pair);
+            }
+        }
+        self.broken > before
+    }
+
     /// Adds a 6×6 global matrix of pair (i, j) to the tangent.
     fn add_block(
         tangent: &mut Tangent,
@@ -584,6 +617,12 @@ impl Model for BondedParticles {
 
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
         let bonds = &self.bonds;
+        self.motion
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(BOND_CHUNK)
+            .for_each(|(p, m)| *m = Self::dofs(state, p));
+        let motion = &self.motion;
         self.bond_force
             .par_iter_mut()
             .with_min_len(BOND_CHUNK)
@@ -595,8 +634,8 @@ impl Model for BondedParticles {
                     *stress = 0.0;
                     return;
                 }
-                let (ui, vi) = Self::dofs(state, b.i as usize);
-                let (uj, vj) = Self::dofs(state, b.j as usize);
+                let (ui, vi) = motion[b.i as usize];
+                let (uj, vj) = motion[b.j as usize];
                 let local = b.to_local(&ui, &uj);
                 let elastic = b.local_forces(&local);
                 *stress = b.stress(&elastic);
@@ -734,10 +773,12 @@ impl Model for BondedParticles {
             self.stress_trial = trial;
         }
         let eps = self.settings.tolerance;
-        let bonds = self
-            .bonds
-            .par_iter()
-            .zip(self.stress_trial.par_iter().zip(&self.stress_committed))
+        let trial = self.stress_trial.par_iter().zip(&self.stress_committed);
+        let bonds_and_trial = self.bonds.par_iter().zip(trial);
+        self.breaking = bonds_and_trial
+            .clone()
+            .any(|(b, (&now, _))| now >= b.strength);
+        let bonds = bonds_and_trial
             .filter(|(b, (&now, _))| now > b.strength * (1.0 + eps))
             .map(|(b, (&now, &before))| (b.strength - before) / (now - before))
             .min_by(f64::total_cmp);
@@ -754,23 +795,8 @@ impl Model for BondedParticles {
 
     fn commit_step(&mut self, state: &State) -> bool {
         let mut changed = std::mem::take(&mut self.activated);
-        for k in 0..self.bonds.len() {
-            if self.intact[k] && self.stress_trial[k] >= self.bonds[k].strength {
-                self.intact[k] = false;
-                self.bond_tangent.remove(k);
-                self.broken += 1;
-                self.broken_log.push((state.time, k as u32));
-                changed = true;
-                let b = self.bonds[k];
-                let key = (b.i.min(b.j), b.i.max(b.j));
-                if self.pair_index.insert(key) {
-                    let rest = b
-                        .length
-                        .min(self.radius[b.i as usize] + self.radius[b.j as usize]);
-                    let pair = self.candidate(state, key.0, key.1, rest, b.stiffness[0]);
-                    self.pairs.push(pair);
-                }
-            }
+        if std::mem::take(&mut self.breaking) {
+            changed |= self.break_bonds(state);
         }
         self.stress_committed.copy_from_slice(&self.stress_trial);
         if self.moved_past_skin(state) {
