@@ -1,0 +1,112 @@
+//! Criterion benchmark of paper 001's bonded beam (`fixtures/bbm`, 7,898 particles: the scene
+//! with the paper's 7,676-element count) before it cracks:
+//!
+//! - one explicit Newmark step (β = 0, adaptive, the scene's ∆t), in particle-steps/s
+//!   (criterion's "elements"), the paper's Table 1 t_b;
+//! - one implicit Newmark step (β = ¼, ∆t = 5 ms) on the kept factorisation, Table 2's t_b;
+//! - one refactorisation of the implicit step's matrix M + γ∆tC + β∆t²K (tangent, assembly
+//!   into the kept pattern, numeric Cholesky), what every step that breaks a bond or changes a
+//!   contact repeats while the beam cracks.
+//!
+//! On one thread, inside its pool as `qdem run --threads 1` runs (a parallel loop started from
+//! outside the pool waits for a worker at every call). The whole runs to the failure, with
+//! their totals, are in `docs/bbm.md`.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use qdem_core::sparse::{Assembler, FreeDofs, Scales, SparseCholesky};
+use qdem_core::{Stepper, Tangent};
+use qdem_io::build::Simulation;
+use qdem_io::runner::make_stepper;
+use qdem_io::scene::Scene;
+use std::path::Path;
+use std::time::Instant;
+
+/// A time (s) by which no bond has come near its strength (the first breaks at 0.23 s).
+const UNCRACKED: f64 = 0.15;
+
+/// Runs `work` on one thread, inside its pool.
+fn on_one_thread<T: Send>(work: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a thread pool")
+        .install(work)
+}
+
+/// The benchmark scene `beam_{kind}_n7676.toml`, built.
+fn beam(kind: &str) -> Simulation {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fixtures/bbm")
+        .join(format!("beam_{kind}_n7676.toml"));
+    Simulation::build(Scene::load(&path).expect("scene")).expect("built")
+}
+
+fn newmark_step(c: &mut Criterion) {
+    let mut group = c.benchmark_group("bonded_beam_step");
+    group.sample_size(20);
+    for kind in ["explicit", "implicit"] {
+        let mut sim = beam(kind);
+        let start = sim.state.clone();
+        group.throughput(Throughput::Elements(sim.state.len() as u64));
+        group.bench_function(BenchmarkId::new(kind, sim.state.len()), |b| {
+            b.iter_custom(|iterations| {
+                on_one_thread(|| {
+                    let mut stepper = make_stepper(&sim).expect("stepper");
+                    stepper
+                        .initialize(&mut sim.state, &mut sim.models)
+                        .expect("initialised");
+                    let begin = Instant::now();
+                    for _ in 0..iterations {
+                        // Back to the start before the ramped load brings the first crack.
+                        if sim.state.time > UNCRACKED {
+                            sim.state.copy_motion_from(&start);
+                        }
+                        stepper.step(&mut sim.state, &mut sim.models).expect("step");
+                    }
+                    begin.elapsed()
+                })
+            })
+        });
+    }
+    group.finish();
+}
+
+fn implicit_refactorisation(c: &mut Criterion) {
+    let sim = beam("implicit");
+    let dt = sim.dt;
+    let scales = Scales {
+        mass: 1.0,
+        damping: 0.5 * dt,
+        stiffness: 0.25 * dt * dt,
+    };
+    let (mass, dofs) = (
+        sim.state.node_mass(),
+        FreeDofs::new(&sim.state.node_fixity()),
+    );
+    let (mut tangent, mut assembler, mut cholesky) =
+        (Tangent::new(), Assembler::new(), SparseCholesky::new());
+    let mut group = c.benchmark_group("bonded_beam_refactorisation");
+    group.sample_size(20);
+    group.bench_function(BenchmarkId::new("implicit", sim.state.len()), |b| {
+        b.iter_custom(|iterations| {
+            on_one_thread(|| {
+                let begin = Instant::now();
+                for _ in 0..iterations {
+                    tangent.clear();
+                    for model in &sim.models {
+                        model.add_tangent(&sim.state, &mut tangent);
+                    }
+                    let matrix = assembler
+                        .assemble(&tangent, &mass, &dofs, scales)
+                        .expect("assembled");
+                    cholesky.factorize(matrix, "effective").expect("factorised");
+                }
+                begin.elapsed()
+            })
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, newmark_step, implicit_refactorisation);
+criterion_main!(benches);
