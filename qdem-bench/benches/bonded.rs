@@ -14,7 +14,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use qdem_core::sparse::{Assembler, FreeDofs, Scales, SparseCholesky};
-use qdem_core::{Stepper, Tangent};
+use qdem_core::Tangent;
 use qdem_io::build::Simulation;
 use qdem_io::runner::make_stepper;
 use qdem_io::scene::Scene;
