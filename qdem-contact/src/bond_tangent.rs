@@ -5,7 +5,8 @@
 //! change only when a bond breaks: its 21 lower-triangle stiffness and 21 damping entries
 //! then stay in place with zero values, so the pattern (and with it the symbolic analysis of
 //! the implicit solve) holds, and adding the bonds to a tangent is one copy instead of a
-//! 6×6 transformation per bond at every refactorisation.
+//! 6×6 transformation per bond at every refactorisation. The price is memory: 42 entries of
+//! 24 bytes, about 1 kB, per bond (200 MB for the 0.005 m benchmark beam's 204,714 bonds).
 
 use crate::beam_bond::{to_global_matrix, BeamBond};
 use qdem_core::sparse::Entry;

@@ -8,7 +8,7 @@
 //! - [`FreeDofs`] eliminates the constraints of Eqs. 23 and 27 (B∆u = 0, Bü = 0 with B selecting
 //!   the fixed directions): fixed DOFs are removed from the system, the others numbered
 //!   compactly in ascending order (so the lower triangle stays lower).
-//! - [`assemble`] forms s_M M + s_C C + s_K K over the free DOFs (M the lumped mass), e.g.
+//! - [`Assembler`] forms s_M M + s_C C + s_K K over the free DOFs (M the lumped mass), e.g.
 //!   M + γ∆t C + β∆t² K of Eq. 26 or K alone for a static solve.
 //! - [`SparseCholesky`] factorises such a matrix with faer's sparse LLᵀ. The symbolic analysis
 //!   (fill-reducing AMD ordering, elimination tree, supernodes) is kept and reused as long as the
@@ -339,7 +339,7 @@ impl FreeDofs {
     }
 }
 
-/// Coefficients of the combination s_M M + s_C C + s_K K that [`assemble`] forms.
+/// Coefficients of the combination s_M M + s_C C + s_K K that [`Assembler`] forms.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Scales {
     /// Factor of the lumped mass M.
