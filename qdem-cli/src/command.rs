@@ -163,7 +163,7 @@ fn no_positional(o: &Options, command: &str) -> Result<(), CliError> {
 }
 
 /// The thread pool of `--threads N` (one number for `run` and `check`; rayon's default
-/// without it). Commands run inside it ([`rayon::ThreadPool::install`]) rather than on the
+/// without it, and for `verify`). Commands run inside it ([`rayon::ThreadPool::install`]) rather than on the
 /// main thread: a parallel loop started outside the pool is handed to a worker and waited
 /// for, a sleep and a wake-up per loop, which cost an explicit bonded-beam step (ten loops
 /// of a few microseconds each) about a fifth of its time.
@@ -212,7 +212,8 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
                 ));
             }
             let out = o.out.unwrap_or_else(|| PathBuf::from("out/verify"));
-            verify::run_and_print(o.json, o.full.then_some(out.as_path()))
+            thread_pool(None)?
+                .install(|| verify::run_and_print(o.json, o.full.then_some(out.as_path())))
         }
         "bench" => {
             let o = parse(

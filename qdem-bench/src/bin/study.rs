@@ -25,7 +25,16 @@ fn main() -> ExitCode {
             .and_then(|i| args.get(i + 1))
             .cloned()
     };
-    match args.first().map(String::as_str) {
+    // Inside rayon's pool, as `qdem run` runs: a parallel loop started from the main thread
+    // waits for a worker at every call.
+    let pool = match rayon::ThreadPoolBuilder::new().build() {
+        Ok(pool) => pool,
+        Err(e) => {
+            eprintln!("error: no thread pool: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    pool.install(|| match args.first().map(String::as_str) {
         Some("speed-vs-error") => speed_vs_error(&option),
         Some("packing") => packing(&option),
         Some("dem-throughput") => dem_throughput(&option),
@@ -33,7 +42,7 @@ fn main() -> ExitCode {
             eprintln!("{USAGE}");
             ExitCode::FAILURE
         }
-    }
+    })
 }
 
 /// A required numeric option, or a message.
