@@ -447,7 +447,7 @@ impl BondedParticles {
                 _ => continue,
             };
             if alpha < 1.0 - eps {
-                earliest = Some(earliest.map_or(alpha, |e: f64| e.min(alpha)));
+                earliest = earlier(earliest, Some(alpha));
             }
         }
         earliest
@@ -499,6 +499,14 @@ impl BondedParticles {
                 }
             }
         }
+    }
+}
+
+/// The earlier of two optional event fractions α (the smaller; either if one is absent).
+fn earlier(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(std::cmp::min_by(a, b, f64::total_cmp)),
+        (a, b) => a.or(b),
     }
 }
 
@@ -774,19 +782,21 @@ impl Model for BondedParticles {
         }
         let eps = self.settings.tolerance;
         let trial = self.stress_trial.par_iter().zip(&self.stress_committed);
-        let bonds_and_trial = self.bonds.par_iter().zip(trial);
-        self.breaking = bonds_and_trial
-            .clone()
-            .any(|(b, (&now, _))| now >= b.strength);
-        let bonds = bonds_and_trial
-            .filter(|(b, (&now, _))| now > b.strength * (1.0 + eps))
-            .map(|(b, (&now, &before))| (b.strength - before) / (now - before))
-            .min_by(f64::total_cmp);
-        let contacts = self.contact_overshoot(state, forces_here);
-        match (bonds, contacts) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        }
+        // One pass: whether a bond reached its strength (it breaks on commit) and the α of
+        // the earliest that overshot it by more than ε.
+        let (breaking, bonds) = self
+            .bonds
+            .par_iter()
+            .zip(trial)
+            .with_min_len(BOND_CHUNK)
+            .map(|(b, (&now, &before))| {
+                let overshot = now > b.strength * (1.0 + eps);
+                let alpha = overshot.then(|| (b.strength - before) / (now - before));
+                (now >= b.strength, alpha)
+            })
+            .reduce(|| (false, None), |a, b| (a.0 || b.0, earlier(a.1, b.1)));
+        self.breaking = breaking;
+        earlier(bonds, self.contact_overshoot(state, forces_here))
     }
 
     fn tangent_stale(&self) -> bool {
