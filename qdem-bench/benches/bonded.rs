@@ -13,6 +13,7 @@
 //! their totals, are in `docs/bbm.md`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use qdem_bench::throughput::on_threads;
 use qdem_core::sparse::{Assembler, FreeDofs, Scales, SparseCholesky};
 use qdem_core::Tangent;
 use qdem_io::build::Simulation;
@@ -23,15 +24,6 @@ use std::time::Instant;
 
 /// A time (s) by which no bond has come near its strength (the first breaks at 0.23 s).
 const UNCRACKED: f64 = 0.15;
-
-/// Runs `work` on one thread, inside its pool.
-fn on_one_thread<T: Send>(work: impl FnOnce() -> T + Send) -> T {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("a thread pool")
-        .install(work)
-}
 
 /// The benchmark scene `beam_{kind}_n7676.toml`, built.
 fn beam(kind: &str) -> Simulation {
@@ -50,7 +42,7 @@ fn newmark_step(c: &mut Criterion) {
         group.throughput(Throughput::Elements(sim.state.len() as u64));
         group.bench_function(BenchmarkId::new(kind, sim.state.len()), |b| {
             b.iter_custom(|iterations| {
-                on_one_thread(|| {
+                on_threads(1, || {
                     let mut stepper = make_stepper(&sim).expect("stepper");
                     stepper
                         .initialize(&mut sim.state, &mut sim.models)
@@ -89,7 +81,7 @@ fn implicit_refactorisation(c: &mut Criterion) {
     group.sample_size(20);
     group.bench_function(BenchmarkId::new("implicit", sim.state.len()), |b| {
         b.iter_custom(|iterations| {
-            on_one_thread(|| {
+            on_threads(1, || {
                 let begin = Instant::now();
                 for _ in 0..iterations {
                     tangent.clear();

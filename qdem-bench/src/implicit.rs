@@ -3,7 +3,7 @@
 //! factorisation, one forward/backward solve, and one implicit Newmark step that reuses the
 //! factorisation (force evaluation + solve + update), on a structured block clamped on one face.
 
-use crate::throughput::{block_mesh, body_on, Ordering};
+use crate::throughput::{block_mesh, body_on, on_threads, Ordering};
 use qdem_core::sparse::{Assembler, FreeDofs, Scales, SparseCholesky};
 use qdem_core::{CoreError, Dofs, Model, Newmark, Stepper, Tangent};
 use std::time::Instant;
@@ -33,11 +33,7 @@ pub struct ImplicitResult {
 
 /// Measures the implicit path on a block of about `tets` tetrahedra on `threads` threads.
 pub fn measure_implicit(tets: usize, threads: usize) -> Result<ImplicitResult, CoreError> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool");
-    pool.install(|| {
+    on_threads(threads, || {
         let mesh = block_mesh(tets, Ordering::Structured);
         let clamp = mesh.group("xmin").expect("structured groups").nodes.clone();
         let (body, mut state) = body_on(mesh, false);

@@ -149,11 +149,7 @@ pub fn measure_ordered(
     threads: usize,
     steps: Option<usize>,
 ) -> BenchResult {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool");
-    pool.install(|| {
+    on_threads(threads, || {
         let (body, mut state) = body_on(block_mesh(tets, ordering), viscous);
         let tets = body.tets().len();
         let dt = 0.9 * body.stable_dt(&state).expect("a body bounds the step");
@@ -186,11 +182,7 @@ pub fn measure_ordered(
 pub fn triad_bandwidth(threads: usize) -> f64 {
     use rayon::prelude::*;
     let n = 16 << 20;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool");
-    pool.install(|| {
+    on_threads(threads, || {
         let (b, c) = (vec![1.0f64; n], vec![2.0f64; n]);
         let mut a = vec![0.0f64; n];
         let mut best = f64::INFINITY;
@@ -205,6 +197,16 @@ pub fn triad_bandwidth(threads: usize) -> f64 {
         assert!(a[n / 2] == 7.0);
         (3 * 8 * n) as f64 / best
     })
+}
+
+/// Runs `work` inside a pool of `threads` threads, 0 for rayon's default (as `qdem run` runs a
+/// scene: a parallel loop started from outside a pool waits for a worker at every call).
+pub fn on_threads<T: Send>(threads: usize, work: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool")
+        .install(work)
 }
 
 /// The CPU model from /proc/cpuinfo, or "unknown".

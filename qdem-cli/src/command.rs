@@ -163,10 +163,10 @@ fn no_positional(o: &Options, command: &str) -> Result<(), CliError> {
 }
 
 /// The thread pool of `--threads N` (one number for `run` and `check`; rayon's default
-/// without it, and for `verify`). Commands run inside it ([`rayon::ThreadPool::install`]) rather than on the
-/// main thread: a parallel loop started outside the pool is handed to a worker and waited
-/// for, a sleep and a wake-up per loop, which cost an explicit bonded-beam step (ten loops
-/// of a few microseconds each) about a fifth of its time.
+/// without it, and for `verify`). Commands run inside it ([`rayon::ThreadPool::install`])
+/// rather than on the main thread: a parallel loop started outside the pool is handed to a
+/// worker and waited for, a sleep and a wake-up per loop, which cost an explicit bonded-beam
+/// step (ten loops of a few microseconds each) about a fifth of its time.
 fn thread_pool(threads: Option<&[usize]>) -> Result<rayon::ThreadPool, CliError> {
     let count = match threads {
         Some(&[threads]) => threads,

@@ -9,7 +9,7 @@
 use qdem_bench::cantilever::fixtures_dir;
 use qdem_bench::granular::{throughput, Packing};
 use qdem_bench::speed_vs_error::{run_study, write_report};
-use qdem_bench::throughput::cpu_model;
+use qdem_bench::throughput::{cpu_model, on_threads};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -25,16 +25,8 @@ fn main() -> ExitCode {
             .and_then(|i| args.get(i + 1))
             .cloned()
     };
-    // Inside rayon's pool, as `qdem run` runs: a parallel loop started from the main thread
-    // waits for a worker at every call.
-    let pool = match rayon::ThreadPoolBuilder::new().build() {
-        Ok(pool) => pool,
-        Err(e) => {
-            eprintln!("error: no thread pool: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
-    pool.install(|| match args.first().map(String::as_str) {
+    // Inside a pool of rayon's default size, as `qdem run` runs.
+    on_threads(0, || match args.first().map(String::as_str) {
         Some("speed-vs-error") => speed_vs_error(&option),
         Some("packing") => packing(&option),
         Some("dem-throughput") => dem_throughput(&option),
