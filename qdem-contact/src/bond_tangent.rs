@@ -32,11 +32,12 @@ impl BondTangent {
             damping: Vec::with_capacity(PER_BOND * bonds.len()),
         };
         for (b, &ok) in bonds.iter().zip(intact) {
-            let dofs = pair_dofs((b.i, b.j), nodes);
             let k = to_global_matrix(&b.local_stiffness(), b.axis);
             let c = to_global_matrix(&b.local_damping(), b.axis);
-            push_lower(&mut tangent.stiffness, &dofs, &k, ok);
-            push_lower(&mut tangent.damping, &dofs, &c, ok);
+            for (list, a) in [(&mut tangent.stiffness, &k), (&mut tangent.damping, &c)] {
+                let entries = lower_entries((b.i, b.j), nodes, a);
+                list.extend(entries.map(|e| if ok { e } else { Entry::new(e.row, e.col, 0.0) }));
+            }
         }
         tangent
     }
@@ -66,28 +67,29 @@ impl BondTangent {
 /// Global DOF numbers of particle p's x, y and θ in a state of `nodes` particles (its
 /// rotation is generalised node N + p).
 #[inline]
-pub(crate) fn particle_dofs(p: u32, nodes: usize) -> [usize; 3] {
+fn particle_dofs(p: u32, nodes: usize) -> [usize; 3] {
     let p = p as usize;
     [3 * p, 3 * p + 1, 3 * (nodes + p) + 2]
 }
 
 /// Global DOF numbers of the ends of pair (i, j), x, y and θ each.
-pub(crate) fn pair_dofs((i, j): (u32, u32), nodes: usize) -> [usize; 6] {
+fn pair_dofs((i, j): (u32, u32), nodes: usize) -> [usize; 6] {
     let [a, b] = [particle_dofs(i, nodes), particle_dofs(j, nodes)];
     [a[0], a[1], a[2], b[0], b[1], b[2]]
 }
 
-/// Pushes the entries of the 6×6 block `a` at `dofs` that lie on or below the diagonal, with
-/// their values if `keep`, else zero.
-fn push_lower(list: &mut Vec<Entry>, dofs: &[usize; 6], a: &[[f64; 6]; 6], keep: bool) {
-    for (r, row) in a.iter().enumerate() {
-        for (c, &value) in row.iter().enumerate() {
-            let (dr, dc) = (dofs[r], dofs[c]);
-            if dr >= dc {
-                list.push(Entry::new(dr, dc, if keep { value } else { 0.0 }));
-            }
-        }
-    }
+/// The entries of the 6×6 block `a` of pair (i, j) that lie on or below the diagonal (global
+/// DOFs of [`pair_dofs`]), in row order: the form a tangent keeps.
+pub(crate) fn lower_entries(
+    pair: (u32, u32),
+    nodes: usize,
+    a: &[[f64; 6]; 6],
+) -> impl Iterator<Item = Entry> + '_ {
+    let dofs = pair_dofs(pair, nodes);
+    (0..6)
+        .flat_map(move |r| (0..6).map(move |c| (r, c)))
+        .filter(move |&(r, c)| dofs[r] >= dofs[c])
+        .map(move |(r, c)| Entry::new(dofs[r], dofs[c], a[r][c]))
 }
 
 #[cfg(test)]

@@ -37,7 +37,7 @@
 //! moved more than half the skin.
 
 use crate::beam_bond::{to_global_matrix, BeamBond, Dof2};
-use crate::bond_tangent::{pair_dofs, BondTangent};
+use crate::bond_tangent::{lower_entries, BondTangent};
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::error::ContactError;
 use crate::particle_packing::{lattice_section, Packing, SplitMix64};
@@ -487,16 +487,11 @@ impl BondedParticles {
         a: &[[f64; 6]; 6],
         damping: bool,
     ) {
-        let dofs = pair_dofs((i, j), n);
-        for (r, row) in a.iter().enumerate() {
-            for (c, value) in row.iter().enumerate() {
-                let (dr, dc) = (dofs[r], dofs[c]);
-                let (dr, dc) = if dr >= dc { (dr, dc) } else { continue };
-                if damping {
-                    tangent.add_damping_entry(dr, dc, *value);
-                } else {
-                    tangent.add_stiffness_entry(dr, dc, *value);
-                }
+        for e in lower_entries((i, j), n, a) {
+            if damping {
+                tangent.add_damping_entry(e.row, e.col, e.val);
+            } else {
+                tangent.add_stiffness_entry(e.row, e.col, e.val);
             }
         }
     }
