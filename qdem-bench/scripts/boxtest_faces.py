@@ -21,7 +21,8 @@ import math
 import os
 import re
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from boxtest_study import ROOT, svg_frame
+
 FREQUENCY, START = 3.0, 0.2  # the study's load: 3 Hz after the settling time (generate.py)
 BINS = 36
 SERIES = {
@@ -83,12 +84,8 @@ def svg(path, means, seeds):
               if not math.isnan(v)) * 1.1
     x = lambda k: m + (w - 2 * m) * (k + 0.5) / BINS
     y = lambda f: h - m - (h - 2 * m) * f / top
-    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">',
-           f'<rect width="{w}" height="{h}" fill="white"/>',
-           f'<line x1="{m}" y1="{h - m}" x2="{w - m}" y2="{h - m}" stroke="black"/>',
-           f'<line x1="{m}" y1="{m}" x2="{m}" y2="{h - m}" stroke="black"/>',
-           f'<text x="{w / 2}" y="{h - 20}" text-anchor="middle">phase of the middle sleeper\'s load (min, peak at 180°, min)</text>',
-           f'<text x="15" y="{h / 2}" transform="rotate(-90 15 {h / 2})" text-anchor="middle">mean contact force through the face (N)</text>']
+    out = svg_frame(w, h, m, "phase of the middle sleeper's load (min, peak at 180°, min)",
+                    "mean contact force through the face (N)")
     for deg in range(0, 361, 90):
         px = m + (w - 2 * m) * deg / 360
         out.append(f'<text x="{px}" y="{h - m + 15}" text-anchor="middle">{deg}°</text>')

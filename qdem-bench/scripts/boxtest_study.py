@@ -35,6 +35,16 @@ COLOURS = {"three_sleeper": "#000000", "single_fixed": "#1f77b4",
            "single_periodic": "#ff7f0e", "single_delayed": "#2ca02c", "single_shared": "#d62728"}
 
 
+def svg_frame(w, h, m, xlabel, ylabel):
+    """The opening lines of a w x h plot with margin m: white page, x and y axes, labels."""
+    return [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">',
+            f'<rect width="{w}" height="{h}" fill="white"/>',
+            f'<line x1="{m}" y1="{h - m}" x2="{w - m}" y2="{h - m}" stroke="black"/>',
+            f'<line x1="{m}" y1="{m}" x2="{m}" y2="{h - m}" stroke="black"/>',
+            f'<text x="{w / 2}" y="{h - 20}" text-anchor="middle">{xlabel}</text>',
+            f'<text x="15" y="{h / 2}" transform="rotate(-90 15 {h / 2})" text-anchor="middle">{ylabel}</text>']
+
+
 def scene_for(size, name, seed, out):
     """The scene text for `seed`, outputs and samples under `out` (absolute paths)."""
     with open(os.path.join(FIXTURES, f"{size}_{name}.toml")) as f:
@@ -74,12 +84,7 @@ def svg(path, series, cycles):
     top = max(max(v) for _, _, v in series) * 1.1 or 1.0
     x = lambda c: m + (w - 2 * m) * c / cycles
     y = lambda s: h - m - (h - 2 * m) * s / top
-    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">',
-           f'<rect width="{w}" height="{h}" fill="white"/>',
-           f'<line x1="{m}" y1="{h - m}" x2="{w - m}" y2="{h - m}" stroke="black"/>',
-           f'<line x1="{m}" y1="{m}" x2="{m}" y2="{h - m}" stroke="black"/>',
-           f'<text x="{w / 2}" y="{h - 20}" text-anchor="middle">load cycle</text>',
-           f'<text x="15" y="{h / 2}" transform="rotate(-90 15 {h / 2})" text-anchor="middle">middle-sleeper settlement (mm)</text>']
+    out = svg_frame(w, h, m, "load cycle", "middle-sleeper settlement (mm)")
     for c in range(cycles + 1):
         out.append(f'<text x="{x(c)}" y="{h - m + 16}" text-anchor="middle">{c}</text>')
     for k in range(5):
