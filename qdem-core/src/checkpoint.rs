@@ -157,6 +157,12 @@ impl Encoder {
     pub fn str(&mut self, s: &str) {
         self.tag(s);
     }
+
+    /// A block of bytes (another encoder's output), which a reader may take whole or skip.
+    pub fn block(&mut self, bytes: &[u8]) {
+        self.u64(bytes.len() as u64);
+        self.bytes.extend_from_slice(bytes);
+    }
 }
 
 /// Reads values back, in the order they were written.
@@ -206,6 +212,12 @@ impl<'a> Decoder<'a> {
             what,
             detail: "not UTF-8".to_string(),
         })
+    }
+
+    /// A block of bytes written by [`Encoder::block`].
+    pub fn block(&mut self, what: &'static str) -> Result<&'a [u8], CheckpointError> {
+        let n = self.len(1, what)?;
+        self.take(n, what)
     }
 
     /// An unsigned integer.

@@ -184,10 +184,43 @@ pub enum CoreError {
         /// Number of rigid bodies.
         count: usize,
     },
+    /// A step left the run in an impossible state, found by the world's failure check.
+    #[error(
+        "the run became unstable at step {step} (t = {time:.6e} s): {detail}. The step was dt \
+         = {dt:.4e} s; the stable bound at this state is {bound:.4e} s (set by {limiter}): \
+         {advice}",
+        advice = unstable_advice(*dt, *bound)
+    )]
+    Unstable {
+        /// The step that failed (1 for the first).
+        step: u64,
+        /// Simulated time after it.
+        time: f64,
+        /// What went wrong, and where (particle, body, element).
+        detail: String,
+        /// The step size.
+        dt: f64,
+        /// The stable bound at this state.
+        bound: f64,
+        /// The model that sets it.
+        limiter: String,
+    },
     /// The sparse linear algebra failed for a reason other than definiteness.
     #[error("sparse factorisation failed: {0}")]
     Sparse(String),
     /// A checkpoint that cannot be written or read for this scene.
     #[error("checkpoint: {0}")]
     Checkpoint(#[from] CheckpointError),
+}
+
+/// What to do about an instability, given the step and its bound.
+pub fn unstable_advice(dt: f64, bound: f64) -> String {
+    if dt > bound {
+        format!("the step is above the bound: use dt = \"auto\" or dt <= {bound:.4e} s")
+    } else {
+        "the step is within the bound, so the cause is physical: a load or a contact \
+         stiffness too large for the mesh there (reduce it or refine the mesh), or a contact \
+         pushing a vertex through its body (finer contact spheres)"
+            .to_string()
+    }
 }

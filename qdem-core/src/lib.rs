@@ -6,6 +6,9 @@
 //!   lumped masses and fixity, plus the rotation of rigid bodies ([`rigid_body`]).
 //! - [`Model`]: a source of forces (a [`TetBody`], [`Gravity`], a [`NodalLoad`], …) that also
 //!   states the stable time step it allows.
+//! - [`World`]: a state, its models, its stepper and its post-step hooks, stepped as named,
+//!   timed stages ([`stages`]) with the step settings resolved once ([`StepSettings`]): what
+//!   `qdem run` does, for whoever embeds the crate.
 //! - [`Stepper`]: advances the state under a list of models; [`Verlet`] is the explicit
 //!   velocity Verlet of the QDEM paper; [`Newmark`] the Newmark-β family of paper 001 §3,
 //!   explicit (β = 0) or implicit (β > 0, a sparse Cholesky solve per step, [`sparse`]);
@@ -28,14 +31,17 @@ pub mod nodal_load;
 pub mod rigid_body;
 pub mod sparse;
 pub mod stable_step;
+pub mod stages;
 pub mod state;
 pub mod static_solve;
+pub mod step_settings;
 pub mod stepper;
 pub mod tet_body;
 pub mod tet_kernel;
 pub mod tet_subdomain;
 pub mod time_function;
 pub mod verlet;
+pub mod world;
 
 /// A 3-vector of f64.
 pub type Vec3 = nalgebra::Vector3<f64>;
@@ -51,9 +57,12 @@ pub use newmark::{Newmark, StepCounts, TangentUpdate};
 pub use nodal_load::NodalLoad;
 pub use rigid_body::RigidBodies;
 pub use sparse::{FactorStats, Tangent};
+pub use stages::{Stage, StageShare, StageTimes};
 pub use state::{Dofs, ParticleSpin, State};
 pub use static_solve::{StaticSolver, StaticSteps};
+pub use step_settings::{Scheme, StepRequest, StepSettings, Stepping};
 pub use stepper::{choose_step, stable_step, Stepper};
 pub use tet_body::TetBody;
 pub use time_function::{Cyclic, TimeFunction};
 pub use verlet::Verlet;
+pub use world::{Halt, PostStep, World};

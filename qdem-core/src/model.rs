@@ -8,6 +8,7 @@
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::sparse::Tangent;
 use crate::state::State;
+use crate::step_settings::Stepping;
 use crate::Vec3;
 
 /// A source of particle forces. Models are `Any` so that the output can reach a body's
@@ -25,6 +26,14 @@ pub trait Model: std::any::Any + Send + Sync {
     /// rotational DOFs (`state.spin`), `torque` goes on with one moment per particle: entry
     /// `state.rigid.len() + i` is the moment on particle `i`.
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]);
+
+    /// Learns how the run is stepped (implicit or explicit, the step), once, when the
+    /// [`crate::World`] is made; a model whose forces depend on it (a bonded body whose
+    /// contacts push only when active in an implicit run) keeps what it needs. The default
+    /// ignores it.
+    fn prepare(&mut self, stepping: &Stepping) {
+        let _ = stepping;
+    }
 
     /// The largest step (s) explicit central-difference stepping tolerates for this model, from
     /// a rigorous bound; `None` if the model does not limit the step.

@@ -48,10 +48,11 @@ use crate::model::Model;
 use crate::sparse::{
     explain_failure, Assembler, DampingRows, FactorStats, FreeDofs, Scales, SparseCholesky, Tangent,
 };
+use crate::stages::{Stage, StageTimes};
 use crate::state::State;
 use crate::stepper::{
-    check_finite, check_masses, compute_accelerations, refuse_rigid, sum_forces, Stepper,
-    PARTICLE_CHUNK,
+    check_finite, check_masses, compute_accelerations, compute_accelerations_timed, refuse_rigid,
+    sum_forces, Stepper, PARTICLE_CHUNK,
 };
 use crate::Vec3;
 use rayon::prelude::*;
@@ -274,6 +275,7 @@ impl Newmark {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         h: f64,
+        stages: &mut StageTimes,
     ) -> Result<(), CoreError> {
         let nominal = h == self.dt;
         if self.system.factors.get(nominal).step != Some(h)
@@ -281,13 +283,15 @@ impl Newmark {
         {
             self.refactor(state, models, h)?;
         }
+        stages.mark(Stage::Solve);
         let (beta, gamma) = (self.beta, self.gamma);
         let system = &mut self.system;
         let change = &mut system.velocity_change;
         change.0.resize(state.len(), Vec3::zeros());
         change.1.resize(state.spin.len(), Vec3::zeros());
         hold(state, h, beta, gamma, (&mut change.0, &mut change.1));
-        sum_forces(state, models, &mut self.force, &mut self.torque);
+        stages.mark(Stage::Predict);
+        sum_forces(state, models, &mut self.force, &mut self.torque, stages);
         let moments = &mut self.torque[state.rigid.len()..];
         subtract_inertia(state, &mut self.force, moments);
         let change = (&change.0[..], &change.1[..]);
@@ -303,8 +307,11 @@ impl Newmark {
             .cholesky
             .solve_in_place(&mut system.rhs);
         dofs.scatter_nodes(&system.rhs, (&mut self.force, moments));
+        stages.mark(Stage::Solve);
         apply_increment(state, (&self.force, moments), change, h, beta, gamma);
-        check_finite(state)
+        let finite = check_finite(state);
+        stages.mark(Stage::Integrate);
+        finite
     }
 
     /// One Newmark step of length `h` from the current state, without events.
@@ -313,14 +320,18 @@ impl Newmark {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         h: f64,
+        stages: &mut StageTimes,
     ) -> Result<(), CoreError> {
         if self.is_implicit() {
-            return self.implicit_step(state, models, h);
+            return self.implicit_step(state, models, h, stages);
         }
         let (beta, gamma) = (self.beta, self.gamma);
         predict(state, h, beta, gamma);
-        compute_accelerations(state, models, &mut self.force, &mut self.torque)?;
+        stages.mark(Stage::Predict);
+        let (force, torque) = (&mut self.force, &mut self.torque);
+        compute_accelerations_timed(state, models, force, torque, stages)?;
         correct(state, h, beta, gamma);
+        stages.mark(Stage::Integrate);
         Ok(())
     }
 
@@ -331,6 +342,7 @@ impl Newmark {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         span: f64,
+        stages: &mut StageTimes,
     ) -> Result<f64, CoreError> {
         let mut h = span;
         if self.adaptive || self.is_implicit() {
@@ -341,8 +353,9 @@ impl Newmark {
         }
         let forces_here = !self.is_implicit();
         let (mut retakes, mut redos) = (0, 0);
+        stages.mark(Stage::Events);
         loop {
-            self.advance(state, models, h)?;
+            self.advance(state, models, h, stages)?;
             let alpha = models
                 .iter_mut()
                 .filter_map(|m| m.check_step(state, forces_here))
@@ -376,6 +389,7 @@ impl Newmark {
             self.counts.event_steps += 1;
             self.system.invalidate();
         }
+        stages.mark(Stage::Events);
         Ok(h)
     }
 }
@@ -609,11 +623,16 @@ impl Stepper for Newmark {
 
     /// Advances by ∆t; with adaptive control possibly in several sub-steps, the last ending
     /// exactly at t + ∆t.
-    fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {
+    fn step_timed(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        stages: &mut StageTimes,
+    ) -> Result<(), CoreError> {
         let end = state.time + self.dt;
         let mut remaining = self.dt;
         while remaining > 1e-9 * self.dt {
-            remaining -= self.advance_adaptively(state, models, remaining)?;
+            remaining -= self.advance_adaptively(state, models, remaining, stages)?;
         }
         state.time = end;
         Ok(())

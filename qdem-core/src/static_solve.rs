@@ -22,6 +22,7 @@ use crate::sparse::{
     explain_failure, unconstrained_bodies, Assembler, FactorStats, FreeDofs, Scales,
     SparseCholesky, Tangent, FIX_HINT,
 };
+use crate::stages::{Stage, StageTimes};
 use crate::state::State;
 use crate::stepper::{refuse_rigid, sum_forces, Stepper};
 use crate::Vec3;
@@ -67,7 +68,13 @@ impl StaticSolver {
         if !self.cholesky.is_factored() {
             self.factorize(state, models)?;
         }
-        sum_forces(state, models, &mut self.force, &mut self.torque);
+        sum_forces(
+            state,
+            models,
+            &mut self.force,
+            &mut self.torque,
+            &mut StageTimes::off(),
+        );
         let dofs = self.dofs.as_ref().expect("factorised above");
         self.rhs.resize(dofs.len(), 0.0);
         let moments = &self.torque[state.rigid.len()..];
@@ -153,9 +160,17 @@ impl Stepper for StaticSteps {
         self.solver.solve(state, models, time)
     }
 
-    fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {
+    /// The whole solve is one stage, [`Stage::Solve`].
+    fn step_timed(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        stages: &mut StageTimes,
+    ) -> Result<(), CoreError> {
         let time = state.time + self.dt;
-        self.solver.solve(state, models, time)
+        let solved = self.solver.solve(state, models, time);
+        stages.mark(Stage::Solve);
+        solved
     }
 
     fn factor_stats(&self) -> Option<&FactorStats> {

@@ -7,6 +7,7 @@ use crate::model::Model;
 use crate::newmark::StepCounts;
 use crate::rigid_body::reduce_member_forces;
 use crate::sparse::FactorStats;
+use crate::stages::{Stage, StageTimes};
 use crate::state::{Dofs, State};
 use crate::Vec3;
 use rayon::prelude::*;
@@ -15,7 +16,7 @@ use rayon::prelude::*;
 pub(crate) const PARTICLE_CHUNK: usize = 4096;
 
 /// Advances a [`State`] by one step under a list of models, without knowing their physics.
-pub trait Stepper {
+pub trait Stepper: Send {
     /// A short name for messages and summaries.
     fn name(&self) -> &str;
 
@@ -31,7 +32,18 @@ pub trait Stepper {
     ) -> Result<(), CoreError>;
 
     /// Advances `state` by one step.
-    fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError>;
+    fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {
+        self.step_timed(state, models, &mut StageTimes::off())
+    }
+
+    /// [`Stepper::step`], marking the end of each of its stages on `stages` (predict, each
+    /// model's forces, integrate, solve, events: [`crate::stages`]).
+    fn step_timed(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        stages: &mut StageTimes,
+    ) -> Result<(), CoreError>;
 
     /// Size and cost of the sparse factorisation, for steppers that solve a linear system;
     /// `None` for explicit steppers and before the first factorisation.
@@ -84,18 +96,22 @@ pub(crate) fn refuse_rigid(state: &State, stepper: &str) -> Result<(), CoreError
 
 /// Sums the forces and torques of all models at `state` into `force` and `torque` (resized and
 /// zeroed here; rigid bodies' torques, then particles' moments), then moves the forces on members of rigid bodies onto their bodies.
+/// Each model's force evaluation is marked as its own stage on `stages` (the caller marks
+/// the stage before).
 pub(crate) fn sum_forces(
     state: &State,
     models: &mut [Box<dyn Model>],
     force: &mut Vec<Vec3>,
     torque: &mut Vec<Vec3>,
+    stages: &mut StageTimes,
 ) {
     force.clear();
     force.resize(state.len(), Vec3::zeros());
     torque.clear();
     torque.resize(state.rigid.len() + state.spin.len(), Vec3::zeros());
-    for model in models.iter_mut() {
+    for (i, model) in models.iter_mut().enumerate() {
         model.add_forces(state, force, torque);
+        stages.mark(Stage::Forces(i));
     }
     if !state.rigid.is_empty() {
         reduce_member_forces(state, force, torque);
@@ -137,9 +153,22 @@ pub fn compute_accelerations(
     force: &mut Vec<Vec3>,
     torque: &mut Vec<Vec3>,
 ) -> Result<(), CoreError> {
-    sum_forces(state, models, force, torque);
+    compute_accelerations_timed(state, models, force, torque, &mut StageTimes::off())
+}
+
+/// [`compute_accelerations`], marking each model's forces and then the integrate stage.
+pub(crate) fn compute_accelerations_timed(
+    state: &mut State,
+    models: &mut [Box<dyn Model>],
+    force: &mut Vec<Vec3>,
+    torque: &mut Vec<Vec3>,
+    stages: &mut StageTimes,
+) -> Result<(), CoreError> {
+    sum_forces(state, models, force, torque, stages);
     set_accelerations(state, force)?;
-    set_spin_accelerations(state, &torque[state.rigid.len()..])
+    let spun = set_spin_accelerations(state, &torque[state.rigid.len()..]);
+    stages.mark(Stage::Integrate);
+    spun
 }
 
 /// Sets θ̈ = M/J for the particles' rotations (`moment`: one per particle), zero about fixed

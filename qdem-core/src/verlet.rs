@@ -16,6 +16,7 @@ use crate::local_damping;
 use crate::model::Model;
 use crate::newmark::predict;
 use crate::rigid_body::place_members;
+use crate::stages::{Stage, StageTimes};
 use crate::state::State;
 use crate::stepper::{
     check_finite_torque, check_masses, refuse_spin, set_accelerations, sum_forces, Stepper,
@@ -56,8 +57,9 @@ impl Verlet {
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
+        stages: &mut StageTimes,
     ) -> Result<(), CoreError> {
-        sum_forces(state, models, &mut self.force, &mut self.torque);
+        sum_forces(state, models, &mut self.force, &mut self.torque, stages);
         if self.local_damping > 0.0 {
             local_damping::apply(state, &mut self.force, &mut self.torque, self.local_damping);
         }
@@ -109,7 +111,7 @@ impl Stepper for Verlet {
         if !state.rigid.is_empty() {
             place_members(state);
         }
-        self.evaluate(state, models)
+        self.evaluate(state, models, &mut StageTimes::off())
     }
 
     /// The rigid bodies' torques of the last evaluation, which the next step's first half
@@ -135,7 +137,12 @@ impl Stepper for Verlet {
         Ok(())
     }
 
-    fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {
+    fn step_timed(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        stages: &mut StageTimes,
+    ) -> Result<(), CoreError> {
         let dt = self.dt;
         // The kick and the drift in one pass: Newmark's predictor with β = 0, γ = ½ is
         // x += ∆t (v + ½∆t a), v += ½∆t a, bit for bit.
@@ -144,9 +151,11 @@ impl Stepper for Verlet {
             state.rigid.kick_and_rotate(&self.torque, dt);
             place_members(state);
         }
-        self.evaluate(state, models)?;
+        stages.mark(Stage::Predict);
+        self.evaluate(state, models, stages)?;
         half_kick(state, dt);
         self.kick_rigid(state);
+        stages.mark(Stage::Integrate);
         Ok(())
     }
 }

@@ -1,0 +1,292 @@
+//! [`World`]: a [`State`], its models, its stepper and its post-step hooks, stepped as named,
+//! timed stages — exactly what `qdem run` does, for whoever embeds the crates.
+//!
+//! One [`World::step`] runs, in this order:
+//! 1. **predict**, **forces** of each model, **integrate** (and **solve**, **events** for
+//!    Newmark-β): the stepper ([`crate::Verlet`], [`crate::Newmark`],
+//!    [`crate::StaticSteps`]) marks each stage as it goes;
+//! 2. the **failure check**: a non-finite acceleration, a model's
+//!    [`Model::failure`] (an inverted tetrahedron) or a kinetic energy growing like an
+//!    unstable step's ([`crate::instability::EnergyGrowth`]) stops the run with
+//!    [`CoreError::Unstable`], which names the stable bound at that state;
+//! 3. the **post-step hooks** ([`PostStep`]) in the order they were added: periodic wrapping
+//!    of bodies, a bonded body's collapse watch; a hook may [`Halt`] the run.
+//!
+//! Every stage's wall time accumulates in the world's [`StageTimes`], which `qdem check` and
+//! `summary.json` report. The step itself is chosen once, by [`StepSettings::resolve`], and
+//! the models learn how they are stepped from [`Model::prepare`].
+
+use crate::checkpoint::{CheckpointError, Decoder, Encoder};
+use crate::error::CoreError;
+use crate::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
+use crate::model::Model;
+use crate::stages::{Stage, StageShare, StageTimes};
+use crate::state::State;
+use crate::step_settings::StepSettings;
+use crate::stepper::{stable_step, Stepper};
+
+/// Something a world does after every step, once the step has passed the failure check:
+/// periodic wrapping of bodies, a watch that ends the run when a body has failed.
+pub trait PostStep: std::any::Any + Send + Sync {
+    /// A short name for the stage counters.
+    fn name(&self) -> &str;
+
+    /// Acts on the state after a step; returns a [`Halt`] to end the run after this step.
+    fn after_step(&mut self, state: &mut State, models: &[Box<dyn Model>]) -> Option<Halt>;
+}
+
+/// Why a post-step hook ended a run early (not a failure: the outputs are complete).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Halt {
+    /// The hook's name.
+    pub hook: String,
+    /// Simulated time (s).
+    pub time: f64,
+    /// The particle that triggered it.
+    pub particle: usize,
+    /// The quantity that passed its limit (a displacement in m for the collapse watch).
+    pub value: f64,
+}
+
+/// A simulation that steps itself: state, models, stepper, hooks and stage counters.
+///
+/// ```
+/// use qdem_core::{Material, Model, NodalLoad, Scheme, State, StepRequest, StepSettings,
+///     TetBody, TimeFunction, Vec3, World};
+///
+/// // One tetrahedron with three corners held, pulled at the fourth.
+/// let nodes = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];
+/// let mut state = State::at_rest(nodes);
+/// let material = Material { density: 1000.0, young: 1e6, poisson: 0.3,
+///     shear_viscosity: 0.0, bulk_viscosity: 0.0 };
+/// let body = TetBody::new("cube corner", &state.reference, vec![[0, 1, 2, 3]], material)
+///     .unwrap();
+/// body.lump_mass(&mut state.mass);
+/// for p in 0..3 {
+///     state.fix(p, qdem_core::Dofs::ALL);
+/// }
+/// let pull = NodalLoad::new("pull", vec![3], Vec3::new(0.0, 0.0, 10.0),
+///     TimeFunction::constant(1.0));
+/// let models: Vec<Box<dyn Model>> = vec![Box::new(body), Box::new(pull)];
+/// let request = StepRequest { scheme: Scheme::Verlet, dt: None, safety: 0.5,
+///     local_damping: 0.0, adaptive: false, implicit_default: None, fit_to: None };
+/// let settings = StepSettings::resolve(&request, &state, &models).unwrap();
+/// let mut world = World::new(state, models, settings).unwrap();
+/// world.initialize().unwrap();
+/// for _ in 0..100 {
+///     world.step().unwrap();
+/// }
+/// assert!(world.state.displacement(3).z > 0.0);
+/// assert_eq!(world.stages().steps(), 100);
+/// ```
+pub struct World {
+    /// The degrees of freedom of every particle and rigid body.
+    pub state: State,
+    /// The force models, in the order their forces are summed.
+    pub models: Vec<Box<dyn Model>>,
+    stepper: Box<dyn Stepper>,
+    hooks: Vec<Box<dyn PostStep>>,
+    settings: StepSettings,
+    stages: StageTimes,
+    energy: EnergyGrowth,
+    steps_done: u64,
+}
+
+impl World {
+    /// A world stepping `state` under `models` as `settings` say; tells every model how it is
+    /// stepped ([`Model::prepare`]). Call [`World::initialize`] (or [`World::restore`])
+    /// before the first step.
+    pub fn new(
+        state: State,
+        mut models: Vec<Box<dyn Model>>,
+        settings: StepSettings,
+    ) -> Result<World, CoreError> {
+        let stepper = settings.stepper()?;
+        prepare(&mut models, &settings);
+        let stages = StageTimes::new(models.len(), 0);
+        Ok(World {
+            state,
+            models,
+            stepper,
+            hooks: Vec::new(),
+            settings,
+            stages,
+            energy: EnergyGrowth::new(),
+            steps_done: 0,
+        })
+    }
+
+    /// Steps with `settings` from now on: a new stepper (call [`World::initialize`] before
+    /// the next step), the models told again. No bound is checked: a step chosen here is the
+    /// caller's responsibility (the failure check still catches an unstable one).
+    pub fn set_settings(&mut self, settings: StepSettings) -> Result<(), CoreError> {
+        self.stepper = settings.stepper()?;
+        prepare(&mut self.models, &settings);
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// Adds a post-step hook, run after the hooks added before it.
+    pub fn add_hook(&mut self, hook: Box<dyn PostStep>) {
+        self.hooks.push(hook);
+        self.stages = StageTimes::new(self.models.len(), self.hooks.len());
+    }
+
+    /// The stepping the world was built with.
+    pub fn settings(&self) -> &StepSettings {
+        &self.settings
+    }
+
+    /// The step (s).
+    pub fn dt(&self) -> f64 {
+        self.settings.dt
+    }
+
+    /// The stepper, for its name, counts and factorisation statistics.
+    pub fn stepper(&self) -> &dyn Stepper {
+        self.stepper.as_ref()
+    }
+
+    /// The stage counters of the steps taken since the world was made.
+    pub fn stages(&self) -> &StageTimes {
+        &self.stages
+    }
+
+    /// The stage counters as named shares of the step.
+    pub fn stage_report(&self) -> Vec<StageShare> {
+        let models: Vec<&str> = self.models.iter().map(|m| m.name()).collect();
+        let hooks: Vec<&str> = self.hooks.iter().map(|h| h.name()).collect();
+        self.stages.report(&models, &hooks)
+    }
+
+    /// Steps taken (counting those before a checkpoint the world was restored from).
+    pub fn steps_done(&self) -> u64 {
+        self.steps_done
+    }
+
+    /// The first model of type `M`, if any.
+    pub fn model<M: Model>(&self) -> Option<&M> {
+        self.models.iter().find_map(|m| {
+            let m: &dyn std::any::Any = m.as_ref();
+            m.downcast_ref::<M>()
+        })
+    }
+
+    /// The first post-step hook of type `H`, if any.
+    pub fn hook<H: PostStep>(&self) -> Option<&H> {
+        self.hooks.iter().find_map(|h| {
+            let h: &dyn std::any::Any = h.as_ref();
+            h.downcast_ref::<H>()
+        })
+    }
+
+    /// Makes the accelerations consistent with the forces at the start (and factorises, for
+    /// an implicit scheme).
+    pub fn initialize(&mut self) -> Result<(), CoreError> {
+        self.stepper.initialize(&mut self.state, &mut self.models)
+    }
+
+    /// Advances one step through every stage; `Ok(Some(halt))` when a hook ends the run.
+    pub fn step(&mut self) -> Result<Option<Halt>, CoreError> {
+        self.stages.begin_step();
+        let stepped = self
+            .stepper
+            .step_timed(&mut self.state, &mut self.models, &mut self.stages);
+        self.steps_done += 1;
+        let checked = self.check(stepped);
+        self.stages.mark(Stage::Check);
+        checked?;
+        let mut halt = None;
+        for (i, hook) in self.hooks.iter_mut().enumerate() {
+            if let Some(h) = hook.after_step(&mut self.state, &self.models) {
+                halt.get_or_insert(h);
+            }
+            self.stages.mark(Stage::Hook(i));
+        }
+        Ok(halt)
+    }
+
+    /// The failure check after a step: a non-finite acceleration, a model's failure or
+    /// runaway kinetic energy becomes [`CoreError::Unstable`]; other stepper errors pass.
+    fn check(&mut self, stepped: Result<(), CoreError>) -> Result<(), CoreError> {
+        let failure = match stepped {
+            Err(CoreError::NonFinite { particle, .. }) => {
+                Some(format!("particle {particle} has a non-finite acceleration"))
+            }
+            Err(source) => return Err(source),
+            Ok(()) => self
+                .models
+                .iter()
+                .find_map(|m| m.failure(&self.state))
+                .map(|e| e.to_string()),
+        };
+        let failure = failure.or_else(|| {
+            self.energy
+                .observe(self.state.kinetic_energy())
+                .map(|growth| {
+                    format!(
+                        "the kinetic energy grew by more than {:.0}% at each of the last \
+                         {GROWTH_STEPS} steps (x{growth:.2e} in all), the signature of an \
+                         unstable step",
+                        100.0 * (GROWTH_PER_STEP - 1.0)
+                    )
+                })
+        });
+        let Some(detail) = failure else {
+            return Ok(());
+        };
+        let (bound, limiter) = stable_step(&self.state, &self.models)
+            .unwrap_or((f64::INFINITY, "nothing".to_string()));
+        Err(CoreError::Unstable {
+            step: self.steps_done,
+            time: self.state.time,
+            detail,
+            dt: self.settings.dt,
+            bound,
+            limiter,
+        })
+    }
+
+    /// Whether the world can be checkpointed, or the first model or the stepper that cannot.
+    pub fn checkpointable(&self) -> Result<(), CheckpointError> {
+        if let Some(m) = self.models.iter().find(|m| !m.checkpointable()) {
+            return Err(CheckpointError::Unsupported {
+                what: format!("model `{}`", m.name()),
+            });
+        }
+        self.stepper.save(&mut Encoder::new())
+    }
+
+    /// Writes the state, every model's history and the stepper's into a checkpoint.
+    pub fn save(&self, out: &mut Encoder) -> Result<(), CheckpointError> {
+        self.state.save(out);
+        for m in &self.models {
+            out.tag(&format!("model {}", m.name()));
+            m.save(out);
+        }
+        self.stepper.save(out)
+    }
+
+    /// Instead of [`World::initialize`]: reads back what [`World::save`] wrote, into a world
+    /// built from the same scene, `steps_done` steps into the run; the stepper resumes after
+    /// the models (it may refactorise with their restored tangents).
+    pub fn restore(&mut self, input: &mut Decoder<'_>, steps_done: u64) -> Result<(), CoreError> {
+        self.state.restore(input)?;
+        for m in self.models.iter_mut() {
+            input.tag(&format!("model {}", m.name()))?;
+            m.restore(input)?;
+        }
+        self.stepper
+            .resume(&mut self.state, &mut self.models, input)?;
+        self.steps_done = steps_done;
+        Ok(())
+    }
+}
+
+/// Tells every model how it is stepped.
+fn prepare(models: &mut [Box<dyn Model>], settings: &StepSettings) {
+    let stepping = settings.stepping();
+    for model in models.iter_mut() {
+        model.prepare(&stepping);
+    }
+}
