@@ -17,7 +17,6 @@ use qdem_bench::throughput::on_threads;
 use qdem_core::sparse::{Assembler, FreeDofs, Scales, SparseCholesky};
 use qdem_core::Tangent;
 use qdem_io::build::Simulation;
-use qdem_io::runner::make_stepper;
 use qdem_io::scene::Scene;
 use std::path::Path;
 use std::time::Instant;
@@ -38,22 +37,20 @@ fn newmark_step(c: &mut Criterion) {
     group.sample_size(20);
     for kind in ["explicit", "implicit"] {
         let mut sim = beam(kind);
-        let start = sim.state.clone();
-        group.throughput(Throughput::Elements(sim.state.len() as u64));
-        group.bench_function(BenchmarkId::new(kind, sim.state.len()), |b| {
+        let start = sim.world.state.clone();
+        group.throughput(Throughput::Elements(sim.world.state.len() as u64));
+        group.bench_function(BenchmarkId::new(kind, sim.world.state.len()), |b| {
             b.iter_custom(|iterations| {
                 on_threads(1, || {
-                    let mut stepper = make_stepper(&sim).expect("stepper");
-                    stepper
-                        .initialize(&mut sim.state, &mut sim.models)
-                        .expect("initialised");
+                    let world = &mut sim.world;
+                    world.initialize().expect("initialised");
                     let begin = Instant::now();
                     for _ in 0..iterations {
                         // Back to the start before the ramped load brings the first crack.
-                        if sim.state.time > UNCRACKED {
-                            sim.state.copy_motion_from(&start);
+                        if world.state.time > UNCRACKED {
+                            world.state.copy_motion_from(&start);
                         }
-                        stepper.step(&mut sim.state, &mut sim.models).expect("step");
+                        world.step().expect("step");
                     }
                     begin.elapsed()
                 })
@@ -65,28 +62,28 @@ fn newmark_step(c: &mut Criterion) {
 
 fn implicit_refactorisation(c: &mut Criterion) {
     let sim = beam("implicit");
-    let dt = sim.dt;
+    let dt = sim.world.dt();
     let scales = Scales {
         mass: 1.0,
         damping: 0.5 * dt,
         stiffness: 0.25 * dt * dt,
     };
     let (mass, dofs) = (
-        sim.state.node_mass(),
-        FreeDofs::new(&sim.state.node_fixity()),
+        sim.world.state.node_mass(),
+        FreeDofs::new(&sim.world.state.node_fixity()),
     );
     let (mut tangent, mut assembler, mut cholesky) =
         (Tangent::new(), Assembler::new(), SparseCholesky::new());
     let mut group = c.benchmark_group("bonded_beam_refactorisation");
     group.sample_size(20);
-    group.bench_function(BenchmarkId::new("implicit", sim.state.len()), |b| {
+    group.bench_function(BenchmarkId::new("implicit", sim.world.state.len()), |b| {
         b.iter_custom(|iterations| {
             on_threads(1, || {
                 let begin = Instant::now();
                 for _ in 0..iterations {
                     tangent.clear();
-                    for model in &sim.models {
-                        model.add_tangent(&sim.state, &mut tangent);
+                    for model in &sim.world.models {
+                        model.add_tangent(&sim.world.state, &mut tangent);
                     }
                     let matrix = assembler
                         .assemble(&tangent, &mass, &dofs, scales)

@@ -3,9 +3,9 @@
 
 use crate::{bench, progress, verify};
 use qdem_bench::throughput::BenchPlan;
-use qdem_core::Model as _;
+use qdem_core::{Halt, Model as _};
 use qdem_io::build::{BodyKind, BuildError, Simulation};
-use qdem_io::runner::{checkpoint_support, make_stepper, run_with, RunError, RunOptions};
+use qdem_io::runner::{run_with, RunError, RunOptions};
 use qdem_io::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -291,11 +291,11 @@ fn run_scene(path: &Path, out: Option<&Path>, resume: Option<&Path>) -> Result<(
     eprintln!(
         "qdem run {}: {} particles, {} tets, {} with dt = {:.4e} s ({:.3}x the explicit stable bound), {} steps, {} threads",
         path.display(),
-        sim.state.len(),
+        sim.world.state.len(),
         sim.tets(),
         sim.scene.run.integrator.name(),
-        sim.dt,
-        sim.dt / sim.stable_dt.0,
+        sim.world.dt(),
+        sim.world.dt() / sim.world.settings().stable_dt.0,
         sim.steps(),
         rayon::current_num_threads()
     );
@@ -322,7 +322,13 @@ fn run_scene(path: &Path, out: Option<&Path>, resume: Option<&Path>) -> Result<(
         progress::finish();
     }
     let report = report?;
-    if let Some((time, particle, u)) = report.crack_timing.collapse {
+    if let Some(Halt {
+        time,
+        particle,
+        value: u,
+        ..
+    }) = report.halt
+    {
         eprintln!(
             "stopped at t = {time:.5} s: particle {particle} of the bonded body moved {u:.3e} m, \
              beyond the small-displacement range of its bonds (the body failed); \
@@ -374,12 +380,12 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
         );
     }
     if let Some(b) = sim.bonded() {
-        let mass: f64 = sim.state.mass.iter().sum();
+        let mass: f64 = sim.world.state.mass.iter().sum();
         println!(
             "bonded body `{}`: {} particles (radius {:.4e} m), {} beam bonds, mass {:.6e} kg; \
              paper 001 Eq. 28 dt_crit {:.4e} s",
             b.name(),
-            sim.state.len(),
+            sim.world.state.len(),
             b.radii()[0],
             b.bonds().len(),
             mass,
@@ -400,68 +406,53 @@ fn check_scene(path: &Path) -> Result<(), CliError> {
             p.name, p.particle, p.distance
         );
     }
-    let (bound, limiter) = &sim.stable_dt;
+    let (bound, limiter) = &sim.world.settings().stable_dt;
     println!(
         "integrator {}: dt {:.6e} s ({:.3}x the explicit stable bound {bound:.6e} s set by `{limiter}`); {} steps to t_end = {} s",
         sim.scene.run.integrator.name(),
-        sim.dt,
-        sim.dt / bound,
+        sim.world.dt(),
+        sim.world.dt() / bound,
         sim.steps(),
         sim.scene.run.t_end
     );
-    match checkpoint_support(&sim) {
+    match sim.world.checkpointable() {
         Ok(()) => println!("checkpoints: supported (`checkpoint_every`, Ctrl-C, --resume)"),
         Err(why) => println!("checkpoints: not supported: {why}"),
     }
-    let (per_step, stepped) = measure_step_cost(&mut sim, 20)?;
+    let per_step = measure_step_cost(&mut sim, 20)?;
     let total = per_step * sim.steps() as f64;
+    // A scene without tetrahedra (spheres, a bonded body) steps particles.
+    let rate = match sim.tets() {
+        0 => format!(
+            "{:.3e} particle-steps/s",
+            sim.world.state.len() as f64 / per_step
+        ),
+        tets => format!("{:.3e} tet-steps/s", tets as f64 / per_step),
+    };
     println!(
-        "measured {:.3e} s/step on {} threads ({:.3e} tet-steps/s): estimated run time {} (outputs not counted)",
+        "measured {:.3e} s/step on {} threads ({rate}): estimated run time {} (outputs not counted)",
         per_step,
         rayon::current_num_threads(),
-        sim.tets() as f64 / per_step,
         progress::clock(total)
     );
-    print_force_split(&mut sim, &stepped, per_step, 10);
+    print_stages(&sim);
     Ok(())
 }
 
-/// Where a step's time goes: each model's force evaluation timed over `n` calls on the state
-/// the cost measurement left, as a share of the measured step; models under 1% are summed.
-fn print_force_split(sim: &mut Simulation, state: &qdem_core::State, per_step: f64, n: usize) {
-    let mut force = vec![qdem_core::Vec3::zeros(); state.len()];
-    let mut torque = vec![qdem_core::Vec3::zeros(); state.rigid.len() + state.spin.len()];
-    let mut rest = 0.0;
-    let mut forces = 0.0;
-    println!("time per step by model (force evaluation, {n} calls each):");
-    for model in sim.models.iter_mut() {
-        let start = Instant::now();
-        for _ in 0..n {
-            model.add_forces(state, &mut force, &mut torque);
-        }
-        let seconds = start.elapsed().as_secs_f64() / n as f64;
-        forces += seconds;
-        if seconds < 0.01 * per_step {
-            rest += seconds;
-            continue;
-        }
+/// Where the measured steps' time went, stage by stage ([`qdem_core::stages`]).
+fn print_stages(sim: &Simulation) {
+    println!(
+        "time per step by stage ({} steps):",
+        sim.world.stages().steps()
+    );
+    for stage in sim.world.stage_report() {
         println!(
-            "  {:<24} {seconds:.3e} s ({:.1}%)",
-            model.name(),
-            100.0 * seconds / per_step
+            "  {:<32} {:.3e} s ({:.1}%)",
+            stage.name,
+            stage.seconds_per_step,
+            100.0 * stage.share
         );
     }
-    println!(
-        "  {:<24} {rest:.3e} s ({:.1}%)",
-        "other models",
-        100.0 * rest / per_step
-    );
-    let integrate = (per_step - forces).max(0.0);
-    println!(
-        "  {:<24} {integrate:.3e} s ({:.1}%)",
-        "integration and checks",
-        100.0 * integrate / per_step
-    );
     if let Some(c) = sim.contacts() {
         println!(
             "  contacts after the measured steps: {} candidate pairs and wall candidates, {} touching",
@@ -471,21 +462,19 @@ fn print_force_split(sim: &mut Simulation, state: &qdem_core::State, per_step: f
     }
 }
 
-/// Wall seconds per step of the scene's own stepper, measured over `n` steps on a copy of the
-/// state; for implicit and static scenes also prints the sparse system's size, non-zeros,
-/// Cholesky fill and factorisation time from the stepper's one factorisation (in
-/// `initialize`, which is not timed).
-fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<(f64, qdem_core::State), CliError> {
+/// Wall seconds per step of the scene's world, measured over `n` steps from its start; for
+/// implicit and static scenes also prints the sparse system's size, non-zeros, Cholesky fill
+/// and factorisation time from the stepper's one factorisation (in `initialize`, which is not
+/// timed).
+fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<f64, CliError> {
+    let scene = sim.scene.path.clone();
     let run_error = |source| RunError::Core {
-        scene: sim.scene.path.clone(),
+        scene: scene.clone(),
         source,
     };
-    let mut state = sim.state.clone();
-    let mut stepper = make_stepper(sim).map_err(run_error)?;
-    stepper
-        .initialize(&mut state, &mut sim.models)
-        .map_err(run_error)?;
-    if let Some(s) = stepper.factor_stats() {
+    let world = &mut sim.world;
+    world.initialize().map_err(run_error)?;
+    if let Some(s) = world.stepper().factor_stats() {
         println!(
             "implicit system: {} unknowns, {} non-zeros (lower triangle), factor {} non-zeros (fill {:.1}x); symbolic {:.3e} s, numeric {:.3e} s",
             s.dofs,
@@ -498,9 +487,9 @@ fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<(f64, qdem_core::
     }
     let start = Instant::now();
     for _ in 0..n {
-        stepper
-            .step(&mut state, &mut sim.models)
-            .map_err(run_error)?;
+        if world.step().map_err(run_error)?.is_some() {
+            break;
+        }
     }
-    Ok((start.elapsed().as_secs_f64() / n as f64, state))
+    Ok(start.elapsed().as_secs_f64() / world.stages().steps().max(1) as f64)
 }

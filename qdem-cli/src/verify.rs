@@ -275,10 +275,10 @@ pub fn p_wave_speed() -> Row {
 /// independent small-strain linear-tet static solve of [`qdem_core::linear_tet`].
 pub fn cantilever_static(scene: &Path) -> Result<f64, CliError> {
     let mut sim = Simulation::build(Scene::load(scene)?)?;
-    sim.state.time = 1.5;
-    let mut load = vec![Vec3::zeros(); sim.state.len()];
-    for model in sim.models.iter_mut() {
-        model.add_forces(&sim.state, &mut load, &mut []);
+    sim.world.state.time = 1.5;
+    let mut load = vec![Vec3::zeros(); sim.world.state.len()];
+    for model in sim.world.models.iter_mut() {
+        model.add_forces(&sim.world.state, &mut load, &mut []);
     }
     let body = &sim.bodies[0];
     let tet_body = sim
@@ -286,8 +286,8 @@ pub fn cantilever_static(scene: &Path) -> Result<f64, CliError> {
         .ok_or_else(|| CliError::Verify("the cantilever must be deformable".into()))?;
     let lame = sim.scene.materials[0].clone();
     let lame = qdem_core::Material::elastic(lame.density, lame.young, lame.poisson).elastic_lame();
-    let oracle = LinearTets::new(&sim.state.reference, tet_body.tets(), lame);
-    let solution = oracle.solve(&load, &sim.state.fixed, 1e-13);
+    let oracle = LinearTets::new(&sim.world.state.reference, tet_body.tets(), lame);
+    let solution = oracle.solve(&load, &sim.world.state.fixed, 1e-13);
     let tip = sim
         .probes
         .first()
@@ -300,7 +300,7 @@ fn static_solve_tip(scene: &Path) -> Result<f64, CliError> {
     let mut sim = Simulation::build(Scene::load(scene)?)?;
     let mut solver = StaticSolver::new();
     solver
-        .solve(&mut sim.state, &mut sim.models, 1.5)
+        .solve(&mut sim.world.state, &mut sim.world.models, 1.5)
         .map_err(|source| {
             CliError::Run(RunError::Core {
                 scene: scene.to_path_buf(),
@@ -311,7 +311,7 @@ fn static_solve_tip(scene: &Path) -> Result<f64, CliError> {
         .probes
         .first()
         .ok_or_else(|| CliError::Verify("the cantilever scene has no probe".into()))?;
-    Ok(sim.state.displacement(tip.particle).z * 1e6)
+    Ok(sim.world.state.displacement(tip.particle).z * 1e6)
 }
 
 fn plot(path: &Path, labels: &Labels<'_>, series: &[Series<'_>]) -> Result<(), CliError> {

@@ -44,7 +44,7 @@ use crate::particle_packing::{lattice_section, Packing, SplitMix64};
 use crate::unbonded_contact::{PairKinematics, UnbondedLaw, UnbondedPair};
 use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
-use qdem_core::{CheckpointError, Decoder, Encoder, Model, State, Tangent, Vec3};
+use qdem_core::{CheckpointError, Decoder, Encoder, Model, State, Stepping, Tangent, Vec3};
 use rayon::prelude::*;
 use std::collections::HashSet;
 
@@ -59,10 +59,6 @@ pub struct BondSettings {
     /// Relative overshoot ε of a bond's strength (or of the step past a contact's opening)
     /// above which a step is retaken.
     pub tolerance: f64,
-    /// Implicit stepping: only the active contacts (touching at the last commit, or met by a
-    /// trial step and activated) push, so that every contact force has its stiffness in the
-    /// matrix; explicit stepping lets every overlapping pair push.
-    pub implicit: bool,
 }
 
 /// The material of a bonded body: the continuum it represents and its bonds' strength.
@@ -109,6 +105,10 @@ pub struct BondedParticles {
     grid_reference: Vec<[f64; 2]>,
     skin: f64,
     settings: BondSettings,
+    /// Implicit stepping ([`Model::prepare`]): only the active contacts (touching at the last
+    /// commit, or met by a trial step and activated) push, so that every contact force has
+    /// its stiffness in the matrix; explicit stepping lets every overlapping pair push.
+    implicit: bool,
     broken: usize,
     broken_log: Vec<(f64, u32)>,
     /// Whether a trial step activated a contact since the last commit.
@@ -168,6 +168,7 @@ impl BondedParticles {
             grid_reference: Vec::new(),
             skin: 0.5 * max_r,
             settings,
+            implicit: false,
             broken: 0,
             broken_log: Vec::new(),
             activated: false,
@@ -565,6 +566,10 @@ impl Model for BondedParticles {
         &self.name
     }
 
+    fn prepare(&mut self, stepping: &Stepping) {
+        self.implicit = stepping.implicit;
+    }
+
     fn checkpointable(&self) -> bool {
         true
     }
@@ -668,7 +673,7 @@ impl Model for BondedParticles {
                 m[2] += sum[2];
             });
         let law = self.settings.contact;
-        let implicit = self.settings.implicit;
+        let implicit = self.implicit;
         for pair in self.pairs.iter().filter(|p| p.touching || !implicit) {
             let (i, j) = (pair.i as usize, pair.j as usize);
             let k = self.kinematics(state, i, j);

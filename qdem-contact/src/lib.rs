@@ -19,6 +19,9 @@
 //! neighbour cells' load phase) and [`clump_sample`] (ballast-like stones as rigid clumps with
 //! a grading).
 //!
+//! Post-step hooks of a [`qdem_core::World`]: [`PeriodicWrap`] (bodies wrapped back into a
+//! periodic cell) and [`CollapseWatch`] (a bonded run ends once its body has failed).
+//!
 //! Rigid bodies are integrated by qdem-core ([`qdem_core::rigid_body`]); their spheres add the
 //! moment of each contact force about the sphere's centre to the body's torque.
 
@@ -27,6 +30,7 @@ mod bond_tangent;
 pub mod bonded_particles;
 pub mod broad_phase;
 pub mod clump_sample;
+pub mod collapse_watch;
 pub mod contact_law;
 pub mod coulomb;
 pub mod dem_contacts;
@@ -36,6 +40,7 @@ pub mod linear_spring;
 pub mod mesh_wall;
 pub mod particle_packing;
 pub mod periodic_boundary;
+pub mod periodic_wrap;
 pub mod plane_wall;
 pub mod time_delayed_boundary;
 pub mod unbonded_contact;
@@ -43,6 +48,7 @@ pub mod wall;
 
 pub use beam_bond::{BeamBond, BeamSection};
 pub use bonded_particles::{BondSettings, BondedMaterial, BondedParticles};
+pub use collapse_watch::CollapseWatch;
 pub use contact_law::{ContactLaw, PairElasticity, PairGeometry};
 pub use dem_contacts::{ContactSettings, ContactSphere, DemContacts};
 pub use error::ContactError;
@@ -51,6 +57,7 @@ pub use linear_spring::LinearSpring;
 pub use mesh_wall::MeshWall;
 pub use particle_packing::{lattice_section, LatticeSection, Packing, PackingKind};
 pub use periodic_boundary::{PeriodicBox, WrapGroup};
+pub use periodic_wrap::PeriodicWrap;
 pub use plane_wall::PlaneWall;
 pub use time_delayed_boundary::{GhostScales, LoadCycle, TimeDelayedBoundary};
 pub use unbonded_contact::{UnbondedLaw, UnbondedPair};

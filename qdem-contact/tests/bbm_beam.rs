@@ -113,13 +113,17 @@ fn lattice_has_the_continuum_modulus_and_poisson_ratio() {
     use qdem_core::{Dofs, NodalLoad, TimeFunction, Vec3};
     let (w, hgt) = (2.0, 0.5);
     let packing = Packing::rectangle([0.0, 0.0], [w, hgt], 0.025, PackingKind::Regular).unwrap();
-    let (mut state, model) = BondedParticles::from_packing(
+    let (mut state, mut model) = BondedParticles::from_packing(
         "block",
         &packing,
         &bbm::material(f64::INFINITY, 0.0),
-        bbm::settings(true),
+        bbm::settings(),
     )
     .unwrap();
+    model.prepare(&qdem_core::Stepping {
+        implicit: true,
+        dt: 0.0,
+    });
     let h = packing.spacing;
     let c = &packing.centers;
     let left: Vec<usize> = (0..c.len()).filter(|&p| c[p][0] < 0.51 * h).collect();

@@ -10,16 +10,22 @@
 //!
 //! The step: `critical_fraction` × ∆t_crit of Eq. 28 when given, else `[run] dt` as for any
 //! scene; an explicit step is always checked against the rigorous bound
-//! ([`qdem_core::Model::stable_dt`]).
+//! ([`qdem_core::Model::stable_dt`]). The world watches the body for collapse
+//! ([`CollapseWatch`]).
 
-use crate::build::{nearest_particle_in, BuildError, Simulation};
-use crate::scene::{Bonded, Integrator, PackingName, Scene, Supports, TimeStep};
+use crate::build::{nearest_particle_in, step_request, BuildError, Simulation};
+use crate::scene::{Bonded, PackingName, Scene, Supports, TimeStep};
 use qdem_contact::{
-    BondSettings, BondedMaterial, BondedParticles, ContactError, Packing, PackingKind, UnbondedLaw,
+    BondSettings, BondedMaterial, BondedParticles, CollapseWatch, ContactError, Packing,
+    PackingKind, UnbondedLaw,
 };
 use qdem_core::{
-    choose_step, stable_step, CoreError, Dofs, Model, NodalLoad, State, TimeFunction, Vec3,
+    Dofs, Model, NodalLoad, State, StepRequest, StepSettings, TimeFunction, Vec3, World,
 };
+
+/// A bonded run ends early once a particle has moved this many particle spacings: its linear
+/// bonds and contacts are meaningless beyond (the body has collapsed or come apart).
+const COLLAPSE_SPACINGS: f64 = 0.5;
 
 /// Builds the simulation of a scene whose body is `[bonded]`.
 pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, BuildError> {
@@ -60,7 +66,6 @@ pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, 
             damping_ratio: bonded.contact_damping_ratio,
         },
         tolerance: bonded.tolerance,
-        implicit: scene.run.beta > 0.0,
     };
     let (mut state, model) =
         BondedParticles::from_packing(&bonded.name, &packing, &bond_material, settings)
@@ -75,24 +80,23 @@ pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, 
         scene: scene.path.clone(),
         source,
     };
-    let dt = bonded_dt(&scene, bonded, critical, &state, &models).map_err(core)?;
+    let request = bonded_step(&scene, bonded, critical);
+    let settings = StepSettings::resolve(&request, &state, &models).map_err(core)?;
     let probes = scene
         .probes
         .iter()
         .map(|p| nearest_particle_in(&state, 0..state.len(), Vec3::from(p.point), &p.name))
         .collect();
-    let stable_dt = stable_step(&state, &models).unwrap_or((f64::INFINITY, String::new()));
+    let mut world = World::new(state, models, settings).map_err(core)?;
+    let body = world.model::<BondedParticles>().expect("built above");
+    world.add_hook(Box::new(CollapseWatch::for_body(body, COLLAPSE_SPACINGS)));
     Ok(Simulation {
         scene,
-        state,
-        models,
+        world,
         bodies: Vec::new(),
         probes,
-        stable_dt,
-        dt,
         warnings: Vec::new(),
         granular: None,
-        periodic: None,
         ballast: None,
     })
 }
@@ -148,25 +152,19 @@ fn top_load(packing: &Packing, bonded: &Bonded) -> NodalLoad {
     NodalLoad::new("top_load", particles, total, factor)
 }
 
-/// The step: `critical_fraction` × Eq. 28's ∆t_crit (`critical`), or `[run] dt`; explicit
-/// steps are refused above the rigorous bound.
-fn bonded_dt(
-    scene: &Scene,
-    bonded: &Bonded,
-    critical: f64,
-    state: &State,
-    models: &[Box<dyn Model>],
-) -> Result<f64, CoreError> {
-    let run = &scene.run;
-    let explicit = run.integrator == Integrator::Newmark && run.beta == 0.0;
-    let requested = match (bonded.critical_fraction, run.dt) {
+/// The step: `critical_fraction` × Eq. 28's ∆t_crit (`critical`), or `[run] dt` (explicit
+/// steps are refused above the rigorous bound; implicit runs must give one, which validation
+/// checks), kept as it is rather than fitted to t_end.
+fn bonded_step(scene: &Scene, bonded: &Bonded, critical: f64) -> StepRequest {
+    let dt = match (bonded.critical_fraction, scene.run.dt) {
         (Some(f), _) => Some(f * critical),
         (None, TimeStep::Fixed(dt)) => Some(dt),
         (None, TimeStep::Auto) => None,
     };
-    if explicit {
-        choose_step(state, models, requested, run.dt_safety)
-    } else {
-        Ok(requested.expect("validated: implicit runs give dt or critical_fraction"))
+    StepRequest {
+        dt,
+        implicit_default: None,
+        fit_to: None,
+        ..step_request(scene)
     }
 }

@@ -13,11 +13,11 @@ use crate::scene::suggest::did_you_mean;
 use crate::scene::{Integrator, Scene, Selection, TimeStep};
 use nalgebra::{Rotation3, UnitQuaternion};
 use qdem_contact::BondedParticles;
-use qdem_contact::{DemContacts, PeriodicBox, WrapGroup};
+use qdem_contact::{DemContacts, PeriodicBox, PeriodicWrap};
 use qdem_core::rigid_body::tet_mass_properties;
 use qdem_core::{
-    choose_step, stable_step, CoreError, Dofs, Gravity, Material, Model, NodalLoad, State, TetBody,
-    TimeFunction, Vec3,
+    CoreError, Dofs, Gravity, Material, Model, NodalLoad, Scheme, State, StepRequest, StepSettings,
+    TetBody, TimeFunction, Vec3, World,
 };
 use qdem_mesh::{read_msh, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
@@ -233,28 +233,23 @@ pub struct ProbePoint {
     pub distance: f64,
 }
 
-/// A ready-to-run simulation.
+/// A ready-to-run simulation: the [`World`] that steps, and what the outputs need to know of
+/// the scene's bodies and probes.
 pub struct Simulation {
     /// The scene it was built from.
     pub scene: Scene,
-    /// Particles of all bodies.
-    pub state: State,
-    /// Bodies first (in scene order), then gravity, then loads.
-    pub models: Vec<Box<dyn Model>>,
+    /// The state of all bodies, their models (bodies first in scene order, then contacts,
+    /// gravity, loads), the stepper and the post-step hooks (periodic wrapping, a bonded
+    /// body's collapse watch).
+    pub world: World,
     /// Per-body output information.
     pub bodies: Vec<BodyInfo>,
     /// Probes in scene order.
     pub probes: Vec<ProbePoint>,
-    /// The stable bound (s) and the model that sets it.
-    pub stable_dt: (f64, String),
-    /// The step that will be used (s).
-    pub dt: f64,
     /// Mesh warnings, one line each, naming the file.
     pub warnings: Vec<String>,
     /// The stones of `[granular]`.
     pub granular: Option<GranularInfo>,
-    /// The periodic cell of `[periodic]` and the groups of particles that wrap together.
-    pub periodic: Option<(PeriodicBox, Vec<WrapGroup>)>,
     /// The stones of `[ballast]`.
     pub ballast: Option<BallastInfo>,
 }
@@ -351,26 +346,26 @@ impl Simulation {
             crate::start_from::restore_state(&scene, file, &mut state, periodic.as_ref())?;
         }
         let probes = resolve_probes(&scene, &bodies, &state);
-        let stable_dt = stable_step(&state, &models).unwrap_or((f64::INFINITY, String::new()));
-        let dt = choose_dt(&scene, &state, &models).map_err(core)?;
+        let settings =
+            StepSettings::resolve(&step_request(&scene), &state, &models).map_err(core)?;
+        let mut world = World::new(state, models, settings).map_err(core)?;
+        if let Some((cell, groups)) = periodic {
+            world.add_hook(Box::new(PeriodicWrap { cell, groups }));
+        }
         Ok(Simulation {
             scene,
-            state,
-            models,
+            world,
             bodies,
             probes,
-            stable_dt,
-            dt,
             warnings,
             granular,
-            periodic,
             ballast,
         })
     }
 
     /// Number of steps to reach `t_end` (the last one may end slightly past it for a fixed dt).
     pub fn steps(&self) -> u64 {
-        (self.scene.run.t_end / self.dt - 1e-9).ceil().max(0.0) as u64
+        self.world.settings().steps_to(self.scene.run.t_end)
     }
 
     /// Number of tetrahedra in all bodies.
@@ -383,32 +378,32 @@ impl Simulation {
         let BodyKind::Deformable { model } = body.kind else {
             return None;
         };
-        let model: &dyn std::any::Any = self.models[model].as_ref();
+        let model: &dyn std::any::Any = self.world.models[model].as_ref();
         model.downcast_ref::<TetBody>()
     }
 
     /// The mass of a body (kg).
     pub fn body_mass(&self, body: &BodyInfo) -> f64 {
+        let mass = &self.world.state.mass;
         match body.kind {
-            BodyKind::Deformable { .. } => self.state.mass[body.particles.clone()].iter().sum(),
-            BodyKind::Rigid { center, .. } => self.state.mass[center],
+            BodyKind::Deformable { .. } => mass[body.particles.clone()].iter().sum(),
+            BodyKind::Rigid { center, .. } => mass[center],
         }
     }
 
     /// The bonded-particle model of a `[bonded]` scene.
     pub fn bonded(&self) -> Option<&BondedParticles> {
-        self.models.iter().find_map(|m| {
-            let m: &dyn std::any::Any = m.as_ref();
-            m.downcast_ref::<BondedParticles>()
-        })
+        self.world.model::<BondedParticles>()
     }
 
     /// The contact model, if the scene has contacts.
     pub fn contacts(&self) -> Option<&DemContacts> {
-        self.models.iter().find_map(|m| {
-            let m: &dyn std::any::Any = m.as_ref();
-            m.downcast_ref::<DemContacts>()
-        })
+        self.world.model::<DemContacts>()
+    }
+
+    /// The periodic cell of `[periodic]`.
+    pub fn periodic(&self) -> Option<&PeriodicBox> {
+        self.world.hook::<PeriodicWrap>().map(|w| &w.cell)
     }
 }
 
@@ -638,30 +633,37 @@ fn build_loads(
     Ok(())
 }
 
-/// The step of the scene's integrator: for Verlet and explicit Newmark (β = 0) the stable
-/// bound times `dt_safety` (or the user's dt, refused above the bound); for implicit Newmark
-/// the user's dt; for the static solve the load-level interval (`dt`, else `probe_every`,
-/// else t_end/100). An automatic step is shrunk so that a whole number of steps reaches t_end.
-fn choose_dt(scene: &Scene, state: &State, models: &[Box<dyn Model>]) -> Result<f64, CoreError> {
+/// The stepping `[run]` and `[contact]` ask for: the integrator, `dt` (or automatic: the
+/// stable bound times `dt_safety` for an explicit scheme, the load-level interval `probe_every`
+/// or t_end/100 for an implicit or static one, shrunk so that a whole number of steps reaches
+/// t_end) and `[contact] local_damping`; [`StepSettings::resolve`] applies the rule.
+pub(crate) fn step_request(scene: &Scene) -> StepRequest {
     let run = &scene.run;
-    let requested = match run.dt {
-        TimeStep::Auto => None,
-        TimeStep::Fixed(dt) => Some(dt),
-    };
-    let explicit = match run.integrator {
-        Integrator::Verlet => true,
-        Integrator::Newmark => run.beta == 0.0,
-        Integrator::Static => false,
-    };
-    let dt = match (explicit, requested) {
-        (true, _) => choose_step(state, models, requested, run.dt_safety)?,
-        (false, Some(dt)) => return Ok(dt),
-        (false, None) => run.probe_every.unwrap_or(run.t_end / 100.0),
-    };
-    Ok(match requested {
-        Some(dt) => dt,
-        None => run.t_end / (run.t_end / dt).ceil(),
-    })
+    StepRequest {
+        scheme: scheme(scene),
+        dt: match run.dt {
+            TimeStep::Auto => None,
+            TimeStep::Fixed(dt) => Some(dt),
+        },
+        safety: run.dt_safety,
+        local_damping: scene.contact.as_ref().map_or(0.0, |c| c.local_damping),
+        adaptive: scene.bonded.as_ref().is_some_and(|b| b.adaptive),
+        implicit_default: Some(run.probe_every.unwrap_or(run.t_end / 100.0)),
+        fit_to: Some(run.t_end),
+    }
+}
+
+/// The scene's integrator as a scheme.
+fn scheme(scene: &Scene) -> Scheme {
+    let run = &scene.run;
+    match run.integrator {
+        Integrator::Verlet => Scheme::Verlet,
+        Integrator::Newmark => Scheme::Newmark {
+            beta: run.beta,
+            gamma: run.gamma,
+        },
+        Integrator::Static => Scheme::Static,
+    }
 }
 
 /// Index of a body that the validated scene guarantees to exist (the `[ballast]` comes after

@@ -18,7 +18,7 @@ use thiserror::Error;
 pub const CHECKPOINT_FILE: &str = "checkpoint.qdc";
 
 /// The version of the layout this build writes and reads.
-pub const FORMAT_VERSION: u64 = 2;
+pub const FORMAT_VERSION: u64 = 3;
 
 const MAGIC: &[u8; 8] = b"QDEMCKPT";
 const HEADER: usize = 8 + 8 + 8;

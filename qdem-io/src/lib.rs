@@ -9,7 +9,8 @@
 //!   A `[bonded]` scene builds a 2D beam-bonded body instead (paper 001). `[granular]` adds a
 //!   sample of rigid stones ([`granular_build`]), `[periodic]` a periodic cell and a
 //!   time-delayed boundary (paper 003).
-//! - [`runner`]: the run loop, sampling probes and writing snapshots.
+//! - [`runner`]: the run loop: steps the [`qdem_core::World`] a build made and hands each
+//!   step to the outputs' recorders (`record`: one file per output).
 //! - [`output`]: atomic writers for VTU/PVD, probe CSV and summary JSON.
 //! - [`spectrum`]: dominant frequency of a probe record by FFT.
 //! - [`plot`]: SVG line plots beside the CSVs.
@@ -34,6 +35,7 @@ pub mod output;
 mod periodic_build;
 pub mod plot;
 pub mod pose_from;
+mod record;
 mod rest_on;
 mod run_record;
 pub mod runner;

@@ -109,7 +109,7 @@ pub fn read_poses_csv(path: &Path) -> Result<Vec<Pose>, BuildError> {
 
 /// The pose of every rigid `[[body]]` of `sim` now (module docs).
 pub fn poses(sim: &Simulation) -> Vec<Pose> {
-    let rigid = &sim.state.rigid;
+    let rigid = &sim.world.state.rigid;
     sim.bodies
         .iter()
         .filter_map(|b| match &b.kind {
@@ -120,7 +120,7 @@ pub fn poses(sim: &Simulation) -> Vec<Pose> {
                 ..
             } => Some(Pose {
                 body: b.name.clone(),
-                center: sim.state.position[*center],
+                center: sim.world.state.position[*center],
                 rotation: rigid.orientation[*body] * design_frame.inverse(),
             }),
             BodyKind::Deformable { .. } => None,

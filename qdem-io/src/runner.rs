@@ -1,31 +1,19 @@
-//! The run loop: steps a [`Simulation`] to `t_end`, sampling probes and writing VTU
-//! snapshots at their intervals, and a summary and a plot of the probe displacements
-//! (`probes.svg`, beside `probes.csv`) at the end. Every output file is written
-//! atomically; a run stopped by an instability still commits the probe rows up to the failure.
-//!
-//! The loop is an explicit pipeline: step → wrap (periodic cells) → probes → snapshot →
-//! progress. A scene with `[granular]` also gets `stones.csv` (the stones' spheres at the end,
-//! the sample format `[granular] sample` reads); one with a time-delayed boundary gets
-//! `boundary.csv` (time, the measured average boundary force, the left and right ghost
-//! scales) at the probe interval, and one with `[[section]]`s `sections.csv` (time, the
-//! average contact force across each section plane); one with rigid `[[body]]`s gets
-//! `poses.csv` (where each ended, the file `[[body]] pose_from` reads: [`crate::pose_from`]).
+//! The run loop: steps a [`Simulation`]'s [`qdem_core::World`] to `t_end`, hands the state
+//! after every step to the outputs' recorders ([`crate::record`]: probes, VTU/PVD, sections,
+//! boundary, crack picture, stones, poses), checkpoints when due or asked to, and writes
+//! `summary.json` at the end. Every output file is written atomically; a run stopped by an
+//! instability still commits the probe rows up to the failure and its end-of-run files.
 
-use crate::build::{BodyKind, Simulation};
+use crate::build::Simulation;
 use crate::checkpoint::{
     read_checkpoint, scene_fingerprint, write_checkpoint, CheckpointFileError, CHECKPOINT_FILE,
 };
-use crate::crack_svg::write_crack_svg;
-use crate::granular_build::write_stones_csv;
-use crate::output::{write_atomic, write_summary, write_vtu, OutputError, ProbeCsv, VtuGrid};
-use crate::plot::{line_plot_svg, Labels, Series};
-use crate::pose_from::{poses, write_poses_csv};
-use crate::run_record::{check_checkpointable, decode_run, encode_run, RunRecord};
-use crate::scene::Integrator;
-use qdem_contact::BondedParticles;
-use qdem_core::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
-use qdem_core::{stable_step, CoreError, Newmark, StaticSteps, Stepper, Vec3, Verlet};
-use serde_json::json;
+use crate::output::OutputError;
+use crate::record::schedule::{probe_interval, Schedule};
+use crate::record::{self, Recorder, RunFigures, StepInfo};
+use crate::run_record::{decode_run, encode_run, RunRecord};
+use qdem_core::error::unstable_advice;
+use qdem_core::{CoreError, Halt};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -59,7 +47,7 @@ pub enum RunError {
          was dt = {dt:.4e} s; the stable bound at this state is {bound:.4e} s (set by \
          {limiter}): {advice}",
         scene = scene.display(),
-        advice = unstable_advice(dt, bound)
+        advice = unstable_advice(*dt, *bound)
     )]
     Unstable {
         /// The scene file.
@@ -139,50 +127,11 @@ pub struct RunReport {
     pub wall_seconds: f64,
     /// Tetrahedron-steps per wall-clock second.
     pub tet_steps_per_second: f64,
-    /// Rows written to `probes.csv`.
-    pub probe_rows: usize,
-    /// VTU snapshots written.
-    pub vtu_files: usize,
     /// Particle-steps per wall-clock second.
     pub particle_steps_per_second: f64,
-    /// Wall-clock seconds of the steps before and after the first broken bond, and the
-    /// number of each (bonded scenes; zero otherwise): the t_b, t_u of paper 001 Tables 1–2.
-    pub crack_timing: CrackTiming,
+    /// Why a post-step hook ended the run before `t_end` (a bonded body that collapsed).
+    pub halt: Option<Halt>,
 }
-
-/// Wall time per step before and after cracking starts.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct CrackTiming {
-    /// Seconds in steps that began with no bond broken.
-    pub before_seconds: f64,
-    /// Steps that began with no bond broken.
-    pub before_steps: u64,
-    /// Seconds in steps that began with bonds broken.
-    pub after_seconds: f64,
-    /// Steps that began with bonds broken.
-    pub after_steps: u64,
-    /// Time of the first broken bond (s), if any.
-    pub first_break: Option<f64>,
-    /// When the run stopped early because the bonded body moved beyond its
-    /// small-displacement range: (time, particle, displacement).
-    pub collapse: Option<(f64, usize, f64)>,
-}
-
-impl CrackTiming {
-    pub(crate) fn add(&mut self, cracked: bool, seconds: f64) {
-        if cracked {
-            self.after_seconds += seconds;
-            self.after_steps += 1;
-        } else {
-            self.before_seconds += seconds;
-            self.before_steps += 1;
-        }
-    }
-}
-
-/// A bonded run ends early once a particle has moved this many particle spacings: its linear
-/// bonds and contacts are meaningless beyond (the body has collapsed or come apart).
-const COLLAPSE_SPACINGS: f64 = 0.5;
 
 /// Wall-clock seconds between the in-memory copies of the last good state (on the main
 /// cantilever job, probing every 26 steps, a copy at every probe sample cost 16% of the run).
@@ -212,6 +161,10 @@ pub fn run(
     run_with(sim, out_dir, RunOptions::default(), progress)
 }
 
+/// The last good state of a run, kept in memory: its time, its checkpoint body and when it
+/// was taken.
+type GoodState = (f64, Vec<u8>, Instant);
+
 /// [`run`], resuming from a checkpoint or stopping on request as `options` say. With
 /// `[output] checkpoint_every`, a resume or a stop request, the scene's models and stepper
 /// must be checkpointable, which is checked before the first step. At every checkpoint the
@@ -226,95 +179,67 @@ pub fn run_with(
     options: RunOptions<'_>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<RunReport, RunError> {
-    let dir_error = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| RunError::OutputDir { path, source }
-    };
-    std::fs::create_dir_all(out_dir).map_err(dir_error(out_dir))?;
-    let vtu_dir = out_dir.join("vtu");
+    create_dir(out_dir)?;
     if sim.scene.output.writes_vtu() {
-        std::fs::create_dir_all(&vtu_dir).map_err(dir_error(&vtu_dir))?;
+        create_dir(&out_dir.join("vtu"))?;
     }
-    let names: Vec<String> = sim.probes.iter().map(|p| p.name.clone()).collect();
     let steps = sim.steps();
-    let mut stepper = make_stepper(sim).map_err(|source| core_error(sim, source))?;
     let checkpoint_path = out_dir.join(CHECKPOINT_FILE);
     let fingerprint = scene_fingerprint(&sim.scene.path);
-    let can_checkpoint = check_checkpointable(sim, stepper.as_ref());
+    let can_checkpoint = sim.world.checkpointable();
     if sim.scene.output.checkpoint_every > 0.0 || options.resume.is_some() {
         if let Err(source) = &can_checkpoint {
             return Err(core_error(sim, source.clone().into()));
         }
     }
-    let mut record = RunRecord::new(sim);
-    let probes_path = out_dir.join("probes.csv");
-    let mut csv = match options.resume {
-        Some(path) => {
-            let body = read_checkpoint(path, fingerprint, &sim.scene.path)?;
-            decode_run(&body, sim, stepper.as_mut(), &mut record)
-                .map_err(|source| core_error(sim, source))?;
-            ProbeCsv::resume(&probes_path, &names, record.probe_rows as usize)?
-        }
-        None => ProbeCsv::create(&probes_path, &names)?,
-    };
-    let first_step = record.next_step;
+    let mut recorders = record::register(sim, out_dir);
+    let mut run = RunRecord::new(sim);
+    if let Some(path) = options.resume {
+        let body = read_checkpoint(path, fingerprint, &sim.scene.path)?;
+        decode_run(&body, sim, &mut run, &mut recorders)
+            .map_err(|source| core_error(sim, source))?;
+    }
+    for r in recorders.iter_mut() {
+        r.start(options.resume.is_some())?;
+    }
+    let first_step = run.next_step;
     let start = Instant::now();
     let mut last_report = start;
-    let mut last_good: Option<(f64, Vec<u8>, Instant)> = None;
-    let mut energy = EnergyGrowth::new();
+    let mut last_good: Option<GoodState> = None;
+    let mut good_schedule = Schedule::new(probe_interval(sim));
+    let mut halt = None;
     let outcome = (|| -> Result<(), RunError> {
         if options.resume.is_none() {
-            stepper
-                .initialize(&mut sim.state, &mut sim.models)
+            sim.world
+                .initialize()
                 .map_err(|source| core_error(sim, source))?;
         }
         for step in first_step..=steps {
+            let dt = sim.world.dt();
+            let mut seconds = None;
             if step > 0 {
-                let cracked = sim.bonded().is_some_and(|b| b.broken() > 0);
                 let begin = Instant::now();
-                let stepped = stepper.step(&mut sim.state, &mut sim.models);
-                check_stability(sim, stepped, step, &mut energy)?;
-                record.timing.add(cracked, begin.elapsed().as_secs_f64());
-                if let Some((cell, groups)) = &sim.periodic {
-                    cell.wrap_bodies(&mut sim.state, groups);
-                }
-                if let Some((p, u)) = sim.bonded().and_then(|b| {
-                    b.beyond_small_displacement(&sim.state, COLLAPSE_SPACINGS * 2.0 * b.radii()[0])
-                }) {
-                    record.timing.collapse = Some((sim.state.time, p, u));
-                }
+                halt = sim.world.step().map_err(|source| core_error(sim, source))?;
+                seconds = Some(begin.elapsed().as_secs_f64());
             }
-            let (time, dt) = (sim.state.time, sim.dt);
-            let sampled = record.probes.due(time, dt);
-            if sampled {
-                let samples = probe_samples(sim);
-                for (p, sample) in samples.iter().enumerate() {
-                    for (axis, u) in sample[0].iter().enumerate() {
-                        record.history[3 * p + axis].push((time, *u));
-                    }
-                }
-                csv.row(time, &samples)?;
-                record.probe_rows += 1;
-                if let Some((scales, force)) = sim.contacts().and_then(|c| c.time_delay_state()) {
-                    record
-                        .boundary_rows
-                        .push([time, force, scales.left, scales.right]);
-                }
-                record_sections(sim, time, &mut record.section_rows);
+            let info = StepInfo {
+                dt,
+                seconds,
+                halt: halt.as_ref(),
+            };
+            for r in recorders.iter_mut() {
+                r.record(sim, &info)?;
             }
-            if record.vtu.due(time, dt) {
-                let file = format!("vtu/state_{:05}.vtu", record.pvd.len());
-                write_snapshot(sim, &out_dir.join(&file))?;
-                record.pvd.push(time, file);
-                record.pvd.write(&out_dir.join("results.pvd"))?;
-            }
-            record.next_step = step + 1;
+            let time = sim.world.state.time;
+            let sampled = good_schedule.due(time, dt);
+            run.next_step = step + 1;
             let stop = options.stop.is_some_and(|s| s.load(Ordering::Relaxed))
                 || options.stop_after == Some(step);
-            if record.checkpoints.due(time, dt) || stop {
-                csv.publish()?;
-                let body = encode_run(sim, stepper.as_ref(), &record)
-                    .map_err(|source| core_error(sim, source.into()))?;
+            if run.checkpoints.due(time, dt) || stop {
+                for r in recorders.iter_mut() {
+                    r.publish()?;
+                }
+                let body = encode(sim, &run, &recorders)?;
                 write_checkpoint(&checkpoint_path, fingerprint, &body)?;
             } else if sampled
                 && can_checkpoint.is_ok()
@@ -322,9 +247,7 @@ pub fn run_with(
                     .as_ref()
                     .is_none_or(|g| g.2.elapsed().as_secs_f64() >= GOOD_STATE_EVERY)
             {
-                let body = encode_run(sim, stepper.as_ref(), &record)
-                    .map_err(|source| core_error(sim, source.into()))?;
-                last_good = Some((time, body, Instant::now()));
+                last_good = Some((time, encode(sim, &run, &recorders)?, Instant::now()));
             }
             if stop {
                 return Err(RunError::Interrupted {
@@ -342,15 +265,16 @@ pub fn run_with(
                     start,
                 ));
             }
-            if record.timing.collapse.is_some() {
+            if halt.is_some() {
                 break;
             }
         }
         Ok(())
     })();
     let wall_seconds = start.elapsed().as_secs_f64();
-    let probe_rows = csv.num_rows();
-    csv.finish()?;
+    for r in recorders.iter_mut() {
+        r.finish(sim)?;
+    }
     let outcome = match (outcome, last_good) {
         (
             Err(source @ (RunError::Core { .. } | RunError::Unstable { .. })),
@@ -365,232 +289,69 @@ pub fn run_with(
         }
         (outcome, _) => outcome,
     };
-    let mut timing = record.timing;
-    if !names.is_empty() {
-        plot_probes(&out_dir.join("probes.svg"), &names, &record.history)?;
-    }
-    if let Some(model) = sim.bonded() {
-        timing.first_break = model.broken_log().first().map(|b| b.0);
-        write_crack_svg(&out_dir.join("crack.svg"), model, &sim.state)?;
-    }
-    if let Some(info) = &sim.granular {
-        write_stones_csv(&out_dir.join("stones.csv"), info, &sim.state)?;
-    }
-    let poses = poses(sim);
-    if !poses.is_empty() {
-        write_poses_csv(&out_dir.join("poses.csv"), &poses)?;
-    }
-    if !record.boundary_rows.is_empty() {
-        write_boundary_csv(&out_dir.join("boundary.csv"), &record.boundary_rows)?;
-    }
-    if !record.section_rows.is_empty() {
-        write_sections_csv(&out_dir.join("sections.csv"), sim, &record.section_rows)?;
-    }
     outcome?;
-    let steps = match timing.collapse {
-        Some(_) => timing.before_steps + timing.after_steps,
+    let steps = match halt {
+        Some(_) => sim.world.steps_done(),
         None => steps,
     };
-    let stepped = steps.saturating_sub(first_step.saturating_sub(1)) as f64;
-    let tet_steps = (sim.tets() as f64) * stepped;
-    let report = RunReport {
-        integrator: stepper.name().to_string(),
-        steps,
-        dt: sim.dt,
-        final_time: sim.state.time,
+    let figures = RunFigures {
+        steps_taken: steps.saturating_sub(first_step.saturating_sub(1)) as f64,
         wall_seconds,
-        tet_steps_per_second: tet_steps / wall_seconds.max(1e-9),
-        probe_rows,
-        vtu_files: record.pvd.len(),
-        particle_steps_per_second: sim.state.len() as f64 * stepped / wall_seconds.max(1e-9),
-        crack_timing: timing,
     };
-    let mut summary = summary_json(sim, &report);
-    if options.resume.is_some() {
-        summary["resumed_at_step"] = json!(first_step.saturating_sub(1));
-    }
-    if let Some(model) = sim.bonded() {
-        summary["bonded"] = bonded_summary(model, &report, stepper.as_ref());
-    }
-    if let Some(info) = &sim.granular {
-        let spheres = info.radii.len() as f64;
-        summary["granular"] = json!({
-            "name": info.name,
-            "stones": info.len(),
-            "spheres": info.radii.len(),
-            "sphere_steps_per_second": spheres * stepped / wall_seconds.max(1e-9),
-        });
-    }
-    if let Some(contacts) = sim.contacts() {
-        summary["contact"] = json!({
-            "spheres": contacts.spheres(),
-            "contacts": contacts.contacts(),
-            "rebuilds": contacts.rebuilds(),
-            "sphere_steps_per_second":
-                contacts.spheres() as f64 * stepped / wall_seconds.max(1e-9),
-        });
-    }
-    if let Some((cell, _)) = &sim.periodic {
-        summary["periodic"] = json!({
-            "length": [cell.length(0), cell.length(1), cell.length(2)],
-            "origin": [cell.origin().x, cell.origin().y, cell.origin().z],
-            "time_delay": sim.contacts().and_then(|c| c.time_delay_state()).map(|(s, f)| json!({
-                "last_left_scale": s.left,
-                "last_right_scale": s.right,
-                "last_boundary_force": f,
-            })),
-        });
-    }
-    write_summary(&out_dir.join("summary.json"), &summary)?;
+    let report = RunReport {
+        integrator: sim.world.stepper().name().to_string(),
+        steps,
+        dt: sim.world.dt(),
+        final_time: sim.world.state.time,
+        wall_seconds,
+        tet_steps_per_second: figures.rate(sim.tets()),
+        particle_steps_per_second: figures.rate(sim.world.state.len()),
+        halt,
+    };
+    let resumed_at = options.resume.map(|_| first_step.saturating_sub(1));
+    record::summary::write(out_dir, sim, &report, &figures, &recorders, resumed_at)?;
     Ok(report)
 }
 
-/// Stops the run after a failed step (a non-finite acceleration), a step that left a model
-/// in an impossible state (an inverted tetrahedron), or runaway kinetic energy, with the
-/// diagnosis and the stable step at this state; passes other stepper errors on.
-fn check_stability(
-    sim: &Simulation,
-    stepped: Result<(), CoreError>,
-    step: u64,
-    energy: &mut EnergyGrowth,
-) -> Result<(), RunError> {
-    let failure = match stepped {
-        Err(CoreError::NonFinite { particle, .. }) => {
-            Some(format!("particle {particle} has a non-finite acceleration"))
-        }
-        Err(source) => return Err(core_error(sim, source)),
-        Ok(()) => sim
-            .models
-            .iter()
-            .find_map(|m| m.failure(&sim.state))
-            .map(|e| e.to_string()),
-    };
-    let failure = failure.or_else(|| {
-        energy.observe(sim.state.kinetic_energy()).map(|growth| {
-            format!(
-                "the kinetic energy grew by more than {:.0}% at each of the last {GROWTH_STEPS} \
-                 steps (x{growth:.2e} in all), the signature of an unstable step",
-                100.0 * (GROWTH_PER_STEP - 1.0)
-            )
-        })
-    });
-    let Some(detail) = failure else {
-        return Ok(());
-    };
-    let (bound, limiter) =
-        stable_step(&sim.state, &sim.models).unwrap_or((f64::INFINITY, "nothing".to_string()));
-    Err(RunError::Unstable {
-        scene: sim.scene.path.clone(),
-        step,
-        time: sim.state.time,
-        detail,
-        dt: sim.dt,
-        bound,
-        limiter,
-    })
-}
-
-/// What to do about an instability, given the step and its bound.
-fn unstable_advice(dt: &f64, bound: &f64) -> String {
-    if dt > bound {
-        format!("the step is above the bound: use dt = \"auto\" or dt <= {bound:.4e} s")
-    } else {
-        "the step is within the bound, so the cause is physical: a load or a contact \
-         stiffness too large for the mesh there (reduce it or refine the mesh), or a contact \
-         pushing a vertex through its body (finer contact spheres)"
-            .to_string()
-    }
-}
-
-/// The time-delayed boundary's record: time, F_Ave_current, left and right ghost scales.
-fn write_boundary_csv(path: &Path, rows: &[[f64; 4]]) -> Result<(), OutputError> {
-    write_atomic(path, |w| {
-        writeln!(w, "time,boundary_force,left_scale,right_scale")?;
-        for r in rows {
-            writeln!(w, "{:.9e},{:.9e},{:.9e},{:.9e}", r[0], r[1], r[2], r[3])?;
-        }
-        Ok(())
-    })
-}
-
-/// Appends a row of `sections.csv`: the time and each `[[section]]`'s average contact force
-/// (0 in a scene where nothing can touch, which builds no contact model).
-fn record_sections(sim: &Simulation, time: f64, rows: &mut Vec<f64>) {
-    if sim.scene.sections.is_empty() {
-        return;
-    }
-    let contacts = sim.contacts();
-    rows.push(time);
-    for s in &sim.scene.sections {
-        let axis = "xyz".find(&s.axis).expect("validated: x, y or z");
-        rows.push(contacts.map_or(0.0, |c| c.section_force(axis, s.at)));
-    }
-}
-
-/// The sections' record: time, then the average magnitude of the contact forces across each
-/// `[[section]]` plane (N), one column per section named after it.
-fn write_sections_csv(path: &Path, sim: &Simulation, rows: &[f64]) -> Result<(), OutputError> {
-    let names: Vec<&str> = sim.scene.sections.iter().map(|s| s.name.as_str()).collect();
-    write_atomic(path, |w| {
-        writeln!(w, "time,{}", names.join(","))?;
-        for row in rows.chunks_exact(names.len() + 1) {
-            let cells: Vec<String> = row.iter().map(|v| format!("{v:.9e}")).collect();
-            writeln!(w, "{}", cells.join(","))?;
-        }
-        Ok(())
-    })
-}
-
-/// Displacement of every probe against time, one curve per component.
-fn plot_probes(
-    path: &Path,
-    names: &[String],
-    history: &[Vec<(f64, f64)>],
-) -> Result<(), OutputError> {
-    let labels: Vec<String> = names
-        .iter()
-        .flat_map(|n| ["ux", "uy", "uz"].map(|c| format!("{n}.{c}")))
-        .collect();
-    let series: Vec<Series<'_>> = labels
-        .iter()
-        .zip(history)
-        .map(|(label, points)| Series { label, points })
-        .collect();
-    let labels = Labels {
-        title: "probe displacements",
-        x: "t (s)",
-        y: "displacement (m)",
-    };
-    line_plot_svg(path, &labels, &series)
-}
-
-/// Whether runs of `sim` can be checkpointed and resumed, or the model or stepper that
-/// cannot.
-pub fn checkpoint_support(sim: &Simulation) -> Result<(), CoreError> {
-    let stepper = make_stepper(sim)?;
-    Ok(check_checkpointable(sim, stepper.as_ref())?)
-}
-
-/// The scene's stepper with the simulation's step.
-pub fn make_stepper(sim: &Simulation) -> Result<Box<dyn Stepper>, CoreError> {
-    let run = &sim.scene.run;
-    Ok(match run.integrator {
-        Integrator::Verlet => {
-            let damping = sim.scene.contact.as_ref().map_or(0.0, |c| c.local_damping);
-            Box::new(Verlet::new(sim.dt).with_local_damping(damping))
-        }
-        Integrator::Newmark => {
-            let adaptive = sim.scene.bonded.as_ref().is_some_and(|b| b.adaptive);
-            Box::new(Newmark::new(run.beta, run.gamma, sim.dt)?.with_adaptive(adaptive))
-        }
-        Integrator::Static => Box::new(StaticSteps::new(sim.dt)),
-    })
-}
-
-fn core_error(sim: &Simulation, source: CoreError) -> RunError {
-    RunError::Core {
-        scene: sim.scene.path.clone(),
+/// Creates an output directory.
+fn create_dir(path: &Path) -> Result<(), RunError> {
+    std::fs::create_dir_all(path).map_err(|source| RunError::OutputDir {
+        path: path.to_path_buf(),
         source,
+    })
+}
+
+/// The checkpoint body of the run so far.
+fn encode(
+    sim: &Simulation,
+    run: &RunRecord,
+    recorders: &[Box<dyn Recorder>],
+) -> Result<Vec<u8>, RunError> {
+    encode_run(sim, run, recorders).map_err(|source| core_error(sim, source.into()))
+}
+
+/// A core error of `sim`'s run, naming the scene; an instability found by the world's
+/// failure check becomes [`RunError::Unstable`].
+fn core_error(sim: &Simulation, source: CoreError) -> RunError {
+    let scene = sim.scene.path.clone();
+    match source {
+        CoreError::Unstable {
+            step,
+            time,
+            detail,
+            dt,
+            bound,
+            limiter,
+        } => RunError::Unstable {
+            scene,
+            step,
+            time,
+            detail,
+            dt,
+            bound,
+            limiter,
+        },
+        source => RunError::Core { scene, source },
     }
 }
 
@@ -604,118 +365,4 @@ fn progress_at(step: u64, steps: u64, time: f64, start: Instant) -> Progress {
         steps_per_second: rate,
         eta_seconds: (steps - step) as f64 / rate.max(1e-9),
     }
-}
-
-fn probe_samples(sim: &Simulation) -> Vec<[Vec3; 3]> {
-    let s = &sim.state;
-    sim.probes
-        .iter()
-        .map(|p| {
-            [
-                s.displacement(p.particle),
-                s.velocity[p.particle],
-                s.acceleration[p.particle],
-            ]
-        })
-        .collect()
-}
-
-/// One VTU of all bodies: reference points with displacement and velocity per particle, von
-/// Mises stress and volumetric strain per tetrahedron.
-fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
-    let s = &sim.state;
-    let displacement: Vec<Vec3> = (0..s.len()).map(|i| s.displacement(i)).collect();
-    let mut tets = Vec::new();
-    let (mut von_mises, mut volumetric) = (Vec::new(), Vec::new());
-    for body in &sim.bodies {
-        match (&body.kind, sim.tet_body(body)) {
-            (_, Some(tet_body)) => {
-                tets.extend_from_slice(tet_body.tets());
-                let (vm, vol) = tet_body.tet_fields(s);
-                von_mises.extend(vm);
-                volumetric.extend(vol);
-            }
-            (BodyKind::Rigid { tets: rigid, .. }, None) => {
-                tets.extend_from_slice(rigid);
-                von_mises.extend(std::iter::repeat_n(0.0, rigid.len()));
-                volumetric.extend(std::iter::repeat_n(0.0, rigid.len()));
-            }
-            (BodyKind::Deformable { .. }, None) => unreachable!("a deformable body has a TetBody"),
-        }
-    }
-    let grid = VtuGrid {
-        points: &s.reference,
-        tets: &tets,
-        point_vectors: vec![("displacement", &displacement), ("velocity", &s.velocity)],
-        cell_scalars: vec![
-            ("von_mises", &von_mises),
-            ("volumetric_strain", &volumetric),
-        ],
-    };
-    write_vtu(path, &grid)
-}
-
-/// The bonded body's figures: bonds, breaks, the paper's step bound and Table 1–2 timings.
-fn bonded_summary(
-    model: &BondedParticles,
-    report: &RunReport,
-    stepper: &dyn Stepper,
-) -> serde_json::Value {
-    let t = &report.crack_timing;
-    let per = |s: f64, n: u64| if n > 0 { s / n as f64 } else { 0.0 };
-    let counts = stepper.counts();
-    let factor = stepper.factor_stats();
-    json!({
-        "bonds": model.bonds().len(),
-        "broken_bonds": model.broken(),
-        "first_break_time": t.first_break,
-        "touching_pairs": model.touching(),
-        "critical_step_eq28": model.initial_critical_step(),
-        "stopped_at_collapse": t.collapse.map(|(time, particle, u)| json!({
-            "time": time, "particle": particle, "displacement": u,
-        })),
-        "step_before_crack_seconds": per(t.before_seconds, t.before_steps),
-        "step_after_crack_seconds": per(t.after_seconds, t.after_steps),
-        "steps_before_crack": t.before_steps,
-        "steps_after_crack": t.after_steps,
-        "retakes": counts.retakes,
-        "substeps": counts.substeps,
-        "event_steps": counts.event_steps,
-        "factorizations": counts.factorizations,
-        "factor_dofs": factor.map(|f| f.dofs),
-        "factor_nonzeros": factor.map(|f| f.factor_nonzeros),
-        "particle_steps_per_second": report.particle_steps_per_second,
-    })
-}
-
-fn summary_json(sim: &Simulation, report: &RunReport) -> serde_json::Value {
-    json!({
-        "scene": sim.scene.path.display().to_string(),
-        "integrator": report.integrator,
-        "steps": report.steps,
-        "dt": report.dt,
-        "stable_dt": sim.stable_dt.0,
-        "dt_limited_by": sim.stable_dt.1,
-        "t_end": sim.scene.run.t_end,
-        "final_time": report.final_time,
-        "wall_seconds": report.wall_seconds,
-        "particles": sim.state.len(),
-        "tets": sim.tets(),
-        "tet_steps_per_second": report.tet_steps_per_second,
-        "threads": rayon::current_num_threads(),
-        "probe_rows": report.probe_rows,
-        "vtu_files": report.vtu_files,
-        "kinetic_energy": sim.state.kinetic_energy(),
-        "bodies": sim.bodies.iter().map(|b| json!({
-            "name": b.name,
-            "mesh": b.mesh.display().to_string(),
-            "particles": b.particles.len(),
-            "tets": b.stats.tets,
-        })).collect::<Vec<_>>(),
-        "probes": sim.probes.iter().map(|p| json!({
-            "name": p.name,
-            "particle": p.particle,
-            "distance": p.distance,
-        })).collect::<Vec<_>>(),
-    })
 }

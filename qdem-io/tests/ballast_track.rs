@@ -95,7 +95,7 @@ fn stones_are_laid_out_apart_in_the_region_sized_by_the_grading_and_seeded() {
         assert!((0.05..=0.07).contains(&size), "sieve size {size}");
     }
     // Every node inside the region, and stones further apart than two contact radii.
-    let x = &sim.state.position;
+    let x = &sim.world.state.position;
     for s in &info.stones {
         for p in &x[s.clone()] {
             assert!(
@@ -130,9 +130,9 @@ fn stones_are_laid_out_apart_in_the_region_sized_by_the_grading_and_seeded() {
     assert_eq!(sim.bodies.len(), 1, "the stones form one deformable body");
     // The same seed lays out the same stones; another seed does not.
     let again = build(&stones_scene(&dir, "b.toml", &[])).unwrap();
-    assert_eq!(again.state.reference, sim.state.reference);
+    assert_eq!(again.world.state.reference, sim.world.state.reference);
     let other = build(&stones_scene(&dir, "c.toml", &[("seed = 3", "seed = 4")])).unwrap();
-    assert_ne!(other.state.reference, sim.state.reference);
+    assert_ne!(other.world.state.reference, sim.world.state.reference);
 }
 
 #[test]
@@ -165,7 +165,7 @@ fn a_run_starts_from_another_scenes_checkpoint_and_refuses_one_of_other_bodies()
         &mut |_| {},
     )
     .unwrap();
-    assert!(first.state.time > 0.0039);
+    assert!(first.world.state.time > 0.0039);
     let checkpoint = format!(
         "start_from = \"{}\"\n[[material]]",
         dir.join("out/checkpoint.qdc").display()
@@ -177,25 +177,25 @@ fn a_run_starts_from_another_scenes_checkpoint_and_refuses_one_of_other_bodies()
     ];
     let load = stones_scene(&dir, "load.toml", &edits);
     let second = build(&load).unwrap();
-    assert_eq!(second.state.time, 0.0);
-    let moved = (0..first.state.len())
-        .map(|i| (first.state.position[i] - first.state.reference[i]).norm())
+    assert_eq!(second.world.state.time, 0.0);
+    let moved = (0..first.world.state.len())
+        .map(|i| (first.world.state.position[i] - first.world.state.reference[i]).norm())
         .fold(0.0, f64::max);
     assert!(moved > 1e-3, "the stones fell {moved} m");
-    for i in 0..first.state.len() {
+    for i in 0..first.world.state.len() {
         assert_eq!(
-            second.state.position[i].map(f64::to_bits),
-            first.state.position[i].map(f64::to_bits)
+            second.world.state.position[i].map(f64::to_bits),
+            first.world.state.position[i].map(f64::to_bits)
         );
         assert_eq!(
-            second.state.velocity[i].map(f64::to_bits),
-            first.state.velocity[i].map(f64::to_bits)
+            second.world.state.velocity[i].map(f64::to_bits),
+            first.world.state.velocity[i].map(f64::to_bits)
         );
     }
     // The probe is resolved where the stones are now, not where they started.
     let b = &second.probes[0];
-    let nearest = (0..second.state.len())
-        .map(|i| (second.state.position[i] - Vec3::new(0.1, 0.1, 0.05)).norm())
+    let nearest = (0..second.world.state.len())
+        .map(|i| (second.world.state.position[i] - Vec3::new(0.1, 0.1, 0.05)).norm())
         .fold(f64::INFINITY, f64::min);
     assert_eq!(b.distance, nearest);
 
@@ -284,8 +284,9 @@ fn a_series_load_follows_its_csv_column_linearly_between_rows() {
     let dir = test_dir("ballast-series");
     let path = series_scene(&dir, "time,Rp2,Rp1\n0,9,0\n0.001,9,1000\n0.002,9,-500\n");
     let mut sim = build(&path).unwrap();
-    let mut state = sim.state.clone();
+    let mut state = sim.world.state.clone();
     let load = sim
+        .world
         .models
         .iter_mut()
         .find(|m| m.name() == "[[load]] #1")

@@ -56,23 +56,23 @@ fn stone_centers(sim: &Simulation) -> Vec<Vec3> {
     let info = sim.granular.as_ref().unwrap();
     info.stones
         .iter()
-        .map(|(c, _)| sim.state.position[*c])
+        .map(|(c, _)| sim.world.state.position[*c])
         .collect()
 }
 
 /// The settlement (m, down positive) of probe `name` at the end of a run.
 fn settlement(sim: &Simulation, name: &str) -> f64 {
     let p = sim.probes.iter().find(|p| p.name == name).unwrap();
-    -sim.state.displacement(p.particle).z
+    -sim.world.state.displacement(p.particle).z
 }
 
 /// Every stone's centre is inside the periodic cell along y.
 fn assert_wrapped(sim: &Simulation, case: &str) {
-    let (cell, _) = sim.periodic.as_ref().unwrap();
+    let cell = sim.periodic().unwrap();
     let origin = cell.origin().y;
     let length = cell.length(1).unwrap();
     for (c, _) in &sim.granular.as_ref().unwrap().stones {
-        let y = sim.state.position[*c].y;
+        let y = sim.world.state.position[*c].y;
         assert!(
             y >= origin && y < origin + length,
             "{case}: stone at y = {y}"
@@ -102,12 +102,12 @@ fn box_tests_deposit_settle_and_wrap() {
     let weight: f64 = info
         .stones
         .iter()
-        .map(|(c, _)| 9.81 * bed.state.mass[*c])
+        .map(|(c, _)| 9.81 * bed.world.state.mass[*c])
         .sum();
     assert!(
-        bed.state.kinetic_energy() < 1e-3 * weight,
+        bed.world.state.kinetic_energy() < 1e-3 * weight,
         "{}",
-        bed.state.kinetic_energy()
+        bed.world.state.kinetic_energy()
     );
 
     run_scene(&dir, "deposit_cell_crib");
@@ -144,7 +144,7 @@ fn box_tests_deposit_settle_and_wrap() {
         let sim = run_scene(&dir, case);
         let s = settlement(&sim, "sleeper2");
         assert!(s > 0.0 && s < 0.2, "{case}: {s}");
-        if sim.periodic.is_some() {
+        if sim.periodic().is_some() {
             assert_wrapped(&sim, case);
         }
     }
@@ -203,7 +203,7 @@ origin = [-0.15, 0.0, 0.0]
     std::fs::write(&path, text).unwrap();
     let mut sim = Simulation::build(Scene::load(&path).unwrap()).unwrap();
     run(&mut sim, &dir.join("out"), &mut |_| {}).unwrap();
-    let xs: Vec<f64> = sim.state.position.iter().map(|p| p.x).collect();
+    let xs: Vec<f64> = sim.world.state.position.iter().map(|p| p.x).collect();
     let (lo, hi) = xs
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
@@ -215,8 +215,8 @@ origin = [-0.15, 0.0, 0.0]
     assert!((centre - 0.08).abs() < 1e-3, "centre {centre}");
     // The displacement field stayed continuous: every node moved by the same 0.3 m, less
     // the wrap, so u = x − X is the same rigid motion everywhere.
-    let u0 = sim.state.displacement(0);
-    for i in 0..sim.state.len() {
-        assert!((sim.state.displacement(i) - u0).norm() < 1e-6);
+    let u0 = sim.world.state.displacement(0);
+    for i in 0..sim.world.state.len() {
+        assert!((sim.world.state.displacement(i) - u0).norm() < 1e-6);
     }
 }

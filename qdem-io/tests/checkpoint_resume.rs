@@ -132,7 +132,7 @@ fn run(sim: &mut Simulation, out: &Path, options: RunOptions<'_>) -> Result<(), 
 
 /// Every evolving array of the state, by bit pattern.
 fn state_bits(sim: &Simulation) -> Vec<u64> {
-    let s = &sim.state;
+    let s = &sim.world.state;
     let vectors = [&s.position, &s.velocity, &s.acceleration, &s.reference];
     let mut bits: Vec<u64> = vectors
         .iter()
@@ -179,8 +179,8 @@ fn resume_equals_uninterrupted(
         Err(RunError::Interrupted { step, .. }) => assert_eq!(step, stop_after),
         other => panic!("expected an interrupted run, got {other:?}"),
     }
-    let half = b.state.time;
-    assert!(half > 0.0 && half < a.state.time);
+    let half = b.world.state.time;
+    assert!(half > 0.0 && half < a.world.state.time);
     let checkpoint = parts.join(CHECKPOINT_FILE);
     let mut c = build(scene);
     let resume = RunOptions {
@@ -196,7 +196,7 @@ fn resume_equals_uninterrupted(
     eprintln!(
         "{name}: stopped at t = {half:.4} s, resumed to {:.4} s: {} state values equal bit \
          for bit, {files:?} equal byte for byte",
-        c.state.time,
+        c.world.state.time,
         state_bits(&c).len()
     );
     dir
@@ -337,5 +337,5 @@ fn a_scene_that_cannot_be_checkpointed_is_refused_before_the_first_step() {
         message.contains("static stepper") && message.contains("cannot be checkpointed"),
         "{message}"
     );
-    assert_eq!(sim.state.time, 0.0, "no step may be taken");
+    assert_eq!(sim.world.state.time, 0.0, "no step may be taken");
 }

@@ -10,7 +10,6 @@
 
 use qdem_core::Vec3;
 use qdem_io::build::{BodyKind, Simulation};
-use qdem_io::runner::make_stepper;
 use qdem_io::scene::{Scene, Section, Wall};
 use std::path::{Path, PathBuf};
 
@@ -27,13 +26,12 @@ fn centre_velocities(scene: Scene, t_end: f64, every: f64) -> Vec<(f64, Vec3)> {
     let BodyKind::Rigid { center, .. } = sim.bodies[0].kind else {
         panic!("the block is rigid");
     };
-    let mut stepper = make_stepper(&sim).unwrap();
-    stepper.initialize(&mut sim.state, &mut sim.models).unwrap();
-    let mut out = vec![(0.0, sim.state.velocity[center])];
-    while sim.state.time < t_end {
-        stepper.step(&mut sim.state, &mut sim.models).unwrap();
-        if sim.state.time >= out.len() as f64 * every {
-            out.push((sim.state.time, sim.state.velocity[center]));
+    sim.world.initialize().unwrap();
+    let mut out = vec![(0.0, sim.world.state.velocity[center])];
+    while sim.world.state.time < t_end {
+        sim.world.step().unwrap();
+        if sim.world.state.time >= out.len() as f64 * every {
+            out.push((sim.world.state.time, sim.world.state.velocity[center]));
         }
     }
     out

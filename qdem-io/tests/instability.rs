@@ -23,7 +23,9 @@ fn failed_run(name: &str, tip_force: f64, dt_factor: f64) -> (RunError, PathBuf,
     let dir = test_dir(name);
     let scene = cantilever(&dir, tip_force);
     let mut sim = Simulation::build(Scene::load(&scene).unwrap()).unwrap();
-    sim.dt *= dt_factor;
+    let mut settings = sim.world.settings().clone();
+    settings.dt *= dt_factor;
+    sim.world.set_settings(settings).unwrap();
     let out = dir.join("out");
     let error = run(&mut sim, &out, &mut |_| {}).expect_err("the run must be stopped");
     (error, scene, out.join(CHECKPOINT_FILE))

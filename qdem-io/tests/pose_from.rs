@@ -12,7 +12,6 @@ use common::{fixture, test_dir};
 use qdem_core::Vec3;
 use qdem_io::build::Simulation;
 use qdem_io::pose_from::{poses, write_poses_csv};
-use qdem_io::runner::make_stepper;
 use qdem_io::scene::Scene;
 use std::path::Path;
 
@@ -60,14 +59,13 @@ dir = "out"
 fn run(scene: Scene, dir: &Path, name: &str) -> (Vec<Vec3>, Vec<Vec3>) {
     let mut sim = Simulation::build(scene).unwrap();
     let nodes = sim.bodies[0].particles.clone();
-    let start = sim.state.position[nodes.clone()].to_vec();
-    let mut stepper = make_stepper(&sim).unwrap();
-    stepper.initialize(&mut sim.state, &mut sim.models).unwrap();
-    while sim.state.time < sim.scene.run.t_end {
-        stepper.step(&mut sim.state, &mut sim.models).unwrap();
+    let start = sim.world.state.position[nodes.clone()].to_vec();
+    sim.world.initialize().unwrap();
+    while sim.world.state.time < sim.scene.run.t_end {
+        sim.world.step().unwrap();
     }
     write_poses_csv(&dir.join(format!("{name}.csv")), &poses(&sim)).unwrap();
-    (start, sim.state.position[nodes].to_vec())
+    (start, sim.world.state.position[nodes].to_vec())
 }
 
 /// `pose_from = FILE`.

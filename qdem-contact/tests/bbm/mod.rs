@@ -31,8 +31,7 @@ pub fn beam(h: f64, q: f64, mean: f64, std: f64, pin_both: bool) -> Beam {
     let packing =
         Packing::rectangle([0.0, 0.0], [LENGTH, HEIGHT], h, PackingKind::Regular).unwrap();
     let (mut state, model) =
-        BondedParticles::from_packing("beam", &packing, &material(mean, std), settings(false))
-            .unwrap();
+        BondedParticles::from_packing("beam", &packing, &material(mean, std), settings()).unwrap();
     let hs = packing.spacing;
     let y_mid = HEIGHT / 2.0;
     let x_max = packing
@@ -130,7 +129,7 @@ pub fn material(mean: f64, std: f64) -> BondedMaterial {
 }
 
 /// Undamped unbonded contacts (k_t0/k_n = 0.2, μ = 0.5), ε = 0.05.
-pub fn settings(implicit: bool) -> BondSettings {
+pub fn settings() -> BondSettings {
     BondSettings {
         contact: UnbondedLaw {
             shear_ratio: 0.2,
@@ -138,7 +137,6 @@ pub fn settings(implicit: bool) -> BondSettings {
             damping_ratio: 0.0,
         },
         tolerance: 0.05,
-        implicit,
     }
 }
 
