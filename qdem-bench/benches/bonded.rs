@@ -4,9 +4,10 @@
 //! - one explicit Newmark step (β = 0, adaptive, the scene's ∆t), in particle-steps/s
 //!   (criterion's "elements"), the paper's Table 1 t_b;
 //! - one implicit Newmark step (β = ¼, ∆t = 5 ms) on the kept factorisation, Table 2's t_b;
-//! - one refactorisation of the implicit step's matrix M + γ∆tC + β∆t²K (tangent, assembly
-//!   into the kept pattern, numeric Cholesky), what every step that breaks a bond or changes a
-//!   contact repeats while the beam cracks.
+//! - one refactorisation of the implicit step's matrix M + γ∆tC + β∆t²K
+//!   ([`Newmark::refactorize`]: tangent, damping rows, assembly into the kept pattern, numeric
+//!   Cholesky), what every step that breaks a bond or changes a contact repeats while the beam
+//!   cracks.
 //!
 //! On one thread, inside its pool as `qdem run --threads 1` runs (a parallel loop started from
 //! outside the pool waits for a worker at every call). The whole runs to the failure, with
@@ -14,8 +15,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use qdem_bench::throughput::on_threads;
-use qdem_core::sparse::{Assembler, FreeDofs, Scales, SparseCholesky};
-use qdem_core::Tangent;
+use qdem_core::{Newmark, Scheme, Stepper};
 use qdem_io::build::Simulation;
 use qdem_io::scene::Scene;
 use std::path::Path;
@@ -61,34 +61,25 @@ fn newmark_step(c: &mut Criterion) {
 }
 
 fn implicit_refactorisation(c: &mut Criterion) {
-    let sim = beam("implicit");
-    let dt = sim.world.dt();
-    let scales = Scales {
-        mass: 1.0,
-        damping: 0.5 * dt,
-        stiffness: 0.25 * dt * dt,
+    let mut sim = beam("implicit");
+    let Scheme::Newmark { beta, gamma } = sim.world.settings().scheme else {
+        panic!("the implicit beam steps by Newmark")
     };
-    let (mass, dofs) = (
-        sim.world.state.node_mass(),
-        FreeDofs::new(&sim.world.state.node_fixity()),
-    );
-    let (mut tangent, mut assembler, mut cholesky) =
-        (Tangent::new(), Assembler::new(), SparseCholesky::new());
+    let mut stepper = Newmark::new(beta, gamma, sim.world.dt()).expect("implicit Newmark");
+    let world = &mut sim.world;
+    stepper
+        .initialize(&mut world.state, &mut world.models)
+        .expect("initialised");
     let mut group = c.benchmark_group("bonded_beam_refactorisation");
     group.sample_size(20);
-    group.bench_function(BenchmarkId::new("implicit", sim.world.state.len()), |b| {
+    group.bench_function(BenchmarkId::new("implicit", world.state.len()), |b| {
         b.iter_custom(|iterations| {
             on_threads(1, || {
                 let begin = Instant::now();
                 for _ in 0..iterations {
-                    tangent.clear();
-                    for model in &sim.world.models {
-                        model.add_tangent(&sim.world.state, &mut tangent);
-                    }
-                    let matrix = assembler
-                        .assemble(&tangent, &mass, &dofs, scales)
-                        .expect("assembled");
-                    cholesky.factorize(matrix, "effective").expect("factorised");
+                    stepper
+                        .refactorize(&world.state, &world.models)
+                        .expect("factorised");
                 }
                 begin.elapsed()
             })

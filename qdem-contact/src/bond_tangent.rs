@@ -9,7 +9,7 @@
 //! 24 bytes, about 1 kB, per bond (200 MB for the 0.005 m benchmark beam's 204,714 bonds).
 
 use crate::beam_bond::{to_global_matrix, BeamBond};
-use qdem_core::sparse::Entry;
+use qdem_core::tangent::Entry;
 use qdem_core::Tangent;
 
 /// Entries of one bond's 6×6 block on or below the diagonal (its six DOFs are distinct).

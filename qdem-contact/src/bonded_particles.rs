@@ -44,7 +44,10 @@ use crate::particle_packing::{lattice_section, Packing, SplitMix64};
 use crate::unbonded_contact::{PairKinematics, UnbondedLaw, UnbondedPair};
 use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
-use qdem_core::{CheckpointError, Decoder, Encoder, Model, State, Stepping, Tangent, Vec3};
+use qdem_core::{
+    CheckpointError, Decoder, Encoder, Linearized, Model, Persistence, Persistent, State,
+    StepEvents, Stepping, Tangent, Vec3,
+};
 use rayon::prelude::*;
 use std::collections::HashSet;
 
@@ -261,7 +264,7 @@ impl BondedParticles {
         &self.radius
     }
 
-    /// The stress (Eq. 11) of every bond at the last [`Model::check_step`] (Pa).
+    /// The stress (Eq. 11) of every bond at the last [`StepEvents::check_step`] (Pa).
     pub fn trial_stresses(&self) -> &[f64] {
         &self.stress_trial
     }
@@ -570,59 +573,6 @@ impl Model for BondedParticles {
         self.implicit = stepping.implicit;
     }
 
-    fn checkpointable(&self) -> bool {
-        true
-    }
-
-    /// The bonds left intact, their stresses, the unbonded pairs with their committed
-    /// contact state, the broad phase's reference positions and the breakage log.
-    fn save(&self, out: &mut Encoder) {
-        out.tag("bonded particles");
-        out.bools(&self.intact);
-        for stress in [
-            &self.stress_eval,
-            &self.stress_trial,
-            &self.stress_committed,
-        ] {
-            out.f64s(stress);
-        }
-        save_pairs(&self.pairs, out);
-        out.f64s(&self.grid_reference.concat());
-        out.u64(self.broken as u64);
-        out.f64s(&self.broken_log.iter().map(|b| b.0).collect::<Vec<_>>());
-        out.u32s(&self.broken_log.iter().map(|b| b.1).collect::<Vec<_>>());
-        out.bool(self.activated);
-        out.bool(self.stale);
-    }
-
-    fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
-        input.tag("bonded particles")?;
-        let bonds = self.bonds.len();
-        self.intact = input.bools("intact bonds")?;
-        same_count("bonds", bonds, self.intact.len())?;
-        self.bond_tangent = BondTangent::new(&self.bonds, &self.intact, self.bond_tangent.nodes());
-        for stress in [
-            &mut self.stress_eval,
-            &mut self.stress_trial,
-            &mut self.stress_committed,
-        ] {
-            *stress = input.f64s("bond stresses")?;
-            same_count("bond stresses", bonds, stress.len())?;
-        }
-        self.pairs = restore_pairs(input, self.radius.len())?;
-        self.pair_index = self.pairs.iter().map(|p| (p.i, p.j)).collect();
-        let grid = input.f64s("the broad phase's positions")?;
-        self.grid_reference = grid.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
-        self.broken = input.u64("the broken-bond count")? as usize;
-        let times = input.f64s("the breakage log")?;
-        let which = input.u32s("the breakage log")?;
-        same_count("breakage log entries", times.len(), which.len())?;
-        self.broken_log = times.into_iter().zip(which).collect();
-        self.activated = input.bool("the activation flag")?;
-        self.stale = input.bool("the stale flag")?;
-        Ok(())
-    }
-
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
         let bonds = &self.bonds;
         self.motion
@@ -750,7 +700,25 @@ impl Model for BondedParticles {
         Some(bonds + contacts)
     }
 
-    fn add_tangent(&self, state: &State, tangent: &mut Tangent) -> bool {
+    fn linearized(&self) -> Option<&dyn Linearized> {
+        Some(self)
+    }
+
+    fn events(&mut self) -> Option<&mut dyn StepEvents> {
+        Some(self)
+    }
+
+    fn persistence(&self) -> Persistence<'_> {
+        Persistence::Saved(self)
+    }
+
+    fn persistent_mut(&mut self) -> Option<&mut dyn Persistent> {
+        Some(self)
+    }
+}
+
+impl Linearized for BondedParticles {
+    fn add_tangent(&self, state: &State, tangent: &mut Tangent) {
         let n = state.len();
         if self.bond_tangent.nodes() == n {
             self.bond_tangent.add_to(tangent);
@@ -768,9 +736,10 @@ impl Model for BondedParticles {
             let damping = law.matrix(pair, &frame, k.r, true);
             Self::add_block(tangent, n, key, &damping, true);
         }
-        true
     }
+}
 
+impl StepEvents for BondedParticles {
     fn check_step(&mut self, state: &State, forces_here: bool) -> Option<f64> {
         self.stale = false;
         if forces_here {
@@ -798,11 +767,9 @@ impl Model for BondedParticles {
         self.breaking = breaking;
         earlier(bonds, self.contact_overshoot(state, forces_here))
     }
-
     fn tangent_stale(&self) -> bool {
         self.stale
     }
-
     fn commit_step(&mut self, state: &State) -> bool {
         let mut changed = std::mem::take(&mut self.activated);
         if std::mem::take(&mut self.breaking) {
@@ -829,5 +796,55 @@ impl Model for BondedParticles {
             p.overlap = frame.overlap;
         }
         changed
+    }
+}
+
+impl Persistent for BondedParticles {
+    /// The bonds left intact, their stresses, the unbonded pairs with their committed
+    /// contact state, the broad phase's reference positions and the breakage log.
+    fn save(&self, out: &mut Encoder) {
+        out.tag("bonded particles");
+        out.bools(&self.intact);
+        for stress in [
+            &self.stress_eval,
+            &self.stress_trial,
+            &self.stress_committed,
+        ] {
+            out.f64s(stress);
+        }
+        save_pairs(&self.pairs, out);
+        out.f64s(&self.grid_reference.concat());
+        out.u64(self.broken as u64);
+        out.f64s(&self.broken_log.iter().map(|b| b.0).collect::<Vec<_>>());
+        out.u32s(&self.broken_log.iter().map(|b| b.1).collect::<Vec<_>>());
+        out.bool(self.activated);
+        out.bool(self.stale);
+    }
+    fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+        input.tag("bonded particles")?;
+        let bonds = self.bonds.len();
+        self.intact = input.bools("intact bonds")?;
+        same_count("bonds", bonds, self.intact.len())?;
+        self.bond_tangent = BondTangent::new(&self.bonds, &self.intact, self.bond_tangent.nodes());
+        for stress in [
+            &mut self.stress_eval,
+            &mut self.stress_trial,
+            &mut self.stress_committed,
+        ] {
+            *stress = input.f64s("bond stresses")?;
+            same_count("bond stresses", bonds, stress.len())?;
+        }
+        self.pairs = restore_pairs(input, self.radius.len())?;
+        self.pair_index = self.pairs.iter().map(|p| (p.i, p.j)).collect();
+        let grid = input.f64s("the broad phase's positions")?;
+        self.grid_reference = grid.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+        self.broken = input.u64("the broken-bond count")? as usize;
+        let times = input.f64s("the breakage log")?;
+        let which = input.u32s("the breakage log")?;
+        same_count("breakage log entries", times.len(), which.len())?;
+        self.broken_log = times.into_iter().zip(which).collect();
+        self.activated = input.bool("the activation flag")?;
+        self.stale = input.bool("the stale flag")?;
+        Ok(())
     }
 }

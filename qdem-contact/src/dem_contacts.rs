@@ -35,7 +35,9 @@ use crate::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
 use crate::wall::Wall;
 use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
-use qdem_core::{CheckpointError, Decoder, Dofs, Encoder, Model, State, Vec3};
+use qdem_core::{
+    CheckpointError, Decoder, Dofs, Encoder, Model, Persistence, Persistent, State, Vec3,
+};
 use rayon::prelude::*;
 
 /// Marks a sphere that is no part of a rigid body.
@@ -857,10 +859,30 @@ impl Model for DemContacts {
         (omega_squared > 0.0).then(|| critical_step(omega_squared, damping_rate))
     }
 
-    fn checkpointable(&self) -> bool {
-        true
+    fn potential_energy(&self, state: &State) -> Option<f64> {
+        let law = &self.settings.law;
+        let (p, w) = (&self.pairs, &self.wall_contacts);
+        let pairs = (0..p.len()).filter_map(|k| {
+            self.pair_geometry(p.first[k] as usize, p.second[k] as usize)
+                .map(|(g, _, e, _)| law.energy(&g, &e, &p.history[k]))
+        });
+        let walls = (0..w.len()).filter_map(|k| {
+            self.wall_geometry(state, w.first[k] as usize, w.second[k] as usize)
+                .map(|(g, _, e, _)| law.energy(&g, &e, &w.history[k]))
+        });
+        Some(pairs.chain(walls).sum())
     }
 
+    fn persistence(&self) -> Persistence<'_> {
+        Persistence::Saved(self)
+    }
+
+    fn persistent_mut(&mut self) -> Option<&mut dyn Persistent> {
+        Some(self)
+    }
+}
+
+impl Persistent for DemContacts {
     /// The candidate lists with their tangential springs, where and when they were built, and
     /// the time-delayed boundary's estimates: everything but the sphere centres, which are
     /// read from the state.
@@ -881,7 +903,6 @@ impl Model for DemContacts {
             delay.boundary.save(out);
         }
     }
-
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
         input.tag("contact")?;
         let spheres = self.particle.len();
@@ -911,19 +932,5 @@ impl Model for DemContacts {
         }
         self.build_incidence();
         Ok(())
-    }
-
-    fn potential_energy(&self, state: &State) -> Option<f64> {
-        let law = &self.settings.law;
-        let (p, w) = (&self.pairs, &self.wall_contacts);
-        let pairs = (0..p.len()).filter_map(|k| {
-            self.pair_geometry(p.first[k] as usize, p.second[k] as usize)
-                .map(|(g, _, e, _)| law.energy(&g, &e, &p.history[k]))
-        });
-        let walls = (0..w.len()).filter_map(|k| {
-            self.wall_geometry(state, w.first[k] as usize, w.second[k] as usize)
-                .map(|(g, _, e, _)| law.energy(&g, &e, &w.history[k]))
-        });
-        Some(pairs.chain(walls).sum())
     }
 }

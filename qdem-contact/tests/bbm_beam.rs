@@ -5,7 +5,7 @@
 mod bbm;
 
 use bbm::{beam, cracking_load, timoshenko_deflection};
-use qdem_core::{Model, StaticSolver};
+use qdem_core::{Model, StaticSolver, StepEvents};
 
 /// Static midspan deflection of the bonded beam at three element sizes against Timoshenko's
 /// (bending plus shear): the error shrinks with refinement and is within 2% at 0.01 m. The

@@ -5,7 +5,7 @@
 //! length and then its elements; every part starts with a named tag, so a checkpoint read
 //! against a different scene fails at the first part that does not fit, naming it, rather
 //! than giving a silently wrong run. [`State`] is encoded here; models and steppers encode
-//! their own history through [`crate::Model::save`] and [`crate::Stepper::save`]. The file
+//! their own history through [`crate::Persistent::save`] and [`crate::Stepper::save`]. The file
 //! around it (header, version, scene fingerprint) belongs to the caller.
 
 use crate::rigid_body::RigidBodies;

@@ -1,8 +1,8 @@
 //! Uniform gravity: the force m g on every particle.
 
-use crate::model::Model;
-use crate::sparse::Tangent;
+use crate::model::{Linearized, Model, Persistence};
 use crate::state::State;
+use crate::tangent::Tangent;
 use crate::Vec3;
 
 /// Uniform gravitational acceleration acting on every particle.
@@ -19,11 +19,6 @@ impl Gravity {
 }
 
 impl Model for Gravity {
-    /// No history: the forces follow from the state alone.
-    fn checkpointable(&self) -> bool {
-        true
-    }
-
     fn name(&self) -> &str {
         "gravity"
     }
@@ -32,11 +27,6 @@ impl Model for Gravity {
         for (f, m) in force.iter_mut().zip(&state.mass) {
             *f += *m * self.g;
         }
-    }
-
-    /// Position- and velocity-independent: no tangent.
-    fn add_tangent(&self, _state: &State, _tangent: &mut Tangent) -> bool {
-        true
     }
 
     fn potential_energy(&self, state: &State) -> Option<f64> {
@@ -49,4 +39,18 @@ impl Model for Gravity {
                 .sum::<f64>(),
         )
     }
+
+    fn linearized(&self) -> Option<&dyn Linearized> {
+        Some(self)
+    }
+
+    /// No history: the forces follow from the state alone.
+    fn persistence(&self) -> Persistence<'_> {
+        Persistence::Stateless
+    }
+}
+
+impl Linearized for Gravity {
+    /// Position- and velocity-independent: no tangent.
+    fn add_tangent(&self, _state: &State, _tangent: &mut Tangent) {}
 }

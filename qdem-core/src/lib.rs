@@ -11,7 +11,7 @@
 //!   `qdem run` does, for whoever embeds the crate.
 //! - [`Stepper`]: advances the state under a list of models; [`Verlet`] is the explicit
 //!   velocity Verlet of the QDEM paper; [`Newmark`] the Newmark-β family of paper 001 §3,
-//!   explicit (β = 0) or implicit (β > 0, a sparse Cholesky solve per step, [`sparse`]);
+//!   explicit (β = 0) or implicit (β > 0, a sparse Cholesky solve per step);
 //!   [`StaticSolver`] the linear static solve K u = f.
 //!
 //! The QDEM tetrahedron (Nishiura, Sakaguchi & Aikawa 2017, Eqs. 1–11) is in [`tet_kernel`],
@@ -29,13 +29,14 @@ pub mod model;
 pub mod newmark;
 pub mod nodal_load;
 pub mod rigid_body;
-pub mod sparse;
+pub(crate) mod sparse;
 pub mod stable_step;
 pub mod stages;
 pub mod state;
 pub mod static_solve;
 pub mod step_settings;
 pub mod stepper;
+pub mod tangent;
 pub mod tet_body;
 pub mod tet_kernel;
 pub mod tet_subdomain;
@@ -52,16 +53,17 @@ pub use checkpoint::{CheckpointError, Decoder, Encoder};
 pub use error::CoreError;
 pub use gravity::Gravity;
 pub use material::Material;
-pub use model::Model;
+pub use model::{Linearized, Model, Persistence, Persistent, StepEvents};
 pub use newmark::{Newmark, StepCounts, TangentUpdate};
 pub use nodal_load::NodalLoad;
 pub use rigid_body::RigidBodies;
-pub use sparse::{FactorStats, Tangent};
+pub use sparse::FactorStats;
 pub use stages::{Stage, StageShare, StageTimes};
 pub use state::{Dofs, ParticleSpin, State};
 pub use static_solve::{StaticSolver, StaticSteps};
 pub use step_settings::{Scheme, StepRequest, StepSettings, Stepping};
 pub use stepper::{choose_step, stable_step, Stepper};
+pub use tangent::Tangent;
 pub use tet_body::TetBody;
 pub use time_function::{Cyclic, TimeFunction};
 pub use verlet::Verlet;

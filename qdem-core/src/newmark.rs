@@ -36,8 +36,8 @@
 //!   systems.
 //!
 //! Constraints (Eqs. 23, 27) are eliminated: fixed DOFs are left out of the system
-//! ([`FreeDofs`]) and keep zero velocity and acceleration. The effective matrix is factorised by
-//! [`SparseCholesky`]: with [`TangentUpdate::Fixed`] once, at [`Stepper::initialize`] (exact for
+//! (`sparse::FreeDofs`) and keep zero velocity and acceleration. The effective matrix is factorised by
+//! `sparse::SparseCholesky`: with [`TangentUpdate::Fixed`] once, at [`Stepper::initialize`] (exact for
 //! a linear small-strain run; each step then costs one force evaluation and two triangular
 //! solves); with [`TangentUpdate::EveryStep`] K and C are reassembled at every step's start
 //! and refactorised, reusing the symbolic analysis. The fixity is read when factorising.
@@ -61,7 +61,7 @@ use rayon::prelude::*;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TangentUpdate {
     /// With K and C at the initial state, and again only when a model's events change its
-    /// tangent ([`Model::commit_step`]: bonds broken, contacts made or lost).
+    /// tangent ([`crate::StepEvents::commit_step`]: bonds broken, contacts made or lost).
     #[default]
     Fixed,
     /// Every step, with K and C at the step's start (large displacements or rotations).
@@ -195,7 +195,7 @@ impl Newmark {
     }
 
     /// The same stepper with the adaptive control of paper 001 Eqs. 29–30: a step that a
-    /// model's [`Model::check_step`] rejects is retaken once from its start with ∆t·√α (but
+    /// model's [`crate::StepEvents::check_step`] rejects is retaken once from its start with ∆t·√α (but
     /// not shorter than ∆t/16), and the remainder of the nominal step follows as further
     /// sub-steps, each checked the same way (so outputs stay on the nominal grid). Off by
     /// default.
@@ -263,6 +263,18 @@ impl Newmark {
         system.dofs = Some(dofs);
         self.counts.factorizations += 1;
         Ok(())
+    }
+
+    /// Collects the models' tangent at `state` and factorises the effective matrix of the
+    /// nominal step again: what the next step does after an event changed the tangent (a bond
+    /// broke, a contact opened). Implicit steppers only.
+    pub fn refactorize(
+        &mut self,
+        state: &State,
+        models: &[Box<dyn Model>],
+    ) -> Result<(), CoreError> {
+        self.system.invalidate();
+        self.refactor(state, models, self.dt)
     }
 
     /// One implicit step of length `h` (Eq. 26, linearised at the step's start): refactorises
@@ -358,9 +370,11 @@ impl Newmark {
             self.advance(state, models, h, stages)?;
             let alpha = models
                 .iter_mut()
-                .filter_map(|m| m.check_step(state, forces_here))
+                .filter_map(|m| m.events()?.check_step(state, forces_here))
                 .min_by(f64::total_cmp);
-            let stale = models.iter().any(|m| m.tangent_stale());
+            let stale = models
+                .iter_mut()
+                .any(|m| m.events().is_some_and(|e| e.tangent_stale()));
             let Some(saved) = &self.saved else { break };
             if stale && redos < MAX_REDOS {
                 // Redo with the contacts the trial met in the matrix (an active-set pass).
@@ -381,9 +395,9 @@ impl Newmark {
                 _ => break,
             }
         }
-        let changed = models
-            .iter_mut()
-            .fold(false, |changed, m| m.commit_step(state) | changed);
+        let changed = models.iter_mut().fold(false, |changed, m| {
+            m.events().is_some_and(|e| e.commit_step(state)) | changed
+        });
         self.counts.substeps += 1;
         if changed {
             self.counts.event_steps += 1;
@@ -401,12 +415,15 @@ pub(crate) fn collect_tangent(
     tangent: &mut Tangent,
 ) -> Result<(), CoreError> {
     tangent.clear();
-    match models.iter().find(|m| !m.add_tangent(state, tangent)) {
-        Some(model) => Err(CoreError::NoTangent {
-            model: model.name().to_string(),
-        }),
-        None => Ok(()),
+    for model in models {
+        let Some(linear) = model.linearized() else {
+            return Err(CoreError::NoTangent {
+                model: model.name().to_string(),
+            });
+        };
+        linear.add_tangent(state, tangent);
     }
+    Ok(())
 }
 
 /// Number of DOFs of the generalised nodes (particles, then their rotations), 3 each.

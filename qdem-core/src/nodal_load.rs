@@ -1,9 +1,9 @@
 //! A force shared equally by a set of particles, scaled by a time function (the scene's
 //! `[[load]]`).
 
-use crate::model::Model;
-use crate::sparse::Tangent;
+use crate::model::{Linearized, Model, Persistence};
 use crate::state::State;
+use crate::tangent::Tangent;
 use crate::time_function::TimeFunction;
 use crate::Vec3;
 
@@ -30,11 +30,6 @@ impl NodalLoad {
 }
 
 impl Model for NodalLoad {
-    /// No history: the forces follow from the state alone.
-    fn checkpointable(&self) -> bool {
-        true
-    }
-
     fn name(&self) -> &str {
         &self.name
     }
@@ -46,8 +41,17 @@ impl Model for NodalLoad {
         }
     }
 
-    /// Position- and velocity-independent: no tangent.
-    fn add_tangent(&self, _state: &State, _tangent: &mut Tangent) -> bool {
-        true
+    fn linearized(&self) -> Option<&dyn Linearized> {
+        Some(self)
     }
+
+    /// No history: the forces follow from the state alone.
+    fn persistence(&self) -> Persistence<'_> {
+        Persistence::Stateless
+    }
+}
+
+impl Linearized for NodalLoad {
+    /// Position- and velocity-independent: no tangent.
+    fn add_tangent(&self, _state: &State, _tangent: &mut Tangent) {}
 }

@@ -1,10 +1,8 @@
 //! Sparse assembly and Cholesky factorisation for the implicit Newmark step (paper 001 Eq. 26)
 //! and the linear static solve.
 //!
-//! - [`Tangent`] collects the models' tangent stiffness K and damping C as 3×3 blocks per
-//!   particle pair in global numbering (DOF 3·particle + axis). Only the lower triangle
-//!   (row ≥ column) is kept: both matrices are symmetric and the Cholesky factorisation reads
-//!   the lower triangle only.
+//! - The models' tangent stiffness K and damping C arrive as a [`Tangent`] (lower-triangle
+//!   3×3 blocks per particle pair, [`crate::tangent`]).
 //! - [`FreeDofs`] eliminates the constraints of Eqs. 23 and 27 (B∆u = 0, Bü = 0 with B selecting
 //!   the fixed directions): fixed DOFs are removed from the system, the others numbered
 //!   compactly in ascending order (so the lower triangle stays lower).
@@ -18,7 +16,6 @@
 //!   move rigidly (a singular stiffness), and [`explain_failure`] turns a failed factorisation
 //!   into a message naming the particle of the failing pivot, its body and the free bodies.
 
-use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::model::Model;
 use crate::state::{Dofs, State};
@@ -36,8 +33,7 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::time::Instant;
 
-/// One stored matrix entry (row, column, value).
-pub type Entry = Triplet<usize, usize, f64>;
+pub(crate) use crate::tangent::Tangent;
 
 /// The damping C of a [`Tangent`] as whole rows (each stored lower-triangle entry on both
 /// sides, duplicates kept, in the tangent's order), so that C x runs row by row in parallel and
@@ -127,118 +123,6 @@ pub const FIX_HINT: &str = "fix at least 3 non-collinear particles of it, or a f
 const GENERIC_CAUSE: &str = "a body is probably not constrained against rigid motion (fix some \
                              of its nodes) or a free particle belongs to no tetrahedron";
 
-/// The tangent stiffness K = −∂f/∂x and damping C = −∂f/∂v of a scene, as lower-triangle
-/// triplets in global DOF numbering; duplicates are summed on assembly.
-#[derive(Clone, Debug, Default)]
-pub struct Tangent {
-    stiffness: Vec<Entry>,
-    damping: Vec<Entry>,
-}
-
-impl Tangent {
-    /// An empty tangent.
-    pub fn new() -> Tangent {
-        Tangent::default()
-    }
-
-    /// Removes every entry, keeping the allocations.
-    pub fn clear(&mut self) {
-        self.stiffness.clear();
-        self.damping.clear();
-    }
-
-    /// Adds the stiffness block K_ij (∂ of the force on particle i by the position of j,
-    /// negated). Entries above the diagonal are dropped: add every block of a symmetric matrix.
-    pub fn add_stiffness(&mut self, i: usize, j: usize, block: &Mat3) {
-        push_lower(&mut self.stiffness, i, j, block);
-    }
-
-    /// Adds the damping block C_ij, as [`Tangent::add_stiffness`] does for K.
-    pub fn add_damping(&mut self, i: usize, j: usize, block: &Mat3) {
-        push_lower(&mut self.damping, i, j, block);
-    }
-
-    /// Adds K at (row DOF, column DOF), if on or below the diagonal: for models whose blocks
-    /// are mostly zero (a 2D beam couples x, y and the rotation about z only). A DOF is
-    /// 3·node + axis, node `state.len() + i` being the rotation of particle i.
-    pub fn add_stiffness_entry(&mut self, row: usize, col: usize, value: f64) {
-        if row >= col {
-            self.stiffness.push(Triplet::new(row, col, value));
-        }
-    }
-
-    /// Adds C at (row DOF, column DOF), as [`Tangent::add_stiffness_entry`] does for K.
-    pub fn add_damping_entry(&mut self, row: usize, col: usize, value: f64) {
-        if row >= col {
-            self.damping.push(Triplet::new(row, col, value));
-        }
-    }
-
-    /// Appends ready stiffness and damping entries (global DOFs, on or below the diagonal,
-    /// as [`Tangent::add_stiffness_entry`] keeps them): for models that keep their entries
-    /// between assemblies.
-    pub fn extend(&mut self, stiffness: &[Entry], damping: &[Entry]) {
-        debug_assert!(stiffness.iter().chain(damping).all(|e| e.row >= e.col));
-        self.stiffness.extend_from_slice(stiffness);
-        self.damping.extend_from_slice(damping);
-    }
-
-    /// The stored stiffness entries (lower triangle, global DOFs, duplicates not summed).
-    pub fn stiffness_entries(&self) -> &[Entry] {
-        &self.stiffness
-    }
-
-    /// Writes the entries into a checkpoint (an implicit stepper's factorised tangent).
-    pub(crate) fn save(&self, out: &mut Encoder) {
-        for list in [&self.stiffness, &self.damping] {
-            out.u64(list.len() as u64);
-            for e in list {
-                out.u64(e.row as u64);
-                out.u64(e.col as u64);
-                out.f64(e.val);
-            }
-        }
-    }
-
-    /// Reads back what [`Tangent::save`] wrote, for `dofs` degrees of freedom.
-    pub(crate) fn restore(
-        &mut self,
-        input: &mut Decoder<'_>,
-        dofs: usize,
-    ) -> Result<(), CheckpointError> {
-        for list in [&mut self.stiffness, &mut self.damping] {
-            let n = input.u64("tangent entries")?;
-            list.clear();
-            for _ in 0..n {
-                let (row, col) = (input.u64("a tangent row")?, input.u64("a tangent column")?);
-                let val = input.f64("a tangent value")?;
-                if row >= dofs as u64 || col > row {
-                    return Err(CheckpointError::Invalid {
-                        what: "tangent",
-                        detail: format!(
-                            "entry ({row}, {col}) outside the lower triangle of {dofs} DOFs"
-                        ),
-                    });
-                }
-                list.push(Triplet::new(row as usize, col as usize, val));
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Pushes the entries of block (i, j) that lie on or below the diagonal.
-fn push_lower(list: &mut Vec<Entry>, i: usize, j: usize, block: &Mat3) {
-    for a in 0..3 {
-        for b in 0..3 {
-            let (row, col) = (3 * i + a, 3 * j + b);
-            if row >= col {
-                list.push(Triplet::new(row, col, block[(a, b)]));
-            }
-        }
-    }
-}
-
 /// The numbering of the free DOFs: fixed DOFs (Eqs. 23, 27) are eliminated.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FreeDofs {
@@ -270,11 +154,6 @@ impl FreeDofs {
         self.count
     }
 
-    /// Whether every DOF is fixed.
-    pub fn is_empty(&self) -> bool {
-        self.count == 0
-    }
-
     /// The system index of global DOF `dof`, `None` if it is fixed.
     #[inline]
     pub fn index(&self, dof: usize) -> Option<usize> {
@@ -291,24 +170,9 @@ impl FreeDofs {
         self.index.iter().position(|&k| k == i)
     }
 
-    /// Copies the free components of per-particle vectors into `out` (length [`Self::len`]).
-    pub fn gather(&self, v: &[Vec3], out: &mut [f64]) {
-        for (dof, &i) in self.index.iter().enumerate() {
-            if i != FIXED {
-                out[i] = v[dof / 3][dof % 3];
-            }
-        }
-    }
-
-    /// Writes a system vector back to per-particle vectors, zero in fixed directions.
-    pub fn scatter(&self, x: &[f64], out: &mut [Vec3]) {
-        for (dof, &i) in self.index.iter().enumerate() {
-            out[dof / 3][dof % 3] = if i == FIXED { 0.0 } else { x[i] };
-        }
-    }
-
-    /// [`FreeDofs::gather`] over generalised nodes: the particles' vectors `parts.0`, then
-    /// their rotations' `parts.1` (empty when nothing rotates).
+    /// Copies the free components of the generalised nodes' vectors into `out` (length
+    /// [`Self::len`]): the particles' vectors `parts.0`, then their rotations' `parts.1`
+    /// (empty when nothing rotates).
     pub fn gather_nodes(&self, parts: (&[Vec3], &[Vec3]), out: &mut [f64]) {
         let n = parts.0.len();
         for (dof, &i) in self.index.iter().enumerate() {
@@ -375,14 +239,15 @@ impl Assembler {
     }
 
     /// The assembled matrix of `tangent` and the lumped `mass` (one per generalised node)
-    /// over `dofs`, scaled by `scales`.
+    /// over `dofs`, scaled by `scales`, and the seconds the assembly took.
     pub fn assemble(
         &mut self,
         tangent: &Tangent,
         mass: &[f64],
         dofs: &FreeDofs,
         scales: Scales,
-    ) -> Result<SparseColMatRef<'_, usize, f64>, CoreError> {
+    ) -> Result<(SparseColMatRef<'_, usize, f64>, f64), CoreError> {
+        let start = Instant::now();
         let terms = Terms {
             tangent,
             mass,
@@ -399,7 +264,8 @@ impl Assembler {
             debug_assert!(filled, "a pattern built from the entries holds them");
             self.matrix = Some(matrix);
         }
-        Ok(self.matrix.as_ref().expect("assembled above").as_ref())
+        let matrix = self.matrix.as_ref().expect("assembled above").as_ref();
+        Ok((matrix, start.elapsed().as_secs_f64()))
     }
 }
 
@@ -505,6 +371,10 @@ pub struct FactorStats {
     pub symbolic_seconds: f64,
     /// Time of the last numeric factorisation (s).
     pub numeric_seconds: f64,
+    /// Time of the assembly of the matrix last factorised (s).
+    pub assembly_seconds: f64,
+    /// Time of the last solve, a forward and a backward triangular solve (s).
+    pub solve_seconds: f64,
     /// Number of symbolic analyses so far (one per sparsity pattern met).
     pub analyses: usize,
     /// Number of numeric factorisations so far.
@@ -540,11 +410,6 @@ pub struct SparseCholesky {
 }
 
 impl SparseCholesky {
-    /// An empty factorisation.
-    pub fn new() -> SparseCholesky {
-        SparseCholesky::default()
-    }
-
     /// Whether a numeric factorisation is available for [`Self::solve_in_place`].
     pub fn is_factored(&self) -> bool {
         self.factored
@@ -561,13 +426,14 @@ impl SparseCholesky {
         &self.stats
     }
 
-    /// Factorises the symmetric matrix `a`, given by its lower triangle: the symbolic analysis
-    /// is redone only if the pattern differs from the last one. `what` names the matrix in the
-    /// error raised when it is not positive definite; the failing pivot is then kept for
-    /// [`Self::failed_pivot`] (see [`explain_failure`] for a message naming its body).
+    /// Factorises the symmetric matrix `a`, given by its lower triangle, which took
+    /// `assembly_seconds` to assemble: the symbolic analysis is redone only if the pattern
+    /// differs from the last one. `what` names the matrix in the error raised when it is not
+    /// positive definite; the failing pivot is then kept for [`Self::failed_pivot`] (see
+    /// [`explain_failure`] for a message naming its body).
     pub fn factorize(
         &mut self,
-        a: SparseColMatRef<'_, usize, f64>,
+        (a, assembly_seconds): (SparseColMatRef<'_, usize, f64>, f64),
         what: &'static str,
     ) -> Result<(), CoreError> {
         self.factored = false;
@@ -598,6 +464,7 @@ impl SparseCholesky {
             });
         }
         self.stats.numeric_seconds = start.elapsed().as_secs_f64();
+        self.stats.assembly_seconds = assembly_seconds;
         self.stats.factorizations += 1;
         self.factored = true;
         Ok(())
@@ -626,6 +493,8 @@ impl SparseCholesky {
             factor_nonzeros: symbolic.len_val(),
             symbolic_seconds: start.elapsed().as_secs_f64(),
             numeric_seconds: 0.0,
+            assembly_seconds: 0.0,
+            solve_seconds: 0.0,
             analyses: self.stats.analyses + 1,
             factorizations: self.stats.factorizations,
         };
@@ -648,6 +517,7 @@ impl SparseCholesky {
     /// If no factorisation is available or `rhs` has the wrong length.
     pub fn solve_in_place(&mut self, rhs: &mut [f64]) {
         assert!(self.factored, "solve_in_place before a factorisation");
+        let start = Instant::now();
         let analysis = self.analysis.as_mut().expect("factored implies analysed");
         let n = rhs.len();
         let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
@@ -657,6 +527,7 @@ impl SparseCholesky {
             faer::get_global_parallelism(),
             MemStack::new(&mut analysis.solve_scratch),
         );
+        self.stats.solve_seconds = start.elapsed().as_secs_f64();
     }
 }
 
@@ -701,7 +572,7 @@ pub fn explain_failure(
             particle = Some(p);
             body = models
                 .iter()
-                .find(|m| m.particles().binary_search(&p).is_ok())
+                .find(|m| particles_of(m.as_ref()).binary_search(&p).is_ok())
                 .map(|m| m.name().to_string());
             let axis = ["x", "y", "z"][dof % 3];
             match &body {
@@ -738,7 +609,7 @@ pub fn explain_failure(
     }
 }
 
-/// The models owning particles ([`Model::particles`], i.e. deformable bodies) that the fixed
+/// The models owning particles ([`crate::Linearized::particles`], i.e. deformable bodies) that the fixed
 /// directions of `dofs` leave free to move rigidly with no stiffness against it, each with the
 /// number of its free rigid-body modes (of 3 translations and 3 rotations, at the current
 /// positions).
@@ -757,7 +628,7 @@ pub fn unconstrained_bodies(
     models
         .iter()
         .filter_map(|m| {
-            let modes = free_rigid_modes(state, &m.particles(), tangent, dofs);
+            let modes = free_rigid_modes(state, &particles_of(m.as_ref()), tangent, dofs);
             (modes > 0).then(|| (m.name().to_string(), modes))
         })
         .collect()
@@ -959,21 +830,26 @@ mod tests {
         let mut assembler = Assembler::new();
         let first = chain(1.0);
         assert_close(
-            &stored(assembler.assemble(&first, &mass, &dofs, s).unwrap()),
+            &stored(assembler.assemble(&first, &mass, &dofs, s).unwrap().0),
             &dense(&first, &mass, &dofs, s),
         );
         // New values at the same entries: filled through the kept slots.
         let second = chain(7.0);
-        let kept = stored(assembler.assemble(&second, &mass, &dofs, s).unwrap());
+        let kept = stored(assembler.assemble(&second, &mass, &dofs, s).unwrap().0);
         assert_close(&kept, &dense(&second, &mass, &dofs, s));
         assert_close(
             &kept,
-            &stored(Assembler::new().assemble(&second, &mass, &dofs, s).unwrap()),
+            &stored(
+                Assembler::new()
+                    .assemble(&second, &mass, &dofs, s)
+                    .unwrap()
+                    .0,
+            ),
         );
         // An entry outside the pattern (particles 1 and 3) rebuilds it.
         let mut third = chain(7.0);
         third.add_stiffness(3, 1, &Mat3::from_element(0.3));
-        let rebuilt = assembler.assemble(&third, &mass, &dofs, s).unwrap();
+        let rebuilt = assembler.assemble(&third, &mass, &dofs, s).unwrap().0;
         assert_eq!(
             rebuilt.compute_nnz(),
             kept_nnz(&second, &mass, &dofs, s) + 9
@@ -985,6 +861,13 @@ mod tests {
         Assembler::new()
             .assemble(t, mass, dofs, s)
             .unwrap()
+            .0
             .compute_nnz()
     }
+}
+
+/// The particles a model's elements join ([`crate::Linearized::particles`]); none for a model
+/// without a linearisation.
+fn particles_of(model: &dyn Model) -> Vec<usize> {
+    model.linearized().map_or_else(Vec::new, |l| l.particles())
 }

@@ -3,17 +3,17 @@
 //!
 //! f is the total force the models give on the reference configuration at the requested time
 //! (loads and gravity; the internal force vanishes there), K the models' tangent stiffness at
-//! the reference configuration ([`crate::Model::add_tangent`]). For QDEM tetrahedra this is the
+//! the reference configuration ([`crate::Linearized::add_tangent`]). For QDEM tetrahedra this is the
 //! small-strain linear-tetrahedron stiffness, so the answer is the mesh's linear FEM solution.
-//! K is assembled and factorised by [`SparseCholesky`] on the first solve (with the fixity of
+//! K is assembled and factorised by `sparse::SparseCholesky` on the first solve (with the fixity of
 //! that moment) and reused for every later load level: one further force evaluation and two
 //! triangular solves per level.
 //!
 //! K alone is singular when a deformable body is free to move rigidly (no or too few fixed
 //! directions), so such a body is refused before factorising with
-//! [`CoreError::Unconstrained`], naming it ([`crate::sparse::unconstrained_bodies`]); any other
+//! [`CoreError::Unconstrained`], naming it (`sparse::unconstrained_bodies`); any other
 //! failed factorisation names the particle of the failing pivot and its body
-//! ([`crate::sparse::explain_failure`]).
+//! (`sparse::explain_failure`).
 
 use crate::error::CoreError;
 use crate::model::Model;

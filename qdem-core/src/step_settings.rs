@@ -3,7 +3,7 @@
 //! ([`StepSettings`]); and what the models learn of it ([`Stepping`]).
 //!
 //! The step rule: an explicit scheme (Verlet, Newmark with β = 0) takes `safety` times the
-//! rigorous stable bound of [`crate::stable_step`] when no step is requested, and refuses a
+//! rigorous stable bound of [`crate::stepper::stable_step`] when no step is requested, and refuses a
 //! requested step above the bound; an implicit or static scheme takes the requested step, or
 //! the fallback the request names. An automatic step is shrunk so that a whole number of steps
 //! reaches the request's `fit_to` time.

@@ -7,7 +7,7 @@
 //! bit-identical for any number of threads (no atomics, no reduction-order dependence).
 //! Elastic materials take a path without the viscous stress.
 //!
-//! For implicit and static solves the body adds its tangent (the [`Model::add_tangent`] hook):
+//! For implicit and static solves the body adds its tangent (its [`crate::Linearized`] facet):
 //! the small-strain linear-tetrahedron stiffness K_e = V Gᵀ D G per element, with the volume V
 //! and shape-function gradients G of the current configuration, and the same operator with the
 //! viscous Lamé pair for the damping C_e. This is the exact linearisation of Eqs. 1–10 about an
@@ -16,10 +16,10 @@
 
 use crate::error::CoreError;
 use crate::material::{Lame, Material};
-use crate::model::Model;
-use crate::sparse::Tangent;
+use crate::model::{Linearized, Model, Persistence};
 use crate::stable_step::{critical_step, element_rate_bound};
 use crate::state::State;
+use crate::tangent::Tangent;
 use crate::tet_kernel::{
     deformation_gradient, edge_matrix, strain_energy, tet_stress, vertex_forces, von_mises,
 };
@@ -268,11 +268,6 @@ fn incidence_lists(tets: &[[u32; 4]]) -> (usize, Vec<u32>, Vec<u32>) {
 }
 
 impl Model for TetBody {
-    /// No history: the forces follow from the state alone.
-    fn checkpointable(&self) -> bool {
-        true
-    }
-
     fn failure(&self, state: &State) -> Option<CoreError> {
         let tet = self.inverted?;
         let x = self.tets[tet].map(|n| state.position[n as usize]);
@@ -297,32 +292,6 @@ impl Model for TetBody {
         self.gather(force);
     }
 
-    fn add_tangent(&self, state: &State, tangent: &mut Tangent) -> bool {
-        let viscous = !self.material.is_elastic();
-        for tet in &self.tets {
-            let (volume, g) = current_gradients(&tet.map(|n| state.position[n as usize]));
-            for (a, &i) in tet.iter().enumerate() {
-                for (b, &j) in tet.iter().enumerate() {
-                    let (i, j) = (i as usize, j as usize);
-                    tangent.add_stiffness(i, j, &lame_block(volume, &g[a], &g[b], self.pair()));
-                    if viscous {
-                        tangent.add_damping(i, j, &lame_block(volume, &g[a], &g[b], self.vpair()));
-                    }
-                }
-            }
-        }
-        true
-    }
-
-    fn particles(&self) -> Vec<usize> {
-        self.incidence_start
-            .windows(2)
-            .enumerate()
-            .filter(|(_, w)| w[1] > w[0])
-            .map(|(i, _)| self.first + i)
-            .collect()
-    }
-
     fn stable_dt(&self, _state: &State) -> Option<f64> {
         Some(critical_step(self.omega_squared, self.damping_rate))
     }
@@ -337,5 +306,41 @@ impl Model for TetBody {
             })
             .sum();
         Some(energy)
+    }
+
+    fn linearized(&self) -> Option<&dyn Linearized> {
+        Some(self)
+    }
+
+    /// No history: the forces follow from the state alone.
+    fn persistence(&self) -> Persistence<'_> {
+        Persistence::Stateless
+    }
+}
+
+impl Linearized for TetBody {
+    fn add_tangent(&self, state: &State, tangent: &mut Tangent) {
+        let viscous = !self.material.is_elastic();
+        for tet in &self.tets {
+            let (volume, g) = current_gradients(&tet.map(|n| state.position[n as usize]));
+            for (a, &i) in tet.iter().enumerate() {
+                for (b, &j) in tet.iter().enumerate() {
+                    let (i, j) = (i as usize, j as usize);
+                    tangent.add_stiffness(i, j, &lame_block(volume, &g[a], &g[b], self.pair()));
+                    if viscous {
+                        tangent.add_damping(i, j, &lame_block(volume, &g[a], &g[b], self.vpair()));
+                    }
+                }
+            }
+        }
+    }
+
+    fn particles(&self) -> Vec<usize> {
+        self.incidence_start
+            .windows(2)
+            .enumerate()
+            .filter(|(_, w)| w[1] > w[0])
+            .map(|(i, _)| self.first + i)
+            .collect()
     }
 }

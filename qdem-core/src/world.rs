@@ -19,7 +19,7 @@
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
-use crate::model::Model;
+use crate::model::{Model, Persistence};
 use crate::stages::{Stage, StageShare, StageTimes};
 use crate::state::State;
 use crate::step_settings::StepSettings;
@@ -249,7 +249,8 @@ impl World {
 
     /// Whether the world can be checkpointed, or the first model or the stepper that cannot.
     pub fn checkpointable(&self) -> Result<(), CheckpointError> {
-        if let Some(m) = self.models.iter().find(|m| !m.checkpointable()) {
+        let unsupported = |m: &&Box<dyn Model>| matches!(m.persistence(), Persistence::Unsupported);
+        if let Some(m) = self.models.iter().find(unsupported) {
             return Err(CheckpointError::Unsupported {
                 what: format!("model `{}`", m.name()),
             });
@@ -262,7 +263,9 @@ impl World {
         self.state.save(out);
         for m in &self.models {
             out.tag(&format!("model {}", m.name()));
-            m.save(out);
+            if let Persistence::Saved(history) = m.persistence() {
+                history.save(out);
+            }
         }
         self.stepper.save(out)
     }
@@ -274,7 +277,9 @@ impl World {
         self.state.restore(input)?;
         for m in self.models.iter_mut() {
             input.tag(&format!("model {}", m.name()))?;
-            m.restore(input)?;
+            if let Some(history) = m.persistent_mut() {
+                history.restore(input)?;
+            }
         }
         self.stepper
             .resume(&mut self.state, &mut self.models, input)?;

@@ -2,7 +2,9 @@
 //! average acceleration conserves energy exactly and lengthens the period to
 //! T̃/T = ω∆t / (2 atan(ω∆t/2)); central difference is stable for ω∆t ≤ 2 only.
 
-use qdem_core::{CoreError, Model, Newmark, State, StaticSolver, Stepper, Tangent, Vec3};
+use qdem_core::{
+    CoreError, Linearized, Model, Newmark, State, StaticSolver, Stepper, Tangent, Vec3,
+};
 
 /// A linear spring of stiffness k from one particle to its reference position.
 struct Spring {
@@ -18,9 +20,14 @@ impl Model for Spring {
         force[0] -= self.k * state.displacement(0);
     }
 
-    fn add_tangent(&self, _state: &State, tangent: &mut Tangent) -> bool {
+    fn linearized(&self) -> Option<&dyn Linearized> {
+        Some(self)
+    }
+}
+
+impl Linearized for Spring {
+    fn add_tangent(&self, _state: &State, tangent: &mut Tangent) {
         tangent.add_stiffness(0, 0, &(qdem_core::Mat3::identity() * self.k));
-        true
     }
 }
 
@@ -152,9 +159,14 @@ impl Model for Contact {
         force[0].x += self.k * (-x).max(0.0) - self.weight;
     }
 
-    fn add_tangent(&self, _state: &State, tangent: &mut Tangent) -> bool {
+    fn linearized(&self) -> Option<&dyn Linearized> {
+        Some(self)
+    }
+}
+
+impl Linearized for Contact {
+    fn add_tangent(&self, _state: &State, tangent: &mut Tangent) {
         tangent.add_stiffness(0, 0, &(qdem_core::Mat3::identity() * self.k));
-        true
     }
 }
 
@@ -209,9 +221,14 @@ impl Model for OneSidedDashpot {
         force[0].x += self.c * (-state.velocity[0].x).max(0.0) - self.push;
     }
 
-    fn add_tangent(&self, _state: &State, tangent: &mut Tangent) -> bool {
+    fn linearized(&self) -> Option<&dyn Linearized> {
+        Some(self)
+    }
+}
+
+impl Linearized for OneSidedDashpot {
+    fn add_tangent(&self, _state: &State, tangent: &mut Tangent) {
         tangent.add_damping(0, 0, &(qdem_core::Mat3::identity() * self.c));
-        true
     }
 }
 

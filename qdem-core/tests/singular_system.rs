@@ -4,8 +4,8 @@
 //! factorisation names the particle of the failing pivot and its model.
 
 use qdem_core::{
-    CoreError, Dofs, Mat3, Material, Model, Newmark, NodalLoad, State, StaticSolver, Stepper,
-    Tangent, TetBody, TimeFunction, Vec3,
+    CoreError, Dofs, Linearized, Mat3, Material, Model, Newmark, NodalLoad, State, StaticSolver,
+    Stepper, Tangent, TetBody, TimeFunction, Vec3,
 };
 use qdem_mesh::structured_box;
 
@@ -136,13 +136,17 @@ impl Model for Springs {
         }
     }
 
-    fn add_tangent(&self, _state: &State, tangent: &mut Tangent) -> bool {
+    fn linearized(&self) -> Option<&dyn Linearized> {
+        Some(self)
+    }
+}
+
+impl Linearized for Springs {
+    fn add_tangent(&self, _state: &State, tangent: &mut Tangent) {
         for i in (0..self.count).filter(|&i| i != self.loose) {
             tangent.add_stiffness(i, i, &Mat3::identity());
         }
-        true
     }
-
     fn particles(&self) -> Vec<usize> {
         (0..self.count).collect()
     }
