@@ -1,15 +1,13 @@
 //! Command-line parsing and the four commands. Errors from the libraries are rendered once,
 //! by `main`, through [`CliError`]'s `Display`.
 
-use crate::{bench, progress, verify};
+use crate::{bench, check, progress, verify};
 use qdem_bench::throughput::BenchPlan;
-use qdem_core::Model as _;
-use qdem_io::build::{BodyKind, BuildError, Simulation};
-use qdem_io::runner::{checkpoint_support, make_stepper, run_with, RunError, RunOptions};
+use qdem_io::build::{BuildError, Simulation};
+use qdem_io::runner::{run_with, RunError, RunOptions};
 use qdem_io::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
 use thiserror::Error;
 
 /// Usage text.
@@ -197,7 +195,7 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
         "check" => {
             let o = parse(rest, &["--threads"])?;
             let scene = one_scene(&o, "check")?;
-            thread_pool(o.threads.as_deref())?.install(|| check_scene(&scene))
+            thread_pool(o.threads.as_deref())?.install(|| check::check_scene(&scene))
         }
         "analyze" => {
             let o = parse(rest, &["--out", "--from", "--to", "--bandwidth", "--fmax"])?;
@@ -343,164 +341,4 @@ fn run_scene(path: &Path, out: Option<&Path>, resume: Option<&Path>) -> Result<(
         out_dir.display()
     );
     Ok(())
-}
-
-fn check_scene(path: &Path) -> Result<(), CliError> {
-    let scene = Scene::load(path)?;
-    let mut sim = Simulation::build(scene)?;
-    println!("scene {}: valid", path.display());
-    for w in &sim.warnings {
-        println!("warning: {w}");
-    }
-    for body in &sim.bodies {
-        let s = &body.stats;
-        let mass = sim.body_mass(body);
-        let kind = match body.kind {
-            BodyKind::Rigid { .. } => "rigid",
-            BodyKind::Deformable { .. } => "deformable",
-        };
-        println!(
-            "body `{}` ({}, {kind}): {} particles, {} tets, volume {:.6e} m^3, mass {:.6e} kg, edges {:.4e}..{:.4e} m, worst quality {:.3} (tet {})",
-            body.name,
-            body.mesh.display(),
-            s.nodes,
-            s.tets,
-            s.volume,
-            mass,
-            s.min_edge,
-            s.max_edge,
-            s.worst_quality,
-            s.worst_tet
-        );
-    }
-    if let Some(b) = sim.bonded() {
-        let mass: f64 = sim.state.mass.iter().sum();
-        println!(
-            "bonded body `{}`: {} particles (radius {:.4e} m), {} beam bonds, mass {:.6e} kg; \
-             paper 001 Eq. 28 dt_crit {:.4e} s",
-            b.name(),
-            sim.state.len(),
-            b.radii()[0],
-            b.bonds().len(),
-            mass,
-            b.initial_critical_step()
-        );
-    }
-    if let Some(contacts) = sim.contacts() {
-        println!(
-            "contact: {} spheres, {} walls, {} candidate pairs and wall contacts at the start",
-            contacts.spheres(),
-            contacts.walls(),
-            contacts.candidates()
-        );
-    }
-    for p in &sim.probes {
-        println!(
-            "probe `{}`: particle {} at {:.3e} m from the requested point",
-            p.name, p.particle, p.distance
-        );
-    }
-    let (bound, limiter) = &sim.stable_dt;
-    println!(
-        "integrator {}: dt {:.6e} s ({:.3}x the explicit stable bound {bound:.6e} s set by `{limiter}`); {} steps to t_end = {} s",
-        sim.scene.run.integrator.name(),
-        sim.dt,
-        sim.dt / bound,
-        sim.steps(),
-        sim.scene.run.t_end
-    );
-    match checkpoint_support(&sim) {
-        Ok(()) => println!("checkpoints: supported (`checkpoint_every`, Ctrl-C, --resume)"),
-        Err(why) => println!("checkpoints: not supported: {why}"),
-    }
-    let (per_step, stepped) = measure_step_cost(&mut sim, 20)?;
-    let total = per_step * sim.steps() as f64;
-    println!(
-        "measured {:.3e} s/step on {} threads ({:.3e} tet-steps/s): estimated run time {} (outputs not counted)",
-        per_step,
-        rayon::current_num_threads(),
-        sim.tets() as f64 / per_step,
-        progress::clock(total)
-    );
-    print_force_split(&mut sim, &stepped, per_step, 10);
-    Ok(())
-}
-
-/// Where a step's time goes: each model's force evaluation timed over `n` calls on the state
-/// the cost measurement left, as a share of the measured step; models under 1% are summed.
-fn print_force_split(sim: &mut Simulation, state: &qdem_core::State, per_step: f64, n: usize) {
-    let mut force = vec![qdem_core::Vec3::zeros(); state.len()];
-    let mut torque = vec![qdem_core::Vec3::zeros(); state.rigid.len() + state.spin.len()];
-    let mut rest = 0.0;
-    let mut forces = 0.0;
-    println!("time per step by model (force evaluation, {n} calls each):");
-    for model in sim.models.iter_mut() {
-        let start = Instant::now();
-        for _ in 0..n {
-            model.add_forces(state, &mut force, &mut torque);
-        }
-        let seconds = start.elapsed().as_secs_f64() / n as f64;
-        forces += seconds;
-        if seconds < 0.01 * per_step {
-            rest += seconds;
-            continue;
-        }
-        println!(
-            "  {:<24} {seconds:.3e} s ({:.1}%)",
-            model.name(),
-            100.0 * seconds / per_step
-        );
-    }
-    println!(
-        "  {:<24} {rest:.3e} s ({:.1}%)",
-        "other models",
-        100.0 * rest / per_step
-    );
-    let integrate = (per_step - forces).max(0.0);
-    println!(
-        "  {:<24} {integrate:.3e} s ({:.1}%)",
-        "integration and checks",
-        100.0 * integrate / per_step
-    );
-    if let Some(c) = sim.contacts() {
-        println!(
-            "  contacts after the measured steps: {} candidate pairs and wall candidates, {} touching",
-            c.candidates(),
-            c.contacts()
-        );
-    }
-}
-
-/// Wall seconds per step of the scene's own stepper, measured over `n` steps on a copy of the
-/// state; for implicit and static scenes also prints the sparse system's size, non-zeros,
-/// Cholesky fill and factorisation time from the stepper's one factorisation (in
-/// `initialize`, which is not timed).
-fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<(f64, qdem_core::State), CliError> {
-    let run_error = |source| RunError::Core {
-        scene: sim.scene.path.clone(),
-        source,
-    };
-    let mut state = sim.state.clone();
-    let mut stepper = make_stepper(sim).map_err(run_error)?;
-    stepper
-        .initialize(&mut state, &mut sim.models)
-        .map_err(run_error)?;
-    if let Some(s) = stepper.factor_stats() {
-        println!(
-            "implicit system: {} unknowns, {} non-zeros (lower triangle), factor {} non-zeros (fill {:.1}x); symbolic {:.3e} s, numeric {:.3e} s",
-            s.dofs,
-            s.nonzeros,
-            s.factor_nonzeros,
-            s.factor_nonzeros as f64 / s.nonzeros.max(1) as f64,
-            s.symbolic_seconds,
-            s.numeric_seconds
-        );
-    }
-    let start = Instant::now();
-    for _ in 0..n {
-        stepper
-            .step(&mut state, &mut sim.models)
-            .map_err(run_error)?;
-    }
-    Ok((start.elapsed().as_secs_f64() / n as f64, state))
 }

@@ -6,6 +6,7 @@
 //! `qdem-bench` beside the criterion benches that share it.
 
 pub mod bench;
+pub mod check;
 pub mod command;
 pub mod progress;
 pub mod verify;
