@@ -1,8 +1,10 @@
 //! Command-line parsing and the four commands. Errors from the libraries are rendered once,
 //! by `main`, through [`CliError`]'s `Display`.
 
-use crate::{bench, check, progress, verify};
+use crate::{check, progress};
 use qdem_bench::throughput::BenchPlan;
+use qdem_bench::{implicit, throughput, verify};
+use qdem_core::CoreError;
 use qdem_io::build::{BuildError, Simulation};
 use qdem_io::runner::{run_with, RunError, RunOptions};
 use qdem_io::scene::{Scene, SceneError};
@@ -42,12 +44,12 @@ pub enum CliError {
     /// A run that failed.
     #[error(transparent)]
     Run(#[from] RunError),
-    /// A cantilever run of `verify --full` failed.
-    #[error(transparent)]
-    Study(#[from] qdem_bench::cantilever::StudyError),
     /// A verification fixture that failed to run or missed its tolerance.
-    #[error("{0}")]
-    Verify(String),
+    #[error(transparent)]
+    Verify(#[from] verify::VerifyError),
+    /// A measurement of `qdem bench --implicit` failed.
+    #[error(transparent)]
+    Bench(#[from] CoreError),
     /// An analysis that could not be made.
     #[error(transparent)]
     Analyze(#[from] qdem_io::analyze::AnalyzeError),
@@ -212,6 +214,7 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
             let out = o.out.unwrap_or_else(|| PathBuf::from("out/verify"));
             thread_pool(None)?
                 .install(|| verify::run_and_print(o.json, o.full.then_some(out.as_path())))
+                .map_err(CliError::from)
         }
         "bench" => {
             let o = parse(
@@ -225,9 +228,9 @@ pub fn dispatch(args: &[String]) -> Result<(), CliError> {
                     .as_deref()
                     .and_then(|t| t.last().copied())
                     .unwrap_or(2);
-                return bench::implicit_and_print(o.tets, threads, o.json);
+                return Ok(implicit::run_and_print(o.tets, threads, o.json)?);
             }
-            bench::run_and_print(&BenchPlan::new(o.tets, o.threads, o.steps), o.json);
+            throughput::run_and_print(&BenchPlan::new(o.tets, o.threads, o.steps), o.json);
             Ok(())
         }
         "help" | "--help" | "-h" => {
