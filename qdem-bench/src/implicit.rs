@@ -2,9 +2,11 @@
 //! number of unknowns: assembly of M + γ∆t C + β∆t² K, symbolic analysis, numeric
 //! factorisation, one forward/backward solve, and one implicit Newmark step that reuses the
 //! factorisation (force evaluation + solve + update), on a structured block clamped on one face.
+//! [`run_and_print`] is `qdem bench --implicit`: those costs as a table or as one JSON document.
 
-use crate::throughput::{block_mesh, body_on, on_threads, Ordering};
+use crate::throughput::{block_mesh, body_on, cpu_model, on_threads, Ordering};
 use qdem_core::{CoreError, Dofs, Model, Newmark, Stepper};
+use serde_json::json;
 use std::time::Instant;
 
 /// One measurement of the implicit path.
@@ -65,4 +67,61 @@ pub fn measure_implicit(tets: usize, threads: usize) -> Result<ImplicitResult, C
             step_seconds,
         })
     })
+}
+
+/// `qdem bench --implicit`: the implicit path's costs against the number of unknowns, by
+/// default on blocks of about 10⁴, 10⁵ and 3 × 10⁵ unknowns.
+pub fn run_and_print(
+    tets: Option<Vec<usize>>,
+    threads: usize,
+    as_json: bool,
+) -> Result<(), CoreError> {
+    let sizes = tets.unwrap_or_else(|| vec![16_000, 180_000, 550_000]);
+    if !as_json {
+        println!("machine: {}, {threads} threads", cpu_model());
+        println!(
+            "{:>8} {:>8} {:>10} {:>12} {:>9} {:>9} {:>9} {:>9} {:>9} {:>10}",
+            "tets",
+            "unknowns",
+            "nnz(A)",
+            "nnz(L)",
+            "assemble",
+            "symbolic",
+            "numeric",
+            "solve",
+            "step",
+            "step/solve"
+        );
+    }
+    let mut results = Vec::new();
+    for size in sizes {
+        let r = measure_implicit(size, threads)?;
+        let ratio = r.step_seconds / r.solve_seconds;
+        if !as_json {
+            println!(
+                "{:>8} {:>8} {:>10} {:>12} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>10.2}",
+                r.tets,
+                r.dofs,
+                r.nonzeros,
+                r.factor_nonzeros,
+                r.assembly_seconds,
+                r.symbolic_seconds,
+                r.numeric_seconds,
+                r.solve_seconds,
+                r.step_seconds,
+                ratio
+            );
+        }
+        results.push(json!({
+            "tets": r.tets, "unknowns": r.dofs, "nonzeros": r.nonzeros, "factor_nonzeros": r.factor_nonzeros,
+            "assembly_seconds": r.assembly_seconds, "symbolic_seconds": r.symbolic_seconds,
+            "numeric_seconds": r.numeric_seconds, "solve_seconds": r.solve_seconds,
+            "step_seconds": r.step_seconds, "step_over_solve": ratio,
+        }));
+    }
+    if as_json {
+        let doc = json!({"machine": {"cpu": cpu_model(), "threads": threads}, "implicit": results});
+        println!("{}", serde_json::to_string_pretty(&doc).expect("json"));
+    }
+    Ok(())
 }

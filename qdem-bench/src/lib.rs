@@ -1,13 +1,16 @@
 //! # qdem-bench
 //!
-//! Speed measurements of qdem: [`implicit`] times the sparse Cholesky path against the number
-//! of unknowns; [`throughput`] holds the structured-mesh kernel benchmark used
-//! by the criterion benches (`cargo bench -p qdem-bench`) and by `qdem bench` (JSON output);
-//! [`granular`] is the settled sphere packing compared with LIGGGHTS; [`cantilever`] runs the paper's cantilever and measures it; [`speed_vs_error`] is the study
-//! behind `docs/speed-vs-error.md` (binary `study`).
+//! Speed and accuracy measurements of qdem: [`implicit`] times the sparse Cholesky path against
+//! the number of unknowns (`qdem bench --implicit`); [`throughput`] holds the structured-mesh
+//! kernel benchmark used by the criterion benches (`cargo bench -p qdem-bench`) and by
+//! `qdem bench` (table or JSON); [`verify`] holds the analytical fixtures of `qdem verify`;
+//! [`granular`] is the settled sphere packing compared with LIGGGHTS; [`cantilever`] runs the
+//! paper's cantilever and measures it; [`speed_vs_error`] is the study behind
+//! `docs/speed-vs-error.md` (binary `study`).
 
 pub mod cantilever;
 pub mod granular;
 pub mod implicit;
 pub mod speed_vs_error;
 pub mod throughput;
+pub mod verify;

@@ -2,10 +2,12 @@
 //! structured meshes, elastic and viscoelastic, for several thread counts, in
 //! tetrahedron-steps per second. A STREAM-like triad measured in the same process gives the
 //! machine's memory bandwidth, the peer against which the kernel's compulsory memory traffic
-//! per tet-step is judged.
+//! per tet-step is judged. [`run_and_print`] is `qdem bench`: the measurements as a table or as
+//! one JSON document.
 
 use qdem_core::{Material, Model, State, Stepper, TetBody, Vec3, Verlet};
 use qdem_mesh::{structured_box, TetMesh};
+use serde_json::json;
 use std::time::Instant;
 
 /// What to measure.
@@ -219,4 +221,100 @@ pub fn cpu_model() -> String {
                 .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
         })
         .unwrap_or_else(|| "unknown".into())
+}
+
+/// Runs the plan and prints a table or one JSON document.
+pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
+    let mut results = Vec::new();
+    let bandwidth: Vec<(usize, f64)> = plan
+        .threads
+        .iter()
+        .map(|&t| (t, triad_bandwidth(t)))
+        .collect();
+    if !as_json {
+        println!(
+            "machine: {} ({} cores available)",
+            cpu_model(),
+            std::thread::available_parallelism().map_or(0, |n| n.get())
+        );
+        for (t, bw) in &bandwidth {
+            println!("triad bandwidth, {t} threads: {:.2} GB/s", bw / 1e9);
+        }
+        println!(
+            "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14} {:>10} {:>10}",
+            "tets",
+            "particles",
+            "material",
+            "threads",
+            "steps",
+            "tet-steps/s",
+            "B/tet-step",
+            "% of triad"
+        );
+    }
+    for &tets in &plan.tets {
+        for viscous in [false, true] {
+            for &threads in &plan.threads {
+                let r = measure(tets, viscous, threads, plan.steps);
+                let bw = bandwidth
+                    .iter()
+                    .find(|b| b.0 == threads)
+                    .map_or(f64::NAN, |b| b.1);
+                let fraction = r.tet_steps_per_second() * r.bytes_per_tet_step() / bw;
+                if !as_json {
+                    println!(
+                        "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14.4e} {:>10.0} {:>9.0}%",
+                        r.tets,
+                        r.particles,
+                        if viscous { "visco" } else { "elastic" },
+                        threads,
+                        r.steps,
+                        r.tet_steps_per_second(),
+                        r.bytes_per_tet_step(),
+                        100.0 * fraction
+                    );
+                }
+                results.push(json!({
+                    "tets": r.tets, "particles": r.particles,
+                    "material": if viscous { "viscoelastic" } else { "elastic" },
+                    "threads": r.threads, "steps": r.steps, "seconds": r.seconds,
+                    "tet_steps_per_second": r.tet_steps_per_second(),
+                    "particle_steps_per_second": (r.particles * r.steps) as f64 / r.seconds,
+                    "bytes_per_tet_step": r.bytes_per_tet_step(),
+                    "fraction_of_triad_bandwidth": fraction,
+                }));
+            }
+        }
+    }
+    let locality = locality_rows(plan, as_json);
+    if as_json {
+        let doc = json!({
+            "locality": locality,
+            "machine": { "cpu": cpu_model(), "cores": std::thread::available_parallelism().map_or(0, |n| n.get()) },
+            "triad_bandwidth_bytes_per_second": bandwidth.iter().map(|(t, b)| json!({"threads": t, "value": b})).collect::<Vec<_>>(),
+            "results": results,
+        });
+        println!("{}", serde_json::to_string_pretty(&doc).expect("json"));
+    }
+}
+
+/// Effect of node ordering: the largest planned block, elastic, on the most threads, in
+/// generator order, shuffled, and shuffled then reordered (reverse Cuthill–McKee).
+fn locality_rows(plan: &BenchPlan, as_json: bool) -> Vec<serde_json::Value> {
+    let (Some(&tets), Some(&threads)) = (plan.tets.iter().max(), plan.threads.iter().max()) else {
+        return Vec::new();
+    };
+    if !as_json {
+        println!("node ordering, {tets} tets, elastic, {threads} threads:");
+    }
+    [Ordering::Structured, Ordering::Shuffled, Ordering::Reordered]
+        .into_iter()
+        .map(|ordering| {
+            let r = measure_ordered(tets, ordering, false, threads, plan.steps);
+            if !as_json {
+                println!("{:>12?} {:>14.4e} tet-steps/s", ordering, r.tet_steps_per_second());
+            }
+            json!({"ordering": format!("{ordering:?}").to_lowercase(), "tets": r.tets, "threads": threads, "tet_steps_per_second": r.tet_steps_per_second()})
+        })
+        .collect()
 }

@@ -1,40 +1,27 @@
-//! Command-line parsing and the four commands. Errors from the libraries are rendered once,
-//! by `main`, through [`CliError`]'s `Display`.
+//! The command line (clap's derive API: [`Cli`]) and the five commands. Values are checked as
+//! they are parsed, so that a bad argument is refused before any work, naming its flag. Errors
+//! from the libraries are rendered once, by `main`, through [`CliError`]'s `Display`.
 
-use crate::{bench, progress, verify};
+use crate::{check, progress};
+use clap::{Args, Parser, Subcommand};
 use qdem_bench::throughput::BenchPlan;
-use qdem_core::{Halt, Model as _};
-use qdem_io::build::{BodyKind, BuildError, Simulation};
+use qdem_bench::{implicit, throughput, verify};
+use qdem_core::{CoreError, Halt};
+use qdem_io::analyze::AnalyzeOptions;
+use qdem_io::build::{BuildError, Simulation};
 use qdem_io::runner::{run_with, RunError, RunOptions};
 use qdem_io::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
 use thiserror::Error;
-
-/// Usage text.
-pub const USAGE: &str = "\
-usage:
-  qdem run SCENE [--out DIR] [--threads N] [--resume CHECKPOINT]
-                                             run a scene; outputs go to DIR (default: the scene's [output] dir);
-                                             Ctrl-C or SIGTERM stops it with DIR/checkpoint.qdc, which --resume continues
-  qdem check SCENE [--threads N]             validate a scene; print meshes, mass, stable dt, cost estimate
-  qdem analyze SCENE [--out DIR] [--from T] [--to T] [--bandwidth HZ] [--fmax HZ]
-                                             spectra (Parzen window, default 20 Hz) and mobility of a finished
-                                             run's probes into DIR/analysis (default: the scene's [output] dir)
-  qdem verify [--json] [--full [--out DIR]]  run the analytical fixtures (--full adds the cantilever meshes,
-                                             keeping their outputs and plots in DIR, default out/verify)
-  qdem bench [--json] [--tets N,N,..] [--threads N,N,..] [--steps N]
-                                             kernel throughput on structured meshes, tet-steps/s
-  qdem bench --implicit [--json] [--tets N,..] [--threads N]
-                                             sparse Cholesky: factorisation, solve and implicit step vs unknowns";
 
 /// Everything the command line reports as an error.
 #[derive(Debug, Error)]
 pub enum CliError {
-    /// Bad command-line usage.
-    #[error("{0}\n{USAGE}")]
-    Usage(String),
+    /// Bad command-line usage: clap's message (which names the argument), the usage line and
+    /// where to find help, without clap's own `error: ` prefix (`main` adds it).
+    #[error("{}", usage_message(.0))]
+    Usage(#[from] clap::Error),
     /// A scene that does not parse or validate.
     #[error(transparent)]
     Scene(#[from] SceneError),
@@ -44,12 +31,12 @@ pub enum CliError {
     /// A run that failed.
     #[error(transparent)]
     Run(#[from] RunError),
-    /// A cantilever run of `verify --full` failed.
-    #[error(transparent)]
-    Study(#[from] qdem_bench::cantilever::StudyError),
     /// A verification fixture that failed to run or missed its tolerance.
-    #[error("{0}")]
-    Verify(String),
+    #[error(transparent)]
+    Verify(#[from] verify::VerifyError),
+    /// A measurement of `qdem bench --implicit` failed.
+    #[error(transparent)]
+    Bench(#[from] CoreError),
     /// An analysis that could not be made.
     #[error(transparent)]
     Analyze(#[from] qdem_io::analyze::AnalyzeError),
@@ -63,116 +50,196 @@ pub enum CliError {
     },
 }
 
-/// Parsed options common to the commands.
-#[derive(Debug, Default)]
-struct Options {
-    positional: Vec<String>,
-    out: Option<PathBuf>,
-    threads: Option<Vec<usize>>,
-    json: bool,
-    full: bool,
-    implicit: bool,
-    tets: Option<Vec<usize>>,
-    steps: Option<usize>,
-    resume: Option<PathBuf>,
-    analyze: qdem_io::analyze::AnalyzeOptions,
+/// Clap's rendering of a usage error, plain text, without its leading `error: ` and trailing
+/// newline; `qdem` alone is told that a command is missing, above the help that lists them.
+fn usage_message(error: &clap::Error) -> String {
+    let text = error.to_string();
+    if error.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+        return format!(
+            "no command given; give one of the commands below\n\n{}",
+            text.trim_end()
+        );
+    }
+    text.strip_prefix("error: ")
+        .unwrap_or(&text)
+        .trim_end()
+        .to_string()
+}
+
+/// Simulation of deformable and granular bodies with the quadruple discrete element method
+/// (QDEM).
+#[derive(Debug, Parser)]
+#[command(name = "qdem", version, propagate_version = true)]
+pub struct Cli {
+    /// The command to run.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The commands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run a scene (or continue one from its checkpoint)
+    ///
+    /// Outputs go to DIR (default: the scene's [output] dir, relative to the scene file).
+    /// Ctrl-C or SIGTERM stops the run after its current step with DIR/checkpoint.qdc (exit
+    /// status 130), which --resume continues bit for bit.
+    Run(RunArgs),
+    /// Validate a scene; print mesh statistics, mass, stable dt, measured cost per step,
+    /// estimated run time
+    ///
+    /// Also times each model's force evaluation at the scene's start, so it shows where a step
+    /// goes (continuum kernel, contacts, loads, integration), and says whether the scene can be
+    /// checkpointed.
+    Check(CheckArgs),
+    /// Analytical fixtures: fixture, analytical, computed, error, tolerance, CPU s
+    ///
+    /// Exits non-zero if a fixture misses its tolerance. --full adds the paper's cantilever on
+    /// every fixture mesh (about 16 min), keeping their outputs and plots in DIR.
+    Verify(VerifyArgs),
+    /// Kernel throughput in tet-steps/s on structured meshes
+    ///
+    /// Elastic and viscoelastic blocks of about each --tets size on each --threads count, the
+    /// machine's triad bandwidth and the effect of node ordering. --implicit measures the
+    /// sparse Cholesky path instead: assembly, factorisation, solve and implicit step against
+    /// the number of unknowns.
+    Bench(BenchArgs),
+    /// A finished run's sensors: Parzen-smoothed linear spectra and mobility, CSV + SVG
+    ///
+    /// Reads the run's probes.csv and writes DIR/analysis (default: the scene's [output] dir):
+    /// spectra smoothed by the Parzen window (20 Hz bandwidth by default) and the mobility over
+    /// the scene's series loads.
+    Analyze(AnalyzeArgs),
+}
+
+/// `qdem run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// The scene file (TOML)
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+    /// Output directory [default: the scene's [output] dir]
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Worker threads [default: one per core]
+    #[arg(long, value_name = "N", value_parser = thread_count)]
+    pub threads: Option<usize>,
+    /// Continue the run from this checkpoint (DIR/checkpoint.qdc of a stopped run)
+    #[arg(long, value_name = "CHECKPOINT")]
+    pub resume: Option<PathBuf>,
+}
+
+/// `qdem check`.
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// The scene file (TOML)
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+    /// Worker threads for the cost measurement [default: one per core]
+    #[arg(long, value_name = "N", value_parser = thread_count)]
+    pub threads: Option<usize>,
+}
+
+/// `qdem verify`.
+#[derive(Debug, Args)]
+pub struct VerifyArgs {
+    /// Print one JSON document instead of the table
+    #[arg(long)]
+    pub json: bool,
+    /// Add the cantilever meshes (about 16 min)
+    #[arg(long)]
+    pub full: bool,
+    /// Where --full keeps the cantilever outputs and plots [default: out/verify]
+    #[arg(long, value_name = "DIR", requires = "full")]
+    pub out: Option<PathBuf>,
+}
+
+/// `qdem bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Print one JSON document instead of the table
+    #[arg(long)]
+    pub json: bool,
+    /// Approximate tetrahedron counts, comma-separated [default: 10000,100000,1000000; with
+    /// --implicit 16000,180000,550000]
+    #[arg(long, value_name = "N,..", value_delimiter = ',', value_parser = positive_whole)]
+    pub tets: Option<Vec<usize>>,
+    /// Thread counts, comma-separated [default: 1,2; with --implicit the last one, default 2]
+    #[arg(long, value_name = "N,..", value_delimiter = ',', value_parser = positive_whole)]
+    pub threads: Option<Vec<usize>>,
+    /// Steps per measurement [default: about one second's worth, at least 3]
+    #[arg(long, value_name = "N", value_parser = positive_whole)]
+    pub steps: Option<usize>,
+    /// Measure the implicit path (sparse Cholesky) against the number of unknowns instead
+    #[arg(long)]
+    pub implicit: bool,
+}
+
+/// `qdem analyze`.
+#[derive(Debug, Args)]
+pub struct AnalyzeArgs {
+    /// The scene file (TOML) of the finished run
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+    /// The run's output directory [default: the scene's [output] dir]
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Start of the analysed window (s) [default: the first row]
+    #[arg(long, value_name = "T", value_parser = non_negative,
+          allow_negative_numbers = true)]
+    pub from: Option<f64>,
+    /// End of the analysed window (s) [default: the last row]
+    #[arg(long, value_name = "T", value_parser = non_negative,
+          allow_negative_numbers = true)]
+    pub to: Option<f64>,
+    /// Bandwidth of the Parzen window (Hz)
+    #[arg(long, value_name = "HZ", value_parser = non_negative,
+          allow_negative_numbers = true, default_value_t = AnalyzeOptions::default().bandwidth)]
+    pub bandwidth: f64,
+    /// Highest frequency written and plotted (Hz)
+    #[arg(long, value_name = "HZ", value_parser = non_negative,
+          allow_negative_numbers = true, default_value_t = AnalyzeOptions::default().max_frequency)]
+    pub fmax: f64,
+}
+
+/// A count (tetrahedra, threads or steps of `bench`): a whole number of at least 1.
+fn positive_whole(value: &str) -> Result<usize, String> {
+    value
+        .trim()
+        .parse::<usize>()
+        .ok()
+        .filter(|&n| n > 0)
+        .ok_or_else(|| "give a positive whole number (1 or more)".to_string())
+}
+
+/// The one thread count of `run` and `check`.
+fn thread_count(value: &str) -> Result<usize, String> {
+    positive_whole(value).map_err(|e| {
+        if value.contains(',') {
+            "give one positive whole number here (lists N,.. are for `qdem bench`)".to_string()
+        } else {
+            e
+        }
+    })
 }
 
 /// A finite non-negative number of seconds or hertz.
-fn parse_number(flag: &str, value: &str) -> Result<f64, CliError> {
+fn non_negative(value: &str) -> Result<f64, String> {
     value
         .trim()
         .parse::<f64>()
         .ok()
         .filter(|v| v.is_finite() && *v >= 0.0)
-        .ok_or_else(|| CliError::Usage(format!("{flag} takes a number >= 0, got `{value}`")))
+        .ok_or_else(|| "give a finite number >= 0".to_string())
 }
 
-fn parse_list(flag: &str, value: &str) -> Result<Vec<usize>, CliError> {
-    value
-        .split(',')
-        .map(|v| {
-            v.trim()
-                .parse::<usize>()
-                .ok()
-                .filter(|&n| n > 0)
-                .ok_or_else(|| {
-                    CliError::Usage(format!(
-                        "{flag} takes positive whole numbers, got `{value}`"
-                    ))
-                })
-        })
-        .collect()
-}
-
-fn parse(args: &[String], allowed: &[&str]) -> Result<Options, CliError> {
-    let mut o = Options::default();
-    let mut it = args.iter();
-    while let Some(arg) = it.next() {
-        if !arg.starts_with("--") {
-            o.positional.push(arg.clone());
-            continue;
-        }
-        if !allowed.contains(&arg.as_str()) {
-            return Err(CliError::Usage(format!("unknown option `{arg}`")));
-        }
-        let mut value = || {
-            it.next()
-                .cloned()
-                .ok_or_else(|| CliError::Usage(format!("`{arg}` needs a value")))
-        };
-        match arg.as_str() {
-            "--out" => o.out = Some(PathBuf::from(value()?)),
-            "--resume" => o.resume = Some(PathBuf::from(value()?)),
-            "--json" => o.json = true,
-            "--full" => o.full = true,
-            "--implicit" => o.implicit = true,
-            "--steps" => o.steps = Some(parse_list(arg, &value()?)?[0]),
-            "--tets" => o.tets = Some(parse_list(arg, &value()?)?),
-            "--threads" => o.threads = Some(parse_list(arg, &value()?)?),
-            "--from" => o.analyze.from = Some(parse_number(arg, &value()?)?),
-            "--to" => o.analyze.to = Some(parse_number(arg, &value()?)?),
-            "--bandwidth" => o.analyze.bandwidth = parse_number(arg, &value()?)?,
-            "--fmax" => o.analyze.max_frequency = parse_number(arg, &value()?)?,
-            _ => unreachable!("every allowed option is matched"),
-        }
-    }
-    Ok(o)
-}
-
-fn one_scene(o: &Options, command: &str) -> Result<PathBuf, CliError> {
-    match o.positional.as_slice() {
-        [scene] => Ok(PathBuf::from(scene)),
-        [] => Err(CliError::Usage(format!(
-            "`qdem {command}` needs a scene file"
-        ))),
-        more => Err(CliError::Usage(format!(
-            "`qdem {command}` takes one scene file, got {}",
-            more.len()
-        ))),
-    }
-}
-
-fn no_positional(o: &Options, command: &str) -> Result<(), CliError> {
-    match o.positional.first() {
-        Some(extra) => Err(CliError::Usage(format!(
-            "`qdem {command}` takes no argument `{extra}`"
-        ))),
-        None => Ok(()),
-    }
-}
-
-/// The thread pool of `--threads N` (one number for `run` and `check`; rayon's default
-/// without it, and for `verify`). Commands run inside it ([`rayon::ThreadPool::install`])
-/// rather than on the main thread: a parallel loop started outside the pool is handed to a
-/// worker and waited for, a sleep and a wake-up per loop, which cost an explicit bonded-beam
-/// step (ten loops of a few microseconds each) about a fifth of its time.
-fn thread_pool(threads: Option<&[usize]>) -> Result<rayon::ThreadPool, CliError> {
-    let count = match threads {
-        Some(&[threads]) => threads,
-        Some(_) => return Err(CliError::Usage("--threads takes one number here".into())),
-        None => 0,
-    };
+/// The thread pool of `--threads N` (rayon's default without it, and for `verify`). Commands
+/// run inside it ([`rayon::ThreadPool::install`]) rather than on the main thread: a parallel
+/// loop started outside the pool is handed to a worker and waited for, a sleep and a wake-up
+/// per loop, which cost an explicit bonded-beam step (ten loops of a few microseconds each)
+/// about a fifth of its time.
+fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, CliError> {
+    let count = threads.unwrap_or(0);
     rayon::ThreadPoolBuilder::new()
         .num_threads(count)
         .build()
@@ -182,69 +249,43 @@ fn thread_pool(threads: Option<&[usize]>) -> Result<rayon::ThreadPool, CliError>
         })
 }
 
-/// Runs the command named by the first argument.
-pub fn dispatch(args: &[String]) -> Result<(), CliError> {
-    let Some((command, rest)) = args.split_first() else {
-        return Err(CliError::Usage("no command given".into()));
-    };
-    match command.as_str() {
-        "run" => {
-            let o = parse(rest, &["--out", "--threads", "--resume"])?;
-            let scene = one_scene(&o, "run")?;
-            thread_pool(o.threads.as_deref())?
-                .install(|| run_scene(&scene, o.out.as_deref(), o.resume.as_deref()))
+/// Runs the parsed command.
+pub fn dispatch(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Run(a) => thread_pool(a.threads)?
+            .install(|| run_scene(&a.scene, a.out.as_deref(), a.resume.as_deref())),
+        Command::Check(a) => thread_pool(a.threads)?.install(|| check::check_scene(&a.scene)),
+        Command::Analyze(a) => {
+            let options = AnalyzeOptions {
+                from: a.from,
+                to: a.to,
+                bandwidth: a.bandwidth,
+                max_frequency: a.fmax,
+            };
+            analyze_run(&a.scene, a.out.as_deref(), &options)
         }
-        "check" => {
-            let o = parse(rest, &["--threads"])?;
-            let scene = one_scene(&o, "check")?;
-            thread_pool(o.threads.as_deref())?.install(|| check_scene(&scene))
-        }
-        "analyze" => {
-            let o = parse(rest, &["--out", "--from", "--to", "--bandwidth", "--fmax"])?;
-            analyze_run(&one_scene(&o, "analyze")?, o.out.as_deref(), &o.analyze)
-        }
-        "verify" => {
-            let o = parse(rest, &["--json", "--full", "--out"])?;
-            no_positional(&o, "verify")?;
-            if o.out.is_some() && !o.full {
-                return Err(CliError::Usage(
-                    "`qdem verify --out DIR` goes with `--full`".into(),
-                ));
-            }
-            let out = o.out.unwrap_or_else(|| PathBuf::from("out/verify"));
+        Command::Verify(a) => {
+            let out = a.out.unwrap_or_else(|| PathBuf::from("out/verify"));
             thread_pool(None)?
-                .install(|| verify::run_and_print(o.json, o.full.then_some(out.as_path())))
+                .install(|| verify::run_and_print(a.json, a.full.then_some(out.as_path())))
+                .map_err(CliError::from)
         }
-        "bench" => {
-            let o = parse(
-                rest,
-                &["--json", "--tets", "--threads", "--steps", "--implicit"],
-            )?;
-            no_positional(&o, "bench")?;
-            if o.implicit {
-                let threads = o
+        Command::Bench(a) => {
+            if a.implicit {
+                let threads = a
                     .threads
                     .as_deref()
                     .and_then(|t| t.last().copied())
                     .unwrap_or(2);
-                return bench::implicit_and_print(o.tets, threads, o.json);
+                return Ok(implicit::run_and_print(a.tets, threads, a.json)?);
             }
-            bench::run_and_print(&BenchPlan::new(o.tets, o.threads, o.steps), o.json);
+            throughput::run_and_print(&BenchPlan::new(a.tets, a.threads, a.steps), a.json);
             Ok(())
         }
-        "help" | "--help" | "-h" => {
-            println!("{USAGE}");
-            Ok(())
-        }
-        other => Err(CliError::Usage(format!("unknown command `{other}`"))),
     }
 }
 
-fn analyze_run(
-    path: &Path,
-    out: Option<&Path>,
-    options: &qdem_io::analyze::AnalyzeOptions,
-) -> Result<(), CliError> {
+fn analyze_run(path: &Path, out: Option<&Path>, options: &AnalyzeOptions) -> Result<(), CliError> {
     let scene = Scene::load(path)?;
     let out_dir = match out {
         Some(dir) => dir.to_path_buf(),
@@ -349,147 +390,4 @@ fn run_scene(path: &Path, out: Option<&Path>, resume: Option<&Path>) -> Result<(
         out_dir.display()
     );
     Ok(())
-}
-
-fn check_scene(path: &Path) -> Result<(), CliError> {
-    let scene = Scene::load(path)?;
-    let mut sim = Simulation::build(scene)?;
-    println!("scene {}: valid", path.display());
-    for w in &sim.warnings {
-        println!("warning: {w}");
-    }
-    for body in &sim.bodies {
-        let s = &body.stats;
-        let mass = sim.body_mass(body);
-        let kind = match body.kind {
-            BodyKind::Rigid { .. } => "rigid",
-            BodyKind::Deformable { .. } => "deformable",
-        };
-        println!(
-            "body `{}` ({}, {kind}): {} particles, {} tets, volume {:.6e} m^3, mass {:.6e} kg, edges {:.4e}..{:.4e} m, worst quality {:.3} (tet {})",
-            body.name,
-            body.mesh.display(),
-            s.nodes,
-            s.tets,
-            s.volume,
-            mass,
-            s.min_edge,
-            s.max_edge,
-            s.worst_quality,
-            s.worst_tet
-        );
-    }
-    if let Some(b) = sim.bonded() {
-        let mass: f64 = sim.world.state.mass.iter().sum();
-        println!(
-            "bonded body `{}`: {} particles (radius {:.4e} m), {} beam bonds, mass {:.6e} kg; \
-             paper 001 Eq. 28 dt_crit {:.4e} s",
-            b.name(),
-            sim.world.state.len(),
-            b.radii()[0],
-            b.bonds().len(),
-            mass,
-            b.initial_critical_step()
-        );
-    }
-    if let Some(contacts) = sim.contacts() {
-        println!(
-            "contact: {} spheres, {} walls, {} candidate pairs and wall contacts at the start",
-            contacts.spheres(),
-            contacts.walls(),
-            contacts.candidates()
-        );
-    }
-    for p in &sim.probes {
-        println!(
-            "probe `{}`: particle {} at {:.3e} m from the requested point",
-            p.name, p.particle, p.distance
-        );
-    }
-    let (bound, limiter) = &sim.world.settings().stable_dt;
-    println!(
-        "integrator {}: dt {:.6e} s ({:.3}x the explicit stable bound {bound:.6e} s set by `{limiter}`); {} steps to t_end = {} s",
-        sim.scene.run.integrator.name(),
-        sim.world.dt(),
-        sim.world.dt() / bound,
-        sim.steps(),
-        sim.scene.run.t_end
-    );
-    match sim.world.checkpointable() {
-        Ok(()) => println!("checkpoints: supported (`checkpoint_every`, Ctrl-C, --resume)"),
-        Err(why) => println!("checkpoints: not supported: {why}"),
-    }
-    let per_step = measure_step_cost(&mut sim, 20)?;
-    let total = per_step * sim.steps() as f64;
-    // A scene without tetrahedra (spheres, a bonded body) steps particles.
-    let rate = match sim.tets() {
-        0 => format!(
-            "{:.3e} particle-steps/s",
-            sim.world.state.len() as f64 / per_step
-        ),
-        tets => format!("{:.3e} tet-steps/s", tets as f64 / per_step),
-    };
-    println!(
-        "measured {:.3e} s/step on {} threads ({rate}): estimated run time {} (outputs not counted)",
-        per_step,
-        rayon::current_num_threads(),
-        progress::clock(total)
-    );
-    print_stages(&sim);
-    Ok(())
-}
-
-/// Where the measured steps' time went, stage by stage ([`qdem_core::stages`]).
-fn print_stages(sim: &Simulation) {
-    println!(
-        "time per step by stage ({} steps):",
-        sim.world.stages().steps()
-    );
-    for stage in sim.world.stage_report() {
-        println!(
-            "  {:<32} {:.3e} s ({:.1}%)",
-            stage.name,
-            stage.seconds_per_step,
-            100.0 * stage.share
-        );
-    }
-    if let Some(c) = sim.contacts() {
-        println!(
-            "  contacts after the measured steps: {} candidate pairs and wall candidates, {} touching",
-            c.candidates(),
-            c.contacts()
-        );
-    }
-}
-
-/// Wall seconds per step of the scene's world, measured over `n` steps from its start; for
-/// implicit and static scenes also prints the sparse system's size, non-zeros, Cholesky fill
-/// and factorisation time from the stepper's one factorisation (in `initialize`, which is not
-/// timed).
-fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<f64, CliError> {
-    let scene = sim.scene.path.clone();
-    let run_error = |source| RunError::Core {
-        scene: scene.clone(),
-        source,
-    };
-    let world = &mut sim.world;
-    world.initialize().map_err(run_error)?;
-    if let Some(s) = world.stepper().factor_stats() {
-        println!(
-            "implicit system: {} unknowns, {} non-zeros (lower triangle), factor {} non-zeros (fill {:.1}x); symbolic {:.3e} s, numeric {:.3e} s",
-            s.dofs,
-            s.nonzeros,
-            s.factor_nonzeros,
-            s.factor_nonzeros as f64 / s.nonzeros.max(1) as f64,
-            s.symbolic_seconds,
-            s.numeric_seconds
-        );
-    }
-    let start = Instant::now();
-    for _ in 0..n {
-        if world.step().map_err(run_error)?.is_some() {
-            break;
-        }
-    }
-    Ok(start.elapsed().as_secs_f64() / world.stages().steps().max(1) as f64)
 }

@@ -1,11 +1,12 @@
 //! # qdem-cli
 //!
-//! The `qdem` command: `run`, `check`, `verify` and `bench`. The binary is a thin shell over
-//! [`command::dispatch`]; the verification fixtures ([`verify`]) are library code so that the
-//! tests run exactly what `qdem verify` prints, and the throughput measurement lives in
-//! `qdem-bench` beside the criterion benches that share it.
+//! The `qdem` command: `run`, `check`, `analyze`, `verify` and `bench`. The binary is a thin
+//! shell over [`command::dispatch`]; this crate parses the command line, dispatches, shows
+//! progress and renders errors. The verification fixtures (`qdem_bench::verify`) and the
+//! throughput measurements (`qdem_bench::throughput`, `qdem_bench::implicit`) live in
+//! `qdem-bench`, so that its tests and benches run exactly what `qdem verify` and `qdem bench`
+//! print.
 
-pub mod bench;
+pub mod check;
 pub mod command;
 pub mod progress;
-pub mod verify;

@@ -10,9 +10,8 @@
 //! deflection against the small-strain linear-tet static solve on the same mesh (the kernel's
 //! own oracle: they must agree in the small-strain limit).
 
-use crate::command::CliError;
-use qdem_bench::cantilever::{
-    cantilever, cantilever_scene, newmark_variant, CALCULIX_F1_HZ, CALCULIX_TIP_UZ_UM,
+use crate::cantilever::{
+    cantilever, cantilever_scene, newmark_variant, StudyError, CALCULIX_F1_HZ, CALCULIX_TIP_UZ_UM,
 };
 use qdem_core::linear_tet::LinearTets;
 use qdem_core::tet_kernel::{edge_matrix, tet_stress, vertex_forces};
@@ -21,14 +20,55 @@ use qdem_core::{
     Mat3, Material, Model, NodalLoad, State, StaticSolver, Stepper, TetBody, TimeFunction, Vec3,
     Verlet,
 };
-use qdem_io::build::Simulation;
+use qdem_io::build::{BuildError, Simulation};
+use qdem_io::output::OutputError;
 use qdem_io::plot::{line_plot_svg, Labels, Series};
 use qdem_io::runner::RunError;
-use qdem_io::scene::Scene;
+use qdem_io::scene::{Scene, SceneError};
 use qdem_mesh::structured_box;
 use serde_json::json;
 use std::path::Path;
 use std::time::Instant;
+use thiserror::Error;
+
+/// Why `qdem verify` failed: a fixture that could not run, or rows outside their tolerance.
+#[derive(Debug, Error)]
+pub enum VerifyError {
+    /// A cantilever scene did not load.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A cantilever scene could not be built.
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    /// A static solve of a cantilever scene failed.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// A cantilever run of `verify --full` failed (boxed: it carries the scene, build and run
+    /// errors too).
+    #[error(transparent)]
+    Study(Box<StudyError>),
+    /// A plot could not be written.
+    #[error(transparent)]
+    Plot(#[from] OutputError),
+    /// The cantilever scene's body is rigid.
+    #[error("the cantilever must be deformable")]
+    NotDeformable,
+    /// The cantilever scene has no probe at the tip.
+    #[error("the cantilever scene has no probe")]
+    NoProbe,
+    /// Rows that missed their tolerance.
+    #[error("{} fixture(s) outside tolerance: {}", .failed.len(), .failed.join("; "))]
+    OutsideTolerance {
+        /// The fixtures of those rows.
+        failed: Vec<String>,
+    },
+}
+
+impl From<StudyError> for VerifyError {
+    fn from(error: StudyError) -> Self {
+        VerifyError::Study(Box::new(error))
+    }
+}
 
 /// One verification result.
 #[derive(Clone, Debug)]
@@ -273,7 +313,7 @@ pub fn p_wave_speed() -> Row {
 
 /// Tip deflection (µm) of a cantilever scene's mesh, loads (at t = 1.5 s) and fixity, from the
 /// independent small-strain linear-tet static solve of [`qdem_core::linear_tet`].
-pub fn cantilever_static(scene: &Path) -> Result<f64, CliError> {
+pub fn cantilever_static(scene: &Path) -> Result<f64, VerifyError> {
     let mut sim = Simulation::build(Scene::load(scene)?)?;
     sim.world.state.time = 1.5;
     let mut load = vec![Vec3::zeros(); sim.world.state.len()];
@@ -281,46 +321,38 @@ pub fn cantilever_static(scene: &Path) -> Result<f64, CliError> {
         model.add_forces(&sim.world.state, &mut load, &mut []);
     }
     let body = &sim.bodies[0];
-    let tet_body = sim
-        .tet_body(body)
-        .ok_or_else(|| CliError::Verify("the cantilever must be deformable".into()))?;
+    let tet_body = sim.tet_body(body).ok_or(VerifyError::NotDeformable)?;
     let lame = sim.scene.materials[0].clone();
     let lame = qdem_core::Material::elastic(lame.density, lame.young, lame.poisson).elastic_lame();
     let oracle = LinearTets::new(&sim.world.state.reference, tet_body.tets(), lame);
     let solution = oracle.solve(&load, &sim.world.state.fixed, 1e-13);
-    let tip = sim
-        .probes
-        .first()
-        .ok_or_else(|| CliError::Verify("the cantilever scene has no probe".into()))?;
+    let tip = sim.probes.first().ok_or(VerifyError::NoProbe)?;
     Ok(solution.displacement[tip.particle].z * 1e6)
 }
 
 /// Tip deflection (µm) of the scene's `integrator = "static"` solve at t = 1.5 s (full load).
-fn static_solve_tip(scene: &Path) -> Result<f64, CliError> {
+fn static_solve_tip(scene: &Path) -> Result<f64, VerifyError> {
     let mut sim = Simulation::build(Scene::load(scene)?)?;
     let mut solver = StaticSolver::new();
     solver
         .solve(&mut sim.world.state, &mut sim.world.models, 1.5)
         .map_err(|source| {
-            CliError::Run(RunError::Core {
+            VerifyError::Run(RunError::Core {
                 scene: scene.to_path_buf(),
                 source,
             })
         })?;
-    let tip = sim
-        .probes
-        .first()
-        .ok_or_else(|| CliError::Verify("the cantilever scene has no probe".into()))?;
+    let tip = sim.probes.first().ok_or(VerifyError::NoProbe)?;
     Ok(sim.world.state.displacement(tip.particle).z * 1e6)
 }
 
-fn plot(path: &Path, labels: &Labels<'_>, series: &[Series<'_>]) -> Result<(), CliError> {
-    line_plot_svg(path, labels, series).map_err(|e| CliError::Verify(e.to_string()))
+fn plot(path: &Path, labels: &Labels<'_>, series: &[Series<'_>]) -> Result<(), VerifyError> {
+    Ok(line_plot_svg(path, labels, series)?)
 }
 
 /// The cantilever on every fixture mesh: rows, the outputs of each run under `out`, its
 /// spectrum, and the error against tetrahedra and against wall time (speed versus error).
-fn cantilever_rows(rows: &mut Vec<Row>, out: &Path) -> Result<(), CliError> {
+fn cantilever_rows(rows: &mut Vec<Row>, out: &Path) -> Result<(), VerifyError> {
     let mut convergence = [Vec::new(), Vec::new()];
     let mut speed = Vec::new();
     for lc in ["100", "070", "050"] {
@@ -457,7 +489,7 @@ fn cantilever_rows(rows: &mut Vec<Row>, out: &Path) -> Result<(), CliError> {
 
 /// Runs the fixtures (with `full`, the cantilever too, its outputs under that directory),
 /// prints a table (or JSON), and fails if any row misses its tolerance.
-pub fn run_and_print(as_json: bool, full: Option<&Path>) -> Result<(), CliError> {
+pub fn run_and_print(as_json: bool, full: Option<&Path>) -> Result<(), VerifyError> {
     let mut rows = vec![
         oracle_agreement(),
         rigid_spin(),
@@ -493,18 +525,14 @@ pub fn run_and_print(as_json: bool, full: Option<&Path>) -> Result<(), CliError>
             );
         }
     }
-    let failed: Vec<&str> = rows
+    let failed: Vec<String> = rows
         .iter()
         .filter(|r| !r.passed())
-        .map(|r| r.fixture.as_str())
+        .map(|r| r.fixture.clone())
         .collect();
     if failed.is_empty() {
         Ok(())
     } else {
-        Err(CliError::Verify(format!(
-            "{} fixture(s) outside tolerance: {}",
-            failed.len(),
-            failed.join("; ")
-        )))
+        Err(VerifyError::OutsideTolerance { failed })
     }
 }

@@ -1,0 +1,133 @@
+//! The command line itself: `--help` lists the five commands and each command's flags,
+//! `--version` prints the version, and `qdem bench` takes its comma-separated lists and prints
+//! the JSON document whose keys `docs/BENCHMARKS.md` is made from.
+
+use std::process::{Command, Output};
+
+fn qdem(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_qdem"))
+        .args(args)
+        .env("CI", "1")
+        .output()
+        .expect("start the qdem binary")
+}
+
+/// Stdout of a command that must succeed with nothing on stderr.
+fn success(args: &[&str]) -> String {
+    let out = qdem(args);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success(),
+        "qdem {args:?} failed ({}):\n{stderr}\n{stdout}",
+        out.status
+    );
+    assert!(
+        stderr.is_empty(),
+        "qdem {args:?} wrote on stderr:\n{stderr}"
+    );
+    stdout
+}
+
+#[test]
+fn help_lists_the_five_commands() {
+    for help in [&["--help"][..], &["-h"], &["help"]] {
+        let stdout = success(help);
+        for command in ["run", "check", "verify", "bench", "analyze"] {
+            assert!(
+                stdout
+                    .lines()
+                    .any(|l| l.trim_start().starts_with(&format!("{command} "))
+                        && l.trim().len() > command.len() + 10),
+                "qdem {help:?} does not list `{command}` with its description:\n{stdout}"
+            );
+        }
+    }
+}
+
+#[test]
+fn each_command_has_help_with_its_flags() {
+    let flags: [(&str, &[&str]); 5] = [
+        ("run", &["SCENE", "--out", "--threads", "--resume"]),
+        ("check", &["SCENE", "--threads"]),
+        ("verify", &["--json", "--full", "--out"]),
+        (
+            "bench",
+            &["--json", "--tets", "--threads", "--steps", "--implicit"],
+        ),
+        (
+            "analyze",
+            &["SCENE", "--out", "--from", "--to", "--bandwidth", "--fmax"],
+        ),
+    ];
+    for (command, flags) in flags {
+        for help in [vec![command, "--help"], vec!["help", command]] {
+            let stdout = success(&help);
+            assert!(
+                stdout.starts_with(|c: char| c.is_alphabetic()),
+                "qdem {help:?} does not start with a description:\n{stdout}"
+            );
+            for flag in flags {
+                assert!(
+                    stdout.contains(flag),
+                    "qdem {help:?} does not mention {flag}:\n{stdout}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn version_prints_the_version() {
+    let stdout = success(&["--version"]);
+    assert_eq!(stdout.trim(), format!("qdem {}", env!("CARGO_PKG_VERSION")));
+}
+
+#[test]
+fn bench_takes_comma_separated_lists() {
+    let stdout = success(&[
+        "bench",
+        "--json",
+        "--tets",
+        "750,1500",
+        "--threads",
+        "1,2",
+        "--steps",
+        "3",
+    ]);
+    let doc: serde_json::Value = serde_json::from_str(&stdout)
+        .unwrap_or_else(|e| panic!("stdout is not JSON ({e}):\n{stdout}"));
+    for key in [
+        "locality",
+        "machine",
+        "triad_bandwidth_bytes_per_second",
+        "results",
+    ] {
+        assert!(doc.get(key).is_some(), "no `{key}` in {doc:#}");
+    }
+    let results = doc["results"].as_array().expect("results is an array");
+    // 2 sizes x (elastic, viscoelastic) x 2 thread counts.
+    assert_eq!(results.len(), 8, "{doc:#}");
+    for row in results {
+        assert_eq!(row["steps"], 3, "{row}");
+        for key in [
+            "tets",
+            "particles",
+            "material",
+            "threads",
+            "seconds",
+            "tet_steps_per_second",
+            "particle_steps_per_second",
+            "bytes_per_tet_step",
+            "fraction_of_triad_bandwidth",
+        ] {
+            assert!(row.get(key).is_some(), "row without `{key}`: {row}");
+        }
+    }
+    let threads: Vec<u64> = results
+        .iter()
+        .filter_map(|r| r["threads"].as_u64())
+        .collect();
+    assert!(threads.contains(&1) && threads.contains(&2), "{doc:#}");
+    assert_eq!(doc["locality"].as_array().map(Vec::len), Some(3), "{doc:#}");
+}
