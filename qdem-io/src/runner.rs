@@ -239,7 +239,7 @@ pub fn run_with(
     let steps = sim.steps();
     let mut stepper = make_stepper(sim).map_err(|source| core_error(sim, source))?;
     let checkpoint_path = out_dir.join(CHECKPOINT_FILE);
-    let fingerprint = scene_fingerprint(&sim.scene.path);
+    let fingerprint = scene_fingerprint(&sim.scene);
     let can_checkpoint = check_checkpointable(sim, stepper.as_ref());
     if sim.scene.output.checkpoint_every > 0.0 || options.resume.is_some() {
         if let Err(source) = &can_checkpoint {
@@ -250,7 +250,7 @@ pub fn run_with(
     let probes_path = out_dir.join("probes.csv");
     let mut csv = match options.resume {
         Some(path) => {
-            let body = read_checkpoint(path, fingerprint, &sim.scene.path)?;
+            let body = read_checkpoint(path, Some(&fingerprint))?;
             decode_run(&body, sim, stepper.as_mut(), &mut record)
                 .map_err(|source| core_error(sim, source))?;
             ProbeCsv::resume(&probes_path, &names, record.probe_rows as usize)?
@@ -315,7 +315,7 @@ pub fn run_with(
                 csv.publish()?;
                 let body = encode_run(sim, stepper.as_ref(), &record)
                     .map_err(|source| core_error(sim, source.into()))?;
-                write_checkpoint(&checkpoint_path, fingerprint, &body)?;
+                write_checkpoint(&checkpoint_path, &fingerprint, &body)?;
             } else if sampled
                 && can_checkpoint.is_ok()
                 && last_good
@@ -356,7 +356,7 @@ pub fn run_with(
             Err(source @ (RunError::Core { .. } | RunError::Unstable { .. })),
             Some((time, body, _)),
         ) => {
-            write_checkpoint(&checkpoint_path, fingerprint, &body)?;
+            write_checkpoint(&checkpoint_path, &fingerprint, &body)?;
             Err(RunError::Failed {
                 source: Box::new(source),
                 time,
