@@ -235,6 +235,7 @@ pub fn run_with(
     if sim.scene.output.writes_vtu() {
         std::fs::create_dir_all(&vtu_dir).map_err(dir_error(&vtu_dir))?;
     }
+    crate::output::remove_stale_temporaries(out_dir);
     let names: Vec<String> = sim.probes.iter().map(|p| p.name.clone()).collect();
     let steps = sim.steps();
     let mut stepper = make_stepper(sim).map_err(|source| core_error(sim, source))?;

@@ -2,7 +2,8 @@
 //! nodes were moved (the counts unchanged, so the state would load and the run fail later
 //! with a false inverted tetrahedron), or after a load series or a granular sample was
 //! edited, is refused before the first step, naming the file; restored exactly, the same
-//! checkpoint resumes.
+//! checkpoint resumes. Also: at a run's start the temporary files that killed runs left in
+//! the output directory are removed, those of a live process kept.
 
 mod common;
 
@@ -176,4 +177,42 @@ fn a_resume_with_an_edited_granular_sample_is_refused_by_name() {
     assert!(matches!(error, CheckpointFileError::InputChanged { .. }));
     std::fs::write(&sample, STONES).unwrap();
     resume(&scene, &out, &checkpoint).unwrap();
+}
+
+/// A process id above Linux's largest `pid_max` (2^22): no such process can run.
+#[cfg(target_os = "linux")]
+const DEAD_PID: u32 = 999_999_999;
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_run_removes_the_temporary_files_of_dead_processes_and_keeps_those_of_live_ones() {
+    let dir = test_dir("ckpt-stale-temporaries");
+    let scene = short_cantilever(&dir, &[("vtu_every = 0.05", "vtu_every = 0.01")]);
+    let out = dir.join("out");
+    std::fs::create_dir_all(out.join("vtu")).unwrap();
+    // This process and its parent run; the run writes none of these names itself.
+    let (own, parent) = (std::process::id(), std::os::unix::process::parent_id());
+    let dead = [
+        out.join(format!(".checkpoint.qdc.tmp-{DEAD_PID}")),
+        out.join(format!(".probes.csv.publish-{DEAD_PID}")),
+        out.join("vtu")
+            .join(format!(".state_00001.vtu.tmp-{DEAD_PID}")),
+    ];
+    let kept = [
+        out.join(format!(".earlier.csv.tmp-{own}")),
+        out.join(format!(".probes.csv.tmp-{parent}")),
+        out.join("vtu")
+            .join(format!(".state_00009.vtu.tmp-{parent}")),
+        out.join(format!("notes.tmp-{DEAD_PID}")),
+    ];
+    for file in dead.iter().chain(&kept) {
+        std::fs::write(file, "left by a run").unwrap();
+    }
+    checkpointed(&scene, &out, 5);
+    for file in &dead {
+        assert!(!file.exists(), "{} is left", file.display());
+    }
+    for file in &kept {
+        assert!(file.exists(), "{} was removed", file.display());
+    }
 }
