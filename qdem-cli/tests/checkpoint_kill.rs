@@ -1,12 +1,14 @@
 //! Checkpoints survive the worst interruptions (issue 8): `qdem run` writing a checkpoint at
 //! every step is killed with SIGKILL at staggered moments until two kills have landed inside
 //! a checkpoint write (the killed process's leftover temporary file shows it: about one kill
-//! in five does); each time the checkpoint on disk still reads back whole (magic, version, scene, checksum) and a run resumes from it; that resumed run,
-//! stopped by SIGTERM, exits with 130 after writing a fresh checkpoint, which reads back too.
+//! in five does); each time the checkpoint on disk still reads back whole (magic, version,
+//! scene and its input files, checksum) and a run resumes from it; that resumed run, stopped
+//! by SIGTERM, exits with 130 after writing a fresh checkpoint, which reads back too.
 
 mod common;
 use common::{workspace, TempDir};
 use qdem_io::checkpoint::{read_checkpoint, scene_fingerprint, CHECKPOINT_FILE};
+use qdem_io::scene::Scene;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -71,7 +73,7 @@ fn a_kill_during_a_checkpoint_write_leaves_the_previous_checkpoint_intact() {
     let scene = scene(dir.path());
     let out = dir.path().join("out");
     let checkpoint = out.join(CHECKPOINT_FILE);
-    let fingerprint = scene_fingerprint(&scene);
+    let fingerprint = scene_fingerprint(&Scene::load(&scene).unwrap());
     let (mut mid_write, mut rounds) = (0, 0);
     // About one kill in five lands inside a write here; 60 rounds without one would happen
     // with probability 0.8^60 ≈ 2e-6.
@@ -88,7 +90,7 @@ fn a_kill_during_a_checkpoint_write_leaves_the_previous_checkpoint_intact() {
         // The killed process's temporary checkpoint is left only if the kill came between
         // its creation and its rename.
         mid_write += out.join(format!(".checkpoint.qdc.tmp-{pid}")).exists() as usize;
-        let body = read_checkpoint(&checkpoint, fingerprint, &scene);
+        let body = read_checkpoint(&checkpoint, Some(&fingerprint));
         assert!(
             body.is_ok(),
             "round {round}: the checkpoint is damaged: {}",
@@ -116,5 +118,5 @@ fn a_kill_during_a_checkpoint_write_leaves_the_previous_checkpoint_intact() {
         stderr.contains("resuming from") && stderr.contains("interrupted at t ="),
         "{stderr}"
     );
-    read_checkpoint(&checkpoint, fingerprint, &scene).expect("the SIGTERM checkpoint reads back");
+    read_checkpoint(&checkpoint, Some(&fingerprint)).expect("the SIGTERM checkpoint reads back");
 }

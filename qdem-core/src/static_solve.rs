@@ -14,7 +14,14 @@
 //! [`CoreError::Unconstrained`], naming it (`sparse::unconstrained_bodies`); any other
 //! failed factorisation names the particle of the failing pivot and its body
 //! (`sparse::explain_failure`).
+//!
+//! A static run is checkpointed like the others: what a load level depends on beyond the
+//! state and the models is the factorisation of the first solve, so [`StaticSteps`] saves the
+//! tangent it factorised and a resumed run factorises that same matrix again (the models' own
+//! tangent at the resumed moment need not be the first one's), giving the same answers bit
+//! for bit.
 
+use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::model::Model;
 use crate::newmark::collect_tangent;
@@ -31,6 +38,8 @@ use crate::Vec3;
 #[derive(Debug, Default)]
 pub struct StaticSolver {
     dofs: Option<FreeDofs>,
+    /// The tangent factorised (kept for checkpoints).
+    tangent: Tangent,
     cholesky: SparseCholesky,
     force: Vec<Vec3>,
     torque: Vec<Vec3>,
@@ -91,10 +100,19 @@ impl StaticSolver {
     /// Assembles K at the reference state and factorises it; refuses a body free to move
     /// rigidly first.
     fn factorize(&mut self, state: &State, models: &[Box<dyn Model>]) -> Result<(), CoreError> {
-        let mut tangent = Tangent::new();
-        collect_tangent(state, models, &mut tangent)?;
+        collect_tangent(state, models, &mut self.tangent)?;
+        self.factorize_tangent(state, models)
+    }
+
+    /// Factorises the stored tangent with the state's fixity and masses.
+    fn factorize_tangent(
+        &mut self,
+        state: &State,
+        models: &[Box<dyn Model>],
+    ) -> Result<(), CoreError> {
+        let tangent = &self.tangent;
         let dofs = FreeDofs::new(&state.node_fixity());
-        if let Some((body, modes)) = unconstrained_bodies(state, models, &tangent, &dofs)
+        if let Some((body, modes)) = unconstrained_bodies(state, models, tangent, &dofs)
             .into_iter()
             .next()
         {
@@ -112,12 +130,10 @@ impl StaticSolver {
         };
         let mass = state.node_mass();
         let mut assembler = Assembler::new();
-        let matrix = assembler.assemble(&tangent, &mass, &dofs, scales)?;
+        let matrix = assembler.assemble(tangent, &mass, &dofs, scales)?;
         if let Err(error) = self.cholesky.factorize(matrix, "stiffness") {
             let pivot = self.cholesky.failed_pivot();
-            return Err(explain_failure(
-                error, pivot, &dofs, state, models, &tangent,
-            ));
+            return Err(explain_failure(error, pivot, &dofs, state, models, tangent));
         }
         self.dofs = Some(dofs);
         Ok(())
@@ -175,5 +191,35 @@ impl Stepper for StaticSteps {
 
     fn factor_stats(&self) -> Option<&FactorStats> {
         self.solver.factor_stats()
+    }
+
+    /// Whether K is factorised and, if so, the tangent it was assembled from: the later load
+    /// levels solve with that factorisation. The solver's other buffers are overwritten at
+    /// every solve.
+    fn save(&self, out: &mut Encoder) -> Result<(), CheckpointError> {
+        out.tag("static");
+        let factored = self.solver.cholesky.is_factored();
+        out.bool(factored);
+        if factored {
+            self.solver.tangent.save(out);
+        }
+        Ok(())
+    }
+
+    /// Reads back the factorised tangent and factorises it again, evaluating no force.
+    fn resume(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        input: &mut Decoder<'_>,
+    ) -> Result<(), CoreError> {
+        refuse_rigid(state, "static")?;
+        input.tag("static")?;
+        if input.bool("the factorisation flag")? {
+            let dofs = 3 * (state.len() + state.spin.len());
+            self.solver.tangent.restore(input, dofs)?;
+            self.solver.factorize_tangent(state, models)?;
+        }
+        Ok(())
     }
 }

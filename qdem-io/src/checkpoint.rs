@@ -2,22 +2,30 @@
 //! --resume CHECKPOINT` continues it bit for bit.
 //!
 //! Layout: the magic bytes `QDEMCKPT`, the format version, a fingerprint of the scene file
-//! (FNV-1a of its bytes: a checkpoint is refused for an edited or another scene), the body
-//! and an FNV-1a checksum of the body. The body is the run loop's record (step, output
+//! (FNV-1a of its bytes: a checkpoint is refused for an edited or another scene), the files
+//! the scene reads with their fingerprints (each mesh, sample, series, poses file and start
+//! checkpoint, as written in the scene: [`crate::inputs`]; a checkpoint is refused when any
+//! of them changed or is missing), the body and an FNV-1a checksum of everything after the
+//! scene's fingerprint. The body is the run loop's record (step, output
 //! schedules, probe rows written, the plot's history), then the [`qdem_core::State`], the
 //! stepper's and every model's history, each part tagged ([`qdem_core::checkpoint`]). The
 //! file is written atomically (temporary file, fsync, rename), so a kill at any moment leaves
 //! the previous checkpoint intact.
 
+use crate::inputs::{decode_inputs, fnv1a, InputChange};
 use crate::output::{write_atomic, OutputError};
+use crate::scene::Scene;
 use qdem_core::CheckpointError;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+pub use crate::inputs::SceneFingerprint;
+
 /// The checkpoint's file name in the output directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.qdc";
 
-/// The version of the layout this build writes and reads.
+/// The version of the layout this build writes and reads (3: the files the scene reads are
+/// recorded with their fingerprints, and the run record is one block, the recorders' histories).
 pub const FORMAT_VERSION: u64 = 3;
 
 const MAGIC: &[u8; 8] = b"QDEMCKPT";
@@ -64,6 +72,35 @@ pub enum CheckpointFileError {
         /// The scene file.
         scene: PathBuf,
     },
+    /// A file the scene reads whose content is not the one the checkpointed run was built
+    /// from.
+    #[error(
+        "cannot resume from `{path}`: `{input}`, which the scene reads (at {resolved}), has \
+         changed since the checkpoint was written, so the resumed run would not continue the \
+         checkpointed one: restore the file exactly as it was, or run the scene from the start"
+    )]
+    InputChanged {
+        /// The checkpoint.
+        path: PathBuf,
+        /// The file as written in the scene.
+        input: PathBuf,
+        /// Where it is on disk.
+        resolved: PathBuf,
+    },
+    /// A file the scene reads that existed when the checkpoint was written and is gone.
+    #[error(
+        "cannot resume from `{path}`: `{input}`, which the scene reads (at {resolved}), is \
+         missing or unreadable, but the checkpointed run was built from it: restore the file \
+         exactly as it was, or run the scene from the start"
+    )]
+    InputMissing {
+        /// The checkpoint.
+        path: PathBuf,
+        /// The file as written in the scene.
+        input: PathBuf,
+        /// Where it is on disk.
+        resolved: PathBuf,
+    },
     /// A checksum that does not match.
     #[error(
         "the checkpoint `{path}` is corrupt (its checksum does not match): use an earlier \
@@ -83,49 +120,52 @@ pub enum CheckpointFileError {
     },
 }
 
-/// FNV-1a, 64 bit.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-    })
+/// The fingerprints of the scene file and of every file it reads, for
+/// [`write_checkpoint`] and [`read_checkpoint`].
+pub fn scene_fingerprint(scene: &Scene) -> SceneFingerprint {
+    SceneFingerprint::of(scene)
 }
 
-/// The fingerprint of the scene file at `path` (0 if it cannot be read, e.g. a scene built
-/// from text in a test).
-pub fn scene_fingerprint(path: &Path) -> u64 {
-    std::fs::read(path).map_or(0, |bytes| fnv1a(&bytes))
-}
-
-/// Writes a checkpoint with `body` for the scene of fingerprint `scene`, atomically.
+/// Writes a checkpoint with `body` for the scene and inputs of `fingerprint`, atomically.
 ///
 /// # Errors
 /// [`OutputError::Io`] if the file cannot be written; the previous file is then untouched.
-pub fn write_checkpoint(path: &Path, scene: u64, body: &[u8]) -> Result<(), OutputError> {
+pub fn write_checkpoint(
+    path: &Path,
+    fingerprint: &SceneFingerprint,
+    body: &[u8],
+) -> Result<(), OutputError> {
+    let inputs = fingerprint.encode_inputs();
+    let mut checked = Vec::with_capacity(8 + inputs.len() + body.len());
+    checked.extend_from_slice(&(inputs.len() as u64).to_le_bytes());
+    checked.extend_from_slice(&inputs);
+    checked.extend_from_slice(body);
     write_atomic(path, |w| {
         w.write_all(MAGIC)?;
         w.write_all(&FORMAT_VERSION.to_le_bytes())?;
-        w.write_all(&scene.to_le_bytes())?;
-        w.write_all(body)?;
-        w.write_all(&fnv1a(body).to_le_bytes())
+        w.write_all(&fingerprint.scene.to_le_bytes())?;
+        w.write_all(&checked)?;
+        w.write_all(&fnv1a(&checked).to_le_bytes())
     })
 }
 
-/// Reads the body of the checkpoint at `path`, checking the magic, the version, the scene
-/// fingerprint (`scene` of `scene_path`; 0 skips the check) and the checksum.
+/// Reads the body of the checkpoint at `path`, checking the magic, the version and the
+/// checksum and, with `expected` (the scene being resumed; `None` to read another scene's
+/// checkpoint, as `[run] start_from` does), the scene fingerprint (0 skips it) and every
+/// recorded input file against the files as they are now.
 ///
 /// # Errors
 /// The [`CheckpointFileError`] that names what is wrong.
 pub fn read_checkpoint(
     path: &Path,
-    scene: u64,
-    scene_path: &Path,
+    expected: Option<&SceneFingerprint>,
 ) -> Result<Vec<u8>, CheckpointFileError> {
     let bytes = std::fs::read(path).map_err(|source| CheckpointFileError::Read {
         path: path.to_path_buf(),
         source,
     })?;
     let path = path.to_path_buf();
-    if bytes.len() < HEADER + 8 || &bytes[..8] != MAGIC {
+    if bytes.len() < HEADER + 8 + 8 || &bytes[..8] != MAGIC {
         return Err(CheckpointFileError::NotCheckpoint { path });
     }
     let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().expect("8 bytes"));
@@ -137,18 +177,45 @@ pub fn read_checkpoint(
             expected: FORMAT_VERSION,
         });
     }
-    if scene != 0 && word(16) != scene {
+    if let Some(scene) = expected.filter(|e| e.scene != 0 && word(16) != e.scene) {
         return Err(CheckpointFileError::Scene {
             path,
-            scene: scene_path.to_path_buf(),
+            scene: scene.path.clone(),
         });
     }
     let end = bytes.len() - 8;
-    let body = &bytes[HEADER..end];
-    if fnv1a(body) != word(end) {
+    if fnv1a(&bytes[HEADER..end]) != word(end) {
         return Err(CheckpointFileError::Corrupt { path });
     }
-    Ok(body.to_vec())
+    let body_start = usize::try_from(word(HEADER))
+        .ok()
+        .and_then(|n| n.checked_add(HEADER + 8))
+        .filter(|&at| at <= end)
+        .ok_or_else(|| CheckpointFileError::Corrupt { path: path.clone() })?;
+    if let Some(expected) = expected {
+        let recorded = decode_inputs(&bytes[HEADER + 8..body_start]).map_err(|source| {
+            CheckpointFileError::Content {
+                path: path.clone(),
+                source,
+            }
+        })?;
+        if let Some((input, change)) = expected.first_change(&recorded) {
+            let resolved = expected.resolve(&input);
+            return Err(match change {
+                InputChange::Changed => CheckpointFileError::InputChanged {
+                    path,
+                    input,
+                    resolved,
+                },
+                InputChange::Missing => CheckpointFileError::InputMissing {
+                    path,
+                    input,
+                    resolved,
+                },
+            });
+        }
+    }
+    Ok(bytes[body_start..end].to_vec())
 }
 
 #[cfg(test)]
@@ -161,36 +228,71 @@ mod tests {
         dir.join(CHECKPOINT_FILE)
     }
 
+    fn fingerprint(scene: u64, mesh: Option<u64>) -> SceneFingerprint {
+        SceneFingerprint {
+            path: PathBuf::from("dir/scene.toml"),
+            scene,
+            inputs: vec![crate::inputs::Input {
+                file: PathBuf::from("beam.msh"),
+                fingerprint: mesh,
+            }],
+        }
+    }
+
     #[test]
     fn a_checkpoint_reads_back_and_refuses_what_does_not_fit() {
         let path = temp("roundtrip");
-        let scene = Path::new("scene.toml");
-        write_checkpoint(&path, 42, b"body bytes").unwrap();
-        assert_eq!(read_checkpoint(&path, 42, scene).unwrap(), b"body bytes");
+        let written = fingerprint(42, Some(1));
+        write_checkpoint(&path, &written, b"body bytes").unwrap();
+        assert_eq!(
+            read_checkpoint(&path, Some(&written)).unwrap(),
+            b"body bytes"
+        );
+        assert_eq!(read_checkpoint(&path, None).unwrap(), b"body bytes");
         assert!(matches!(
-            read_checkpoint(&path, 43, scene),
+            read_checkpoint(&path, Some(&fingerprint(43, Some(1)))),
             Err(CheckpointFileError::Scene { .. })
         ));
+        let message = match read_checkpoint(&path, Some(&fingerprint(42, Some(2)))) {
+            Err(e @ CheckpointFileError::InputChanged { .. }) => e.to_string(),
+            other => panic!("expected a changed input, got {other:?}"),
+        };
+        assert!(
+            message.contains("`beam.msh`") && message.contains("dir/beam.msh"),
+            "{message}"
+        );
+        assert!(matches!(
+            read_checkpoint(&path, Some(&fingerprint(42, None))),
+            Err(CheckpointFileError::InputMissing { .. })
+        ));
         let mut bytes = std::fs::read(&path).unwrap();
-        bytes[HEADER + 2] ^= 1;
+        let at = bytes.len() - 10;
+        bytes[at] ^= 1;
         std::fs::write(&path, &bytes).unwrap();
         assert!(matches!(
-            read_checkpoint(&path, 42, scene),
+            read_checkpoint(&path, Some(&written)),
             Err(CheckpointFileError::Corrupt { .. })
         ));
-        bytes[8] = 9;
+        bytes[at] ^= 1;
+        bytes[HEADER + 9] ^= 1;
         std::fs::write(&path, &bytes).unwrap();
         assert!(matches!(
-            read_checkpoint(&path, 42, scene),
+            read_checkpoint(&path, None),
+            Err(CheckpointFileError::Corrupt { .. })
+        ));
+        bytes[8] = 2;
+        std::fs::write(&path, &bytes).unwrap();
+        assert!(matches!(
+            read_checkpoint(&path, Some(&written)),
             Err(CheckpointFileError::Version {
-                found: 9,
+                found: 2,
                 expected: FORMAT_VERSION,
                 ..
             })
         ));
         std::fs::write(&path, b"t,tip.ux\n0,0\n").unwrap();
         assert!(matches!(
-            read_checkpoint(&path, 42, scene),
+            read_checkpoint(&path, Some(&written)),
             Err(CheckpointFileError::NotCheckpoint { .. })
         ));
     }

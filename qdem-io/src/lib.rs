@@ -29,6 +29,7 @@ mod contact_build;
 pub mod crack_svg;
 mod csv_rows;
 pub mod granular_build;
+pub mod inputs;
 pub mod linear_spectrum;
 mod load_series;
 pub mod output;

@@ -183,9 +183,10 @@ pub fn run_with(
     if sim.scene.output.writes_vtu() {
         create_dir(&out_dir.join("vtu"))?;
     }
+    crate::output::remove_stale_temporaries(out_dir);
     let steps = sim.steps();
     let checkpoint_path = out_dir.join(CHECKPOINT_FILE);
-    let fingerprint = scene_fingerprint(&sim.scene.path);
+    let fingerprint = scene_fingerprint(&sim.scene);
     let can_checkpoint = sim.world.checkpointable();
     if sim.scene.output.checkpoint_every > 0.0 || options.resume.is_some() {
         if let Err(source) = &can_checkpoint {
@@ -195,7 +196,7 @@ pub fn run_with(
     let mut recorders = record::register(sim, out_dir);
     let mut run = RunRecord::new(sim);
     if let Some(path) = options.resume {
-        let body = read_checkpoint(path, fingerprint, &sim.scene.path)?;
+        let body = read_checkpoint(path, Some(&fingerprint))?;
         decode_run(&body, sim, &mut run, &mut recorders)
             .map_err(|source| core_error(sim, source))?;
     }
@@ -240,7 +241,7 @@ pub fn run_with(
                     r.publish()?;
                 }
                 let body = encode(sim, &run, &recorders)?;
-                write_checkpoint(&checkpoint_path, fingerprint, &body)?;
+                write_checkpoint(&checkpoint_path, &fingerprint, &body)?;
             } else if sampled
                 && can_checkpoint.is_ok()
                 && last_good
@@ -280,7 +281,7 @@ pub fn run_with(
             Err(source @ (RunError::Core { .. } | RunError::Unstable { .. })),
             Some((time, body, _)),
         ) => {
-            write_checkpoint(&checkpoint_path, fingerprint, &body)?;
+            write_checkpoint(&checkpoint_path, &fingerprint, &body)?;
             Err(RunError::Failed {
                 source: Box::new(source),
                 time,

@@ -37,7 +37,7 @@ pub(crate) fn restore_state(
         checkpoint: path.clone(),
         message,
     };
-    let body = read_checkpoint(&path, 0, &scene.path).map_err(|e| refused(e.to_string()))?;
+    let body = read_checkpoint(&path, None).map_err(|e| refused(e.to_string()))?;
     let built = state.reference.clone();
     let mut input = Decoder::new(&body);
     crate::run_record::skip_record(&mut input)

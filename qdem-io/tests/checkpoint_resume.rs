@@ -3,7 +3,8 @@
 //! acceleration, compared by bit pattern) and every output file byte for byte. Checked on a
 //! deformable body under a ramped load (Verlet), and on a rigid sleeper dropped onto a
 //! generated clump sample in a periodic cell with a time-delayed boundary (contact springs,
-//! candidate lists, rigid rotations, the boundary's running estimates). Also: a checkpoint
+//! candidate lists, rigid rotations, the boundary's running estimates), on a bonded beam
+//! (explicit and implicit) and on a static solve (its reused factorisation). Also: a checkpoint
 //! of another scene, and a scene whose models cannot be checkpointed, are refused up front.
 
 mod common;
@@ -320,21 +321,63 @@ fn a_resumed_implicit_bonded_beam_equals_the_uninterrupted_one() {
     resume_equals_uninterrupted("ckpt-implicit", &scene, steps / 2, &files);
 }
 
-#[test]
-fn a_scene_that_cannot_be_checkpointed_is_refused_before_the_first_step() {
-    let dir = test_dir("ckpt-static");
-    let text = std::fs::read_to_string(cantilever_scene(&dir))
+/// The short cantilever solved statically at 20 load levels (dt = 1 ms), a VTU every 5 ms.
+fn static_scene(dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(cantilever_scene(dir))
         .unwrap()
         .replace("integrator = \"verlet\"", "integrator = \"static\"")
-        .replace("dt = \"auto\"", "dt = 0.001")
-        .replace("[output]\n", "[output]\ncheckpoint_every = 0.005\n");
+        .replace("dt = \"auto\"", "dt = 0.001");
     let scene = dir.join("static.toml");
     std::fs::write(&scene, text).unwrap();
+    scene
+}
+
+#[test]
+fn a_resumed_static_run_equals_the_uninterrupted_one() {
+    let dir = test_dir("ckpt-static-scene");
+    let scene = static_scene(&dir);
+    assert_eq!(build(&scene).steps(), 20);
+    let files = [
+        "probes.csv",
+        "probes.svg",
+        "results.pvd",
+        "vtu/state_00002.vtu",
+        "vtu/state_00004.vtu",
+    ];
+    resume_equals_uninterrupted("ckpt-static", &scene, 10, &files);
+}
+
+/// A model without a checkpoint of its history (none of the scene models is one any more).
+struct Forgetful;
+
+impl qdem_core::Model for Forgetful {
+    fn name(&self) -> &str {
+        "forgetful"
+    }
+
+    fn add_forces(
+        &mut self,
+        _state: &qdem_core::State,
+        _force: &mut [qdem_core::Vec3],
+        _torque: &mut [qdem_core::Vec3],
+    ) {
+    }
+}
+
+#[test]
+fn a_scene_that_cannot_be_checkpointed_is_refused_before_the_first_step() {
+    let dir = test_dir("ckpt-unsupported");
+    let text = std::fs::read_to_string(cantilever_scene(&dir))
+        .unwrap()
+        .replace("[output]\n", "[output]\ncheckpoint_every = 0.005\n");
+    let scene = dir.join("unsupported.toml");
+    std::fs::write(&scene, text).unwrap();
     let mut sim = build(&scene);
+    sim.world.models.push(Box::new(Forgetful));
     let error = run(&mut sim, &dir.join("out"), RunOptions::default()).unwrap_err();
     let message = error.to_string();
     assert!(
-        message.contains("static stepper") && message.contains("cannot be checkpointed"),
+        message.contains("model `forgetful`") && message.contains("cannot be checkpointed"),
         "{message}"
     );
     assert_eq!(sim.world.state.time, 0.0, "no step may be taken");

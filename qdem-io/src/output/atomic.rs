@@ -9,6 +9,10 @@
 //! same process at the same time would share that name; the writers of this crate never
 //! do that.
 //!
+//! A run that is killed mid-write leaves its temporary file behind; at the start of every run
+//! [`remove_stale_temporaries`] removes those of processes that no longer run (never those of
+//! a live process, which may be writing them right now).
+//!
 //! After the rename the containing directory is synced too (on Unix), on a best-effort
 //! basis: the rename has already happened at that point, so a failure there is not
 //! reported as a failed write.
@@ -70,6 +74,64 @@ fn temp_path(path: &Path) -> Result<PathBuf, OutputError> {
     temp_name.push(name);
     temp_name.push(format!(".tmp-{}", std::process::id()));
     Ok(path.with_file_name(temp_name))
+}
+
+/// Removes, in `out_dir` and its `vtu/` subfolder, the temporary files this module names
+/// (`.NAME.tmp-<pid>`, and `.NAME.publish-<pid>` of [`AtomicFile::publish`]) whose process no
+/// longer runs: the leftovers of killed runs. A file of a live process (this one included) is
+/// kept, and so is every file when liveness cannot be told (no `/proc`, or not Linux). Best
+/// effort: a directory that cannot be listed or a file that cannot be removed is skipped.
+/// Returns the files removed.
+pub fn remove_stale_temporaries(out_dir: &Path) -> Vec<PathBuf> {
+    let mut removed = Vec::new();
+    for dir in [out_dir.to_path_buf(), out_dir.join("vtu")] {
+        let Ok(entries) = fs::read_dir(&dir) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let name = entry.file_name();
+            let Some(pid) = name.to_str().and_then(temporary_pid) else {
+                continue;
+            };
+            if process_may_run(pid) || !entry.file_type().is_ok_and(|t| t.is_file()) {
+                continue;
+            }
+            let path = entry.path();
+            if fs::remove_file(&path).is_ok() {
+                removed.push(path);
+            }
+        }
+    }
+    removed
+}
+
+/// The process id in a temporary file's name `.NAME.tmp-<pid>` or `.NAME.publish-<pid>`.
+fn temporary_pid(name: &str) -> Option<u32> {
+    let rest = name.strip_prefix('.')?;
+    let (stem, pid) = [".tmp-", ".publish-"]
+        .iter()
+        .find_map(|marker| rest.rsplit_once(marker))?;
+    if stem.is_empty() || pid.is_empty() || !pid.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    pid.parse().ok()
+}
+
+/// Whether process `pid` may be running: false only when it certainly is not (on Linux,
+/// `/proc` is there and `/proc/<pid>` is not).
+fn process_may_run(pid: u32) -> bool {
+    if pid == std::process::id() {
+        return true;
+    }
+    #[cfg(target_os = "linux")]
+    {
+        let proc = Path::new("/proc");
+        !proc.join("self").exists() || proc.join(pid.to_string()).exists()
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        true
+    }
 }
 
 /// Syncs the directory containing `path`, so that a completed rename survives a crash.
@@ -283,6 +345,23 @@ mod tests {
             t,
             PathBuf::from(format!(".x.csv.tmp-{}", std::process::id()))
         );
+    }
+
+    #[test]
+    fn a_temporary_name_gives_its_pid() {
+        assert_eq!(temporary_pid(".probes.csv.tmp-123"), Some(123));
+        assert_eq!(temporary_pid(".probes.csv.publish-45"), Some(45));
+        assert_eq!(temporary_pid(".checkpoint.qdc.tmp-7"), Some(7));
+        for other in [
+            "probes.csv.tmp-123",
+            ".probes.csv.tmp-",
+            ".probes.csv.tmp-12x",
+            ".tmp-12",
+            ".probes.csv",
+        ] {
+            assert_eq!(temporary_pid(other), None, "{other}");
+        }
+        assert!(process_may_run(std::process::id()));
     }
 
     #[test]

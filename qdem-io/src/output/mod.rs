@@ -3,7 +3,9 @@
 //! Every file is written atomically ([`write_atomic`], [`AtomicFile`]): written to a
 //! temporary file `.NAME.tmp-<pid>` in the target's directory, synced, then renamed over
 //! the target. A reader never sees a partial file, and a failed write leaves the previous
-//! content in place and no temporary file behind.
+//! content in place and no temporary file behind. A run that is killed mid-write does leave
+//! one: [`remove_stale_temporaries`], called at the start of every run, removes those whose
+//! process is gone.
 //!
 //! | file | writer |
 //! | --- | --- |
@@ -23,7 +25,7 @@ mod pvd;
 mod summary;
 mod vtu;
 
-pub use atomic::{write_atomic, AtomicFile};
+pub use atomic::{remove_stale_temporaries, write_atomic, AtomicFile};
 pub use error::{IoStage, OutputError};
 pub use probes_csv::{ProbeCsv, PROBE_COLUMNS};
 pub use pvd::PvdIndex;
