@@ -6,6 +6,8 @@
 //! [`granular`] is the settled sphere packing compared with LIGGGHTS; [`cantilever`] runs the paper's cantilever and measures it; [`speed_vs_error`] is the study
 //! behind `docs/speed-vs-error.md` (binary `study`).
 
+#![warn(missing_docs)]
+
 pub mod cantilever;
 pub mod granular;
 pub mod implicit;

@@ -5,6 +5,8 @@
 //! tests run exactly what `qdem verify` prints, and the throughput measurement lives in
 //! `qdem-bench` beside the criterion benches that share it.
 
+#![warn(missing_docs)]
+
 pub mod bench;
 pub mod command;
 pub mod progress;

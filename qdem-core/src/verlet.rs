@@ -3,7 +3,7 @@
 //! v_{n+½} = v_n + ½∆t a_n; x_{n+1} = x_n + ∆t v_{n+½};
 //! a_{n+1} = M⁻¹ f(t_{n+1}, x_{n+1}, v_{n+½}); v_{n+1} = v_{n+½} + ½∆t a_{n+1}.
 //! Viscous forces see the half-step velocity, as in explicit FE codes, which is what the step
-//! bound of [`crate::stable_step`] assumes. Fixed directions keep zero velocity.
+//! bound of [`mod@crate::stable_step`] assumes. Fixed directions keep zero velocity.
 //!
 //! Rigid bodies ([`crate::rigid_body`]) ride along: their angular momentum gets the same two
 //! half kicks from the torque and their orientation the drift, and their members are placed
