@@ -25,6 +25,26 @@ use crate::Vec3;
 use rayon::prelude::*;
 
 /// Velocity Verlet with a fixed step.
+///
+/// ```
+/// use qdem_core::{Gravity, Model, State, Stepper, Vec3, Verlet};
+///
+/// // A particle dropped from rest: under a constant force velocity Verlet is exact.
+/// let mut state = State::at_rest(vec![Vec3::zeros()]);
+/// state.mass[0] = 2.0;
+/// let g = Vec3::new(0.0, 0.0, -9.81);
+/// let mut models: Vec<Box<dyn Model>> = vec![Box::new(Gravity::new(g))];
+/// let mut verlet = Verlet::new(1e-3);
+/// verlet.initialize(&mut state, &mut models)?;
+/// for _ in 0..500 {
+///     verlet.step(&mut state, &mut models)?;
+/// }
+/// let t = state.time;
+/// assert!((t - 0.5).abs() < 1e-12);
+/// assert!((state.position[0] - 0.5 * g * t * t).norm() < 1e-12);
+/// assert!((state.velocity[0] - g * t).norm() < 1e-12);
+/// # Ok::<(), qdem_core::CoreError>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct Verlet {
     dt: f64,
