@@ -132,7 +132,8 @@ fn main() -> ExitCode {
     println!("after:  a {} m/s, b {} m/s", fmt(va), fmt(vb));
     println!(
         "rebound: approach {approach:.4} m/s, separation {separation:.4} m/s along x \
-         (restitution {restitution:.3}; the rest of the energy rings in the bodies)"
+         (restitution {restitution:.3}: the off-centre impact also deflects and spins the bodies \
+         and sets them ringing)"
     );
     println!("largest drift over the run: momentum {drift_p:.2e} (relative), energy {drift_e:.2e}");
     let mut ok = true;
