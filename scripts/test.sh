@@ -11,3 +11,8 @@ fi
 export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
 cargo test --workspace --all-targets
 cargo test --workspace --doc
+# The embedding examples: each checks a physical quantity and exits non-zero when it is off
+# (a few seconds each in release).
+cargo run --release -p qdem-core --example beam_under_load
+cargo run --release -p qdem-contact --example two_bodies_collide
+cargo run --release -p qdem-contact --example spheres_on_wall

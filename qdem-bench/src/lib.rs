@@ -8,6 +8,8 @@
 //! paper's cantilever and measures it; [`speed_vs_error`] is the study behind
 //! `docs/speed-vs-error.md` (binary `study`).
 
+#![warn(missing_docs)]
+
 pub mod cantilever;
 pub mod granular;
 pub mod implicit;

@@ -7,6 +7,8 @@
 //! `qdem-bench`, so that its tests and benches run exactly what `qdem verify` and `qdem bench`
 //! print.
 
+#![warn(missing_docs)]
+
 pub mod check;
 pub mod command;
 pub mod progress;

@@ -170,6 +170,46 @@ impl ContactList {
 }
 
 /// Contact spheres, walls and their contacts: a [`Model`].
+///
+/// ```
+/// use qdem_contact::{
+///     ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring, PlaneWall, Wall,
+///     WallShape,
+/// };
+/// use qdem_core::{Model, State, Vec3};
+///
+/// // Two spheres of radius 0.01 m on particles of bodies 0 and 1, overlapping by 1 mm, the
+/// // second also resting 0.5 mm into a floor z = 0.
+/// let (top, bottom) = (Vec3::new(0.0, 0.0, 0.0285), Vec3::new(0.0, 0.0, 0.0095));
+/// let mut state = State::at_rest(vec![top, bottom]);
+/// state.mass = vec![0.01, 0.01];
+/// let spheres: Vec<ContactSphere> = (0..2)
+///     .map(|i| ContactSphere { particle: i, radius: 0.01, body: i, material: 0 })
+///     .collect();
+/// let floor = Wall {
+///     shape: WallShape::Plane(PlaneWall::new(Vec3::zeros(), Vec3::z(), Vec3::zeros())),
+///     friction: 0.5,
+/// };
+/// let k = 1e5;
+/// let settings = ContactSettings {
+///     law: ContactLaw::Linear(LinearSpring {
+///         normal_stiffness: k,
+///         tangential_stiffness: k,
+///         damping_ratio: 0.0,
+///     }),
+///     friction: 0.5,
+///     skin: 0.001,
+/// };
+/// let names = vec!["top".to_string(), "bottom".to_string()];
+/// let materials = [(1e9, 0.25)];
+/// let mut contacts = DemContacts::new(&state, &spheres, names, &materials, settings, vec![floor]);
+/// let mut force = vec![Vec3::zeros(); 2];
+/// contacts.add_forces(&state, &mut force, &mut []);
+/// assert_eq!(contacts.contacts(), 2);
+/// // The pair pushes the spheres apart with k δ; the floor pushes the lower one up.
+/// assert!((force[0].z - k * 1e-3).abs() < 1e-9);
+/// assert!((force[1].z - (k * 5e-4 - k * 1e-3)).abs() < 1e-9);
+/// ```
 pub struct DemContacts {
     name: String,
     particle: Vec<u32>,

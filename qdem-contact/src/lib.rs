@@ -25,6 +25,8 @@
 //! Rigid bodies are integrated by qdem-core ([`qdem_core::rigid_body`]); their spheres add the
 //! moment of each contact force about the sphere's centre to the body's torque.
 
+#![warn(missing_docs)]
+
 pub mod beam_bond;
 mod bond_tangent;
 pub mod bonded_particles;

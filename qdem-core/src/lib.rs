@@ -16,7 +16,9 @@
 //!
 //! The QDEM tetrahedron (Nishiura, Sakaguchi & Aikawa 2017, Eqs. 1–11) is in [`tet_kernel`],
 //! with the literal 12-triangle subdomain construction kept as its oracle in
-//! [`tet_subdomain`], and the rigorous explicit step bound in [`stable_step`].
+//! [`tet_subdomain`], and the rigorous explicit step bound in [`mod@stable_step`].
+
+#![warn(missing_docs)]
 
 pub mod checkpoint;
 pub mod error;

@@ -62,6 +62,26 @@ impl Dofs {
 }
 
 /// Degrees of freedom of all particles of a scene, one entry per particle in each array.
+///
+/// ```
+/// use qdem_core::{Dofs, State, Vec3};
+///
+/// // Two particles at rest where they were put; masses are the caller's (or a body's
+/// // `lump_mass`) to fill in.
+/// let mut state = State::at_rest(vec![Vec3::zeros(), Vec3::x()]);
+/// state.mass = vec![2.0, 1.0];
+/// state.velocity[1] = Vec3::new(0.0, 3.0, 0.0);
+/// assert_eq!(state.momentum(), Vec3::new(0.0, 3.0, 0.0));
+/// assert_eq!(state.kinetic_energy(), 4.5);
+///
+/// // Displacements are measured from the reference configuration.
+/// state.position[0].x += 0.25;
+/// assert_eq!(state.displacement(0), Vec3::new(0.25, 0.0, 0.0));
+///
+/// // Fixing a particle zeroes its velocity in the fixed directions.
+/// state.fix(1, Dofs::ALL);
+/// assert_eq!(state.velocity[1], Vec3::zeros());
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct State {
     /// Simulated time (s).

@@ -32,6 +32,27 @@ const TET_CHUNK: usize = 512;
 const PARTICLE_CHUNK: usize = 1024;
 
 /// A deformable body of linear QDEM tetrahedra.
+///
+/// ```
+/// use qdem_core::{Material, Model, State, TetBody, Vec3};
+///
+/// // One tetrahedron of volume 1/6 m³.
+/// let nodes = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];
+/// let material = Material::elastic(1200.0, 1e6, 0.25);
+/// let mut body = TetBody::new("tet", &nodes, vec![[0, 1, 2, 3]], material)?;
+/// let mut state = State::at_rest(nodes);
+/// body.lump_mass(&mut state.mass);
+/// assert!(state.mass.iter().all(|&m| (m - 1200.0 / 6.0 / 4.0).abs() < 1e-9));
+///
+/// // Stretch one vertex: the body pulls it back, and its internal forces sum to zero.
+/// state.position[1].x += 0.01;
+/// let mut force = vec![Vec3::zeros(); state.len()];
+/// body.add_forces(&state, &mut force, &mut []);
+/// assert!(force[1].x < 0.0);
+/// let total: Vec3 = force.iter().sum();
+/// assert!(total.norm() < 1e-9 * force[1].norm());
+/// # Ok::<(), qdem_core::CoreError>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct TetBody {
     name: String,

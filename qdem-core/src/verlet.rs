@@ -3,7 +3,7 @@
 //! v_{n+½} = v_n + ½∆t a_n; x_{n+1} = x_n + ∆t v_{n+½};
 //! a_{n+1} = M⁻¹ f(t_{n+1}, x_{n+1}, v_{n+½}); v_{n+1} = v_{n+½} + ½∆t a_{n+1}.
 //! Viscous forces see the half-step velocity, as in explicit FE codes, which is what the step
-//! bound of [`crate::stable_step`] assumes. Fixed directions keep zero velocity.
+//! bound of [`mod@crate::stable_step`] assumes. Fixed directions keep zero velocity.
 //!
 //! Rigid bodies ([`crate::rigid_body`]) ride along: their angular momentum gets the same two
 //! half kicks from the torque and their orientation the drift, and their members are placed
@@ -26,6 +26,26 @@ use crate::Vec3;
 use rayon::prelude::*;
 
 /// Velocity Verlet with a fixed step.
+///
+/// ```
+/// use qdem_core::{Gravity, Model, State, Stepper, Vec3, Verlet};
+///
+/// // A particle dropped from rest: under a constant force velocity Verlet is exact.
+/// let mut state = State::at_rest(vec![Vec3::zeros()]);
+/// state.mass[0] = 2.0;
+/// let g = Vec3::new(0.0, 0.0, -9.81);
+/// let mut models: Vec<Box<dyn Model>> = vec![Box::new(Gravity::new(g))];
+/// let mut verlet = Verlet::new(1e-3);
+/// verlet.initialize(&mut state, &mut models)?;
+/// for _ in 0..500 {
+///     verlet.step(&mut state, &mut models)?;
+/// }
+/// let t = state.time;
+/// assert!((t - 0.5).abs() < 1e-12);
+/// assert!((state.position[0] - 0.5 * g * t * t).norm() < 1e-12);
+/// assert!((state.velocity[0] - g * t).norm() < 1e-12);
+/// # Ok::<(), qdem_core::CoreError>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct Verlet {
     dt: f64,

@@ -20,6 +20,8 @@
 //! - [`analyze`]: Parzen-smoothed linear spectra and mobility of a run's sensors
 //!   ([`linear_spectrum`], paper 000 §4.2).
 
+#![warn(missing_docs)]
+
 pub mod analyze;
 pub mod ballast_build;
 mod bonded_build;
