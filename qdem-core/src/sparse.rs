@@ -755,6 +755,12 @@ fn sparse_error(e: impl std::fmt::Debug) -> CoreError {
     CoreError::Sparse(format!("{e:?}"))
 }
 
+/// The particles a model's elements join ([`crate::Linearized::particles`]); none for a model
+/// without a linearisation.
+fn particles_of(model: &dyn Model) -> Vec<usize> {
+    model.linearized().map_or_else(Vec::new, |l| l.particles())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -864,10 +870,4 @@ mod tests {
             .0
             .compute_nnz()
     }
-}
-
-/// The particles a model's elements join ([`crate::Linearized::particles`]); none for a model
-/// without a linearisation.
-fn particles_of(model: &dyn Model) -> Vec<usize> {
-    model.linearized().map_or_else(Vec::new, |l| l.particles())
 }

@@ -249,8 +249,11 @@ impl World {
 
     /// Whether the world can be checkpointed, or the first model or the stepper that cannot.
     pub fn checkpointable(&self) -> Result<(), CheckpointError> {
-        let unsupported = |m: &&Box<dyn Model>| matches!(m.persistence(), Persistence::Unsupported);
-        if let Some(m) = self.models.iter().find(unsupported) {
+        let unsupported = self
+            .models
+            .iter()
+            .find(|m| matches!(m.persistence(), Persistence::Unsupported));
+        if let Some(m) = unsupported {
             return Err(CheckpointError::Unsupported {
                 what: format!("model `{}`", m.name()),
             });
