@@ -62,7 +62,7 @@ pub(crate) fn build_contacts(
         .collect();
     let mut model = DemContacts::new(state, &spheres, names, &materials, settings, walls);
     if let (Some(cell), Some(periodic)) = (extra.periodic, &scene.periodic) {
-        model = crate::periodic_build::periodic_contacts(scene, periodic, &cell, model)?;
+        model = super::periodic::periodic_contacts(scene, periodic, &cell, model)?;
     }
     model
         .check_initial_overlaps(state, contact.overlap_tolerance)

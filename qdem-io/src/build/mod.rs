@@ -3,14 +3,39 @@
 //! (then one centre particle per rigid body), and only the models the scene needs: a
 //! [`TetBody`] per deformable body (a rigid body gets none: its mass and inertia come from its
 //! tetrahedra, [`qdem_core::rigid_body`]), contacts only when bodies carry contact spheres
-//! ([`crate::contact_build`]), [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per
-//! load.
+//! (`contact`), [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per load.
+//!
+//! # The stage
+//!
+//! Building is the stage after [validation](crate::scene): it reads a validated [`Scene`] and
+//! the references validation resolved ([`Scene::refs`]: each body's material, each fix's, load's
+//! and probe's body as indices), so no name is looked up again here. One module per part of a
+//! scene, each taking the table it builds and the indices it needs:
+//!
+//! - this module: the `[[body]]` meshes, fixes, loads, probes and the step request;
+//! - `contact`: contact spheres, the `[contact]` law and the `[[wall]]`s;
+//! - [`granular`]: the rigid stones of `[granular]`; [`ballast`]: the deformable stones of
+//!   `[ballast]`; `bonded`: a `[bonded]` body (built instead of everything else);
+//! - `periodic`: the `[periodic]` cell, its wrap groups and time delay;
+//! - `rest_on`: bodies laid on a granular sample; `load_series`: a load's CSV time series;
+//! - [`BuildError`] (`error`): why a build failed.
 
-use crate::ballast_build::{place_ballast, BallastInfo};
-use crate::contact_build::ExtraSpheres;
-use crate::granular_build::GranularInfo;
+pub mod ballast;
+mod bonded;
+mod contact;
+mod error;
+pub mod granular;
+pub(crate) mod load_series;
+mod periodic;
+mod rest_on;
+
+pub use error::BuildError;
+
 use crate::scene::suggest::did_you_mean;
 use crate::scene::{Integrator, Scene, Selection, TimeStep};
+use ballast::{place_ballast, BallastInfo};
+use contact::ExtraSpheres;
+use granular::GranularInfo;
 use nalgebra::{Rotation3, UnitQuaternion};
 use qdem_contact::BondedParticles;
 use qdem_contact::{DemContacts, PeriodicBox, PeriodicWrap};
@@ -22,166 +47,6 @@ use qdem_core::{
 use qdem_mesh::{read_msh, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
-use thiserror::Error;
-
-/// Why a scene could not be turned into a simulation.
-#[derive(Debug, Error)]
-pub enum BuildError {
-    /// A mesh could not be read or lacks a group.
-    #[error(transparent)]
-    Mesh(#[from] MeshError),
-    /// The core refused a body, a ramp or the time step.
-    #[error("{scene}: {source}")]
-    Core {
-        /// The scene file.
-        scene: PathBuf,
-        /// What the core refused.
-        source: CoreError,
-    },
-    /// A fix or load names a physical group the body's mesh does not have.
-    #[error(
-        "{scene}: {what}: the mesh {mesh} has no physical group `{group}`{candidates}; fix: \
-         name one of them, or select particles with box = [[xmin, ymin, zmin], [xmax, ymax, zmax]]"
-    )]
-    MissingGroup {
-        /// The scene file.
-        scene: PathBuf,
-        /// `[[fix]] #N on body `name`` or the same for a load.
-        what: String,
-        /// The mesh file.
-        mesh: String,
-        /// The requested group.
-        group: String,
-        /// `; did you mean `…`?` if a name is close, then `(available: …)`.
-        candidates: String,
-    },
-    /// The contact set-up is refused (initial overlap, a bad wall, a sphere too large).
-    #[error("{scene}: {source}")]
-    Contact {
-        /// The scene file.
-        scene: PathBuf,
-        /// What is wrong.
-        source: Box<qdem_contact::ContactError>,
-    },
-    /// A body's contact radius is too large for it.
-    #[error(
-        "{scene}: body `{body}`: contact_radius = {radius} m is more than half its smallest \
-         extent {extent:.4e} m, so its spheres stick out through the opposite side: use a \
-         radius of at most {limit:.4e} m"
-    )]
-    ContactRadius {
-        /// The scene file.
-        scene: PathBuf,
-        /// The body.
-        body: String,
-        /// Its contact radius.
-        radius: f64,
-        /// Its smallest bounding-box extent.
-        extent: f64,
-        /// Half that extent.
-        limit: f64,
-    },
-    /// A `[granular]` sample or its generation is refused.
-    #[error("{scene}: [granular]: {source}")]
-    Granular {
-        /// The scene file.
-        scene: PathBuf,
-        /// What is wrong.
-        source: qdem_contact::clump_sample::SampleError,
-    },
-    /// A body's `rest_on` finds no stone beneath it.
-    #[error(
-        "{scene}: body `{body}`: rest_on: no stone lies beneath its contact spheres, so it has \
-         nothing to rest on; fix: translate the body over the sample, or drop rest_on"
-    )]
-    RestOn {
-        /// The scene file.
-        scene: PathBuf,
-        /// The body.
-        body: String,
-    },
-    /// A body's `pose_from` file has no row for it (or for its `pose_body`).
-    #[error(
-        "{scene}: pose_from: {path} has no pose for a body `{body}`; fix: name the body (or \
-         its pose_body) as in the run that wrote the file, or drop pose_from"
-    )]
-    PoseMissing {
-        /// The scene file.
-        scene: PathBuf,
-        /// The body whose pose was looked for.
-        body: String,
-        /// The poses file.
-        path: PathBuf,
-    },
-    /// A poses file is malformed.
-    #[error(
-        "{path}:{line}: {message} (a poses file is CSV `body,x,y,z,qw,qx,qy,qz`, one row per \
-         rigid body, as a run writes it)"
-    )]
-    Poses {
-        /// The file.
-        path: PathBuf,
-        /// Line number (1-based; 0 when the file could not be read).
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A stones file is malformed.
-    #[error(
-        "{path}:{line}: {message} (a stones file is CSV `stone,x,y,z,radius`, one row per sphere)"
-    )]
-    Sample {
-        /// The file.
-        path: PathBuf,
-        /// Line number (1-based; 0 when the file could not be read).
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// `[ballast]` stones cannot be made or placed.
-    #[error("{scene}: [ballast]: {message}")]
-    Ballast {
-        /// The scene file.
-        scene: PathBuf,
-        /// What is wrong and how to fix it.
-        message: String,
-    },
-    /// A load's series file is malformed.
-    #[error(
-        "{path}:{line}: {message} (a series file is CSV with a header row, time in s in the \
-         first column, rows in non-decreasing time)"
-    )]
-    Series {
-        /// The file.
-        path: PathBuf,
-        /// Line number (1-based; 0 when the file could not be read).
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// `[run] start_from` cannot be used.
-    #[error("{scene}: [run] start_from {checkpoint}: {message}")]
-    StartFrom {
-        /// The scene file.
-        scene: PathBuf,
-        /// The checkpoint.
-        checkpoint: PathBuf,
-        /// What is wrong and how to fix it.
-        message: String,
-    },
-    /// A fix or load selects no particle.
-    #[error("{scene}: {what} on body `{body}` selects no particle: {fix}")]
-    EmptySelection {
-        /// The scene file.
-        scene: PathBuf,
-        /// `[[fix]]` or `[[load]]` with its index.
-        what: String,
-        /// The body.
-        body: String,
-        /// How to fix it.
-        fix: &'static str,
-    },
-}
 
 /// How a body is integrated.
 #[derive(Clone, Debug)]
@@ -268,7 +133,7 @@ impl Simulation {
     /// non-zero), then loads; fixes go into the state.
     pub fn build(scene: Scene) -> Result<Simulation, BuildError> {
         if let Some(bonded) = scene.bonded.clone() {
-            return crate::bonded_build::build_bonded(scene, &bonded);
+            return bonded::build_bonded(scene, &bonded);
         }
         let core = |source| BuildError::Core {
             scene: scene.path.clone(),
@@ -276,15 +141,15 @@ impl Simulation {
         };
         let (mut meshes, warnings, ballast) = read_meshes(&scene)?;
         let stones = match &scene.granular {
-            Some(g) => crate::granular_build::stones(&scene, g)?,
+            Some(g) => granular::stones(&scene, g)?,
             None => Vec::new(),
         };
         let periodic_box = match &scene.periodic {
-            Some(p) => Some(crate::periodic_build::periodic_box(&scene, p)?),
+            Some(p) => Some(periodic::periodic_box(&scene, p)?),
             None => None,
         };
         crate::pose_from::pose_bodies(&scene, &mut meshes)?;
-        crate::rest_on::rest_bodies(&scene, &mut meshes, &stones, periodic_box.as_ref())?;
+        rest_on::rest_bodies(&scene, &mut meshes, &stones, periodic_box.as_ref())?;
         let reference = meshes
             .iter()
             .flat_map(|m| m.mesh.nodes.iter().map(|p| Vec3::from(*p)));
@@ -307,7 +172,7 @@ impl Simulation {
                     .iter()
                     .position(|m| m.name == g.material)
                     .expect("validated scene");
-                let (info, spheres) = crate::granular_build::add_stones(
+                let (info, spheres) = granular::add_stones(
                     &scene,
                     g,
                     &stones,
@@ -324,18 +189,12 @@ impl Simulation {
             None => None,
         };
         let periodic = periodic_box.map(|p| {
-            let groups = crate::periodic_build::wrap_groups(
-                &state,
-                &bodies,
-                granular.as_ref(),
-                ballast.as_ref(),
-            );
+            let groups =
+                periodic::wrap_groups(&state, &bodies, granular.as_ref(), ballast.as_ref());
             (p, groups)
         });
         extra.periodic = periodic.as_ref().map(|p| p.0.clone());
-        if let Some(contacts) =
-            crate::contact_build::build_contacts(&scene, &meshes, &state, extra)?
-        {
+        if let Some(contacts) = contact::build_contacts(&scene, &meshes, &state, extra)? {
             models.push(Box::new(contacts));
         }
         if scene.run.gravity.iter().any(|&g| g != 0.0) {
@@ -617,7 +476,7 @@ fn build_loads(
             .collect();
         let ramp = match (&load.cyclic, &load.series) {
             (Some(c), _) => TimeFunction::cyclic(c.cycle()),
-            (None, Some(series)) => TimeFunction::new(crate::load_series::read_series(
+            (None, Some(series)) => TimeFunction::new(load_series::read_series(
                 &scene.resolve(&series.file),
                 &series.column,
             )?),

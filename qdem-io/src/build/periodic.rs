@@ -2,9 +2,9 @@
 //! (every body whole: paper 003's ghosts are copies of whole particles), and the time-delayed
 //! boundary that follows a sleeper's cyclic load (paper 003 §5).
 
-use crate::ballast_build::BallastInfo;
+use super::ballast::BallastInfo;
+use super::granular::GranularInfo;
 use crate::build::{BodyInfo, BodyKind, BuildError};
-use crate::granular_build::GranularInfo;
 use crate::scene::{Periodic, Scene};
 use qdem_contact::time_delayed_boundary::lag_from_spacing;
 use qdem_contact::{DemContacts, LoadCycle, PeriodicBox, TimeDelayedBoundary, WrapGroup};

@@ -239,7 +239,7 @@ fn exclude_images(scene: &Scene, ballast: &Ballast) -> Result<Vec<[Vec3; 2]>, Bu
     };
     let mut images = vec![[a, b]];
     if let Some(p) = &scene.periodic {
-        let cell = crate::periodic_build::periodic_box(scene, p)?;
+        let cell = super::periodic::periodic_box(scene, p)?;
         for k in 0..3 {
             let Some(length) = cell.length(k) else {
                 continue;
