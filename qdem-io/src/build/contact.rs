@@ -4,7 +4,7 @@
 //! single body and no wall) gets no contact model, and the initial configuration is checked
 //! for interpenetration before anything runs.
 
-use crate::build::{body_index, BuildError, PlacedMesh};
+use crate::build::{BuildError, PlacedMesh};
 use crate::scene::{Contact, ContactLawName, Scene};
 use qdem_contact::broad_phase::bounds;
 use qdem_contact::{
@@ -90,11 +90,12 @@ fn law(contact: &Contact) -> ContactLaw {
 /// larger than half the body's smallest extent.
 fn contact_spheres(scene: &Scene, meshes: &[PlacedMesh]) -> Result<Vec<ContactSphere>, BuildError> {
     let mut spheres = Vec::new();
-    for (b, body) in scene.bodies.iter().enumerate() {
+    let materials = &scene.refs().body_materials;
+    for (b, (body, &material)) in scene.bodies.iter().zip(materials).enumerate() {
         let Some(radius) = body.contact_radius else {
             continue;
         };
-        let placed = &meshes[body_index(scene, &body.name)];
+        let placed = &meshes[b];
         let extent = smallest_extent(&placed.mesh.nodes);
         if radius > 0.5 * extent {
             return Err(BuildError::ContactRadius {
@@ -105,11 +106,6 @@ fn contact_spheres(scene: &Scene, meshes: &[PlacedMesh]) -> Result<Vec<ContactSp
                 limit: 0.5 * extent,
             });
         }
-        let material = scene
-            .materials
-            .iter()
-            .position(|m| m.name == body.material)
-            .expect("validated scene");
         spheres.extend(
             placed
                 .mesh

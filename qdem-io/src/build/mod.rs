@@ -132,8 +132,9 @@ impl Simulation {
     /// Reads the meshes and builds every model of `scene`: bodies, then gravity (only if
     /// non-zero), then loads; fixes go into the state.
     pub fn build(scene: Scene) -> Result<Simulation, BuildError> {
-        if let Some(bonded) = scene.bonded.clone() {
-            return bonded::build_bonded(scene, &bonded);
+        if let Some((bonded, material)) = scene.bonded.clone().zip(scene.refs().bonded_material) {
+            let material = scene.materials[material].clone();
+            return bonded::build_bonded(scene, &bonded, &material);
         }
         let core = |source| BuildError::Core {
             scene: scene.path.clone(),
@@ -165,29 +166,7 @@ impl Simulation {
                 .map(|k| format!("{} stone {k}", info.name))
                 .collect();
         }
-        let granular = match &scene.granular {
-            Some(g) => {
-                let material = scene
-                    .materials
-                    .iter()
-                    .position(|m| m.name == g.material)
-                    .expect("validated scene");
-                let (info, spheres) = granular::add_stones(
-                    &scene,
-                    g,
-                    &stones,
-                    &mut state,
-                    scene.bodies.len() + extra.names.len(),
-                    material,
-                )?;
-                extra.spheres.extend(spheres);
-                extra
-                    .names
-                    .extend((1..=info.len()).map(|k| format!("{} stone {k}", g.name)));
-                Some(info)
-            }
-            None => None,
-        };
+        let granular = add_granular(&scene, &stones, &mut state, &mut extra)?;
         let periodic = periodic_box.map(|p| {
             let groups =
                 periodic::wrap_groups(&state, &bodies, granular.as_ref(), ballast.as_ref());
@@ -266,14 +245,41 @@ impl Simulation {
     }
 }
 
+/// The `[granular]` stones appended to `state` as rigid bodies after the mesh bodies and the
+/// ballast stones, their spheres and names added to `extra`.
+fn add_granular(
+    scene: &Scene,
+    stones: &[qdem_contact::clump_sample::Stone],
+    state: &mut State,
+    extra: &mut ExtraSpheres,
+) -> Result<Option<GranularInfo>, BuildError> {
+    let Some((g, material)) = scene.granular.as_ref().zip(scene.refs().granular_material) else {
+        return Ok(None);
+    };
+    let (info, spheres) = granular::add_stones(
+        &scene.path,
+        g,
+        stones,
+        state,
+        scene.bodies.len() + extra.names.len(),
+        (material, scene.materials[material].density),
+    )?;
+    extra.spheres.extend(spheres);
+    extra
+        .names
+        .extend((1..=info.len()).map(|k| format!("{} stone {k}", g.name)));
+    Ok(Some(info))
+}
+
 /// Each probe at the particle of its body nearest its point at the start of the run (after
 /// `start_from`, the settled positions).
 fn resolve_probes(scene: &Scene, bodies: &[BodyInfo], state: &State) -> Vec<ProbePoint> {
     scene
         .probes
         .iter()
-        .map(|p| {
-            let body = &bodies[body_index(scene, &p.body)];
+        .zip(&scene.refs().probe_bodies)
+        .map(|(p, &body)| {
+            let body = &bodies[body];
             let center = match body.kind {
                 BodyKind::Rigid { center, .. } => Some(center),
                 BodyKind::Deformable { .. } => None,
@@ -309,9 +315,10 @@ fn read_meshes(scene: &Scene) -> Result<ReadMeshes, BuildError> {
         });
     }
     let mut ballast = None;
-    if let Some(b) = &scene.ballast {
+    if let Some((b, material)) = scene.ballast.as_ref().zip(scene.refs().ballast_material) {
         let start = meshes.last().map_or(0, |m| m.particles.end);
-        let (placed, info, stone_warnings) = place_ballast(scene, b, start, scene.bodies.len())?;
+        let first_body = scene.bodies.len();
+        let (placed, info, stone_warnings) = place_ballast(scene, b, start, first_body, material)?;
         meshes.push(placed);
         warnings.extend(stone_warnings);
         ballast = Some(info);
@@ -360,8 +367,9 @@ fn build_bodies(
     models: &mut Vec<Box<dyn Model>>,
 ) -> Result<Vec<BodyInfo>, CoreError> {
     let mut bodies = Vec::new();
-    for (body, placed) in scene.bodies.iter().zip(meshes) {
-        let material = scene.material(&body.material).expect("validated scene");
+    let materials = &scene.refs().body_materials;
+    for ((body, placed), &material) in scene.bodies.iter().zip(meshes).zip(materials) {
+        let material = &scene.materials[material];
         let tets = offset_tets(&placed.mesh, placed.particles.start);
         let velocity = Vec3::from(body.velocity);
         let kind = if body.rigid {
@@ -396,32 +404,45 @@ fn build_bodies(
             mesh: placed.path.clone(),
         });
     }
-    if let (Some(b), Some(placed)) = (&scene.ballast, meshes.get(scene.bodies.len())) {
-        let material = core_material(scene.material(&b.material).expect("validated scene"));
-        let tets = offset_tets(&placed.mesh, placed.particles.start);
-        let stones = TetBody::new(&b.name, &state.reference, tets, material)?;
-        stones.lump_mass(&mut state.mass);
-        models.push(Box::new(stones));
-        for i in placed.particles.clone() {
-            state.velocity[i] = Vec3::from(b.velocity);
-        }
-        bodies.push(BodyInfo {
-            name: b.name.clone(),
-            particles: placed.particles.clone(),
-            kind: BodyKind::Deformable {
-                model: models.len() - 1,
-            },
-            stats: placed.mesh.stats(),
-            mesh: placed.path.clone(),
-        });
+    let ballast = scene.ballast.as_ref().zip(scene.refs().ballast_material);
+    if let (Some((b, material)), Some(placed)) = (ballast, meshes.get(scene.bodies.len())) {
+        let material = core_material(&scene.materials[material]);
+        bodies.push(ballast_body(b, material, placed, state, models)?);
     }
     Ok(bodies)
+}
+
+/// The `[ballast]` stones as one [`TetBody`] of `material`, their lumped mass added to the
+/// state, with their initial velocity.
+fn ballast_body(
+    b: &crate::scene::Ballast,
+    material: Material,
+    placed: &PlacedMesh,
+    state: &mut State,
+    models: &mut Vec<Box<dyn Model>>,
+) -> Result<BodyInfo, CoreError> {
+    let tets = offset_tets(&placed.mesh, placed.particles.start);
+    let stones = TetBody::new(&b.name, &state.reference, tets, material)?;
+    stones.lump_mass(&mut state.mass);
+    models.push(Box::new(stones));
+    for i in placed.particles.clone() {
+        state.velocity[i] = Vec3::from(b.velocity);
+    }
+    Ok(BodyInfo {
+        name: b.name.clone(),
+        particles: placed.particles.clone(),
+        kind: BodyKind::Deformable {
+            model: models.len() - 1,
+        },
+        stats: placed.mesh.stats(),
+        mesh: placed.path.clone(),
+    })
 }
 
 /// A rigid body is fixed in every direction any of its particles is fixed in, and its
 /// rotation too when all three are or a `[[fix]]` on it says `rotation = true`.
 fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], state: &mut State) {
-    for body in bodies {
+    for (k, body) in bodies.iter().enumerate() {
         let BodyKind::Rigid {
             body: b, center, ..
         } = body.kind
@@ -436,7 +457,8 @@ fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], state: &mut State) {
         let held = scene
             .fixes
             .iter()
-            .any(|f| f.body == body.name && f.rotation);
+            .zip(&scene.refs().fix_bodies)
+            .any(|(f, &on)| on == k && f.rotation);
         if dofs == Dofs::ALL || held {
             state.rigid.spin_fixed[b] = true;
             state.rigid.set_angular_velocity(b, Vec3::zeros());
@@ -446,8 +468,9 @@ fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], state: &mut State) {
 
 /// Fixes the selected directions of the selected particles of every `[[fix]]`.
 fn apply_fixes(scene: &Scene, meshes: &[PlacedMesh], state: &mut State) -> Result<(), BuildError> {
-    for (i, fix) in scene.fixes.iter().enumerate() {
-        let placed = &meshes[body_index(scene, &fix.body)];
+    let on = &scene.refs().fix_bodies;
+    for (i, (fix, &body)) in scene.fixes.iter().zip(on).enumerate() {
+        let placed = &meshes[body];
         let what = format!("[[fix]] #{}", i + 1);
         for n in select(scene, placed, &fix.selection, &what, &fix.body)? {
             state.fix(
@@ -465,8 +488,9 @@ fn build_loads(
     meshes: &[PlacedMesh],
     models: &mut Vec<Box<dyn Model>>,
 ) -> Result<(), BuildError> {
-    for (i, load) in scene.loads.iter().enumerate() {
-        let placed = &meshes[body_index(scene, &load.body)];
+    let on = &scene.refs().load_bodies;
+    for (i, (load, &body)) in scene.loads.iter().zip(on).enumerate() {
+        let placed = &meshes[body];
         let what = format!("[[load]] #{}", i + 1);
         let selected = select(scene, placed, &load.selection, &what, &load.body)?;
         let start = placed.particles.start;
@@ -523,23 +547,6 @@ fn scheme(scene: &Scene) -> Scheme {
         },
         Integrator::Static => Scheme::Static,
     }
-}
-
-/// Index of a body that the validated scene guarantees to exist (the `[ballast]` comes after
-/// the `[[body]]`s).
-pub(crate) fn body_index(scene: &Scene, name: &str) -> usize {
-    scene
-        .bodies
-        .iter()
-        .position(|b| b.name == name)
-        .or_else(|| {
-            scene
-                .ballast
-                .as_ref()
-                .filter(|b| b.name == name)
-                .map(|_| scene.bodies.len())
-        })
-        .expect("validated scene")
 }
 
 pub(crate) fn core_material(m: &crate::scene::Material) -> Material {
