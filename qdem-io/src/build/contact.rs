@@ -4,6 +4,7 @@
 //! single body and no wall) gets no contact model, and the initial configuration is checked
 //! for interpenetration before anything runs.
 
+use super::ballast::BallastInfo;
 use crate::build::{BuildError, PlacedMesh};
 use crate::scene::{Contact, ContactLawName, Scene};
 use qdem_contact::broad_phase::bounds;
@@ -21,6 +22,21 @@ pub(crate) struct ExtraSpheres {
     pub(crate) spheres: Vec<ContactSphere>,
     pub(crate) names: Vec<String>,
     pub(crate) periodic: Option<PeriodicBox>,
+}
+
+impl ExtraSpheres {
+    /// The contact spheres of the `[ballast]` stones, each stone a body of its own named
+    /// `<ballast> stone <k>`.
+    pub(crate) fn of_ballast(ballast: Option<&BallastInfo>) -> ExtraSpheres {
+        let mut extra = ExtraSpheres::default();
+        if let Some(info) = ballast {
+            extra.spheres.clone_from(&info.spheres);
+            extra.names = (1..=info.stones.len())
+                .map(|k| format!("{} stone {k}", info.name))
+                .collect();
+        }
+        extra
+    }
 }
 
 /// The contact model, or `None` when no body has contact spheres.

@@ -159,13 +159,7 @@ impl Simulation {
         let bodies = build_bodies(&scene, &meshes, &mut state, &mut models).map_err(core)?;
         apply_fixes(&scene, &meshes, &mut state)?;
         fix_rigid_bodies(&scene, &bodies, &mut state);
-        let mut extra = ExtraSpheres::default();
-        if let Some(info) = &ballast {
-            extra.spheres.clone_from(&info.spheres);
-            extra.names = (1..=info.stones.len())
-                .map(|k| format!("{} stone {k}", info.name))
-                .collect();
-        }
+        let mut extra = ExtraSpheres::of_ballast(ballast.as_ref());
         let granular = add_granular(&scene, &stones, &mut state, &mut extra)?;
         let periodic = periodic_box.map(|p| {
             let groups =
@@ -173,13 +167,7 @@ impl Simulation {
             (p, groups)
         });
         extra.periodic = periodic.as_ref().map(|p| p.0.clone());
-        if let Some(contacts) = contact::build_contacts(&scene, &meshes, &state, extra)? {
-            models.push(Box::new(contacts));
-        }
-        if scene.run.gravity.iter().any(|&g| g != 0.0) {
-            models.push(Box::new(Gravity::new(Vec3::from(scene.run.gravity))));
-        }
-        build_loads(&scene, &meshes, &mut models)?;
+        add_forces(&scene, &meshes, &state, extra, &mut models)?;
         if let Some(file) = &scene.run.start_from {
             crate::start_from::restore_state(&scene, file, &mut state, periodic.as_ref())?;
         }
@@ -243,6 +231,24 @@ impl Simulation {
     pub fn periodic(&self) -> Option<&PeriodicBox> {
         self.world.hook::<PeriodicWrap>().map(|w| &w.cell)
     }
+}
+
+/// The models that act between and on the bodies, after the bodies': contacts (when something
+/// can touch), gravity (when it is not zero), then one [`NodalLoad`] per `[[load]]`.
+fn add_forces(
+    scene: &Scene,
+    meshes: &[PlacedMesh],
+    state: &State,
+    extra: ExtraSpheres,
+    models: &mut Vec<Box<dyn Model>>,
+) -> Result<(), BuildError> {
+    if let Some(contacts) = contact::build_contacts(scene, meshes, state, extra)? {
+        models.push(Box::new(contacts));
+    }
+    if scene.run.gravity.iter().any(|&g| g != 0.0) {
+        models.push(Box::new(Gravity::new(Vec3::from(scene.run.gravity))));
+    }
+    build_loads(scene, meshes, models)
 }
 
 /// The `[granular]` stones appended to `state` as rigid bodies after the mesh bodies and the

@@ -15,8 +15,10 @@
 //!    key and to propose the closest valid key ([`suggest`]): `unknown key `t_ned` in [run];
 //!    did you mean `t_end`?`.
 //! 3. **Semantics** ([`SceneError::Invalid`]): ranges, references between tables, ramps, boxes
-//!    (private `validate` module). All problems are collected and reported one per line, in file order,
-//!    each located through the span map.
+//!    (private `validate` module, one file per table). All problems are collected and reported
+//!    one per line, in file order, each located through the span map. The references between
+//!    tables (a fix's body, a body's material, …) are resolved into [`Refs`] on the way, so
+//!    the build indexes instead of looking names up.
 //!
 //! [`Scene::load`] reads the file first and, after parsing, checks that the mesh files exist
 //! ([`SceneError::MissingFiles`]); [`Scene::parse`] touches no file so that it can be tested on
