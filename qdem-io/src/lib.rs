@@ -5,7 +5,8 @@
 //! - [`scene`]: the TOML scene format (a public contract), parsed with serde and validated with
 //!   messages that name the file, line and key.
 //! - [`build`]: turns a scene into a [`build::Simulation`]: one [`qdem_core::State`] for all
-//!   bodies and only the models the scene needs.
+//!   bodies and only the models the scene needs, from the validated scene and the references it
+//!   resolved (one module per part of the scene under `build/`).
 //!   A `[bonded]` scene builds a 2D beam-bonded body instead (paper 001). `[granular]` adds a
 //!   sample of rigid stones ([`granular_build`]), `[periodic]` a periodic cell and a
 //!   time-delayed boundary (paper 003).
@@ -23,25 +24,24 @@
 #![warn(missing_docs)]
 
 pub mod analyze;
-pub mod ballast_build;
-mod bonded_build;
 pub mod build;
 pub mod checkpoint;
-mod contact_build;
 pub mod crack_svg;
 mod csv_rows;
-pub mod granular_build;
 pub mod inputs;
 pub mod linear_spectrum;
-mod load_series;
 pub mod output;
-mod periodic_build;
 pub mod plot;
 pub mod pose_from;
 mod record;
-mod rest_on;
 mod run_record;
 pub mod runner;
 pub mod scene;
 pub mod spectrum;
 mod start_from;
+
+/// `[ballast]` stones ([`build::ballast`], kept at its former path).
+pub use build::ballast as ballast_build;
+/// `[granular]` stones ([`build::granular`], kept at its former path).
+pub use build::granular as granular_build;
+pub(crate) use build::load_series;

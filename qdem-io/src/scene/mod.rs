@@ -15,8 +15,10 @@
 //!    key and to propose the closest valid key ([`suggest`]): `unknown key `t_ned` in [run];
 //!    did you mean `t_end`?`.
 //! 3. **Semantics** ([`SceneError::Invalid`]): ranges, references between tables, ramps, boxes
-//!    (private `validate` module). All problems are collected and reported one per line, in file order,
-//!    each located through the span map.
+//!    (private `validate` module, one file per table). All problems are collected and reported
+//!    one per line, in file order, each located through the span map. The references between
+//!    tables (a fix's body, a body's material, …) are resolved into [`Refs`] on the way, so
+//!    the build indexes instead of looking names up.
 //!
 //! [`Scene::load`] reads the file first and, after parsing, checks that the mesh files exist
 //! ([`SceneError::MissingFiles`]); [`Scene::parse`] touches no file so that it can be tested on
@@ -35,12 +37,14 @@
 use std::path::{Path, PathBuf};
 
 mod error;
+mod refs;
 pub mod schema;
 mod spans;
 pub mod suggest;
 mod validate;
 
 pub use error::{Diagnostic, SceneError};
+pub use refs::Refs;
 pub use schema::{
     Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load,
     Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section, Selection, Series,
@@ -162,6 +166,9 @@ pub struct Scene {
     pub output: Output,
     /// The scene file; relative paths inside the scene are resolved against its directory.
     pub path: PathBuf,
+    /// The references between the tables, resolved by validation ([`Scene::refs`]).
+    #[serde(skip)]
+    pub(crate) refs: Refs,
 }
 
 impl Scene {
@@ -190,6 +197,19 @@ impl Scene {
     /// passed them). Messages carry no line numbers.
     pub fn validate(&self) -> Result<(), SceneError> {
         validate::validate(validate::to_raw(self), &self.path, None, None).map(|_| ())
+    }
+
+    /// Check the semantic rules again, as [`Scene::validate`], and return the scene with its
+    /// references resolved anew: for a scene whose names or references were changed in code
+    /// after parsing, before it is built.
+    pub fn validated(&self) -> Result<Scene, SceneError> {
+        validate::validate(validate::to_raw(self), &self.path, None, None)
+    }
+
+    /// The references between the scene's tables (a body's material, a fix's body, …) as
+    /// indices, resolved when the scene was validated.
+    pub fn refs(&self) -> &Refs {
+        &self.refs
     }
 
     /// Check that the files the scene refers to exist: every body's mesh, resolved with

@@ -69,20 +69,16 @@ struct Draw {
 }
 
 /// The ballast as one placed mesh (all stones, one after another from particle `start`), its
-/// stones with their contact spheres (stone `k` is contact body `first_body + k`), and mesh
-/// warnings.
+/// stones with their contact spheres (stone `k` is contact body `first_body + k`, of material
+/// `material`, the index validation resolved), and mesh warnings.
 pub(crate) fn place_ballast(
     scene: &Scene,
     ballast: &Ballast,
     start: usize,
     first_body: usize,
+    material: usize,
 ) -> Result<(PlacedMesh, BallastInfo, Vec<String>), BuildError> {
     let (shapes, warnings) = read_shapes(scene, ballast)?;
-    let material = scene
-        .materials
-        .iter()
-        .position(|m| m.name == ballast.material)
-        .expect("validated scene");
     let mut rng = SplitMix64(ballast.seed);
     let draws = draw_stones(scene, ballast, &shapes, &mut rng)?;
     let size =
@@ -239,7 +235,7 @@ fn exclude_images(scene: &Scene, ballast: &Ballast) -> Result<Vec<[Vec3; 2]>, Bu
     };
     let mut images = vec![[a, b]];
     if let Some(p) = &scene.periodic {
-        let cell = crate::periodic_build::periodic_box(scene, p)?;
+        let cell = super::periodic::periodic_box(scene, p)?;
         for k in 0..3 {
             let Some(length) = cell.length(k) else {
                 continue;

@@ -14,7 +14,7 @@
 //! ([`CollapseWatch`]).
 
 use crate::build::{nearest_particle_in, step_request, BuildError, Simulation};
-use crate::scene::{Bonded, PackingName, Scene, Supports, TimeStep};
+use crate::scene::{Bonded, Material, PackingName, Scene, Supports, TimeStep};
 use qdem_contact::{
     BondSettings, BondedMaterial, BondedParticles, CollapseWatch, ContactError, Packing,
     PackingKind, UnbondedLaw,
@@ -27,8 +27,12 @@ use qdem_core::{
 /// bonds and contacts are meaningless beyond (the body has collapsed or come apart).
 const COLLAPSE_SPACINGS: f64 = 0.5;
 
-/// Builds the simulation of a scene whose body is `[bonded]`.
-pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, BuildError> {
+/// Builds the simulation of a scene whose body is `[bonded]`, of `material`.
+pub(crate) fn build_bonded(
+    scene: Scene,
+    bonded: &Bonded,
+    material: &Material,
+) -> Result<Simulation, BuildError> {
     let contact = |source| BuildError::Contact {
         scene: scene.path.clone(),
         source: Box::new(source),
@@ -48,25 +52,7 @@ pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, 
                 element_size: bonded.element_size,
             })
         })?;
-    let material = scene.material(&bonded.material).expect("validated scene");
-    let bond_material = BondedMaterial {
-        density: material.density,
-        young: material.young,
-        poisson: material.poisson,
-        thickness: bonded.thickness,
-        damping_ratio: bonded.damping_ratio,
-        strength_mean: bonded.strength_mean,
-        strength_std: bonded.strength_std,
-        seed: bonded.strength_seed,
-    };
-    let settings = BondSettings {
-        contact: UnbondedLaw {
-            shear_ratio: bonded.contact_shear_ratio,
-            friction: bonded.friction,
-            damping_ratio: bonded.contact_damping_ratio,
-        },
-        tolerance: bonded.tolerance,
-    };
+    let (bond_material, settings) = bond_settings(bonded, material);
     let (mut state, model) =
         BondedParticles::from_packing(&bonded.name, &packing, &bond_material, settings)
             .map_err(contact)?;
@@ -99,6 +85,30 @@ pub(crate) fn build_bonded(scene: Scene, bonded: &Bonded) -> Result<Simulation, 
         granular: None,
         ballast: None,
     })
+}
+
+/// The bonds' material (`material` with the body's thickness, damping and strengths) and the
+/// settings of its unbonded contacts.
+fn bond_settings(bonded: &Bonded, material: &Material) -> (BondedMaterial, BondSettings) {
+    let bond_material = BondedMaterial {
+        density: material.density,
+        young: material.young,
+        poisson: material.poisson,
+        thickness: bonded.thickness,
+        damping_ratio: bonded.damping_ratio,
+        strength_mean: bonded.strength_mean,
+        strength_std: bonded.strength_std,
+        seed: bonded.strength_seed,
+    };
+    let settings = BondSettings {
+        contact: UnbondedLaw {
+            shear_ratio: bonded.contact_shear_ratio,
+            friction: bonded.friction,
+            damping_ratio: bonded.contact_damping_ratio,
+        },
+        tolerance: bonded.tolerance,
+    };
+    (bond_material, settings)
 }
 
 /// The end lines of full rows held vertically, a mid-height particle (or two) horizontally.

@@ -118,20 +118,17 @@ pub(crate) fn stones(scene: &Scene, granular: &Granular) -> Result<Vec<Stone>, B
     Ok(stones)
 }
 
-/// Appends `stones` to `state` as rigid bodies of `density` and returns where they went and
-/// their contact spheres (bodies numbered from `first_body`, material `material`).
+/// Appends `stones` to `state` as rigid bodies and returns where they went and their contact
+/// spheres (bodies numbered from `first_body`; `(material, density)`: the index of the
+/// `[granular]` material and its density). `scene` is the scene file, for messages.
 pub(crate) fn add_stones(
-    scene: &Scene,
+    scene: &Path,
     granular: &Granular,
     stones: &[Stone],
     state: &mut State,
     first_body: usize,
-    material: usize,
+    (material, density): (usize, f64),
 ) -> Result<(GranularInfo, Vec<ContactSphere>), BuildError> {
-    let density = scene
-        .material(&granular.material)
-        .expect("validated scene")
-        .density;
     let first_member = state.len();
     let mut radii = Vec::new();
     for stone in stones {
@@ -151,7 +148,7 @@ pub(crate) fn add_stones(
     for (k, stone) in stones.iter().enumerate() {
         let props =
             clump_mass_properties(stone, density).map_err(|source| BuildError::Granular {
-                scene: scene.path.clone(),
+                scene: scene.to_path_buf(),
                 source,
             })?;
         let center = state.push_particle(props.center, Vec3::zeros(), props.mass);
@@ -161,7 +158,7 @@ pub(crate) fn add_stones(
         state
             .add_rigid_body(&name, center, &ids, props.inertia)
             .map_err(|source| BuildError::Core {
-                scene: scene.path.clone(),
+                scene: scene.to_path_buf(),
                 source,
             })?;
         for p in members.clone() {

@@ -2,9 +2,9 @@
 //! (every body whole: paper 003's ghosts are copies of whole particles), and the time-delayed
 //! boundary that follows a sleeper's cyclic load (paper 003 §5).
 
-use crate::ballast_build::BallastInfo;
+use super::ballast::BallastInfo;
+use super::granular::GranularInfo;
 use crate::build::{BodyInfo, BodyKind, BuildError};
-use crate::granular_build::GranularInfo;
 use crate::scene::{Periodic, Scene};
 use qdem_contact::time_delayed_boundary::lag_from_spacing;
 use qdem_contact::{DemContacts, LoadCycle, PeriodicBox, TimeDelayedBoundary, WrapGroup};
@@ -112,15 +112,10 @@ pub(crate) fn periodic_contacts(
         source: Box::new(source),
     };
     let contacts = contacts.with_periodic(cell.clone()).map_err(refused)?;
-    let Some(delay) = &periodic.time_delay else {
+    let (Some(delay), Some(cyclic)) = (&periodic.time_delay, scene.refs().time_delay_cycle) else {
         return Ok(contacts);
     };
-    let cyclic = scene
-        .loads
-        .iter()
-        .find_map(|l| l.cyclic.filter(|_| l.body == delay.body))
-        .expect("validated scene")
-        .cycle();
+    let cyclic = cyclic.cycle();
     let axis = match &delay.axis {
         Some(a) => axes(a)[0],
         None => axes(&periodic.axes)[0],

@@ -3,14 +3,39 @@
 //! (then one centre particle per rigid body), and only the models the scene needs: a
 //! [`TetBody`] per deformable body (a rigid body gets none: its mass and inertia come from its
 //! tetrahedra, [`qdem_core::rigid_body`]), contacts only when bodies carry contact spheres
-//! ([`crate::contact_build`]), [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per
-//! load.
+//! (`contact`), [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per load.
+//!
+//! # The stage
+//!
+//! Building is the stage after [validation](crate::scene): it reads a validated [`Scene`] and
+//! the references validation resolved ([`Scene::refs`]: each body's material, each fix's, load's
+//! and probe's body as indices), so no name is looked up again here. One module per part of a
+//! scene, each taking the table it builds and the indices it needs:
+//!
+//! - this module: the `[[body]]` meshes, fixes, loads, probes and the step request;
+//! - `contact`: contact spheres, the `[contact]` law and the `[[wall]]`s;
+//! - [`granular`]: the rigid stones of `[granular]`; [`ballast`]: the deformable stones of
+//!   `[ballast]`; `bonded`: a `[bonded]` body (built instead of everything else);
+//! - `periodic`: the `[periodic]` cell, its wrap groups and time delay;
+//! - `rest_on`: bodies laid on a granular sample; `load_series`: a load's CSV time series;
+//! - [`BuildError`] (`error`): why a build failed.
 
-use crate::ballast_build::{place_ballast, BallastInfo};
-use crate::contact_build::ExtraSpheres;
-use crate::granular_build::GranularInfo;
+pub mod ballast;
+mod bonded;
+mod contact;
+mod error;
+pub mod granular;
+pub(crate) mod load_series;
+mod periodic;
+mod rest_on;
+
+pub use error::BuildError;
+
 use crate::scene::suggest::did_you_mean;
 use crate::scene::{Integrator, Scene, Selection, TimeStep};
+use ballast::{place_ballast, BallastInfo};
+use contact::ExtraSpheres;
+use granular::GranularInfo;
 use nalgebra::{Rotation3, UnitQuaternion};
 use qdem_contact::BondedParticles;
 use qdem_contact::{DemContacts, PeriodicBox, PeriodicWrap};
@@ -22,166 +47,6 @@ use qdem_core::{
 use qdem_mesh::{read_msh, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
-use thiserror::Error;
-
-/// Why a scene could not be turned into a simulation.
-#[derive(Debug, Error)]
-pub enum BuildError {
-    /// A mesh could not be read or lacks a group.
-    #[error(transparent)]
-    Mesh(#[from] MeshError),
-    /// The core refused a body, a ramp or the time step.
-    #[error("{scene}: {source}")]
-    Core {
-        /// The scene file.
-        scene: PathBuf,
-        /// What the core refused.
-        source: CoreError,
-    },
-    /// A fix or load names a physical group the body's mesh does not have.
-    #[error(
-        "{scene}: {what}: the mesh {mesh} has no physical group `{group}`{candidates}; fix: \
-         name one of them, or select particles with box = [[xmin, ymin, zmin], [xmax, ymax, zmax]]"
-    )]
-    MissingGroup {
-        /// The scene file.
-        scene: PathBuf,
-        /// `[[fix]] #N on body `name`` or the same for a load.
-        what: String,
-        /// The mesh file.
-        mesh: String,
-        /// The requested group.
-        group: String,
-        /// `; did you mean `…`?` if a name is close, then `(available: …)`.
-        candidates: String,
-    },
-    /// The contact set-up is refused (initial overlap, a bad wall, a sphere too large).
-    #[error("{scene}: {source}")]
-    Contact {
-        /// The scene file.
-        scene: PathBuf,
-        /// What is wrong.
-        source: Box<qdem_contact::ContactError>,
-    },
-    /// A body's contact radius is too large for it.
-    #[error(
-        "{scene}: body `{body}`: contact_radius = {radius} m is more than half its smallest \
-         extent {extent:.4e} m, so its spheres stick out through the opposite side: use a \
-         radius of at most {limit:.4e} m"
-    )]
-    ContactRadius {
-        /// The scene file.
-        scene: PathBuf,
-        /// The body.
-        body: String,
-        /// Its contact radius.
-        radius: f64,
-        /// Its smallest bounding-box extent.
-        extent: f64,
-        /// Half that extent.
-        limit: f64,
-    },
-    /// A `[granular]` sample or its generation is refused.
-    #[error("{scene}: [granular]: {source}")]
-    Granular {
-        /// The scene file.
-        scene: PathBuf,
-        /// What is wrong.
-        source: qdem_contact::clump_sample::SampleError,
-    },
-    /// A body's `rest_on` finds no stone beneath it.
-    #[error(
-        "{scene}: body `{body}`: rest_on: no stone lies beneath its contact spheres, so it has \
-         nothing to rest on; fix: translate the body over the sample, or drop rest_on"
-    )]
-    RestOn {
-        /// The scene file.
-        scene: PathBuf,
-        /// The body.
-        body: String,
-    },
-    /// A body's `pose_from` file has no row for it (or for its `pose_body`).
-    #[error(
-        "{scene}: pose_from: {path} has no pose for a body `{body}`; fix: name the body (or \
-         its pose_body) as in the run that wrote the file, or drop pose_from"
-    )]
-    PoseMissing {
-        /// The scene file.
-        scene: PathBuf,
-        /// The body whose pose was looked for.
-        body: String,
-        /// The poses file.
-        path: PathBuf,
-    },
-    /// A poses file is malformed.
-    #[error(
-        "{path}:{line}: {message} (a poses file is CSV `body,x,y,z,qw,qx,qy,qz`, one row per \
-         rigid body, as a run writes it)"
-    )]
-    Poses {
-        /// The file.
-        path: PathBuf,
-        /// Line number (1-based; 0 when the file could not be read).
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A stones file is malformed.
-    #[error(
-        "{path}:{line}: {message} (a stones file is CSV `stone,x,y,z,radius`, one row per sphere)"
-    )]
-    Sample {
-        /// The file.
-        path: PathBuf,
-        /// Line number (1-based; 0 when the file could not be read).
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// `[ballast]` stones cannot be made or placed.
-    #[error("{scene}: [ballast]: {message}")]
-    Ballast {
-        /// The scene file.
-        scene: PathBuf,
-        /// What is wrong and how to fix it.
-        message: String,
-    },
-    /// A load's series file is malformed.
-    #[error(
-        "{path}:{line}: {message} (a series file is CSV with a header row, time in s in the \
-         first column, rows in non-decreasing time)"
-    )]
-    Series {
-        /// The file.
-        path: PathBuf,
-        /// Line number (1-based; 0 when the file could not be read).
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// `[run] start_from` cannot be used.
-    #[error("{scene}: [run] start_from {checkpoint}: {message}")]
-    StartFrom {
-        /// The scene file.
-        scene: PathBuf,
-        /// The checkpoint.
-        checkpoint: PathBuf,
-        /// What is wrong and how to fix it.
-        message: String,
-    },
-    /// A fix or load selects no particle.
-    #[error("{scene}: {what} on body `{body}` selects no particle: {fix}")]
-    EmptySelection {
-        /// The scene file.
-        scene: PathBuf,
-        /// `[[fix]]` or `[[load]]` with its index.
-        what: String,
-        /// The body.
-        body: String,
-        /// How to fix it.
-        fix: &'static str,
-    },
-}
 
 /// How a body is integrated.
 #[derive(Clone, Debug)]
@@ -267,8 +132,9 @@ impl Simulation {
     /// Reads the meshes and builds every model of `scene`: bodies, then gravity (only if
     /// non-zero), then loads; fixes go into the state.
     pub fn build(scene: Scene) -> Result<Simulation, BuildError> {
-        if let Some(bonded) = scene.bonded.clone() {
-            return crate::bonded_build::build_bonded(scene, &bonded);
+        if let Some((bonded, material)) = scene.bonded.clone().zip(scene.refs().bonded_material) {
+            let material = scene.materials[material].clone();
+            return bonded::build_bonded(scene, &bonded, &material);
         }
         let core = |source| BuildError::Core {
             scene: scene.path.clone(),
@@ -276,15 +142,15 @@ impl Simulation {
         };
         let (mut meshes, warnings, ballast) = read_meshes(&scene)?;
         let stones = match &scene.granular {
-            Some(g) => crate::granular_build::stones(&scene, g)?,
+            Some(g) => granular::stones(&scene, g)?,
             None => Vec::new(),
         };
         let periodic_box = match &scene.periodic {
-            Some(p) => Some(crate::periodic_build::periodic_box(&scene, p)?),
+            Some(p) => Some(periodic::periodic_box(&scene, p)?),
             None => None,
         };
         crate::pose_from::pose_bodies(&scene, &mut meshes)?;
-        crate::rest_on::rest_bodies(&scene, &mut meshes, &stones, periodic_box.as_ref())?;
+        rest_on::rest_bodies(&scene, &mut meshes, &stones, periodic_box.as_ref())?;
         let reference = meshes
             .iter()
             .flat_map(|m| m.mesh.nodes.iter().map(|p| Vec3::from(*p)));
@@ -293,55 +159,15 @@ impl Simulation {
         let bodies = build_bodies(&scene, &meshes, &mut state, &mut models).map_err(core)?;
         apply_fixes(&scene, &meshes, &mut state)?;
         fix_rigid_bodies(&scene, &bodies, &mut state);
-        let mut extra = ExtraSpheres::default();
-        if let Some(info) = &ballast {
-            extra.spheres.clone_from(&info.spheres);
-            extra.names = (1..=info.stones.len())
-                .map(|k| format!("{} stone {k}", info.name))
-                .collect();
-        }
-        let granular = match &scene.granular {
-            Some(g) => {
-                let material = scene
-                    .materials
-                    .iter()
-                    .position(|m| m.name == g.material)
-                    .expect("validated scene");
-                let (info, spheres) = crate::granular_build::add_stones(
-                    &scene,
-                    g,
-                    &stones,
-                    &mut state,
-                    scene.bodies.len() + extra.names.len(),
-                    material,
-                )?;
-                extra.spheres.extend(spheres);
-                extra
-                    .names
-                    .extend((1..=info.len()).map(|k| format!("{} stone {k}", g.name)));
-                Some(info)
-            }
-            None => None,
-        };
+        let mut extra = ExtraSpheres::of_ballast(ballast.as_ref());
+        let granular = add_granular(&scene, &stones, &mut state, &mut extra)?;
         let periodic = periodic_box.map(|p| {
-            let groups = crate::periodic_build::wrap_groups(
-                &state,
-                &bodies,
-                granular.as_ref(),
-                ballast.as_ref(),
-            );
+            let groups =
+                periodic::wrap_groups(&state, &bodies, granular.as_ref(), ballast.as_ref());
             (p, groups)
         });
         extra.periodic = periodic.as_ref().map(|p| p.0.clone());
-        if let Some(contacts) =
-            crate::contact_build::build_contacts(&scene, &meshes, &state, extra)?
-        {
-            models.push(Box::new(contacts));
-        }
-        if scene.run.gravity.iter().any(|&g| g != 0.0) {
-            models.push(Box::new(Gravity::new(Vec3::from(scene.run.gravity))));
-        }
-        build_loads(&scene, &meshes, &mut models)?;
+        add_forces(&scene, &meshes, &state, extra, &mut models)?;
         if let Some(file) = &scene.run.start_from {
             crate::start_from::restore_state(&scene, file, &mut state, periodic.as_ref())?;
         }
@@ -407,14 +233,59 @@ impl Simulation {
     }
 }
 
+/// The models that act between and on the bodies, after the bodies': contacts (when something
+/// can touch), gravity (when it is not zero), then one [`NodalLoad`] per `[[load]]`.
+fn add_forces(
+    scene: &Scene,
+    meshes: &[PlacedMesh],
+    state: &State,
+    extra: ExtraSpheres,
+    models: &mut Vec<Box<dyn Model>>,
+) -> Result<(), BuildError> {
+    if let Some(contacts) = contact::build_contacts(scene, meshes, state, extra)? {
+        models.push(Box::new(contacts));
+    }
+    if scene.run.gravity.iter().any(|&g| g != 0.0) {
+        models.push(Box::new(Gravity::new(Vec3::from(scene.run.gravity))));
+    }
+    build_loads(scene, meshes, models)
+}
+
+/// The `[granular]` stones appended to `state` as rigid bodies after the mesh bodies and the
+/// ballast stones, their spheres and names added to `extra`.
+fn add_granular(
+    scene: &Scene,
+    stones: &[qdem_contact::clump_sample::Stone],
+    state: &mut State,
+    extra: &mut ExtraSpheres,
+) -> Result<Option<GranularInfo>, BuildError> {
+    let Some((g, material)) = scene.granular.as_ref().zip(scene.refs().granular_material) else {
+        return Ok(None);
+    };
+    let (info, spheres) = granular::add_stones(
+        &scene.path,
+        g,
+        stones,
+        state,
+        scene.bodies.len() + extra.names.len(),
+        (material, scene.materials[material].density),
+    )?;
+    extra.spheres.extend(spheres);
+    extra
+        .names
+        .extend((1..=info.len()).map(|k| format!("{} stone {k}", g.name)));
+    Ok(Some(info))
+}
+
 /// Each probe at the particle of its body nearest its point at the start of the run (after
 /// `start_from`, the settled positions).
 fn resolve_probes(scene: &Scene, bodies: &[BodyInfo], state: &State) -> Vec<ProbePoint> {
     scene
         .probes
         .iter()
-        .map(|p| {
-            let body = &bodies[body_index(scene, &p.body)];
+        .zip(&scene.refs().probe_bodies)
+        .map(|(p, &body)| {
+            let body = &bodies[body];
             let center = match body.kind {
                 BodyKind::Rigid { center, .. } => Some(center),
                 BodyKind::Deformable { .. } => None,
@@ -450,9 +321,10 @@ fn read_meshes(scene: &Scene) -> Result<ReadMeshes, BuildError> {
         });
     }
     let mut ballast = None;
-    if let Some(b) = &scene.ballast {
+    if let Some((b, material)) = scene.ballast.as_ref().zip(scene.refs().ballast_material) {
         let start = meshes.last().map_or(0, |m| m.particles.end);
-        let (placed, info, stone_warnings) = place_ballast(scene, b, start, scene.bodies.len())?;
+        let first_body = scene.bodies.len();
+        let (placed, info, stone_warnings) = place_ballast(scene, b, start, first_body, material)?;
         meshes.push(placed);
         warnings.extend(stone_warnings);
         ballast = Some(info);
@@ -501,8 +373,9 @@ fn build_bodies(
     models: &mut Vec<Box<dyn Model>>,
 ) -> Result<Vec<BodyInfo>, CoreError> {
     let mut bodies = Vec::new();
-    for (body, placed) in scene.bodies.iter().zip(meshes) {
-        let material = scene.material(&body.material).expect("validated scene");
+    let materials = &scene.refs().body_materials;
+    for ((body, placed), &material) in scene.bodies.iter().zip(meshes).zip(materials) {
+        let material = &scene.materials[material];
         let tets = offset_tets(&placed.mesh, placed.particles.start);
         let velocity = Vec3::from(body.velocity);
         let kind = if body.rigid {
@@ -537,32 +410,45 @@ fn build_bodies(
             mesh: placed.path.clone(),
         });
     }
-    if let (Some(b), Some(placed)) = (&scene.ballast, meshes.get(scene.bodies.len())) {
-        let material = core_material(scene.material(&b.material).expect("validated scene"));
-        let tets = offset_tets(&placed.mesh, placed.particles.start);
-        let stones = TetBody::new(&b.name, &state.reference, tets, material)?;
-        stones.lump_mass(&mut state.mass);
-        models.push(Box::new(stones));
-        for i in placed.particles.clone() {
-            state.velocity[i] = Vec3::from(b.velocity);
-        }
-        bodies.push(BodyInfo {
-            name: b.name.clone(),
-            particles: placed.particles.clone(),
-            kind: BodyKind::Deformable {
-                model: models.len() - 1,
-            },
-            stats: placed.mesh.stats(),
-            mesh: placed.path.clone(),
-        });
+    let ballast = scene.ballast.as_ref().zip(scene.refs().ballast_material);
+    if let (Some((b, material)), Some(placed)) = (ballast, meshes.get(scene.bodies.len())) {
+        let material = core_material(&scene.materials[material]);
+        bodies.push(ballast_body(b, material, placed, state, models)?);
     }
     Ok(bodies)
+}
+
+/// The `[ballast]` stones as one [`TetBody`] of `material`, their lumped mass added to the
+/// state, with their initial velocity.
+fn ballast_body(
+    b: &crate::scene::Ballast,
+    material: Material,
+    placed: &PlacedMesh,
+    state: &mut State,
+    models: &mut Vec<Box<dyn Model>>,
+) -> Result<BodyInfo, CoreError> {
+    let tets = offset_tets(&placed.mesh, placed.particles.start);
+    let stones = TetBody::new(&b.name, &state.reference, tets, material)?;
+    stones.lump_mass(&mut state.mass);
+    models.push(Box::new(stones));
+    for i in placed.particles.clone() {
+        state.velocity[i] = Vec3::from(b.velocity);
+    }
+    Ok(BodyInfo {
+        name: b.name.clone(),
+        particles: placed.particles.clone(),
+        kind: BodyKind::Deformable {
+            model: models.len() - 1,
+        },
+        stats: placed.mesh.stats(),
+        mesh: placed.path.clone(),
+    })
 }
 
 /// A rigid body is fixed in every direction any of its particles is fixed in, and its
 /// rotation too when all three are or a `[[fix]]` on it says `rotation = true`.
 fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], state: &mut State) {
-    for body in bodies {
+    for (k, body) in bodies.iter().enumerate() {
         let BodyKind::Rigid {
             body: b, center, ..
         } = body.kind
@@ -577,7 +463,8 @@ fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], state: &mut State) {
         let held = scene
             .fixes
             .iter()
-            .any(|f| f.body == body.name && f.rotation);
+            .zip(&scene.refs().fix_bodies)
+            .any(|(f, &on)| on == k && f.rotation);
         if dofs == Dofs::ALL || held {
             state.rigid.spin_fixed[b] = true;
             state.rigid.set_angular_velocity(b, Vec3::zeros());
@@ -587,8 +474,9 @@ fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], state: &mut State) {
 
 /// Fixes the selected directions of the selected particles of every `[[fix]]`.
 fn apply_fixes(scene: &Scene, meshes: &[PlacedMesh], state: &mut State) -> Result<(), BuildError> {
-    for (i, fix) in scene.fixes.iter().enumerate() {
-        let placed = &meshes[body_index(scene, &fix.body)];
+    let on = &scene.refs().fix_bodies;
+    for (i, (fix, &body)) in scene.fixes.iter().zip(on).enumerate() {
+        let placed = &meshes[body];
         let what = format!("[[fix]] #{}", i + 1);
         for n in select(scene, placed, &fix.selection, &what, &fix.body)? {
             state.fix(
@@ -606,8 +494,9 @@ fn build_loads(
     meshes: &[PlacedMesh],
     models: &mut Vec<Box<dyn Model>>,
 ) -> Result<(), BuildError> {
-    for (i, load) in scene.loads.iter().enumerate() {
-        let placed = &meshes[body_index(scene, &load.body)];
+    let on = &scene.refs().load_bodies;
+    for (i, (load, &body)) in scene.loads.iter().zip(on).enumerate() {
+        let placed = &meshes[body];
         let what = format!("[[load]] #{}", i + 1);
         let selected = select(scene, placed, &load.selection, &what, &load.body)?;
         let start = placed.particles.start;
@@ -617,7 +506,7 @@ fn build_loads(
             .collect();
         let ramp = match (&load.cyclic, &load.series) {
             (Some(c), _) => TimeFunction::cyclic(c.cycle()),
-            (None, Some(series)) => TimeFunction::new(crate::load_series::read_series(
+            (None, Some(series)) => TimeFunction::new(load_series::read_series(
                 &scene.resolve(&series.file),
                 &series.column,
             )?),
@@ -664,23 +553,6 @@ fn scheme(scene: &Scene) -> Scheme {
         },
         Integrator::Static => Scheme::Static,
     }
-}
-
-/// Index of a body that the validated scene guarantees to exist (the `[ballast]` comes after
-/// the `[[body]]`s).
-pub(crate) fn body_index(scene: &Scene, name: &str) -> usize {
-    scene
-        .bodies
-        .iter()
-        .position(|b| b.name == name)
-        .or_else(|| {
-            scene
-                .ballast
-                .as_ref()
-                .filter(|b| b.name == name)
-                .map(|_| scene.bodies.len())
-        })
-        .expect("validated scene")
 }
 
 pub(crate) fn core_material(m: &crate::scene::Material) -> Material {

@@ -4,7 +4,8 @@
 //! single body and no wall) gets no contact model, and the initial configuration is checked
 //! for interpenetration before anything runs.
 
-use crate::build::{body_index, BuildError, PlacedMesh};
+use super::ballast::BallastInfo;
+use crate::build::{BuildError, PlacedMesh};
 use crate::scene::{Contact, ContactLawName, Scene};
 use qdem_contact::broad_phase::bounds;
 use qdem_contact::{
@@ -21,6 +22,21 @@ pub(crate) struct ExtraSpheres {
     pub(crate) spheres: Vec<ContactSphere>,
     pub(crate) names: Vec<String>,
     pub(crate) periodic: Option<PeriodicBox>,
+}
+
+impl ExtraSpheres {
+    /// The contact spheres of the `[ballast]` stones, each stone a body of its own named
+    /// `<ballast> stone <k>`.
+    pub(crate) fn of_ballast(ballast: Option<&BallastInfo>) -> ExtraSpheres {
+        let mut extra = ExtraSpheres::default();
+        if let Some(info) = ballast {
+            extra.spheres.clone_from(&info.spheres);
+            extra.names = (1..=info.stones.len())
+                .map(|k| format!("{} stone {k}", info.name))
+                .collect();
+        }
+        extra
+    }
 }
 
 /// The contact model, or `None` when no body has contact spheres.
@@ -62,7 +78,7 @@ pub(crate) fn build_contacts(
         .collect();
     let mut model = DemContacts::new(state, &spheres, names, &materials, settings, walls);
     if let (Some(cell), Some(periodic)) = (extra.periodic, &scene.periodic) {
-        model = crate::periodic_build::periodic_contacts(scene, periodic, &cell, model)?;
+        model = super::periodic::periodic_contacts(scene, periodic, &cell, model)?;
     }
     model
         .check_initial_overlaps(state, contact.overlap_tolerance)
@@ -90,11 +106,12 @@ fn law(contact: &Contact) -> ContactLaw {
 /// larger than half the body's smallest extent.
 fn contact_spheres(scene: &Scene, meshes: &[PlacedMesh]) -> Result<Vec<ContactSphere>, BuildError> {
     let mut spheres = Vec::new();
-    for (b, body) in scene.bodies.iter().enumerate() {
+    let materials = &scene.refs().body_materials;
+    for (b, (body, &material)) in scene.bodies.iter().zip(materials).enumerate() {
         let Some(radius) = body.contact_radius else {
             continue;
         };
-        let placed = &meshes[body_index(scene, &body.name)];
+        let placed = &meshes[b];
         let extent = smallest_extent(&placed.mesh.nodes);
         if radius > 0.5 * extent {
             return Err(BuildError::ContactRadius {
@@ -105,11 +122,6 @@ fn contact_spheres(scene: &Scene, meshes: &[PlacedMesh]) -> Result<Vec<ContactSp
                 limit: 0.5 * extent,
             });
         }
-        let material = scene
-            .materials
-            .iter()
-            .position(|m| m.name == body.material)
-            .expect("validated scene");
         spheres.extend(
             placed
                 .mesh

@@ -1,0 +1,169 @@
+//! `[contact]` and `[[wall]]`: a contact table exactly when something can touch (bodies with
+//! `contact_radius`, stones); the linear law's stiffnesses (and none for Hertz–Mindlin), a
+//! non-negative friction, damping in [0, 1), local damping and contacts only with an explicit
+//! integrator, a positive skin and overlap tolerance; each wall a plane (point and non-zero
+//! normal) or a mesh.
+
+use super::super::schema::{Contact, ContactLawName, Integrator, RawScene, Wall};
+use super::checker::{fraction, label, Checker};
+
+/// `[contact]` and every `[[wall]]` (`spheres`: whether a `[[body]]` has contact spheres).
+pub(super) fn contact_tables(c: &mut Checker<'_>, raw: &RawScene, spheres: bool) {
+    let Some(contact) = &raw.contact else {
+        no_contact(c, raw, spheres);
+        return;
+    };
+    if !spheres && raw.granular.is_none() && raw.ballast.is_none() {
+        c.error(
+            &["contact"],
+            "[contact]: no [[body]] has contact_radius, so nothing can touch: give the bodies \
+             that touch a contact_radius (m)"
+                .to_owned(),
+        );
+    }
+    law_keys(c, contact);
+    contact_numbers(c, raw, contact, spheres);
+    for (i, w) in raw.walls.iter().enumerate() {
+        wall(c, i, w);
+    }
+}
+
+/// Without `[contact]`: no body may have contact spheres and there may be no wall.
+fn no_contact(c: &mut Checker<'_>, raw: &RawScene, spheres: bool) {
+    if spheres {
+        c.error(
+            &[],
+            "a [[body]] has contact_radius but there is no [contact] table: add one with \
+             law, normal_stiffness, tangential_stiffness and friction"
+                .to_owned(),
+        );
+    }
+    if !raw.walls.is_empty() {
+        c.error(
+            &["wall", "0"],
+            "[[wall]] needs a [contact] table and bodies with contact_radius".to_owned(),
+        );
+    }
+}
+
+/// The stiffnesses the law needs, and none it does not.
+fn law_keys(c: &mut Checker<'_>, contact: &Contact) {
+    let l = "[contact]";
+    match contact.law {
+        ContactLawName::Linear => {
+            for (key, v) in [
+                ("normal_stiffness", contact.normal_stiffness),
+                ("tangential_stiffness", contact.tangential_stiffness),
+            ] {
+                match v {
+                    Some(k) => c.positive(&["contact", key], l, key, k, "N/m"),
+                    None => c.error(
+                        &["contact", "law"],
+                        format!("{l}: the linear law needs {key} (N/m), e.g. 1.6e9"),
+                    ),
+                }
+            }
+        }
+        ContactLawName::HertzMindlin => {
+            for (key, v) in [
+                ("normal_stiffness", contact.normal_stiffness),
+                ("tangential_stiffness", contact.tangential_stiffness),
+            ] {
+                if v.is_some() {
+                    c.error(
+                        &["contact", key],
+                        format!(
+                            "{l}: {key} is for the linear law; hertz-mindlin takes its \
+                             stiffness from each body's young and poisson: remove it, or use law = \"linear\""
+                        ),
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Friction, damping, skin and overlap tolerance, and the integrator contacts need.
+fn contact_numbers(c: &mut Checker<'_>, raw: &RawScene, contact: &Contact, spheres: bool) {
+    let (l, run) = ("[contact]", &raw.run);
+    c.non_negative(
+        &["contact", "friction"],
+        l,
+        "friction",
+        contact.friction,
+        "",
+    );
+    fraction(
+        c,
+        &["contact", "damping_ratio"],
+        l,
+        "damping_ratio",
+        contact.damping_ratio,
+        "0 for no dashpot",
+    );
+    fraction(
+        c,
+        &["contact", "local_damping"],
+        l,
+        "local_damping",
+        contact.local_damping,
+        "0 for none, 0.7 for quasi-static packing",
+    );
+    if contact.local_damping > 0.0 && run.integrator != Integrator::Verlet {
+        c.error(
+            &["contact", "local_damping"],
+            format!("{l}: local_damping needs integrator = \"verlet\""),
+        );
+    }
+    if spheres && run.integrator != Integrator::Verlet && run.beta > 0.0 {
+        c.error(
+            &["run", "integrator"],
+            "[run]: contacts need an explicit integrator (verlet, or newmark with beta = 0): \
+             contact forces have no tangent"
+                .to_owned(),
+        );
+    }
+    if let Some(skin) = contact.skin {
+        c.positive(&["contact", "skin"], l, "skin", skin, "m");
+    }
+    c.positive(
+        &["contact", "overlap_tolerance"],
+        l,
+        "overlap_tolerance",
+        contact.overlap_tolerance,
+        "fraction of the reduced radius",
+    );
+}
+
+/// One `[[wall]]`: a plane or a mesh, a non-negative friction, a finite velocity.
+fn wall(c: &mut Checker<'_>, i: usize, w: &Wall) {
+    let idx = i.to_string();
+    let l = label("wall", i, None);
+    match (&w.point, &w.normal, &w.mesh) {
+        (Some(p), Some(n), None) => {
+            c.finite(&["wall", &idx, "point"], &l, "point", p);
+            if c.finite(&["wall", &idx, "normal"], &l, "normal", n) && n.iter().all(|&v| v == 0.0) {
+                c.error(
+                    &["wall", &idx, "normal"],
+                    format!("{l}: normal is zero; give the direction towards the bodies"),
+                );
+            }
+        }
+        (None, None, Some(mesh)) if mesh.as_os_str().is_empty() => c.error(
+            &["wall", &idx, "mesh"],
+            format!("{l}: mesh is empty; give a gmsh file relative to the scene file"),
+        ),
+        (None, None, Some(_)) => {}
+        _ => c.error(
+            &["wall", &idx],
+            format!(
+                "{l}: give either point and normal (a plane) or mesh (a triangulated wall), not \
+                 both and not only one of point and normal"
+            ),
+        ),
+    }
+    if let Some(f) = w.friction {
+        c.non_negative(&["wall", &idx, "friction"], &l, "friction", f, "");
+    }
+    c.finite(&["wall", &idx, "velocity"], &l, "velocity", &w.velocity);
+}

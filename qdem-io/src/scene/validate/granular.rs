@@ -1,0 +1,116 @@
+//! `[granular]`: a defined material, a `[contact]` table and no `[bonded]` body (what it shares
+//! with `[ballast]`, [`stone_table`]); a `sample` file or a generation (`region`, `count` and
+//! `grading`, `spheres_per_stone` in order), boxes with the upper corner above the lower one,
+//! and at least one translation in `copies` (more only with a sample).
+
+use super::super::schema::{Granular, RawScene};
+use super::checker::{box_corners, quoted_names, Checker};
+use super::material::Materials;
+
+/// `[granular]`: its material (returned as an index), a sample file or a generation (region,
+/// count, grading), a crop.
+pub(super) fn granular_table(
+    c: &mut Checker<'_>,
+    raw: &RawScene,
+    g: &Granular,
+    materials: &Materials<'_>,
+) -> Option<usize> {
+    let l = format!("[granular] {:?}", g.name);
+    let material = stone_table(
+        c,
+        raw,
+        "granular",
+        &l,
+        &g.material,
+        materials,
+        "a [granular] sample",
+    );
+    let generates = g.region.is_some() || g.count.is_some() || g.grading.is_some();
+    if !generates && g.sample.is_none() {
+        c.error(
+            &["granular"],
+            format!("{l}: give a `sample` file, or `region`, `count` and `grading` to generate stones (or both: the generated stones go above the sample's)"),
+        );
+    }
+    if generates {
+        if g.region.is_none() || g.count.is_none() || g.grading.is_none() {
+            c.error(
+                &["granular"],
+                format!("{l}: generating stones needs all of `region`, `count` and `grading`"),
+            );
+        }
+        let [lo, hi] = g.spheres_per_stone;
+        if lo == 0 || lo > hi {
+            c.error(
+                &["granular", "spheres_per_stone"],
+                format!(
+                    "{l}: spheres_per_stone = [{lo}, {hi}]: give [min, max] with 1 <= min <= max"
+                ),
+            );
+        }
+    }
+    for (key, b) in [("region", &g.region), ("crop", &g.crop)] {
+        if let Some(b) = b {
+            box_corners(c, "granular", &l, key, b);
+        }
+    }
+    copies_key(c, &l, g);
+    material
+}
+
+/// `[granular] copies`: translations of a sample file's stones, at least one.
+fn copies_key(c: &mut Checker<'_>, l: &str, g: &Granular) {
+    let at = ["granular", "copies"];
+    if g.copies.is_empty() {
+        c.error(
+            &at,
+            format!("{l}: copies = [] places no stone; give at least one translation, [[0, 0, 0]] for the sample where it is"),
+        );
+    }
+    if g.sample.is_none() && g.copies != [[0.0; 3]] {
+        c.error(
+            &at,
+            format!("{l}: copies repeats the stones of a `sample` file; give one or drop copies"),
+        );
+    }
+    for t in &g.copies {
+        c.finite(&at, l, "copies", t);
+    }
+}
+
+/// What `[granular]` and `[ballast]` share: a defined material, a `[contact]` table, no
+/// `[bonded]` body (`holds` names what a bonded scene cannot hold). Returns the material's
+/// index.
+pub(super) fn stone_table(
+    c: &mut Checker<'_>,
+    raw: &RawScene,
+    table: &str,
+    l: &str,
+    material: &str,
+    materials: &Materials<'_>,
+    holds: &str,
+) -> Option<usize> {
+    let found = materials.position(material);
+    if found.is_none() {
+        c.error(
+            &[table, "material"],
+            format!(
+                "{l}: material {material:?} is not defined (defined materials: {})",
+                quoted_names(materials.names.iter().copied())
+            ),
+        );
+    }
+    if raw.contact.is_none() {
+        c.error(
+            &[table],
+            format!("{l}: stones touch through contacts: add a [contact] table"),
+        );
+    }
+    if raw.bonded.is_some() {
+        c.error(
+            &[table],
+            format!("{l}: a [bonded] scene cannot hold {holds}; drop one"),
+        );
+    }
+    found
+}
