@@ -1,44 +1,39 @@
 //! # qdem-io
 //!
-//! Scene files and outputs of qdem:
+//! Scene files and outputs of qdem, laid out by stage:
 //!
 //! - [`scene`]: the TOML scene format (a public contract), parsed with serde and validated with
-//!   messages that name the file, line and key.
-//! - [`build`]: turns a scene into a [`build::Simulation`]: one [`qdem_core::State`] for all
-//!   bodies and only the models the scene needs, from the validated scene and the references it
-//!   resolved (one module per part of the scene under `build/`).
-//!   A `[bonded]` scene builds a 2D beam-bonded body instead (paper 001). `[granular]` adds a
-//!   sample of rigid stones ([`granular_build`]), `[periodic]` a periodic cell and a
-//!   time-delayed boundary (paper 003).
-//! - [`runner`]: the run loop: steps the [`qdem_core::World`] a build made and hands each
-//!   step to the outputs' recorders (`record`: one file per output).
+//!   messages that name the file, line and key; validation resolves the references between
+//!   tables into indices.
+//! - [`build`]: turns a validated scene into a [`build::Simulation`]: the
+//!   [`qdem_core::World`] (one [`qdem_core::State`] for all bodies, only the models the scene
+//!   needs, the step settings, the post-step hooks) and what the outputs need to know of its
+//!   bodies and probes; one module per part of the scene (contacts, `[granular]` stones,
+//!   `[ballast]`, a `[bonded]` beam of paper 001, the `[periodic]` cell of paper 003,
+//!   `pose_from`, `rest_on`, `[run] start_from`, load series).
+//! - [`run`]: the run loop ([`runner`]) that steps the world and hands each step to one
+//!   recorder per output, checkpoints ([`checkpoint`]) and the fingerprints of the files they
+//!   depend on ([`inputs`]).
 //! - [`output`]: atomic writers for VTU/PVD, probe CSV and summary JSON.
-//! - [`spectrum`]: dominant frequency of a probe record by FFT.
-//! - [`plot`]: SVG line plots beside the CSVs.
-//! - `[ballast]` ([`ballast_build`]): deformable stones laid out for deposition (paper 000 §4);
-//!   `[run] start_from` begins a run from another scene's checkpoint; a `[[load]]` may follow
-//!   a CSV time series.
-//! - [`analyze`]: Parzen-smoothed linear spectra and mobility of a run's sensors
-//!   ([`linear_spectrum`], paper 000 §4.2).
+//! - [`post`]: post-processing: spectra and mobility of a run's sensors ([`analyze`],
+//!   `qdem analyze`), dominant frequencies ([`spectrum`]), plots ([`plot`]) and the crack
+//!   picture ([`crack_svg`]).
+//!
+//! The modules of each stage are also reachable at the crate root under their own names
+//! ([`runner`], [`checkpoint`], [`analyze`], …), the paths the other crates use.
 
 #![warn(missing_docs)]
 
-pub mod analyze;
 pub mod build;
-pub mod checkpoint;
-pub mod crack_svg;
 mod csv_rows;
-pub mod inputs;
-pub mod linear_spectrum;
 pub mod output;
-pub mod plot;
-pub mod pose_from;
-mod record;
-mod run_record;
-pub mod runner;
+pub mod post;
+pub mod run;
 pub mod scene;
-pub mod spectrum;
-mod start_from;
+
+pub use build::pose_from;
+pub use post::{analyze, crack_svg, linear_spectrum, plot, spectrum};
+pub use run::{checkpoint, inputs, runner};
 
 /// `[ballast]` stones ([`build::ballast`], kept at its former path).
 pub use build::ballast as ballast_build;

@@ -27,7 +27,9 @@ mod error;
 pub mod granular;
 pub(crate) mod load_series;
 mod periodic;
+pub mod pose_from;
 mod rest_on;
+mod start_from;
 
 pub use error::BuildError;
 
@@ -51,7 +53,7 @@ use std::path::{Path, PathBuf};
 /// How a body is integrated.
 #[derive(Clone, Debug)]
 pub enum BodyKind {
-    /// A QDEM body: index of its [`TetBody`] in [`Simulation::models`].
+    /// A QDEM body: index of its [`TetBody`] in the world's models ([`qdem_core::World::models`]).
     Deformable {
         /// The model index.
         model: usize,
@@ -67,7 +69,7 @@ pub enum BodyKind {
         tets: Vec<[u32; 4]>,
         /// Orientation its principal frame had in the body's design placement (after
         /// `rotate_deg` and `translate`, before `pose_from`): the pose written to `poses.csv`
-        /// is measured from it ([`crate::pose_from`]).
+        /// is measured from it ([`pose_from`]).
         design_frame: UnitQuaternion<f64>,
     },
 }
@@ -149,7 +151,7 @@ impl Simulation {
             Some(p) => Some(periodic::periodic_box(&scene, p)?),
             None => None,
         };
-        crate::pose_from::pose_bodies(&scene, &mut meshes)?;
+        pose_from::pose_bodies(&scene, &mut meshes)?;
         rest_on::rest_bodies(&scene, &mut meshes, &stones, periodic_box.as_ref())?;
         let reference = meshes
             .iter()
@@ -169,7 +171,7 @@ impl Simulation {
         extra.periodic = periodic.as_ref().map(|p| p.0.clone());
         add_forces(&scene, &meshes, &state, extra, &mut models)?;
         if let Some(file) = &scene.run.start_from {
-            crate::start_from::restore_state(&scene, file, &mut state, periodic.as_ref())?;
+            start_from::restore_state(&scene, file, &mut state, periodic.as_ref())?;
         }
         let probes = resolve_probes(&scene, &bodies, &state);
         let settings =

@@ -40,7 +40,7 @@ pub(crate) fn restore_state(
     let body = read_checkpoint(&path, None).map_err(|e| refused(e.to_string()))?;
     let built = state.reference.clone();
     let mut input = Decoder::new(&body);
-    crate::run_record::skip_record(&mut input)
+    crate::run::run_record::skip_record(&mut input)
         .and_then(|()| state.restore(&mut input))
         .map_err(|e| {
             refused(format!(

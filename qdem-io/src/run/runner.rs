@@ -1,5 +1,5 @@
 //! The run loop: steps a [`Simulation`]'s [`qdem_core::World`] to `t_end`, hands the state
-//! after every step to the outputs' recorders ([`crate::record`]: probes, VTU/PVD, sections,
+//! after every step to the outputs' recorders (`record`: probes, VTU/PVD, sections,
 //! boundary, crack picture, stones, poses), checkpoints when due or asked to, and writes
 //! `summary.json` at the end. Every output file is written atomically; a run stopped by an
 //! instability still commits the probe rows up to the failure and its end-of-run files.
@@ -9,9 +9,9 @@ use crate::checkpoint::{
     read_checkpoint, scene_fingerprint, write_checkpoint, CheckpointFileError, CHECKPOINT_FILE,
 };
 use crate::output::OutputError;
-use crate::record::schedule::{probe_interval, Schedule};
-use crate::record::{self, Recorder, RunFigures, StepInfo};
-use crate::run_record::{decode_run, encode_run, RunRecord};
+use crate::run::record::schedule::{probe_interval, Schedule};
+use crate::run::record::{self, Recorder, RunFigures, StepInfo};
+use crate::run::run_record::{decode_run, encode_run, RunRecord};
 use qdem_core::error::unstable_advice;
 use qdem_core::{CoreError, Halt};
 use std::path::{Path, PathBuf};
