@@ -8,6 +8,7 @@ mod common;
 use common::{short_cantilever, test_dir};
 use qdem_io::build::Simulation;
 use qdem_io::checkpoint::{read_checkpoint, scene_fingerprint, CHECKPOINT_FILE};
+use qdem_core::CoreError;
 use qdem_io::runner::{run, RunError};
 use qdem_io::scene::Scene;
 use std::path::{Path, PathBuf};
@@ -37,12 +38,16 @@ fn unstable(error: &RunError) -> (u64, f64, &str, f64, f64) {
         panic!("expected a failure with a checkpoint, got {error}")
     };
     match source.as_ref() {
-        RunError::Unstable {
-            step,
-            time,
-            detail,
-            dt,
-            bound,
+        RunError::Core {
+            source:
+                CoreError::Unstable {
+                    step,
+                    time,
+                    detail,
+                    dt,
+                    bound,
+                    ..
+                },
             ..
         } => (*step, *time, detail.as_str(), *dt, *bound),
         other => panic!("expected an instability, got {other}"),

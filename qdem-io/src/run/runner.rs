@@ -12,7 +12,6 @@ use crate::output::OutputError;
 use crate::run::record::schedule::{probe_interval, Schedule};
 use crate::run::record::{self, Recorder, RunFigures, StepInfo};
 use crate::run::run_record::{decode_run, encode_run, RunRecord};
-use qdem_core::error::unstable_advice;
 use qdem_core::{CoreError, Halt};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -33,37 +32,15 @@ pub enum RunError {
         /// The io error.
         source: std::io::Error,
     },
-    /// The stepper failed (an instability).
+    /// The step failed: an instability the world's failure check found
+    /// ([`CoreError::Unstable`], naming the step, the time, where, and the stable bound), or
+    /// another error of the core.
     #[error("{scene}: {source}")]
     Core {
         /// The scene file.
         scene: PathBuf,
         /// What went wrong.
         source: CoreError,
-    },
-    /// The run went unstable.
-    #[error(
-        "{scene}: the run became unstable at step {step} (t = {time:.6e} s): {detail}. The step \
-         was dt = {dt:.4e} s; the stable bound at this state is {bound:.4e} s (set by \
-         {limiter}): {advice}",
-        scene = scene.display(),
-        advice = unstable_advice(*dt, *bound)
-    )]
-    Unstable {
-        /// The scene file.
-        scene: PathBuf,
-        /// The step that failed.
-        step: u64,
-        /// Simulated time after it.
-        time: f64,
-        /// What went wrong, and where (particle, body, element).
-        detail: String,
-        /// The step size.
-        dt: f64,
-        /// The stable bound at this state.
-        bound: f64,
-        /// The model that sets it.
-        limiter: String,
     },
     /// A checkpoint that cannot be resumed from.
     #[error(transparent)]
@@ -278,7 +255,7 @@ pub fn run_with(
     }
     let outcome = match (outcome, last_good) {
         (
-            Err(source @ (RunError::Core { .. } | RunError::Unstable { .. })),
+            Err(source @ RunError::Core { .. }),
             Some((time, body, _)),
         ) => {
             write_checkpoint(&checkpoint_path, &fingerprint, &body)?;
@@ -331,28 +308,12 @@ fn encode(
     encode_run(sim, run, recorders).map_err(|source| core_error(sim, source.into()))
 }
 
-/// A core error of `sim`'s run, naming the scene; an instability found by the world's
-/// failure check becomes [`RunError::Unstable`].
+/// A core error of `sim`'s run (an instability found by the world's failure check among
+/// them: [`CoreError::Unstable`]), naming the scene.
 fn core_error(sim: &Simulation, source: CoreError) -> RunError {
-    let scene = sim.scene.path.clone();
-    match source {
-        CoreError::Unstable {
-            step,
-            time,
-            detail,
-            dt,
-            bound,
-            limiter,
-        } => RunError::Unstable {
-            scene,
-            step,
-            time,
-            detail,
-            dt,
-            bound,
-            limiter,
-        },
-        source => RunError::Core { scene, source },
+    RunError::Core {
+        scene: sim.scene.path.clone(),
+        source,
     }
 }
 
