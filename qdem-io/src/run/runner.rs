@@ -9,6 +9,7 @@ use crate::checkpoint::{
     read_checkpoint, scene_fingerprint, write_checkpoint, CheckpointFileError, CHECKPOINT_FILE,
 };
 use crate::output::OutputError;
+use crate::run::inputs::SceneFingerprint;
 use crate::run::record::schedule::{probe_interval, Schedule};
 use crate::run::record::{self, Recorder, RunFigures, StepInfo};
 use crate::run::run_record::{decode_run, encode_run, RunRecord};
@@ -156,35 +157,11 @@ pub fn run_with(
     options: RunOptions<'_>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<RunReport, RunError> {
-    create_dir(out_dir)?;
-    if sim.scene.output.writes_vtu() {
-        create_dir(&out_dir.join("vtu"))?;
-    }
-    crate::output::remove_stale_temporaries(out_dir);
+    let mut run = Run::open(sim, out_dir, options)?;
     let steps = sim.steps();
-    let checkpoint_path = out_dir.join(CHECKPOINT_FILE);
-    let fingerprint = scene_fingerprint(&sim.scene);
-    let can_checkpoint = sim.world.checkpointable();
-    if sim.scene.output.checkpoint_every > 0.0 || options.resume.is_some() {
-        if let Err(source) = &can_checkpoint {
-            return Err(core_error(sim, source.clone().into()));
-        }
-    }
-    let mut recorders = record::register(sim, out_dir);
-    let mut run = RunRecord::new(sim);
-    if let Some(path) = options.resume {
-        let body = read_checkpoint(path, Some(&fingerprint))?;
-        decode_run(&body, sim, &mut run, &mut recorders)
-            .map_err(|source| core_error(sim, source))?;
-    }
-    for r in recorders.iter_mut() {
-        r.start(options.resume.is_some())?;
-    }
-    let first_step = run.next_step;
+    let first_step = run.record.next_step;
     let start = Instant::now();
     let mut last_report = start;
-    let mut last_good: Option<GoodState> = None;
-    let mut good_schedule = Schedule::new(probe_interval(sim));
     let mut halt = None;
     let outcome = (|| -> Result<(), RunError> {
         if options.resume.is_none() {
@@ -205,37 +182,10 @@ pub fn run_with(
                 seconds,
                 halt: halt.as_ref(),
             };
-            for r in recorders.iter_mut() {
-                r.record(sim, &info)?;
-            }
-            let time = sim.world.state.time;
-            let sampled = good_schedule.due(time, dt);
-            run.next_step = step + 1;
-            let stop = options.stop.is_some_and(|s| s.load(Ordering::Relaxed))
-                || options.stop_after == Some(step);
-            if run.checkpoints.due(time, dt) || stop {
-                for r in recorders.iter_mut() {
-                    r.publish()?;
-                }
-                let body = encode(sim, &run, &recorders)?;
-                write_checkpoint(&checkpoint_path, &fingerprint, &body)?;
-            } else if sampled
-                && can_checkpoint.is_ok()
-                && last_good
-                    .as_ref()
-                    .is_none_or(|g| g.2.elapsed().as_secs_f64() >= GOOD_STATE_EVERY)
-            {
-                last_good = Some((time, encode(sim, &run, &recorders)?, Instant::now()));
-            }
-            if stop {
-                return Err(RunError::Interrupted {
-                    time,
-                    step,
-                    checkpoint: checkpoint_path.clone(),
-                });
-            }
+            run.after_step(sim, step, &info)?;
             if step % 64 == 0 && last_report.elapsed().as_secs_f64() > 0.5 {
                 last_report = Instant::now();
+                let time = sim.world.state.time;
                 progress(&progress_at(
                     step - first_step,
                     steps - first_step,
@@ -250,24 +200,7 @@ pub fn run_with(
         Ok(())
     })();
     let wall_seconds = start.elapsed().as_secs_f64();
-    for r in recorders.iter_mut() {
-        r.finish(sim)?;
-    }
-    let outcome = match (outcome, last_good) {
-        (
-            Err(source @ RunError::Core { .. }),
-            Some((time, body, _)),
-        ) => {
-            write_checkpoint(&checkpoint_path, &fingerprint, &body)?;
-            Err(RunError::Failed {
-                source: Box::new(source),
-                time,
-                checkpoint: checkpoint_path.clone(),
-            })
-        }
-        (outcome, _) => outcome,
-    };
-    outcome?;
+    run.close(sim, outcome)?;
     let steps = match halt {
         Some(_) => sim.world.steps_done(),
         None => steps,
@@ -287,8 +220,127 @@ pub fn run_with(
         halt,
     };
     let resumed_at = options.resume.map(|_| first_step.saturating_sub(1));
-    record::summary::write(out_dir, sim, &report, &figures, &recorders, resumed_at)?;
+    let recorders = &run.recorders;
+    record::summary::write(out_dir, sim, &report, &figures, recorders, resumed_at)?;
     Ok(report)
+}
+
+/// A run in progress besides its world: the recorders, the run record, and what checkpoints
+/// need (the file, the scene's fingerprint, the last good state kept in memory).
+struct Run<'a> {
+    options: RunOptions<'a>,
+    recorders: Vec<Box<dyn Recorder>>,
+    record: RunRecord,
+    checkpoint_path: PathBuf,
+    fingerprint: SceneFingerprint,
+    can_checkpoint: bool,
+    last_good: Option<GoodState>,
+    good_schedule: Schedule,
+}
+
+impl<'a> Run<'a> {
+    /// Prepares `out_dir` (its folders, no temporary files of killed runs), refuses a run that
+    /// must checkpoint but cannot, registers the recorders and, resuming, restores the world
+    /// and the recorders from the checkpoint; then opens the recorders' files.
+    fn open(
+        sim: &mut Simulation,
+        out_dir: &Path,
+        options: RunOptions<'a>,
+    ) -> Result<Run<'a>, RunError> {
+        create_dir(out_dir)?;
+        if sim.scene.output.writes_vtu() {
+            create_dir(&out_dir.join("vtu"))?;
+        }
+        crate::output::remove_stale_temporaries(out_dir);
+        let can_checkpoint = sim.world.checkpointable();
+        if sim.scene.output.checkpoint_every > 0.0 || options.resume.is_some() {
+            if let Err(source) = &can_checkpoint {
+                return Err(core_error(sim, source.clone().into()));
+            }
+        }
+        let mut run = Run {
+            options,
+            recorders: record::register(sim, out_dir),
+            record: RunRecord::new(sim),
+            checkpoint_path: out_dir.join(CHECKPOINT_FILE),
+            fingerprint: scene_fingerprint(&sim.scene),
+            can_checkpoint: can_checkpoint.is_ok(),
+            last_good: None,
+            good_schedule: Schedule::new(probe_interval(sim)),
+        };
+        if let Some(path) = options.resume {
+            let body = read_checkpoint(path, Some(&run.fingerprint))?;
+            decode_run(&body, sim, &mut run.record, &mut run.recorders)
+                .map_err(|source| core_error(sim, source))?;
+        }
+        for r in run.recorders.iter_mut() {
+            r.start(options.resume.is_some())?;
+        }
+        Ok(run)
+    }
+
+    /// After the sample at the start (step 0) and after every step: the recorders record,
+    /// then a checkpoint when due or asked for (a stop request ends the run with
+    /// [`RunError::Interrupted`]), else, at a probe interval, the last good state in memory.
+    fn after_step(
+        &mut self,
+        sim: &Simulation,
+        step: u64,
+        info: &StepInfo<'_>,
+    ) -> Result<(), RunError> {
+        for r in self.recorders.iter_mut() {
+            r.record(sim, info)?;
+        }
+        let time = sim.world.state.time;
+        let sampled = self.good_schedule.due(time, info.dt);
+        self.record.next_step = step + 1;
+        let options = &self.options;
+        let stop = options.stop.is_some_and(|s| s.load(Ordering::Relaxed))
+            || options.stop_after == Some(step);
+        if self.record.checkpoints.due(time, info.dt) || stop {
+            for r in self.recorders.iter_mut() {
+                r.publish()?;
+            }
+            let body = encode(sim, &self.record, &self.recorders)?;
+            write_checkpoint(&self.checkpoint_path, &self.fingerprint, &body)?;
+        } else if sampled
+            && self.can_checkpoint
+            && self
+                .last_good
+                .as_ref()
+                .is_none_or(|g| g.2.elapsed().as_secs_f64() >= GOOD_STATE_EVERY)
+        {
+            let body = encode(sim, &self.record, &self.recorders)?;
+            self.last_good = Some((time, body, Instant::now()));
+        }
+        match stop {
+            true => Err(RunError::Interrupted {
+                time,
+                step,
+                checkpoint: self.checkpoint_path.clone(),
+            }),
+            false => Ok(()),
+        }
+    }
+
+    /// Ends the run, finished or failed: the recorders write their end-of-run files, and a
+    /// run that failed leaves its last good state in the checkpoint.
+    fn close(&mut self, sim: &Simulation, outcome: Result<(), RunError>) -> Result<(), RunError> {
+        for r in self.recorders.iter_mut() {
+            r.finish(sim)?;
+        }
+        match (outcome, self.last_good.take()) {
+            (Err(source @ RunError::Core { .. }), Some((time, body, _))) => {
+                write_checkpoint(&self.checkpoint_path, &self.fingerprint, &body)?;
+                Err(RunError::Failed {
+                    source: Box::new(source),
+                    time,
+                    checkpoint: self.checkpoint_path.clone(),
+                })
+            }
+            (outcome, _) => outcome,
+        }
+    }
 }
 
 /// Creates an output directory.
