@@ -12,7 +12,8 @@ export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
 cargo test --workspace --all-targets
 cargo test --workspace --doc
 # The embedding examples: each checks a physical quantity and exits non-zero when it is off
-# (a few seconds each in release).
-cargo run --release -p qdem-core --example beam_under_load
-cargo run --release -p qdem-contact --example two_bodies_collide
-cargo run --release -p qdem-contact --example spheres_on_wall
+# (a few seconds each). The test profile reuses what `cargo test --all-targets` built (the
+# examples are among its targets) instead of a second, release build of every dependency.
+cargo run --profile test -p qdem-core --example beam_under_load
+cargo run --profile test -p qdem-contact --example two_bodies_collide
+cargo run --profile test -p qdem-contact --example spheres_on_wall
