@@ -82,7 +82,9 @@ pub struct Halt {
 pub struct World {
     /// The degrees of freedom of every particle and rigid body.
     pub state: State,
-    /// The force models, in the order their forces are summed.
+    /// The force models, in the order their forces are summed. Give them to [`World::new`]:
+    /// one pushed here later is not told how it is stepped ([`Model::prepare`]) and has no
+    /// stage counter of its own.
     pub models: Vec<Box<dyn Model>>,
     stepper: Box<dyn Stepper>,
     hooks: Vec<Box<dyn PostStep>>,
@@ -126,7 +128,8 @@ impl World {
         Ok(())
     }
 
-    /// Adds a post-step hook, run after the hooks added before it.
+    /// Adds a post-step hook, run after the hooks added before it; the stage counters start
+    /// again (add hooks before stepping).
     pub fn add_hook(&mut self, hook: Box<dyn PostStep>) {
         self.hooks.push(hook);
         self.stages = StageTimes::new(self.models.len(), self.hooks.len());

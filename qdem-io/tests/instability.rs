@@ -6,9 +6,9 @@
 mod common;
 
 use common::{short_cantilever, test_dir};
+use qdem_core::CoreError;
 use qdem_io::build::Simulation;
 use qdem_io::checkpoint::{read_checkpoint, scene_fingerprint, CHECKPOINT_FILE};
-use qdem_core::CoreError;
 use qdem_io::runner::{run, RunError};
 use qdem_io::scene::Scene;
 use std::path::{Path, PathBuf};
