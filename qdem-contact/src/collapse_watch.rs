@@ -5,7 +5,7 @@
 //! outputs.
 
 use crate::bonded_particles::BondedParticles;
-use qdem_core::{Halt, Model, PostStep, State};
+use qdem_core::{find_model, Halt, Model, PostStep, State};
 
 /// Halts a run when a particle of its [`BondedParticles`] has moved more than `limit`.
 #[derive(Clone, Debug)]
@@ -30,10 +30,7 @@ impl PostStep for CollapseWatch {
 
     /// The particle that moved furthest beyond the limit, if any.
     fn after_step(&mut self, state: &mut State, models: &[Box<dyn Model>]) -> Option<Halt> {
-        let body = models.iter().find_map(|m| {
-            let m: &dyn std::any::Any = m.as_ref();
-            m.downcast_ref::<BondedParticles>()
-        })?;
+        let body = find_model::<BondedParticles>(models)?;
         let (particle, value) = body.beyond_small_displacement(state, self.limit)?;
         Some(Halt {
             hook: self.name().to_string(),

@@ -55,7 +55,7 @@ pub use checkpoint::{CheckpointError, Decoder, Encoder};
 pub use error::CoreError;
 pub use gravity::Gravity;
 pub use material::Material;
-pub use model::{Linearized, Model, Persistence, Persistent, StepEvents};
+pub use model::{find_model, Linearized, Model, Persistence, Persistent, StepEvents};
 pub use newmark::{Newmark, StepCounts, TangentUpdate};
 pub use nodal_load::NodalLoad;
 pub use rigid_body::RigidBodies;

@@ -89,6 +89,15 @@ pub trait Model: std::any::Any + Send + Sync {
     }
 }
 
+/// The first of `models` of type `M`, if any (models are `Any`: a body's element fields, a
+/// contact set's counts).
+pub fn find_model<M: Model>(models: &[Box<dyn Model>]) -> Option<&M> {
+    models.iter().find_map(|m| {
+        let m: &dyn std::any::Any = m.as_ref();
+        m.downcast_ref::<M>()
+    })
+}
+
 /// The implicit facet of a model: its tangent and the particles it joins.
 pub trait Linearized {
     /// Adds the tangent stiffness K = −∂f/∂x and damping C = −∂f/∂v, linearised at `state`,

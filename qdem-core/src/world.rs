@@ -19,7 +19,7 @@
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
-use crate::model::{Model, Persistence};
+use crate::model::{find_model, Model, Persistence};
 use crate::stages::{Stage, StageShare, StageTimes};
 use crate::state::State;
 use crate::step_settings::StepSettings;
@@ -169,10 +169,7 @@ impl World {
 
     /// The first model of type `M`, if any.
     pub fn model<M: Model>(&self) -> Option<&M> {
-        self.models.iter().find_map(|m| {
-            let m: &dyn std::any::Any = m.as_ref();
-            m.downcast_ref::<M>()
-        })
+        find_model(&self.models)
     }
 
     /// The first post-step hook of type `H`, if any.
