@@ -43,6 +43,8 @@ pub struct BenchResult {
     pub tets: usize,
     /// Particles.
     pub particles: usize,
+    /// Entries of the block sums (`qdem_core::tet_blocks::BlockLayout::block_nodes`).
+    pub block_nodes: usize,
     /// Whether the viscous path ran.
     pub viscous: bool,
     /// Threads.
@@ -59,15 +61,22 @@ impl BenchResult {
         (self.tets * self.steps) as f64 / self.seconds
     }
 
-    /// Compulsory memory traffic of one step divided by the tetrahedra (bytes): per tetrahedron
-    /// its 4 indices and dX⁻¹ (88 B), the force buffer written and read back (192 B) and the
-    /// incidence entries (16 B); per particle positions, velocities, accelerations read and
-    /// written across the two half kicks and the drift (~216 B), force written and read
-    /// (48 B), mass and fixity (9 B), gathered positions (24 B, 48 B with velocities).
+    /// Compulsory memory traffic of one step divided by the tetrahedra (bytes), for the blocked
+    /// kernel of `qdem_core::tet_blocks`:
+    /// - per tetrahedron its hot record, dX⁻¹ and four local corners (80 B);
+    /// - per block node (a particle counted once per block that touches it): its index (4 B),
+    ///   its position copied in (24 B, 48 B with velocities), its block sum written and read
+    ///   back by the gather (48 B) and the gather's entry index (4 B);
+    /// - per particle: the gather's range (4 B); the force zeroed, added to and read by the
+    ///   accelerations (96 B); the drift and first half kick reading x, v, a and writing x, v
+    ///   (120 B); a = f/m with mass and fixity (33 B); the second half kick (72 B).
     pub fn bytes_per_tet_step(&self) -> f64 {
-        let per_tet = 88.0 + 192.0 + 16.0;
-        let per_particle = 216.0 + 48.0 + 9.0 + if self.viscous { 48.0 } else { 24.0 };
-        per_tet + per_particle * self.particles as f64 / self.tets as f64
+        let per_block_node = 80.0 + if self.viscous { 24.0 } else { 0.0 };
+        let per_particle = 4.0 + 96.0 + 120.0 + 33.0 + 72.0;
+        (80.0 * self.tets as f64
+            + per_block_node * self.block_nodes as f64
+            + per_particle * self.particles as f64)
+            / self.tets as f64
     }
 }
 
@@ -154,6 +163,7 @@ pub fn measure_ordered(
     on_threads(threads, || {
         let (body, mut state) = body_on(block_mesh(tets, ordering), viscous);
         let tets = body.tets().len();
+        let block_nodes = body.block_layout().block_nodes;
         let dt = 0.9 * body.stable_dt(&state).expect("a body bounds the step");
         let mut models: Vec<Box<dyn Model>> = vec![Box::new(body)];
         let mut stepper = Verlet::new(dt);
@@ -171,6 +181,7 @@ pub fn measure_ordered(
         BenchResult {
             tets,
             particles: state.len(),
+            block_nodes,
             viscous,
             threads,
             steps,
@@ -275,7 +286,7 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
                     );
                 }
                 results.push(json!({
-                    "tets": r.tets, "particles": r.particles,
+                    "tets": r.tets, "particles": r.particles, "block_nodes": r.block_nodes,
                     "material": if viscous { "viscoelastic" } else { "elastic" },
                     "threads": r.threads, "steps": r.steps, "seconds": r.seconds,
                     "tet_steps_per_second": r.tet_steps_per_second(),

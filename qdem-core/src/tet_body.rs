@@ -1,10 +1,12 @@
 //! A deformable QDEM body: a set of tetrahedra sharing particles, as a [`Model`].
 //!
 //! Each step computes the Kelvin–Voigt stress and the four particle forces of every
-//! tetrahedron in parallel into a buffer (paper 000 Eqs. 1–10, see [`crate::tet_kernel`]), then
-//! sums them per particle over a fixed incidence list (Eq. 11). The gather runs in parallel over
-//! particles, each summing its own incident entries in ascending order, so the result is
-//! bit-identical for any number of threads (no atomics, no reduction-order dependence).
+//! tetrahedron (paper 000 Eqs. 1–10, see [`crate::tet_kernel`]) block by block: the blocks of
+//! [`crate::tet_blocks`] run in parallel, each against a cached copy of its nodes' positions,
+//! summing its forces per node; a per-particle gather then adds each particle's block sums in
+//! ascending block order (Eq. 11). Blocks are fixed by the mesh, so every particle sums its
+//! contributions in the same order for any number of threads: results are bit-identical (no
+//! atomics, no reduction-order dependence).
 //! Elastic materials take a path without the viscous stress.
 //!
 //! For implicit and static solves the body adds its tangent (its [`crate::Linearized`] facet):
@@ -20,13 +22,15 @@ use crate::model::{Linearized, Model, Persistence};
 use crate::stable_step::{critical_step, element_rate_bound};
 use crate::state::State;
 use crate::tangent::Tangent;
+use crate::tet_blocks::{BlockLayout, TetBlocks};
 use crate::tet_kernel::{
-    deformation_gradient, edge_matrix, strain_energy, tet_stress, vertex_forces, von_mises,
+    deformation_gradient, edge_matrix, strain_energy, tet_forces, tet_stress, von_mises,
 };
 use crate::{Mat3, Vec3};
 use rayon::prelude::*;
+use std::sync::Mutex;
 
-/// Tetrahedra per parallel task: large enough to amortise scheduling, small enough to balance.
+/// Tetrahedra per parallel task in the per-element fields.
 const TET_CHUNK: usize = 512;
 /// Particles per parallel task in the gather.
 const PARTICLE_CHUNK: usize = 1024;
@@ -60,12 +64,12 @@ pub struct TetBody {
     elastic: Lame,
     viscous: Lame,
     tets: Vec<[u32; 4]>,
-    dm_inv: Vec<Mat3>,
     volume: Vec<f64>,
-    first: usize,
-    incidence_start: Vec<u32>,
-    incidence: Vec<u32>,
-    tet_forces: Vec<Vec3>,
+    blocks: TetBlocks,
+    /// Per block node, the sum of its block's tetrahedron forces (laid out like the blocks'
+    /// node lists), written by the block pass and read by the gather.
+    sums: Vec<Vec3>,
+    scratch: ScratchPool,
     omega_squared: f64,
     damping_rate: f64,
     /// The first tetrahedron found inverted at the last force evaluation.
@@ -116,7 +120,7 @@ impl TetBody {
             dm_inv.push(inverse);
             volume.push(v);
         }
-        let (first, incidence_start, incidence) = incidence_lists(&tets);
+        let blocks = TetBlocks::new(reference, &tets, &dm_inv);
         let elastic = material.elastic_lame();
         let viscous = material.viscous_lame();
         let omega_squared = rate_bound(&dm_inv, &material, elastic);
@@ -127,16 +131,14 @@ impl TetBody {
         };
         Ok(TetBody {
             name: name.to_string(),
-            tet_forces: vec![Vec3::zeros(); 4 * tets.len()],
+            sums: vec![Vec3::zeros(); blocks.nodes.len()],
             material,
             elastic,
             viscous,
             tets,
-            dm_inv,
             volume,
-            first,
-            incidence_start,
-            incidence,
+            blocks,
+            scratch: ScratchPool::default(),
             omega_squared,
             damping_rate,
             inverted: None,
@@ -146,6 +148,11 @@ impl TetBody {
     /// The body's tetrahedra (indices into the scene's particles).
     pub fn tets(&self) -> &[[u32; 4]] {
         &self.tets
+    }
+
+    /// How the tetrahedra are cut into blocks for the force pass ([`crate::tet_blocks`]).
+    pub fn block_layout(&self) -> BlockLayout {
+        self.blocks.layout()
     }
 
     /// Adds a quarter of each tetrahedron's mass to each of its particles (paper 000 §2.4).
@@ -167,8 +174,14 @@ impl TetBody {
             .map(|e| {
                 let x = self.tets[e].map(|n| state.position[n as usize]);
                 let v = viscous.then(|| self.tets[e].map(|n| state.velocity[n as usize]));
-                let (t, _) = tet_stress(&x, v.as_ref(), &self.dm_inv[e], self.pair(), self.vpair());
-                let j = deformation_gradient(&x, &self.dm_inv[e]).determinant();
+                let (t, _) = tet_stress(
+                    &x,
+                    v.as_ref(),
+                    self.blocks.dm_inv(e),
+                    self.pair(),
+                    self.vpair(),
+                );
+                let j = deformation_gradient(&x, self.blocks.dm_inv(e)).determinant();
                 (von_mises(&t), j - 1.0)
             })
             .unzip()
@@ -182,45 +195,72 @@ impl TetBody {
         (self.viscous.lambda, self.viscous.mu)
     }
 
-    /// Stage 1: stress and particle forces of every tetrahedron into the buffer.
-    fn compute_tet_forces<const VISCOUS: bool>(&mut self, state: &State) {
-        let (elastic, viscous) = (self.pair(), self.vpair());
-        let (tets, dm_inv) = (&self.tets, &self.dm_inv);
-        let inverted = self
-            .tet_forces
-            .par_chunks_mut(4 * TET_CHUNK)
-            .enumerate()
-            .map(|(chunk, out)| {
-                let start = chunk * TET_CHUNK;
-                let mut first_inverted = usize::MAX;
-                for (local, f) in out.chunks_exact_mut(4).enumerate() {
-                    let e = start + local;
-                    let tet = &tets[e];
-                    let x = tet.map(|n| state.position[n as usize]);
-                    let v = VISCOUS.then(|| tet.map(|n| state.velocity[n as usize]));
-                    let (t, cof) = tet_stress(&x, v.as_ref(), &dm_inv[e], elastic, viscous);
-                    f.copy_from_slice(&vertex_forces(&t, &cof));
-                    // 6 × the current volume; B = FFᵀ cannot tell an inverted tetrahedron
-                    // from its mirror image, so the sign is checked here.
-                    let six_volume = (x[1] - x[0]).dot(&cof.column(0));
-                    let positive =
-                        six_volume.partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater);
-                    if !positive && first_inverted == usize::MAX {
-                        first_inverted = e;
-                    }
-                }
-                first_inverted
-            })
-            .min()
-            .unwrap_or(usize::MAX);
+    /// Stage 1: every block's tetrahedra, their forces summed per block node into
+    /// `self.sums` ([`crate::tet_blocks`]), the blocks in parallel.
+    fn compute_block_sums<const VISCOUS: bool>(&mut self, state: &State) {
+        self.scratch.fit(rayon::current_num_threads());
+        let mut sums = std::mem::take(&mut self.sums);
+        let this = &*self;
+        let inverted = for_blocks(
+            &mut sums,
+            0..self.blocks.len(),
+            &self.blocks.node_start,
+            &|b, out| {
+                let mut scratch = this.scratch.for_this_thread();
+                this.block_pass::<VISCOUS>(b, state, out, &mut scratch)
+            },
+        );
+        self.sums = sums;
         self.inverted = (inverted != usize::MAX).then_some(inverted);
     }
 
-    /// Stage 2: per-particle sums over the incidence list, in a fixed order (Eq. 11).
+    /// The tetrahedra of block `b` against a local copy of its nodes' positions (and
+    /// velocities), their forces added into `out` (the block's sums, one per node, in tet
+    /// order). Returns the body's index of its first inverted tetrahedron, `usize::MAX` if none.
+    fn block_pass<const VISCOUS: bool>(
+        &self,
+        b: usize,
+        state: &State,
+        out: &mut [Vec3],
+        scratch: &mut Scratch,
+    ) -> usize {
+        let blocks = &self.blocks;
+        let nodes = &blocks.nodes[blocks.node_start[b] as usize..blocks.node_start[b + 1] as usize];
+        scratch.load(
+            nodes,
+            &state.position,
+            VISCOUS.then_some(&state.velocity[..]),
+        );
+        out.fill(Vec3::zeros());
+        let (elastic, viscous) = (self.pair(), self.vpair());
+        let range = blocks.tet_start[b] as usize..blocks.tet_start[b + 1] as usize;
+        let mut first_inverted = usize::MAX;
+        for (k, hot) in range.clone().zip(&blocks.hot[range]) {
+            let x = corners(&scratch.x, hot.local);
+            let v = if VISCOUS {
+                corners(&scratch.v, hot.local)
+            } else {
+                x
+            };
+            let (forces, six_volume) = tet_forces::<VISCOUS>(&x, &v, &hot.dm_inv, elastic, viscous);
+            for (&l, f) in hot.local.iter().zip(forces) {
+                out[l as usize] += f;
+            }
+            // B = FFᵀ cannot tell an inverted tetrahedron from its mirror image, so the sign
+            // of the volume is checked here.
+            if six_volume.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                first_inverted = first_inverted.min(blocks.order[k] as usize);
+            }
+        }
+        first_inverted
+    }
+
+    /// Stage 2: per-particle sums of its block entries, in ascending block order (Eq. 11).
     fn gather(&self, force: &mut [Vec3]) {
-        let count = self.incidence_start.len() - 1;
-        let (starts, entries, buffer) = (&self.incidence_start, &self.incidence, &self.tet_forces);
-        force[self.first..self.first + count]
+        let blocks = &self.blocks;
+        let count = blocks.entry_start.len() - 1;
+        let (starts, entries, sums) = (&blocks.entry_start, &blocks.entries, &self.sums);
+        force[blocks.first..blocks.first + count]
             .par_iter_mut()
             .with_min_len(PARTICLE_CHUNK)
             .enumerate()
@@ -228,10 +268,85 @@ impl TetBody {
                 let range = starts[i] as usize..starts[i + 1] as usize;
                 let mut sum = Vec3::zeros();
                 for &entry in &entries[range] {
-                    sum += buffer[entry as usize];
+                    sum += sums[entry as usize];
                 }
                 *f += sum;
             });
+    }
+}
+
+/// The four values of a tetrahedron's corners (written out: `array::map` is not inlined here).
+#[inline(always)]
+fn corners(values: &[Vec3], local: [u16; 4]) -> [Vec3; 4] {
+    let [a, b, c, d] = local.map(usize::from);
+    [values[a], values[b], values[c], values[d]]
+}
+
+/// Runs `pass(b, sums of b)` for the blocks in `range` in parallel, splitting `sums` (laid out
+/// per block by `node_start`) between them; returns the smallest index `pass` returned.
+fn for_blocks(
+    sums: &mut [Vec3],
+    range: std::ops::Range<usize>,
+    node_start: &[u32],
+    pass: &(dyn Fn(usize, &mut [Vec3]) -> usize + Sync),
+) -> usize {
+    if range.len() == 1 {
+        return pass(range.start, sums);
+    }
+    let mid = range.start + range.len() / 2;
+    let (left, right) = sums.split_at_mut((node_start[mid] - node_start[range.start]) as usize);
+    let (a, b) = rayon::join(
+        || for_blocks(left, range.start..mid, node_start, pass),
+        || for_blocks(right, mid..range.end, node_start, pass),
+    );
+    a.min(b)
+}
+
+/// A worker's copy of one block's node positions and velocities.
+#[derive(Debug, Default)]
+struct Scratch {
+    x: Vec<Vec3>,
+    v: Vec<Vec3>,
+}
+
+impl Scratch {
+    /// Copies the positions (and velocities, when given) of `nodes`.
+    fn load(&mut self, nodes: &[u32], position: &[Vec3], velocity: Option<&[Vec3]>) {
+        self.x.clear();
+        self.x.extend(nodes.iter().map(|&n| position[n as usize]));
+        if let Some(velocity) = velocity {
+            self.v.clear();
+            self.v.extend(nodes.iter().map(|&n| velocity[n as usize]));
+        }
+    }
+}
+
+/// One [`Scratch`] per worker thread, kept from step to step (no allocation once warm). A
+/// clone starts empty.
+#[derive(Debug, Default)]
+struct ScratchPool(Vec<Mutex<Scratch>>);
+
+impl Clone for ScratchPool {
+    fn clone(&self) -> ScratchPool {
+        ScratchPool::default()
+    }
+}
+
+impl ScratchPool {
+    /// At least one scratch per thread of a pool of `threads`.
+    fn fit(&mut self, threads: usize) {
+        while self.0.len() < threads.max(1) {
+            self.0.push(Mutex::default());
+        }
+    }
+
+    /// The calling worker's scratch (each worker runs one block at a time, so the lock is
+    /// never contended).
+    fn for_this_thread(&self) -> std::sync::MutexGuard<'_, Scratch> {
+        let i = rayon::current_thread_index().unwrap_or(0) % self.0.len();
+        self.0[i]
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 }
 
@@ -264,30 +379,6 @@ fn rate_bound(dm_inv: &[Mat3], material: &Material, lame: Lame) -> f64 {
         .reduce(|| 0.0, f64::max)
 }
 
-/// Compressed incidence lists: for each particle from the smallest to the largest index the
-/// tetrahedra use, the buffer entries `4·tet + corner` that belong to it, in ascending order.
-fn incidence_lists(tets: &[[u32; 4]]) -> (usize, Vec<u32>, Vec<u32>) {
-    let first = tets.iter().flatten().min().copied().unwrap_or(0) as usize;
-    let last = tets.iter().flatten().max().copied().unwrap_or(0) as usize;
-    let mut start = vec![0u32; last - first + 2];
-    for &n in tets.iter().flatten() {
-        start[n as usize - first + 1] += 1;
-    }
-    for i in 1..start.len() {
-        start[i] += start[i - 1];
-    }
-    let mut fill = start.clone();
-    let mut entries = vec![0u32; 4 * tets.len()];
-    for (e, tet) in tets.iter().enumerate() {
-        for (corner, &n) in tet.iter().enumerate() {
-            let slot = &mut fill[n as usize - first];
-            entries[*slot as usize] = (4 * e + corner) as u32;
-            *slot += 1;
-        }
-    }
-    (first, start, entries)
-}
-
 impl Model for TetBody {
     fn failure(&self, state: &State) -> Option<CoreError> {
         let tet = self.inverted?;
@@ -295,7 +386,7 @@ impl Model for TetBody {
         Some(CoreError::Inverted {
             body: self.name.clone(),
             tet,
-            det: (edge_matrix(&x) * self.dm_inv[tet]).determinant(),
+            det: (edge_matrix(&x) * self.blocks.dm_inv(tet)).determinant(),
             time: state.time,
         })
     }
@@ -306,9 +397,9 @@ impl Model for TetBody {
 
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
         if self.material.is_elastic() {
-            self.compute_tet_forces::<false>(state);
+            self.compute_block_sums::<false>(state);
         } else {
-            self.compute_tet_forces::<true>(state);
+            self.compute_block_sums::<true>(state);
         }
         self.gather(force);
     }
@@ -322,7 +413,7 @@ impl Model for TetBody {
         let energy = (0..self.tets.len())
             .map(|e| {
                 let x = self.tets[e].map(|n| state.position[n as usize]);
-                let f = deformation_gradient(&x, &self.dm_inv[e]);
+                let f = deformation_gradient(&x, self.blocks.dm_inv(e));
                 strain_energy(&f, self.volume[e], lambda, mu)
             })
             .sum();
@@ -357,11 +448,12 @@ impl Linearized for TetBody {
     }
 
     fn particles(&self) -> Vec<usize> {
-        self.incidence_start
+        self.blocks
+            .entry_start
             .windows(2)
             .enumerate()
             .filter(|(_, w)| w[1] > w[0])
-            .map(|(i, _)| self.first + i)
+            .map(|(i, _)| self.blocks.first + i)
             .collect()
     }
 }

@@ -90,6 +90,116 @@ pub fn tet_stress(
     (t, cof)
 }
 
+/// A symmetric 3×3 tensor by its six components, for the hot loop.
+#[derive(Clone, Copy, Debug)]
+struct Sym3 {
+    xx: f64,
+    yy: f64,
+    zz: f64,
+    xy: f64,
+    yz: f64,
+    xz: f64,
+}
+
+impl Sym3 {
+    fn trace(&self) -> f64 {
+        self.xx + self.yy + self.zz
+    }
+
+    /// The isotropic law of Eqs. 2 and 7: λ tr(e) I + 2μ e.
+    fn lame(&self, lambda: f64, mu: f64) -> Sym3 {
+        let (p, two_mu) = (lambda * self.trace(), 2.0 * mu);
+        Sym3 {
+            xx: p + two_mu * self.xx,
+            yy: p + two_mu * self.yy,
+            zz: p + two_mu * self.zz,
+            xy: two_mu * self.xy,
+            yz: two_mu * self.yz,
+            xz: two_mu * self.xz,
+        }
+    }
+
+    fn add(&self, o: &Sym3) -> Sym3 {
+        Sym3 {
+            xx: self.xx + o.xx,
+            yy: self.yy + o.yy,
+            zz: self.zz + o.zz,
+            xy: self.xy + o.xy,
+            yz: self.yz + o.yz,
+            xz: self.xz + o.xz,
+        }
+    }
+
+    fn mul(&self, a: &Vec3) -> Vec3 {
+        Vec3::new(
+            self.xx * a.x + self.xy * a.y + self.xz * a.z,
+            self.xy * a.x + self.yy * a.y + self.yz * a.z,
+            self.xz * a.x + self.yz * a.y + self.zz * a.z,
+        )
+    }
+}
+
+/// The strain ε = (F Fᵀ − I)/2 of Eq. 4 from the edge vectors d and dX⁻¹ (F = [d₁ d₂ d₃] dX⁻¹).
+#[inline(always)]
+fn green_strain(d: &[Vec3; 3], dm_inv: &Mat3) -> Sym3 {
+    // Row r of F is Σ_k d_k[r] · (row k of dX⁻¹).
+    let row = |r: usize| -> Vec3 {
+        (0..3).fold(Vec3::zeros(), |acc, k| {
+            acc + dm_inv.row(k).transpose() * d[k][r]
+        })
+    };
+    let (f0, f1, f2) = (row(0), row(1), row(2));
+    Sym3 {
+        xx: 0.5 * (f0.dot(&f0) - 1.0),
+        yy: 0.5 * (f1.dot(&f1) - 1.0),
+        zz: 0.5 * (f2.dot(&f2) - 1.0),
+        xy: 0.5 * f0.dot(&f1),
+        yz: 0.5 * f1.dot(&f2),
+        xz: 0.5 * f0.dot(&f2),
+    }
+}
+
+/// The rate of deformation D = sym(dv · dx⁻¹) of Eqs. 5–6, with dx⁻¹ = cofᵀ / det:
+/// D = sym(Σ_k dv_k ⊗ c_k) / det.
+#[inline(always)]
+fn rate_of_deformation(dv: &[Vec3; 3], c: &[Vec3; 3], inv_det: f64) -> Sym3 {
+    let l = |i: usize, j: usize| dv[0][i] * c[0][j] + dv[1][i] * c[1][j] + dv[2][i] * c[2][j];
+    let h = 0.5 * inv_det;
+    Sym3 {
+        xx: inv_det * l(0, 0),
+        yy: inv_det * l(1, 1),
+        zz: inv_det * l(2, 2),
+        xy: h * (l(0, 1) + l(1, 0)),
+        yz: h * (l(1, 2) + l(2, 1)),
+        xz: h * (l(0, 2) + l(2, 0)),
+    }
+}
+
+/// The hot-loop form of [`tet_stress`] and [`vertex_forces`] (Eqs. 1–10): the forces on the
+/// four particles and 6 × the current volume (whose sign tells an inverted tetrahedron),
+/// with the symmetric tensors kept as six components. `v` is read only when `VISCOUS`.
+#[inline(always)]
+pub fn tet_forces<const VISCOUS: bool>(
+    x: &[Vec3; 4],
+    v: &[Vec3; 4],
+    dm_inv: &Mat3,
+    elastic: (f64, f64),
+    viscous: (f64, f64),
+) -> ([Vec3; 4], f64) {
+    let d = [x[1] - x[0], x[2] - x[0], x[3] - x[0]];
+    // Columns of cof(dx): the area vectors A_j = −½ c_j of the faces opposite vertices 1–3.
+    let c = [d[1].cross(&d[2]), d[2].cross(&d[0]), d[0].cross(&d[1])];
+    let six_volume = d[0].dot(&c[0]);
+    let mut t = green_strain(&d, dm_inv).lame(elastic.0, elastic.1);
+    if VISCOUS {
+        let dv = [v[1] - v[0], v[2] - v[0], v[3] - v[0]];
+        let rate = rate_of_deformation(&dv, &c, 1.0 / six_volume);
+        t = t.add(&rate.lame(viscous.0, viscous.1));
+    }
+    let f = c.map(|cj| t.mul(&cj) * (-1.0 / 6.0));
+    ([-(f[0] + f[1] + f[2]), f[0], f[1], f[2]], six_volume)
+}
+
 /// Von Mises equivalent stress √(3/2 s:s) of a Cauchy stress, s its deviator.
 pub fn von_mises(t: &Mat3) -> f64 {
     let s = t - Mat3::from_diagonal_element(t.trace() / 3.0);

@@ -1,8 +1,9 @@
-//! The closed-form particle force T·A_j/3 equals the literal 12-triangle subdomain sum of
-//! paper 000 Eqs. 9–10 on random tetrahedra, deformation gradients and velocity gradients.
+//! The closed-form particle force T·A_j/3, in its matrix form and in the hot loop's
+//! six-component form, equals the literal 12-triangle subdomain sum of paper 000 Eqs. 9–10 on
+//! random tetrahedra, deformation gradients and velocity gradients.
 
 use proptest::prelude::*;
-use qdem_core::tet_kernel::{cofactor, edge_matrix, tet_stress, vertex_forces};
+use qdem_core::tet_kernel::{cofactor, edge_matrix, tet_forces, tet_stress, vertex_forces};
 use qdem_core::tet_subdomain::subdomain_forces;
 use qdem_core::{Mat3, Vec3};
 
@@ -37,11 +38,15 @@ proptest! {
         let (t, cof) = tet_stress(&x, Some(&v), &dm_inv, (3.0e9, 2.0e9), (40.0, 70.0));
         let closed = vertex_forces(&t, &cof);
         let oracle = subdomain_forces(&x, &t);
+        let (hot, six_volume) = tet_forces::<true>(&x, &v, &dm_inv, (3.0e9, 2.0e9), (40.0, 70.0));
         let scale = closed.iter().chain(&oracle).map(|g| g.norm()).fold(0.0, f64::max);
         for j in 0..4 {
             prop_assert!((closed[j] - oracle[j]).norm() <= 1e-12 * scale,
                 "vertex {}: closed {:?} oracle {:?}", j, closed[j], oracle[j]);
+            prop_assert!((hot[j] - oracle[j]).norm() <= 1e-12 * scale,
+                "vertex {}: hot loop {:?} oracle {:?}", j, hot[j], oracle[j]);
         }
+        prop_assert!((six_volume - edge_matrix(&x).determinant()).abs() <= 1e-12);
         prop_assert!(cofactor(&edge_matrix(&x)).determinant() > 0.0);
     }
 }
