@@ -13,7 +13,7 @@ use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, PlaneWall, Wall,
     WallShape,
 };
-use qdem_core::{Gravity, Mat3, Model, State, Stepper, Vec3, Verlet};
+use qdem_core::{Gravity, Model, State, Stepper, Vec3, Verlet};
 use serde_json::{json, Value};
 use std::path::Path;
 use std::time::Instant;
@@ -119,7 +119,7 @@ impl Packing {
         ]
     }
 
-    /// The state (one rigid body per sphere) and the models: contacts, gravity.
+    /// The state (one rotating particle per sphere) and the models: contacts, gravity.
     pub fn build(&self) -> (State, Vec<Box<dyn Model>>) {
         self.build_with(damping_ratio(RESTITUTION))
     }
@@ -128,12 +128,9 @@ impl Packing {
     fn build_with(&self, zeta: f64) -> (State, Vec<Box<dyn Model>>) {
         let mut state = State::at_rest(self.centers.clone());
         let mass = DENSITY * 4.0 / 3.0 * std::f64::consts::PI * RADIUS.powi(3);
-        let inertia = Mat3::identity() * (0.4 * mass * RADIUS * RADIUS);
         for i in 0..self.centers.len() {
             state.mass[i] = mass;
-            state
-                .add_rigid_body("sphere", i, &[], inertia)
-                .expect("a sphere has positive mass and inertia");
+            state.let_turn(i, 0.4 * mass * RADIUS * RADIUS);
         }
         let spheres: Vec<ContactSphere> = (0..self.centers.len())
             .map(|i| ContactSphere {

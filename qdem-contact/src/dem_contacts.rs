@@ -2,7 +2,8 @@
 //! broad phase → narrow phase → contact forces → gather.
 //!
 //! Paper 000 §4 puts a sphere at each surface vertex of a QDEM body, used only for contact;
-//! a rigid body's spheres sit on its members or at its centre ([`qdem_core::rigid_body`]).
+//! a rigid body's spheres sit on its members or at its centre ([`qdem_core::rigid_body`]); a
+//! one-sphere grain is a particle that rotates ([`qdem_core::ParticleSpin`]).
 //! Spheres of one body never interact. Each evaluation
 //! 1. reads the sphere centres from their particles,
 //! 2. rebuilds the pair and wall candidate lists if some sphere (or wall) moved more than the
@@ -12,10 +13,11 @@
 //!    buffers,
 //! 4. gathers them per sphere over a fixed incidence list (no atomics, so results do not depend
 //!    on the thread count) and adds them, in sphere order, to the particle forces, and the
-//!    moment of each contact force about its sphere's centre to the sphere's rigid body.
+//!    moment of each contact force about its sphere's centre to the sphere's rigid body or
+//!    rotating particle.
 //!
-//! The contact point is at x_a + (r_a − δ/2) n; its velocity includes the rigid body's spin,
-//! v + ω × (x_cp − x). Tangential springs grow by the relative displacement over the time since
+//! The contact point is at x_a + (r_a − δ/2) n; its velocity includes the rigid body's (or
+//! the rotating particle's) spin, v + ω × (x_cp − x). Tangential springs grow by the relative displacement over the time since
 //! the previous evaluation, so the model needs no step size.
 //!
 //! With periodic axes ([`DemContacts::with_periodic`]) separations are minimum images, so a
@@ -40,7 +42,7 @@ use qdem_core::{
 };
 use rayon::prelude::*;
 
-/// Marks a sphere that is no part of a rigid body.
+/// Marks a sphere that is no part of a rigid body, or whose moments go nowhere.
 const NOT_RIGID: u32 = u32::MAX;
 
 /// Contacts per parallel task.
@@ -216,6 +218,7 @@ pub struct DemContacts {
     radius: Vec<f64>,
     body: Vec<u32>,
     rigid: Vec<u32>,
+    turn: Vec<u32>,
     lever: Vec<f64>,
     bound_mass: Vec<f64>,
     body_names: Vec<String>,
@@ -311,10 +314,22 @@ impl DemContacts {
             .zip(&rigid)
             .map(|(s, &r)| state.mass[carrier(s, r)])
             .collect();
+        let turns = |p: usize| state.spin.fixed.get(p).is_some_and(|f| *f != Dofs::ALL);
+        let turn: Vec<u32> = spheres
+            .iter()
+            .zip(&rigid)
+            .map(|(s, &r)| match r {
+                NOT_RIGID if turns(s.particle) => (state.rigid.len() + s.particle) as u32,
+                r => r,
+            })
+            .collect();
         let lever = spheres
             .iter()
             .zip(&rigid)
             .map(|(s, &r)| match r {
+                NOT_RIGID if turns(s.particle) => {
+                    s.radius * s.radius / state.spin.inertia[s.particle]
+                }
                 NOT_RIGID => 0.0,
                 b if state.rigid.spin_fixed[b as usize] => 0.0,
                 b => {
@@ -335,7 +350,11 @@ impl DemContacts {
         // oscillate: it does not limit the step (infinite mass in the bound below).
         let held = |s: &ContactSphere, r: u32| {
             let c = carrier(s, r);
-            state.fixed[c] == Dofs::ALL && (r == NOT_RIGID || state.rigid.spin_fixed[r as usize])
+            let still = match r {
+                NOT_RIGID => !turns(s.particle),
+                b => state.rigid.spin_fixed[b as usize],
+            };
+            state.fixed[c] == Dofs::ALL && still
         };
         let bound_mass: Vec<f64> = spheres
             .iter()
@@ -359,6 +378,7 @@ impl DemContacts {
             radius: spheres.iter().map(|s| s.radius).collect(),
             body: spheres.iter().map(|s| s.body as u32).collect(),
             rigid,
+            turn,
             lever,
             bound_mass,
             body_names,
@@ -550,12 +570,13 @@ impl DemContacts {
         Ok(())
     }
 
-    /// Copies every sphere's centre, velocity and spin (its rigid body's angular velocity,
-    /// zero for a vertex of a deformable body) out of the state, in sphere order, and returns
+    /// Copies every sphere's centre, velocity and spin (its rigid body's or its particle's
+    /// angular velocity, zero for a vertex of a deformable body) out of the state, in sphere order, and returns
     /// the largest distance a sphere has moved since the last build (infinite before it).
     fn read_centers(&mut self, state: &State) -> f64 {
-        let (particle, rigid, built_at) = (&self.particle, &self.rigid, &self.built_at);
+        let (particle, turn, built_at) = (&self.particle, &self.turn, &self.built_at);
         let built = self.built && built_at.len() == particle.len();
+        let bodies = state.rigid.len();
         let moved = self
             .now
             .par_iter_mut()
@@ -565,9 +586,10 @@ impl DemContacts {
                 let p = particle[s] as usize;
                 now.center = state.position[p];
                 now.velocity = state.velocity[p];
-                now.spin = match rigid[s] {
-                    NOT_RIGID => Vec3::zeros(),
-                    b => state.rigid.angular_velocity[b as usize],
+                now.spin = match turn[s] as usize {
+                    t if t == NOT_RIGID as usize => Vec3::zeros(),
+                    b if b < bodies => state.rigid.angular_velocity[b],
+                    t => state.spin.velocity[t - bodies],
                 };
                 if built {
                     (now.center - built_at[s]).norm_squared()
@@ -774,12 +796,12 @@ impl DemContacts {
     }
 
     /// Per-sphere sums of contact forces, and their moments about the sphere's centre for
-    /// spheres of rigid bodies, in a fixed order; forces from delayed ghosts scaled.
+    /// spheres that turn (of rigid bodies, rotating particles), in a fixed order; forces from delayed ghosts scaled.
     fn gather(&mut self) {
         let (pairs, walls) = (&self.pairs, &self.wall_contacts);
         let (start, incidence, wall_start) =
             (&self.incidence_start, &self.incidence, &self.wall_start);
-        let (now, rigid) = (&self.now, &self.rigid);
+        let (now, turn) = (&self.now, &self.turn);
         let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
         self.sphere_force
             .par_iter_mut()
@@ -787,7 +809,7 @@ impl DemContacts {
             .enumerate()
             .for_each(|(s, out)| {
                 let (mut f, mut t) = (Vec3::zeros(), Vec3::zeros());
-                let spins = rigid[s] != NOT_RIGID;
+                let spins = turn[s] != NOT_RIGID;
                 for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
                     let k = (e / 2) as usize;
                     let first = e % 2 == 0;
@@ -844,8 +866,8 @@ impl Model for DemContacts {
         self.gather();
         for (s, (f, t)) in self.sphere_force.iter().enumerate() {
             force[self.particle[s] as usize] += f;
-            if self.rigid[s] != NOT_RIGID {
-                torque[self.rigid[s] as usize] += t;
+            if self.turn[s] != NOT_RIGID {
+                torque[self.turn[s] as usize] += t;
             }
         }
     }
