@@ -301,9 +301,14 @@ pub fn throughput(packing: &Packing, steps: usize) -> Result<Value, GranularErro
     let mut stepper = Verlet::new(dt);
     stepper.initialize(&mut state, &mut models)?;
     let start = Instant::now();
-    for _ in 0..steps {
-        stepper.step(&mut state, &mut models)?;
-    }
+    // On a worker of the pool, as `World::step` runs, so that each parallel loop of a step is
+    // no hand-over from the calling thread.
+    rayon::scope(|_| -> Result<(), GranularError> {
+        for _ in 0..steps {
+            stepper.step(&mut state, &mut models)?;
+        }
+        Ok(())
+    })?;
     let seconds = start.elapsed().as_secs_f64();
     let model: &dyn std::any::Any = models[0].as_ref();
     let contacts = model.downcast_ref::<DemContacts>().expect("contacts first");
