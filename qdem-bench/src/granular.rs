@@ -370,6 +370,18 @@ impl Packing {
     }
 }
 
+/// The bytes a Verlet step of a sphere packing moves per sphere, with `candidates` candidate
+/// contacts (pairs and wall contacts) per sphere, each array read or written once per pass:
+/// the kick and drift of x, v, a and θ, ω, θ̈ (240 B), the sphere read (x, v, ω and the
+/// build position in, a 96-byte sphere record out: 192 B), zeroing the forces and moments
+/// (48 B), per candidate its 112-byte record read and written by the narrow phase and law and
+/// read twice, once per partner, by the gather with its two incidence entries (456 B), the
+/// gather's sums out and into the particle forces and moments (48 + 144 B), gravity (56 B), and
+/// a = f/m, θ̈ = M/J with the second half kick (210 B).
+pub fn bytes_per_sphere_step(candidates: f64) -> f64 {
+    240.0 + 192.0 + 48.0 + 456.0 * candidates + 192.0 + 56.0 + 210.0
+}
+
 /// Times `steps` Verlet steps of the packing with its spheres replaced by clumps
 /// ([`Packing::build_clumps`]), with the packing's own step, and returns the JSON record:
 /// particle-steps/s counts the contact spheres, clump-steps/s the clumps.
@@ -423,9 +435,13 @@ pub fn throughput(packing: &Packing, steps: usize) -> Result<Value, GranularErro
     let model: &dyn std::any::Any = models[0].as_ref();
     let contacts = model.downcast_ref::<DemContacts>().expect("contacts first");
     let n = packing.centers.len();
+    let candidates = contacts.candidates() as f64 / n as f64;
     Ok(json!({
         "code": "qdem",
         "spheres": n,
+        "candidates_per_sphere": candidates,
+        "bytes_per_particle_step": bytes_per_sphere_step(candidates),
+        "triad_bytes_per_s": crate::throughput::triad_bandwidth(rayon::current_num_threads()),
         "steps": steps,
         "dt": dt,
         "stable_bound": bound,
