@@ -269,10 +269,11 @@ class Qdem:
         log(f"qdem: settling a packing of {n} spheres into {d}")
         sh([str(self.exe), "packing", "--spheres", str(n), "--out", str(d)], cwd=ROOT)
 
-    def throughput(self, d: Path, steps: int) -> dict:
-        log(f"qdem: timing {steps} steps on {d}")
+    def throughput(self, d: Path, steps: int, threads: int) -> dict:
+        log(f"qdem: timing {steps} steps on {d} on {threads} threads")
         out = sh([str(self.exe), "dem-throughput", "--packing", str(d), "--steps", str(steps)],
-                 cwd=ROOT, capture_output=True).stdout
+                 cwd=ROOT, capture_output=True,
+                 env=dict(os.environ, RAYON_NUM_THREADS=str(threads))).stdout
         # the last line that parses as a JSON object
         for line in reversed(out.strip().splitlines()):
             line = line.strip()
@@ -428,6 +429,15 @@ def row(code, n, steps, dt, wall_s, parallel, contacts, machine, **extra):
     return r
 
 
+def traffic(r: dict) -> str:
+    """qdem's modelled bytes per particle-step and the share of the triad bandwidth (measured in
+    the same process, on as many threads) the run moved."""
+    b, t = r.get("bytes_per_particle_step"), r.get("triad_bytes_per_s")
+    if not b or not t or not r["particle_steps_per_s"]:
+        return ""
+    return f"{b:,.0f} ({100 * b * r['particle_steps_per_s'] / t:.0f}% of {t / 1e9:.1f} GB/s)"
+
+
 def sci(v) -> str:
     return "—" if v is None else f"{v:.3e}"
 
@@ -436,6 +446,7 @@ def markdown(rows: list[dict], args, version: str, mpi_desc: str, machine: str,
              liggghts_only: bool) -> str:
     cmd = (f"python3 qdem-bench/scripts/liggghts_compare.py --spheres "
            f"{','.join(map(str, args.spheres))} --steps {args.steps}"
+           + (f" --np {','.join(map(str, args.np))}" if args.np != [2, 1] else "")
            + (f" --repeats {args.repeats}" if args.repeats != 3 else "")
            + (" --fake-packing" if args.fake_packing else "")
            + (" --skip-qdem" if args.skip_qdem else ""))
@@ -468,10 +479,12 @@ def markdown(rows: list[dict], args, version: str, mpi_desc: str, machine: str,
                "steps / wall time.")
     out.append("")
     out.append("| spheres | steps | dt (s) | code | run as | wall (s) | particle-steps/s | "
-               "contacts at end | KE at end (J) | qdem / LIGGGHTS |")
-    out.append("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-    for n in sorted({r["spheres"] for r in rows}):
-        rs = [r for r in rows if r["spheres"] == n]
+               "contacts at end | KE at end (J) | bytes/particle-step (of triad) | "
+               "qdem / LIGGGHTS |")
+    out.append("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    for n, width in sorted({(r["spheres"], r["threads_or_procs"]) for r in rows},
+                           key=lambda t: (t[0], -t[1])):
+        rs = [r for r in rows if (r["spheres"], r["threads_or_procs"]) == (n, width)]
         lig = next((r for r in rs if r["code"] == "liggghts"), None)
         for r in rs:
             ratio = ""
@@ -483,7 +496,7 @@ def markdown(rows: list[dict], args, version: str, mpi_desc: str, machine: str,
                        f"{r['wall_s']:.2f} | {sci(r['particle_steps_per_s'])} | "
                        f"{'—' if r['contacts'] is None else format(r['contacts'], ',')} | "
                        f"{'—' if r.get('kinetic_energy') is None else format(r['kinetic_energy'], '.3g')} | "
-                       f"{ratio} |")
+                       f"{traffic(r)} | {ratio} |")
     out.append("")
     out.append("Contacts at the end of the run, sphere–sphere plus sphere–wall: qdem's as "
                "`dem-throughput` reports them (pairs with a non-zero force); LIGGGHTS's from "
@@ -529,7 +542,9 @@ def main() -> None:
     ap.add_argument("--work", default="out/liggghts")
     ap.add_argument("--docs", default=None, help="where liggghts_compare.json and BENCHMARKS.md "
                     "are (default docs; with --fake-packing, only if given)")
-    ap.add_argument("--np", type=int, default=2, help="MPI processes for LIGGGHTS (default 2)")
+    ap.add_argument("--np", default="2,1",
+                    help="comma-separated widths: LIGGGHTS on that many MPI processes against "
+                    "qdem on as many threads (default 2,1)")
     ap.add_argument("--fake-packing", action="store_true",
                     help="test the LIGGGHTS half alone on a lattice the script writes")
     ap.add_argument("--regen-packing", action="store_true",
@@ -546,6 +561,7 @@ def main() -> None:
                     "(default 300; a warning, not an error, if they are not)")
     args = ap.parse_args()
     args.spheres = [int(s) for s in args.spheres.split(",") if s.strip()]
+    args.np = [int(s) for s in args.np.split(",") if s.strip()]
 
     work = (ROOT / args.work) if not Path(args.work).is_absolute() else Path(args.work)
     docs = None
@@ -556,7 +572,8 @@ def main() -> None:
 
     exe = ensure_liggghts()
     version = liggghts_version(exe)
-    launcher, mpi_desc = mpi_launcher(args.np)
+    launchers = {w: mpi_launcher(w) for w in args.np}
+    mpi_desc = "; ".join(desc for _, desc in launchers.values())
     machine = cpu_model()
     log(f"LIGGGHTS {version} at {exe}; {mpi_desc}; CPU {machine}")
     liggghts_only = args.fake_packing or args.skip_qdem
@@ -577,65 +594,69 @@ def main() -> None:
         metas[n] = meta
         n_real = len(spheres)
         deck = write_liggghts_inputs(meta, spheres, args.steps, d)
-        # the two codes alternate, `--repeats` times; each keeps its fastest run (least disturbed)
-        q_runs, l_runs = [], []
-        for rep in range(args.repeats):
-            if qdem is not None:
+        for width in args.np:
+            launcher = launchers[width][0]
+            # the two codes alternate, `--repeats` times; each keeps its fastest run (least disturbed)
+            q_runs, l_runs = [], []
+            for rep in range(args.repeats):
+                if qdem is not None:
+                    busy = wait_idle(args.wait_idle)
+                    with OtherLoad() as ol:
+                        q = qdem.throughput(d, args.steps, width)
+                    if q.get("spheres", n_real) != n_real or q["steps"] != args.steps:
+                        sys.exit(f"error: qdem timed {q.get('spheres')} spheres for {q['steps']} "
+                                 f"steps; expected {n_real} for {args.steps}")
+                    if rep == 0 and q["dt"] != meta["dt"]:
+                        # qdem picks its step from its own stability bound too; LIGGGHTS must use
+                        # the step qdem actually ran
+                        log(f"qdem ran dt = {q['dt']!r}, packing.json says {meta['dt']!r}: "
+                            "LIGGGHTS gets qdem's")
+                        meta = dict(meta, dt=q["dt"], dt_packing_json=meta["dt"])
+                        metas[n] = meta
+                        deck = write_liggghts_inputs(meta, spheres, args.steps, d)
+                    elif q["dt"] != meta["dt"]:
+                        sys.exit(f"error: qdem's dt changed between runs ({meta['dt']!r} then "
+                                 f"{q['dt']!r}): was the study binary rebuilt meanwhile?")
+                    q_runs.append((q, busy, ol.cores))
+                    log(f"qdem run {rep + 1}/{args.repeats}: {q}")
                 busy = wait_idle(args.wait_idle)
                 with OtherLoad() as ol:
-                    q = qdem.throughput(d, args.steps)
-                if q.get("spheres", n_real) != n_real or q["steps"] != args.steps:
-                    sys.exit(f"error: qdem timed {q.get('spheres')} spheres for {q['steps']} "
-                             f"steps; expected {n_real} for {args.steps}")
-                if rep == 0 and q["dt"] != meta["dt"]:
-                    # qdem picks its step from its own stability bound too; LIGGGHTS must use
-                    # the step qdem actually ran
-                    log(f"qdem ran dt = {q['dt']!r}, packing.json says {meta['dt']!r}: "
-                        "LIGGGHTS gets qdem's")
-                    meta = dict(meta, dt=q["dt"], dt_packing_json=meta["dt"])
-                    metas[n] = meta
-                    deck = write_liggghts_inputs(meta, spheres, args.steps, d)
-                elif q["dt"] != meta["dt"]:
-                    sys.exit(f"error: qdem's dt changed between runs ({meta['dt']!r} then "
-                             f"{q['dt']!r}): was the study binary rebuilt meanwhile?")
-                q_runs.append((q, busy, ol.cores))
-                log(f"qdem run {rep + 1}/{args.repeats}: {q}")
-            busy = wait_idle(args.wait_idle)
-            with OtherLoad() as ol:
-                lg = run_liggghts(exe, launcher, deck, meta, spheres)
-            if lg["atoms"] != n_real or lg["steps"] != args.steps:
-                sys.exit(f"error: LIGGGHTS ran {lg['steps']} steps with {lg['atoms']} atoms, "
-                         f"expected {args.steps} with {n_real}")
-            l_runs.append((lg, busy, ol.cores))
-            log(f"LIGGGHTS run {rep + 1}/{args.repeats}: {n_real} spheres, {lg['steps']} steps in "
-                f"{lg['wall_s']:.3f} s on {lg['procs']} procs = "
-                f"{n_real * lg['steps'] / lg['wall_s']:.4g} particle-steps/s")
-        if q_runs:
-            q, busy, other = min(q_runs, key=lambda t: t[0]["wall_s"])
-            rows.append(row("qdem", n_real, q["steps"], q["dt"], q["wall_s"],
-                            q.get("threads"), q.get("contacts"), machine,
-                            reported_particle_steps_per_s=q.get("particle_steps_per_s"),
-                            version=qdem.version,
-                            **{k: q[k] for k in ("stable_bound", "rebuilds", "kinetic_energy")
-                               if k in q},
-                            all_wall_s=[t[0]["wall_s"] for t in q_runs],
-                            cpu_busy_before=round(busy, 3), other_cores_during=round(other, 3)))
-        lg, busy, other = min(l_runs, key=lambda t: t[0]["wall_s"])
-        rows.append(row("liggghts", n_real, lg["steps"], meta["dt"], lg["wall_s"], lg["procs"],
-                        lg["contacts"], machine, version=version, launcher=mpi_desc,
-                        neighbor_builds=lg["neighbor_builds"],
-                        sphere_sphere_contacts=lg["sphere_sphere_contacts"],
-                        sphere_wall_contacts=lg["sphere_wall_contacts"],
-                        kinetic_energy=lg["kinetic_energy"],
-                        all_wall_s=[t[0]["wall_s"] for t in l_runs],
-                        cpu_busy_before=round(busy, 3), other_cores_during=round(other, 3),
-                        deck=str(deck.relative_to(ROOT) if deck.is_relative_to(ROOT) else deck)))
-        if q_runs:
-            log(f"{n_real} spheres: qdem / LIGGGHTS = "
-                f"{rows[-2]['particle_steps_per_s'] / rows[-1]['particle_steps_per_s']:.3f}")
+                    lg = run_liggghts(exe, launcher, deck, meta, spheres)
+                if lg["atoms"] != n_real or lg["steps"] != args.steps:
+                    sys.exit(f"error: LIGGGHTS ran {lg['steps']} steps with {lg['atoms']} atoms, "
+                             f"expected {args.steps} with {n_real}")
+                l_runs.append((lg, busy, ol.cores))
+                log(f"LIGGGHTS run {rep + 1}/{args.repeats}: {n_real} spheres, {lg['steps']} steps in "
+                    f"{lg['wall_s']:.3f} s on {lg['procs']} procs = "
+                    f"{n_real * lg['steps'] / lg['wall_s']:.4g} particle-steps/s")
+            if q_runs:
+                q, busy, other = min(q_runs, key=lambda t: t[0]["wall_s"])
+                rows.append(row("qdem", n_real, q["steps"], q["dt"], q["wall_s"],
+                                q.get("threads"), q.get("contacts"), machine,
+                                reported_particle_steps_per_s=q.get("particle_steps_per_s"),
+                                version=qdem.version,
+                                **{k: q[k] for k in ("stable_bound", "rebuilds", "kinetic_energy",
+                                                     "candidates_per_sphere",
+                                                     "bytes_per_particle_step", "triad_bytes_per_s")
+                                   if k in q},
+                                all_wall_s=[t[0]["wall_s"] for t in q_runs],
+                                cpu_busy_before=round(busy, 3), other_cores_during=round(other, 3)))
+            lg, busy, other = min(l_runs, key=lambda t: t[0]["wall_s"])
+            rows.append(row("liggghts", n_real, lg["steps"], meta["dt"], lg["wall_s"], lg["procs"],
+                            lg["contacts"], machine, version=version, launcher=launchers[width][1],
+                            neighbor_builds=lg["neighbor_builds"],
+                            sphere_sphere_contacts=lg["sphere_sphere_contacts"],
+                            sphere_wall_contacts=lg["sphere_wall_contacts"],
+                            kinetic_energy=lg["kinetic_energy"],
+                            all_wall_s=[t[0]["wall_s"] for t in l_runs],
+                            cpu_busy_before=round(busy, 3), other_cores_during=round(other, 3),
+                            deck=str(deck.relative_to(ROOT) if deck.is_relative_to(ROOT) else deck)))
+            if q_runs:
+                log(f"{n_real} spheres, width {width}: qdem / LIGGGHTS = "
+                    f"{rows[-2]['particle_steps_per_s'] / rows[-1]['particle_steps_per_s']:.3f}")
 
-    for n in sorted({r["spheres"] for r in rows}):
-        q = [r for r in rows if r["spheres"] == n]
+    for n, width in sorted({(r["spheres"], r["threads_or_procs"]) for r in rows}):
+        q = [r for r in rows if (r["spheres"], r["threads_or_procs"]) == (n, width)]
         qd = next((r for r in q if r["code"] == "qdem"), None)
         lg = next((r for r in q if r["code"] == "liggghts"), None)
         if qd and lg:

@@ -2,7 +2,9 @@
 //! friction, damping, gravity) in a box of plane walls, and the throughput of qdem on it in
 //! sphere-steps per second. `study packing` writes the packing for both qdem and LIGGGHTS
 //! (`qdem-bench/scripts/liggghts_compare.py` runs the two side by side on the same file and
-//! time step); `study dem-throughput` times qdem on it.
+//! time step); `study dem-throughput` times qdem on it, and with `--clumps` the same packing
+//! with every sphere replaced by a rigid clump of 2, 3 or 4 smaller spheres inside it
+//! ([`Packing::build_clumps`]).
 //!
 //! Material: E = 50 MPa (soft, as DEM benchmarks use to afford a long step), ν = 0.25,
 //! ρ = 2700 kg/m³, μ = 0.5, restitution 0.5 (damping ratio ζ = −ln e/√(π² + ln² e)),
@@ -13,6 +15,7 @@ use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, PlaneWall, Wall,
     WallShape,
 };
+use qdem_core::rigid_body::point_inertia;
 use qdem_core::{Gravity, Mat3, Model, State, Stepper, Vec3, Verlet};
 use serde_json::{json, Value};
 use std::path::Path;
@@ -119,7 +122,7 @@ impl Packing {
         ]
     }
 
-    /// The state (one rigid body per sphere) and the models: contacts, gravity.
+    /// The state (one rotating particle per sphere) and the models: contacts, gravity.
     pub fn build(&self) -> (State, Vec<Box<dyn Model>>) {
         self.build_with(damping_ratio(RESTITUTION))
     }
@@ -128,12 +131,9 @@ impl Packing {
     fn build_with(&self, zeta: f64) -> (State, Vec<Box<dyn Model>>) {
         let mut state = State::at_rest(self.centers.clone());
         let mass = DENSITY * 4.0 / 3.0 * std::f64::consts::PI * RADIUS.powi(3);
-        let inertia = Mat3::identity() * (0.4 * mass * RADIUS * RADIUS);
         for i in 0..self.centers.len() {
             state.mass[i] = mass;
-            state
-                .add_rigid_body("sphere", i, &[], inertia)
-                .expect("a sphere has positive mass and inertia");
+            state.let_turn(i, 0.4 * mass * RADIUS * RADIUS);
         }
         let spheres: Vec<ContactSphere> = (0..self.centers.len())
             .map(|i| ContactSphere {
@@ -143,6 +143,20 @@ impl Packing {
                 material: 0,
             })
             .collect();
+        let names = vec!["sphere".to_string(); self.centers.len()];
+        let models = self.models(&state, &spheres, names, zeta);
+        (state, models)
+    }
+
+    /// The contacts of `spheres` (of bodies `names`) with each other and the walls, and
+    /// gravity.
+    fn models(
+        &self,
+        state: &State,
+        spheres: &[ContactSphere],
+        names: Vec<String>,
+        zeta: f64,
+    ) -> Vec<Box<dyn Model>> {
         let walls = self
             .walls()
             .into_iter()
@@ -158,20 +172,81 @@ impl Packing {
             friction: FRICTION,
             skin: SKIN,
         };
-        let names = vec!["sphere".to_string(); self.centers.len()];
-        let contacts = DemContacts::new(
-            &state,
-            &spheres,
-            names,
-            &[(YOUNG, POISSON)],
-            settings,
-            walls,
-        );
-        let models: Vec<Box<dyn Model>> = vec![
+        let contacts =
+            DemContacts::new(state, spheres, names, &[(YOUNG, POISSON)], settings, walls);
+        vec![
             Box::new(contacts),
             Box::new(Gravity::new(Vec3::from(GRAVITY))),
+        ]
+    }
+
+    /// The state and models of the packing with sphere i replaced by a rigid clump of k = 2, 3,
+    /// 4 (in turn) spheres inside it, on the vertices of a segment, triangle or tetrahedron of
+    /// circumradius a about the sphere's centre, turned by a fixed rotation per clump, with
+    /// radius r − a so that the clump reaches the sphere's surface: a = r/2, 2r/(2 + √3),
+    /// 2r/(2 + √(8/3)), the smallest for which the clump's spheres do not overlap, so that its
+    /// mass properties are the sum of its spheres' (2/5 m r² plus the parallel-axis term each).
+    /// Returns the number of contact spheres too.
+    pub fn build_clumps(&self) -> (State, Vec<Box<dyn Model>>, usize) {
+        let shapes: [(&[[f64; 3]], f64); 3] = [
+            (&[[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]], 0.5),
+            (
+                &[
+                    [1.0, 0.0, 0.0],
+                    [-0.5, 0.866_025_403_784_438_6, 0.0],
+                    [-0.5, -0.866_025_403_784_438_6, 0.0],
+                ],
+                2.0 / (2.0 + 3f64.sqrt()),
+            ),
+            (
+                &[
+                    [1.0, 1.0, 1.0],
+                    [1.0, -1.0, -1.0],
+                    [-1.0, 1.0, -1.0],
+                    [-1.0, -1.0, 1.0],
+                ],
+                2.0 / (2.0 + (8.0f64 / 3.0).sqrt()),
+            ),
         ];
-        (state, models)
+        let mut members = Vec::new();
+        for (i, c) in self.centers.iter().enumerate() {
+            let (vertices, arm) = shapes[i % 3];
+            let turn = nalgebra::UnitQuaternion::from_euler_angles(
+                0.7 * i as f64,
+                1.3 * i as f64,
+                2.1 * i as f64,
+            );
+            let r = (1.0 - arm) * RADIUS;
+            let at = vertices
+                .iter()
+                .map(|v| c + turn * (arm * RADIUS * Vec3::from(*v).normalize()))
+                .collect::<Vec<_>>();
+            members.push((at, r));
+        }
+        let positions = members.iter().flat_map(|(at, _)| at.iter().copied());
+        let mut state = State::at_rest(positions.collect());
+        let mut spheres = Vec::new();
+        for (b, (at, r)) in members.iter().enumerate() {
+            let m = DENSITY * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
+            let first = spheres.len();
+            let ids: Vec<usize> = (first..first + at.len()).collect();
+            let center = state.push_particle(self.centers[b], Vec3::zeros(), m * at.len() as f64);
+            let own = Mat3::identity() * (0.4 * m * r * r * at.len() as f64);
+            let inertia = own + point_inertia(self.centers[b], at, &vec![m; at.len()]);
+            state
+                .add_rigid_body("clump", center, &ids, inertia)
+                .expect("a clump has positive mass and inertia");
+            spheres.extend(ids.iter().map(|&p| ContactSphere {
+                particle: p,
+                radius: *r,
+                body: b,
+                material: 0,
+            }));
+        }
+        let count = spheres.len();
+        let names = vec!["clump".to_string(); self.centers.len()];
+        let models = self.models(&state, &spheres, names, damping_ratio(RESTITUTION));
+        (state, models, count)
     }
 
     /// Pours the lattice under gravity for `seconds` of simulated time and keeps the settled
@@ -295,6 +370,55 @@ impl Packing {
     }
 }
 
+/// The bytes a Verlet step of a sphere packing moves per sphere, with `candidates` candidate
+/// contacts (pairs and wall contacts) per sphere, each array read or written once per pass:
+/// the kick and drift of x, v, a and θ, ω, θ̈ (240 B), the sphere read (x, v, ω and the
+/// build position in, a 96-byte sphere record out: 192 B), zeroing the forces and moments
+/// (48 B), per candidate its 112-byte record read and written by the narrow phase and law and
+/// read twice, once per partner, by the gather with its two incidence entries (456 B), the
+/// gather's sums out and into the particle forces and moments (48 + 144 B), gravity (56 B), and
+/// a = f/m, θ̈ = M/J with the second half kick (210 B).
+pub fn bytes_per_sphere_step(candidates: f64) -> f64 {
+    240.0 + 192.0 + 48.0 + 456.0 * candidates + 192.0 + 56.0 + 210.0
+}
+
+/// Times `steps` Verlet steps of the packing with its spheres replaced by clumps
+/// ([`Packing::build_clumps`]), with the packing's own step, and returns the JSON record:
+/// particle-steps/s counts the contact spheres, clump-steps/s the clumps.
+pub fn clump_throughput(packing: &Packing, steps: usize) -> Result<Value, GranularError> {
+    let (mut state, mut models, spheres) = packing.build_clumps();
+    let dt = {
+        let (state, models) = packing.build();
+        time_step(&state, &models)
+    };
+    let bound = qdem_core::stable_step(&state, &models).map_or(f64::INFINITY, |b| b.0);
+    let mut stepper = Verlet::new(dt.min(0.9 * bound));
+    stepper.initialize(&mut state, &mut models)?;
+    let start = Instant::now();
+    for _ in 0..steps {
+        stepper.step(&mut state, &mut models)?;
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let model: &dyn std::any::Any = models[0].as_ref();
+    let contacts = model.downcast_ref::<DemContacts>().expect("contacts first");
+    let clumps = packing.centers.len();
+    Ok(json!({
+        "code": "qdem",
+        "clumps": clumps,
+        "spheres": spheres,
+        "steps": steps,
+        "dt": stepper.dt(),
+        "stable_bound": bound,
+        "wall_s": seconds,
+        "particle_steps_per_s": (spheres * steps) as f64 / seconds,
+        "clump_steps_per_s": (clumps * steps) as f64 / seconds,
+        "threads": rayon::current_num_threads(),
+        "contacts": contacts.contacts(),
+        "rebuilds": contacts.rebuilds(),
+        "kinetic_energy": state.kinetic_energy(),
+    }))
+}
+
 /// Times `steps` Verlet steps of the packing (after the initial force evaluation, as
 /// LIGGGHTS's "Loop time" excludes its set-up) and returns the JSON record.
 pub fn throughput(packing: &Packing, steps: usize) -> Result<Value, GranularError> {
@@ -311,9 +435,13 @@ pub fn throughput(packing: &Packing, steps: usize) -> Result<Value, GranularErro
     let model: &dyn std::any::Any = models[0].as_ref();
     let contacts = model.downcast_ref::<DemContacts>().expect("contacts first");
     let n = packing.centers.len();
+    let candidates = contacts.candidates() as f64 / n as f64;
     Ok(json!({
         "code": "qdem",
         "spheres": n,
+        "candidates_per_sphere": candidates,
+        "bytes_per_particle_step": bytes_per_sphere_step(candidates),
+        "triad_bytes_per_s": crate::throughput::triad_bandwidth(rayon::current_num_threads()),
         "steps": steps,
         "dt": dt,
         "stable_bound": bound,

@@ -2,7 +2,8 @@
 //! broad phase → narrow phase → contact forces → gather.
 //!
 //! Paper 000 §4 puts a sphere at each surface vertex of a QDEM body, used only for contact;
-//! a rigid body's spheres sit on its members or at its centre ([`qdem_core::rigid_body`]).
+//! a rigid body's spheres sit on its members or at its centre ([`qdem_core::rigid_body`]); a
+//! one-sphere grain is a particle that rotates ([`qdem_core::ParticleSpin`]).
 //! Spheres of one body never interact. Each evaluation
 //! 1. reads the sphere centres from their particles,
 //! 2. rebuilds the pair and wall candidate lists if some sphere (or wall) moved more than the
@@ -12,10 +13,11 @@
 //!    buffers,
 //! 4. gathers them per sphere over a fixed incidence list (no atomics, so results do not depend
 //!    on the thread count) and adds them, in sphere order, to the particle forces, and the
-//!    moment of each contact force about its sphere's centre to the sphere's rigid body.
+//!    moment of each contact force about its sphere's centre to the sphere's rigid body or
+//!    rotating particle.
 //!
-//! The contact point is at x_a + (r_a − δ/2) n; its velocity includes the rigid body's spin,
-//! v + ω × (x_cp − x). Tangential springs grow by the relative displacement over the time since
+//! The contact point is at x_a + (r_a − δ/2) n; its velocity includes the rigid body's (or
+//! the rotating particle's) spin, v + ω × (x_cp − x). Tangential springs grow by the relative displacement over the time since
 //! the previous evaluation, so the model needs no step size.
 //!
 //! With periodic axes ([`DemContacts::with_periodic`]) separations are minimum images, so a
@@ -29,6 +31,7 @@
 
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
+use crate::contact_list::{Contact, ContactList};
 use crate::error::ContactError;
 use crate::periodic_boundary::PeriodicBox;
 use crate::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
@@ -40,11 +43,16 @@ use qdem_core::{
 };
 use rayon::prelude::*;
 
-/// Marks a sphere that is no part of a rigid body.
+/// Marks a sphere that is no part of a rigid body, or whose moments go nowhere.
 const NOT_RIGID: u32 = u32::MAX;
 
-/// Contacts per parallel task.
+/// Contacts per parallel task of the narrow phase and law, and spheres per task of the gather
+/// (about 30 µs of work each: a task much shorter than waking a worker, tens of µs on the
+/// 2-core benchmark machine, makes a parallel loop slower than a serial one).
 const CONTACT_CHUNK: usize = 2048;
+
+/// Spheres per parallel task when reading their centres (a copy: a few ns each).
+const SPHERE_CHUNK: usize = 16384;
 
 /// Overlap, as a fraction of the reduced radius, at which the stable step evaluates Hertz's
 /// stiffness (which grows as √δ).
@@ -80,93 +88,53 @@ pub struct ContactSettings {
 /// What the narrow phase reads of one sphere, kept together so that a pair touches two
 /// cache lines per sphere rather than one per array.
 #[derive(Clone, Copy, Debug, Default)]
-struct SphereNow {
-    center: Vec3,
-    velocity: Vec3,
-    spin: Vec3,
-    radius: f64,
-    mass: f64,
-    material: u32,
+pub(crate) struct SphereNow {
+    /// Centre x (m).
+    pub(crate) center: Vec3,
+    /// Velocity of the centre v (m/s).
+    pub(crate) velocity: Vec3,
+    /// Angular velocity ω (rad/s), zero for a sphere that does not turn.
+    pub(crate) spin: Vec3,
+    /// Radius r (m).
+    pub(crate) radius: f64,
+    /// Mass of the particle or body that carries it (kg).
+    pub(crate) mass: f64,
+    /// Index of its elastic constants.
+    pub(crate) material: u32,
 }
 
-/// Per-contact buffers of a candidate list: who, spring history, and this step's force on
-/// the first partner, contact point and image translation of the second partner (zero unless
-/// the pair touches through a periodic boundary).
-#[derive(Default)]
-struct ContactList {
-    first: Vec<u32>,
-    second: Vec<u32>,
-    history: Vec<Vec3>,
-    force: Vec<Vec3>,
-    point: Vec<Vec3>,
-    shift: Vec<Vec3>,
-}
-
-impl ContactList {
-    /// Replaces the list by `keys`, sorted, keeping the springs of pairs that stay.
-    fn rebuild(&mut self, keys: Vec<(u32, u32)>) {
-        let mut history = vec![Vec3::zeros(); keys.len()];
-        let mut old = 0;
-        for (k, key) in keys.iter().enumerate() {
-            while old < self.first.len() && (self.first[old], self.second[old]) < *key {
-                old += 1;
-            }
-            if old < self.first.len() && (self.first[old], self.second[old]) == *key {
-                history[k] = self.history[old];
-            }
-        }
-        self.first = keys.iter().map(|k| k.0).collect();
-        self.second = keys.iter().map(|k| k.1).collect();
-        self.history = history;
-        self.force = vec![Vec3::zeros(); keys.len()];
-        self.point = vec![Vec3::zeros(); keys.len()];
-        self.shift = vec![Vec3::zeros(); keys.len()];
+/// The narrow phase, a pure function of two sphere records: the contact of spheres a and b,
+/// b's image translated by `shift` (zero except through a periodic boundary), or `None` when
+/// they are apart. With d = x_b + shift − x_a: overlap δ = r_a + r_b − |d|, normal n = d/|d|,
+/// the contact point at x_a + (r_a − δ/2) n, and the velocity of a's contact point relative to
+/// b's, v_a − v_b + (r_a − δ/2) ω_a × n + (r_b − δ/2) ω_b × n; R* = r_a r_b/(r_a + r_b),
+/// m* = m_a m_b/(m_a + m_b).
+#[inline]
+pub(crate) fn narrow_phase(
+    a: &SphereNow,
+    b: &SphereNow,
+    shift: Vec3,
+    friction: f64,
+) -> Option<PairGeometry> {
+    let d = b.center + shift - a.center;
+    let distance_squared = d.norm_squared();
+    let reach = a.radius + b.radius;
+    if distance_squared >= reach * reach || distance_squared == 0.0 {
+        return None;
     }
-
-    fn len(&self) -> usize {
-        self.first.len()
-    }
-
-    /// Writes the list and its per-contact buffers into a checkpoint.
-    fn save(&self, out: &mut Encoder) {
-        out.u32s(&self.first);
-        out.u32s(&self.second);
-        for v in [&self.history, &self.force, &self.point, &self.shift] {
-            out.vec3s(v);
-        }
-    }
-
-    /// Reads back a list whose first partners index `0..firsts` and second partners
-    /// `0..seconds`.
-    fn restore(
-        input: &mut Decoder<'_>,
-        firsts: usize,
-        seconds: usize,
-    ) -> Result<ContactList, CheckpointError> {
-        let first = input.u32s("contact partners")?;
-        let second = input.u32s("contact partners")?;
-        same_count("contact partners", first.len(), second.len())?;
-        if let Some(k) =
-            (0..first.len()).find(|&k| first[k] as usize >= firsts || second[k] as usize >= seconds)
-        {
-            return Err(CheckpointError::Invalid {
-                what: "contact list",
-                detail: format!(
-                    "contact {k} joins {} and {}, beyond the scene's {firsts} spheres",
-                    first[k], second[k]
-                ),
-            });
-        }
-        let n = first.len();
-        Ok(ContactList {
-            first,
-            second,
-            history: input.vec3s_exact(n, "tangential springs")?,
-            force: input.vec3s_exact(n, "contact forces")?,
-            point: input.vec3s_exact(n, "contact points")?,
-            shift: input.vec3s_exact(n, "image translations")?,
-        })
-    }
+    let distance = distance_squared.sqrt();
+    let overlap = reach - distance;
+    let normal = d / distance;
+    let half = 0.5 * overlap;
+    let spin = (a.radius - half) * a.spin + (b.radius - half) * b.spin;
+    Some(PairGeometry {
+        overlap,
+        normal,
+        velocity: a.velocity - b.velocity + spin.cross(&normal),
+        radius: reduced(a.radius, b.radius),
+        mass: a.mass * b.mass / (a.mass + b.mass),
+        friction,
+    })
 }
 
 /// Contact spheres, walls and their contacts: a [`Model`].
@@ -216,6 +184,7 @@ pub struct DemContacts {
     radius: Vec<f64>,
     body: Vec<u32>,
     rigid: Vec<u32>,
+    turn: Vec<u32>,
     lever: Vec<f64>,
     bound_mass: Vec<f64>,
     body_names: Vec<String>,
@@ -311,10 +280,22 @@ impl DemContacts {
             .zip(&rigid)
             .map(|(s, &r)| state.mass[carrier(s, r)])
             .collect();
+        let turns = |p: usize| state.spin.fixed.get(p).is_some_and(|f| *f != Dofs::ALL);
+        let turn: Vec<u32> = spheres
+            .iter()
+            .zip(&rigid)
+            .map(|(s, &r)| match r {
+                NOT_RIGID if turns(s.particle) => (state.rigid.len() + s.particle) as u32,
+                r => r,
+            })
+            .collect();
         let lever = spheres
             .iter()
             .zip(&rigid)
             .map(|(s, &r)| match r {
+                NOT_RIGID if turns(s.particle) => {
+                    s.radius * s.radius / state.spin.inertia[s.particle]
+                }
                 NOT_RIGID => 0.0,
                 b if state.rigid.spin_fixed[b as usize] => 0.0,
                 b => {
@@ -335,7 +316,11 @@ impl DemContacts {
         // oscillate: it does not limit the step (infinite mass in the bound below).
         let held = |s: &ContactSphere, r: u32| {
             let c = carrier(s, r);
-            state.fixed[c] == Dofs::ALL && (r == NOT_RIGID || state.rigid.spin_fixed[r as usize])
+            let still = match r {
+                NOT_RIGID => !turns(s.particle),
+                b => state.rigid.spin_fixed[b as usize],
+            };
+            state.fixed[c] == Dofs::ALL && still
         };
         let bound_mass: Vec<f64> = spheres
             .iter()
@@ -359,6 +344,7 @@ impl DemContacts {
             radius: spheres.iter().map(|s| s.radius).collect(),
             body: spheres.iter().map(|s| s.body as u32).collect(),
             rigid,
+            turn,
             lever,
             bound_mass,
             body_names,
@@ -436,21 +422,20 @@ impl DemContacts {
     /// for Eqs. 4–5 is a statement about that force).
     pub fn section_force(&self, axis: usize, at: f64) -> f64 {
         let period = self.periodic.as_ref().and_then(|p| p.length(axis));
-        self.mean_pair_force(|k| {
-            let (i, j) = (self.pairs.first[k] as usize, self.pairs.second[k] as usize);
-            let a = self.now[i].center[axis] - at;
-            let b = self.now[j].center[axis] + self.pairs.shift[k][axis] - at;
+        self.mean_pair_force(|c| {
+            let a = self.now[c.first as usize].center[axis] - at;
+            let b = self.now[c.second as usize].center[axis] + c.shift[axis] - at;
             crosses(a, b, period)
         })
     }
 
-    /// The average magnitude of the forces of the touching pairs k for which `counted(k)`
+    /// The average magnitude of the forces of the touching pairs c for which `counted(c)`
     /// (serial, in pair order, so it does not depend on the thread count); 0 without any.
-    fn mean_pair_force(&self, counted: impl Fn(usize) -> bool) -> f64 {
+    fn mean_pair_force(&self, counted: impl Fn(&Contact) -> bool) -> f64 {
         let (mut sum, mut count) = (0.0, 0usize);
-        for (k, f) in self.pairs.force.iter().enumerate() {
-            if *f != Vec3::zeros() && counted(k) {
-                sum += f.norm();
+        for c in &self.pairs.items {
+            if c.force != Vec3::zeros() && counted(c) {
+                sum += c.force.norm();
                 count += 1;
             }
         }
@@ -492,10 +477,10 @@ impl DemContacts {
     /// Number of touching contacts (sphere–sphere and sphere–wall) at the last evaluation.
     pub fn contacts(&self) -> usize {
         self.pairs
-            .force
+            .items
             .iter()
-            .chain(&self.wall_contacts.force)
-            .filter(|f| **f != Vec3::zeros())
+            .chain(&self.wall_contacts.items)
+            .filter(|c| c.force != Vec3::zeros())
             .count()
     }
 
@@ -513,8 +498,8 @@ impl DemContacts {
     ) -> Result<(), ContactError> {
         self.read_centers(state);
         self.rebuild(state.time);
-        for k in 0..self.pairs.len() {
-            let (a, b) = (self.pairs.first[k] as usize, self.pairs.second[k] as usize);
+        for c in &self.pairs.items {
+            let (a, b) = (c.first as usize, c.second as usize);
             let radius = reduced(self.radius[a], self.radius[b]);
             let overlap = self.radius[a] + self.radius[b] - self.separation(a, b).0.norm();
             if overlap > tolerance * radius {
@@ -529,11 +514,8 @@ impl DemContacts {
                 });
             }
         }
-        for k in 0..self.wall_contacts.len() {
-            let (s, w) = (
-                self.wall_contacts.first[k] as usize,
-                self.wall_contacts.second[k] as usize,
-            );
+        for c in &self.wall_contacts.items {
+            let (s, w) = (c.first as usize, c.second as usize);
             let (overlap, _) =
                 self.walls[w].overlap(&self.now[s].center, self.radius[s], state.time);
             if overlap > tolerance * self.radius[s] {
@@ -550,24 +532,26 @@ impl DemContacts {
         Ok(())
     }
 
-    /// Copies every sphere's centre, velocity and spin (its rigid body's angular velocity,
-    /// zero for a vertex of a deformable body) out of the state, in sphere order, and returns
+    /// Copies every sphere's centre, velocity and spin (its rigid body's or its particle's
+    /// angular velocity, zero for a vertex of a deformable body) out of the state, in sphere order, and returns
     /// the largest distance a sphere has moved since the last build (infinite before it).
     fn read_centers(&mut self, state: &State) -> f64 {
-        let (particle, rigid, built_at) = (&self.particle, &self.rigid, &self.built_at);
+        let (particle, turn, built_at) = (&self.particle, &self.turn, &self.built_at);
         let built = self.built && built_at.len() == particle.len();
+        let bodies = state.rigid.len();
         let moved = self
             .now
             .par_iter_mut()
-            .with_min_len(CONTACT_CHUNK)
+            .with_min_len(SPHERE_CHUNK)
             .enumerate()
             .map(|(s, now)| {
                 let p = particle[s] as usize;
                 now.center = state.position[p];
                 now.velocity = state.velocity[p];
-                now.spin = match rigid[s] {
-                    NOT_RIGID => Vec3::zeros(),
-                    b => state.rigid.angular_velocity[b as usize],
+                now.spin = match turn[s] as usize {
+                    t if t == NOT_RIGID as usize => Vec3::zeros(),
+                    b if b < bodies => state.rigid.angular_velocity[b],
+                    t => state.spin.velocity[t - bodies],
                 };
                 if built {
                     (now.center - built_at[s]).norm_squared()
@@ -626,24 +610,25 @@ impl DemContacts {
     fn build_incidence(&mut self) {
         let n = self.particle.len();
         let mut start = vec![0u32; n + 1];
-        for (&a, &b) in self.pairs.first.iter().zip(&self.pairs.second) {
-            start[a as usize + 1] += 1;
-            start[b as usize + 1] += 1;
+        for c in &self.pairs.items {
+            start[c.first as usize + 1] += 1;
+            start[c.second as usize + 1] += 1;
         }
         for i in 0..n {
             start[i + 1] += start[i];
         }
         let mut fill = start.clone();
         let mut incidence = vec![0u32; 2 * self.pairs.len()];
-        for (k, (&a, &b)) in self.pairs.first.iter().zip(&self.pairs.second).enumerate() {
+        for (k, c) in self.pairs.items.iter().enumerate() {
+            let (a, b) = (c.first, c.second);
             incidence[fill[a as usize] as usize] = 2 * k as u32;
             fill[a as usize] += 1;
             incidence[fill[b as usize] as usize] = 2 * k as u32 + 1;
             fill[b as usize] += 1;
         }
         let mut wall_start = vec![0u32; n + 1];
-        for &s in &self.wall_contacts.first {
-            wall_start[s as usize + 1] += 1;
+        for c in &self.wall_contacts.items {
+            wall_start[c.first as usize + 1] += 1;
         }
         for i in 0..n {
             wall_start[i + 1] += wall_start[i];
@@ -653,113 +638,86 @@ impl DemContacts {
         self.wall_start = wall_start;
     }
 
-    /// Velocity of the material point at `x` of sphere `s`: v + ω × (x − c).
+    /// The geometry and elasticity of the pair of spheres of `contact`, with the image
+    /// translation of its second sphere (written into `contact`); `None` when apart.
     #[inline]
-    fn point_velocity(now: &SphereNow, x: &Vec3) -> Vec3 {
-        now.velocity + now.spin.cross(&(x - now.center))
-    }
-
-    /// Geometry of the pair of spheres a < b: (geometry, contact point, elasticity, image
-    /// translation of b); `None` when apart.
-    #[inline]
-    fn pair_geometry(&self, a: usize, b: usize) -> Option<PairContact> {
+    fn pair_contact(&self, contact: &mut Contact) -> Option<(PairGeometry, PairElasticity)> {
+        let (a, b) = (contact.first as usize, contact.second as usize);
         let (sa, sb) = (&self.now[a], &self.now[b]);
-        let (d, shift) = self.separation(a, b);
-        let distance_squared = d.norm_squared();
-        let reach = sa.radius + sb.radius;
-        if distance_squared >= reach * reach || distance_squared == 0.0 {
-            return None;
-        }
-        let distance = distance_squared.sqrt();
-        let overlap = reach - distance;
-        let normal = d / distance;
-        let point = sa.center + (sa.radius - 0.5 * overlap) * normal;
-        let velocity =
-            Self::point_velocity(sa, &point) - Self::point_velocity(sb, &(point - shift));
-        let geometry = PairGeometry {
-            overlap,
-            normal,
-            velocity,
-            radius: reduced(sa.radius, sb.radius),
-            mass: sa.mass * sb.mass / (sa.mass + sb.mass),
-            friction: self.settings.friction,
-        };
+        contact.shift = self.separation(a, b).1;
+        let geometry = narrow_phase(sa, sb, contact.shift, self.settings.friction)?;
         let e = self.elasticity[sa.material as usize * self.materials + sb.material as usize];
-        Some((geometry, point, e, shift))
+        Some((geometry, e))
     }
 
-    /// Geometry of the contact of sphere s with wall w.
+    /// The geometry and elasticity of the contact of sphere s with wall w: the contact point
+    /// at x + (r − δ/2) n, its velocity v + (r − δ/2) ω × n against the wall's; `None` when
+    /// apart.
     #[inline]
-    fn wall_geometry(&self, state: &State, s: usize, w: usize) -> Option<PairContact> {
+    fn wall_contact(
+        &self,
+        time: f64,
+        s: usize,
+        w: usize,
+    ) -> Option<(PairGeometry, PairElasticity)> {
         let wall = &self.walls[w];
         let sphere = &self.now[s];
-        let (overlap, normal) = wall.overlap(&sphere.center, sphere.radius, state.time);
+        let (overlap, normal) = wall.overlap(&sphere.center, sphere.radius, time);
         if overlap <= 0.0 || normal == Vec3::zeros() {
             return None;
         }
-        let point = sphere.center + (sphere.radius - 0.5 * overlap) * normal;
+        let lever = sphere.radius - 0.5 * overlap;
         let geometry = PairGeometry {
             overlap,
             normal,
-            velocity: Self::point_velocity(sphere, &point) - wall.velocity(),
+            velocity: sphere.velocity + lever * sphere.spin.cross(&normal) - wall.velocity(),
             radius: sphere.radius,
             mass: sphere.mass,
             friction: wall.friction,
         };
-        Some((
-            geometry,
-            point,
-            self.wall_elasticity[sphere.material as usize],
-            Vec3::zeros(),
-        ))
+        Some((geometry, self.wall_elasticity[sphere.material as usize]))
     }
 
-    /// Narrow phase and law over one list, in parallel.
-    fn evaluate_list(&mut self, state: &State, dt: f64, walls: bool) {
-        let mut list = std::mem::take(if walls {
-            &mut self.wall_contacts
-        } else {
-            &mut self.pairs
-        });
-        let law = &self.settings.law;
+    /// Narrow phase and law over the pairs and the wall contacts, one parallel region: the
+    /// wall contacts are a task beside the pairs' (one record per contact).
+    fn evaluate(&mut self, time: f64, dt: f64) {
+        let (mut pairs, mut walls) = (
+            std::mem::take(&mut self.pairs),
+            std::mem::take(&mut self.wall_contacts),
+        );
         let this = &*self;
-        let (first, second) = (&list.first, &list.second);
-        list.history
+        rayon::join(
+            || this.evaluate_list(&mut pairs, time, dt, false),
+            || this.evaluate_list(&mut walls, time, dt, true),
+        );
+        (self.pairs, self.wall_contacts) = (pairs, walls);
+    }
+
+    /// Narrow phase and law over one list, in parallel, one record per contact.
+    fn evaluate_list(&self, list: &mut ContactList, time: f64, dt: f64, walls: bool) {
+        let law = &self.settings.law;
+        list.items
             .par_iter_mut()
-            .zip(list.force.par_iter_mut())
-            .zip(list.point.par_iter_mut())
-            .zip(list.shift.par_iter_mut())
             .with_min_len(CONTACT_CHUNK)
-            .enumerate()
-            .for_each(|(k, (((history, force), point), shift))| {
-                let (i, j) = (first[k] as usize, second[k] as usize);
-                let contact = if walls {
-                    this.wall_geometry(state, i, j)
+            .for_each(|contact| {
+                let touching = if walls {
+                    self.wall_contact(time, contact.first as usize, contact.second as usize)
                 } else {
-                    this.pair_geometry(i, j)
+                    self.pair_contact(contact)
                 };
-                match contact {
-                    Some((g, x, e, t)) => {
-                        *force = law.force(&g, &e, history, dt);
-                        *point = x;
-                        *shift = t;
+                match touching {
+                    Some((g, e)) => {
+                        let force = law.force(&g, &e, &mut contact.history, dt);
+                        contact.touch(force, &g.normal, g.overlap);
                     }
-                    None => {
-                        *history = Vec3::zeros();
-                        *force = Vec3::zeros();
-                    }
+                    None => contact.part(),
                 }
             });
-        *(if walls {
-            &mut self.wall_contacts
-        } else {
-            &mut self.pairs
-        }) = list;
     }
 
     /// The average magnitude of the touching pairs' forces through the boundaries of `axis`.
     fn boundary_force(&self, axis: usize) -> f64 {
-        self.mean_pair_force(|k| self.pairs.shift[k][axis] != 0.0)
+        self.mean_pair_force(|c| c.shift[axis] != 0.0)
     }
 
     /// Measures the boundary force and updates the ghost scales of a time-delayed boundary.
@@ -774,12 +732,13 @@ impl DemContacts {
     }
 
     /// Per-sphere sums of contact forces, and their moments about the sphere's centre for
-    /// spheres of rigid bodies, in a fixed order; forces from delayed ghosts scaled.
+    /// spheres that turn (of rigid bodies, rotating particles), in a fixed order; forces from
+    /// delayed ghosts scaled.
     fn gather(&mut self) {
-        let (pairs, walls) = (&self.pairs, &self.wall_contacts);
+        let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
         let (start, incidence, wall_start) =
             (&self.incidence_start, &self.incidence, &self.wall_start);
-        let (now, rigid) = (&self.now, &self.rigid);
+        let (now, turn) = (&self.now, &self.turn);
         let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
         self.sphere_force
             .par_iter_mut()
@@ -787,38 +746,36 @@ impl DemContacts {
             .enumerate()
             .for_each(|(s, out)| {
                 let (mut f, mut t) = (Vec3::zeros(), Vec3::zeros());
-                let spins = rigid[s] != NOT_RIGID;
+                let (spins, radius) = (turn[s] != NOT_RIGID, now[s].radius);
                 for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
-                    let k = (e / 2) as usize;
+                    let c = &pairs[(e / 2) as usize];
                     let first = e % 2 == 0;
-                    let (mut fk, center) = if first {
-                        (pairs.force[k], now[s].center)
-                    } else {
-                        (-pairs.force[k], now[s].center + pairs.shift[k])
+                    let scale = match &delay {
+                        Some((axis, scales)) => {
+                            let (a, b) = pair_scales(c.shift[*axis], scales);
+                            if first {
+                                a
+                            } else {
+                                b
+                            }
+                        }
+                        None => 1.0,
                     };
-                    if let Some((axis, scales)) = &delay {
-                        let (a, b) = pair_scales(pairs.shift[k][*axis], scales);
-                        fk *= if first { a } else { b };
-                    }
-                    f += fk;
+                    f += if first { scale } else { -scale } * c.force;
                     if spins {
-                        t += (pairs.point[k] - center).cross(&fk);
+                        t += c.moment(radius, scale);
                     }
                 }
-                for k in wall_start[s] as usize..wall_start[s + 1] as usize {
-                    f += walls.force[k];
+                for c in &walls[wall_start[s] as usize..wall_start[s + 1] as usize] {
+                    f += c.force;
                     if spins {
-                        t += (walls.point[k] - now[s].center).cross(&walls.force[k]);
+                        t += c.moment(radius, 1.0);
                     }
                 }
                 *out = (f, t);
             });
     }
 }
-
-/// A touching contact: its geometry, contact point, elasticity and the image translation of
-/// its second sphere.
-type PairContact = (PairGeometry, Vec3, PairElasticity, Vec3);
 
 /// r_a r_b / (r_a + r_b).
 #[inline]
@@ -838,14 +795,13 @@ impl Model for DemContacts {
         if self.needs_rebuild(moved, state.time) {
             self.rebuild(state.time);
         }
-        self.evaluate_list(state, dt, false);
-        self.evaluate_list(state, dt, true);
+        self.evaluate(state.time, dt);
         self.update_time_delay(state.time);
         self.gather();
         for (s, (f, t)) in self.sphere_force.iter().enumerate() {
             force[self.particle[s] as usize] += f;
-            if self.rigid[s] != NOT_RIGID {
-                torque[self.rigid[s] as usize] += t;
+            if self.turn[s] != NOT_RIGID {
+                torque[self.turn[s] as usize] += t;
             }
         }
     }
@@ -901,14 +857,13 @@ impl Model for DemContacts {
 
     fn potential_energy(&self, state: &State) -> Option<f64> {
         let law = &self.settings.law;
-        let (p, w) = (&self.pairs, &self.wall_contacts);
-        let pairs = (0..p.len()).filter_map(|k| {
-            self.pair_geometry(p.first[k] as usize, p.second[k] as usize)
-                .map(|(g, _, e, _)| law.energy(&g, &e, &p.history[k]))
+        let pairs = self.pairs.items.iter().filter_map(|c| {
+            self.pair_contact(&mut c.clone())
+                .map(|(g, e)| law.energy(&g, &e, &c.history))
         });
-        let walls = (0..w.len()).filter_map(|k| {
-            self.wall_geometry(state, w.first[k] as usize, w.second[k] as usize)
-                .map(|(g, _, e, _)| law.energy(&g, &e, &w.history[k]))
+        let walls = self.wall_contacts.items.iter().filter_map(|c| {
+            self.wall_contact(state.time, c.first as usize, c.second as usize)
+                .map(|(g, e)| law.energy(&g, &e, &c.history))
         });
         Some(pairs.chain(walls).sum())
     }
@@ -972,5 +927,41 @@ impl Persistent for DemContacts {
         }
         self.build_incidence();
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sphere(center: Vec3, radius: f64, spin: Vec3) -> SphereNow {
+        SphereNow {
+            center,
+            radius,
+            spin,
+            mass: 1.0,
+            ..SphereNow::default()
+        }
+    }
+
+    #[test]
+    fn the_narrow_phase_sees_the_overlap_normal_and_the_contact_points_spin() {
+        // r_a = 0.02, r_b = 0.01, centres 0.025 apart along x: δ = 0.005, the contact point
+        // 0.0175 from a and 0.0075 from b. a spins at 10 rad/s about z, b at −10: a's point
+        // moves at 10 · 0.0175 = 0.175 m/s along y, b's at 0.075 along y.
+        let a = sphere(Vec3::zeros(), 0.02, Vec3::new(0.0, 0.0, 10.0));
+        let b = sphere(Vec3::new(0.025, 0.0, 0.0), 0.01, Vec3::new(0.0, 0.0, -10.0));
+        let g = narrow_phase(&a, &b, Vec3::zeros(), 0.3).unwrap();
+        assert!((g.overlap - 0.005).abs() < 1e-15);
+        assert_eq!(g.normal, Vec3::x());
+        assert!((g.velocity - Vec3::new(0.0, 0.1, 0.0)).norm() < 1e-15);
+        assert!((g.radius - 0.02 / 3.0).abs() < 1e-17);
+        assert_eq!((g.mass, g.friction), (0.5, 0.3));
+        // The same pair through a periodic boundary of period 1: b's image at x = −0.025.
+        let far = sphere(Vec3::new(0.975, 0.0, 0.0), 0.01, Vec3::zeros());
+        let g = narrow_phase(&a, &far, Vec3::new(-1.0, 0.0, 0.0), 0.3).unwrap();
+        assert!((g.normal + Vec3::x()).norm() < 1e-12);
+        assert!((g.overlap - 0.005).abs() < 1e-12);
+        assert!(narrow_phase(&a, &far, Vec3::zeros(), 0.3).is_none());
     }
 }

@@ -34,6 +34,7 @@ pub mod broad_phase;
 pub mod clump_sample;
 pub mod collapse_watch;
 pub mod contact_law;
+mod contact_list;
 pub mod coulomb;
 pub mod dem_contacts;
 pub mod error;

@@ -164,15 +164,6 @@ pub enum CoreError {
         /// Its principal moments of inertia.
         inertia: [f64; 3],
     },
-    /// A stepper that cannot integrate particle rotations met particles that have them.
-    #[error(
-        "the {stepper} integrator does not integrate particle rotations (bonded particles); \
-         fix: use integrator = \"newmark\" (beta = 0 for explicit, 0.25 for implicit)"
-    )]
-    SpinNeedsNewmark {
-        /// The stepper's name.
-        stepper: String,
-    },
     /// A stepper that cannot integrate rigid bodies met one.
     #[error(
         "the {stepper} stepper cannot integrate rigid bodies (the scene has {count}); use \

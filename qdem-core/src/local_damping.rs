@@ -2,7 +2,7 @@
 //! the acceleration of the particles by 70%"): every component of the unbalanced force on a
 //! particle is reduced by a fraction α of its magnitude against that component of the velocity,
 //! f_k ← f_k − α |f_k| sgn(v_k), and likewise the torque on a rigid body against its angular
-//! velocity. It dissipates energy without a viscosity scale, for quasi-static packing; it is
+//! velocity and the moment on a rotating particle against its rate. It dissipates energy without a viscosity scale, for quasi-static packing; it is
 //! not physical damping and is off unless a scene asks for it.
 
 use crate::state::State;
@@ -14,7 +14,11 @@ pub fn apply(state: &State, force: &mut [Vec3], torque: &mut [Vec3], alpha: f64)
     for (f, v) in force.iter_mut().zip(&state.velocity) {
         damp(f, v, alpha);
     }
-    for (t, w) in torque.iter_mut().zip(&state.rigid.angular_velocity) {
+    let (rigid, particles) = torque.split_at_mut(state.rigid.len().min(torque.len()));
+    for (t, w) in rigid.iter_mut().zip(&state.rigid.angular_velocity) {
+        damp(t, w, alpha);
+    }
+    for (t, w) in particles.iter_mut().zip(&state.spin.velocity) {
         damp(t, w, alpha);
     }
 }

@@ -292,13 +292,14 @@ pub fn place_members(state: &mut State) {
 }
 
 /// Moves the forces models put on members onto their bodies: the centre particle receives
-/// Σ f and the body the torque Σ (x − c) × f. Member forces are zeroed.
+/// Σ f and the body the torque Σ (x − c) × f. Member forces are zeroed. `torque` starts with
+/// the bodies' torques (the particles' moments that may follow are left alone).
 pub fn reduce_member_forces(state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
     let rigid = &state.rigid;
     if rigid.member.is_empty() {
         return;
     }
-    for (b, body_torque) in torque.iter_mut().enumerate() {
+    for (b, body_torque) in torque.iter_mut().take(rigid.len()).enumerate() {
         let c = rigid.center[b];
         let (mut total, mut moment) = (Vec3::zeros(), Vec3::zeros());
         for &m in rigid.members(b) {

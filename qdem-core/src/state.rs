@@ -100,8 +100,8 @@ pub struct State {
     pub fixed: Vec<Dofs>,
     /// Rotation of the rigid bodies (empty when the scene has none).
     pub rigid: RigidBodies,
-    /// Rotational degrees of freedom of the particles (empty unless the particles rotate,
-    /// as in bonded-particle DEM).
+    /// Rotational degrees of freedom of the particles (empty unless some particles rotate:
+    /// bonded-particle DEM, single spheres of a granular sample).
     pub spin: ParticleSpin,
 }
 
@@ -113,6 +113,8 @@ pub struct State {
 ///
 /// Rotations are integrated linearly, like translations (small rotations, the setting of the
 /// paper's beam matrices); a model that needs finite rotations uses [`crate::RigidBodies`].
+/// A sphere needs no orientation (its contacts read only ω), so a one-sphere grain rotates
+/// here, with θ̇ = ω exact and θ its accumulated rotation vector, which nothing reads.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ParticleSpin {
     /// Rotation vector θ (rad) about x, y, z.
@@ -128,6 +130,15 @@ pub struct ParticleSpin {
 }
 
 impl ParticleSpin {
+    /// Appends a particle whose rotation is held in every axis.
+    fn push_held(&mut self) {
+        self.angle.push(Vec3::zeros());
+        self.velocity.push(Vec3::zeros());
+        self.acceleration.push(Vec3::zeros());
+        self.inertia.push(0.0);
+        self.fixed.push(Dofs::ALL);
+    }
+
     /// Number of particles with rotational DOFs (0 or all of them).
     pub fn len(&self) -> usize {
         self.angle.len()
@@ -199,8 +210,8 @@ impl State {
     }
 
     /// Appends a free particle at `position` (also its reference position) with `velocity`
-    /// and `mass`, and returns its index. A state with particle rotations gets none for it:
-    /// call this before [`State::add_spin`].
+    /// and `mass`, and returns its index. In a state with particle rotations it gets a
+    /// rotation held in every axis ([`State::let_turn`] frees it).
     pub fn push_particle(&mut self, position: Vec3, velocity: Vec3, mass: f64) -> usize {
         self.reference.push(position);
         self.position.push(position);
@@ -208,7 +219,22 @@ impl State {
         self.acceleration.push(Vec3::zeros());
         self.mass.push(mass);
         self.fixed.push(Dofs::NONE);
+        if !self.spin.is_empty() {
+            self.spin.push_held();
+        }
         self.len() - 1
+    }
+
+    /// Lets particle `p` rotate freely with moment of inertia `inertia` (kg m²): a sphere of
+    /// radius r and mass m has J = 2/5 m r². A state without particle rotations gets them
+    /// first, held in every axis with zero inertia for every other particle (a tetrahedron's
+    /// node, a rigid body's centre), so that only the particles let turn here rotate.
+    pub fn let_turn(&mut self, p: usize, inertia: f64) {
+        if self.spin.is_empty() {
+            self.add_spin(vec![0.0; self.len()], Dofs::ALL);
+        }
+        self.spin.inertia[p] = inertia;
+        self.spin.fixed[p] = Dofs::NONE;
     }
 
     /// Number of particles.

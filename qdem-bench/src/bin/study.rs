@@ -3,11 +3,12 @@
 //!   by the explicit run on the finest mesh).
 //! - `study packing --spheres N --out DIR [--settle SECONDS]`: pours and settles N rigid
 //!   spheres and writes `DIR/packing.csv` and `DIR/packing.json` (the granular benchmark).
-//! - `study dem-throughput --packing DIR --steps S`: times qdem on that packing and prints one
-//!   JSON object.
+//! - `study dem-throughput --packing DIR --steps S [--grains spheres|clumps]`: times qdem on
+//!   that packing (with `clumps`, every sphere replaced by a rigid clump of 2–4 spheres inside
+//!   it) and prints one JSON object.
 
 use qdem_bench::cantilever::fixtures_dir;
-use qdem_bench::granular::{throughput, Packing};
+use qdem_bench::granular::{clump_throughput, throughput, Packing};
 use qdem_bench::speed_vs_error::{run_study, write_report};
 use qdem_bench::throughput::{cpu_model, on_threads};
 use std::path::PathBuf;
@@ -15,7 +16,7 @@ use std::process::ExitCode;
 
 const USAGE: &str = "usage: study speed-vs-error [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]
        study packing --spheres N --out DIR [--settle SECONDS]
-       study dem-throughput --packing DIR --steps S";
+       study dem-throughput --packing DIR --steps S [--grains spheres|clumps]";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -79,7 +80,12 @@ fn dem_throughput(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
         let steps: usize = number(option, "--steps", None)?;
         let dir = option("--packing").ok_or(format!("--packing is required\n{USAGE}"))?;
         let packing = Packing::read(dir.as_ref()).map_err(|e| e.to_string())?;
-        let record = throughput(&packing, steps).map_err(|e| e.to_string())?;
+        let record = match option("--grains").as_deref() {
+            None | Some("spheres") => throughput(&packing, steps),
+            Some("clumps") => clump_throughput(&packing, steps),
+            Some(other) => return Err(format!("--grains {other}: spheres or clumps\n{USAGE}")),
+        };
+        let record = record.map_err(|e| e.to_string())?;
         Ok(record.to_string())
     };
     match run() {

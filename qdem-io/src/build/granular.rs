@@ -19,16 +19,20 @@
 //! sample's stones then new ones (deposition in stages: a bed, then the sleepers laid on it,
 //! then the crib ballast poured around them).
 //!
-//! Each stone becomes a centre particle at its centre of mass with its mass (the union of its
-//! spheres at the material's density, [`clump_mass_properties`]) plus one massless member per
-//! sphere, which carries the sphere's contact radius.
+//! A stone of several spheres becomes a rigid body: a centre particle at its centre of mass
+//! with its mass (the union of its spheres at the material's density,
+//! [`clump_mass_properties`]) plus one massless member per sphere, which carries the sphere's
+//! contact radius. A one-sphere stone is one particle at the sphere's centre with that mass,
+//! which rotates ([`State::let_turn`]) with the moment of inertia J = tr(I)/3 (the sphere's
+//! isotropic I): it needs no orientation, and integrating it as a rigid body would carry a
+//! centre, a member and their passes for nothing.
 
 use crate::build::BuildError;
 use crate::csv_rows::{finite, read_text, rows};
 use crate::output::{write_atomic, OutputError};
 use crate::scene::{Granular, Scene};
 use qdem_contact::clump_sample::{
-    clump_mass_properties, generate_stones, Grading, SampleError, SampleSpec, Stone,
+    clump_mass_properties, generate_stones, Grading, MassProperties, SampleError, SampleSpec, Stone,
 };
 use qdem_contact::ContactSphere;
 use qdem_core::{State, Vec3};
@@ -40,7 +44,8 @@ use std::path::Path;
 pub struct GranularInfo {
     /// `[granular] name`.
     pub name: String,
-    /// Per stone: its centre particle and its member particles (one per sphere).
+    /// Per stone: its centre particle and its member particles (one per sphere); a one-sphere
+    /// stone is its own centre and only member.
     pub stones: Vec<(usize, Range<usize>)>,
     /// Radius of every member particle's sphere, in member order.
     pub radii: Vec<f64>,
@@ -118,7 +123,8 @@ pub(crate) fn stones(scene: &Scene, granular: &Granular) -> Result<Vec<Stone>, B
     Ok(stones)
 }
 
-/// Appends `stones` to `state` as rigid bodies and returns where they went and their contact
+/// Appends `stones` to `state` as rigid bodies (a one-sphere stone as a rotating particle) and
+/// returns where they went and their contact
 /// spheres (bodies numbered from `first_body`; `(material, density)`: the index of the
 /// `[granular]` material and its density). `scene` is the scene file, for messages.
 pub(crate) fn add_stones(
@@ -151,16 +157,14 @@ pub(crate) fn add_stones(
                 scene: scene.to_path_buf(),
                 source,
             })?;
-        let center = state.push_particle(props.center, Vec3::zeros(), props.mass);
         let members: Range<usize> = member..member + stone.centers.len();
-        let name = format!("{} stone {}", granular.name, k + 1);
-        let ids: Vec<usize> = members.clone().collect();
-        state
-            .add_rigid_body(&name, center, &ids, props.inertia)
-            .map_err(|source| BuildError::Core {
-                scene: scene.to_path_buf(),
-                source,
-            })?;
+        let center = if members.len() == 1 {
+            state.mass[member] = props.mass;
+            state.let_turn(member, props.inertia.trace() / 3.0);
+            member
+        } else {
+            add_clump(scene, state, &props, &members, &granular.name, k)?
+        };
         for p in members.clone() {
             spheres.push(ContactSphere {
                 particle: p,
@@ -173,6 +177,28 @@ pub(crate) fn add_stones(
         info.stones.push((center, members));
     }
     Ok((info, spheres))
+}
+
+/// Stone `k` of several spheres, on the particles `members`, as a rigid body: its centre
+/// particle, whose index is returned.
+fn add_clump(
+    scene: &Path,
+    state: &mut State,
+    props: &MassProperties,
+    members: &Range<usize>,
+    sample: &str,
+    k: usize,
+) -> Result<usize, BuildError> {
+    let center = state.push_particle(props.center, Vec3::zeros(), props.mass);
+    let name = format!("{} stone {}", sample, k + 1);
+    let ids: Vec<usize> = members.clone().collect();
+    state
+        .add_rigid_body(&name, center, &ids, props.inertia)
+        .map_err(|source| BuildError::Core {
+            scene: scene.to_path_buf(),
+            source,
+        })?;
+    Ok(center)
 }
 
 /// The header of a stones file.

@@ -68,7 +68,9 @@ pub(crate) fn wrap_groups(
     if let Some(g) = granular {
         for (center, members) in &g.stones {
             let mut particles: Vec<usize> = members.clone().collect();
-            particles.push(*center);
+            if !members.contains(center) {
+                particles.push(*center);
+            }
             groups.push(WrapGroup {
                 anchor: *center,
                 particles,

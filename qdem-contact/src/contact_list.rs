@@ -1,0 +1,177 @@
+//! The candidate list of a contact set: one record per candidate contact (a pair of spheres, or
+//! a sphere and a wall) holding everything a step reads and writes of it, so that the pair
+//! loop streams through one array and the gather touches one record per contact.
+//!
+//! A record keeps its partners, its tangential spring ξ, and this evaluation's results: the
+//! force f on the first partner, n × f and δ/2. The moment of the contact force about a
+//! partner's centre follows from them: the contact point lies at x_a + (r_a − δ/2) n, at a
+//! distance r − δ/2 from either centre along ∓n, so the moment on a is (r_a − δ/2) n × f and
+//! the moment on b, which feels −f, is (r_b − δ/2) n × f. The image translation of the second
+//! partner is kept for contacts through a periodic boundary (zero otherwise).
+
+use qdem_core::checkpoint::same_count;
+use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
+
+/// One candidate contact.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Contact {
+    /// The first partner (a sphere).
+    pub(crate) first: u32,
+    /// The second partner (a sphere after the first, or a wall).
+    pub(crate) second: u32,
+    /// Tangential spring elongation ξ (m).
+    pub(crate) history: Vec3,
+    /// Force on the first partner at the last evaluation (N), zero when apart.
+    pub(crate) force: Vec3,
+    /// n × f (N): the moment about a partner's centre per metre of lever.
+    pub(crate) turn: Vec3,
+    /// Half the overlap, δ/2 (m).
+    pub(crate) half_overlap: f64,
+    /// Image translation of the second partner (m).
+    pub(crate) shift: Vec3,
+}
+
+impl Contact {
+    /// Records a touching contact's force `force` with its normal and overlap.
+    #[inline]
+    pub(crate) fn touch(&mut self, force: Vec3, normal: &Vec3, overlap: f64) {
+        self.force = force;
+        self.turn = normal.cross(&force);
+        self.half_overlap = 0.5 * overlap;
+    }
+
+    /// Records a contact that is apart: no force, the spring released.
+    #[inline]
+    pub(crate) fn part(&mut self) {
+        self.history = Vec3::zeros();
+        self.force = Vec3::zeros();
+        self.turn = Vec3::zeros();
+        self.half_overlap = 0.0;
+    }
+
+    /// The moment about the centre of a partner of radius `radius` of the force `scale` f (or
+    /// −`scale` f on the second partner): (r − δ/2) `scale` n × f.
+    #[inline]
+    pub(crate) fn moment(&self, radius: f64, scale: f64) -> Vec3 {
+        ((radius - self.half_overlap) * scale) * self.turn
+    }
+}
+
+/// The records of a candidate list, sorted by partners.
+#[derive(Default)]
+pub(crate) struct ContactList {
+    /// The records.
+    pub(crate) items: Vec<Contact>,
+}
+
+impl ContactList {
+    /// Replaces the list by `keys`, sorted, keeping the springs of contacts that stay.
+    pub(crate) fn rebuild(&mut self, keys: Vec<(u32, u32)>) {
+        let old = std::mem::take(&mut self.items);
+        let mut at = 0;
+        self.items = keys
+            .iter()
+            .map(|&(first, second)| {
+                while at < old.len() && (old[at].first, old[at].second) < (first, second) {
+                    at += 1;
+                }
+                let kept = old
+                    .get(at)
+                    .filter(|c| (c.first, c.second) == (first, second));
+                Contact {
+                    first,
+                    second,
+                    history: kept.map_or(Vec3::zeros(), |c| c.history),
+                    ..Contact::default()
+                }
+            })
+            .collect();
+    }
+
+    /// Number of candidates.
+    pub(crate) fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// Writes the list into a checkpoint: partners, springs, forces and image translations
+    /// (n × f and δ/2 are rewritten by every evaluation before they are read).
+    pub(crate) fn save(&self, out: &mut Encoder) {
+        let column = |f: fn(&Contact) -> Vec3| self.items.iter().map(f).collect::<Vec<_>>();
+        out.u32s(&self.items.iter().map(|c| c.first).collect::<Vec<_>>());
+        out.u32s(&self.items.iter().map(|c| c.second).collect::<Vec<_>>());
+        out.vec3s(&column(|c| c.history));
+        out.vec3s(&column(|c| c.force));
+        out.vec3s(&column(|c| c.shift));
+    }
+
+    /// Reads back a list whose first partners index `0..firsts` and second partners
+    /// `0..seconds`.
+    pub(crate) fn restore(
+        input: &mut Decoder<'_>,
+        firsts: usize,
+        seconds: usize,
+    ) -> Result<ContactList, CheckpointError> {
+        let first = input.u32s("contact partners")?;
+        let second = input.u32s("contact partners")?;
+        same_count("contact partners", first.len(), second.len())?;
+        if let Some(k) =
+            (0..first.len()).find(|&k| first[k] as usize >= firsts || second[k] as usize >= seconds)
+        {
+            return Err(CheckpointError::Invalid {
+                what: "contact list",
+                detail: format!(
+                    "contact {k} joins {} and {}, beyond the scene's {firsts} spheres",
+                    first[k], second[k]
+                ),
+            });
+        }
+        let n = first.len();
+        let history = input.vec3s_exact(n, "tangential springs")?;
+        let force = input.vec3s_exact(n, "contact forces")?;
+        let shift = input.vec3s_exact(n, "image translations")?;
+        let items = (0..n)
+            .map(|k| Contact {
+                first: first[k],
+                second: second[k],
+                history: history[k],
+                force: force[k],
+                shift: shift[k],
+                ..Contact::default()
+            })
+            .collect();
+        Ok(ContactList { items })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_rebuild_keeps_the_springs_of_the_pairs_that_stay() {
+        let mut list = ContactList::default();
+        list.rebuild(vec![(0, 1), (0, 2), (1, 2)]);
+        for (k, c) in list.items.iter_mut().enumerate() {
+            c.history = Vec3::repeat(k as f64 + 1.0);
+        }
+        list.rebuild(vec![(0, 2), (1, 3)]);
+        assert_eq!(list.items[0].history, Vec3::repeat(2.0));
+        assert_eq!(list.items[1].history, Vec3::zeros());
+    }
+
+    #[test]
+    fn the_moments_on_both_partners_are_their_levers_times_n_cross_f() {
+        // Spheres of radii 2 and 1 overlapping by 0.5 along x: the contact point is 1.75 from
+        // a's centre and 0.75 from b's; a force f = (0, 3, 0) on a gives a the moment
+        // 1.75 x × f and b, which feels −f at 0.75 along −x, the moment 0.75 x × f.
+        let mut c = Contact::default();
+        let f = Vec3::new(0.0, 3.0, 0.0);
+        c.touch(f, &Vec3::x(), 0.5);
+        let point_from_a = 1.75 * Vec3::x();
+        let point_from_b = -0.75 * Vec3::x();
+        assert_eq!(c.moment(2.0, 1.0), point_from_a.cross(&f));
+        assert_eq!(c.moment(1.0, 1.0), point_from_b.cross(&-f));
+        c.part();
+        assert_eq!(c.moment(2.0, 1.0), Vec3::zeros());
+    }
+}
