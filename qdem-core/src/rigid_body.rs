@@ -276,18 +276,19 @@ fn principal_axes(inertia: Mat3) -> (Vec3, UnitQuaternion<f64>) {
 
 /// Puts every member at x = c + R s with velocity v = v_c + ω × R s.
 pub fn place_members(state: &mut State) {
-    let rigid = &state.rigid;
-    if rigid.member.is_empty() {
-        return;
-    }
-    let (position, velocity) = (&state.position, &state.velocity);
-    let placed: Vec<(Vec3, Vec3)> = (0..rigid.member.len())
-        .into_par_iter()
-        .map(|slot| rigid.placed(slot, position, velocity))
-        .collect();
-    for (&m, (x, v)) in state.rigid.member.iter().zip(placed) {
-        state.position[m] = x;
-        state.velocity[m] = v;
+    let State {
+        rigid,
+        position,
+        velocity,
+        ..
+    } = state;
+    // In place and in one serial pass: a member's pose reads only its body's centre, which is
+    // no member, and a pass of a few flops per member is cheaper than waking a worker (and
+    // allocates nothing).
+    for (slot, &m) in rigid.member.iter().enumerate() {
+        let (x, v) = rigid.placed(slot, position, velocity);
+        position[m] = x;
+        velocity[m] = v;
     }
 }
 
