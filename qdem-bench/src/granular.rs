@@ -382,6 +382,29 @@ pub fn bytes_per_sphere_step(candidates: f64) -> f64 {
     240.0 + 192.0 + 48.0 + 456.0 * candidates + 192.0 + 56.0 + 210.0
 }
 
+/// Initialises a Verlet stepper of step `dt` and times `steps` steps (the initial force
+/// evaluation excluded); returns the stepper and the wall seconds.
+fn timed_steps(
+    state: &mut State,
+    models: &mut [Box<dyn Model>],
+    dt: f64,
+    steps: usize,
+) -> Result<(Verlet, f64), GranularError> {
+    let mut stepper = Verlet::new(dt);
+    stepper.initialize(state, models)?;
+    let start = Instant::now();
+    for _ in 0..steps {
+        stepper.step(state, models)?;
+    }
+    Ok((stepper, start.elapsed().as_secs_f64()))
+}
+
+/// The packing's contact model, which its builders put first.
+fn first_contacts(models: &[Box<dyn Model>]) -> &DemContacts {
+    let model: &dyn std::any::Any = models[0].as_ref();
+    model.downcast_ref::<DemContacts>().expect("contacts first")
+}
+
 /// Times `steps` Verlet steps of the packing with its spheres replaced by clumps
 /// ([`Packing::build_clumps`]), with the packing's own step, and returns the JSON record:
 /// particle-steps/s counts the contact spheres, clump-steps/s the clumps.
@@ -392,15 +415,8 @@ pub fn clump_throughput(packing: &Packing, steps: usize) -> Result<Value, Granul
         time_step(&state, &models)
     };
     let bound = qdem_core::stable_step(&state, &models).map_or(f64::INFINITY, |b| b.0);
-    let mut stepper = Verlet::new(dt.min(0.9 * bound));
-    stepper.initialize(&mut state, &mut models)?;
-    let start = Instant::now();
-    for _ in 0..steps {
-        stepper.step(&mut state, &mut models)?;
-    }
-    let seconds = start.elapsed().as_secs_f64();
-    let model: &dyn std::any::Any = models[0].as_ref();
-    let contacts = model.downcast_ref::<DemContacts>().expect("contacts first");
+    let (stepper, seconds) = timed_steps(&mut state, &mut models, dt.min(0.9 * bound), steps)?;
+    let contacts = first_contacts(&models);
     let clumps = packing.centers.len();
     Ok(json!({
         "code": "qdem",
@@ -425,15 +441,8 @@ pub fn throughput(packing: &Packing, steps: usize) -> Result<Value, GranularErro
     let (mut state, mut models) = packing.build();
     let dt = time_step(&state, &models);
     let bound = qdem_core::stable_step(&state, &models).map_or(f64::INFINITY, |b| b.0);
-    let mut stepper = Verlet::new(dt);
-    stepper.initialize(&mut state, &mut models)?;
-    let start = Instant::now();
-    for _ in 0..steps {
-        stepper.step(&mut state, &mut models)?;
-    }
-    let seconds = start.elapsed().as_secs_f64();
-    let model: &dyn std::any::Any = models[0].as_ref();
-    let contacts = model.downcast_ref::<DemContacts>().expect("contacts first");
+    let (_, seconds) = timed_steps(&mut state, &mut models, dt, steps)?;
+    let contacts = first_contacts(&models);
     let n = packing.centers.len();
     let candidates = contacts.candidates() as f64 / n as f64;
     Ok(json!({
