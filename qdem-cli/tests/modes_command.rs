@@ -43,7 +43,7 @@ fn rows(csv: &str) -> Vec<(f64, String, String)> {
         .skip(1)
         .map(|line| {
             let cells: Vec<&str> = line.split(',').collect();
-            assert_eq!(cells.len(), 11, "{line}");
+            assert_eq!(cells.len(), 14, "{line}");
             (cells[1].parse().unwrap(), cells[2].into(), cells[3].into())
         })
         .collect()
@@ -53,20 +53,32 @@ fn rows(csv: &str) -> Vec<(f64, String, String)> {
 fn free_beam_lists_six_rigid_modes_first_then_its_elastic_modes() {
     let dir = TempDir::new("modes-free");
     let out = modes(&scene(dir.path(), false), "9", &dir.path().join("out"));
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let csv = std::fs::read_to_string(dir.path().join("out/modes.csv")).unwrap();
-    assert_eq!(String::from_utf8_lossy(&out.stdout), csv, "the table printed is the file");
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        csv,
+        "the table printed is the file"
+    );
     assert!(csv.starts_with(
-        "mode,frequency_hz,kind,direction,participation,mass_x,mass_y,mass_z,mass_rx,mass_ry,mass_rz\n"
+        "mode,frequency_hz,kind,direction,participation,mass_x,mass_y,mass_z,mass_rx,mass_ry,mass_rz,motion_x,motion_y,motion_z\n"
     ));
     let rows = rows(&csv);
     assert_eq!(rows.len(), 9);
-    assert!(rows[..6].iter().all(|(f, kind, _)| *f < 1.0 && kind == "rigid"));
+    assert!(rows[..6]
+        .iter()
+        .all(|(f, kind, _)| *f < 1.0 && kind == "rigid"));
     let mut directions: Vec<&str> = rows[..6].iter().map(|r| r.2.as_str()).collect();
     directions.sort_unstable();
     assert_eq!(directions, ["rx", "ry", "rz", "x", "y", "z"]);
     // The free-free beam's first bending mode: well above the clamped one's 27 Hz.
-    assert!(rows[6..].iter().all(|(f, kind, _)| *f > 100.0 && kind == "elastic"));
+    assert!(rows[6..]
+        .iter()
+        .all(|(f, kind, _)| *f > 100.0 && kind == "elastic"));
     assert!(rows.windows(2).skip(5).all(|w| w[0].0 <= w[1].0));
     let pvd = std::fs::read_to_string(dir.path().join("out/modes.pvd")).unwrap();
     for k in 1..=9 {
@@ -80,7 +92,11 @@ fn free_beam_lists_six_rigid_modes_first_then_its_elastic_modes() {
 fn clamped_beam_bends_vertically_first() {
     let dir = TempDir::new("modes-clamped");
     let out = modes(&scene(dir.path(), true), "2", &dir.path().join("out"));
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let rows = rows(&String::from_utf8_lossy(&out.stdout));
     // The 0.22 m depth is the smaller: vertical (z) bending is the lowest mode, lateral (y)
     // the next; the coarse linear tets are stiff, so both lie above the converged 26.9 and
@@ -109,5 +125,8 @@ fn zero_modes_is_a_usage_error() {
     let out = modes(&scene(dir.path(), true), "0", &dir.path().join("out"));
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("--count") && stderr.contains("positive whole number"), "{stderr}");
+    assert!(
+        stderr.contains("--count") && stderr.contains("positive whole number"),
+        "{stderr}"
+    );
 }

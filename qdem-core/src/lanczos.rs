@@ -128,6 +128,10 @@ pub struct Mode {
     /// Effective modal mass fractions along x, y, z and about the axes x, y, z through the mass
     /// centre ([`DIRECTIONS`]).
     pub participation: [f64; 6],
+    /// Share of the mode's kinetic energy in x, y and z motion, Σ m u_d² / Σ m |u|² (sums to
+    /// 1): what tells the elastic modes of a free body apart, whose effective masses are all
+    /// zero (vertical bending is z motion, lateral bending and torsion y, extension x).
+    pub motion: [f64; 3],
 }
 
 impl Mode {
@@ -425,6 +429,16 @@ impl Problem {
                 0.0
             };
         }
+        let mut motion = [0.0; 3];
+        for ((&d, v), m) in self.global.iter().zip(&x).zip(&self.mass) {
+            if d / 3 < self.particles {
+                motion[d % 3] += m * v * v;
+            }
+        }
+        let total: f64 = motion.iter().sum();
+        motion
+            .iter_mut()
+            .for_each(|e| *e /= total.max(f64::MIN_POSITIVE));
         let mut shape = vec![Vec3::zeros(); self.particles];
         for (&d, v) in self.global.iter().zip(&x) {
             if d / 3 < self.particles {
@@ -437,6 +451,7 @@ impl Problem {
             rigid,
             shape,
             participation,
+            motion,
         }
     }
 }

@@ -2,11 +2,12 @@
 //! and their files.
 //!
 //! - `modes.csv`: one row per mode, `mode,frequency_hz,kind,direction,participation,mass_x,
-//!   mass_y,mass_z,mass_rx,mass_ry,mass_rz`: `kind` is `rigid` (a rigid-body mode of a body
+//!   mass_y,mass_z,mass_rx,mass_ry,mass_rz,motion_x,motion_y,motion_z`: `kind` is `rigid` (a rigid-body mode of a body
 //!   with no fixity, frequency zero to rounding) or `elastic`; `mass_*` are the effective
 //!   modal mass fractions along x, y, z and about the axes x, y, z through the mass centre
 //!   (each column sums to 1 over all modes); `direction` and `participation` are the largest
-//!   of them.
+//!   of them; `motion_*` the shares of the mode's kinetic energy in x, y and z motion (they
+//!   tell apart the elastic modes of a free body, whose effective masses are all zero).
 //! - `vtu/mode_NNNN.vtu`: the mode shape as the point vector `mode_shape`, scaled so that its
 //!   largest particle displacement is 1 (warp by it with the amplitude you want, in metres),
 //!   on the reference positions; indexed by `modes.pvd`, whose "time" is the mode number.
@@ -120,7 +121,7 @@ fn deformable_tets(sim: &Simulation) -> Vec<[u32; 4]> {
 
 /// The header of `modes.csv`.
 pub const MODES_HEADER: &str = "mode,frequency_hz,kind,direction,participation,mass_x,mass_y,\
-                                mass_z,mass_rx,mass_ry,mass_rz";
+                                mass_z,mass_rx,mass_ry,mass_rz,motion_x,motion_y,motion_z";
 
 /// Writes the modes' table as `modes.csv` holds it.
 pub fn write_table(w: &mut dyn Write, modes: &Modes) -> std::io::Result<()> {
@@ -136,7 +137,7 @@ pub fn write_table(w: &mut dyn Write, modes: &Modes) -> std::io::Result<()> {
             DIRECTIONS[direction],
             share
         )?;
-        for p in mode.participation {
+        for p in mode.participation.iter().chain(&mode.motion) {
             write!(w, ",{p:.6}")?;
         }
         writeln!(w)?;
