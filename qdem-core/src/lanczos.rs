@@ -11,13 +11,16 @@
 //!   is positive definite even for a body free to move rigidly, the eigenvalues θ of the
 //!   operator A⁻¹M, self-adjoint in the M inner product ⟨x, y⟩ = xᵀMy, are θ = 1/(ω² − σ):
 //!   the lowest ω² become the largest, best separated θ. A is factorised once with faer's
-//!   sparse Cholesky ([`crate::sparse::SparseCholesky`]); each Lanczos step is one pair of
+//!   sparse Cholesky (the crate's `sparse::SparseCholesky`); each Lanczos step is one pair of
 //!   triangular solves.
 //! - Lanczos in the M inner product (Golub & Van Loan §10.1, with full reorthogonalisation:
 //!   classical Gram–Schmidt twice against every earlier vector): A⁻¹M Q_m = Q_m T_m +
 //!   β_m q_{m+1} e_mᵀ, T_m tridiagonal. A Ritz pair (θ, Q_m y) of T_m y = θ y has residual
 //!   norm |β_m y_m|, so an eigenvalue is accepted when |β_m y_m| ≤ [`TOLERANCE`] · θ; then
-//!   |θ − θ_true| ≤ (β_m y_m)²/gap, far below the tolerance.
+//!   |θ − θ_true| ≤ (β_m y_m)²/gap, far below the tolerance. T_m is taken as the
+//!   projection QᵀM A⁻¹M Q from every Gram–Schmidt coefficient (tridiagonal to rounding), so
+//!   the Ritz pairs stay a Rayleigh–Ritz projection also near the end of the space; when a
+//!   Krylov space closes (β ≈ 0) Lanczos continues from a fresh vector orthogonal to it.
 //! - Rigid-body modes: a deformable body with no fixed direction has six exact zero modes (3
 //!   translations, 3 small rotations about its mass centre, K r = 0 for the linear-tet K).
 //!   Single-vector Lanczos finds only one vector of a repeated eigenvalue, so these are not
@@ -509,6 +512,9 @@ fn collect_stiffness(
     ignored
 }
 
+/// A Ritz value θ and its vector.
+type RitzPair = (f64, Vec<f64>);
+
 /// A deterministic start vector (a fixed xorshift sequence in (−1, 1)).
 fn start_vector(n: usize) -> Vec<f64> {
     let mut s: u64 = 0x9E37_79B9_7F4A_7C15;
@@ -529,7 +535,7 @@ fn lanczos(
     solver: &mut ShiftInvert,
     rigid: &[Vec<f64>],
     wanted: usize,
-) -> Result<(Vec<(f64, Vec<f64>)>, usize), ModalError> {
+) -> Result<(Vec<RitzPair>, usize), ModalError> {
     let space = problem.dofs.len() - rigid.len();
     let max_steps = space.min(10 * wanted + 60);
     let mut q = start_vector(problem.dofs.len());
@@ -539,7 +545,7 @@ fn lanczos(
     let mut basis = vec![q];
     // Column j: the coefficients of A⁻¹M q_j along q_0..q_j (both Gram–Schmidt passes).
     let mut columns: Vec<Vec<f64>> = Vec::new();
-    let mut restarts = 1u64;
+    let mut restarts = 1usize;
     loop {
         let j = basis.len() - 1;
         let mut w = solver.apply(&problem.mass, &basis[j]);
@@ -568,7 +574,7 @@ fn lanczos(
         }
         if b <= 1e-10 * scale {
             // An invariant subspace: continue from a fresh vector orthogonal to it.
-            w = start_vector(problem.dofs.len() + restarts as usize).split_off(restarts as usize);
+            w = start_vector(problem.dofs.len() + restarts).split_off(restarts);
             restarts += 1;
             problem.orthogonalize(&mut w, rigid, &basis);
         }
@@ -583,7 +589,7 @@ fn lanczos(
 /// decreasing θ with their eigenvectors, and how many of the first `wanted` have converged
 /// given the norm `next` of the next Lanczos vector before normalisation: the residual of a
 /// Ritz pair (θ, Qy) is `next`·|y_m|.
-fn ritz_pairs(columns: &[Vec<f64>], next: f64, wanted: usize) -> (usize, Vec<(f64, Vec<f64>)>) {
+fn ritz_pairs(columns: &[Vec<f64>], next: f64, wanted: usize) -> (usize, Vec<RitzPair>) {
     let m = columns.len();
     // H[r][c] for r ≤ c is ⟨q_r, A⁻¹M q_c⟩_M; the operator is M-self-adjoint, so the
     // upper triangle, mirrored, is the projection (its subdiagonal, the norms that
@@ -592,7 +598,7 @@ fn ritz_pairs(columns: &[Vec<f64>], next: f64, wanted: usize) -> (usize, Vec<(f6
     let eigen = SymmetricEigen::new(t);
     let mut order: Vec<usize> = (0..m).collect();
     order.sort_by(|&a, &b| eigen.eigenvalues[b].total_cmp(&eigen.eigenvalues[a]));
-    let pairs: Vec<(f64, Vec<f64>)> = order
+    let pairs: Vec<RitzPair> = order
         .iter()
         .map(|&k| {
             let y = eigen.eigenvectors.column(k).iter().copied().collect();
