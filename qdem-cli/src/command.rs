@@ -1,4 +1,4 @@
-//! The command line (clap's derive API: [`Cli`]) and the five commands. Values are checked as
+//! The command line (clap's derive API: [`Cli`]) and the six commands. Values are checked as
 //! they are parsed, so that a bad argument is refused before any work, naming its flag. Errors
 //! from the libraries are rendered once, by `main`, through [`CliError`]'s `Display`.
 
@@ -37,6 +37,9 @@ pub enum CliError {
     /// A measurement of `qdem bench --implicit` failed.
     #[error(transparent)]
     Bench(#[from] CoreError),
+    /// A modal analysis that could not be made.
+    #[error(transparent)]
+    Modes(#[from] qdem_io::modes::ModesError),
     /// An analysis that could not be made.
     #[error(transparent)]
     Analyze(#[from] qdem_io::analyze::AnalyzeError),
@@ -110,6 +113,31 @@ pub enum Command {
     /// spectra smoothed by the Parzen window (20 Hz bandwidth by default) and the mobility over
     /// the scene's series loads.
     Analyze(AnalyzeArgs),
+    /// Natural frequencies and mode shapes of the scene's deformable bodies
+    ///
+    /// The N lowest modes about the reference configuration (the tetrahedra's linear stiffness,
+    /// the lumped masses, the scene's fixes) by shift-invert Lanczos: DIR/modes.csv (frequency,
+    /// dominant direction, effective mass fractions), DIR/modes.pvd and DIR/vtu/mode_NNNN.vtu.
+    /// A body with no fix reports its six rigid-body modes first. Contacts add no stiffness
+    /// (a note says so); rigid bodies are refused.
+    Modes(ModesArgs),
+}
+
+/// `qdem modes`.
+#[derive(Debug, Args)]
+pub struct ModesArgs {
+    /// The scene file (TOML)
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+    /// Number of modes, rigid-body modes included
+    #[arg(long, value_name = "N", value_parser = positive_whole, default_value_t = 10)]
+    pub count: usize,
+    /// Output directory [default: the scene's [output] dir, then modes/]
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Worker threads [default: one per core]
+    #[arg(long, value_name = "N", value_parser = thread_count)]
+    pub threads: Option<usize>,
 }
 
 /// `qdem run`.
@@ -254,6 +282,9 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Run(a) => thread_pool(a.threads)?
             .install(|| run_scene(&a.scene, a.out.as_deref(), a.resume.as_deref())),
+        Command::Modes(a) => {
+            thread_pool(a.threads)?.install(|| modes_of(&a.scene, a.count, a.out.as_deref()))
+        }
         Command::Check(a) => thread_pool(a.threads)?.install(|| check::check_scene(&a.scene)),
         Command::Analyze(a) => {
             let options = AnalyzeOptions {
@@ -310,6 +341,40 @@ fn analyze_run(path: &Path, out: Option<&Path>, options: &AnalyzeOptions) -> Res
         println!("no `series` load in the scene: mobility not computed");
     }
     println!("spectra, mobility and plots in {}", a.dir.display());
+    Ok(())
+}
+
+/// `qdem modes`: builds the scene, computes and writes the modes, prints the table.
+fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliError> {
+    let scene = Scene::load(path)?;
+    let out_dir = match out {
+        Some(dir) => dir.to_path_buf(),
+        None => scene.base_dir().join(&scene.output.dir).join("modes"),
+    };
+    let sim = Simulation::build(scene)?;
+    for w in &sim.warnings {
+        eprintln!("warning: {w}");
+    }
+    let report = qdem_io::modes::compute_and_write(&sim, count, &out_dir)?;
+    for name in &report.ignored {
+        eprintln!("note: model `{name}` gives no stiffness and is left out of the modes");
+    }
+    let m = &report.modes;
+    eprintln!(
+        "qdem modes {}: {} free DOFs, K factorised in {:.2} s, {} Lanczos steps",
+        path.display(),
+        m.dofs,
+        m.factor_seconds,
+        m.steps
+    );
+    let mut table = Vec::new();
+    qdem_io::modes::write_table(&mut table, m).expect("writing to memory");
+    print!("{}", String::from_utf8_lossy(&table));
+    eprintln!(
+        "{} and {} written",
+        report.csv.display(),
+        report.pvd.display()
+    );
     Ok(())
 }
 

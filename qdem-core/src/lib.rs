@@ -24,6 +24,7 @@ pub mod checkpoint;
 pub mod error;
 pub mod gravity;
 pub mod instability;
+pub mod lanczos;
 pub mod linear_tet;
 pub mod local_damping;
 pub mod material;

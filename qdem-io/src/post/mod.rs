@@ -6,5 +6,6 @@
 pub mod analyze;
 pub mod crack_svg;
 pub mod linear_spectrum;
+pub mod modes;
 pub mod plot;
 pub mod spectrum;

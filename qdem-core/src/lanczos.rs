@@ -1,0 +1,623 @@
+//! Natural frequencies and mode shapes by shift-invert Lanczos: the lowest eigenpairs of
+//! K φ = ω² M φ about the reference configuration.
+//!
+//! - K is the models' tangent stiffness at the reference state ([`crate::Linearized`]; for
+//!   QDEM tetrahedra the small-strain linear-tet stiffness, so these are the mesh's linear FEM
+//!   modes with lumped mass), M the lumped mass (a quarter of each tetrahedron's mass to each
+//!   vertex), both over the free DOFs of the deformable bodies' particles (fixed directions
+//!   are eliminated as in the static solve, paper 001 Eq. 23). Models without a linearisation
+//!   (DEM contacts) add nothing and are listed in [`Modes::ignored`].
+//! - Shift and invert (Ericsson & Ruhe 1980): with A = K − σM, σ = −(2π · 1 Hz)² < 0 so that A
+//!   is positive definite even for a body free to move rigidly, the eigenvalues θ of the
+//!   operator A⁻¹M, self-adjoint in the M inner product ⟨x, y⟩ = xᵀMy, are θ = 1/(ω² − σ):
+//!   the lowest ω² become the largest, best separated θ. A is factorised once with faer's
+//!   sparse Cholesky (the crate's `sparse::SparseCholesky`); each Lanczos step is one pair of
+//!   triangular solves.
+//! - Lanczos in the M inner product (Golub & Van Loan §10.1, with full reorthogonalisation:
+//!   classical Gram–Schmidt twice against every earlier vector): A⁻¹M Q_m = Q_m T_m +
+//!   β_m q_{m+1} e_mᵀ, T_m tridiagonal. A Ritz pair (θ, Q_m y) of T_m y = θ y has residual
+//!   norm |β_m y_m|, so an eigenvalue is accepted when |β_m y_m| ≤ [`TOLERANCE`] · θ; then
+//!   |θ − θ_true| ≤ (β_m y_m)²/gap, far below the tolerance. T_m is taken as the
+//!   projection QᵀM A⁻¹M Q from every Gram–Schmidt coefficient (tridiagonal to rounding), so
+//!   the Ritz pairs stay a Rayleigh–Ritz projection also near the end of the space; when a
+//!   Krylov space closes (β ≈ 0) Lanczos continues from a fresh vector orthogonal to it.
+//! - Rigid-body modes: a deformable body with no fixed direction has six exact zero modes (3
+//!   translations, 3 small rotations about its mass centre, K r = 0 for the linear-tet K).
+//!   Single-vector Lanczos finds only one vector of a repeated eigenvalue, so these are not
+//!   iterated: they are formed directly, M-orthonormalised, reported first (with their
+//!   Rayleigh quotient rᵀKr/rᵀMr, zero to rounding) and projected out of every Lanczos vector,
+//!   which then iterates in their M-orthogonal complement. A body that is fixed in some
+//!   directions but still free to move rigidly is refused ([`ModalError::PartlyConstrained`]).
+//!   Other exactly repeated eigenvalues (a square section's two bending planes) are likewise
+//!   found once only: give such test geometries distinct dimensions.
+//! - Participation: for an M-normalised mode φ and a unit rigid motion r_d (translation along
+//!   x, y, z or rotation about the axes through the mass centre, restricted to the free DOFs),
+//!   the effective modal mass fraction is Γ_d² / (r_dᵀ M r_d) with Γ_d = φᵀ M r_d; over all
+//!   modes the fractions of each direction sum to 1 (the modes are an M-orthonormal basis of
+//!   the free DOFs). The direction with the largest fraction is the mode's dominant direction.
+
+use crate::error::CoreError;
+use crate::model::Model;
+use crate::sparse::{unconstrained_bodies, Assembler, FreeDofs, Scales, SparseCholesky, Tangent};
+use crate::state::{Dofs, State};
+use crate::Vec3;
+use nalgebra::{DMatrix, SymmetricEigen};
+use std::f64::consts::PI;
+use thiserror::Error;
+
+/// Relative residual |β_m y_m| / θ below which a Ritz value counts as converged.
+pub const TOLERANCE: f64 = 1e-12;
+
+/// Frequency of the shift σ = −(2π f)² (Hz): makes K − σM positive definite for free bodies.
+pub const SHIFT_HZ: f64 = 1.0;
+
+/// Names of the participation directions, in the order of [`Mode::participation`].
+pub const DIRECTIONS: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
+
+/// Everything a modal analysis refuses.
+#[derive(Debug, Error)]
+pub enum ModalError {
+    /// No model has particles with stiffness (no deformable body).
+    #[error(
+        "nothing deformable: no model gives a stiffness to particles with mass, so there are no \
+         natural modes to compute (add a deformable [[body]] with a tetrahedral mesh)"
+    )]
+    NothingDeformable,
+    /// Zero modes asked for.
+    #[error("asked for 0 modes: give a count of at least 1")]
+    ZeroCount,
+    /// More modes than free degrees of freedom.
+    #[error(
+        "asked for {count} modes, but the deformable bodies have only {dofs} free degrees of \
+         freedom: give a count of at most {dofs}"
+    )]
+    TooManyModes {
+        /// Modes asked for.
+        count: usize,
+        /// Free DOFs.
+        dofs: usize,
+    },
+    /// The scene has rigid bodies (6-DOF stones), which the analysis does not take.
+    #[error(
+        "the scene has {count} rigid bodies; modal analysis takes deformable bodies only: \
+         remove them or make them deformable"
+    )]
+    RigidBodies {
+        /// How many.
+        count: usize,
+    },
+    /// A body fixed in some directions but still free to move rigidly.
+    #[error(
+        "body `{body}` is fixed in some directions but {modes} of its 6 rigid-body modes are \
+         still free: either fix it against rigid motion (at least 3 non-collinear particles or \
+         a face, with [[fix]]) or remove its fixes to get its free-free modes"
+    )]
+    PartlyConstrained {
+        /// The body's name.
+        body: String,
+        /// Free rigid-body modes.
+        modes: usize,
+    },
+    /// Lanczos stopped before the wanted modes converged.
+    #[error(
+        "Lanczos did not converge: {converged} of {wanted} modes after {steps} steps; ask for \
+         fewer modes"
+    )]
+    NotConverged {
+        /// Modes converged.
+        converged: usize,
+        /// Modes wanted (excluding rigid-body modes).
+        wanted: usize,
+        /// Lanczos steps taken.
+        steps: usize,
+    },
+    /// The factorisation or the assembly failed.
+    #[error(transparent)]
+    Core(#[from] CoreError),
+}
+
+/// One natural mode.
+#[derive(Clone, Debug)]
+pub struct Mode {
+    /// ω² (rad²/s²); for a rigid-body mode its Rayleigh quotient (zero to rounding).
+    pub eigenvalue: f64,
+    /// Natural frequency √max(ω², 0) / 2π (Hz).
+    pub frequency_hz: f64,
+    /// Whether this is a rigid-body mode of a body with no fixity.
+    pub rigid: bool,
+    /// The mode shape, M-normalised (φᵀMφ = 1), one vector per particle (zero where fixed
+    /// and on particles of no deformable body).
+    pub shape: Vec<Vec3>,
+    /// Effective modal mass fractions along x, y, z and about the axes x, y, z through the mass
+    /// centre ([`DIRECTIONS`]).
+    pub participation: [f64; 6],
+    /// Share of the mode's kinetic energy in x, y and z motion, Σ m u_d² / Σ m |u|² (sums to
+    /// 1): what tells the elastic modes of a free body apart, whose effective masses are all
+    /// zero (vertical bending is z motion, lateral bending and torsion y, extension x).
+    pub motion: [f64; 3],
+}
+
+impl Mode {
+    /// The direction with the largest effective mass fraction (index into [`DIRECTIONS`]) and
+    /// that fraction.
+    pub fn dominant(&self) -> (usize, f64) {
+        self.participation.iter().copied().enumerate().fold(
+            (0, f64::NEG_INFINITY),
+            |best, (d, p)| {
+                if p > best.1 {
+                    (d, p)
+                } else {
+                    best
+                }
+            },
+        )
+    }
+}
+
+/// The result of [`natural_modes`].
+#[derive(Clone, Debug)]
+pub struct Modes {
+    /// The modes by increasing frequency, rigid-body modes first.
+    pub modes: Vec<Mode>,
+    /// Free degrees of freedom of the eigenproblem.
+    pub dofs: usize,
+    /// Models that gave no stiffness and were left out (contacts, say).
+    pub ignored: Vec<String>,
+    /// Lanczos steps taken.
+    pub steps: usize,
+    /// Wall time of the assembly and factorisation of K − σM (s).
+    pub factor_seconds: f64,
+}
+
+/// The `count` lowest natural modes of the deformable bodies of `models` about the reference
+/// positions of `state`, with the lumped masses and the fixity of `state`.
+///
+/// ```
+/// use qdem_core::lanczos::natural_modes;
+/// use qdem_core::{Dofs, Material, Model, State, TetBody, Vec3};
+///
+/// // One tetrahedron, three vertices fixed: 3 free DOFs, 3 modes.
+/// let nodes = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];
+/// let body = TetBody::new("tet", &nodes, vec![[0, 1, 2, 3]], Material::elastic(1000.0, 1e6, 0.25))?;
+/// let mut state = State::at_rest(nodes);
+/// body.lump_mass(&mut state.mass);
+/// state.fixed[..3].fill(Dofs::ALL);
+/// let models: Vec<Box<dyn Model>> = vec![Box::new(body)];
+/// let modes = natural_modes(&state, &models, 3)?;
+/// assert_eq!(modes.modes.len(), 3);
+/// assert!(modes.modes.windows(2).all(|w| w[0].frequency_hz <= w[1].frequency_hz));
+/// # Ok::<(), qdem_core::lanczos::ModalError>(())
+/// ```
+pub fn natural_modes(
+    state: &State,
+    models: &[Box<dyn Model>],
+    count: usize,
+) -> Result<Modes, ModalError> {
+    if !state.rigid.is_empty() {
+        return Err(ModalError::RigidBodies {
+            count: state.rigid.len(),
+        });
+    }
+    if count == 0 {
+        return Err(ModalError::ZeroCount);
+    }
+    let mut reference = state.clone();
+    reference.position.clone_from(&state.reference);
+    let problem = Problem::new(&reference, models)?;
+    if count > problem.dofs.len() {
+        return Err(ModalError::TooManyModes {
+            count,
+            dofs: problem.dofs.len(),
+        });
+    }
+    let rigid = problem.rigid_basis(&reference, models)?;
+    let start = std::time::Instant::now();
+    let mut solver = ShiftInvert::new(&problem)?;
+    let factor_seconds = start.elapsed().as_secs_f64();
+    let mut modes: Vec<Mode> = rigid
+        .iter()
+        .take(count)
+        .map(|r| problem.mode(problem.rayleigh(r), r.clone(), true))
+        .collect();
+    let wanted = count - modes.len();
+    let mut steps = 0;
+    if wanted > 0 {
+        let (pairs, taken) = lanczos(&problem, &mut solver, &rigid, wanted)?;
+        steps = taken;
+        let shift = solver.shift;
+        modes.extend(
+            pairs
+                .into_iter()
+                .map(|(theta, x)| problem.mode(1.0 / theta + shift, x, false)),
+        );
+    }
+    Ok(Modes {
+        modes,
+        dofs: problem.dofs.len(),
+        ignored: problem.ignored,
+        steps,
+        factor_seconds,
+    })
+}
+
+/// K, M and the free DOFs of the eigenproblem, with what the outputs need.
+struct Problem {
+    tangent: Tangent,
+    node_mass: Vec<f64>,
+    dofs: FreeDofs,
+    /// Lumped mass of each system DOF.
+    mass: Vec<f64>,
+    /// For each system DOF, its global DOF.
+    global: Vec<usize>,
+    /// Particles (not rotations) in the state.
+    particles: usize,
+    /// Unit rigid motions (6 directions) over the system DOFs.
+    directions: Vec<Vec<f64>>,
+    ignored: Vec<String>,
+}
+
+impl Problem {
+    /// Collects K from every model with a linearisation and the free DOFs of their particles.
+    fn new(state: &State, models: &[Box<dyn Model>]) -> Result<Problem, ModalError> {
+        let mut tangent = Tangent::new();
+        let ignored = collect_stiffness(state, models, &mut tangent);
+        let n = state.len();
+        let mut in_body = vec![false; n];
+        for l in models.iter().filter_map(|m| m.linearized()) {
+            for p in l.particles() {
+                in_body[p] = true;
+            }
+        }
+        let mut fixity = state.node_fixity();
+        for (node, fixed) in fixity.iter_mut().enumerate() {
+            if !in_body[node % n.max(1)] {
+                *fixed = Dofs::ALL;
+            }
+        }
+        let dofs = FreeDofs::new(&fixity);
+        if dofs.len() == 0 || tangent.stiffness_entries().is_empty() {
+            return Err(ModalError::NothingDeformable);
+        }
+        let node_mass = state.node_mass();
+        let global: Vec<usize> = (0..3 * fixity.len())
+            .filter(|&d| dofs.index(d).is_some())
+            .collect();
+        let mass: Vec<f64> = global.iter().map(|&d| node_mass[d / 3]).collect();
+        let mut problem = Problem {
+            tangent,
+            node_mass,
+            dofs,
+            mass,
+            global,
+            particles: n,
+            directions: Vec::new(),
+            ignored,
+        };
+        problem.directions = problem.unit_motions(state, None);
+        Ok(problem)
+    }
+
+    /// The six unit rigid motions (translations along x, y, z, rotations about axes through
+    /// the mass centre) over the system DOFs, of the particles `only` where given (else of
+    /// all).
+    fn unit_motions(&self, state: &State, only: Option<&[bool]>) -> Vec<Vec<f64>> {
+        let n = self.particles;
+        let node = |d: usize| (d / 3) % n;
+        let included = |d: usize| only.is_none_or(|o| o[node(d)]);
+        let (mut centre, mut total) = (Vec3::zeros(), 0.0);
+        for (i, &d) in self.global.iter().enumerate() {
+            if included(d) && d / 3 < n {
+                centre += self.mass[i] * state.reference[node(d)];
+                total += self.mass[i];
+            }
+        }
+        let centre = centre / total.max(f64::MIN_POSITIVE);
+        (0..6)
+            .map(|k| {
+                self.global
+                    .iter()
+                    .map(|&d| {
+                        if !included(d) {
+                            return 0.0;
+                        }
+                        let axis = d % 3;
+                        let spin = d / 3 >= n;
+                        if k < 3 {
+                            return if axis == k && !spin { 1.0 } else { 0.0 };
+                        }
+                        let omega = Vec3::ith(k - 3, 1.0);
+                        if spin {
+                            omega[axis]
+                        } else {
+                            omega.cross(&(state.reference[node(d)] - centre))[axis]
+                        }
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The M-orthonormal rigid-body modes of the bodies with no fixity; refuses a body fixed
+    /// in some directions but free to move rigidly.
+    fn rigid_basis(
+        &self,
+        state: &State,
+        models: &[Box<dyn Model>],
+    ) -> Result<Vec<Vec<f64>>, ModalError> {
+        let mut basis: Vec<Vec<f64>> = Vec::new();
+        for (body, modes) in unconstrained_bodies(state, models, &self.tangent, &self.dofs) {
+            let model = models.iter().find(|m| m.name() == body);
+            let particles = model
+                .and_then(|m| m.linearized())
+                .map_or_else(Vec::new, |l| l.particles());
+            let fixed = particles
+                .iter()
+                .any(|&p| (0..3).any(|a| self.dofs.index(3 * p + a).is_none()));
+            if fixed || modes < 6 {
+                return Err(ModalError::PartlyConstrained { body, modes });
+            }
+            let mut only = vec![false; self.particles];
+            for p in particles {
+                only[p] = true;
+            }
+            for mut r in self.unit_motions(state, Some(&only)) {
+                self.orthogonalize(&mut r, &basis, &[]);
+                let norm = self.norm(&r);
+                if norm > 0.0 {
+                    r.iter_mut().for_each(|x| *x /= norm);
+                    basis.push(r);
+                }
+            }
+        }
+        Ok(basis)
+    }
+
+    /// ⟨x, y⟩_M.
+    fn inner(&self, x: &[f64], y: &[f64]) -> f64 {
+        x.iter()
+            .zip(y)
+            .zip(&self.mass)
+            .map(|((a, b), m)| a * m * b)
+            .sum()
+    }
+
+    fn norm(&self, x: &[f64]) -> f64 {
+        self.inner(x, x).sqrt()
+    }
+
+    /// Removes from `x` its M-components along the M-orthonormal vectors of `fixed` and
+    /// `basis` together (classical Gram–Schmidt, twice), returning the coefficients removed
+    /// along `basis`.
+    fn orthogonalize(&self, x: &mut [f64], fixed: &[Vec<f64>], basis: &[Vec<f64>]) -> Vec<f64> {
+        let mut total = vec![0.0; basis.len()];
+        for _ in 0..2 {
+            let h: Vec<f64> = fixed
+                .iter()
+                .chain(basis)
+                .map(|q| self.inner(q, x))
+                .collect();
+            for (q, c) in fixed.iter().chain(basis).zip(&h) {
+                x.iter_mut().zip(q).for_each(|(a, b)| *a -= c * b);
+            }
+            for (t, c) in total.iter_mut().zip(&h[fixed.len()..]) {
+                *t += c;
+            }
+        }
+        total
+    }
+
+    /// xᵀKx / xᵀMx.
+    fn rayleigh(&self, x: &[f64]) -> f64 {
+        let system = |dof: usize| self.dofs.index(dof).map(|i| x[i]);
+        let mut quadratic = 0.0;
+        for e in self.tangent.stiffness_entries() {
+            if let (Some(a), Some(b)) = (system(e.row), system(e.col)) {
+                let twice = if e.row == e.col { 1.0 } else { 2.0 };
+                quadratic += twice * a * e.val * b;
+            }
+        }
+        quadratic / self.inner(x, x)
+    }
+
+    /// A [`Mode`] of eigenvalue `lambda` and shape `x` over the system DOFs.
+    fn mode(&self, lambda: f64, mut x: Vec<f64>, rigid: bool) -> Mode {
+        let norm = self.norm(&x);
+        x.iter_mut().for_each(|v| *v /= norm);
+        let mut participation = [0.0; 6];
+        for (p, r) in participation.iter_mut().zip(&self.directions) {
+            let total = self.inner(r, r);
+            *p = if total > 0.0 {
+                self.inner(&x, r).powi(2) / total
+            } else {
+                0.0
+            };
+        }
+        let mut motion = [0.0; 3];
+        for ((&d, v), m) in self.global.iter().zip(&x).zip(&self.mass) {
+            if d / 3 < self.particles {
+                motion[d % 3] += m * v * v;
+            }
+        }
+        let total: f64 = motion.iter().sum();
+        motion
+            .iter_mut()
+            .for_each(|e| *e /= total.max(f64::MIN_POSITIVE));
+        let mut shape = vec![Vec3::zeros(); self.particles];
+        for (&d, v) in self.global.iter().zip(&x) {
+            if d / 3 < self.particles {
+                shape[d / 3][d % 3] = *v;
+            }
+        }
+        Mode {
+            eigenvalue: lambda,
+            frequency_hz: lambda.max(0.0).sqrt() / (2.0 * PI),
+            rigid,
+            shape,
+            participation,
+            motion,
+        }
+    }
+}
+
+/// The factorised K − σM and its solve.
+struct ShiftInvert {
+    cholesky: SparseCholesky,
+    shift: f64,
+    rhs: Vec<f64>,
+}
+
+impl ShiftInvert {
+    fn new(problem: &Problem) -> Result<ShiftInvert, ModalError> {
+        let shift = -(2.0 * PI * SHIFT_HZ).powi(2);
+        let scales = Scales {
+            mass: -shift,
+            damping: 0.0,
+            stiffness: 1.0,
+        };
+        let mut assembler = Assembler::new();
+        let matrix =
+            assembler.assemble(&problem.tangent, &problem.node_mass, &problem.dofs, scales)?;
+        let mut cholesky = SparseCholesky::default();
+        cholesky.factorize(matrix, "shifted stiffness")?;
+        Ok(ShiftInvert {
+            cholesky,
+            shift,
+            rhs: Vec::new(),
+        })
+    }
+
+    /// w = (K − σM)⁻¹ M q.
+    fn apply(&mut self, mass: &[f64], q: &[f64]) -> Vec<f64> {
+        self.rhs.clear();
+        self.rhs.extend(q.iter().zip(mass).map(|(x, m)| x * m));
+        self.cholesky.solve_in_place(&mut self.rhs);
+        self.rhs.clone()
+    }
+}
+
+/// Adds the tangent of every model with a linearisation to `tangent`; returns the names of
+/// the models without one (they add no stiffness).
+fn collect_stiffness(
+    state: &State,
+    models: &[Box<dyn Model>],
+    tangent: &mut Tangent,
+) -> Vec<String> {
+    let mut ignored = Vec::new();
+    for model in models {
+        match model.linearized() {
+            Some(linear) => linear.add_tangent(state, tangent),
+            None => ignored.push(model.name().to_string()),
+        }
+    }
+    ignored
+}
+
+/// A Ritz value θ and its vector.
+type RitzPair = (f64, Vec<f64>);
+
+/// A deterministic start vector (a fixed xorshift sequence in (−1, 1)).
+fn start_vector(n: usize) -> Vec<f64> {
+    let mut s: u64 = 0x9E37_79B9_7F4A_7C15;
+    (0..n)
+        .map(|_| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        })
+        .collect()
+}
+
+/// The `wanted` largest eigenpairs (θ, x) of (K − σM)⁻¹M in the M-orthogonal complement of
+/// `rigid`, and the Lanczos steps taken.
+fn lanczos(
+    problem: &Problem,
+    solver: &mut ShiftInvert,
+    rigid: &[Vec<f64>],
+    wanted: usize,
+) -> Result<(Vec<RitzPair>, usize), ModalError> {
+    let space = problem.dofs.len() - rigid.len();
+    let max_steps = space.min(10 * wanted + 60);
+    let mut q = start_vector(problem.dofs.len());
+    problem.orthogonalize(&mut q, rigid, &[]);
+    let norm = problem.norm(&q);
+    q.iter_mut().for_each(|x| *x /= norm);
+    let mut basis = vec![q];
+    // Column j: the coefficients of A⁻¹M q_j along q_0..q_j (both Gram–Schmidt passes).
+    let mut columns: Vec<Vec<f64>> = Vec::new();
+    let mut restarts = 1usize;
+    loop {
+        let j = basis.len() - 1;
+        let mut w = solver.apply(&problem.mass, &basis[j]);
+        let h = problem.orthogonalize(&mut w, rigid, &basis);
+        let scale = h[j].abs();
+        columns.push(h);
+        let b = problem.norm(&w);
+        let steps = basis.len();
+        let (converged, ritz) = ritz_pairs(&columns, b, wanted);
+        // The whole space spanned: the Ritz pairs are the eigenpairs.
+        let complete = steps == space && steps >= wanted;
+        if converged >= wanted || complete {
+            let pairs = ritz
+                .into_iter()
+                .take(wanted)
+                .map(|(theta, y)| (theta, combine(&basis, &y)))
+                .collect();
+            return Ok((pairs, steps));
+        }
+        if steps == max_steps {
+            return Err(ModalError::NotConverged {
+                converged,
+                wanted,
+                steps,
+            });
+        }
+        if b <= 1e-10 * scale {
+            // An invariant subspace: continue from a fresh vector orthogonal to it.
+            w = start_vector(problem.dofs.len() + restarts).split_off(restarts);
+            restarts += 1;
+            problem.orthogonalize(&mut w, rigid, &basis);
+        }
+        let b = problem.norm(&w);
+        w.iter_mut().for_each(|x| *x /= b);
+        basis.push(w);
+    }
+}
+
+/// The Ritz values of the projected operator H = QᵀM(K − σM)⁻¹MQ (its columns as
+/// [`lanczos`] kept them; tridiagonal to rounding) by
+/// decreasing θ with their eigenvectors, and how many of the first `wanted` have converged
+/// given the norm `next` of the next Lanczos vector before normalisation: the residual of a
+/// Ritz pair (θ, Qy) is `next`·|y_m|.
+fn ritz_pairs(columns: &[Vec<f64>], next: f64, wanted: usize) -> (usize, Vec<RitzPair>) {
+    let m = columns.len();
+    // H[r][c] for r ≤ c is ⟨q_r, A⁻¹M q_c⟩_M; the operator is M-self-adjoint, so the
+    // upper triangle, mirrored, is the projection (its subdiagonal, the norms that
+    // normalised the vectors, equals the first superdiagonal to rounding).
+    let t = DMatrix::from_fn(m, m, |r, c| columns[r.max(c)][r.min(c)]);
+    let eigen = SymmetricEigen::new(t);
+    let mut order: Vec<usize> = (0..m).collect();
+    order.sort_by(|&a, &b| eigen.eigenvalues[b].total_cmp(&eigen.eigenvalues[a]));
+    let pairs: Vec<RitzPair> = order
+        .iter()
+        .map(|&k| {
+            let y = eigen.eigenvectors.column(k).iter().copied().collect();
+            (eigen.eigenvalues[k], y)
+        })
+        .collect();
+    let converged = pairs
+        .iter()
+        .take(wanted)
+        .take_while(|(theta, y)| (next * y[m - 1]).abs() <= TOLERANCE * theta.abs())
+        .count();
+    (converged, pairs)
+}
+
+/// Q y.
+fn combine(basis: &[Vec<f64>], y: &[f64]) -> Vec<f64> {
+    let mut x = vec![0.0; basis[0].len()];
+    for (q, c) in basis.iter().zip(y) {
+        x.iter_mut().zip(q).for_each(|(a, b)| *a += c * b);
+    }
+    x
+}

@@ -1,0 +1,146 @@
+//! `qdem modes`: the natural modes of a scene's deformable bodies ([`qdem_core::lanczos`])
+//! and their files.
+//!
+//! - `modes.csv`: one row per mode, `mode,frequency_hz,kind,direction,participation,mass_x,
+//!   mass_y,mass_z,mass_rx,mass_ry,mass_rz,motion_x,motion_y,motion_z`: `kind` is `rigid` (a rigid-body mode of a body
+//!   with no fixity, frequency zero to rounding) or `elastic`; `mass_*` are the effective
+//!   modal mass fractions along x, y, z and about the axes x, y, z through the mass centre
+//!   (each column sums to 1 over all modes); `direction` and `participation` are the largest
+//!   of them; `motion_*` the shares of the mode's kinetic energy in x, y and z motion (they
+//!   tell apart the elastic modes of a free body, whose effective masses are all zero).
+//! - `vtu/mode_NNNN.vtu`: the mode shape as the point vector `mode_shape`, scaled so that its
+//!   largest particle displacement is 1 (warp by it with the amplitude you want, in metres),
+//!   on the reference positions; indexed by `modes.pvd`, whose "time" is the mode number.
+//!
+//! All files are written atomically. Models without a linearisation (DEM contacts) add no
+//! stiffness and are listed in [`ModesReport::ignored`]; rigid bodies are refused.
+
+use crate::build::{BodyKind, Simulation};
+use crate::output::{write_atomic, write_vtu, OutputError, PvdIndex, VtuGrid};
+use qdem_core::lanczos::{natural_modes, ModalError, Modes, DIRECTIONS};
+use qdem_core::Vec3;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// What `qdem modes` can fail on.
+#[derive(Debug, Error)]
+pub enum ModesError {
+    /// The eigenproblem was refused or did not converge.
+    #[error("scene {}: {source}", .scene.display())]
+    Modal {
+        /// The scene file.
+        scene: PathBuf,
+        /// Why.
+        source: ModalError,
+    },
+    /// The output directory could not be created.
+    #[error("cannot create the output directory {}: {source}", .path.display())]
+    CreateDir {
+        /// The directory.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// An output file could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+/// The modes and where their files went.
+#[derive(Debug)]
+pub struct ModesReport {
+    /// The modes.
+    pub modes: Modes,
+    /// Models left out of the stiffness (no linearisation).
+    pub ignored: Vec<String>,
+    /// `modes.csv`.
+    pub csv: PathBuf,
+    /// `modes.pvd`.
+    pub pvd: PathBuf,
+}
+
+/// Computes the `count` lowest modes of `sim`'s deformable bodies about their reference
+/// positions and writes `modes.csv`, `modes.pvd` and `vtu/mode_NNNN.vtu` into `dir`.
+pub fn compute_and_write(
+    sim: &Simulation,
+    count: usize,
+    dir: &Path,
+) -> Result<ModesReport, ModesError> {
+    let world = &sim.world;
+    let modes =
+        natural_modes(&world.state, &world.models, count).map_err(|source| ModesError::Modal {
+            scene: sim.scene.path.clone(),
+            source,
+        })?;
+    let vtu_dir = dir.join("vtu");
+    std::fs::create_dir_all(&vtu_dir).map_err(|source| ModesError::CreateDir {
+        path: vtu_dir.clone(),
+        source,
+    })?;
+    let csv = dir.join("modes.csv");
+    write_atomic(&csv, |w| write_table(w, &modes))?;
+    let pvd = dir.join("modes.pvd");
+    let tets = deformable_tets(sim);
+    let mut index = PvdIndex::new();
+    for (k, mode) in modes.modes.iter().enumerate() {
+        let name = format!("vtu/mode_{:04}.vtu", k + 1);
+        let largest = mode.shape.iter().map(|u| u.norm()).fold(0.0, f64::max);
+        let shape: Vec<Vec3> = mode
+            .shape
+            .iter()
+            .map(|u| u / largest.max(f64::MIN_POSITIVE))
+            .collect();
+        let grid = VtuGrid {
+            points: &world.state.reference,
+            tets: &tets,
+            point_vectors: vec![("mode_shape", &shape)],
+            cell_scalars: vec![],
+        };
+        write_vtu(&dir.join(&name), &grid)?;
+        index.push((k + 1) as f64, name);
+    }
+    index.write(&pvd)?;
+    Ok(ModesReport {
+        ignored: modes.ignored.clone(),
+        modes,
+        csv,
+        pvd,
+    })
+}
+
+/// The tetrahedra of every deformable body, as state particle indices.
+fn deformable_tets(sim: &Simulation) -> Vec<[u32; 4]> {
+    sim.bodies
+        .iter()
+        .filter(|b| matches!(b.kind, BodyKind::Deformable { .. }))
+        .filter_map(|b| sim.tet_body(b))
+        .flat_map(|t| t.tets().iter().copied())
+        .collect()
+}
+
+/// The header of `modes.csv`.
+pub const MODES_HEADER: &str = "mode,frequency_hz,kind,direction,participation,mass_x,mass_y,\
+                                mass_z,mass_rx,mass_ry,mass_rz,motion_x,motion_y,motion_z";
+
+/// Writes the modes' table as `modes.csv` holds it.
+pub fn write_table(w: &mut dyn Write, modes: &Modes) -> std::io::Result<()> {
+    writeln!(w, "{MODES_HEADER}")?;
+    for (k, mode) in modes.modes.iter().enumerate() {
+        let (direction, share) = mode.dominant();
+        let kind = if mode.rigid { "rigid" } else { "elastic" };
+        write!(
+            w,
+            "{},{:.9e},{kind},{},{:.6}",
+            k + 1,
+            mode.frequency_hz,
+            DIRECTIONS[direction],
+            share
+        )?;
+        for p in mode.participation.iter().chain(&mode.motion) {
+            write!(w, ",{p:.6}")?;
+        }
+        writeln!(w)?;
+    }
+    Ok(())
+}
