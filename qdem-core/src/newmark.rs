@@ -284,7 +284,7 @@ impl Newmark {
         if !system.tangent_current || self.update == TangentUpdate::EveryStep {
             collect_tangent(state, models, &mut system.tangent)?;
             system.tangent_current = true;
-            system.damping.build(&system.tangent, node_dofs(state));
+            system.damping.build(&system.tangent, state.dofs());
         }
         let dofs = FreeDofs::new(&state.node_fixity());
         let matrix =
@@ -471,11 +471,6 @@ pub(crate) fn collect_tangent(
     Ok(())
 }
 
-/// Number of DOFs of the generalised nodes (particles, then their rotations), 3 each.
-fn node_dofs(state: &State) -> usize {
-    3 * (state.len() + state.spin.len())
-}
-
 /// The predictor of Eqs. 13–14 (the a_n, b_n of Eq. 22): x ← x + ∆t (v + (½ − β)∆t a),
 /// v ← v + (1 − γ)∆t a, t ← t + ∆t; the same for the particles' rotations.
 pub fn predict(state: &mut State, dt: f64, beta: f64, gamma: f64) {
@@ -654,7 +649,7 @@ impl Stepper for Newmark {
         };
         if self.is_implicit() {
             self.system.tangent_current = input.bool("the tangent flag")?;
-            let dofs = node_dofs(state);
+            let dofs = state.dofs();
             self.system.tangent.restore(input, dofs)?;
             self.system.damping.build(&self.system.tangent, dofs);
             let steps = [

@@ -242,6 +242,12 @@ impl State {
         self.position.len()
     }
 
+    /// Degrees of freedom of a tangent over this state: three translations per particle, and
+    /// three rotations per particle when the particles rotate.
+    pub fn dofs(&self) -> usize {
+        3 * (self.len() + self.spin.len())
+    }
+
     /// Whether the state holds no particle.
     pub fn is_empty(&self) -> bool {
         self.position.is_empty()

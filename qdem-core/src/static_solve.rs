@@ -216,8 +216,7 @@ impl Stepper for StaticSteps {
         refuse_rigid(state, "static")?;
         input.tag("static")?;
         if input.bool("the factorisation flag")? {
-            let dofs = 3 * (state.len() + state.spin.len());
-            self.solver.tangent.restore(input, dofs)?;
+            self.solver.tangent.restore(input, state.dofs())?;
             self.solver.factorize_tangent(state, models)?;
         }
         Ok(())
