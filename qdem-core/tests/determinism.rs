@@ -1,15 +1,14 @@
 //! The same run gives bit-identical states with 1 and with 2 threads: tetrahedron forces are
 //! gathered per particle in a fixed order, never accumulated atomically.
 
-use qdem_core::{
-    Dofs, Gravity, Material, Model, NodalLoad, State, Stepper, TetBody, TimeFunction, Vec3, Verlet,
-};
+mod common;
+
+use qdem_core::{Material, State, Stepper, Vec3, Verlet};
 use qdem_mesh::structured_box;
 
 fn run() -> State {
     // Large enough that rayon splits both the tetrahedron and the particle loops.
     let mesh = structured_box([0.0; 3], [2.4, 0.25, 0.22], [60, 6, 6]);
-    let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let material = Material {
         density: 2350.0,
         young: 45e9,
@@ -17,19 +16,7 @@ fn run() -> State {
         shear_viscosity: 2e3,
         bulk_viscosity: 1e3,
     };
-    let body = TetBody::new("beam", &reference, mesh.tets.clone(), material).unwrap();
-    let mut state = State::at_rest(reference);
-    body.lump_mass(&mut state.mass);
-    for &n in &mesh.group("xmin").unwrap().nodes {
-        state.fix(n as usize, Dofs::ALL);
-    }
-    let tip = mesh.group("xmax").unwrap().nodes.clone();
-    let ramp = TimeFunction::new(vec![(0.0, 0.0), (1e-3, 1.0)]).unwrap();
-    let mut models: Vec<Box<dyn Model>> = vec![
-        Box::new(body),
-        Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81))),
-        Box::new(NodalLoad::new("tip", tip, Vec3::new(0.0, 1e5, -2e5), ramp)),
-    ];
+    let (mut state, mut models) = common::clamped_beam(&mesh, material, Vec3::new(0.0, 1e5, -2e5));
     let dt = 0.9 * models[0].stable_dt(&state).unwrap();
     let mut stepper = Verlet::new(dt);
     stepper.initialize(&mut state, &mut models).unwrap();

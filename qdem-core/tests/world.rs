@@ -3,16 +3,17 @@
 //! unstable step with the bound; a hook can halt a run; the step rule refuses an explicit step
 //! above the bound and fits an automatic one to the end time.
 
+mod common;
+
 use qdem_core::{
-    CoreError, Dofs, Gravity, Halt, Material, Model, NodalLoad, PostStep, Scheme, State,
-    StepRequest, StepSettings, Stepper, TetBody, TimeFunction, Vec3, Verlet, World,
+    CoreError, Halt, Material, Model, PostStep, Scheme, State, StepRequest, StepSettings, Stepper,
+    Vec3, Verlet, World,
 };
 use qdem_mesh::structured_box;
 
 /// A viscoelastic cantilever under gravity and a ramped tip load.
 fn cantilever() -> (State, Vec<Box<dyn Model>>) {
     let mesh = structured_box([0.0; 3], [1.2, 0.2, 0.2], [12, 2, 2]);
-    let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let material = Material {
         density: 2350.0,
         young: 30e9,
@@ -20,20 +21,7 @@ fn cantilever() -> (State, Vec<Box<dyn Model>>) {
         shear_viscosity: 1e3,
         bulk_viscosity: 1e3,
     };
-    let body = TetBody::new("beam", &reference, mesh.tets.clone(), material).unwrap();
-    let mut state = State::at_rest(reference);
-    body.lump_mass(&mut state.mass);
-    for &n in &mesh.group("xmin").unwrap().nodes {
-        state.fix(n as usize, Dofs::ALL);
-    }
-    let tip = mesh.group("xmax").unwrap().nodes.clone();
-    let ramp = TimeFunction::new(vec![(0.0, 0.0), (1e-3, 1.0)]).unwrap();
-    let models: Vec<Box<dyn Model>> = vec![
-        Box::new(body),
-        Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81))),
-        Box::new(NodalLoad::new("tip", tip, Vec3::new(0.0, 0.0, -2e4), ramp)),
-    ];
-    (state, models)
+    common::clamped_beam(&mesh, material, Vec3::new(0.0, 0.0, -2e4))
 }
 
 fn verlet(dt: Option<f64>, fit_to: Option<f64>) -> StepRequest {
