@@ -202,6 +202,10 @@ pub enum CoreError {
     /// A checkpoint that cannot be written or read for this scene.
     #[error("checkpoint: {0}")]
     Checkpoint(#[from] CheckpointError),
+    /// A scene that cannot be decomposed over processes (an implicit or static run, a particle
+    /// shared by two bodies).
+    #[error("cannot decompose the run over processes: {0}")]
+    Decomposition(String),
 }
 
 /// What to do about an instability, given the step and its bound.

@@ -21,6 +21,7 @@
 #![warn(missing_docs)]
 
 pub mod checkpoint;
+pub mod distributed;
 pub mod error;
 pub mod gravity;
 pub mod instability;
@@ -54,6 +55,7 @@ pub type Vec3 = nalgebra::Vector3<f64>;
 pub type Mat3 = nalgebra::Matrix3<f64>;
 
 pub use checkpoint::{CheckpointError, Decoder, Encoder};
+pub use distributed::{Communicator, Decomposition};
 pub use error::CoreError;
 pub use gravity::Gravity;
 pub use material::Material;

@@ -22,6 +22,9 @@ pub enum Stage {
     Solve,
     /// The models' step checks, retakes and commits (bond breaks, contacts opening).
     Events,
+    /// A decomposed run's exchange of the particles each process owns
+    /// ([`crate::distributed`]).
+    Share,
     /// The post-step hook at this index of the world's hooks.
     Hook(usize),
     /// The failure check: inverted elements, non-finite values, runaway energy.
@@ -38,6 +41,7 @@ pub struct StageTimes {
     integrate: f64,
     solve: f64,
     events: f64,
+    share: f64,
     hooks: Vec<f64>,
     check: f64,
     steps: u64,
@@ -47,7 +51,7 @@ pub struct StageTimes {
 #[derive(Clone, Debug, PartialEq)]
 pub struct StageShare {
     /// `predict`, `forces: NAME` (the model's name), `integrate`, `solve`, `events`,
-    /// `hook: NAME` or `failure check`.
+    /// `share`, `hook: NAME` or `failure check`.
     pub name: String,
     /// Mean wall seconds per step.
     pub seconds_per_step: f64,
@@ -94,6 +98,7 @@ impl StageTimes {
             Stage::Integrate => &mut self.integrate,
             Stage::Solve => &mut self.solve,
             Stage::Events => &mut self.events,
+            Stage::Share => &mut self.share,
             Stage::Hook(i) => match self.hooks.get_mut(i) {
                 Some(slot) => slot,
                 None => return,
@@ -116,6 +121,7 @@ impl StageTimes {
             Stage::Integrate => self.integrate,
             Stage::Solve => self.solve,
             Stage::Events => self.events,
+            Stage::Share => self.share,
             Stage::Hook(i) => self.hooks.get(i).copied().unwrap_or(0.0),
             Stage::Check => self.check,
         }
@@ -134,6 +140,7 @@ impl StageTimes {
         named.push(("integrate".into(), self.integrate));
         named.push(("solve".into(), self.solve));
         named.push(("events".into(), self.events));
+        named.push(("share".into(), self.share));
         named.extend(
             self.hooks
                 .iter()

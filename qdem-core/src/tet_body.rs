@@ -16,6 +16,7 @@
 //! unstrained configuration (it omits the stress-dependent geometric stiffness, of the order of
 //! the strain), so for small strain f(x + ∆x, v) ≈ f(x, v) − K ∆x (paper 001 Eq. 20).
 
+use crate::distributed::{BodyLayout, BodySplit};
 use crate::error::CoreError;
 use crate::material::{Lame, Material};
 use crate::model::{Linearized, Model, Persistence};
@@ -74,6 +75,9 @@ pub struct TetBody {
     damping_rate: f64,
     /// The first tetrahedron found inverted at the last force evaluation.
     inverted: Option<usize>,
+    /// In a run decomposed over processes, this process's share of the body
+    /// ([`crate::distributed`]); `None`: the whole body.
+    split: Option<BodySplit>,
 }
 
 impl TetBody {
@@ -142,6 +146,7 @@ impl TetBody {
             omega_squared,
             damping_rate,
             inverted: None,
+            split: None,
         })
     }
 
@@ -153,6 +158,36 @@ impl TetBody {
     /// How the tetrahedra are cut into blocks for the force pass ([`crate::tet_blocks`]).
     pub fn block_layout(&self) -> BlockLayout {
         self.blocks.layout()
+    }
+
+    /// Whether the material has no viscosity (the kernel's cheaper path).
+    pub(crate) fn is_elastic(&self) -> bool {
+        self.material.is_elastic()
+    }
+
+    /// The number of tetrahedra of each block, in block order.
+    pub(crate) fn block_tets(&self) -> impl Iterator<Item = usize> + '_ {
+        self.blocks
+            .tet_start
+            .windows(2)
+            .map(|w| (w[1] - w[0]) as usize)
+    }
+
+    /// What a decomposition reads of the blocks.
+    pub(crate) fn body_layout(&self) -> BodyLayout<'_> {
+        let b = &self.blocks;
+        BodyLayout {
+            node_start: &b.node_start,
+            nodes: &b.nodes,
+            first: b.first,
+            entry_start: &b.entry_start,
+            entries: &b.entries,
+        }
+    }
+
+    /// Computes only this process's share of the body from now on.
+    pub(crate) fn set_split(&mut self, split: BodySplit) {
+        self.split = Some(split);
     }
 
     /// Adds a quarter of each tetrahedron's mass to each of its particles (paper 000 §2.4).
@@ -195,16 +230,26 @@ impl TetBody {
         (self.viscous.lambda, self.viscous.mu)
     }
 
-    /// Stage 1: every block's tetrahedra, their forces summed per block node into
-    /// `self.sums` ([`crate::tet_blocks`]), the blocks in parallel.
+    /// Stage 1: every block's tetrahedra (this process's blocks, in a decomposed run), their
+    /// forces summed per block node into `self.sums` ([`crate::tet_blocks`]), the blocks in
+    /// parallel.
     fn compute_block_sums<const VISCOUS: bool>(&mut self, state: &State) {
+        let range = self
+            .split
+            .as_ref()
+            .map_or(0..self.blocks.len(), |s| s.mine.clone());
+        self.inverted = None;
+        if range.is_empty() {
+            return;
+        }
         self.scratch.fit(rayon::current_num_threads());
         let mut sums = std::mem::take(&mut self.sums);
         let this = &*self;
+        let start = &self.blocks.node_start;
         let inverted = for_blocks(
-            &mut sums,
-            0..self.blocks.len(),
-            &self.blocks.node_start,
+            &mut sums[start[range.start] as usize..start[range.end] as usize],
+            range,
+            start,
             &|b, out| {
                 let mut scratch = this.scratch.for_this_thread();
                 this.block_pass::<VISCOUS>(b, state, out, &mut scratch)
@@ -255,16 +300,25 @@ impl TetBody {
         first_inverted
     }
 
-    /// Stage 2: per-particle sums of its block entries, in ascending block order (Eq. 11).
+    /// Stage 2: per-particle sums of its block entries, in ascending block order (Eq. 11);
+    /// in a decomposed run, of the particles this process owns only.
     fn gather(&self, force: &mut [Vec3]) {
         let blocks = &self.blocks;
         let count = blocks.entry_start.len() - 1;
         let (starts, entries, sums) = (&blocks.entry_start, &blocks.entries, &self.sums);
+        // A rank owns a particle only where it computes the particle's first block.
+        if self.split.as_ref().is_some_and(|s| s.mine.is_empty()) {
+            return;
+        }
+        let owner = self.split.as_ref().map(|s| (s.me, &s.owner[..]));
         force[blocks.first..blocks.first + count]
             .par_iter_mut()
             .with_min_len(PARTICLE_CHUNK)
             .enumerate()
             .for_each(|(i, f)| {
+                if owner.is_some_and(|(me, owner)| owner[i] != me) {
+                    return;
+                }
                 let range = starts[i] as usize..starts[i + 1] as usize;
                 let mut sum = Vec3::zeros();
                 for &entry in &entries[range] {
@@ -400,6 +454,9 @@ impl Model for TetBody {
             self.compute_block_sums::<false>(state);
         } else {
             self.compute_block_sums::<true>(state);
+        }
+        if let Some(exchange) = self.split.as_mut().and_then(|s| s.exchange.as_mut()) {
+            exchange.run(&mut self.sums);
         }
         self.gather(force);
     }

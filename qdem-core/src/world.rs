@@ -9,6 +9,8 @@
 //!    [`Model::failure`] (an inverted tetrahedron) or a kinetic energy growing like an
 //!    unstable step's ([`crate::instability::EnergyGrowth`]) stops the run with
 //!    [`CoreError::Unstable`], which names the stable bound at that state;
+//!    In a run decomposed over processes ([`World::decompose`]), the **share** of each rank's
+//!    owned particles comes first, and the ranks agree on the failure;
 //! 3. the **post-step hooks** ([`PostStep`]) in the order they were added: periodic wrapping
 //!    of bodies, a bonded body's collapse watch; a hook may [`Halt`] the run.
 //!
@@ -17,13 +19,16 @@
 //! the models learn how they are stepped from [`Model::prepare`].
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
+use crate::distributed::{decompose, Communicator, Decomposition, StateShare};
 use crate::error::CoreError;
 use crate::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
 use crate::model::{find_model, Model, Persistence};
 use crate::stages::{Stage, StageShare, StageTimes};
 use crate::state::State;
+use crate::step_settings::Scheme;
 use crate::step_settings::StepSettings;
 use crate::stepper::{stable_step, Stepper};
+use std::sync::Arc;
 
 /// Something a world does after every step, once the step has passed the failure check:
 /// periodic wrapping of bodies, a watch that ends the run when a body has failed.
@@ -92,6 +97,7 @@ pub struct World {
     stages: StageTimes,
     energy: EnergyGrowth,
     steps_done: u64,
+    share: Option<StateShare>,
 }
 
 impl World {
@@ -115,6 +121,7 @@ impl World {
             stages,
             energy: EnergyGrowth::new(),
             steps_done: 0,
+            share: None,
         })
     }
 
@@ -180,10 +187,36 @@ impl World {
         })
     }
 
+    /// Decomposes the run over `comm`'s ranks ([`crate::distributed`]): from now on this
+    /// process computes its share of the deformable bodies and every step ends with the
+    /// exchange of the particles each rank owns, so that every rank holds the state one
+    /// process would. Call it on every rank, before [`World::initialize`] or
+    /// [`World::restore`]. Only explicit Verlet runs can be decomposed.
+    pub fn decompose(&mut self, comm: Arc<dyn Communicator>) -> Result<Decomposition, CoreError> {
+        if self.settings.scheme != Scheme::Verlet {
+            return Err(CoreError::Decomposition(format!(
+                "only explicit Verlet runs can be decomposed, and this one is stepped by {}; \
+                 run it as one process (without mpirun)",
+                self.stepper.name()
+            )));
+        }
+        let (share, figures) = decompose(&self.state, &mut self.models, comm)?;
+        self.share = Some(share);
+        Ok(figures)
+    }
+
     /// Makes the accelerations consistent with the forces at the start (and factorises, for
     /// an implicit scheme).
     pub fn initialize(&mut self) -> Result<(), CoreError> {
-        self.stepper.initialize(&mut self.state, &mut self.models)
+        let done = self.stepper.initialize(&mut self.state, &mut self.models);
+        let Some(share) = &mut self.share else {
+            return done;
+        };
+        share.share(&mut self.state);
+        match share.agree(done.err().map(|e| e.to_string())) {
+            Some(failure) => Err(CoreError::Decomposition(failure)),
+            None => Ok(()),
+        }
     }
 
     /// Advances one step through every stage; `Ok(Some(halt))` when a hook ends the run.
@@ -193,6 +226,10 @@ impl World {
             .stepper
             .step_timed(&mut self.state, &mut self.models, &mut self.stages);
         self.steps_done += 1;
+        if let Some(share) = &mut self.share {
+            share.share(&mut self.state);
+            self.stages.mark(Stage::Share);
+        }
         let checked = self.check(stepped);
         self.stages.mark(Stage::Check);
         checked?;
@@ -207,18 +244,24 @@ impl World {
     }
 
     /// The failure check after a step: a non-finite acceleration, a model's failure or
-    /// runaway kinetic energy becomes [`CoreError::Unstable`]; other stepper errors pass.
+    /// runaway kinetic energy becomes [`CoreError::Unstable`]; other stepper errors pass (in
+    /// a decomposed run they too become the failure every rank agrees on).
     fn check(&mut self, stepped: Result<(), CoreError>) -> Result<(), CoreError> {
-        let failure = match stepped {
+        let local = match stepped {
             Err(CoreError::NonFinite { particle, .. }) => {
                 Some(format!("particle {particle} has a non-finite acceleration"))
             }
-            Err(source) => return Err(source),
+            Err(source) if self.share.is_none() => return Err(source),
+            Err(source) => Some(source.to_string()),
             Ok(()) => self
                 .models
                 .iter()
                 .find_map(|m| m.failure(&self.state))
                 .map(|e| e.to_string()),
+        };
+        let failure = match &self.share {
+            Some(share) => share.agree(local),
+            None => local,
         };
         let failure = failure.or_else(|| {
             self.energy

@@ -1,0 +1,403 @@
+//! A run decomposed over processes (MPI ranks), bit-identical to one process.
+//!
+//! The continuum kernel (paper 000 Eqs. 1–11) is where an explicit run spends its time, so it
+//! is what is decomposed. Every deformable body's blocks ([`crate::tet_blocks`]), taken in
+//! model order and then block order (their spatial order: recursive bisection), are cut into
+//! one contiguous range per rank of about equal cost; a body whose blocks all fall on one rank
+//! is computed there alone. A particle of a deformable body is **owned** by the rank of the
+//! block of its first entry. Each step:
+//!
+//! 1. every rank predicts every particle (the same arithmetic on the same state everywhere,
+//!    so the predicted positions and half-step velocities agree bit for bit);
+//! 2. each rank computes the tetrahedra of its blocks only; the block sums of a node owned by
+//!    another rank are sent to it ([`Communicator::all_to_all`], only for bodies cut between
+//!    ranks), so that the owner adds **every** block sum of its particle in ascending block
+//!    order, exactly as one process does (Eq. 11);
+//! 3. the other models (contacts, loads, gravity, rigid bodies) are computed whole on every
+//!    rank, from the same state;
+//! 4. after the integration, each rank's owned particles' accelerations and velocities (and
+//!    spins) go to every rank ([`Communicator::all_gather`]), so that every rank holds the one
+//!    state a single process holds; then the failure check agrees across ranks.
+//!
+//! There is no floating-point reduction across ranks: a value is computed by one rank in the
+//! single-process order and copied, so outputs are byte-identical for any number of ranks
+//! and threads. Each rank keeps the whole state (the outputs are written by rank 0 from it);
+//! what is divided is the kernel's work.
+
+use crate::error::CoreError;
+use crate::model::Model;
+use crate::state::State;
+use crate::tet_body::TetBody;
+use crate::Vec3;
+use std::ops::Range;
+use std::sync::Arc;
+
+/// What a decomposed run needs of its message passing: the collectives every rank calls in
+/// the same order. `qdem` implements it over MPI (`--features mpi`); a test can implement it
+/// over threads.
+///
+/// Counts are per rank, in rank order; buffers hold the ranks' parts one after the other.
+pub trait Communicator: Send + Sync {
+    /// This process's rank, `0..size`.
+    fn rank(&self) -> usize;
+
+    /// The number of ranks.
+    fn size(&self) -> usize;
+
+    /// Sends `send` (`send_counts[q]` values to rank `q`, in rank order) and receives into
+    /// `recv` (`recv_counts[q]` values from rank `q`, in rank order).
+    fn all_to_all(
+        &self,
+        send: &[f64],
+        send_counts: &[usize],
+        recv: &mut [f64],
+        recv_counts: &[usize],
+    );
+
+    /// Every rank's `mine` into `all`, in rank order (`counts[q]` values from rank `q`).
+    fn all_gather(&self, mine: &[f64], all: &mut [f64], counts: &[usize]);
+
+    /// The smallest of the ranks' `value`s, on every rank.
+    fn min(&self, value: u64) -> u64;
+
+    /// Rank `root`'s `bytes`, on every rank (resized to the root's length).
+    fn broadcast(&self, root: usize, bytes: &mut Vec<u8>);
+}
+
+/// How the deformable bodies' blocks fall on the ranks, the same on every rank.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Decomposition {
+    /// The number of ranks.
+    pub ranks: usize,
+    /// Per rank, the tetrahedra it computes.
+    pub tets: Vec<usize>,
+    /// Per rank, the particles it owns (those of deformable bodies; the others are computed
+    /// by every rank).
+    pub owned: Vec<usize>,
+    /// Per rank, the block sums it receives per step from the other ranks (its halo).
+    pub halo: Vec<usize>,
+    /// The bodies cut between ranks (an exchange of block sums each step).
+    pub cut_bodies: usize,
+}
+
+/// One deformable body's share of the decomposition, for one rank: which of its blocks the
+/// rank computes, which of its particles the rank owns, which block sums go where.
+#[derive(Clone, Debug)]
+pub(crate) struct BodySplit {
+    /// The blocks this rank computes.
+    pub mine: Range<usize>,
+    /// This rank.
+    pub me: u32,
+    /// The body's first particle.
+    pub first: usize,
+    /// Per particle of the body (from `first`), the rank that owns it and sums its force.
+    pub owner: Vec<u32>,
+    /// The exchange of block sums, for a body cut between ranks.
+    pub exchange: Option<SumExchange>,
+}
+
+/// The block sums a rank sends to and receives from the others each step (slots of the
+/// body's sums, grouped by rank, ascending within a rank: both sides list them alike).
+#[derive(Clone)]
+pub(crate) struct SumExchange {
+    comm: Arc<dyn Communicator>,
+    send_slots: Vec<u32>,
+    send_counts: Vec<usize>,
+    recv_slots: Vec<u32>,
+    recv_counts: Vec<usize>,
+    send: Vec<f64>,
+    recv: Vec<f64>,
+}
+
+impl std::fmt::Debug for SumExchange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SumExchange")
+            .field("send", &self.send_slots.len())
+            .field("recv", &self.recv_slots.len())
+            .finish()
+    }
+}
+
+impl SumExchange {
+    /// Sends the sums this rank computed for other ranks' particles, and writes those the
+    /// others computed for this rank's particles into `sums`.
+    pub fn run(&mut self, sums: &mut [Vec3]) {
+        self.send.clear();
+        for &s in &self.send_slots {
+            self.send.extend_from_slice(sums[s as usize].as_slice());
+        }
+        let counts3 = |c: &[usize]| c.iter().map(|n| 3 * n).collect::<Vec<_>>();
+        let (send_counts, recv_counts) = (counts3(&self.send_counts), counts3(&self.recv_counts));
+        self.recv.resize(3 * self.recv_slots.len(), 0.0);
+        self.comm
+            .all_to_all(&self.send, &send_counts, &mut self.recv, &recv_counts);
+        for (&s, v) in self.recv_slots.iter().zip(self.recv.chunks_exact(3)) {
+            sums[s as usize] = Vec3::new(v[0], v[1], v[2]);
+        }
+    }
+
+    /// Block sums received per step.
+    pub fn halo(&self) -> usize {
+        self.recv_slots.len()
+    }
+}
+
+/// This rank's [`BodySplit`] of a body whose block `b` is computed by rank `block_rank[b]`.
+pub(crate) fn split_body(
+    layout: BodyLayout<'_>,
+    block_rank: &[u32],
+    comm: &Arc<dyn Communicator>,
+) -> BodySplit {
+    let me = comm.rank() as u32;
+    let ranks = comm.size();
+    let first_mine = block_rank.iter().position(|&r| r == me);
+    let mine = match first_mine {
+        Some(a) => a..a + block_rank[a..].iter().take_while(|&&r| r == me).count(),
+        None => 0..0,
+    };
+    let block_of_slot = slot_blocks(layout.node_start);
+    let owner: Vec<u32> = (0..layout.entry_start.len() - 1)
+        .map(|i| {
+            block_rank
+                [block_of_slot[layout.entries[layout.entry_start[i] as usize] as usize] as usize]
+        })
+        .collect();
+    let cut = block_rank.iter().any(|&r| r != block_rank[0]);
+    let exchange = cut.then(|| {
+        let (mut send, mut recv) = (vec![Vec::new(); ranks], vec![Vec::new(); ranks]);
+        for (s, &node) in layout.nodes.iter().enumerate() {
+            let from = block_rank[block_of_slot[s] as usize];
+            let to = owner[node as usize - layout.first];
+            if from == me && to != me {
+                send[to as usize].push(s as u32);
+            } else if to == me && from != me {
+                recv[from as usize].push(s as u32);
+            }
+        }
+        SumExchange {
+            comm: comm.clone(),
+            send_counts: send.iter().map(Vec::len).collect(),
+            send_slots: send.concat(),
+            recv_counts: recv.iter().map(Vec::len).collect(),
+            recv_slots: recv.concat(),
+            send: Vec::new(),
+            recv: Vec::new(),
+        }
+    });
+    BodySplit {
+        mine,
+        me,
+        first: layout.first,
+        owner,
+        exchange,
+    }
+}
+
+/// What [`split_body`] reads of a body's blocks.
+#[derive(Clone, Copy)]
+pub(crate) struct BodyLayout<'a> {
+    /// Block `b`'s slots are `node_start[b]..node_start[b + 1]`.
+    pub node_start: &'a [u32],
+    /// The particle of each slot.
+    pub nodes: &'a [u32],
+    /// The body's first particle.
+    pub first: usize,
+    /// Particle `first + i`'s entries are `entries[entry_start[i]..entry_start[i + 1]]`.
+    pub entry_start: &'a [u32],
+    /// Slots, per particle in ascending block order.
+    pub entries: &'a [u32],
+}
+
+/// The block of every slot.
+fn slot_blocks(node_start: &[u32]) -> Vec<u32> {
+    let mut block = Vec::with_capacity(*node_start.last().unwrap_or(&0) as usize);
+    for (b, w) in node_start.windows(2).enumerate() {
+        block.extend(std::iter::repeat_n(b as u32, (w[1] - w[0]) as usize));
+    }
+    block
+}
+
+/// Cost of a block relative to an elastic tetrahedron: the viscous path costs about 1.6 times
+/// the elastic one (docs/BENCHMARKS.md, kernel section).
+const VISCOUS_COST: f64 = 1.6;
+
+/// Cuts the blocks of every deformable body of `models` (model order, then block order) into
+/// `ranks` contiguous ranges of about equal cost; per body, the rank of each block.
+fn assign_blocks(bodies: &[&TetBody], ranks: usize) -> Vec<Vec<u32>> {
+    let weight = |body: &TetBody| match body.is_elastic() {
+        true => 1.0,
+        false => VISCOUS_COST,
+    };
+    let total: f64 = bodies
+        .iter()
+        .map(|b| weight(b) * b.tets().len() as f64)
+        .sum();
+    let mut done = 0.0;
+    bodies
+        .iter()
+        .map(|body| {
+            let w = weight(body);
+            body.block_tets()
+                .map(|tets| {
+                    let cost = w * tets as f64;
+                    let middle = done + 0.5 * cost;
+                    done += cost;
+                    ((middle / total * ranks as f64) as usize).min(ranks - 1) as u32
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Decomposes `models`' deformable bodies over `comm`'s ranks: tells every body which of its
+/// blocks this rank computes and which particles it owns, and returns the exchange of the
+/// owned particles that ends each step (and the decomposition's figures).
+pub(crate) fn decompose(
+    state: &State,
+    models: &mut [Box<dyn Model>],
+    comm: Arc<dyn Communicator>,
+) -> Result<(StateShare, Decomposition), CoreError> {
+    let ranks = comm.size();
+    let bodies: Vec<&TetBody> = models.iter().filter_map(|m| as_body(m.as_ref())).collect();
+    let block_ranks = assign_blocks(&bodies, ranks);
+    let mut figures = Decomposition {
+        ranks,
+        tets: vec![0; ranks],
+        owned: vec![0; ranks],
+        halo: vec![0; ranks],
+        cut_bodies: 0,
+    };
+    let mut owner = vec![u32::MAX; state.len()];
+    let mut block_ranks = block_ranks.into_iter();
+    for model in models.iter_mut() {
+        let any: &mut dyn std::any::Any = model.as_mut();
+        let Some(body) = any.downcast_mut::<TetBody>() else {
+            continue;
+        };
+        let block_rank = block_ranks.next().expect("one block assignment per body");
+        for (tets, &r) in body.block_tets().zip(&block_rank) {
+            figures.tets[r as usize] += tets;
+        }
+        figures.cut_bodies += usize::from(block_rank.iter().any(|&r| r != block_rank[0]));
+        let split = split_body(body.body_layout(), &block_rank, &comm);
+        for (i, &r) in split.owner.iter().enumerate() {
+            let p = split.first + i;
+            if owner[p] != u32::MAX {
+                return Err(CoreError::Decomposition(format!(
+                    "particle {p} belongs to two deformable bodies"
+                )));
+            }
+            owner[p] = r;
+            figures.owned[r as usize] += 1;
+        }
+        figures.halo[comm.rank()] += split.exchange.as_ref().map_or(0, SumExchange::halo);
+        body.set_split(split);
+    }
+    let share = StateShare::new(owner, comm);
+    Ok((share, figures))
+}
+
+/// The model as a deformable body, if it is one.
+fn as_body(model: &dyn Model) -> Option<&TetBody> {
+    let any: &dyn std::any::Any = model;
+    any.downcast_ref::<TetBody>()
+}
+
+/// The end of a decomposed step: each rank's owned particles' accelerations and velocities
+/// (and rotations) copied to every rank, in rank order; and the agreement of the ranks on
+/// whether the step failed.
+pub(crate) struct StateShare {
+    comm: Arc<dyn Communicator>,
+    /// The particles each rank owns, rank after rank, ascending within a rank.
+    particles: Vec<u32>,
+    /// Particles per rank.
+    counts: Vec<usize>,
+    /// Where this rank's particles start in `particles`.
+    start: usize,
+    mine: Vec<f64>,
+    all: Vec<f64>,
+}
+
+impl StateShare {
+    fn new(owner: Vec<u32>, comm: Arc<dyn Communicator>) -> StateShare {
+        let ranks = comm.size();
+        let mut by_rank = vec![Vec::new(); ranks];
+        for (p, &r) in owner.iter().enumerate() {
+            if r != u32::MAX {
+                by_rank[r as usize].push(p as u32);
+            }
+        }
+        let counts: Vec<usize> = by_rank.iter().map(Vec::len).collect();
+        let start = counts[..comm.rank()].iter().sum();
+        StateShare {
+            comm,
+            particles: by_rank.concat(),
+            counts,
+            start,
+            mine: Vec::new(),
+            all: Vec::new(),
+        }
+    }
+
+    /// Copies every rank's owned particles' motion into `state` on every rank.
+    pub fn share(&mut self, state: &mut State) {
+        let per = values_per_particle(state);
+        let me = self.comm.rank();
+        let own = &self.particles[self.start..self.start + self.counts[me]];
+        self.mine.clear();
+        for &p in own {
+            pack(state, p as usize, &mut self.mine);
+        }
+        let counts: Vec<usize> = self.counts.iter().map(|c| per * c).collect();
+        self.all.resize(per * self.particles.len(), 0.0);
+        self.comm.all_gather(&self.mine, &mut self.all, &counts);
+        for (&p, values) in self.particles.iter().zip(self.all.chunks_exact(per)) {
+            unpack(state, p as usize, values);
+        }
+    }
+
+    /// The failure every rank reports: the one of the lowest rank that found one.
+    pub fn agree(&self, local: Option<String>) -> Option<String> {
+        let mine = match local {
+            Some(_) => self.comm.rank() as u64,
+            None => u64::MAX,
+        };
+        let root = self.comm.min(mine);
+        if root == u64::MAX {
+            return None;
+        }
+        let mut bytes = local.map(String::into_bytes).unwrap_or_default();
+        self.comm.broadcast(root as usize, &mut bytes);
+        Some(String::from_utf8_lossy(&bytes).into_owned())
+    }
+}
+
+/// Values [`pack`] writes per particle: acceleration and velocity, and the rotation's when the
+/// particles have rotational DOFs.
+fn values_per_particle(state: &State) -> usize {
+    match state.spin.is_empty() {
+        true => 6,
+        false => 12,
+    }
+}
+
+/// Appends particle `p`'s motion after the integration.
+fn pack(state: &State, p: usize, out: &mut Vec<f64>) {
+    out.extend_from_slice(state.acceleration[p].as_slice());
+    out.extend_from_slice(state.velocity[p].as_slice());
+    if !state.spin.is_empty() {
+        out.extend_from_slice(state.spin.acceleration[p].as_slice());
+        out.extend_from_slice(state.spin.velocity[p].as_slice());
+    }
+}
+
+/// Sets particle `p`'s motion from what [`pack`] wrote.
+fn unpack(state: &mut State, p: usize, v: &[f64]) {
+    let at = |k: usize| Vec3::new(v[k], v[k + 1], v[k + 2]);
+    state.acceleration[p] = at(0);
+    state.velocity[p] = at(3);
+    if !state.spin.is_empty() {
+        state.spin.acceleration[p] = at(6);
+        state.spin.velocity[p] = at(9);
+    }
+}
