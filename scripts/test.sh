@@ -11,6 +11,15 @@ fi
 export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
 cargo test --workspace --all-targets
 cargo test --workspace --doc
+# The MPI runs (`mpirun -np N qdem run`, byte-identical for 1-3 ranks): Open MPI and, for
+# rsmpi's bindgen, libclang, installed from Debian's packages where missing.
+if ! dpkg -s openmpi-bin libopenmpi-dev libclang-dev >/dev/null 2>&1; then
+    SUDO=""
+    if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq openmpi-bin libopenmpi-dev libclang-dev >/dev/null
+fi
+cargo test -p qdem-cli --features mpi --test mpi_runs
 # The embedding examples: each checks a physical quantity and exits non-zero when it is off
 # (a few seconds each). The test profile reuses what `cargo test --all-targets` built (the
 # examples are among its targets) instead of a second, release build of every dependency.

@@ -1,21 +1,55 @@
 //! `qdem check SCENE`: validates a scene and prints its meshes, mass, stable step, checkpoint
 //! support, the measured cost of a step with the projected run time, and where a step's time
-//! goes, stage by stage of the world's step ([`qdem_core::stages`]).
+//! goes, stage by stage of the world's step ([`qdem_core::stages`]). Under `mpirun` (N > 1)
+//! the run is decomposed as `qdem run` decomposes it, and rank 0 also prints each rank's
+//! tetrahedra, owned particles, halo and measured step cost, and the imbalance.
 
 use crate::command::CliError;
 use crate::progress;
-use qdem_core::Model as _;
+use qdem_core::{Communicator, Decomposition, Model as _, Stage, TetBody};
 use qdem_io::build::{BodyKind, Simulation};
 use qdem_io::runner::RunError;
 use qdem_io::scene::Scene;
 use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Loads and builds the scene at `path`, prints what `qdem check` reports, and measures the
-/// cost of a step (inside the caller's thread pool).
-pub fn check_scene(path: &Path) -> Result<(), CliError> {
+/// cost of a step (inside the caller's thread pool); over `ranks`, decomposed, with the
+/// ranks' figures.
+pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<(), CliError> {
     let scene = Scene::load(path)?;
     let mut sim = Simulation::build(scene)?;
+    let decomposition = match &ranks {
+        Some(r) => Some(
+            sim.world
+                .decompose(r.clone())
+                .map_err(|source| CliError::Decompose {
+                    scene: path.to_path_buf(),
+                    source,
+                })?,
+        ),
+        None => None,
+    };
+    let leader = ranks.as_ref().is_none_or(|r| r.rank() == 0);
+    if leader {
+        print_scene(path, &sim);
+    }
+    let (per_step, exchange) = measure_step_cost(&mut sim, 20)?;
+    if let (Some(ranks), Some(d)) = (&ranks, &decomposition) {
+        let table = rank_table(&sim, ranks.as_ref(), d, per_step, exchange);
+        if leader {
+            print!("{table}");
+        }
+    }
+    if leader {
+        print_cost(&sim, per_step);
+    }
+    Ok(())
+}
+
+/// What the scene is: bodies, contacts, probes, the step, checkpoint support.
+fn print_scene(path: &Path, sim: &Simulation) {
     println!("scene {}: valid", path.display());
     for w in &sim.warnings {
         println!("warning: {w}");
@@ -81,7 +115,10 @@ pub fn check_scene(path: &Path) -> Result<(), CliError> {
         Ok(()) => println!("checkpoints: supported (`checkpoint_every`, Ctrl-C, --resume)"),
         Err(why) => println!("checkpoints: not supported: {why}"),
     }
-    let per_step = measure_step_cost(&mut sim, 20)?;
+}
+
+/// The measured cost of a step, the projected run time and the stages.
+fn print_cost(sim: &Simulation, per_step: f64) {
     let total = per_step * sim.steps() as f64;
     // A scene without tetrahedra (spheres, a bonded body) steps particles.
     let rate = match sim.tets() {
@@ -97,8 +134,53 @@ pub fn check_scene(path: &Path) -> Result<(), CliError> {
         rayon::current_num_threads(),
         progress::clock(total)
     );
-    print_stages(&sim);
-    Ok(())
+    print_stages(sim);
+}
+
+/// Each rank's share of a decomposed step, gathered to every rank (a collective: every rank
+/// calls it): tetrahedra, owned particles, halo, its step and kernel seconds, and the
+/// imbalance of the kernel (the slowest rank's kernel time over the mean).
+fn rank_table(
+    sim: &Simulation,
+    ranks: &dyn Communicator,
+    d: &Decomposition,
+    per_step: f64,
+    exchange: f64,
+) -> String {
+    let world = &sim.world;
+    let steps = world.stages().steps().max(1) as f64;
+    // The bodies' force time without their exchange of block sums (which waits for the
+    // slowest rank) is the work each rank was given.
+    let bodies: f64 = world
+        .models
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| as_body(m.as_ref()).is_some())
+        .map(|(i, _)| world.stages().seconds(Stage::Forces(i)))
+        .sum();
+    let kernel = bodies - exchange;
+    let share = world.stages().seconds(Stage::Share);
+    let mine = [per_step, kernel / steps, share / steps];
+    let mut all = vec![0.0; 3 * d.ranks];
+    ranks.all_gather(&mine, &mut all, &vec![3; d.ranks]);
+    let mut table = format!(
+        "decomposed over {} ranks ({} bodies cut between ranks):\n  rank  tets      owned     halo      step (s)   kernel (s) share (s)\n",
+        d.ranks, d.cut_bodies
+    );
+    for (r, row) in all.chunks_exact(3).enumerate() {
+        table += &format!(
+            "  {r:<5} {:<9} {:<9} {:<9} {:.3e}  {:.3e}  {:.3e}\n",
+            d.tets[r], d.owned[r], d.halo[r], row[0], row[1], row[2]
+        );
+    }
+    let kernels: Vec<f64> = all.chunks_exact(3).map(|row| row[1]).collect();
+    let mean = kernels.iter().sum::<f64>() / d.ranks as f64;
+    let slowest = kernels.iter().cloned().fold(0.0, f64::max);
+    table += &format!(
+        "  kernel imbalance (slowest / mean): {:.3}\n",
+        slowest / mean.max(f64::MIN_POSITIVE)
+    );
+    table
 }
 
 /// Where the measured steps' time went, stage by stage ([`qdem_core::stages`]).
@@ -124,11 +206,28 @@ fn print_stages(sim: &Simulation) {
     }
 }
 
-/// Wall seconds per step of the scene's world, measured over `n` steps from its start; for
+/// The model as a deformable body, if it is one.
+fn as_body(model: &dyn qdem_core::Model) -> Option<&TetBody> {
+    let any: &dyn std::any::Any = model;
+    any.downcast_ref::<TetBody>()
+}
+
+/// The deformable bodies' seconds of block-sum exchange so far (a decomposed run).
+fn exchange_seconds(sim: &Simulation) -> f64 {
+    let models = &sim.world.models;
+    models
+        .iter()
+        .filter_map(|m| as_body(m.as_ref()))
+        .map(TetBody::exchange_seconds)
+        .sum()
+}
+
+/// Wall seconds per step of the scene's world, measured over `n` steps from its start, and
+/// the deformable bodies' seconds of block-sum exchange in those steps; for
 /// implicit and static scenes also prints the sparse system's size, non-zeros, Cholesky fill
 /// and factorisation time from the stepper's one factorisation (in `initialize`, which is not
 /// timed).
-fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<f64, CliError> {
+fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<(f64, f64), CliError> {
     let scene = sim.scene.path.clone();
     let run_error = |source| RunError::Core {
         scene: scene.clone(),
@@ -147,11 +246,14 @@ fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<f64, CliError> {
             s.numeric_seconds
         );
     }
+    let exchanged = exchange_seconds(sim);
+    let world = &mut sim.world;
     let start = Instant::now();
     for _ in 0..n {
         if world.step().map_err(run_error)?.is_some() {
             break;
         }
     }
-    Ok(start.elapsed().as_secs_f64() / world.stages().steps().max(1) as f64)
+    let per_step = start.elapsed().as_secs_f64() / world.stages().steps().max(1) as f64;
+    Ok((per_step, exchange_seconds(sim) - exchanged))
 }

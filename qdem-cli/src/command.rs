@@ -6,13 +6,14 @@ use crate::{check, progress};
 use clap::{Args, Parser, Subcommand};
 use qdem_bench::throughput::BenchPlan;
 use qdem_bench::{implicit, throughput, verify};
-use qdem_core::{CoreError, Halt};
+use qdem_core::{Communicator, CoreError, Halt};
 use qdem_io::analyze::AnalyzeOptions;
 use qdem_io::build::{BuildError, Simulation};
 use qdem_io::runner::{run_with, RunError, RunOptions};
 use qdem_io::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use thiserror::Error;
 
 /// Everything the command line reports as an error.
@@ -43,6 +44,23 @@ pub enum CliError {
     /// An analysis that could not be made.
     #[error(transparent)]
     Analyze(#[from] qdem_io::analyze::AnalyzeError),
+    /// A run that cannot be decomposed over the processes of `mpirun`.
+    #[error("{}: {source}", scene.display())]
+    Decompose {
+        /// The scene file.
+        scene: PathBuf,
+        /// Why.
+        source: CoreError,
+    },
+    /// A command other than `run` and `check` started by `mpirun` on several processes.
+    #[error(
+        "`qdem {command}` runs as one process; only `qdem run` and `qdem check` are \
+         decomposed over the processes of mpirun: start it without mpirun"
+    )]
+    NotDecomposed {
+        /// The command.
+        command: &'static str,
+    },
     /// The thread pool could not be set up.
     #[error("cannot start {threads} threads: {message}")]
     Threads {
@@ -155,6 +173,10 @@ pub struct RunArgs {
     /// Continue the run from this checkpoint (DIR/checkpoint.qdc of a stopped run)
     #[arg(long, value_name = "CHECKPOINT")]
     pub resume: Option<PathBuf>,
+    /// Stop after step N as Ctrl-C does: with DIR/checkpoint.qdc, exit status 130 (a batch
+    /// slot's last step)
+    #[arg(long, value_name = "N")]
+    pub stop_after: Option<u64>,
 }
 
 /// `qdem check`.
@@ -277,15 +299,20 @@ fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, CliError> {
         })
 }
 
-/// Runs the parsed command.
-pub fn dispatch(cli: Cli) -> Result<(), CliError> {
+/// Runs the parsed command; `ranks`: the processes of an `mpirun` (of more than one), over
+/// which `qdem run` decomposes its run.
+pub fn dispatch(cli: Cli, ranks: Option<Arc<dyn Communicator>>) -> Result<(), CliError> {
+    if let Some(command) = ranks.as_ref().and_then(|_| cli.command.single_process()) {
+        return Err(CliError::NotDecomposed { command });
+    }
     match cli.command {
-        Command::Run(a) => thread_pool(a.threads)?
-            .install(|| run_scene(&a.scene, a.out.as_deref(), a.resume.as_deref())),
+        Command::Run(a) => thread_pool(a.threads)?.install(|| run_scene(&a, ranks)),
         Command::Modes(a) => {
             thread_pool(a.threads)?.install(|| modes_of(&a.scene, a.count, a.out.as_deref()))
         }
-        Command::Check(a) => thread_pool(a.threads)?.install(|| check::check_scene(&a.scene)),
+        Command::Check(a) => {
+            thread_pool(a.threads)?.install(|| check::check_scene(&a.scene, ranks))
+        }
         Command::Analyze(a) => {
             let options = AnalyzeOptions {
                 from: a.from,
@@ -378,12 +405,47 @@ fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliErro
     Ok(())
 }
 
+/// The line `qdem run` prints of a decomposed run: per rank, the tetrahedra it computes, the
+/// particles it owns and the block sums it receives per step.
+fn decomposition_line(d: &qdem_core::Decomposition) -> String {
+    let list = |v: &[usize]| {
+        v.iter()
+            .map(|n| n.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    format!(
+        "decomposed over {} ranks: tets per rank [{}], owned particles [{}], block sums received per step \
+         [{}], {} bodies cut between ranks",
+        d.ranks,
+        list(&d.tets),
+        list(&d.owned),
+        list(&d.halo),
+        d.cut_bodies
+    )
+}
+
 /// Set by the Ctrl-C / SIGTERM handler: the run stops after its current step, checkpointed.
 static STOP: AtomicBool = AtomicBool::new(false);
 
-fn run_scene(path: &Path, out: Option<&Path>, resume: Option<&Path>) -> Result<(), CliError> {
+impl Command {
+    /// The name of a command that is not decomposed over processes (all but `run` and
+    /// `check`).
+    fn single_process(&self) -> Option<&'static str> {
+        match self {
+            Command::Run(_) | Command::Check(_) => None,
+            Command::Verify(_) => Some("verify"),
+            Command::Bench(_) => Some("bench"),
+            Command::Analyze(_) => Some("analyze"),
+            Command::Modes(_) => Some("modes"),
+        }
+    }
+}
+
+fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(), CliError> {
+    let (path, resume) = (args.scene.as_path(), args.resume.as_deref());
     let scene = Scene::load(path)?;
-    let out_dir = match out {
+    let out_dir = match args.out.as_deref() {
         Some(dir) => dir.to_path_buf(),
         None => path
             .parent()
@@ -391,6 +453,32 @@ fn run_scene(path: &Path, out: Option<&Path>, resume: Option<&Path>) -> Result<(
             .join(&scene.output.dir),
     };
     let mut sim = Simulation::build(scene)?;
+    let leader = ranks.as_ref().is_none_or(|r| r.rank() == 0);
+    if let Some(ranks) = &ranks {
+        let figures = sim
+            .world
+            .decompose(ranks.clone())
+            .map_err(|source| CliError::Decompose {
+                scene: path.to_path_buf(),
+                source,
+            })?;
+        if leader {
+            eprintln!("{}", decomposition_line(&figures));
+        }
+    }
+    // A second signal while the checkpoint is being written is ignored; the handler can
+    // only fail if one is already installed, which this process never does twice.
+    let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed));
+    if !leader {
+        let options = RunOptions {
+            resume,
+            stop: Some(&STOP),
+            stop_after: args.stop_after,
+            ranks: ranks.as_deref(),
+        };
+        run_with(&mut sim, &out_dir, options, &mut |_| {})?;
+        return Ok(());
+    }
     for w in &sim.warnings {
         eprintln!("warning: {w}");
     }
@@ -412,13 +500,11 @@ fn run_scene(path: &Path, out: Option<&Path>, resume: Option<&Path>) -> Result<(
             progress::draw(p, t_end)
         }
     };
-    // A second signal while the checkpoint is being written is ignored; the handler can
-    // only fail if one is already installed, which this process never does twice.
-    let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed));
     let options = RunOptions {
         resume,
         stop: Some(&STOP),
-        stop_after: None,
+        stop_after: args.stop_after,
+        ranks: ranks.as_deref(),
     };
     if let Some(checkpoint) = resume {
         eprintln!("resuming from {}", checkpoint.display());

@@ -11,4 +11,6 @@
 
 pub mod check;
 pub mod command;
+#[cfg(feature = "mpi")]
+pub mod mpi_ranks;
 pub mod progress;

@@ -94,6 +94,8 @@ pub(crate) struct BodySplit {
     pub owner: Vec<u32>,
     /// The exchange of block sums, for a body cut between ranks.
     pub exchange: Option<SumExchange>,
+    /// Per rank, the body's block sums it receives per step.
+    pub halo: Vec<usize>,
 }
 
 /// The block sums a rank sends to and receives from the others each step (slots of the
@@ -107,6 +109,8 @@ pub(crate) struct SumExchange {
     recv_counts: Vec<usize>,
     send: Vec<f64>,
     recv: Vec<f64>,
+    /// Wall seconds spent in the exchange so far (waiting for the other ranks included).
+    pub seconds: f64,
 }
 
 impl std::fmt::Debug for SumExchange {
@@ -122,6 +126,7 @@ impl SumExchange {
     /// Sends the sums this rank computed for other ranks' particles, and writes those the
     /// others computed for this rank's particles into `sums`.
     pub fn run(&mut self, sums: &mut [Vec3]) {
+        let start = std::time::Instant::now();
         self.send.clear();
         for &s in &self.send_slots {
             self.send.extend_from_slice(sums[s as usize].as_slice());
@@ -134,11 +139,7 @@ impl SumExchange {
         for (&s, v) in self.recv_slots.iter().zip(self.recv.chunks_exact(3)) {
             sums[s as usize] = Vec3::new(v[0], v[1], v[2]);
         }
-    }
-
-    /// Block sums received per step.
-    pub fn halo(&self) -> usize {
-        self.recv_slots.len()
+        self.seconds += start.elapsed().as_secs_f64();
     }
 }
 
@@ -162,6 +163,14 @@ pub(crate) fn split_body(
                 [block_of_slot[layout.entries[layout.entry_start[i] as usize] as usize] as usize]
         })
         .collect();
+    let mut halo = vec![0; ranks];
+    for (s, &node) in layout.nodes.iter().enumerate() {
+        let (from, to) = (
+            block_rank[block_of_slot[s] as usize],
+            owner[node as usize - layout.first],
+        );
+        halo[to as usize] += usize::from(from != to);
+    }
     let cut = block_rank.iter().any(|&r| r != block_rank[0]);
     let exchange = cut.then(|| {
         let (mut send, mut recv) = (vec![Vec::new(); ranks], vec![Vec::new(); ranks]);
@@ -182,6 +191,7 @@ pub(crate) fn split_body(
             recv_slots: recv.concat(),
             send: Vec::new(),
             recv: Vec::new(),
+            seconds: 0.0,
         }
     });
     BodySplit {
@@ -190,6 +200,7 @@ pub(crate) fn split_body(
         first: layout.first,
         owner,
         exchange,
+        halo,
     }
 }
 
@@ -290,7 +301,9 @@ pub(crate) fn decompose(
             owner[p] = r;
             figures.owned[r as usize] += 1;
         }
-        figures.halo[comm.rank()] += split.exchange.as_ref().map_or(0, SumExchange::halo);
+        for (total, n) in figures.halo.iter_mut().zip(&split.halo) {
+            *total += n;
+        }
         body.set_split(split);
     }
     let share = StateShare::new(owner, comm);

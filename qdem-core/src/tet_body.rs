@@ -185,6 +185,13 @@ impl TetBody {
         }
     }
 
+    /// In a run decomposed over processes, the wall seconds this process has spent
+    /// exchanging block sums with the other ranks (waiting for them included); 0 otherwise.
+    pub fn exchange_seconds(&self) -> f64 {
+        let exchange = self.split.as_ref().and_then(|s| s.exchange.as_ref());
+        exchange.map_or(0.0, |e| e.seconds)
+    }
+
     /// Computes only this process's share of the body from now on.
     pub(crate) fn set_split(&mut self, split: BodySplit) {
         self.split = Some(split);

@@ -97,7 +97,7 @@ pub struct World {
     stages: StageTimes,
     energy: EnergyGrowth,
     steps_done: u64,
-    share: Option<StateShare>,
+    share: Option<(StateShare, Decomposition)>,
 }
 
 impl World {
@@ -201,15 +201,20 @@ impl World {
             )));
         }
         let (share, figures) = decompose(&self.state, &mut self.models, comm)?;
-        self.share = Some(share);
+        self.share = Some((share, figures.clone()));
         Ok(figures)
+    }
+
+    /// How the run is decomposed over processes; `None` for a run of one process.
+    pub fn decomposition(&self) -> Option<&Decomposition> {
+        self.share.as_ref().map(|(_, d)| d)
     }
 
     /// Makes the accelerations consistent with the forces at the start (and factorises, for
     /// an implicit scheme).
     pub fn initialize(&mut self) -> Result<(), CoreError> {
         let done = self.stepper.initialize(&mut self.state, &mut self.models);
-        let Some(share) = &mut self.share else {
+        let Some((share, _)) = &mut self.share else {
             return done;
         };
         share.share(&mut self.state);
@@ -226,7 +231,7 @@ impl World {
             .stepper
             .step_timed(&mut self.state, &mut self.models, &mut self.stages);
         self.steps_done += 1;
-        if let Some(share) = &mut self.share {
+        if let Some((share, _)) = &mut self.share {
             share.share(&mut self.state);
             self.stages.mark(Stage::Share);
         }
@@ -260,7 +265,7 @@ impl World {
                 .map(|e| e.to_string()),
         };
         let failure = match &self.share {
-            Some(share) => share.agree(local),
+            Some((share, _)) => share.agree(local),
             None => local,
         };
         let failure = failure.or_else(|| {

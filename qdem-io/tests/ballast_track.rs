@@ -157,11 +157,7 @@ fn a_run_starts_from_another_scenes_checkpoint_and_refuses_one_of_other_bodies()
     run_with(
         &mut first,
         &dir.join("out"),
-        RunOptions {
-            resume: None,
-            stop: None,
-            stop_after: None,
-        },
+        RunOptions::default(),
         &mut |_| {},
     )
     .unwrap();

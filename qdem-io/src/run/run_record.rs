@@ -75,6 +75,18 @@ pub(crate) fn decode_run(
     Ok(())
 }
 
+/// Restores only the world of a run encoded by [`encode_run`] (a rank of a decomposed run
+/// that writes no outputs); returns the next step.
+pub(crate) fn decode_world(body: &[u8], sim: &mut Simulation) -> Result<u64, CoreError> {
+    let mut input = Decoder::new(body);
+    let mut record = Decoder::new(input.block("the run record")?);
+    record.tag("run")?;
+    let next_step = record.u64("the next step")?;
+    sim.world.restore(&mut input, next_step.saturating_sub(1))?;
+    done(&input, "the last model")?;
+    Ok(next_step)
+}
+
 /// Fails if bytes are left after `what`.
 fn done(input: &Decoder<'_>, what: &str) -> Result<(), CheckpointError> {
     if input.is_done() {

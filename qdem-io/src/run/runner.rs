@@ -12,8 +12,8 @@ use crate::output::OutputError;
 use crate::run::inputs::SceneFingerprint;
 use crate::run::record::schedule::{probe_interval, Schedule};
 use crate::run::record::{self, Recorder, RunFigures, StepInfo};
-use crate::run::run_record::{decode_run, encode_run, RunRecord};
-use qdem_core::{CoreError, Halt};
+use crate::run::run_record::{decode_run, decode_world, encode_run, RunRecord};
+use qdem_core::{Communicator, CoreError, Halt};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -116,7 +116,7 @@ pub struct RunReport {
 const GOOD_STATE_EVERY: f64 = 1.0;
 
 /// How a run starts and when it stops early.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Default)]
 pub struct RunOptions<'a> {
     /// A checkpoint to continue from (`qdem run --resume`), written by a run of the same scene
     /// into the same output directory.
@@ -126,6 +126,33 @@ pub struct RunOptions<'a> {
     pub stop: Option<&'a AtomicBool>,
     /// Stops as on a stop request once this step is done (a batch slot's last step, a test).
     pub stop_after: Option<u64>,
+    /// The ranks of a run decomposed over processes (its world already
+    /// [`qdem_core::World::decompose`]d): rank 0 writes every output, the others only step;
+    /// all agree at every step on whether to stop.
+    pub ranks: Option<&'a dyn Communicator>,
+}
+
+impl std::fmt::Debug for RunOptions<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RunOptions")
+            .field("resume", &self.resume)
+            .field("stop", &self.stop)
+            .field("stop_after", &self.stop_after)
+            .field("ranks", &self.ranks.map(|r| (r.rank(), r.size())))
+            .finish()
+    }
+}
+
+impl RunOptions<'_> {
+    /// Whether the run stops after `step`: asked to (on any rank, in a decomposed run).
+    fn stops_after(&self, step: u64) -> bool {
+        let asked =
+            self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) || self.stop_after == Some(step);
+        match self.ranks {
+            Some(ranks) => ranks.min(u64::from(!asked)) == 0,
+            None => asked,
+        }
+    }
 }
 
 /// Runs `sim` to its end time, writing `probes.csv`, `summary.json` and, if asked,
@@ -157,6 +184,9 @@ pub fn run_with(
     options: RunOptions<'_>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<RunReport, RunError> {
+    if options.ranks.is_some_and(|r| r.rank() != 0) {
+        return follow(sim, options);
+    }
     let mut run = Run::open(sim, out_dir, options)?;
     let steps = sim.steps();
     let first_step = run.record.next_step;
@@ -294,9 +324,7 @@ impl<'a> Run<'a> {
         let time = sim.world.state.time;
         let sampled = self.good_schedule.due(time, info.dt);
         self.record.next_step = step + 1;
-        let options = &self.options;
-        let stop = options.stop.is_some_and(|s| s.load(Ordering::Relaxed))
-            || options.stop_after == Some(step);
+        let stop = self.options.stops_after(step);
         if self.record.checkpoints.due(time, info.dt) || stop {
             for r in self.recorders.iter_mut() {
                 r.publish()?;
@@ -341,6 +369,51 @@ impl<'a> Run<'a> {
             (outcome, _) => outcome,
         }
     }
+}
+
+/// A rank other than 0 of a decomposed run: the same steps, the same stop agreements, no
+/// outputs (rank 0 writes them from the same state).
+fn follow(sim: &mut Simulation, options: RunOptions<'_>) -> Result<RunReport, RunError> {
+    let start = Instant::now();
+    let first_step = match options.resume {
+        Some(path) => {
+            let body = read_checkpoint(path, Some(&scene_fingerprint(&sim.scene)))?;
+            decode_world(&body, sim).map_err(|source| core_error(sim, source))?
+        }
+        None => {
+            let initialized = sim.world.initialize();
+            initialized.map_err(|source| core_error(sim, source))?;
+            0
+        }
+    };
+    let steps = sim.steps();
+    let mut halt = None;
+    for step in first_step..=steps {
+        if step > 0 {
+            halt = sim.world.step().map_err(|source| core_error(sim, source))?;
+        }
+        if options.stops_after(step) || halt.is_some() {
+            break;
+        }
+    }
+    let wall_seconds = start.elapsed().as_secs_f64();
+    let figures = RunFigures {
+        steps_taken: sim
+            .world
+            .steps_done()
+            .saturating_sub(first_step.saturating_sub(1)) as f64,
+        wall_seconds,
+    };
+    Ok(RunReport {
+        integrator: sim.world.stepper().name().to_string(),
+        steps: sim.world.steps_done(),
+        dt: sim.world.dt(),
+        final_time: sim.world.state.time,
+        wall_seconds,
+        tet_steps_per_second: figures.rate(sim.tets()),
+        particle_steps_per_second: figures.rate(sim.world.state.len()),
+        halt,
+    })
 }
 
 /// Creates an output directory.

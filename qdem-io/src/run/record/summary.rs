@@ -66,6 +66,7 @@ fn base(sim: &Simulation, report: &RunReport) -> serde_json::Value {
         "tets": sim.tets(),
         "tet_steps_per_second": report.tet_steps_per_second,
         "threads": rayon::current_num_threads(),
+        "ranks": world.decomposition().map_or(1, |d| d.ranks),
         "kinetic_energy": world.state.kinetic_energy(),
         "stages": world.stage_report().iter().map(|s| json!({
             "stage": s.name,

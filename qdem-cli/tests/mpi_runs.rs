@@ -1,0 +1,274 @@
+//! `mpirun -np N qdem run SCENE` (the binary built with `--features mpi`) writes the files one
+//! process writes, byte for byte, for 1, 2 and 3 ranks (oversubscribed on a 2-core machine) and
+//! 1 or 2 threads per rank; a checkpoint written at 2 ranks resumes at 1 and at 3 ranks to the
+//! same files. `summary.json` is compared without its wall-clock figures and its thread and
+//! rank counts. Needs Open MPI's `mpirun` on the PATH (scripts/test.sh installs it).
+
+#![cfg(feature = "mpi")]
+
+mod common;
+use common::{workspace, TempDir};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const QDEM: &str = env!("CARGO_BIN_EXE_qdem");
+
+/// A copy of a fixture scene beside it (so that its relative paths hold) with `[run] t_end`
+/// replaced; removed on drop.
+struct ShortScene(PathBuf);
+
+impl ShortScene {
+    fn new(fixture: &str, t_end: f64, tag: &str) -> ShortScene {
+        let path = workspace().join("fixtures").join(fixture);
+        let text = std::fs::read_to_string(&path).expect("read the fixture scene");
+        let lines: Vec<String> = text
+            .lines()
+            .map(|l| match l.starts_with("t_end = ") {
+                true => format!("t_end = {t_end:?}"),
+                false => l.to_string(),
+            })
+            .collect();
+        assert!(text.lines().filter(|l| l.starts_with("t_end = ")).count() == 1);
+        let name = format!(".mpi-{tag}-{}.toml", std::process::id());
+        let copy = path.with_file_name(name);
+        std::fs::write(&copy, lines.join("\n") + "\n").expect("write the short scene");
+        ShortScene(copy)
+    }
+}
+
+impl Drop for ShortScene {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+/// Runs `qdem run` of `scene` into `out` on `ranks` processes of `threads` threads (one
+/// process without mpirun for `ranks` = 0), with extra arguments; a run stopped by
+/// `--stop-after` (exit status 130, with its checkpoint) counts as a success.
+fn run(scene: &Path, out: &Path, ranks: usize, threads: usize, extra: &[&str]) {
+    let threads = threads.to_string();
+    let mut args = vec![
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(["--threads", &threads]);
+    args.extend(extra);
+    let mut command = match ranks {
+        0 => Command::new(QDEM),
+        n => {
+            let mut c = Command::new("mpirun");
+            c.args([
+                "--oversubscribe",
+                "--bind-to",
+                "none",
+                "-np",
+                &n.to_string(),
+                QDEM,
+            ]);
+            c.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+                .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+                .env("OMPI_MCA_rmaps_base_oversubscribe", "1");
+            c
+        }
+    };
+    let output = command
+        .args(&args)
+        .output()
+        .expect("start qdem (is mpirun installed?)");
+    let stopped = extra.contains(&"--stop-after") && output.status.code() == Some(130);
+    assert!(
+        output.status.success() || stopped,
+        "{ranks} ranks x {threads} threads: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+/// Every file under `dir`, relative to it, sorted.
+fn files(dir: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            match path.is_dir() {
+                true => stack.push(path),
+                false => found.push(path.strip_prefix(dir).unwrap().to_path_buf()),
+            }
+        }
+    }
+    found.sort();
+    found
+}
+
+/// `summary.json` without what differs between two runs of the same scene: wall-clock
+/// figures, thread and rank counts, the step a resumed run resumed at.
+fn summary_physics(path: &Path) -> serde_json::Value {
+    fn strip(v: &mut serde_json::Value) {
+        if let Some(map) = v.as_object_mut() {
+            map.retain(|k, _| {
+                !(k.contains("second")
+                    || k == "stages"
+                    || k == "threads"
+                    || k == "ranks"
+                    || k == "resumed_at_step")
+            });
+            map.values_mut().for_each(strip);
+        }
+    }
+    let mut value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    strip(&mut value);
+    value
+}
+
+/// Asserts that `b` holds the same files as `a`, byte for byte (summary.json: its physics).
+fn assert_same_outputs(a: &Path, b: &Path, what: &str) {
+    let (fa, fb) = (files(a), files(b));
+    assert_eq!(fa, fb, "{what}: not the same files");
+    assert!(
+        fa.iter().any(|f| f.ends_with("probes.csv")),
+        "{what}: no probes"
+    );
+    for f in &fa {
+        if f.ends_with("summary.json") {
+            assert_eq!(
+                summary_physics(&a.join(f)),
+                summary_physics(&b.join(f)),
+                "{what}: {f:?}"
+            );
+            continue;
+        }
+        let same = std::fs::read(a.join(f)).unwrap() == std::fs::read(b.join(f)).unwrap();
+        assert!(same, "{what}: {} differs", f.display());
+    }
+}
+
+/// One process, then 2 and 3 ranks of 1 thread and 2 ranks of 2 threads: the same files.
+fn same_for_any_ranks(fixture: &str, t_end: f64, tag: &str) {
+    let scene = ShortScene::new(fixture, t_end, tag);
+    let tmp = TempDir::new(tag);
+    let single = tmp.path().join("single");
+    run(&scene.0, &single, 0, 1, &[]);
+    for (ranks, threads) in [(2, 1), (3, 1), (2, 2)] {
+        let out = tmp.path().join(format!("r{ranks}t{threads}"));
+        run(&scene.0, &out, ranks, threads, &[]);
+        let what = format!("{fixture} on {ranks} ranks x {threads} threads");
+        assert_same_outputs(&single, &out, &what);
+    }
+}
+
+#[test]
+fn the_cantilever_is_byte_identical_on_any_number_of_ranks() {
+    same_for_any_ranks("cantilever/cantilever_lc100.toml", 0.02, "cantilever");
+}
+
+#[test]
+fn the_collision_is_byte_identical_on_any_number_of_ranks() {
+    same_for_any_ranks("contact/collision.toml", 0.01, "collision");
+}
+
+#[test]
+fn a_periodic_granular_packing_is_byte_identical_on_any_number_of_ranks() {
+    same_for_any_ranks("boxtest/small_deposit_cell_bed.toml", 0.02, "packing");
+}
+
+#[test]
+fn a_reduced_ballast_deposit_is_byte_identical_on_any_number_of_ranks() {
+    same_for_any_ranks("ballast/reduced_deposit.toml", 0.004, "deposit");
+}
+
+#[test]
+fn a_checkpoint_written_at_two_ranks_resumes_at_one_and_three() {
+    let scene = ShortScene::new("contact/collision.toml", 0.01, "resume");
+    let tmp = TempDir::new("resume");
+    let whole = tmp.path().join("whole");
+    run(&scene.0, &whole, 0, 1, &[]);
+    let half = tmp.path().join("half");
+    run(&scene.0, &half, 2, 1, &["--stop-after", "300"]);
+    let checkpoint = tmp.path().join("half.qdc");
+    std::fs::copy(half.join("checkpoint.qdc"), &checkpoint).unwrap();
+    for ranks in [0, 3] {
+        let out = tmp.path().join(format!("resumed{ranks}"));
+        copy_dir(&half, &out);
+        std::fs::remove_file(out.join("checkpoint.qdc")).unwrap();
+        run(
+            &scene.0,
+            &out,
+            ranks,
+            1,
+            &["--resume", checkpoint.to_str().unwrap()],
+        );
+        assert_same_outputs(&whole, &out, &format!("resumed at {ranks} ranks"));
+    }
+}
+
+/// Copies the files of `from` into a new `to`.
+fn copy_dir(from: &Path, to: &Path) {
+    for f in files(from) {
+        let target = to.join(&f);
+        std::fs::create_dir_all(target.parent().unwrap()).unwrap();
+        std::fs::copy(from.join(&f), target).unwrap();
+    }
+}
+
+/// Runs `qdem ARGS` on 2 ranks; its exit success and its stdout and stderr.
+fn on_two_ranks(args: &[&str]) -> (bool, String, String) {
+    let output = Command::new("mpirun")
+        .args(["--oversubscribe", "--bind-to", "none", "-np", "2", QDEM])
+        .args(args)
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .output()
+        .expect("start mpirun");
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    (
+        output.status.success(),
+        text(&output.stdout),
+        text(&output.stderr),
+    )
+}
+
+#[test]
+fn check_on_two_ranks_reports_each_ranks_share_of_the_tetrahedra() {
+    let scene = workspace().join("fixtures/contact/collision.toml");
+    let (ok, out, err) = on_two_ranks(&["check", scene.to_str().unwrap(), "--threads", "1"]);
+    assert!(ok, "{err}");
+    let rows: Vec<Vec<&str>> = out
+        .lines()
+        .skip_while(|l| !l.starts_with("decomposed over 2 ranks"))
+        .skip(2)
+        .take(2)
+        .map(|l| l.split_whitespace().collect())
+        .collect();
+    assert_eq!(rows.len(), 2, "{out}");
+    let tets: usize = rows.iter().map(|r| r[1].parse::<usize>().unwrap()).sum();
+    assert_eq!(
+        tets,
+        2 * 205,
+        "the two deformable cubes' tetrahedra, each once: {out}"
+    );
+    assert!(out.contains("kernel imbalance (slowest / mean):"), "{out}");
+    assert_eq!(
+        out.matches("scene ").count(),
+        1,
+        "only rank 0 prints: {out}"
+    );
+}
+
+#[test]
+fn an_implicit_run_and_the_other_commands_are_refused_on_two_ranks() {
+    let implicit = workspace().join("fixtures/bbm/beam_implicit_0.025.toml");
+    let tmp = TempDir::new("implicit");
+    let out = tmp.path().to_str().unwrap();
+    let (ok, _, err) = on_two_ranks(&["run", implicit.to_str().unwrap(), "--out", out]);
+    assert!(!ok);
+    assert!(
+        err.contains("only explicit Verlet runs can be decomposed")
+            && err.contains("without mpirun"),
+        "{err}"
+    );
+    let (ok, _, err) = on_two_ranks(&["modes", implicit.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("`qdem modes` runs as one process"), "{err}");
+}
