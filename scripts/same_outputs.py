@@ -9,7 +9,7 @@ small box tests (the cell's bed and crib deposits, then the single-sleeper boxes
 three-sleeper box on their sample), the small BBM beam and the implicit 0.025 m beam, and the
 reduced ballast deposit cut to 4 ms. Every CSV, SVG, VTU and PVD file is compared byte for byte,
 `summary.json` field by field without the timing fields (wall time, rates, the stage
-counters, the thread count). Prints one JSON line per scene and exits non-zero on any
+counters, the thread and rank counts). Prints one JSON line per scene and exits non-zero on any
 difference. With `--keep DIR`, the runs are kept in DIR/before and DIR/after, and a label
 whose folder is already there is not run again (compare a new build against kept outputs).
 """
@@ -51,7 +51,7 @@ def timing_key(key):
     return (
         "seconds" in key
         or "per_second" in key
-        or key in ("threads", "stages", "scene")
+        or key in ("threads", "ranks", "stages", "scene")
     )
 
 
