@@ -378,11 +378,11 @@ fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliErro
         Some(dir) => dir.to_path_buf(),
         None => scene.base_dir().join(&scene.output.dir).join("modes"),
     };
-    let sim = Simulation::build(scene)?;
+    let mut sim = Simulation::build(scene)?;
     for w in &sim.warnings {
         eprintln!("warning: {w}");
     }
-    let report = qdem_io::modes::compute_and_write(&sim, count, &out_dir)?;
+    let report = qdem_io::modes::compute_and_write(&mut sim, count, &out_dir)?;
     for name in &report.ignored {
         eprintln!("note: model `{name}` gives no stiffness and is left out of the modes");
     }

@@ -38,8 +38,10 @@ use crate::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
 use crate::wall::Wall;
 use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
+use crate::contact_springs::{add_spring, spring};
 use qdem_core::{
-    CheckpointError, Decoder, Dofs, Encoder, Model, Persistence, Persistent, State, Vec3,
+    CheckpointError, Decoder, Dofs, Encoder, Linearized, Model, Persistence, Persistent, State,
+    Tangent, Vec3,
 };
 use rayon::prelude::*;
 
@@ -874,6 +876,44 @@ impl Model for DemContacts {
 
     fn persistent_mut(&mut self) -> Option<&mut dyn Persistent> {
         Some(self)
+    }
+
+    /// The contacts touching at the last evaluation, as sticking springs
+    /// ([`crate::contact_springs`]); none when a sphere turns (a rigid body's, a rotating
+    /// particle's), whose contact springs would couple rotations this leaves out. The contacts
+    /// give no [`Model::linearized`] facet: an implicit step would need the events of contacts
+    /// opening and closing.
+    fn modal_stiffness(&self) -> Option<&dyn Linearized> {
+        let turns = self.turn.iter().any(|&t| t != NOT_RIGID);
+        (!turns).then_some(self as &dyn Linearized)
+    }
+}
+
+impl Linearized for DemContacts {
+    /// The springs of the contacts touching at the last evaluation, at the geometry it saw.
+    fn add_tangent(&self, _state: &State, tangent: &mut Tangent) {
+        let law = &self.settings.law;
+        for c in &self.pairs.items {
+            let (a, b) = (c.first as usize, c.second as usize);
+            let (sa, sb) = (&self.now[a], &self.now[b]);
+            let shift = self.separation(a, b).1;
+            let Some(g) = narrow_phase(sa, sb, shift, self.settings.friction) else {
+                continue;
+            };
+            let e = self.elasticity[sa.material as usize * self.materials + sb.material as usize];
+            let (kn, kt) = law.stiffness(g.overlap, g.radius, &e);
+            let (pa, pb) = (self.particle[a] as usize, self.particle[b] as usize);
+            add_spring(tangent, pa, Some(pb), &spring(&g.normal, kn, kt));
+        }
+        let time = self.last_time.unwrap_or(0.0);
+        for c in &self.wall_contacts.items {
+            let (s, w) = (c.first as usize, c.second as usize);
+            let Some((g, e)) = self.wall_contact(time, s, w) else {
+                continue;
+            };
+            let (kn, kt) = law.stiffness(g.overlap, g.radius, &e);
+            add_spring(tangent, self.particle[s] as usize, None, &spring(&g.normal, kn, kt));
+        }
     }
 }
 

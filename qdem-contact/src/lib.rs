@@ -35,6 +35,7 @@ pub mod clump_sample;
 pub mod collapse_watch;
 pub mod contact_law;
 mod contact_list;
+mod contact_springs;
 pub mod coulomb;
 pub mod dem_contacts;
 pub mod error;

@@ -1,12 +1,14 @@
 //! Natural frequencies and mode shapes by shift-invert Lanczos: the lowest eigenpairs of
-//! K φ = ω² M φ about the reference configuration.
+//! K φ = ω² M φ about a state (a scene's reference configuration, or the settled state a run
+//! starts from).
 //!
-//! - K is the models' tangent stiffness at the reference state ([`crate::Linearized`]; for
-//!   QDEM tetrahedra the small-strain linear-tet stiffness, so these are the mesh's linear FEM
-//!   modes with lumped mass), M the lumped mass (a quarter of each tetrahedron's mass to each
+//! - K is the models' tangent stiffness at the state's positions ([`Model::modal_stiffness`];
+//!   for QDEM tetrahedra the small-strain linear-tet stiffness, so these are the mesh's linear
+//!   FEM modes with lumped mass; for DEM contacts the touching contacts' springs), M the
+//!   lumped mass (a quarter of each tetrahedron's mass to each
 //!   vertex), both over the free DOFs of the deformable bodies' particles (fixed directions
-//!   are eliminated as in the static solve, paper 001 Eq. 23). Models without a linearisation
-//!   (DEM contacts) add nothing and are listed in [`Modes::ignored`].
+//!   are eliminated as in the static solve, paper 001 Eq. 23). Models without a modal
+//!   stiffness (loads, gravity) add nothing and are listed in [`Modes::ignored`].
 //! - Shift and invert (Ericsson & Ruhe 1980): with A = K − σM, σ = −(2π · 1 Hz)² < 0 so that A
 //!   is positive definite even for a body free to move rigidly, the eigenvalues θ of the
 //!   operator A⁻¹M, self-adjoint in the M inner product ⟨x, y⟩ = xᵀMy, are θ = 1/(ω² − σ):
@@ -169,8 +171,10 @@ pub struct Modes {
     pub factor_seconds: f64,
 }
 
-/// The `count` lowest natural modes of the deformable bodies of `models` about the reference
-/// positions of `state`, with the lumped masses and the fixity of `state`.
+/// The `count` lowest natural modes of the deformable bodies of `models` about the positions
+/// of `state`, with the lumped masses and the fixity of `state`. Models that keep what they
+/// saw at their last force evaluation (DEM contacts: which touch) must have been evaluated
+/// at `state`.
 ///
 /// ```
 /// use qdem_core::lanczos::natural_modes;
@@ -201,16 +205,14 @@ pub fn natural_modes(
     if count == 0 {
         return Err(ModalError::ZeroCount);
     }
-    let mut reference = state.clone();
-    reference.position.clone_from(&state.reference);
-    let problem = Problem::new(&reference, models)?;
+    let problem = Problem::new(state, models)?;
     if count > problem.dofs.len() {
         return Err(ModalError::TooManyModes {
             count,
             dofs: problem.dofs.len(),
         });
     }
-    let rigid = problem.rigid_basis(&reference, models)?;
+    let rigid = problem.rigid_basis(state, models)?;
     let start = std::time::Instant::now();
     let mut solver = ShiftInvert::new(&problem)?;
     let factor_seconds = start.elapsed().as_secs_f64();
@@ -263,7 +265,7 @@ impl Problem {
         let ignored = collect_stiffness(state, models, &mut tangent);
         let n = state.len();
         let mut in_body = vec![false; n];
-        for l in models.iter().filter_map(|m| m.linearized()) {
+        for l in models.iter().filter_map(|m| m.modal_stiffness()) {
             for p in l.particles() {
                 in_body[p] = true;
             }
@@ -307,7 +309,7 @@ impl Problem {
         let (mut centre, mut total) = (Vec3::zeros(), 0.0);
         for (i, &d) in self.global.iter().enumerate() {
             if included(d) && d / 3 < n {
-                centre += self.mass[i] * state.reference[node(d)];
+                centre += self.mass[i] * state.position[node(d)];
                 total += self.mass[i];
             }
         }
@@ -329,7 +331,7 @@ impl Problem {
                         if spin {
                             omega[axis]
                         } else {
-                            omega.cross(&(state.reference[node(d)] - centre))[axis]
+                            omega.cross(&(state.position[node(d)] - centre))[axis]
                         }
                     })
                     .collect()
@@ -348,7 +350,7 @@ impl Problem {
         for (body, modes) in unconstrained_bodies(state, models, &self.tangent, &self.dofs) {
             let model = models.iter().find(|m| m.name() == body);
             let particles = model
-                .and_then(|m| m.linearized())
+                .and_then(|m| m.modal_stiffness())
                 .map_or_else(Vec::new, |l| l.particles());
             let fixed = particles
                 .iter()
@@ -504,7 +506,7 @@ fn collect_stiffness(
 ) -> Vec<String> {
     let mut ignored = Vec::new();
     for model in models {
-        match model.linearized() {
+        match model.modal_stiffness() {
             Some(linear) => linear.add_tangent(state, tangent),
             None => ignored.push(model.name().to_string()),
         }

@@ -71,6 +71,15 @@ pub trait Model: std::any::Any + Send + Sync {
         None
     }
 
+    /// The stiffness a modal analysis about the current state takes from the model
+    /// ([`crate::lanczos`]); the default is its linearisation. A model may give one here that
+    /// it cannot be stepped implicitly with: DEM contacts give their touching contacts as
+    /// springs, but an implicit step would also need the events of contacts opening and
+    /// closing.
+    fn modal_stiffness(&self) -> Option<&dyn Linearized> {
+        self.linearized()
+    }
+
     /// The model's step events; `None` (the default): it has none.
     fn events(&mut self) -> Option<&mut dyn StepEvents> {
         None

@@ -12,8 +12,10 @@
 //!   largest particle displacement is 1 (warp by it with the amplitude you want, in metres),
 //!   on the reference positions; indexed by `modes.pvd`, whose "time" is the mode number.
 //!
-//! All files are written atomically. Models without a linearisation (DEM contacts) add no
-//! stiffness and are listed in [`ModesReport::ignored`]; rigid bodies are refused.
+//! All files are written atomically. The contacts touching in the starting state enter as
+//! sticking springs (`qdem_contact`'s contact springs); models without a modal stiffness
+//! (loads, gravity) add none and are listed in [`ModesReport::ignored`]; rigid bodies are
+//! refused.
 
 use crate::build::{BodyKind, Simulation};
 use crate::output::{write_atomic, write_vtu, OutputError, PvdIndex, VtuGrid};
@@ -60,13 +62,16 @@ pub struct ModesReport {
     pub pvd: PathBuf,
 }
 
-/// Computes the `count` lowest modes of `sim`'s deformable bodies about their reference
-/// positions and writes `modes.csv`, `modes.pvd` and `vtu/mode_NNNN.vtu` into `dir`.
+/// Computes the `count` lowest modes of `sim`'s deformable bodies about its starting state
+/// (the reference configuration, or the state of `[run] start_from`), with the contacts
+/// touching there as springs, and writes `modes.csv`, `modes.pvd` and `vtu/mode_NNNN.vtu`
+/// into `dir`.
 pub fn compute_and_write(
-    sim: &Simulation,
+    sim: &mut Simulation,
     count: usize,
     dir: &Path,
 ) -> Result<ModesReport, ModesError> {
+    evaluate_once(sim);
     let world = &sim.world;
     let modes =
         natural_modes(&world.state, &world.models, count).map_err(|source| ModesError::Modal {
@@ -92,7 +97,7 @@ pub fn compute_and_write(
             .map(|u| u / largest.max(f64::MIN_POSITIVE))
             .collect();
         let grid = VtuGrid {
-            points: &world.state.reference,
+            points: &world.state.position,
             tets: &tets,
             point_vectors: vec![("mode_shape", &shape)],
             cell_scalars: vec![],
@@ -107,6 +112,18 @@ pub fn compute_and_write(
         csv,
         pvd,
     })
+}
+
+/// Every model's forces once at the starting state, so that the contacts know which of them
+/// touch there (the forces themselves are not used).
+fn evaluate_once(sim: &mut Simulation) {
+    let world = &mut sim.world;
+    let state = &world.state;
+    let mut force = vec![Vec3::zeros(); state.len()];
+    let mut torque = vec![Vec3::zeros(); state.rigid.len() + state.spin.len()];
+    for model in world.models.iter_mut() {
+        model.add_forces(state, &mut force, &mut torque);
+    }
 }
 
 /// The tetrahedra of every deformable body, as state particle indices.
