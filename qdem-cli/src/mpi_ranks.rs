@@ -10,6 +10,15 @@ use mpi::Threading;
 use qdem_core::Communicator;
 
 /// The processes of an `mpirun`, as a [`Communicator`].
+///
+/// ```no_run
+/// use qdem_core::Communicator;
+///
+/// // Started by `mpirun -np 2`: two ranks; started alone: `None`.
+/// if let Some((_universe, ranks)) = qdem_cli::mpi_ranks::start() {
+///     println!("rank {} of {}", ranks.rank(), ranks.size());
+/// }
+/// ```
 pub struct MpiRanks {
     world: SimpleCommunicator,
 }

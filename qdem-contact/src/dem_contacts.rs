@@ -32,13 +32,13 @@
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
 use crate::contact_list::{Contact, ContactList};
+use crate::contact_springs::{add_spring, spring};
 use crate::error::ContactError;
 use crate::periodic_boundary::PeriodicBox;
 use crate::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
 use crate::wall::Wall;
 use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
-use crate::contact_springs::{add_spring, spring};
 use qdem_core::{
     CheckpointError, Decoder, Dofs, Encoder, Linearized, Model, Persistence, Persistent, State,
     Tangent, Vec3,
@@ -912,7 +912,12 @@ impl Linearized for DemContacts {
                 continue;
             };
             let (kn, kt) = law.stiffness(g.overlap, g.radius, &e);
-            add_spring(tangent, self.particle[s] as usize, None, &spring(&g.normal, kn, kt));
+            add_spring(
+                tangent,
+                self.particle[s] as usize,
+                None,
+                &spring(&g.normal, kn, kt),
+            );
         }
     }
 }

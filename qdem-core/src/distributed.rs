@@ -37,6 +37,45 @@ use std::sync::Arc;
 /// over threads.
 ///
 /// Counts are per rank, in rank order; buffers hold the ranks' parts one after the other.
+///
+/// ```
+/// use qdem_core::{Communicator, Material, Model, Scheme, State, StepRequest, StepSettings,
+///     TetBody, Vec3, World};
+///
+/// /// The communicator of a single process: every collective is a copy.
+/// struct Alone;
+///
+/// impl Communicator for Alone {
+///     fn rank(&self) -> usize { 0 }
+///     fn size(&self) -> usize { 1 }
+///     fn all_to_all(&self, send: &[f64], _: &[usize], recv: &mut [f64], _: &[usize]) {
+///         recv.copy_from_slice(send);
+///     }
+///     fn all_gather(&self, mine: &[f64], all: &mut [f64], _: &[usize]) {
+///         all.copy_from_slice(mine);
+///     }
+///     fn min(&self, value: u64) -> u64 { value }
+///     fn broadcast(&self, _: usize, _: &mut Vec<u8>) {}
+/// }
+///
+/// let nodes = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];
+/// let mut state = State::at_rest(nodes);
+/// let body = TetBody::new("tet", &state.reference, vec![[0, 1, 2, 3]],
+///     Material::elastic(1000.0, 1e6, 0.3)).unwrap();
+/// body.lump_mass(&mut state.mass);
+/// state.position[3].z += 0.01;
+/// let models: Vec<Box<dyn Model>> = vec![Box::new(body)];
+/// let request = StepRequest { scheme: Scheme::Verlet, dt: None, safety: 0.5,
+///     local_damping: 0.0, adaptive: false, implicit_default: None, fit_to: None };
+/// let settings = StepSettings::resolve(&request, &state, &models).unwrap();
+/// let mut world = World::new(state, models, settings).unwrap();
+/// let decomposition = world.decompose(std::sync::Arc::new(Alone)).unwrap();
+/// assert_eq!(decomposition.tets, vec![1]);
+/// assert_eq!(decomposition.owned, vec![4]);
+/// world.initialize().unwrap();
+/// world.step().unwrap();
+/// assert!(world.state.velocity[3].z < 0.0, "the stretched vertex is pulled back");
+/// ```
 pub trait Communicator: Send + Sync {
     /// This process's rank, `0..size`.
     fn rank(&self) -> usize;
@@ -64,7 +103,8 @@ pub trait Communicator: Send + Sync {
     fn broadcast(&self, root: usize, bytes: &mut Vec<u8>);
 }
 
-/// How the deformable bodies' blocks fall on the ranks, the same on every rank.
+/// How the deformable bodies' blocks fall on the ranks, the same on every rank: what
+/// [`crate::World::decompose`] returns (see the example of [`Communicator`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Decomposition {
     /// The number of ranks.
