@@ -387,6 +387,13 @@ fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliErro
         eprintln!("note: model `{name}` gives no stiffness and is left out of the modes");
     }
     let m = &report.modes;
+    if m.mechanisms > 0 {
+        eprintln!(
+            "note: {} rigid motions of single pieces that nothing resists (stones resting on \
+             fewer than three contacts, or on none) are left out of the modes",
+            m.mechanisms
+        );
+    }
     eprintln!(
         "qdem modes {}: {} free DOFs, K factorised in {:.2} s, {} Lanczos steps",
         path.display(),

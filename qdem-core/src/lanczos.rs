@@ -39,9 +39,11 @@
 //!   the free DOFs). The direction with the largest fraction is the mode's dominant direction.
 
 use crate::error::CoreError;
+use crate::mechanisms::{unresisted_motions, SystemDofs};
 use crate::model::Model;
 use crate::sparse::{unconstrained_bodies, Assembler, FreeDofs, Scales, SparseCholesky, Tangent};
 use crate::state::{Dofs, State};
+use crate::tet_body::TetBody;
 use crate::Vec3;
 use nalgebra::{DMatrix, SymmetricEigen};
 use std::f64::consts::PI;
@@ -163,6 +165,9 @@ pub struct Modes {
     pub modes: Vec<Mode>,
     /// Free degrees of freedom of the eigenproblem.
     pub dofs: usize,
+    /// Zero-stiffness rigid motions of single pieces (a stone resting on fewer than three
+    /// contacts) found and left out of the modes ([`crate::mechanisms`]).
+    pub mechanisms: usize,
     /// Models that gave no stiffness and were left out (contacts, say).
     pub ignored: Vec<String>,
     /// Lanczos steps taken.
@@ -212,11 +217,12 @@ pub fn natural_modes(
             dofs: problem.dofs.len(),
         });
     }
-    let rigid = problem.rigid_basis(state, models)?;
+    let mut rigid = problem.rigid_basis(state, models)?;
+    let mechanisms = problem.add_mechanisms(state, models, &mut rigid);
     let start = std::time::Instant::now();
     let mut solver = ShiftInvert::new(&problem)?;
     let factor_seconds = start.elapsed().as_secs_f64();
-    let mut modes: Vec<Mode> = rigid
+    let mut modes: Vec<Mode> = rigid[..rigid.len() - mechanisms]
         .iter()
         .take(count)
         .map(|r| problem.mode(problem.rayleigh(r), r.clone(), true))
@@ -236,6 +242,7 @@ pub fn natural_modes(
     Ok(Modes {
         modes,
         dofs: problem.dofs.len(),
+        mechanisms,
         ignored: problem.ignored,
         steps,
         factor_seconds,
@@ -372,6 +379,35 @@ impl Problem {
             }
         }
         Ok(basis)
+    }
+
+    /// Appends to `basis` the M-orthonormalised motions of single pieces that nothing resists
+    /// ([`crate::mechanisms`]), so that Lanczos iterates without them; returns how many.
+    fn add_mechanisms(
+        &self,
+        state: &State,
+        models: &[Box<dyn Model>],
+        basis: &mut Vec<Vec<f64>>,
+    ) -> usize {
+        let (piece, pieces) = tet_pieces(state.len(), models);
+        let index = |d: usize| self.dofs.index(d);
+        let dofs = SystemDofs {
+            index: &index,
+            mass: &self.mass,
+            global: &self.global,
+        };
+        let stiffness = self.tangent.stiffness_entries();
+        let before = basis.len();
+        for mut x in unresisted_motions(&state.position, &piece, pieces, &dofs, stiffness) {
+            let scale = self.norm(&x);
+            self.orthogonalize(&mut x, basis, &[]);
+            let norm = self.norm(&x);
+            if norm > 1e-6 * scale {
+                x.iter_mut().for_each(|v| *v /= norm);
+                basis.push(x);
+            }
+        }
+        basis.len() - before
     }
 
     /// ⟨x, y⟩_M.
@@ -512,6 +548,51 @@ fn collect_stiffness(
         }
     }
     ignored
+}
+
+/// The connected pieces of the deformable bodies' tetrahedra (union-find over their
+/// corners): each particle's piece (`None` outside every body) and the number of pieces.
+fn tet_pieces(particles: usize, models: &[Box<dyn Model>]) -> (Vec<Option<u32>>, usize) {
+    let mut parent: Vec<usize> = (0..particles).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut in_body = vec![false; particles];
+    for model in models {
+        let any: &dyn std::any::Any = model.as_ref();
+        let Some(body) = any.downcast_ref::<TetBody>() else {
+            continue;
+        };
+        for tet in body.tets() {
+            let first = root(&mut parent, tet[0] as usize);
+            in_body[tet[0] as usize] = true;
+            for &n in &tet[1..] {
+                let r = root(&mut parent, n as usize);
+                parent[r] = first;
+                in_body[n as usize] = true;
+            }
+        }
+    }
+    let mut id = vec![u32::MAX; particles];
+    let mut pieces = 0;
+    let piece = (0..particles)
+        .map(|p| {
+            if !in_body[p] {
+                return None;
+            }
+            let r = root(&mut parent, p);
+            if id[r] == u32::MAX {
+                id[r] = pieces;
+                pieces += 1;
+            }
+            Some(id[r])
+        })
+        .collect();
+    (piece, pieces as usize)
 }
 
 /// A Ritz value θ and its vector.

@@ -29,6 +29,7 @@ pub mod lanczos;
 pub mod linear_tet;
 pub mod local_damping;
 pub mod material;
+mod mechanisms;
 pub mod model;
 pub mod newmark;
 pub mod nodal_load;
