@@ -3,20 +3,10 @@
 
 mod common;
 
-use qdem_core::{Material, State, Stepper, Vec3, Verlet};
-use qdem_mesh::structured_box;
+use qdem_core::{State, Stepper, Verlet};
 
 fn run() -> State {
-    // Large enough that rayon splits both the tetrahedron and the particle loops.
-    let mesh = structured_box([0.0; 3], [2.4, 0.25, 0.22], [60, 6, 6]);
-    let material = Material {
-        density: 2350.0,
-        young: 45e9,
-        poisson: 0.167,
-        shear_viscosity: 2e3,
-        bulk_viscosity: 1e3,
-    };
-    let (mut state, mut models) = common::clamped_beam(&mesh, material, Vec3::new(0.0, 1e5, -2e5));
+    let (mut state, mut models) = common::viscoelastic_beam();
     let dt = 0.9 * models[0].stable_dt(&state).unwrap();
     let mut stepper = Verlet::new(dt);
     stepper.initialize(&mut state, &mut models).unwrap();

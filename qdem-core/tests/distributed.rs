@@ -4,10 +4,7 @@
 
 mod common;
 
-use qdem_core::{
-    Communicator, Decomposition, Material, Scheme, State, StepRequest, StepSettings, Vec3, World,
-};
-use qdem_mesh::structured_box;
+use qdem_core::{Communicator, Decomposition, Scheme, State, StepRequest, StepSettings, World};
 use std::sync::{Arc, Barrier, Mutex};
 
 /// The ranks' mailboxes: what each rank posted for each rank.
@@ -89,15 +86,7 @@ impl Communicator for ThreadRank {
 
 /// The viscoelastic cantilever of the determinism test as a world stepped by Verlet.
 fn beam_world() -> World {
-    let mesh = structured_box([0.0; 3], [2.4, 0.25, 0.22], [60, 6, 6]);
-    let material = Material {
-        density: 2350.0,
-        young: 45e9,
-        poisson: 0.167,
-        shear_viscosity: 2e3,
-        bulk_viscosity: 1e3,
-    };
-    let (state, models) = common::clamped_beam(&mesh, material, Vec3::new(0.0, 1e5, -2e5));
+    let (state, models) = common::viscoelastic_beam();
     let request = StepRequest {
         scheme: Scheme::Verlet,
         dt: None,

@@ -1,7 +1,9 @@
 //! Test scenes shared by several integration tests.
 
+#![allow(dead_code)] // each test binary uses a subset
+
 use qdem_core::{Dofs, Gravity, Material, Model, NodalLoad, State, TetBody, TimeFunction, Vec3};
-use qdem_mesh::TetMesh;
+use qdem_mesh::{structured_box, TetMesh};
 
 /// A cantilever over `mesh` (clamped on its `xmin` group) of `material`, under gravity and a
 /// tip load `tip_force` on its `xmax` group ramped up over the first millisecond: the state at
@@ -26,4 +28,19 @@ pub fn clamped_beam(
         Box::new(NodalLoad::new("tip", tip, tip_force, ramp)),
     ];
     (state, models)
+}
+
+/// The viscoelastic concrete cantilever of the determinism tests: 60 × 6 × 6 cells (12,960
+/// tetrahedra, large enough that rayon splits the tetrahedron and particle loops and that its
+/// 16 blocks fall on several ranks), clamped, under a tip load of (0, 100, −200) kN.
+pub fn viscoelastic_beam() -> (State, Vec<Box<dyn Model>>) {
+    let mesh = structured_box([0.0; 3], [2.4, 0.25, 0.22], [60, 6, 6]);
+    let material = Material {
+        density: 2350.0,
+        young: 45e9,
+        poisson: 0.167,
+        shear_viscosity: 2e3,
+        bulk_viscosity: 1e3,
+    };
+    clamped_beam(&mesh, material, Vec3::new(0.0, 1e5, -2e5))
 }

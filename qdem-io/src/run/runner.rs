@@ -235,20 +235,7 @@ pub fn run_with(
         Some(_) => sim.world.steps_done(),
         None => steps,
     };
-    let figures = RunFigures {
-        steps_taken: steps.saturating_sub(first_step.saturating_sub(1)) as f64,
-        wall_seconds,
-    };
-    let report = RunReport {
-        integrator: sim.world.stepper().name().to_string(),
-        steps,
-        dt: sim.world.dt(),
-        final_time: sim.world.state.time,
-        wall_seconds,
-        tet_steps_per_second: figures.rate(sim.tets()),
-        particle_steps_per_second: figures.rate(sim.world.state.len()),
-        halt,
-    };
+    let (report, figures) = report(sim, steps, first_step, wall_seconds, halt);
     let resumed_at = options.resume.map(|_| first_step.saturating_sub(1));
     let recorders = &run.recorders;
     record::summary::write(out_dir, sim, &report, &figures, recorders, resumed_at)?;
@@ -397,23 +384,34 @@ fn follow(sim: &mut Simulation, options: RunOptions<'_>) -> Result<RunReport, Ru
         }
     }
     let wall_seconds = start.elapsed().as_secs_f64();
+    let steps = sim.world.steps_done();
+    Ok(report(sim, steps, first_step, wall_seconds, halt).0)
+}
+
+/// The report of a run that ended after `steps` steps, having started at `first_step`, and
+/// its figures.
+fn report(
+    sim: &Simulation,
+    steps: u64,
+    first_step: u64,
+    wall_seconds: f64,
+    halt: Option<Halt>,
+) -> (RunReport, RunFigures) {
     let figures = RunFigures {
-        steps_taken: sim
-            .world
-            .steps_done()
-            .saturating_sub(first_step.saturating_sub(1)) as f64,
+        steps_taken: steps.saturating_sub(first_step.saturating_sub(1)) as f64,
         wall_seconds,
     };
-    Ok(RunReport {
+    let report = RunReport {
         integrator: sim.world.stepper().name().to_string(),
-        steps: sim.world.steps_done(),
+        steps,
         dt: sim.world.dt(),
         final_time: sim.world.state.time,
         wall_seconds,
         tet_steps_per_second: figures.rate(sim.tets()),
         particle_steps_per_second: figures.rate(sim.world.state.len()),
         halt,
-    })
+    };
+    (report, figures)
 }
 
 /// Creates an output directory.
