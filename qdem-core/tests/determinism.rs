@@ -31,16 +31,8 @@ fn one_and_two_threads_give_bit_identical_states() {
         a.displacement(a.len() - 1).norm() > 0.0,
         "the run must move"
     );
-    let bits = |s: &State| -> Vec<u64> {
-        s.position
-            .iter()
-            .chain(&s.velocity)
-            .chain(&s.acceleration)
-            .flat_map(|v| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>())
-            .collect()
-    };
     assert!(
-        bits(&a) == bits(&b),
+        common::motion_bits(&a) == common::motion_bits(&b),
         "states differ between 1 and 2 threads"
     );
 }

@@ -144,15 +144,6 @@ fn ranks(size: usize) -> (Vec<State>, Decomposition) {
     (states, figures.unwrap())
 }
 
-fn bits(s: &State) -> Vec<u64> {
-    s.position
-        .iter()
-        .chain(&s.velocity)
-        .chain(&s.acceleration)
-        .flat_map(|v| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>())
-        .collect()
-}
-
 #[test]
 fn two_and_three_ranks_hold_the_bit_identical_state_of_one_process() {
     let reference = one_process();
@@ -161,7 +152,7 @@ fn two_and_three_ranks_hold_the_bit_identical_state_of_one_process() {
         let (states, figures) = ranks(size);
         for (rank, state) in states.iter().enumerate() {
             assert!(
-                bits(state) == bits(&reference),
+                common::motion_bits(state) == common::motion_bits(&reference),
                 "rank {rank} of {size} differs from one process"
             );
         }

@@ -44,3 +44,13 @@ pub fn viscoelastic_beam() -> (State, Vec<Box<dyn Model>>) {
     };
     clamped_beam(&mesh, material, Vec3::new(0.0, 1e5, -2e5))
 }
+
+/// The bits of every position, velocity and acceleration of `s`, for bit-for-bit comparisons.
+pub fn motion_bits(s: &State) -> Vec<u64> {
+    s.position
+        .iter()
+        .chain(&s.velocity)
+        .chain(&s.acceleration)
+        .flat_map(|v| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>())
+        .collect()
+}
