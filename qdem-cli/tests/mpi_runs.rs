@@ -13,6 +13,14 @@ use std::process::Command;
 
 const QDEM: &str = env!("CARGO_BIN_EXE_qdem");
 
+/// Open MPI's settings for the tests: as root (CI), and without the single-copy transport
+/// that containers often forbid (it would fail the shared-memory exchanges there).
+const MPI_ENV: [(&str, &str); 3] = [
+    ("OMPI_ALLOW_RUN_AS_ROOT", "1"),
+    ("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"),
+    ("OMPI_MCA_btl_vader_single_copy_mechanism", "none"),
+];
+
 /// A copy of a fixture scene beside it (so that its relative paths hold) with `[run] t_end`
 /// replaced; removed on drop.
 struct ShortScene(PathBuf);
@@ -67,9 +75,7 @@ fn run(scene: &Path, out: &Path, ranks: usize, threads: usize, extra: &[&str]) {
                 &n.to_string(),
                 QDEM,
             ]);
-            c.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-                .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-                .env("OMPI_MCA_rmaps_base_oversubscribe", "1");
+            c.envs(MPI_ENV);
             c
         }
     };
@@ -217,8 +223,7 @@ fn on_two_ranks(args: &[&str]) -> (bool, String, String) {
     let output = Command::new("mpirun")
         .args(["--oversubscribe", "--bind-to", "none", "-np", "2", QDEM])
         .args(args)
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .envs(MPI_ENV)
         .output()
         .expect("start mpirun");
     let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
