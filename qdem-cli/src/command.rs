@@ -250,6 +250,10 @@ pub struct AnalyzeArgs {
     #[arg(long, value_name = "HZ", value_parser = non_negative,
           allow_negative_numbers = true, default_value_t = AnalyzeOptions::default().max_frequency)]
     pub fmax: f64,
+    /// A modes.csv of `qdem modes`: its modes moving at least 5% of the mass are marked on
+    /// the spectra and mobility plots
+    #[arg(long, value_name = "MODES_CSV")]
+    pub modes: Option<PathBuf>,
 }
 
 /// A count (tetrahedra, threads or steps of `bench`): a whole number of at least 1.
@@ -319,6 +323,7 @@ pub fn dispatch(cli: Cli, ranks: Option<Arc<dyn Communicator>>) -> Result<(), Cl
                 to: a.to,
                 bandwidth: a.bandwidth,
                 max_frequency: a.fmax,
+                modes: a.modes,
             };
             analyze_run(&a.scene, a.out.as_deref(), &options)
         }

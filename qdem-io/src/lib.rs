@@ -32,7 +32,7 @@ pub mod run;
 pub mod scene;
 
 pub use build::pose_from;
-pub use post::{analyze, crack_svg, linear_spectrum, modes, plot, spectrum};
+pub use post::{analyze, crack_svg, linear_spectrum, mode_marks, modes, plot, spectrum};
 pub use run::{checkpoint, inputs, runner};
 
 /// `[ballast]` stones ([`build::ballast`], kept at its former path).

@@ -351,4 +351,34 @@ fn analyze_finds_a_sine_in_the_acceleration_and_the_scale_of_a_proportional_resp
     ] {
         assert!(a.dir.join(file).is_file(), "{file}");
     }
+    // The modes of a modes.csv that move at least 5% of the mass are marked on the spectra.
+    let modes = dir.join("modes.csv");
+    std::fs::write(
+        &modes,
+        format!(
+            "{}\n1,120.0,elastic,z,0.3,0,0,0.3,0,0,0,0,0,1\n2,40.0,elastic,x,0.001,0.001,0,0,0,0,0,1,0,0\n",
+            qdem_io::modes::MODES_HEADER
+        ),
+    )
+    .unwrap();
+    let marked = AnalyzeOptions {
+        modes: Some(modes.clone()),
+        ..AnalyzeOptions::default()
+    };
+    analyze(&scene, &out, &marked).unwrap();
+    let svg = std::fs::read_to_string(a.dir.join("spectra.svg")).unwrap();
+    assert!(
+        svg.contains("mode 1 (z)") && !svg.contains("mode 2"),
+        "the 120 Hz mode only"
+    );
+    std::fs::write(
+        &modes,
+        format!("{}\n1,x,elastic,z,0.3\n", qdem_io::modes::MODES_HEADER),
+    )
+    .unwrap();
+    let error = analyze(&scene, &out, &marked).err().unwrap().to_string();
+    assert!(
+        error.contains("modes.csv:2") && error.contains("`x`"),
+        "{error}"
+    );
 }

@@ -11,8 +11,9 @@
 
 use crate::build::BuildError;
 use crate::linear_spectrum::{linear_spectrum, mobility, parzen_smooth};
+use crate::mode_marks::{read_mode_marks, ModeMark, ModeMarksError};
 use crate::output::{write_atomic, OutputError};
-use crate::plot::{line_plot_svg, Labels, Series};
+use crate::plot::{line_plot_svg, marked_plot_svg, Labels, Mark, Series};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -28,6 +29,9 @@ pub struct AnalyzeOptions {
     pub bandwidth: f64,
     /// Highest frequency written and plotted (Hz); the paper trusts up to 1 kHz.
     pub max_frequency: f64,
+    /// A `modes.csv` of `qdem modes` whose modes are marked on the spectra and mobility
+    /// plots ([`crate::mode_marks`]).
+    pub modes: Option<PathBuf>,
 }
 
 impl Default for AnalyzeOptions {
@@ -38,6 +42,7 @@ impl Default for AnalyzeOptions {
             to: None,
             bandwidth: 20.0,
             max_frequency: 1000.0,
+            modes: None,
         }
     }
 }
@@ -66,6 +71,9 @@ pub enum AnalyzeError {
     /// A load series cannot be read.
     #[error(transparent)]
     Series(#[from] BuildError),
+    /// The modes to mark cannot be read.
+    #[error(transparent)]
+    Modes(#[from] ModeMarksError),
     /// The output directory cannot be made.
     #[error("cannot create the directory {path}: {source}")]
     Dir {
@@ -122,6 +130,19 @@ pub fn analyze(
     out_dir: &Path,
     options: &AnalyzeOptions,
 ) -> Result<Analysis, AnalyzeError> {
+    let marks = match &options.modes {
+        Some(path) => read_mode_marks(path)?,
+        None => Vec::new(),
+    };
+    let labels: Vec<String> = marks.iter().map(ModeMark::label).collect();
+    let marks: Vec<Mark<'_>> = marks
+        .iter()
+        .zip(&labels)
+        .map(|(m, label)| Mark {
+            x: m.frequency_hz,
+            label,
+        })
+        .collect();
     let probes = read_probes(&out_dir.join("probes.csv"), options)?;
     let dt = sampling_step(&probes, &out_dir.join("probes.csv"))?;
     let load = input_load(scene, &probes.time)?;
@@ -162,6 +183,7 @@ pub fn analyze(
         &probes.names,
         &spectra,
         options,
+        &marks,
     )?;
     if let Some(f) = &load {
         let mobilities: Vec<Vec<(f64, f64)>> = probes
@@ -178,6 +200,7 @@ pub fn analyze(
             &probes.names,
             &mobilities,
             options,
+            &marks,
         )?;
         let series = [Series {
             label: "input load",
@@ -342,7 +365,8 @@ fn write_table(
     })
 }
 
-/// Spectra on a log10 scale (the amplitudes span decades), from the first non-zero frequency.
+/// Spectra on a log10 scale (the amplitudes span decades), from the first non-zero frequency,
+/// with the natural frequencies `marks`.
 fn log_plot(
     path: &Path,
     title: &str,
@@ -350,6 +374,7 @@ fn log_plot(
     names: &[String],
     columns: &[Vec<(f64, f64)>],
     options: &AnalyzeOptions,
+    marks: &[Mark<'_>],
 ) -> Result<(), OutputError> {
     let logs: Vec<Vec<(f64, f64)>> = columns
         .iter()
@@ -362,7 +387,7 @@ fn log_plot(
         .collect();
     let series = named_series(names, &logs);
     let title = format!("{title}, bandwidth {} Hz", options.bandwidth);
-    line_plot_svg(
+    marked_plot_svg(
         path,
         &Labels {
             title: &title,
@@ -370,6 +395,7 @@ fn log_plot(
             y,
         },
         &series,
+        marks,
     )
 }
 

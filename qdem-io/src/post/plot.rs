@@ -13,6 +13,14 @@ pub struct Series<'a> {
     pub points: &'a [(f64, f64)],
 }
 
+/// A vertical line at `x` with a label (a natural frequency on a spectrum).
+pub struct Mark<'a> {
+    /// Where (x-axis units).
+    pub x: f64,
+    /// What it is, written beside the line.
+    pub label: &'a str,
+}
+
 /// Axis titles and the plot title.
 pub struct Labels<'a> {
     /// Title above the panel.
@@ -72,6 +80,17 @@ pub fn line_plot_svg(
     labels: &Labels<'_>,
     series: &[Series<'_>],
 ) -> Result<(), OutputError> {
+    marked_plot_svg(path, labels, series, &[])
+}
+
+/// [`line_plot_svg`] with `marks` drawn as dashed vertical lines over the curves, each
+/// labelled at the top of the panel (those outside the curves' x range are left out).
+pub fn marked_plot_svg(
+    path: &Path,
+    labels: &Labels<'_>,
+    series: &[Series<'_>],
+    marks: &[Mark<'_>],
+) -> Result<(), OutputError> {
     let (x0, x1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
     let (y0, y1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
     let mut svg = String::new();
@@ -100,6 +119,26 @@ pub fn line_plot_svg(
                     .label(s.label)
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
             }
+            let grey = RGBColor(110, 110, 110);
+            for (i, mark) in marks
+                .iter()
+                .filter(|m| (x0..=x1).contains(&m.x))
+                .enumerate()
+            {
+                chart.draw_series(DashedLineSeries::new(
+                    [(mark.x, y0), (mark.x, y1)],
+                    4,
+                    3,
+                    grey.stroke_width(1),
+                ))?;
+                // Labels step down the panel so that neighbouring marks stay readable.
+                let at = y1 - (y1 - y0) * (0.03 + 0.05 * (i % 6) as f64);
+                chart.draw_series(std::iter::once(Text::new(
+                    mark.label.to_string(),
+                    (mark.x, at),
+                    ("sans-serif", 11).into_font().color(&grey),
+                )))?;
+            }
             chart
                 .configure_series_labels()
                 .background_style(WHITE.mix(0.8))
@@ -119,6 +158,41 @@ pub fn line_plot_svg(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn marks_inside_the_range_are_drawn_with_their_labels() {
+        let dir = std::env::temp_dir().join(format!("qdem-plot-marks-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("marked.svg");
+        let points: Vec<(f64, f64)> = (0..100).map(|i| (i as f64, (i as f64).sin())).collect();
+        let labels = Labels {
+            title: "t",
+            x: "f",
+            y: "a",
+        };
+        let series = [Series {
+            label: "curve",
+            points: &points,
+        }];
+        let marks = [
+            Mark {
+                x: 42.6,
+                label: "mode 44",
+            },
+            Mark {
+                x: 500.0,
+                label: "beyond",
+            },
+        ];
+        marked_plot_svg(&path, &labels, &series, &marks).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert!(svg.contains("mode 44"));
+        assert!(
+            !svg.contains("beyond"),
+            "a mark outside the x range is left out"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn tick_labels_are_plain_for_moderate_values_and_scientific_otherwise() {
