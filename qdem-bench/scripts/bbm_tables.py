@@ -61,12 +61,13 @@ def fmt(x, spec=".3g"):
 
 def table(kind, tags, runs):
     head = ("| size / tag | particles | Eq. 28 ∆t_crit (s) | ∆t (s) | t_b (s/step) | t_u (s/step) "
-            "| first break (s) | stopped at (s) | bonds broken | retakes | factorisations | total (s) |")
-    lines = [head, "|" + "---|" * 12]
+            "| first break (s) | stopped at (s) | bonds broken | retakes | factorisations "
+            "| crack phase: steps; per step sub-steps / redos / solves / factorisations | total (s) |")
+    lines = [head, "|" + "---|" * 13]
     for tag in tags:
         run = runs.get((kind, tag))
         if run is None:
-            lines.append(f"| {tag} | not run | | | | | | | | | | |")
+            lines.append(f"| {tag} | not run | | | | | | | | | | | |")
             continue
         s, b = run[0], run[0]["bonded"]
         stop = b["stopped_at_collapse"]
@@ -75,8 +76,17 @@ def table(kind, tags, runs):
             f"| {fmt(b['step_before_crack_seconds'])} | {fmt(b['step_after_crack_seconds'])} "
             f"| {fmt(b['first_break_time'], '.4f')} | {fmt(stop and stop['time'], '.4f')} "
             f"| {b['broken_bonds']} of {b['bonds']} | {b['retakes']} | {b['factorizations']} "
-            f"| {s['wall_seconds']:.2f} |")
+            f"| {crack_phase(b)} | {s['wall_seconds']:.2f} |")
     return "\n".join(lines)
+
+
+def crack_phase(bonded):
+    """The stepper's work per nominal step from the step of the first break (issue 26)."""
+    c = bonded.get("crack_phase_per_step")
+    if not c:
+        return "—"
+    return (f"{c['steps']}; {c['substeps']:.1f} / {c['redos']:.1f} / {c['solves']:.1f} / "
+            f"{c['factorizations']:.1f}")
 
 
 def deviation(run, reference, until):

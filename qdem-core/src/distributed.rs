@@ -66,7 +66,8 @@ use std::sync::Arc;
 /// state.position[3].z += 0.01;
 /// let models: Vec<Box<dyn Model>> = vec![Box::new(body)];
 /// let request = StepRequest { scheme: Scheme::Verlet, dt: None, safety: 0.5,
-///     local_damping: 0.0, adaptive: false, implicit_default: None, fit_to: None };
+///     local_damping: 0.0, adaptive: false, event_solve: Default::default(),
+///     implicit_default: None, fit_to: None };
 /// let settings = StepSettings::resolve(&request, &state, &models).unwrap();
 /// let mut world = World::new(state, models, settings).unwrap();
 /// let decomposition = world.decompose(std::sync::Arc::new(Alone)).unwrap();

@@ -21,6 +21,7 @@
 #![warn(missing_docs)]
 
 pub mod checkpoint;
+pub(crate) mod conjugate_gradient;
 pub mod distributed;
 pub mod error;
 pub mod gravity;
@@ -61,7 +62,7 @@ pub use error::CoreError;
 pub use gravity::Gravity;
 pub use material::Material;
 pub use model::{find_model, Linearized, Model, Persistence, Persistent, StepEvents};
-pub use newmark::{Newmark, StepCounts, TangentUpdate};
+pub use newmark::{EventSolve, Newmark, StepCounts, TangentUpdate};
 pub use nodal_load::NodalLoad;
 pub use rigid_body::RigidBodies;
 pub use sparse::FactorStats;

@@ -41,12 +41,23 @@
 //! a linear small-strain run; each step then costs one force evaluation and two triangular
 //! solves); with [`TangentUpdate::EveryStep`] K and C are reassembled at every step's start
 //! and refactorised, reusing the symbolic analysis. The fixity is read when factorising.
+//!
+//! When a model's events change the tangent (bonds break, contacts open or close,
+//! [`crate::StepEvents::commit_step`]), the matrix is reassembled and, by default
+//! ([`EventSolve::Refactorize`]), refactorised. With [`EventSolve::Preconditioned`] (issue 26)
+//! it is solved instead by conjugate gradients preconditioned with the kept factor of the same
+//! step length (`conjugate_gradient`: k events change the matrix by a rank of at most 3k, so
+//! a few events cost a few iterations); only when the iterations pass [`MAX_ITERATIONS`], or
+//! the kept factor's answer is far off (stiff contacts added), is the matrix refactorised, and
+//! the new factor kept in turn. Both answer the same system, to [`ITERATION_TOLERANCE`].
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
+use crate::conjugate_gradient::{self, Scratch};
 use crate::error::CoreError;
 use crate::model::Model;
 use crate::sparse::{
-    explain_failure, Assembler, DampingRows, FactorStats, FreeDofs, Scales, SparseCholesky, Tangent,
+    copy_matrix, explain_failure, restore_matrix, save_matrix, Assembler, DampingRows, FactorStats,
+    FreeDofs, Scales, SparseCholesky, Tangent,
 };
 use crate::stages::{Stage, StageTimes};
 use crate::state::State;
@@ -55,6 +66,7 @@ use crate::stepper::{
     sum_forces, Stepper, PARTICLE_CHUNK,
 };
 use crate::Vec3;
+use faer::sparse::SparseColMat;
 use rayon::prelude::*;
 
 /// When the implicit stepper refactorises its effective matrix.
@@ -67,6 +79,31 @@ pub enum TangentUpdate {
     /// Every step, with K and C at the step's start (large displacements or rotations).
     EveryStep,
 }
+
+/// How the implicit stepper solves a step whose matrix changed since its factorisation
+/// (a model's events changed the tangent).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EventSolve {
+    /// Refactorises the matrix at every change: the faster on the benchmark beam
+    /// (docs/bbm.md), and the default.
+    #[default]
+    Refactorize,
+    /// Conjugate gradients preconditioned by the kept factor of the same step length;
+    /// refactorises when they take more than [`MAX_ITERATIONS`].
+    Preconditioned,
+}
+
+/// The most conjugate-gradient iterations on a kept factor before refactorising. On the
+/// 0.025 m benchmark beam with a bound of 12, 37 solves converged, 36 of them in 2–8
+/// iterations, 9 were still far off after 12 (and 73 far off at the start); the iterations
+/// then cost more wall time than the factorisations they saved, and with 6 about as much
+/// (docs/bbm.md).
+pub const MAX_ITERATIONS: usize = 6;
+
+/// The relative error, in the energy norm of the kept factor, at which the iterations stop:
+/// far below the error of the step's linearisation (Eq. 26 is one Newton iteration), so that
+/// the crack phase follows the refactorising solver's to rounding of the bond stresses.
+pub const ITERATION_TOLERANCE: f64 = 1e-10;
 
 /// Retakes a sub-step at most this many times before accepting it: once, as paper 001 §4
 /// recalculates "the last calculated step" once with ∆t·√α (Eq. 30).
@@ -89,6 +126,55 @@ pub struct StepCounts {
     pub event_steps: u64,
     /// Numeric factorisations of the effective matrix (nominal and sub-step), implicit only.
     pub factorizations: u64,
+    /// Trial steps redone with the contacts the trial met in the matrix (implicit only).
+    pub redos: u64,
+    /// Linear solves of the implicit step (one per trial step).
+    pub solves: u64,
+    /// Of the solves, those by conjugate gradients on a kept factor ([`EventSolve`]).
+    pub iterative_solves: u64,
+    /// Conjugate-gradient iterations of those solves, together.
+    pub iterations: u64,
+}
+
+impl StepCounts {
+    /// The number of counts.
+    pub const LEN: usize = 8;
+
+    /// The counts in field order (for checkpoints).
+    ///
+    /// ```
+    /// use qdem_core::StepCounts;
+    /// let counts = StepCounts { retakes: 2, iterations: 7, ..StepCounts::default() };
+    /// assert_eq!(StepCounts::from_array(counts.to_array()), counts);
+    /// ```
+    pub fn to_array(&self) -> [u64; StepCounts::LEN] {
+        [
+            self.retakes,
+            self.substeps,
+            self.event_steps,
+            self.factorizations,
+            self.redos,
+            self.solves,
+            self.iterative_solves,
+            self.iterations,
+        ]
+    }
+
+    /// The counts [`Self::to_array`] listed.
+    pub fn from_array(n: [u64; StepCounts::LEN]) -> StepCounts {
+        let [retakes, substeps, event_steps, factorizations, redos, solves, iterative_solves, iterations] =
+            n;
+        StepCounts {
+            retakes,
+            substeps,
+            event_steps,
+            factorizations,
+            redos,
+            solves,
+            iterative_solves,
+            iterations,
+        }
+    }
 }
 
 /// The Newmark-β family: explicit for β = 0, implicit for β > 0, optionally adaptive.
@@ -143,6 +229,7 @@ pub struct Newmark {
     gamma: f64,
     dt: f64,
     update: TangentUpdate,
+    events: EventSolve,
     adaptive: bool,
     force: Vec<Vec3>,
     torque: Vec<Vec3>,
@@ -159,6 +246,9 @@ struct ImplicitSystem {
     tangent: Tangent,
     tangent_current: bool,
     assembler: Assembler,
+    /// The step the assembler's matrix is of, with the current tangent.
+    assembled: Option<f64>,
+    iterations: Scratch,
     dofs: Option<FreeDofs>,
     factors: Factors,
     rhs: Vec<f64>,
@@ -187,19 +277,29 @@ impl Factors {
 }
 
 impl ImplicitSystem {
-    /// Marks the tangent and both factorisations out of date (a model's tangent changed).
-    fn invalidate(&mut self) {
+    /// Marks the tangent out of date (a model's tangent changed), and both factorisations:
+    /// dropped to refactorise, or kept as preconditioners.
+    fn invalidate(&mut self, events: EventSolve) {
         self.tangent_current = false;
-        self.factors.nominal.step = None;
-        self.factors.substep.step = None;
+        self.assembled = None;
+        for factor in [&mut self.factors.nominal, &mut self.factors.substep] {
+            factor.stale = true;
+            if events == EventSolve::Refactorize {
+                factor.step = None;
+            }
+        }
     }
 }
 
-/// A factorisation of M + γh C + β h² K for one step h.
+/// A factorisation of M + γh C + β h² K for one step h, and the matrix it factorised (kept
+/// for checkpoints: a resumed run factorises the same matrix again).
 #[derive(Debug, Default)]
 struct Factor {
     cholesky: SparseCholesky,
     step: Option<f64>,
+    /// The tangent changed since the factorisation: the factor is a preconditioner.
+    stale: bool,
+    matrix: Option<SparseColMat<usize, f64>>,
 }
 
 impl Newmark {
@@ -214,6 +314,7 @@ impl Newmark {
             gamma,
             dt,
             update: TangentUpdate::Fixed,
+            events: EventSolve::Preconditioned,
             adaptive: false,
             force: Vec::new(),
             torque: Vec::new(),
@@ -236,6 +337,13 @@ impl Newmark {
     /// The same stepper refactorising as `update` says (default [`TangentUpdate::Fixed`]).
     pub fn with_tangent_update(mut self, update: TangentUpdate) -> Newmark {
         self.update = update;
+        self
+    }
+
+    /// The same stepper solving after events as `events` says (default
+    /// [`EventSolve::Preconditioned`]).
+    pub fn with_event_solve(mut self, events: EventSolve) -> Newmark {
+        self.events = events;
         self
     }
 
@@ -275,38 +383,126 @@ impl Newmark {
         models: &[Box<dyn Model>],
         h: f64,
     ) -> Result<(), CoreError> {
+        if self.update == TangentUpdate::EveryStep {
+            self.system.tangent_current = false;
+        }
+        self.assemble(state, models, h)?;
+        self.factorize_assembled(state, models, h)
+    }
+
+    /// Collects the tangent at `state` unless it is current, and assembles M + γh C + β h² K
+    /// for the step `h` unless the assembler holds it.
+    fn assemble(
+        &mut self,
+        state: &State,
+        models: &[Box<dyn Model>],
+        h: f64,
+    ) -> Result<(), CoreError> {
+        let system = &mut self.system;
+        if !system.tangent_current {
+            collect_tangent(state, models, &mut system.tangent)?;
+            system.tangent_current = true;
+            system.assembled = None;
+            system.damping.build(&system.tangent, state.dofs());
+        }
+        if system.assembled == Some(h) {
+            return Ok(());
+        }
         let scales = Scales {
             mass: 1.0,
             damping: self.gamma * h,
             stiffness: self.beta * h * h,
         };
-        let system = &mut self.system;
-        if !system.tangent_current || self.update == TangentUpdate::EveryStep {
-            collect_tangent(state, models, &mut system.tangent)?;
-            system.tangent_current = true;
-            system.damping.build(&system.tangent, state.dofs());
-        }
         let dofs = FreeDofs::new(&state.node_fixity());
-        let matrix =
-            system
-                .assembler
-                .assemble(&system.tangent, &state.node_mass(), &dofs, scales)?;
+        system
+            .assembler
+            .assemble(&system.tangent, &state.node_mass(), &dofs, scales)?;
+        system.assembled = Some(h);
+        system.dofs = Some(dofs);
+        Ok(())
+    }
+
+    /// Factorises the assembled matrix of the step `h` into the nominal or the sub-step factor.
+    fn factorize_assembled(
+        &mut self,
+        state: &State,
+        models: &[Box<dyn Model>],
+        h: f64,
+    ) -> Result<(), CoreError> {
+        let system = &mut self.system;
+        let matrix = system.assembler.matrix().expect("assembled before");
         let factor = system.factors.get(h == self.dt);
         factor.step = None;
         if let Err(error) = factor.cholesky.factorize(matrix, "effective") {
             let pivot = factor.cholesky.failed_pivot();
+            let dofs = system.dofs.as_ref().expect("assembled before");
             return Err(explain_failure(
                 error,
                 pivot,
-                &dofs,
+                dofs,
                 state,
                 models,
                 &system.tangent,
             ));
         }
         factor.step = Some(h);
-        system.dofs = Some(dofs);
+        factor.stale = false;
+        factor.matrix = Some(copy_matrix(matrix.0));
         self.counts.factorizations += 1;
+        Ok(())
+    }
+
+    /// Prepares the solve of a step of length `h`: refactorises unless a factor of `h` is
+    /// kept; with a kept factor of an older tangent, collects and assembles the current
+    /// matrix for [`Self::solve`] (or refactorises, with [`EventSolve::Refactorize`]).
+    fn prepare_solve(
+        &mut self,
+        state: &State,
+        models: &[Box<dyn Model>],
+        h: f64,
+    ) -> Result<(), CoreError> {
+        let factor = self.system.factors.get(h == self.dt);
+        let kept = factor.step == Some(h) && self.update == TangentUpdate::Fixed;
+        match (kept, factor.stale) {
+            (true, false) => Ok(()),
+            (true, true) if self.events == EventSolve::Preconditioned => {
+                self.assemble(state, models, h)
+            }
+            _ => self.refactor(state, models, h),
+        }
+    }
+
+    /// Overwrites `system.rhs` with the solution for the step `h` ([`Self::prepare_solve`]
+    /// first): the kept factor's two triangular solves, or conjugate gradients on it when the
+    /// tangent changed since, refactorising when they pass [`MAX_ITERATIONS`].
+    fn solve(&mut self, state: &State, models: &[Box<dyn Model>], h: f64) -> Result<(), CoreError> {
+        self.counts.solves += 1;
+        let system = &mut self.system;
+        let factor = system.factors.get(h == self.dt);
+        if !factor.stale {
+            factor.cholesky.solve_in_place(&mut system.rhs);
+            return Ok(());
+        }
+        let matrix = system.assembler.matrix().expect("assembled before").0;
+        let outcome = conjugate_gradient::solve(
+            matrix,
+            &mut factor.cholesky,
+            &mut system.rhs,
+            &mut system.iterations,
+            ITERATION_TOLERANCE,
+            MAX_ITERATIONS,
+        );
+        let iterations = outcome.unwrap_or_else(|n| n);
+        self.counts.iterations += iterations as u64;
+        if outcome.is_ok() {
+            self.counts.iterative_solves += 1;
+            return Ok(());
+        }
+        system.rhs.copy_from_slice(system.iterations.rhs());
+        self.factorize_assembled(state, models, h)?;
+        let system = &mut self.system;
+        let factor = system.factors.get(h == self.dt);
+        factor.cholesky.solve_in_place(&mut system.rhs);
         Ok(())
     }
 
@@ -318,12 +514,12 @@ impl Newmark {
         state: &State,
         models: &[Box<dyn Model>],
     ) -> Result<(), CoreError> {
-        self.system.invalidate();
+        self.system.invalidate(EventSolve::Refactorize);
         self.refactor(state, models, self.dt)
     }
 
-    /// One implicit step of length `h` (Eq. 26, linearised at the step's start): refactorises
-    /// first if no factorisation for `h` is current (the tangent at x_n), holds the positions
+    /// One implicit step of length `h` (Eq. 26, linearised at the step's start): prepares the
+    /// matrix of `h` with the tangent at x_n ([`Self::prepare_solve`]), holds the positions
     /// at x_n with the acceleration a⁰ that keeps them there ([`hold`]), evaluates the models'
     /// force f(t_{n+1}, x_n, v_n), solves (M + γhC + βh²K) δa = f − M a⁰ − C (v⁰ − v_n) and
     /// moves by δa ([`apply_increment`]).
@@ -334,38 +530,36 @@ impl Newmark {
         h: f64,
         stages: &mut StageTimes,
     ) -> Result<(), CoreError> {
-        let nominal = h == self.dt;
-        if self.system.factors.get(nominal).step != Some(h)
-            || self.update == TangentUpdate::EveryStep
-        {
-            self.refactor(state, models, h)?;
-        }
+        self.prepare_solve(state, models, h)?;
         stages.mark(Stage::Solve);
         let (beta, gamma) = (self.beta, self.gamma);
-        let system = &mut self.system;
-        let change = &mut system.velocity_change;
+        let mut change = std::mem::take(&mut self.system.velocity_change);
         change.0.resize(state.len(), Vec3::zeros());
         change.1.resize(state.spin.len(), Vec3::zeros());
         hold(state, h, beta, gamma, (&mut change.0, &mut change.1));
         stages.mark(Stage::Predict);
         sum_forces(state, models, &mut self.force, &mut self.torque, stages);
-        let moments = &mut self.torque[state.rigid.len()..];
+        let rigid = state.rigid.len();
+        let moments = &mut self.torque[rigid..];
         subtract_inertia(state, &mut self.force, moments);
-        let change = (&change.0[..], &change.1[..]);
+        let held = (&change.0[..], &change.1[..]);
+        let system = &mut self.system;
         system
             .damping
-            .subtract_times(change, (&mut self.force, moments));
+            .subtract_times(held, (&mut self.force, moments));
         let dofs = system.dofs.as_ref().expect("factorised before stepping");
         system.rhs.resize(dofs.len(), 0.0);
         dofs.gather_nodes((&self.force, moments), &mut system.rhs);
-        system
-            .factors
-            .get(nominal)
-            .cholesky
-            .solve_in_place(&mut system.rhs);
+        let solved = self.solve(state, models, h);
+        let system = &self.system;
+        let dofs = system.dofs.as_ref().expect("factorised before stepping");
+        let moments = &mut self.torque[rigid..];
         dofs.scatter_nodes(&system.rhs, (&mut self.force, moments));
         stages.mark(Stage::Solve);
-        apply_increment(state, (&self.force, moments), change, h, beta, gamma);
+        let held = (&change.0[..], &change.1[..]);
+        apply_increment(state, (&self.force, moments), held, h, beta, gamma);
+        self.system.velocity_change = change;
+        solved?;
         let finite = check_finite(state);
         stages.mark(Stage::Integrate);
         finite
@@ -424,7 +618,8 @@ impl Newmark {
             if stale && redos < MAX_REDOS {
                 // Redo with the contacts the trial met in the matrix (an active-set pass).
                 state.copy_motion_from(saved);
-                self.system.invalidate();
+                self.system.invalidate(self.events);
+                self.counts.redos += 1;
                 redos += 1;
                 continue;
             }
@@ -446,7 +641,7 @@ impl Newmark {
         self.counts.substeps += 1;
         if changed {
             self.counts.event_steps += 1;
-            self.system.invalidate();
+            self.system.invalidate(self.events);
         }
         stages.mark(Stage::Events);
         Ok(h)
@@ -614,20 +809,24 @@ impl Stepper for Newmark {
         self.counts
     }
 
-    /// The counts and, for the implicit stepper, the tangent it factorised and the steps its
-    /// factorisations are for, so that a resumed run factorises the same matrices again.
+    /// The counts and, for the implicit stepper, the tangent, the assembler's pattern and, for
+    /// each kept factorisation, its step, whether it is a preconditioner and the matrix it
+    /// factorised, so that a resumed run factorises the same matrices again.
     fn save(&self, out: &mut Encoder) -> Result<(), CheckpointError> {
         out.tag("newmark");
-        let c = &self.counts;
-        [c.retakes, c.substeps, c.event_steps, c.factorizations]
-            .into_iter()
-            .for_each(|n| out.u64(n));
+        self.counts.to_array().into_iter().for_each(|n| out.u64(n));
         if self.is_implicit() {
             let system = &self.system;
             out.bool(system.tangent_current);
             system.tangent.save(out);
-            out.option_f64(system.factors.nominal.step);
-            out.option_f64(system.factors.substep.step);
+            system.assembler.save(out);
+            for factor in [&system.factors.nominal, &system.factors.substep] {
+                out.option_f64(factor.step);
+                out.bool(factor.stale);
+                if let (Some(_), Some(matrix)) = (factor.step, &factor.matrix) {
+                    save_matrix(matrix.as_ref(), out);
+                }
+            }
         }
         Ok(())
     }
@@ -635,32 +834,41 @@ impl Stepper for Newmark {
     fn resume(
         &mut self,
         state: &mut State,
-        models: &mut [Box<dyn Model>],
+        _models: &mut [Box<dyn Model>],
         input: &mut Decoder<'_>,
     ) -> Result<(), CoreError> {
         refuse_rigid(state, "newmark")?;
         check_masses(state)?;
         input.tag("newmark")?;
-        let counts = StepCounts {
-            retakes: input.u64("retakes")?,
-            substeps: input.u64("sub-steps")?,
-            event_steps: input.u64("event steps")?,
-            factorizations: input.u64("factorisations")?,
-        };
+        let mut counts = [0; StepCounts::LEN];
+        for n in &mut counts {
+            *n = input.u64("the step counts")?;
+        }
         if self.is_implicit() {
             self.system.tangent_current = input.bool("the tangent flag")?;
             let dofs = state.dofs();
             self.system.tangent.restore(input, dofs)?;
             self.system.damping.build(&self.system.tangent, dofs);
-            let steps = [
-                input.option_f64("a factorised step")?,
-                input.option_f64("a factorised step")?,
-            ];
-            for h in steps.into_iter().flatten() {
-                self.refactor(state, models, h)?;
+            self.system.assembler.restore(input)?;
+            self.system.assembled = None;
+            self.system.dofs = Some(FreeDofs::new(&state.node_fixity()));
+            for nominal in [true, false] {
+                let step = input.option_f64("a factorised step")?;
+                let stale = input.bool("a factor's staleness")?;
+                let factor = self.system.factors.get(nominal);
+                factor.step = None;
+                factor.stale = stale;
+                if step.is_some() {
+                    let matrix = restore_matrix(input)?;
+                    factor
+                        .cholesky
+                        .factorize((matrix.as_ref(), 0.0), "effective")?;
+                    factor.matrix = Some(matrix);
+                    factor.step = step;
+                }
             }
         }
-        self.counts = counts;
+        self.counts = StepCounts::from_array(counts);
         Ok(())
     }
 

@@ -16,6 +16,7 @@
 //!   move rigidly (a singular stiffness), and [`explain_failure`] turns a failed factorisation
 //!   into a message naming the particle of the failing pivot, its body and the free bodies.
 
+use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::model::Model;
 use crate::state::{Dofs, State};
@@ -230,6 +231,8 @@ pub struct Assembler {
     /// The slot of each stiffness, damping and mass entry at the last assembly ([`FIXED`]
     /// for an entry of a fixed DOF).
     slots: [Vec<usize>; 3],
+    /// Seconds the last assembly took.
+    seconds: f64,
 }
 
 impl Assembler {
@@ -264,9 +267,87 @@ impl Assembler {
             debug_assert!(filled, "a pattern built from the entries holds them");
             self.matrix = Some(matrix);
         }
-        let matrix = self.matrix.as_ref().expect("assembled above").as_ref();
-        Ok((matrix, start.elapsed().as_secs_f64()))
+        self.seconds = start.elapsed().as_secs_f64();
+        Ok(self.matrix().expect("assembled above"))
     }
+
+    /// The matrix of the last [`Self::assemble`] and the seconds it took; `None` before one.
+    pub fn matrix(&self) -> Option<(SparseColMatRef<'_, usize, f64>, f64)> {
+        Some((self.matrix.as_ref()?.as_ref(), self.seconds))
+    }
+
+    /// Writes the pattern (not the values): the pattern decides the fill-reducing ordering of
+    /// every later factorisation, and it only grows during a run (entries that left the
+    /// tangent keep their places), so a resumed run must start from the same one.
+    pub(crate) fn save(&self, out: &mut Encoder) {
+        out.bool(self.matrix.is_some());
+        if let Some(matrix) = &self.matrix {
+            save_matrix(matrix.as_ref(), out);
+        }
+    }
+
+    /// Reads back what [`Self::save`] wrote.
+    pub(crate) fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+        *self = Assembler::default();
+        if input.bool("an assembled pattern")? {
+            self.matrix = Some(restore_matrix(input)?);
+        }
+        Ok(())
+    }
+}
+
+/// Writes a compressed-column matrix: its order, pattern and values.
+pub(crate) fn save_matrix(matrix: SparseColMatRef<'_, usize, f64>, out: &mut Encoder) {
+    out.u64(matrix.nrows() as u64);
+    let narrow = |xs: &[usize]| xs.iter().map(|&x| x as u32).collect::<Vec<u32>>();
+    out.u32s(&narrow(matrix.symbolic().col_ptr()));
+    out.u32s(&narrow(matrix.symbolic().row_idx()));
+    out.f64s(matrix.val());
+}
+
+/// Reads back a matrix [`save_matrix`] wrote, checking its pattern.
+pub(crate) fn restore_matrix(
+    input: &mut Decoder<'_>,
+) -> Result<SparseColMat<usize, f64>, CheckpointError> {
+    let n = input.u64("a matrix order")? as usize;
+    let widen = |xs: Vec<u32>| xs.into_iter().map(|x| x as usize).collect::<Vec<usize>>();
+    let col_ptr = widen(input.u32s("a matrix pattern")?);
+    let row_idx = widen(input.u32s("a matrix pattern")?);
+    let values = input.f64s("matrix values")?;
+    let invalid = |detail: &str| CheckpointError::Invalid {
+        what: "matrix",
+        detail: detail.to_string(),
+    };
+    let ordered = col_ptr.len() == n + 1
+        && col_ptr.first() == Some(&0)
+        && col_ptr.windows(2).all(|w| w[0] <= w[1])
+        && col_ptr[n] == row_idx.len()
+        && values.len() == row_idx.len();
+    if !ordered {
+        return Err(invalid("column pointers and entries do not match"));
+    }
+    let sorted = (0..n).all(|j| {
+        let rows = &row_idx[col_ptr[j]..col_ptr[j + 1]];
+        rows.windows(2).all(|w| w[0] < w[1]) && rows.iter().all(|&i| i < n)
+    });
+    if !sorted {
+        return Err(invalid("row indices out of order or range"));
+    }
+    let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+    Ok(SparseColMat::new(pattern, values))
+}
+
+/// An owned copy of `matrix`.
+pub(crate) fn copy_matrix(matrix: SparseColMatRef<'_, usize, f64>) -> SparseColMat<usize, f64> {
+    let (n, symbolic) = (matrix.nrows(), matrix.symbolic());
+    let pattern = SymbolicSparseColMat::new_checked(
+        n,
+        matrix.ncols(),
+        symbolic.col_ptr().to_vec(),
+        None,
+        symbolic.row_idx().to_vec(),
+    );
+    SparseColMat::new(pattern, matrix.val().to_vec())
 }
 
 /// The entries of one assembly: s_K K, s_C C and s_M M over the free DOFs.
@@ -751,7 +832,7 @@ fn free_rigid_modes(
 }
 
 /// Maps a faer error to a core error.
-fn sparse_error(e: impl std::fmt::Debug) -> CoreError {
+pub(crate) fn sparse_error(e: impl std::fmt::Debug) -> CoreError {
     CoreError::Sparse(format!("{e:?}"))
 }
 

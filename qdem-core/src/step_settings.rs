@@ -12,7 +12,7 @@ use crate::error::CoreError;
 use crate::model::Model;
 use crate::state::State;
 use crate::stepper::{choose_step, stable_step, Stepper};
-use crate::{Newmark, StaticSteps, Verlet};
+use crate::{EventSolve, Newmark, StaticSteps, Verlet};
 
 /// The time-integration scheme.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,6 +63,8 @@ pub struct StepRequest {
     pub local_damping: f64,
     /// Adaptive Newmark steps (retakes at events, paper 001 Eqs. 29–30).
     pub adaptive: bool,
+    /// How an implicit Newmark step solves after events changed the tangent.
+    pub event_solve: EventSolve,
     /// The step of an implicit or static scheme when none is requested; `None` makes a
     /// missing step an error.
     pub implicit_default: Option<f64>,
@@ -84,6 +86,8 @@ pub struct StepSettings {
     pub local_damping: f64,
     /// Adaptive Newmark steps.
     pub adaptive: bool,
+    /// How an implicit Newmark step solves after events changed the tangent.
+    pub event_solve: EventSolve,
     /// The rigorous explicit stable bound at the start (s; infinite when no model bounds it)
     /// and the model that sets it.
     pub stable_dt: (f64, String),
@@ -122,6 +126,7 @@ impl StepSettings {
             safety: request.safety,
             local_damping: request.local_damping,
             adaptive: request.adaptive,
+            event_solve: request.event_solve,
             stable_dt,
         })
     }
@@ -139,7 +144,8 @@ impl StepSettings {
         Ok(match self.scheme {
             Scheme::Verlet => Box::new(Verlet::new(self.dt).with_local_damping(self.local_damping)),
             Scheme::Newmark { beta, gamma } => {
-                Box::new(Newmark::new(beta, gamma, self.dt)?.with_adaptive(self.adaptive))
+                let newmark = Newmark::new(beta, gamma, self.dt)?.with_adaptive(self.adaptive);
+                Box::new(newmark.with_event_solve(self.event_solve))
             }
             Scheme::Static => Box::new(StaticSteps::new(self.dt)),
         })

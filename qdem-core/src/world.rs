@@ -74,7 +74,8 @@ pub struct Halt {
 ///     TimeFunction::constant(1.0));
 /// let models: Vec<Box<dyn Model>> = vec![Box::new(body), Box::new(pull)];
 /// let request = StepRequest { scheme: Scheme::Verlet, dt: None, safety: 0.5,
-///     local_damping: 0.0, adaptive: false, implicit_default: None, fit_to: None };
+///     local_damping: 0.0, adaptive: false, event_solve: Default::default(),
+///     implicit_default: None, fit_to: None };
 /// let settings = StepSettings::resolve(&request, &state, &models).unwrap();
 /// let mut world = World::new(state, models, settings).unwrap();
 /// world.initialize().unwrap();

@@ -93,6 +93,7 @@ fn beam_world() -> World {
         safety: 0.9,
         local_damping: 0.0,
         adaptive: false,
+        event_solve: Default::default(),
         implicit_default: None,
         fit_to: None,
     };

@@ -31,6 +31,7 @@ fn verlet(dt: Option<f64>, fit_to: Option<f64>) -> StepRequest {
         safety: 0.9,
         local_damping: 0.0,
         adaptive: false,
+        event_solve: Default::default(),
         implicit_default: None,
         fit_to,
     }

@@ -34,7 +34,7 @@ mod start_from;
 pub use error::BuildError;
 
 use crate::scene::suggest::did_you_mean;
-use crate::scene::{Integrator, Scene, Selection, TimeStep};
+use crate::scene::{EventSolveName, Integrator, Scene, Selection, TimeStep};
 use ballast::{place_ballast, BallastInfo};
 use contact::ExtraSpheres;
 use granular::GranularInfo;
@@ -43,8 +43,8 @@ use qdem_contact::BondedParticles;
 use qdem_contact::{DemContacts, PeriodicBox, PeriodicWrap};
 use qdem_core::rigid_body::tet_mass_properties;
 use qdem_core::{
-    CoreError, Dofs, Gravity, Material, Model, NodalLoad, Scheme, State, StepRequest, StepSettings,
-    TetBody, TimeFunction, Vec3, World,
+    CoreError, Dofs, EventSolve, Gravity, Material, Model, NodalLoad, Scheme, State, StepRequest,
+    StepSettings, TetBody, TimeFunction, Vec3, World,
 };
 use qdem_mesh::{read_msh, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
@@ -539,6 +539,10 @@ pub(crate) fn step_request(scene: &Scene) -> StepRequest {
         safety: run.dt_safety,
         local_damping: scene.contact.as_ref().map_or(0.0, |c| c.local_damping),
         adaptive: scene.bonded.as_ref().is_some_and(|b| b.adaptive),
+        event_solve: match scene.bonded.as_ref().map(|b| b.event_solve) {
+            Some(EventSolveName::Preconditioned) => EventSolve::Preconditioned,
+            _ => EventSolve::Refactorize,
+        },
         implicit_default: Some(run.probe_every.unwrap_or(run.t_end / 100.0)),
         fit_to: Some(run.t_end),
     }

@@ -27,8 +27,10 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.qdc";
 /// The version of the layout this build writes and reads (3: the files the scene reads are
 /// recorded with their fingerprints, and the run record is one block, the recorders' histories;
 /// 4: a one-sphere stone is one rotating particle, not a rigid body of a centre and a member,
-/// and the Verlet stepper keeps the particles' moments beside the rigid bodies' torques).
-pub const FORMAT_VERSION: u64 = 4;
+/// and the Verlet stepper keeps the particles' moments beside the rigid bodies' torques;
+/// 5: an implicit Newmark stepper keeps, with each factorisation, the matrix it factorised and
+/// the assembler's sparsity pattern, and its step counts include redos and iterative solves).
+pub const FORMAT_VERSION: u64 = 5;
 
 const MAGIC: &[u8; 8] = b"QDEMCKPT";
 const HEADER: usize = 8 + 8 + 8;

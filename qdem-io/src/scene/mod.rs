@@ -46,9 +46,9 @@ mod validate;
 pub use error::{Diagnostic, SceneError};
 pub use refs::Refs;
 pub use schema::{
-    Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, Fix, Granular, Integrator, Load,
-    Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section, Selection, Series,
-    Supports, TimeDelay, TimeStep, Wall,
+    Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix, Granular,
+    Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section,
+    Selection, Series, Supports, TimeDelay, TimeStep, Wall,
 };
 
 use schema::RawScene;

@@ -775,6 +775,17 @@ pub enum PackingName {
     Random,
 }
 
+/// `[bonded] event_solve`: how an implicit step is solved after events changed the tangent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EventSolveName {
+    /// Refactorise the matrix at every change.
+    #[default]
+    Refactorize,
+    /// Conjugate gradients preconditioned by the kept factor, refactorising past a bound.
+    Preconditioned,
+}
+
 /// `[bonded] supports`: how the beam is held.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -838,6 +849,10 @@ pub struct Bonded {
     /// default true.
     #[serde(default = "yes")]
     pub adaptive: bool,
+    /// Implicit runs: how a step is solved after bonds broke or contacts changed (issue 26);
+    /// default `"refactorize"`.
+    #[serde(default)]
+    pub event_solve: EventSolveName,
     /// Relative overshoot ε tolerated before a retake; default 0.05.
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,

@@ -6,7 +6,7 @@ use super::{Recorder, RunFigures, StepInfo};
 use crate::build::Simulation;
 use crate::crack_svg::write_crack_svg;
 use crate::output::OutputError;
-use qdem_core::{CheckpointError, Decoder, Encoder, Halt};
+use qdem_core::{CheckpointError, Decoder, Encoder, Halt, StepCounts};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -26,6 +26,9 @@ pub(crate) struct Crack {
     cracked: bool,
     /// Why the collapse watch ended the run.
     collapse: Option<Halt>,
+    /// The stepper's counts at the start of the step in which the first bond broke (until
+    /// then, at the start of the last step).
+    at_crack: StepCounts,
 }
 
 impl Crack {
@@ -56,6 +59,9 @@ impl Recorder for Crack {
             self.collapse = Some(halt.clone());
         }
         self.cracked = sim.bonded().is_some_and(|b| b.broken() > 0);
+        if !self.cracked {
+            self.at_crack = sim.world.stepper().counts();
+        }
         Ok(())
     }
 
@@ -87,6 +93,11 @@ impl Recorder for Crack {
             "substeps": counts.substeps,
             "event_steps": counts.event_steps,
             "factorizations": counts.factorizations,
+            "redos": counts.redos,
+            "solves": counts.solves,
+            "iterative_solves": counts.iterative_solves,
+            "iterations": counts.iterations,
+            "crack_phase_per_step": crack_phase(counts, self.at_crack, self.after_steps + 1),
             "factor_dofs": factor.map(|f| f.dofs),
             "factor_nonzeros": factor.map(|f| f.factor_nonzeros),
             "particle_steps_per_second": run.rate(sim.world.state.len()),
@@ -99,6 +110,10 @@ impl Recorder for Crack {
         out.f64(self.after_seconds);
         out.u64(self.after_steps);
         out.bool(self.cracked);
+        self.at_crack
+            .to_array()
+            .into_iter()
+            .for_each(|n| out.u64(n));
     }
 
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
@@ -107,6 +122,27 @@ impl Recorder for Crack {
         self.after_seconds = input.f64("the crack timing")?;
         self.after_steps = input.u64("the crack timing")?;
         self.cracked = input.bool("the crack flag")?;
+        let mut n = [0; StepCounts::LEN];
+        for x in &mut n {
+            *x = input.u64("the counts at the first break")?;
+        }
+        self.at_crack = StepCounts::from_array(n);
         Ok(())
     }
+}
+
+/// The stepper's work per nominal step of the crack phase (from the step in which the first
+/// bond broke, `steps` steps): counts `now` less those at its start.
+fn crack_phase(now: StepCounts, start: StepCounts, steps: u64) -> serde_json::Value {
+    let per = |a: u64, b: u64| (a - b) as f64 / steps as f64;
+    json!({
+        "steps": steps,
+        "retakes": per(now.retakes, start.retakes),
+        "substeps": per(now.substeps, start.substeps),
+        "redos": per(now.redos, start.redos),
+        "solves": per(now.solves, start.solves),
+        "factorizations": per(now.factorizations, start.factorizations),
+        "iterative_solves": per(now.iterative_solves, start.iterative_solves),
+        "iterations": per(now.iterations, start.iterations),
+    })
 }
