@@ -27,6 +27,8 @@ status a test reads as "skipped".
 import argparse
 import os
 import shutil
+import signal
+import subprocess
 import sys
 import xml.etree.ElementTree as ET
 
@@ -43,11 +45,18 @@ def relaunch():
         print("render.py: pvpython (ParaView) is not installed; nothing rendered", file=sys.stderr)
         sys.exit(SKIPPED)
     args = [pvpython, os.path.abspath(__file__)] + sys.argv[1:]
-    if not os.environ.get("DISPLAY") and shutil.which("xvfb-run"):
-        args = ["xvfb-run", "-a"] + args
-    else:
+    if os.environ.get("DISPLAY") or not shutil.which("xvfb-run"):
         args.insert(1, "--force-offscreen-rendering")
-    os.execvp(args[0], args)
+        sys.exit(subprocess.call(args))
+    # xvfb-run -a now and then hands pvpython a display whose server is not up yet (or is
+    # still going from the previous run): ParaView then aborts at once with "bad X server
+    # connection"; another try gets a working one.
+    args = ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24"] + args
+    for _ in range(3):
+        status = subprocess.call(args)
+        if status != -signal.SIGABRT and status != 128 + signal.SIGABRT:
+            break
+    sys.exit(status)
 
 
 try:
@@ -215,7 +224,7 @@ def bodies(args, array, association, title, direction, scale_default):
     pv.Render(v)
     focal = v.CameraFocalPoint
     distance = sum((p - f) ** 2 for p, f in zip(v.CameraPosition, focal)) ** 0.5
-    camera(v, focal, direction, distance * 0.8)
+    camera(v, focal, direction, distance * args.zoom)
     save(v, args.png)
 
 
@@ -264,6 +273,7 @@ def main():
     p.add_argument("--frequency", type=float, default=3.0)
     p.add_argument("--scale", type=float)
     p.add_argument("--size", default=None)
+    p.add_argument("--zoom", type=float, default=0.5, help="camera distance over ParaView's reset one (ballast, cantilever)")
     args = p.parse_args()
     default = {"boxtest": "360x380"}.get(args.kind, "900x420")
     args.size = tuple(int(x) for x in (args.size or default).split("x"))
