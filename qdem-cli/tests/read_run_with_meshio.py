@@ -9,6 +9,11 @@ contacts: the largest difference, over the spheres, between the sum of the conta
 forces on a sphere (normal_force + tangential_force on `first`, times `scale_first` where
 written; minus the same times `scale_second` on `second`) and the sphere's `contact_force`,
 and the largest contact force, so that the caller can judge the difference against round-off.
+
+meshio 5.3 cannot read an UnstructuredGrid without cells (it indexes the empty cell types):
+a file whose Piece has NumberOfCells="0" (a contacts file at a time nothing touches, the body
+file of a run without tetrahedra) is reported from its header, with "empty": true, the point
+count and the names of its point arrays.
 """
 
 import json
@@ -33,12 +38,31 @@ def describe(mesh):
     }
 
 
+def empty(path):
+    """The report of a file without cells, from its XML, or None if it has cells."""
+    root = ET.parse(path).getroot()
+    piece = root.find("UnstructuredGrid/Piece")
+    if int(piece.get("NumberOfCells")) != 0:
+        return None
+    points = int(piece.get("NumberOfPoints"))
+    arrays = piece.find("PointData").findall("DataArray")
+    return {
+        "points": points,
+        "cells": {},
+        "point_data": {a.get("Name"): [points] for a in arrays},
+        "cell_data": {},
+        "finite": True,
+        "empty": True,
+    }
+
+
 def force_sums(spheres, contacts):
-    """(largest |Σ line forces − contact_force| over the spheres, largest |contact_force|)."""
+    """(largest |Σ line forces − contact_force| over the spheres, largest |contact_force|);
+    `contacts` is None for a time without any contact."""
     applied = spheres.point_data["contact_force"]
     total = np.zeros_like(applied)
-    data = {k: v[0] for k, v in contacts.cell_data.items()}
-    if len(contacts.points) > 0:
+    if contacts is not None:
+        data = {k: v[0] for k, v in contacts.cell_data.items()}
         force = data["normal_force"] + data["tangential_force"]
         first, second = data["first"].astype(int), data["second"].astype(int)
         scale_first = data.get("scale_first", np.ones(len(first)))[:, None]
@@ -56,18 +80,21 @@ def main():
     files, by_time = {}, {}
     for entry in root.iter("DataSet"):
         name = entry.get("file")
-        mesh = meshio.read(os.path.join(out, name))
-        if name not in files:
-            files[name] = describe(mesh)
-        kind = os.path.basename(name).split("_")[0]
-        by_time.setdefault(entry.get("timestep"), {})[kind] = mesh
-        files[name]["part"] = int(entry.get("part"))
+        path = os.path.join(out, name)
+        report = empty(path)
+        if report is None:
+            mesh = meshio.read(path)
+            report = describe(mesh)
+            kind = os.path.basename(name).split("_")[0]
+            by_time.setdefault(entry.get("timestep"), {})[kind] = mesh
+        files[name] = dict(report, part=int(entry.get("part")))
+    times = len({entry.get("timestep") for entry in root.iter("DataSet")})
     sums = []
     for time, meshes in by_time.items():
-        if "spheres" in meshes and "contacts" in meshes:
-            error, largest = force_sums(meshes["spheres"], meshes["contacts"])
+        if "spheres" in meshes:
+            error, largest = force_sums(meshes["spheres"], meshes.get("contacts"))
             sums.append({"time": float(time), "error": error, "largest": largest})
-    print(json.dumps({"files": files, "force_sums": sums, "times": len(by_time)}))
+    print(json.dumps({"files": files, "force_sums": sums, "times": times}))
 
 
 if __name__ == "__main__":
