@@ -10,7 +10,7 @@
 //! - `scripts/render.py` draws a run where pvpython is installed (skipped elsewhere).
 
 mod common;
-use common::{workspace, TempDir};
+use common::{run, workspace, TempDir};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -35,24 +35,6 @@ fn scene(tmp: &Path, dir: &str, name: &str, edits: &[(&str, &str)]) -> PathBuf {
     let path = tmp.join(name);
     std::fs::write(&path, text).unwrap();
     path
-}
-
-/// Runs `scene` into `out` on `threads` threads; panics on failure.
-fn run(scene: &Path, out: &Path, threads: usize) {
-    let output = Command::new(QDEM)
-        .arg("run")
-        .arg(scene)
-        .arg("--out")
-        .arg(out)
-        .args(["--threads", &threads.to_string()])
-        .env("CI", "1")
-        .output()
-        .expect("run the qdem binary");
-    assert!(
-        output.status.success(),
-        "qdem run failed:\n{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
 }
 
 /// What `read_run_with_meshio.py` reads of `out`; fails (never skips) without meshio.

@@ -1,6 +1,6 @@
 //! What an output reads of the contact model ([`DemContacts::touching`],
-//! [`DemContacts::sphere_records`]) on a compressed, spinning packing of rigid spheres,
-//! periodic along x with a time-delayed boundary (whose ghost scales the sums carry), touching
+//! [`DemContacts::sphere_records`]) on the periodic tests' compressed, spinning packing of rigid
+//! spheres, periodic along x with a time-delayed boundary (whose ghost scales the sums carry), touching
 //! a floor:
 //! - the touching contacts' forces, summed per sphere with their ghost scales, are the contact
 //!   force the model applied to each sphere, to round-off;
@@ -9,67 +9,34 @@
 
 mod common;
 
-use common::{contacts, rigid_spheres, stepper};
+use common::packing::{model, packing, run, PERIOD, R};
 use qdem_contact::{
-    ContactLaw, ContactSettings, DemContacts, HertzMindlin, LoadCycle, Partner, PeriodicBox,
-    PlaneWall, TimeDelayedBoundary, Wall, WallShape,
+    DemContacts, LoadCycle, Partner, PlaneWall, TimeDelayedBoundary, Wall, WallShape,
 };
-use qdem_core::{Model, Stepper, Vec3};
-
-const R: f64 = 0.005;
-const ROW: usize = 8;
-const SPACING: f64 = 1.96 * R;
+use qdem_core::Vec3;
 
 #[test]
 fn touching_contacts_sum_per_sphere_to_the_applied_contact_force() {
-    let mut centers = Vec::new();
-    for k in 0..2 {
-        for j in 0..2 {
-            for i in 0..ROW {
-                let jitter = ((i * 7 + j * 13 + k * 29) % 17) as f64 / 17.0 - 0.5;
-                centers.push(Vec3::new(
-                    (i as f64 + 0.5) * SPACING + 0.02 * R * jitter,
-                    1.98 * R * j as f64,
-                    0.99 * R + 1.97 * R * k as f64 + 0.01 * R * jitter,
-                ));
-            }
-        }
-    }
-    let (mut state, spheres) = rigid_spheres(&centers, R, 2700.0);
-    for (i, v) in state.velocity.iter_mut().enumerate() {
-        let f = |m: usize| ((i * m) % 101) as f64 / 101.0 - 0.5;
-        *v = 0.02 * Vec3::new(f(37), f(53), f(71));
-    }
-    let settings = ContactSettings {
-        law: ContactLaw::HertzMindlin(HertzMindlin { damping_ratio: 0.1 }),
-        friction: 0.5,
-        skin: 0.2 * R,
-    };
+    let (state, spheres) = packing(0.0);
+    // A floor 1% of a radius into the bottom layer (z = 0).
     let floor = Wall {
-        shape: WallShape::Plane(PlaneWall::new(Vec3::zeros(), Vec3::z(), Vec3::zeros())),
+        shape: WallShape::Plane(PlaneWall::new(
+            Vec3::new(0.0, 0.0, -0.99 * R),
+            Vec3::z(),
+            Vec3::zeros(),
+        )),
         friction: 0.3,
     };
-    let periodic =
-        PeriodicBox::new(Vec3::zeros(), [Some(ROW as f64 * SPACING), None, None]).unwrap();
     let cycle = LoadCycle {
         frequency: 100.0,
         phase: 0.0,
         start: 0.0,
     };
-    let model = contacts(&state, &spheres, (5e7, 0.25), settings, vec![floor])
-        .with_periodic(periodic)
-        .unwrap()
-        .with_time_delay(
-            0,
-            TimeDelayedBoundary::new(cycle, 0.5 * std::f64::consts::PI),
-        )
+    let lag = 0.5 * std::f64::consts::PI;
+    let contacts = model(&state, &spheres, vec![floor])
+        .with_time_delay(0, TimeDelayedBoundary::new(cycle, lag))
         .unwrap();
-    let dt = 0.5 * model.stable_dt(&state).unwrap();
-    let mut models: Vec<Box<dyn Model>> = vec![Box::new(model)];
-    let mut s = stepper(dt, &mut state, &mut models);
-    for _ in 0..30 {
-        s.step(&mut state, &mut models).unwrap();
-    }
+    let (state, models) = run(state, contacts, 30);
     let any: &dyn std::any::Any = models[0].as_ref();
     let contacts = any.downcast_ref::<DemContacts>().unwrap();
 
@@ -79,9 +46,8 @@ fn touching_contacts_sum_per_sphere_to_the_applied_contact_force() {
         .iter()
         .filter(|c| matches!(c.second, Partner::Wall(_)));
     assert!(walls.count() > 0, "bottom spheres touch the floor");
-    let period = ROW as f64 * SPACING;
     assert!(
-        touching.iter().any(|c| c.to.x < 0.0 || c.to.x >= period),
+        touching.iter().any(|c| c.to.x < 0.0 || c.to.x >= PERIOD),
         "some pair touches through the delayed boundary, at an image outside the cell"
     );
     let mut sum = vec![Vec3::zeros(); contacts.spheres()];
@@ -97,8 +63,8 @@ fn touching_contacts_sum_per_sphere_to_the_applied_contact_force() {
             assert!(gap.norm() < 2.0 * R && gap.norm() > 1.8 * R, "{gap:?}");
             assert!((gap.normalize() - c.normal).norm() < 1e-12);
         } else {
-            // The floor's nearest point lies straight below the centre, on z = 0.
-            assert!(c.to.z.abs() < 1e-15 && (c.to.xy() - c.from.xy()).norm() < 1e-15);
+            // The floor's nearest point lies straight below the centre, on the floor.
+            assert!((c.to.z + 0.99 * R).abs() < 1e-15 && (c.to.xy() - c.from.xy()).norm() < 1e-15);
         }
         assert!(c.normal_force.cross(&c.normal).norm() <= 1e-12 * f.norm());
         assert!(c.tangential_force.dot(&c.normal).abs() <= 1e-12 * f.norm());

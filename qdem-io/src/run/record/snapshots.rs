@@ -76,7 +76,8 @@ pub(crate) struct Snapshots {
     /// The parts besides the bodies, in part order (part 1, 2, …).
     parts: Vec<Part>,
     pvd: PvdIndex,
-    /// Whether this process wrote the file of the walls that stay.
+    /// Whether the file of the walls that stay is written (by this run, or by the run it
+    /// resumes).
     walls_written: bool,
 }
 
@@ -160,6 +161,8 @@ impl Recorder for Snapshots {
             let file = input.str("a VTU file name")?;
             self.index(time, file);
         }
+        // The run resumed wrote the walls that stay with its first time.
+        self.walls_written = !self.times.is_empty();
         Ok(())
     }
 }
