@@ -4,12 +4,9 @@
 
 use std::collections::HashMap;
 mod common;
-use common::{workspace, TempDir};
-use std::ffi::OsStr;
+use common::{run, workspace, TempDir};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-const QDEM: &str = env!("CARGO_BIN_EXE_qdem");
+use std::process::Command;
 
 /// Probe columns of the scene's single probe `tip`.
 const HEADER: &str = "t,tip.ux,tip.uy,tip.uz,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az";
@@ -73,31 +70,6 @@ fn toml_string(s: &str) -> String {
     }
     out.push('"');
     out
-}
-
-/// `qdem run SCENE --out OUT --threads N`, which must succeed.
-fn run(scene: &Path, out: &Path, threads: usize) -> Output {
-    let output = Command::new(QDEM)
-        .args([
-            OsStr::new("run"),
-            scene.as_os_str(),
-            OsStr::new("--out"),
-            out.as_os_str(),
-        ])
-        .args(["--threads", &threads.to_string()])
-        .env("CI", "1")
-        .output()
-        .expect("start the qdem binary");
-    assert!(
-        output.status.success(),
-        "qdem run {} --threads {threads} failed ({}):\n{}",
-        scene.display(),
-        output.status,
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    output
 }
 
 /// The rows of a probe CSV, each as numbers, after checking the header.

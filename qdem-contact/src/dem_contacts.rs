@@ -33,6 +33,7 @@ use crate::broad_phase::{find_pairs, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
 use crate::contact_list::{Contact, ContactList};
 use crate::contact_springs::{add_spring, spring};
+use crate::contact_view::{Partner, SphereRecord, TouchingContact};
 use crate::error::ContactError;
 use crate::periodic_boundary::PeriodicBox;
 use crate::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
@@ -486,6 +487,78 @@ impl DemContacts {
             .count()
     }
 
+    /// The walls.
+    pub fn wall_list(&self) -> &[Wall] {
+        &self.walls
+    }
+
+    /// The names of the bodies the spheres belong to ([`SphereRecord::body`] indexes them).
+    pub fn body_names(&self) -> &[String] {
+        &self.body_names
+    }
+
+    /// Every contact sphere at `state` (the state the last evaluation saw, after the step),
+    /// in sphere order, with the contact force the model applied to it.
+    pub fn sphere_records<'a>(
+        &'a self,
+        state: &'a State,
+    ) -> impl Iterator<Item = SphereRecord> + 'a {
+        let bodies = state.rigid.len();
+        (0..self.particle.len()).map(move |s| {
+            let particle = self.particle[s] as usize;
+            let spin = match self.turn[s] as usize {
+                t if t == NOT_RIGID as usize => None,
+                b if b < bodies => Some(state.rigid.angular_velocity[b]),
+                t => Some(state.spin.velocity[t - bodies]),
+            };
+            SphereRecord {
+                particle,
+                radius: self.radius[s],
+                body: self.body[s] as usize,
+                center: state.position[particle],
+                velocity: state.velocity[particle],
+                spin,
+                force: self.sphere_force[s].0,
+            }
+        })
+    }
+
+    /// Every contact that touched at the last evaluation: the pairs in list order, then the
+    /// wall contacts. Summed per sphere (+f on the first partner times its scale, −f on the
+    /// second times its scale), their forces are [`SphereRecord::force`].
+    pub fn touching(&self) -> impl Iterator<Item = TouchingContact> + '_ {
+        let time = self.last_time.unwrap_or(0.0);
+        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
+        let pairs = self.pairs.items.iter().filter(|c| c.force != Vec3::zeros());
+        let pairs = pairs.map(move |c| {
+            let (a, b) = (c.first as usize, c.second as usize);
+            let (from, to) = (self.now[a].center, self.now[b].center + c.shift);
+            let scales = delay.map_or((1.0, 1.0), |(axis, s)| pair_scales(c.shift[axis], &s));
+            split(
+                a,
+                Partner::Sphere(b),
+                from,
+                to,
+                (to - from).normalize(),
+                c.force,
+                scales,
+            )
+        });
+        let walls = self
+            .wall_contacts
+            .items
+            .iter()
+            .filter(|c| c.force != Vec3::zeros());
+        let walls = walls.map(move |c| {
+            let (s, w) = (c.first as usize, c.second as usize);
+            let from = self.now[s].center;
+            let (overlap, normal) = self.walls[w].overlap(&from, self.radius[s], time);
+            let to = from + (self.radius[s] - overlap) * normal;
+            split(s, Partner::Wall(w), from, to, normal, c.force, (1.0, 1.0))
+        });
+        pairs.chain(walls)
+    }
+
     /// How many times the candidate lists were rebuilt.
     pub fn rebuilds(&self) -> u64 {
         self.rebuilds
@@ -776,6 +849,30 @@ impl DemContacts {
                 }
                 *out = (f, t);
             });
+    }
+}
+
+/// A touching contact of sphere `first` with `second` along the segment `from`–`to`, its
+/// force `force` on the first split along the unit normal `normal`.
+fn split(
+    first: usize,
+    second: Partner,
+    from: Vec3,
+    to: Vec3,
+    normal: Vec3,
+    force: Vec3,
+    scales: (f64, f64),
+) -> TouchingContact {
+    let normal_force = force.dot(&normal) * normal;
+    TouchingContact {
+        first,
+        second,
+        from,
+        to,
+        normal,
+        normal_force,
+        tangential_force: force - normal_force,
+        scales,
     }
 }
 

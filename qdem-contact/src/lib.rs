@@ -7,6 +7,7 @@
 //! - [`DemContacts`]: the [`qdem_core::Model`] that owns the spheres, walls and contact lists
 //!   and runs broad phase → narrow phase → forces → gather each evaluation.
 //! - [`broad_phase`]: the cell grid with a skin.
+//! - [`contact_view`]: what an output reads of the spheres and touching contacts.
 //! - [`contact_law`], [`linear_spring`], [`hertz_mindlin`], [`coulomb`]: the laws.
 //! - [`plane_wall`], [`mesh_wall`], [`wall`]: the walls.
 //!
@@ -36,6 +37,7 @@ pub mod collapse_watch;
 pub mod contact_law;
 mod contact_list;
 mod contact_springs;
+pub mod contact_view;
 pub mod coulomb;
 pub mod dem_contacts;
 pub mod error;
@@ -54,6 +56,7 @@ pub use beam_bond::{BeamBond, BeamSection};
 pub use bonded_particles::{BondSettings, BondedMaterial, BondedParticles};
 pub use collapse_watch::CollapseWatch;
 pub use contact_law::{ContactLaw, PairElasticity, PairGeometry};
+pub use contact_view::{Partner, SphereRecord, TouchingContact};
 pub use dem_contacts::{ContactSettings, ContactSphere, DemContacts};
 pub use error::ContactError;
 pub use hertz_mindlin::HertzMindlin;

@@ -69,6 +69,14 @@ impl MeshWall {
         (0..3).all(|k| local[k] > self.lower[k] - reach && local[k] < self.upper[k] + reach)
     }
 
+    /// The wall's triangles at time `t`: its vertices moved by v t, and three vertex indices
+    /// per triangle.
+    pub fn surface(&self, t: f64) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let shift = self.velocity * t;
+        let vertices = self.mesh.vertices().iter().map(|&v| from_parry(v) + shift);
+        (vertices.collect(), self.mesh.indices().to_vec())
+    }
+
     /// Overlap δ = r − |x − p| with p the closest point of the wall at time `t`, and the unit
     /// normal from the sphere towards p.
     pub fn overlap(&self, x: &Vec3, radius: f64, t: f64) -> (f64, Vec3) {

@@ -11,76 +11,22 @@
 
 mod common;
 
+use common::packing::{model, packing, run, PERIOD, R, SPACING};
 use common::{contacts, rigid_spheres, stepper};
 use qdem_contact::{
-    ContactLaw, ContactSettings, DemContacts, HertzMindlin, LoadCycle, PeriodicBox,
-    TimeDelayedBoundary,
+    ContactLaw, ContactSettings, DemContacts, HertzMindlin, LoadCycle, TimeDelayedBoundary,
 };
 use qdem_core::{Model, State, Stepper, Vec3};
-
-const R: f64 = 0.005;
-/// Spheres along the periodic axis, and their spacing (below 2R: every neighbour pair
-/// overlaps, the last and the first through the boundary).
-const ROW: usize = 10;
-const SPACING: f64 = 1.96 * R;
-const PERIOD: f64 = ROW as f64 * SPACING;
-
-/// 10 × 3 × 3 spheres, rows along x compressed across the boundary, with deterministic
-/// velocities; every coordinate x shifted by `shift`.
-fn packing(shift: f64) -> (State, Vec<qdem_contact::ContactSphere>) {
-    let mut centers = Vec::new();
-    for k in 0..3 {
-        for j in 0..3 {
-            for i in 0..ROW {
-                let jitter = ((i * 7 + j * 13 + k * 29) % 17) as f64 / 17.0 - 0.5;
-                centers.push(Vec3::new(
-                    (i as f64 + 0.5) * SPACING + 0.02 * R * jitter + shift,
-                    2.2 * R * j as f64 + 0.05 * R * jitter,
-                    2.2 * R * k as f64,
-                ));
-            }
-        }
-    }
-    let (mut state, spheres) = rigid_spheres(&centers, R, 2700.0);
-    for (i, v) in state.velocity.iter_mut().enumerate() {
-        let f = |m: usize| ((i * m) % 101) as f64 / 101.0 - 0.5;
-        *v = 0.02 * Vec3::new(f(37), f(53), f(71));
-    }
-    (state, spheres)
-}
-
-fn model(state: &State, spheres: &[qdem_contact::ContactSphere]) -> DemContacts {
-    let settings = ContactSettings {
-        law: ContactLaw::HertzMindlin(HertzMindlin { damping_ratio: 0.1 }),
-        friction: 0.5,
-        skin: 0.2 * R,
-    };
-    let periodic = PeriodicBox::new(Vec3::zeros(), [Some(PERIOD), None, None]).unwrap();
-    contacts(state, spheres, (5e7, 0.25), settings, Vec::new())
-        .with_periodic(periodic)
-        .unwrap()
-}
-
-/// Steps `model` on `state` `steps` times at a fixed step; returns the state.
-fn run(mut state: State, model: DemContacts, steps: usize) -> (State, Vec<Box<dyn Model>>) {
-    let dt = 0.5 * model.stable_dt(&state).unwrap();
-    let mut models: Vec<Box<dyn Model>> = vec![Box::new(model)];
-    let mut s = stepper(dt, &mut state, &mut models);
-    for _ in 0..steps {
-        s.step(&mut state, &mut models).unwrap();
-    }
-    (state, models)
-}
 
 #[test]
 fn shifting_a_periodic_packing_changes_nothing_but_the_shift() {
     let steps = 600;
     let (a, sa) = packing(0.0);
-    let reference = run(a.clone(), model(&a, &sa), steps).0;
+    let reference = run(a.clone(), model(&a, &sa, Vec::new()), steps).0;
     for fraction in [0.37, -1.61] {
         let shift = fraction * PERIOD;
         let (b, sb) = packing(shift);
-        let shifted = run(b.clone(), model(&b, &sb), steps).0;
+        let shifted = run(b.clone(), model(&b, &sb, Vec::new()), steps).0;
         let scale_x = PERIOD;
         let scale_v = reference
             .velocity
@@ -120,7 +66,7 @@ fn a_pair_through_the_boundary_feels_the_force_of_the_pair_side_by_side() {
     ];
     let forces = |centers: &[Vec3], periodic: bool| {
         let (state, spheres) = rigid_spheres(centers, R, 2700.0);
-        let mut m = model(&state, &spheres);
+        let mut m = model(&state, &spheres, Vec::new());
         if !periodic {
             let settings = ContactSettings {
                 law: ContactLaw::HertzMindlin(HertzMindlin { damping_ratio: 0.1 }),
@@ -183,7 +129,7 @@ fn a_section_measures_the_hertz_force_of_the_pair_it_cuts() {
     // In the periodic packing a section repeats every period, and the one at the cell face
     // cuts the nine rows' pairs through the boundary.
     let (a, sa) = packing(0.0);
-    let mut p = model(&a, &sa);
+    let mut p = model(&a, &sa, Vec::new());
     let mut f = vec![Vec3::zeros(); a.len()];
     let mut t = vec![Vec3::zeros(); a.rigid.len()];
     p.add_forces(&a, &mut f, &mut t);
@@ -208,7 +154,9 @@ fn delayed(lag: f64, shared: bool, steps: usize) -> (State, f64, f64) {
     if shared {
         boundary = boundary.with_shared_faces();
     }
-    let m = model(&state, &sa).with_time_delay(0, boundary).unwrap();
+    let m = model(&state, &sa, Vec::new())
+        .with_time_delay(0, boundary)
+        .unwrap();
     let dt = 0.5 * m.stable_dt(&state).unwrap();
     let mut models: Vec<Box<dyn Model>> = vec![Box::new(m)];
     let mut s = stepper(dt, &mut state, &mut models);
@@ -231,7 +179,7 @@ fn delayed(lag: f64, shared: bool, steps: usize) -> (State, f64, f64) {
 fn a_zero_lag_time_delay_is_the_ordinary_periodic_boundary_bit_for_bit() {
     let steps = 2000;
     let (a, sa) = packing(0.0);
-    let (ordinary, _) = run(a.clone(), model(&a, &sa), steps);
+    let (ordinary, _) = run(a.clone(), model(&a, &sa, Vec::new()), steps);
     let (zero, force, spread) = delayed(0.0, false, steps);
     assert_eq!(zero.position, ordinary.position);
     assert_eq!(zero.velocity, ordinary.velocity);

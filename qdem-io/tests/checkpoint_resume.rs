@@ -115,6 +115,9 @@ origin = [0.0, 0.7, 0.0]
 [periodic.time_delay]
 body = "sleeper"
 lag_deg = 90.0
+
+[output]
+vtu_every = 0.1
 "#,
         mesh = fixture("boxtest/sleeper.msh").display()
     );
@@ -229,6 +232,10 @@ fn a_resumed_periodic_contact_run_equals_the_uninterrupted_one() {
         "sections.csv",
         "stones.csv",
         "probes.svg",
+        "results.pvd",
+        "vtu/walls.vtu",
+        "vtu/spheres_00004.vtu",
+        "vtu/contacts_00004.vtu",
     ];
     let dir = resume_equals_uninterrupted("ckpt-boxtest", &scene, steps * 3 / 4, &files);
     // The boundary's estimates were live at the checkpoint (t = 0.3 s): ghost scales other

@@ -236,7 +236,8 @@ fn wrong_lengths_are_rejected_before_writing() {
         matches!(
             err,
             OutputError::PointIndex {
-                tet: 1,
+                kind: "tetrahedron",
+                cell: 1,
                 index: 5,
                 num_points: 5,
                 ..

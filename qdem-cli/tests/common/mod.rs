@@ -2,7 +2,9 @@
 
 #![allow(dead_code)] // each test binary uses a subset
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The workspace root.
@@ -42,4 +44,29 @@ impl Drop for TempDir {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.0);
     }
+}
+
+/// `qdem run SCENE --out OUT --threads N`, which must succeed.
+pub fn run(scene: &Path, out: &Path, threads: usize) -> Output {
+    let output = Command::new(env!("CARGO_BIN_EXE_qdem"))
+        .args([
+            OsStr::new("run"),
+            scene.as_os_str(),
+            OsStr::new("--out"),
+            out.as_os_str(),
+        ])
+        .args(["--threads", &threads.to_string()])
+        .env("CI", "1")
+        .output()
+        .expect("start the qdem binary");
+    assert!(
+        output.status.success(),
+        "qdem run {} --threads {threads} failed ({}):\n{}",
+        scene.display(),
+        output.status,
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    output
 }

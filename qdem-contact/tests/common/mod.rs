@@ -1,6 +1,8 @@
 //! Scenes built directly on the library for the contact tests.
 #![allow(dead_code)]
 
+pub mod packing;
+
 use qdem_contact::{ContactSettings, ContactSphere, DemContacts, Wall};
 use qdem_core::{Mat3, Model, State, Stepper, Vec3, Verlet};
 

@@ -77,16 +77,18 @@ pub enum OutputError {
         /// The number of entries given.
         found: usize,
     },
-    /// A tetrahedron references a point that does not exist.
+    /// A cell (a tetrahedron, line, triangle) references a point that does not exist.
     #[error(
-        "cannot write `{path}`: tetrahedron {tet} references point {index}, \
+        "cannot write `{path}`: {kind} {cell} references point {index}, \
          but there are only {num_points} points"
     )]
     PointIndex {
         /// The target path.
         path: PathBuf,
-        /// The index of the offending tetrahedron.
-        tet: usize,
+        /// What the cells are ("tetrahedron", "line", "triangle").
+        kind: &'static str,
+        /// The index of the offending cell.
+        cell: usize,
         /// The out-of-range point index.
         index: u32,
         /// The number of points in the grid.

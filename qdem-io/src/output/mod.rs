@@ -10,6 +10,7 @@
 //! | file | writer |
 //! | --- | --- |
 //! | `*.vtu` (VTK XML UnstructuredGrid, linear tets, binary base64) | [`write_vtu`] |
+//! | `*.vtu` of vertices, lines or triangles (spheres, contacts, bonds, walls) | [`write_vtu_mesh`] |
 //! | `*.pvd` (ParaView time-series collection) | [`PvdIndex`] |
 //! | `probes.csv` (per-probe u, v, a over time, streamed) | [`ProbeCsv`] |
 //! | `summary.json` | [`write_summary`] |
@@ -30,7 +31,7 @@ pub use error::{IoStage, OutputError};
 pub use probes_csv::{ProbeCsv, PROBE_COLUMNS};
 pub use pvd::PvdIndex;
 pub use summary::write_summary;
-pub use vtu::{write_vtu, VtuGrid, VTK_TETRA};
+pub use vtu::{write_vtu, write_vtu_mesh, VtuCells, VtuField, VtuGrid, VtuMesh, VTK_TETRA};
 
 use std::borrow::Cow;
 use std::io::{self, Write};

@@ -1,8 +1,9 @@
 //! ParaView collection (`.pvd`) index of a time series of VTU files.
 //!
-//! A [`PvdIndex`] collects `(time, file)` pairs; [`PvdIndex::write`] writes the complete
-//! collection atomically. Calling it after every added file keeps the `.pvd` on disk
-//! always complete and loadable while a run is in progress.
+//! A [`PvdIndex`] collects `(time, file)` pairs, each in a part (`part="N"`: the datasets
+//! ParaView shows side by side at one time, such as a run's bodies, spheres and contacts);
+//! [`PvdIndex::write`] writes the complete collection atomically. Calling it after every added
+//! file keeps the `.pvd` on disk always complete and loadable while a run is in progress.
 
 use std::io::{self, Write};
 use std::path::Path;
@@ -30,6 +31,8 @@ use super::{write_f64, xml_escape};
 pub struct PvdIndex {
     /// `(time, file name relative to the .pvd's directory)`, in the order added.
     entries: Vec<(f64, String)>,
+    /// The part of each entry.
+    parts: Vec<u32>,
 }
 
 impl PvdIndex {
@@ -44,10 +47,17 @@ impl PvdIndex {
     ///
     /// Entries are written in the order added; ParaView orders them by time.
     pub fn push(&mut self, time: f64, file: impl Into<String>) {
-        self.entries.push((time, file.into()));
+        self.push_part(time, 0, file);
     }
 
-    /// The entries added so far: `(time, relative file name)`.
+    /// Adds a data file of part `part` written at simulation time `time` (see
+    /// [`PvdIndex::push`]). ParaView reads each part as one block of a multiblock dataset.
+    pub fn push_part(&mut self, time: f64, part: u32, file: impl Into<String>) {
+        self.entries.push((time, file.into()));
+        self.parts.push(part);
+    }
+
+    /// The entries added so far: `(time, relative file name)`, of every part.
     #[must_use]
     pub fn entries(&self) -> &[(f64, String)] {
         &self.entries
@@ -109,12 +119,12 @@ impl PvdIndex {
             "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">"
         )?;
         writeln!(w, "  <Collection>")?;
-        for (time, file) in &self.entries {
+        for ((time, file), part) in self.entries.iter().zip(&self.parts) {
             write!(w, "    <DataSet timestep=\"")?;
             write_f64(w, *time)?;
             writeln!(
                 w,
-                "\" group=\"\" part=\"0\" file=\"{}\"/>",
+                "\" group=\"\" part=\"{part}\" file=\"{}\"/>",
                 xml_escape(file)
             )?;
         }

@@ -1,11 +1,13 @@
-//! VTK XML UnstructuredGrid (`.vtu`) writer for linear tetrahedra.
+//! VTK XML UnstructuredGrid (`.vtu`) writer: linear tetrahedra ([`VtuGrid`], the bodies), and
+//! vertices, lines or triangles ([`VtuMesh`]: contact spheres, force chains, bonds, walls).
 //!
-//! The file is self-contained and readable by ParaView, VTK and meshio:
+//! The file is self-contained and readable by ParaView, VTK and meshio (which reads no VTK
+//! PolyData, hence UnstructuredGrids of vertex and line cells rather than `.vtp` files):
 //! - `byte_order="LittleEndian"`, `header_type="UInt64"`;
 //! - every DataArray is inline `format="binary"`: one base64 stream holding the array's
 //!   byte count as a little-endian `u64`, followed by the little-endian values;
-//! - points and all field data are `Float64`, connectivity and offsets `Int64`, cell types
-//!   `UInt8` (all 10, `VTK_TETRA`).
+//! - points and real fields are `Float64`, integer fields, connectivity and offsets `Int64`,
+//!   cell types `UInt8` (one type per file: [`VtuCells`]).
 //!
 //! Values are written bit for bit (no rounding), so a file can be compared exactly with
 //! the state it came from. The base64 encoding is streamed, so no copy of a field is held
@@ -55,22 +57,154 @@ pub struct VtuGrid<'a> {
     pub cell_scalars: Vec<(&'a str, &'a [f64])>,
 }
 
-impl VtuGrid<'_> {
+impl<'a> VtuGrid<'a> {
+    /// The same grid as a [`VtuMesh`] of tetrahedra.
+    #[must_use]
+    pub fn mesh(&self) -> VtuMesh<'a> {
+        VtuMesh {
+            points: self.points,
+            cells: VtuCells::Tets(self.tets),
+            point_data: self
+                .point_vectors
+                .iter()
+                .map(|&(n, v)| (n, VtuField::Vectors(v)))
+                .collect(),
+            cell_data: self
+                .cell_scalars
+                .iter()
+                .map(|&(n, v)| (n, VtuField::Scalars(v)))
+                .collect(),
+        }
+    }
+
     /// Checks the grid before anything is written to `path` (used in error messages).
     ///
     /// # Errors
-    /// [`OutputError::Length`] if a point field does not have `points.len()` entries or a
-    /// cell field `tets.len()` entries, [`OutputError::PointIndex`] if a tetrahedron
-    /// references a point that does not exist, [`OutputError::InvalidName`] if a field
-    /// name is empty, contains a control character or is used twice in the same section.
+    /// As [`VtuMesh::validate`]: [`OutputError::Length`] if a point field does not have
+    /// `points.len()` entries or a cell field `tets.len()` entries,
+    /// [`OutputError::PointIndex`] if a tetrahedron references a point that does not exist,
+    /// [`OutputError::InvalidName`] if a field name is empty, contains a control character
+    /// or is used twice in the same section.
+    pub fn validate(&self, path: &Path) -> Result<(), OutputError> {
+        self.mesh().validate(path)
+    }
+}
+
+/// The cells of a [`VtuMesh`], all of one VTK type.
+#[derive(Debug, Clone, Copy)]
+pub enum VtuCells<'a> {
+    /// One `VTK_VERTEX` per point, in point order: points for ParaView's Glyph filter.
+    Vertices,
+    /// `VTK_LINE`s, two indices into the points each.
+    Lines(&'a [[u32; 2]]),
+    /// `VTK_TRIANGLE`s, three indices into the points each.
+    Triangles(&'a [[u32; 3]]),
+    /// `VTK_TETRA`s, four indices into the points each.
+    Tets(&'a [[u32; 4]]),
+}
+
+impl VtuCells<'_> {
+    /// The number of cells, given the number of points.
+    fn len(&self, points: usize) -> usize {
+        match self {
+            VtuCells::Vertices => points,
+            VtuCells::Lines(c) => c.len(),
+            VtuCells::Triangles(c) => c.len(),
+            VtuCells::Tets(c) => c.len(),
+        }
+    }
+
+    /// The VTK cell type, the points per cell and what a cell is called in messages.
+    fn kind(&self) -> (u8, usize, &'static str) {
+        match self {
+            VtuCells::Vertices => (1, 1, "vertex"),
+            VtuCells::Lines(_) => (3, 2, "line"),
+            VtuCells::Triangles(_) => (5, 3, "triangle"),
+            VtuCells::Tets(_) => (VTK_TETRA, 4, "tetrahedron"),
+        }
+    }
+
+    /// The point indices of every cell, cell after cell.
+    fn connectivity(&self, points: usize) -> Box<dyn Iterator<Item = u32> + '_> {
+        match self {
+            VtuCells::Vertices => Box::new(0..points as u32),
+            VtuCells::Lines(c) => Box::new(c.iter().flatten().copied()),
+            VtuCells::Triangles(c) => Box::new(c.iter().flatten().copied()),
+            VtuCells::Tets(c) => Box::new(c.iter().flatten().copied()),
+        }
+    }
+}
+
+/// One named field of a [`VtuMesh`]: one value per point or per cell.
+#[derive(Debug, Clone, Copy)]
+pub enum VtuField<'a> {
+    /// Real scalars (`Float64`).
+    Scalars(&'a [f64]),
+    /// Real 3-vectors (`Float64`, three components).
+    Vectors(&'a [Vector3<f64>]),
+    /// Integers (`Int64`): indices, flags.
+    Integers(&'a [i64]),
+}
+
+impl VtuField<'_> {
+    /// The number of values.
+    fn len(&self) -> usize {
+        match self {
+            VtuField::Scalars(v) => v.len(),
+            VtuField::Vectors(v) => v.len(),
+            VtuField::Integers(v) => v.len(),
+        }
+    }
+}
+
+/// Points, cells of one type and named fields, borrowed for writing.
+///
+/// # Example
+/// Two spheres touching, as a line with its force:
+/// ```
+/// # use qdem_io::output::{write_vtu_mesh, VtuCells, VtuField, VtuMesh};
+/// use nalgebra::Vector3;
+/// let ends = [Vector3::zeros(), Vector3::new(0.02, 0.0, 0.0)];
+/// let force = [Vector3::new(-3.0, 0.0, 0.0)];
+/// let spheres = [0, 1];
+/// let mesh = VtuMesh {
+///     points: &ends,
+///     cells: VtuCells::Lines(&[[0, 1]]),
+///     point_data: vec![("sphere", VtuField::Integers(&spheres))],
+///     cell_data: vec![("normal_force", VtuField::Vectors(&force))],
+/// };
+/// let path = std::env::temp_dir().join(format!("qdem-doc-line-{}.vtu", std::process::id()));
+/// write_vtu_mesh(&path, &mesh).unwrap();
+/// # std::fs::remove_file(&path).unwrap();
+/// ```
+#[derive(Debug, Clone)]
+pub struct VtuMesh<'a> {
+    /// Point coordinates.
+    pub points: &'a [Vector3<f64>],
+    /// The cells.
+    pub cells: VtuCells<'a>,
+    /// Named fields with one value per point.
+    pub point_data: Vec<(&'a str, VtuField<'a>)>,
+    /// Named fields with one value per cell.
+    pub cell_data: Vec<(&'a str, VtuField<'a>)>,
+}
+
+impl VtuMesh<'_> {
+    /// Checks the mesh before anything is written to `path` (used in error messages).
+    ///
+    /// # Errors
+    /// [`OutputError::Length`] if a point field does not have one entry per point or a
+    /// cell field one per cell, [`OutputError::PointIndex`] if a cell references a point
+    /// that does not exist, [`OutputError::InvalidName`] if a field name is empty, contains
+    /// a control character or is used twice in the same section.
     pub fn validate(&self, path: &Path) -> Result<(), OutputError> {
         let np = self.points.len();
-        let nc = self.tets.len();
+        let nc = self.cells.len(np);
         let lens = self
-            .point_vectors
+            .point_data
             .iter()
             .map(|(n, v)| (*n, v.len(), np))
-            .chain(self.cell_scalars.iter().map(|(n, v)| (*n, v.len(), nc)));
+            .chain(self.cell_data.iter().map(|(n, v)| (*n, v.len(), nc)));
         for (name, found, expected) in lens {
             if found != expected {
                 return Err(OutputError::Length {
@@ -81,17 +215,22 @@ impl VtuGrid<'_> {
                 });
             }
         }
-        check_names(path, self.point_vectors.iter().map(|(n, _)| *n))?;
-        check_names(path, self.cell_scalars.iter().map(|(n, _)| *n))?;
-        for (tet, nodes) in self.tets.iter().enumerate() {
-            if let Some(&index) = nodes.iter().find(|&&i| i as usize >= np) {
-                return Err(OutputError::PointIndex {
-                    path: path.to_path_buf(),
-                    tet,
-                    index,
-                    num_points: np,
-                });
-            }
+        check_names(path, self.point_data.iter().map(|(n, _)| *n))?;
+        check_names(path, self.cell_data.iter().map(|(n, _)| *n))?;
+        let (_, per_cell, kind) = self.cells.kind();
+        let bad = self
+            .cells
+            .connectivity(np)
+            .enumerate()
+            .find(|&(_, i)| i as usize >= np);
+        if let Some((at, index)) = bad {
+            return Err(OutputError::PointIndex {
+                path: path.to_path_buf(),
+                kind,
+                cell: at / per_cell,
+                index,
+                num_points: np,
+            });
         }
         Ok(())
     }
@@ -122,7 +261,7 @@ fn check_names<'a>(path: &Path, names: impl Iterator<Item = &'a str>) -> Result<
     Ok(())
 }
 
-/// Writes `grid` to `path` as a VTK XML UnstructuredGrid, atomically.
+/// Writes `grid` to `path` as a VTK XML UnstructuredGrid of tetrahedra, atomically.
 ///
 /// The grid is validated first ([`VtuGrid::validate`]); nothing is created on a
 /// validation error.
@@ -132,12 +271,27 @@ fn check_names<'a>(path: &Path, names: impl Iterator<Item = &'a str>) -> Result<
 /// [`OutputError::NoFileName`]) if the file cannot be written; the target is then untouched
 /// and no temporary file is left behind.
 pub fn write_vtu(path: &Path, grid: &VtuGrid<'_>) -> Result<(), OutputError> {
-    grid.validate(path)?;
-    write_atomic_as(path, "VTU file", |w| write_vtu_to(w, grid))
+    write_vtu_mesh(path, &grid.mesh())
 }
 
-/// Writes the XML of an already validated grid.
-fn write_vtu_to(w: &mut dyn Write, grid: &VtuGrid<'_>) -> io::Result<()> {
+/// Writes `mesh` to `path` as a VTK XML UnstructuredGrid, atomically.
+///
+/// The mesh is validated first ([`VtuMesh::validate`]); nothing is created on a
+/// validation error.
+///
+/// # Errors
+/// The validation errors of [`VtuMesh::validate`], and [`OutputError::Io`] (or
+/// [`OutputError::NoFileName`]) if the file cannot be written; the target is then untouched
+/// and no temporary file is left behind.
+pub fn write_vtu_mesh(path: &Path, mesh: &VtuMesh<'_>) -> Result<(), OutputError> {
+    mesh.validate(path)?;
+    write_atomic_as(path, "VTU file", |w| write_vtu_to(w, mesh))
+}
+
+/// Writes the XML of an already validated mesh.
+fn write_vtu_to(w: &mut dyn Write, mesh: &VtuMesh<'_>) -> io::Result<()> {
+    let np = mesh.points.len();
+    let nc = mesh.cells.len(np);
     writeln!(w, "<?xml version=\"1.0\"?>")?;
     writeln!(
         w,
@@ -147,42 +301,10 @@ fn write_vtu_to(w: &mut dyn Write, grid: &VtuGrid<'_>) -> io::Result<()> {
     writeln!(w, "  <UnstructuredGrid>")?;
     writeln!(
         w,
-        "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
-        grid.points.len(),
-        grid.tets.len()
+        "    <Piece NumberOfPoints=\"{np}\" NumberOfCells=\"{nc}\">"
     )?;
-
-    match grid.point_vectors.first() {
-        Some((first, _)) => writeln!(w, "      <PointData Vectors=\"{}\">", xml_escape(first))?,
-        None => writeln!(w, "      <PointData>")?,
-    }
-    for (name, values) in &grid.point_vectors {
-        data_array(
-            w,
-            "Float64",
-            name,
-            3,
-            3 * values.len(),
-            values.iter().flat_map(vec3_bytes),
-        )?;
-    }
-    writeln!(w, "      </PointData>")?;
-
-    match grid.cell_scalars.first() {
-        Some((first, _)) => writeln!(w, "      <CellData Scalars=\"{}\">", xml_escape(first))?,
-        None => writeln!(w, "      <CellData>")?,
-    }
-    for (name, values) in &grid.cell_scalars {
-        data_array(
-            w,
-            "Float64",
-            name,
-            1,
-            values.len(),
-            values.iter().map(|v| v.to_le_bytes()),
-        )?;
-    }
-    writeln!(w, "      </CellData>")?;
+    fields(w, "PointData", &mesh.point_data)?;
+    fields(w, "CellData", &mesh.cell_data)?;
 
     writeln!(w, "      <Points>")?;
     data_array(
@@ -190,44 +312,82 @@ fn write_vtu_to(w: &mut dyn Write, grid: &VtuGrid<'_>) -> io::Result<()> {
         "Float64",
         "Points",
         3,
-        3 * grid.points.len(),
-        grid.points.iter().flat_map(vec3_bytes),
+        3 * np,
+        mesh.points.iter().flat_map(vec3_bytes),
     )?;
     writeln!(w, "      </Points>")?;
 
+    let (vtk_type, per_cell, _) = mesh.cells.kind();
     writeln!(w, "      <Cells>")?;
     data_array(
         w,
         "Int64",
         "connectivity",
         1,
-        4 * grid.tets.len(),
-        grid.tets
-            .iter()
-            .flat_map(|t| t.map(|i| i64::from(i).to_le_bytes())),
+        per_cell * nc,
+        mesh.cells
+            .connectivity(np)
+            .map(|i| i64::from(i).to_le_bytes()),
     )?;
     data_array(
         w,
         "Int64",
         "offsets",
         1,
-        grid.tets.len(),
-        (1..=grid.tets.len() as i64).map(|i| (4 * i).to_le_bytes()),
+        nc,
+        (1..=nc as i64).map(|i| (per_cell as i64 * i).to_le_bytes()),
     )?;
-    data_array(
-        w,
-        "UInt8",
-        "types",
-        1,
-        grid.tets.len(),
-        grid.tets.iter().map(|_| [VTK_TETRA]),
-    )?;
+    data_array(w, "UInt8", "types", 1, nc, (0..nc).map(|_| [vtk_type]))?;
     writeln!(w, "      </Cells>")?;
 
     writeln!(w, "    </Piece>")?;
     writeln!(w, "  </UnstructuredGrid>")?;
     writeln!(w, "</VTKFile>")?;
     Ok(())
+}
+
+/// Writes a `<PointData>` or `<CellData>` section (`section`), naming its first scalar and
+/// first vector field as the active ones.
+fn fields(w: &mut dyn Write, section: &str, data: &[(&str, VtuField<'_>)]) -> io::Result<()> {
+    write!(w, "      <{section}")?;
+    let first_scalar = data.iter().find(|(_, f)| matches!(f, VtuField::Scalars(_)));
+    if let Some((name, _)) = first_scalar {
+        write!(w, " Scalars=\"{}\"", xml_escape(name))?;
+    }
+    let first_vector = data.iter().find(|(_, f)| matches!(f, VtuField::Vectors(_)));
+    if let Some((name, _)) = first_vector {
+        write!(w, " Vectors=\"{}\"", xml_escape(name))?;
+    }
+    writeln!(w, ">")?;
+    for (name, field) in data {
+        match field {
+            VtuField::Scalars(v) => data_array(
+                w,
+                "Float64",
+                name,
+                1,
+                v.len(),
+                v.iter().map(|x| x.to_le_bytes()),
+            )?,
+            VtuField::Vectors(v) => data_array(
+                w,
+                "Float64",
+                name,
+                3,
+                3 * v.len(),
+                v.iter().flat_map(vec3_bytes),
+            )?,
+            VtuField::Integers(v) => data_array(
+                w,
+                "Int64",
+                name,
+                1,
+                v.len(),
+                v.iter().map(|x| x.to_le_bytes()),
+            )?,
+        }
+    }
+    writeln!(w, "      </{section}>")
 }
 
 /// The little-endian bytes of the three components of `v`.

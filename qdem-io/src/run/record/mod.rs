@@ -7,7 +7,7 @@
 //! | [`probes::Probes`] | `probes.csv`, `probes.svg` | every `probe_every` |
 //! | [`boundary::Boundary`] | `boundary.csv` (time-delayed boundary) | every `probe_every` |
 //! | [`sections::Sections`] | `sections.csv` (`[[section]]`s) | every `probe_every` |
-//! | [`snapshots::Snapshots`] | `vtu/state_NNNNN.vtu`, `results.pvd` | every `vtu_every` (never if 0) |
+//! | [`snapshots::Snapshots`] | `vtu/state_NNNNN.vtu`, `results.pvd`; `vtu/spheres_NNNNN.vtu`, `vtu/contacts_NNNNN.vtu`, `vtu/walls.vtu` (contacts), `vtu/bonds_NNNNN.vtu` (`[bonded]`) | every `vtu_every` (never if 0) |
 //! | [`crack::Crack`] | `crack.svg`, the bonded timings | every step; the picture at the end |
 //! | [`stones::Stones`] | `stones.csv` (`[granular]`) | at the end |
 //! | [`poses::Poses`] | `poses.csv` (rigid bodies) | at the end |
@@ -17,15 +17,19 @@
 //! points) goes into the checkpoint in registration order, so a resumed run appends to its
 //! files as if it had never stopped.
 
+pub(crate) mod bonds_vtu;
 pub(crate) mod boundary;
+pub(crate) mod contacts_vtu;
 pub(crate) mod crack;
 pub(crate) mod poses;
 pub(crate) mod probes;
 pub(crate) mod schedule;
 pub(crate) mod sections;
 pub(crate) mod snapshots;
+pub(crate) mod spheres_vtu;
 pub(crate) mod stones;
 pub(crate) mod summary;
+pub(crate) mod walls_vtu;
 
 use crate::build::Simulation;
 use crate::output::OutputError;

@@ -1,29 +1,117 @@
 //! [`Snapshots`]: every `vtu_every`, `vtu/state_NNNNN.vtu` of all bodies (reference points
 //! with displacement and velocity per particle, von Mises stress and volumetric strain per
-//! tetrahedron; rigid bodies' tetrahedra at zero) and `results.pvd`, their ParaView time
-//! index, rewritten after each (the run creates `vtu/`).
+//! tetrahedron; rigid bodies' tetrahedra at zero) and, beside it as further parts of the same
+//! time in `results.pvd`, what else the scene has: the contact spheres
+//! ([`spheres_vtu`](super::spheres_vtu)) and their touching contacts
+//! ([`contacts_vtu`](super::contacts_vtu)), the walls ([`walls_vtu`](super::walls_vtu): one
+//! file for walls that stay, one per time for walls that move), a bonded body's discs and
+//! bonds ([`bonds_vtu`](super::bonds_vtu)). `results.pvd`, the ParaView time index, is
+//! rewritten after each time (the run creates `vtu/`); the bodies stay part 0.
+//!
+//! A checkpoint keeps the times and body files only: the other parts' files follow from the
+//! scene and the time's number.
 
+use super::bonds_vtu::write_bonds;
+use super::contacts_vtu::write_contacts;
 use super::schedule::Schedule;
+use super::spheres_vtu::write_spheres;
+use super::walls_vtu::{walls_move, write_walls};
 use super::{Recorder, RunFigures, StepInfo};
 use crate::build::{BodyKind, Simulation};
 use crate::output::{write_vtu, OutputError, PvdIndex, VtuGrid};
 use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
 use std::path::{Path, PathBuf};
 
+/// A part of every time of the series besides the bodies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Part {
+    /// The contact spheres.
+    Spheres,
+    /// The touching contacts.
+    Contacts,
+    /// The walls, written once (`false`) or at every time (`true`, walls that move).
+    Walls { moving: bool },
+    /// A bonded body's discs and bonds.
+    Bonds,
+}
+
+impl Part {
+    /// The file of this part at time number `k`.
+    fn file(self, k: usize) -> String {
+        match self {
+            Part::Spheres => format!("vtu/spheres_{k:05}.vtu"),
+            Part::Contacts => format!("vtu/contacts_{k:05}.vtu"),
+            Part::Walls { moving: false } => "vtu/walls.vtu".to_string(),
+            Part::Walls { moving: true } => format!("vtu/walls_{k:05}.vtu"),
+            Part::Bonds => format!("vtu/bonds_{k:05}.vtu"),
+        }
+    }
+
+    /// Writes this part of `sim`'s current state to `path`.
+    fn write(self, sim: &Simulation, path: &Path) -> Result<(), OutputError> {
+        let state = &sim.world.state;
+        let contacts = || {
+            sim.contacts()
+                .expect("registered for a scene with contacts")
+        };
+        match self {
+            Part::Spheres => write_spheres(contacts(), state, path),
+            Part::Contacts => write_contacts(contacts(), path),
+            Part::Walls { .. } => write_walls(contacts().wall_list(), state, path),
+            Part::Bonds => write_bonds(
+                sim.bonded().expect("registered for a bonded scene"),
+                state,
+                path,
+            ),
+        }
+    }
+}
+
 /// The VTU series.
 pub(crate) struct Snapshots {
     schedule: Schedule,
     out_dir: PathBuf,
+    /// `(time, body file)` of every time written, what a checkpoint keeps.
+    times: Vec<(f64, String)>,
+    /// The parts besides the bodies, in part order (part 1, 2, …).
+    parts: Vec<Part>,
     pvd: PvdIndex,
+    /// Whether the file of the walls that stay is written (by this run, or by the run it
+    /// resumes).
+    walls_written: bool,
 }
 
 impl Snapshots {
     pub(crate) fn new(sim: &Simulation, out_dir: &Path) -> Snapshots {
+        let mut parts = Vec::new();
+        if let Some(contacts) = sim.contacts().filter(|c| c.spheres() > 0) {
+            parts.extend([Part::Spheres, Part::Contacts]);
+            if contacts.walls() > 0 {
+                let moving = walls_move(contacts.wall_list());
+                parts.push(Part::Walls { moving });
+            }
+        }
+        if sim.bonded().is_some() {
+            parts.push(Part::Bonds);
+        }
         Snapshots {
             schedule: Schedule::new(sim.scene.output.vtu_every),
             out_dir: out_dir.to_path_buf(),
+            times: Vec::new(),
+            parts,
             pvd: PvdIndex::new(),
+            walls_written: false,
         }
+    }
+
+    /// Adds time number `times.len()` at `time` with its body file to the index.
+    fn index(&mut self, time: f64, file: String) {
+        let k = self.times.len();
+        self.pvd.push_part(time, 0, file.clone());
+        for (part, p) in (1..).zip(&self.parts) {
+            self.pvd.push_part(time, part, p.file(k));
+        }
+        self.times.push((time, file));
     }
 }
 
@@ -37,20 +125,30 @@ impl Recorder for Snapshots {
         if !self.schedule.due(time, step.dt) {
             return Ok(());
         }
-        let file = format!("vtu/state_{:05}.vtu", self.pvd.len());
+        let k = self.times.len();
+        let file = format!("vtu/state_{k:05}.vtu");
         write_snapshot(sim, &self.out_dir.join(&file))?;
-        self.pvd.push(time, file);
+        for part in self.parts.clone() {
+            if part == (Part::Walls { moving: false }) {
+                if self.walls_written {
+                    continue;
+                }
+                self.walls_written = true;
+            }
+            part.write(sim, &self.out_dir.join(part.file(k)))?;
+        }
+        self.index(time, file);
         self.pvd.write(&self.out_dir.join("results.pvd"))
     }
 
     fn summarize(&self, _sim: &Simulation, _run: &RunFigures, summary: &mut serde_json::Value) {
-        summary["vtu_files"] = self.pvd.len().into();
+        summary["vtu_files"] = self.times.len().into();
     }
 
     fn save(&self, out: &mut Encoder) {
         out.f64(self.schedule.next);
-        out.u64(self.pvd.len() as u64);
-        for (time, file) in self.pvd.entries() {
+        out.u64(self.times.len() as u64);
+        for (time, file) in &self.times {
             out.f64(*time);
             out.str(file);
         }
@@ -60,8 +158,11 @@ impl Recorder for Snapshots {
         self.schedule.next = input.f64("the VTU schedule")?;
         for _ in 0..input.u64("the VTU count")? {
             let time = input.f64("a VTU time")?;
-            self.pvd.push(time, input.str("a VTU file name")?);
+            let file = input.str("a VTU file name")?;
+            self.index(time, file);
         }
+        // The run resumed wrote the walls that stay with its first time.
+        self.walls_written = !self.times.is_empty();
         Ok(())
     }
 }
