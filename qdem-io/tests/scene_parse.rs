@@ -267,3 +267,27 @@ fn scene_serializes_to_json() {
     assert_eq!(json["fixes"][0]["selection"]["group"], "clamp");
     assert_eq!(json["materials"][0]["young"], 45e9);
 }
+
+#[test]
+fn a_preconditioned_event_solve_in_an_explicit_run_is_warned_about() {
+    let dir = std::env::temp_dir().join(format!("qdem-io-event-solve-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/bbm/small_beam.toml");
+    let text = std::fs::read_to_string(fixture).unwrap();
+    let warned = |text: &str| {
+        let path = dir.join("beam.toml");
+        std::fs::write(&path, text).unwrap();
+        let sim = qdem_io::build::Simulation::build(Scene::load(&path).unwrap()).unwrap();
+        sim.warnings
+            .iter()
+            .any(|w| w.contains("event_solve") && w.contains("no effect"))
+    };
+    let preconditioned = text.replace("[bonded]\n", "[bonded]\nevent_solve = \"preconditioned\"\n");
+    assert!(warned(&preconditioned), "explicit Newmark (beta = 0)");
+    assert!(
+        !warned(&preconditioned.replace("beta = 0.0", "beta = 0.25")),
+        "implicit"
+    );
+    assert!(!warned(&text), "the default");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -76,12 +76,13 @@ pub(crate) fn build_bonded(
     let mut world = World::new(state, models, settings).map_err(core)?;
     let body = world.model::<BondedParticles>().expect("built above");
     world.add_hook(Box::new(CollapseWatch::for_body(body, COLLAPSE_SPACINGS)));
+    let warnings = super::ineffective_event_solve(&scene).into_iter().collect();
     Ok(Simulation {
         scene,
         world,
         bodies: Vec::new(),
         probes,
-        warnings: Vec::new(),
+        warnings,
         granular: None,
         ballast: None,
     })

@@ -548,6 +548,24 @@ pub(crate) fn step_request(scene: &Scene) -> StepRequest {
     }
 }
 
+/// A warning for `[bonded] event_solve = "preconditioned"` in a run that is not implicit,
+/// where it does nothing.
+pub(crate) fn ineffective_event_solve(scene: &Scene) -> Option<String> {
+    let preconditioned = scene
+        .bonded
+        .as_ref()
+        .is_some_and(|b| b.event_solve == EventSolveName::Preconditioned);
+    let implicit = matches!(scheme(scene), Scheme::Newmark { beta, .. } if beta > 0.0);
+    (preconditioned && !implicit).then(|| {
+        format!(
+            "{}: [bonded] event_solve = \"preconditioned\" has no effect in this {} run: it \
+             applies to implicit Newmark steps (beta > 0) only",
+            scene.path.display(),
+            scene.run.integrator.name()
+        )
+    })
+}
+
 /// The scene's integrator as a scheme.
 fn scheme(scene: &Scene) -> Scheme {
     let run = &scene.run;
