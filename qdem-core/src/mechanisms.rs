@@ -15,9 +15,11 @@
 //! dense solve bounds the pieces at [`MAX_PIECES`]; beyond, each piece is tested alone (its
 //! own 6 × 6 block), which misses the mechanisms of several pieces.
 
+use crate::sparse::rigid_motion;
 use crate::tangent::Entry;
 use crate::Vec3;
 use nalgebra::{DMatrix, DVector, Matrix6, SymmetricEigen, Vector6};
+use std::ops::Range;
 
 /// λ / λ_max below which a rigid motion counts as unresisted (rounding of a zero).
 pub const ZERO: f64 = 1e-9;
@@ -51,7 +53,12 @@ pub(crate) fn unresisted_motions(
         let p = d / 3;
         let c = piece.get(p).copied().flatten()? as usize;
         let free = !held[c] && (dofs.index)(d).is_some();
-        free.then(|| (c, unit_motions(position[p] - centre[c], d % 3)))
+        free.then(|| {
+            (
+                c,
+                rigid_motion(position[p] - centre[c]).row(d % 3).transpose(),
+            )
+        })
     };
     let mut h = vec![Matrix6::zeros(); pieces];
     for &d in dofs.global {
@@ -69,60 +76,44 @@ pub(crate) fn unresisted_motions(
         }
     }
     let motion = |d: usize| motion(d).and_then(|(c, r)| slot[c].map(|s| (s, r)));
-    let coupled = active.len() <= MAX_PIECES;
-    let n = match coupled {
-        true => 6 * active.len(),
-        false => 0,
+    // Up to MAX_PIECES the pieces are one group, solved together; beyond, each is its own.
+    let groups: Vec<Range<usize>> = match active.len() <= MAX_PIECES {
+        true => std::iter::once(0..active.len()).collect(),
+        false => (0..active.len()).map(|c| c..c + 1).collect(),
     };
-    let mut g = DMatrix::zeros(n, n);
-    let mut blocks = vec![Matrix6::zeros(); active.len()];
+    let group_of = |c: usize| if groups.len() == 1 { 0 } else { c };
+    let mut g: Vec<DMatrix<f64>> = groups
+        .iter()
+        .map(|r| DMatrix::zeros(6 * r.len(), 6 * r.len()))
+        .collect();
     for e in stiffness {
         let (Some((ci, ri)), Some((cj, rj))) = (motion(e.row), motion(e.col)) else {
             continue;
         };
+        let k = group_of(ci);
+        if k != group_of(cj) {
+            continue;
+        }
+        let (a, b) = (ci - groups[k].start, cj - groups[k].start);
         let block = ri * rj.transpose() * e.val;
-        if coupled {
-            add_block(&mut g, ci, cj, &block);
-            if e.row != e.col {
-                add_block(&mut g, cj, ci, &block.transpose());
-            }
-        } else if ci == cj {
-            blocks[ci] += if e.row == e.col {
-                block
-            } else {
-                block + block.transpose()
-            };
+        add_block(&mut g[k], a, b, &block);
+        if e.row != e.col {
+            add_block(&mut g[k], b, a, &block.transpose());
         }
     }
-    let found: Vec<(usize, DVector<f64>)> = match coupled {
-        true => null_motions(&g, &active)
-            .into_iter()
-            .map(|v| (0, v))
-            .collect(),
-        false => (0..active.len())
-            .flat_map(|c| {
-                let mut one = DMatrix::zeros(6, 6);
-                one.copy_from(&blocks[c]);
-                null_motions(&one, &active[c..=c])
-                    .into_iter()
-                    .map(move |v| (c, v))
-            })
-            .collect(),
-    };
+    let mut found = Vec::new();
+    for (k, range) in groups.iter().enumerate() {
+        for v in null_motions(&g[k], &active[range.clone()]) {
+            let x = dofs.global.iter().map(|&d| match motion(d) {
+                Some((c, r)) if range.contains(&c) => {
+                    r.dot(&v.fixed_rows::<6>(6 * (c - range.start)))
+                }
+                _ => 0.0,
+            });
+            found.push(x.collect());
+        }
+    }
     found
-        .iter()
-        .map(|(first, v)| {
-            dofs.global
-                .iter()
-                .map(|&d| match motion(d) {
-                    Some((c, r)) if c >= *first && 6 * (c - first) < v.len() => {
-                        r.dot(&v.fixed_rows::<6>(6 * (c - first)))
-                    }
-                    _ => 0.0,
-                })
-                .collect()
-        })
-        .collect()
 }
 
 /// Adds `block` at piece rows `a`, piece columns `b` of `g`.
@@ -172,17 +163,6 @@ fn held_pieces(piece: &[Option<u32>], pieces: usize, dofs: &SystemDofs<'_>) -> V
         }
     }
     held
-}
-
-/// The six unit rigid motions' components along `axis` at arm `r` from the piece's centre:
-/// translations along x, y, z, then rotations about them (ω × r).
-fn unit_motions(r: Vec3, axis: usize) -> Vector6<f64> {
-    let mut m = Vector6::zeros();
-    m[axis] = 1.0;
-    for k in 0..3 {
-        m[3 + k] = Vec3::ith(k, 1.0).cross(&r)[axis];
-    }
-    m
 }
 
 #[cfg(test)]

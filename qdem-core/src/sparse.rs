@@ -715,6 +715,16 @@ pub fn unconstrained_bodies(
         .collect()
 }
 
+/// The motion at arm `r` from a centre of the rigid motion v = (translation, small rotation):
+/// t = R v with R = [I | −[r]×].
+pub(crate) fn rigid_motion(r: Vec3) -> SMatrix<f64, 3, 6> {
+    let mut m = SMatrix::<f64, 3, 6>::zeros();
+    m.fixed_view_mut::<3, 3>(0, 0).copy_from(&Mat3::identity());
+    m.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&(-r.cross_matrix()));
+    m
+}
+
 /// Relative size below which a rigid mode counts as unconstrained or as stress-free.
 const RIGID_TOLERANCE: f64 = 1e-8;
 
@@ -738,16 +748,8 @@ fn free_rigid_modes(
     if size.is_nan() || size <= 0.0 {
         return 0;
     }
-    // Rigid motion v = (translation, rotation) at particle i: t_i = R_i v, R_i = [I | −[r]×],
-    // r the scaled arm, so that every mode is of order one.
-    let modes = |i: usize| -> SMatrix<f64, 3, 6> {
-        let r = (state.position[i] - centre) / size;
-        let mut m = SMatrix::<f64, 3, 6>::zeros();
-        m.fixed_view_mut::<3, 3>(0, 0).copy_from(&Mat3::identity());
-        m.fixed_view_mut::<3, 3>(0, 3)
-            .copy_from(&(-r.cross_matrix()));
-        m
-    };
+    // The arm is scaled so that every mode is of order one.
+    let modes = |i: usize| rigid_motion((state.position[i] - centre) / size);
     let fixed = |i: usize, axis: usize| dofs.index(3 * i + axis).is_none();
     let mut gram = Matrix6::zeros();
     let mut rows = 0usize;
