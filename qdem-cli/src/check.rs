@@ -155,7 +155,7 @@ fn rank_table(
         .models
         .iter()
         .enumerate()
-        .filter(|(_, m)| as_body(m.as_ref()).is_some())
+        .filter(|(_, m)| TetBody::of(m.as_ref()).is_some())
         .map(|(i, _)| world.stages().seconds(Stage::Forces(i)))
         .sum();
     let kernel = bodies - exchange;
@@ -206,18 +206,12 @@ fn print_stages(sim: &Simulation) {
     }
 }
 
-/// The model as a deformable body, if it is one.
-fn as_body(model: &dyn qdem_core::Model) -> Option<&TetBody> {
-    let any: &dyn std::any::Any = model;
-    any.downcast_ref::<TetBody>()
-}
-
 /// The deformable bodies' seconds of block-sum exchange so far (a decomposed run).
 fn exchange_seconds(sim: &Simulation) -> f64 {
     let models = &sim.world.models;
     models
         .iter()
-        .filter_map(|m| as_body(m.as_ref()))
+        .filter_map(|m| TetBody::of(m.as_ref()))
         .map(TetBody::exchange_seconds)
         .sum()
 }

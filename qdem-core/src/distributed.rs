@@ -145,8 +145,10 @@ pub(crate) struct BodySplit {
 pub(crate) struct SumExchange {
     comm: Arc<dyn Communicator>,
     send_slots: Vec<u32>,
+    /// Values (three per sum) sent to each rank.
     send_counts: Vec<usize>,
     recv_slots: Vec<u32>,
+    /// Values received from each rank.
     recv_counts: Vec<usize>,
     send: Vec<f64>,
     recv: Vec<f64>,
@@ -172,11 +174,13 @@ impl SumExchange {
         for &s in &self.send_slots {
             self.send.extend_from_slice(sums[s as usize].as_slice());
         }
-        let counts3 = |c: &[usize]| c.iter().map(|n| 3 * n).collect::<Vec<_>>();
-        let (send_counts, recv_counts) = (counts3(&self.send_counts), counts3(&self.recv_counts));
         self.recv.resize(3 * self.recv_slots.len(), 0.0);
-        self.comm
-            .all_to_all(&self.send, &send_counts, &mut self.recv, &recv_counts);
+        self.comm.all_to_all(
+            &self.send,
+            &self.send_counts,
+            &mut self.recv,
+            &self.recv_counts,
+        );
         for (&s, v) in self.recv_slots.iter().zip(self.recv.chunks_exact(3)) {
             sums[s as usize] = Vec3::new(v[0], v[1], v[2]);
         }
@@ -226,9 +230,9 @@ pub(crate) fn split_body(
         }
         SumExchange {
             comm: comm.clone(),
-            send_counts: send.iter().map(Vec::len).collect(),
+            send_counts: send.iter().map(|v| 3 * v.len()).collect(),
             send_slots: send.concat(),
-            recv_counts: recv.iter().map(Vec::len).collect(),
+            recv_counts: recv.iter().map(|v| 3 * v.len()).collect(),
             recv_slots: recv.concat(),
             send: Vec::new(),
             recv: Vec::new(),
@@ -310,7 +314,10 @@ pub(crate) fn decompose(
     comm: Arc<dyn Communicator>,
 ) -> Result<(StateShare, Decomposition), CoreError> {
     let ranks = comm.size();
-    let bodies: Vec<&TetBody> = models.iter().filter_map(|m| as_body(m.as_ref())).collect();
+    let bodies: Vec<&TetBody> = models
+        .iter()
+        .filter_map(|m| TetBody::of(m.as_ref()))
+        .collect();
     let block_ranks = assign_blocks(&bodies, ranks);
     let mut figures = Decomposition {
         ranks,
@@ -347,14 +354,8 @@ pub(crate) fn decompose(
         }
         body.set_split(split);
     }
-    let share = StateShare::new(owner, comm);
+    let share = StateShare::new(owner, values_per_particle(state), comm);
     Ok((share, figures))
-}
-
-/// The model as a deformable body, if it is one.
-fn as_body(model: &dyn Model) -> Option<&TetBody> {
-    let any: &dyn std::any::Any = model;
-    any.downcast_ref::<TetBody>()
 }
 
 /// The end of a decomposed step: each rank's owned particles' accelerations and velocities
@@ -364,16 +365,20 @@ pub(crate) struct StateShare {
     comm: Arc<dyn Communicator>,
     /// The particles each rank owns, rank after rank, ascending within a rank.
     particles: Vec<u32>,
-    /// Particles per rank.
+    /// This rank's part of `particles`.
+    own: Range<usize>,
+    /// Values per particle ([`values_per_particle`]).
+    per: usize,
+    /// Values from each rank.
     counts: Vec<usize>,
-    /// Where this rank's particles start in `particles`.
-    start: usize,
     mine: Vec<f64>,
     all: Vec<f64>,
 }
 
 impl StateShare {
-    fn new(owner: Vec<u32>, comm: Arc<dyn Communicator>) -> StateShare {
+    /// The share of the particles `owner` gives each rank (`u32::MAX`: computed by all), for
+    /// a state with `per` values per particle.
+    fn new(owner: Vec<u32>, per: usize, comm: Arc<dyn Communicator>) -> StateShare {
         let ranks = comm.size();
         let mut by_rank = vec![Vec::new(); ranks];
         for (p, &r) in owner.iter().enumerate() {
@@ -381,13 +386,13 @@ impl StateShare {
                 by_rank[r as usize].push(p as u32);
             }
         }
-        let counts: Vec<usize> = by_rank.iter().map(Vec::len).collect();
-        let start = counts[..comm.rank()].iter().sum();
+        let start: usize = by_rank[..comm.rank()].iter().map(Vec::len).sum();
         StateShare {
-            comm,
+            own: start..start + by_rank[comm.rank()].len(),
+            per,
+            counts: by_rank.iter().map(|b| per * b.len()).collect(),
             particles: by_rank.concat(),
-            counts,
-            start,
+            comm,
             mine: Vec::new(),
             all: Vec::new(),
         }
@@ -395,17 +400,14 @@ impl StateShare {
 
     /// Copies every rank's owned particles' motion into `state` on every rank.
     pub fn share(&mut self, state: &mut State) {
-        let per = values_per_particle(state);
-        let me = self.comm.rank();
-        let own = &self.particles[self.start..self.start + self.counts[me]];
         self.mine.clear();
-        for &p in own {
+        for &p in &self.particles[self.own.clone()] {
             pack(state, p as usize, &mut self.mine);
         }
-        let counts: Vec<usize> = self.counts.iter().map(|c| per * c).collect();
-        self.all.resize(per * self.particles.len(), 0.0);
-        self.comm.all_gather(&self.mine, &mut self.all, &counts);
-        for (&p, values) in self.particles.iter().zip(self.all.chunks_exact(per)) {
+        self.all.resize(self.per * self.particles.len(), 0.0);
+        self.comm
+            .all_gather(&self.mine, &mut self.all, &self.counts);
+        for (&p, values) in self.particles.iter().zip(self.all.chunks_exact(self.per)) {
             unpack(state, p as usize, values);
         }
     }

@@ -563,8 +563,7 @@ fn tet_pieces(particles: usize, models: &[Box<dyn Model>]) -> (Vec<Option<u32>>,
     }
     let mut in_body = vec![false; particles];
     for model in models {
-        let any: &dyn std::any::Any = model.as_ref();
-        let Some(body) = any.downcast_ref::<TetBody>() else {
+        let Some(body) = TetBody::of(model.as_ref()) else {
             continue;
         };
         for tet in body.tets() {

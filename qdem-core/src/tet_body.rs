@@ -150,6 +150,12 @@ impl TetBody {
         })
     }
 
+    /// The model as a deformable body, if it is one (models are `Any`).
+    pub fn of(model: &dyn Model) -> Option<&TetBody> {
+        let any: &dyn std::any::Any = model;
+        any.downcast_ref::<TetBody>()
+    }
+
     /// The body's tetrahedra (indices into the scene's particles).
     pub fn tets(&self) -> &[[u32; 4]] {
         &self.tets

@@ -206,8 +206,7 @@ impl Simulation {
         let BodyKind::Deformable { model } = body.kind else {
             return None;
         };
-        let model: &dyn std::any::Any = self.world.models[model].as_ref();
-        model.downcast_ref::<TetBody>()
+        TetBody::of(self.world.models[model].as_ref())
     }
 
     /// The mass of a body (kg).
