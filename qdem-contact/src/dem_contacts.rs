@@ -197,6 +197,9 @@ pub struct DemContacts {
     settings: ContactSettings,
     walls: Vec<Wall>,
     last_time: Option<f64>,
+    /// Every sphere's centre at the last evaluation.
+    center: Vec<Vec3>,
+    /// What the narrow phase reads of each sphere, current for the partners of candidates.
     now: Vec<SphereNow>,
     built_at: Vec<Vec3>,
     built_time: f64,
@@ -206,6 +209,8 @@ pub struct DemContacts {
     incidence_start: Vec<u32>,
     incidence: Vec<u32>,
     wall_start: Vec<u32>,
+    /// The spheres that are partners of some candidate (pair or wall contact), ascending.
+    partners: Vec<u32>,
     sphere_force: Vec<(Vec3, Vec3)>,
     rebuilds: u64,
     periodic: Option<PeriodicBox>,
@@ -357,6 +362,7 @@ impl DemContacts {
             settings,
             walls,
             last_time: None,
+            center: vec![Vec3::zeros(); spheres.len()],
             now,
             built_at: Vec::new(),
             built_time: 0.0,
@@ -366,6 +372,7 @@ impl DemContacts {
             incidence_start: Vec::new(),
             incidence: Vec::new(),
             wall_start: Vec::new(),
+            partners: Vec::new(),
             sphere_force: vec![(Vec3::zeros(), Vec3::zeros()); spheres.len()],
             rebuilds: 0,
             periodic: None,
@@ -426,8 +433,8 @@ impl DemContacts {
     pub fn section_force(&self, axis: usize, at: f64) -> f64 {
         let period = self.periodic.as_ref().and_then(|p| p.length(axis));
         self.mean_pair_force(|c| {
-            let a = self.now[c.first as usize].center[axis] - at;
-            let b = self.now[c.second as usize].center[axis] + c.shift[axis] - at;
+            let a = self.center[c.first as usize][axis] - at;
+            let b = self.center[c.second as usize][axis] + c.shift[axis] - at;
             crosses(a, b, period)
         })
     }
@@ -452,7 +459,7 @@ impl DemContacts {
     /// x_b − x_a, the minimum image when periodic, and the translation of b's image.
     #[inline]
     fn separation(&self, a: usize, b: usize) -> (Vec3, Vec3) {
-        let d = self.now[b].center - self.now[a].center;
+        let d = self.center[b] - self.center[a];
         match &self.periodic {
             Some(p) => {
                 let shift = p.image_shift(&d);
@@ -532,7 +539,7 @@ impl DemContacts {
         let pairs = self.pairs.items.iter().filter(|c| c.force != Vec3::zeros());
         let pairs = pairs.map(move |c| {
             let (a, b) = (c.first as usize, c.second as usize);
-            let (from, to) = (self.now[a].center, self.now[b].center + c.shift);
+            let (from, to) = (self.center[a], self.center[b] + c.shift);
             let scales = delay.map_or((1.0, 1.0), |(axis, s)| pair_scales(c.shift[axis], &s));
             split(
                 a,
@@ -551,7 +558,7 @@ impl DemContacts {
             .filter(|c| c.force != Vec3::zeros());
         let walls = walls.map(move |c| {
             let (s, w) = (c.first as usize, c.second as usize);
-            let from = self.now[s].center;
+            let from = self.center[s];
             let (overlap, normal) = self.walls[w].overlap(&from, self.radius[s], time);
             let to = from + (self.radius[s] - overlap) * normal;
             split(s, Partner::Wall(w), from, to, normal, c.force, (1.0, 1.0))
@@ -584,15 +591,14 @@ impl DemContacts {
                     overlap,
                     radius,
                     tolerance: 100.0 * tolerance,
-                    at_a: self.now[a].center.into(),
-                    at_b: self.now[b].center.into(),
+                    at_a: self.center[a].into(),
+                    at_b: self.center[b].into(),
                 });
             }
         }
         for c in &self.wall_contacts.items {
             let (s, w) = (c.first as usize, c.second as usize);
-            let (overlap, _) =
-                self.walls[w].overlap(&self.now[s].center, self.radius[s], state.time);
+            let (overlap, _) = self.walls[w].overlap(&self.center[s], self.radius[s], state.time);
             if overlap > tolerance * self.radius[s] {
                 return Err(ContactError::InitialWallOverlap {
                     body: self.body_names[self.body[s] as usize].clone(),
@@ -600,42 +606,54 @@ impl DemContacts {
                     overlap,
                     radius: self.radius[s],
                     tolerance: 100.0 * tolerance,
-                    at: self.now[s].center.into(),
+                    at: self.center[s].into(),
                 });
             }
         }
         Ok(())
     }
 
-    /// Copies every sphere's centre, velocity and spin (its rigid body's or its particle's
-    /// angular velocity, zero for a vertex of a deformable body) out of the state, in sphere order, and returns
-    /// the largest distance a sphere has moved since the last build (infinite before it).
+    /// Copies every sphere's centre out of the state, in sphere order, and the narrow phase's
+    /// record ([`read_motion`]) of the partners of candidates: in the same pass when most
+    /// spheres are partners (a packing), else in a pass over the partners alone (most spheres
+    /// of a ballast stone touch nothing); returns the largest distance a sphere has moved
+    /// since the last build (infinite before it).
     fn read_centers(&mut self, state: &State) -> f64 {
-        let (particle, turn, built_at) = (&self.particle, &self.turn, &self.built_at);
-        let built = self.built && built_at.len() == particle.len();
-        let bodies = state.rigid.len();
+        let built = self.built && self.built_at.len() == self.particle.len();
+        let every = !built || 2 * self.partners.len() >= self.particle.len();
+        let (particle, built_at, turn) = (&self.particle, &self.built_at, &self.turn);
         let moved = self
-            .now
+            .center
             .par_iter_mut()
+            .zip(self.now.par_iter_mut())
             .with_min_len(SPHERE_CHUNK)
             .enumerate()
-            .map(|(s, now)| {
-                let p = particle[s] as usize;
-                now.center = state.position[p];
-                now.velocity = state.velocity[p];
-                now.spin = match turn[s] as usize {
-                    t if t == NOT_RIGID as usize => Vec3::zeros(),
-                    b if b < bodies => state.rigid.angular_velocity[b],
-                    t => state.spin.velocity[t - bodies],
-                };
+            .map(|(s, (center, now))| {
+                *center = state.position[particle[s] as usize];
+                if every {
+                    read_motion(state, *center, particle[s], turn[s], now);
+                }
                 if built {
-                    (now.center - built_at[s]).norm_squared()
+                    (*center - built_at[s]).norm_squared()
                 } else {
                     f64::INFINITY
                 }
             })
             .reduce(|| 0.0, f64::max);
+        if !every {
+            self.read_partners(state);
+        }
         moved.sqrt()
+    }
+
+    /// The narrow phase's record of every partner of a candidate, from `state` (serial: they
+    /// are few when this is called outside [`DemContacts::read_centers`]' pass).
+    fn read_partners(&mut self, state: &State) {
+        for &s in &self.partners {
+            let s = s as usize;
+            let (particle, turn) = (self.particle[s], self.turn[s]);
+            read_motion(state, self.center[s], particle, turn, &mut self.now[s]);
+        }
     }
 
     /// Whether some pair outside the lists may have come within reach since the last build,
@@ -652,7 +670,7 @@ impl DemContacts {
     /// Broad phase: new candidate lists and the incidence of pairs per sphere.
     fn rebuild(&mut self, time: f64) {
         let skin = self.settings.skin;
-        let center: Vec<Vec3> = self.now.iter().map(|s| s.center).collect();
+        let center = self.center.clone();
         let set = SphereSet {
             center: &center,
             radius: &self.radius,
@@ -708,6 +726,12 @@ impl DemContacts {
         for i in 0..n {
             wall_start[i + 1] += wall_start[i];
         }
+        self.partners = (0..n as u32)
+            .filter(|&s| {
+                let s = s as usize;
+                start[s + 1] > start[s] || wall_start[s + 1] > wall_start[s]
+            })
+            .collect();
         self.incidence_start = start;
         self.incidence = incidence;
         self.wall_start = wall_start;
@@ -813,7 +837,7 @@ impl DemContacts {
         let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
         let (start, incidence, wall_start) =
             (&self.incidence_start, &self.incidence, &self.wall_start);
-        let (now, turn) = (&self.now, &self.turn);
+        let (radii, turn) = (&self.radius, &self.turn);
         let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
         self.sphere_force
             .par_iter_mut()
@@ -821,7 +845,7 @@ impl DemContacts {
             .enumerate()
             .for_each(|(s, out)| {
                 let (mut f, mut t) = (Vec3::zeros(), Vec3::zeros());
-                let (spins, radius) = (turn[s] != NOT_RIGID, now[s].radius);
+                let (spins, radius) = (turn[s] != NOT_RIGID, radii[s]);
                 for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
                     let c = &pairs[(e / 2) as usize];
                     let first = e % 2 == 0;
@@ -876,6 +900,21 @@ fn split(
     }
 }
 
+/// Sets the centre `center`, velocity and spin of `now`, the sphere on `particle` that turns
+/// with `turn` (its rigid body's or its particle's angular velocity, zero for a vertex of a
+/// deformable body), from `state`.
+#[inline]
+fn read_motion(state: &State, center: Vec3, particle: u32, turn: u32, now: &mut SphereNow) {
+    let bodies = state.rigid.len();
+    now.center = center;
+    now.velocity = state.velocity[particle as usize];
+    now.spin = match turn as usize {
+        t if t == NOT_RIGID as usize => Vec3::zeros(),
+        b if b < bodies => state.rigid.angular_velocity[b],
+        t => state.spin.velocity[t - bodies],
+    };
+}
+
 /// r_a r_b / (r_a + r_b).
 #[inline]
 fn reduced(a: f64, b: f64) -> f64 {
@@ -893,6 +932,7 @@ impl Model for DemContacts {
         let moved = self.read_centers(state);
         if self.needs_rebuild(moved, state.time) {
             self.rebuild(state.time);
+            self.read_partners(state);
         }
         self.evaluate(state.time, dt);
         self.update_time_delay(state.time);
