@@ -184,16 +184,25 @@ fn a_reduced_ballast_deposit_is_byte_identical_on_any_number_of_ranks() {
     same_for_any_ranks("ballast/reduced_deposit.toml", 0.004, "deposit");
 }
 
-#[test]
-fn a_checkpoint_written_at_two_ranks_resumes_at_one_and_three() {
-    let scene = ShortScene::new("contact/collision.toml", 0.01, "resume");
-    let tmp = TempDir::new("resume");
+/// A run of `fixture` (cut to `t_end`) stopped after step `stop` on 2 ranks writes the
+/// checkpoint one process writes, byte for byte, and resumed from it on 1 and 3 ranks ends
+/// with the uninterrupted run's files.
+fn resumes_on_other_ranks(fixture: &str, t_end: f64, tag: &str, stop: &str) {
+    let scene = ShortScene::new(fixture, t_end, tag);
+    let tmp = TempDir::new(tag);
     let whole = tmp.path().join("whole");
     run(&scene.0, &whole, 0, 1, &[]);
+    let alone = tmp.path().join("alone");
+    run(&scene.0, &alone, 0, 1, &["--stop-after", stop]);
     let half = tmp.path().join("half");
-    run(&scene.0, &half, 2, 1, &["--stop-after", "300"]);
+    run(&scene.0, &half, 2, 1, &["--stop-after", stop]);
     let checkpoint = tmp.path().join("half.qdc");
     std::fs::copy(half.join("checkpoint.qdc"), &checkpoint).unwrap();
+    let one = std::fs::read(alone.join("checkpoint.qdc")).unwrap();
+    assert!(
+        one == std::fs::read(&checkpoint).unwrap(),
+        "{fixture}: the checkpoint of 2 ranks differs from one process's"
+    );
     for ranks in [0, 3] {
         let out = tmp.path().join(format!("resumed{ranks}"));
         copy_dir(&half, &out);
@@ -205,8 +214,23 @@ fn a_checkpoint_written_at_two_ranks_resumes_at_one_and_three() {
             1,
             &["--resume", checkpoint.to_str().unwrap()],
         );
-        assert_same_outputs(&whole, &out, &format!("resumed at {ranks} ranks"));
+        assert_same_outputs(&whole, &out, &format!("{fixture} resumed at {ranks} ranks"));
     }
+}
+
+#[test]
+fn a_checkpoint_written_at_two_ranks_resumes_at_one_and_three() {
+    resumes_on_other_ranks("contact/collision.toml", 0.01, "resume", "300");
+}
+
+#[test]
+fn a_periodic_packing_checkpointed_at_two_ranks_resumes_at_one_and_three() {
+    resumes_on_other_ranks(
+        "boxtest/small_deposit_cell_bed.toml",
+        0.02,
+        "resume-packing",
+        "300",
+    );
 }
 
 /// Copies the files of `from` into a new `to`.
