@@ -5,7 +5,7 @@ Usage (from the workspace root; needs Open MPI and a `--features mpi` build):
 
     python3 qdem-bench/scripts/mpi_scaling.py [--tets 1000000] [--spheres 100000]
         [--tet-steps 200] [--sphere-steps 100] [--pairs 2] [--work out/mpi_scaling]
-        [--qdem target/release/qdem] [--json docs/mpi_scaling.json]
+        [--qdem target/release/qdem] [--json docs/mpi_scaling.json] [--scenes tets,spheres]
 
 Two scenes are written into WORK: a clamped elastic concrete box of about TETS tetrahedra
 (a structured mesh, 6 tetrahedra per cell, written as MSH 2.2) under gravity, and a box of
@@ -221,18 +221,24 @@ def main() -> None:
     ap.add_argument("--work", type=Path, default=ROOT / "out/mpi_scaling")
     ap.add_argument("--qdem", default=str(ROOT / "target/release/qdem"))
     ap.add_argument("--json", type=Path, default=None)
+    ap.add_argument("--scenes", default="tets,spheres",
+                    help="which scenes to run, comma-separated: tets, spheres")
     args = ap.parse_args()
     args.work.mkdir(parents=True, exist_ok=True)
-    box = box_scene(args.work, args.tets, args.tet_steps)
-    box2 = box_scene(args.work, 2 * args.tets, args.tet_steps)
-    spheres = sphere_scene(args.work, args.spheres, args.sphere_steps)
+    wanted = args.scenes.split(",")
+    scenes = []
+    if "tets" in wanted:
+        box = box_scene(args.work, args.tets, args.tet_steps)
+        box2 = box_scene(args.work, 2 * args.tets, args.tet_steps)
+        scenes.append(("tets", box, [("2x1_double", box2, 2, 1)]))
+    if "spheres" in wanted:
+        scenes.append(("spheres", sphere_scene(args.work, args.spheres, args.sphere_steps), []))
     configs = [("1x1", 1, 1), ("2x1", 2, 1), ("1x2", 1, 2)]
     result = {"machine": f"{cpu_model()}, {os.cpu_count()} cores",
               "mpirun": subprocess.run(["mpirun", "--version"], capture_output=True,
                                        text=True).stdout.splitlines()[0],
               "command": " ".join(sys.argv)}
-    for label, scene, extra in (("tets", box, [("2x1_double", box2, 2, 1)]),
-                                ("spheres", spheres, [])):
+    for label, scene, extra in scenes:
         runs = [(key, scene, r, t) for key, r, t in configs] + extra
         m = measure(args.qdem, args.work, label, runs, args.pairs)
         t = {k: v["seconds_per_step"] for k, v in m.items()}
