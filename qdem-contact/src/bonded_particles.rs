@@ -321,6 +321,27 @@ impl BondedParticles {
         ([x[0], x[1], r], [v[0], v[1], w])
     }
 
+    /// [`BondedParticles::dofs`] of every particle into `motion`, walking the state's arrays
+    /// in step rather than indexing each per particle.
+    fn pack_motion(state: &State, motion: &mut [(Dof2, Dof2)]) {
+        let n = motion.len();
+        let translation = state.position[..n]
+            .par_iter()
+            .zip(&state.reference[..n])
+            .zip(&state.velocity[..n]);
+        let rotation = state.spin.angle[..n]
+            .par_iter()
+            .zip(&state.spin.velocity[..n]);
+        motion
+            .par_iter_mut()
+            .with_min_len(BOND_CHUNK)
+            .zip(translation.zip(rotation))
+            .for_each(|(m, (((x, x0), v), (r, w)))| {
+                let u = *x - *x0;
+                *m = ([u[0], u[1], r[2]], [v[0], v[1], w[2]]);
+            });
+    }
+
     /// Elastic end forces and stress of bond `b` at `state`.
     #[inline]
     fn bond_elastic(b: &BeamBond, state: &State) -> ([f64; 6], [f64; 6]) {
@@ -580,11 +601,7 @@ impl Model for BondedParticles {
 
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
         let bonds = &self.bonds;
-        self.motion
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(BOND_CHUNK)
-            .for_each(|(p, m)| *m = Self::dofs(state, p));
+        Self::pack_motion(state, &mut self.motion);
         let motion = &self.motion;
         self.bond_force
             .par_iter_mut()
