@@ -383,7 +383,10 @@ impl BondedParticles {
     /// gives, without the displacements, velocities and tangent the frame also needs).
     #[inline]
     fn overlap(state: &State, pair: &UnbondedPair) -> f64 {
-        let (xi, xj) = (state.position[pair.i as usize], state.position[pair.j as usize]);
+        let (xi, xj) = (
+            state.position[pair.i as usize],
+            state.position[pair.j as usize],
+        );
         overlap([xi[0], xi[1]], [xj[0], xj[1]], pair.rest)
     }
 
