@@ -41,7 +41,7 @@ use crate::bond_tangent::{lower_entries, BondTangent};
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::error::ContactError;
 use crate::particle_packing::{lattice_section, Packing, SplitMix64};
-use crate::unbonded_contact::{PairKinematics, UnbondedLaw, UnbondedPair};
+use crate::unbonded_contact::{overlap, PairKinematics, UnbondedLaw, UnbondedPair};
 use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
 use qdem_core::{
@@ -321,6 +321,27 @@ impl BondedParticles {
         ([x[0], x[1], r], [v[0], v[1], w])
     }
 
+    /// [`BondedParticles::dofs`] of every particle into `motion`, walking the state's arrays
+    /// in step rather than indexing each per particle.
+    fn pack_motion(state: &State, motion: &mut [(Dof2, Dof2)]) {
+        let n = motion.len();
+        let translation = state.position[..n]
+            .par_iter()
+            .zip(&state.reference[..n])
+            .zip(&state.velocity[..n]);
+        let rotation = state.spin.angle[..n]
+            .par_iter()
+            .zip(&state.spin.velocity[..n]);
+        motion
+            .par_iter_mut()
+            .with_min_len(BOND_CHUNK)
+            .zip(translation.zip(rotation))
+            .for_each(|(m, (((x, x0), v), (r, w)))| {
+                let u = *x - *x0;
+                *m = ([u[0], u[1], r[2]], [v[0], v[1], w[2]]);
+            });
+    }
+
     /// Elastic end forces and stress of bond `b` at `state`.
     #[inline]
     fn bond_elastic(b: &BeamBond, state: &State) -> ([f64; 6], [f64; 6]) {
@@ -356,6 +377,17 @@ impl BondedParticles {
             v: [vi, vj],
             r: [self.radius[i], self.radius[j]],
         }
+    }
+
+    /// The overlap of `pair` at `state` from the centres alone (what [`PairKinematics::frame`]
+    /// gives, without the displacements, velocities and tangent the frame also needs).
+    #[inline]
+    fn overlap(state: &State, pair: &UnbondedPair) -> f64 {
+        let (xi, xj) = (
+            state.position[pair.i as usize],
+            state.position[pair.j as usize],
+        );
+        overlap([xi[0], xi[1]], [xj[0], xj[1]], pair.rest)
     }
 
     /// A candidate pair (i, j) with rest distance `rest`.
@@ -429,10 +461,7 @@ impl BondedParticles {
         let mut earliest: Option<f64> = None;
         for idx in 0..self.pairs.len() {
             let p = self.pairs[idx];
-            let frame = self
-                .kinematics(state, p.i as usize, p.j as usize)
-                .frame(p.rest);
-            let (before, now) = (p.overlap, frame.overlap);
+            let (before, now) = (p.overlap, Self::overlap(state, &p));
             let alpha = match (p.touching, now > 0.0) {
                 (true, false) if before > 0.0 => before / (before - now),
                 (false, true) => {
@@ -575,11 +604,7 @@ impl Model for BondedParticles {
 
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
         let bonds = &self.bonds;
-        self.motion
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(BOND_CHUNK)
-            .for_each(|(p, m)| *m = Self::dofs(state, p));
+        Self::pack_motion(state, &mut self.motion);
         let motion = &self.motion;
         self.bond_force
             .par_iter_mut()
@@ -624,13 +649,11 @@ impl Model for BondedParticles {
             });
         let law = self.settings.contact;
         let implicit = self.implicit;
-        for pair in self.pairs.iter().filter(|p| p.touching || !implicit) {
+        let touching = self.pairs.iter().filter(|p| p.touching || !implicit);
+        for pair in touching.filter(|p| Self::overlap(state, p) > 0.0) {
             let (i, j) = (pair.i as usize, pair.j as usize);
             let k = self.kinematics(state, i, j);
-            if k.frame(pair.rest).overlap <= 0.0 {
-                continue;
-            }
-            let out = law.forces(pair, &k);
+            let out = law.forces_in(pair, &k, &k.frame(pair.rest));
             for (p, g) in [(i, out.force[0]), (j, out.force[1])] {
                 force[p][0] += g[0];
                 force[p][1] += g[1];
@@ -785,13 +808,17 @@ impl StepEvents for BondedParticles {
             let k = self.kinematics(state, pair.i as usize, pair.j as usize);
             let frame = k.frame(pair.rest);
             let touching = frame.overlap > 0.0;
-            let out = law.forces(&pair, &k);
+            let elastic = if touching {
+                law.forces_in(&pair, &k, &frame).elastic
+            } else {
+                0.0
+            };
             let p = &mut self.pairs[idx];
             if touching != p.touching {
                 changed = true;
             }
             p.touching = touching;
-            p.elastic = if touching { out.elastic } else { 0.0 };
+            p.elastic = elastic;
             p.slip_reference = frame.slip;
             p.overlap = frame.overlap;
         }

@@ -79,11 +79,25 @@ pub struct PairFrame {
     pub slip: f64,
 }
 
+/// The vector from centre `xi` to centre `xj` and its length.
+#[inline]
+fn separation(xi: [f64; 2], xj: [f64; 2]) -> ([f64; 2], f64) {
+    let d = [xj[0] - xi[0], xj[1] - xi[1]];
+    (d, d[0].hypot(d[1]))
+}
+
+/// The overlap δ = ℓ − |x_j − x_i| of discs centred at `xi` and `xj` for rest distance `rest`
+/// (positive when touching): [`PairFrame::overlap`] from the centres alone, for the passes
+/// that only ask whether pairs touch.
+#[inline]
+pub fn overlap(xi: [f64; 2], xj: [f64; 2], rest: f64) -> f64 {
+    rest - separation(xi, xj).1
+}
+
 impl PairKinematics {
     /// Frame, overlap and tangential displacement for rest distance `rest`.
     pub fn frame(&self, rest: f64) -> PairFrame {
-        let d = [self.x[1][0] - self.x[0][0], self.x[1][1] - self.x[0][1]];
-        let dist = d[0].hypot(d[1]);
+        let (d, dist) = separation(self.x[0], self.x[1]);
         let n = [d[0] / dist, d[1] / dist];
         let t = [-n[1], n[0]];
         let du = [self.u[1][0] - self.u[0][0], self.u[1][1] - self.u[0][1]];
@@ -112,7 +126,11 @@ pub struct PairForces {
 impl UnbondedLaw {
     /// The forces of `pair` at `k` (zero when the discs do not touch).
     pub fn forces(&self, pair: &UnbondedPair, k: &PairKinematics) -> PairForces {
-        let f = k.frame(pair.rest);
+        self.forces_in(pair, k, &k.frame(pair.rest))
+    }
+
+    /// [`UnbondedLaw::forces`] with the pair's frame `f` at `k` already computed.
+    pub fn forces_in(&self, pair: &UnbondedPair, k: &PairKinematics, f: &PairFrame) -> PairForces {
         if f.overlap <= 0.0 {
             return PairForces::default();
         }
