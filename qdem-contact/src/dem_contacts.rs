@@ -619,8 +619,7 @@ impl DemContacts {
     /// of a ballast stone touch nothing); returns the largest distance a sphere has moved
     /// since the last build (infinite before it).
     fn read_centers(&mut self, state: &State) -> f64 {
-        let built = self.built && self.built_at.len() == self.particle.len();
-        let every = !built || 2 * self.partners.len() >= self.particle.len();
+        let (every, built) = (self.reads_every_sphere(), self.lists_built());
         let (particle, built_at, turn) = (&self.particle, &self.built_at, &self.turn);
         let moved = self
             .center
@@ -646,8 +645,20 @@ impl DemContacts {
         moved.sqrt()
     }
 
-    /// The narrow phase's record of every partner of a candidate, from `state` (serial: they
-    /// are few when this is called outside [`DemContacts::read_centers`]' pass).
+    /// Whether [`DemContacts::read_centers`] fills every sphere's narrow-phase record in its
+    /// pass: before the first build, and when most spheres are partners of candidates.
+    fn reads_every_sphere(&self) -> bool {
+        !self.lists_built() || 2 * self.partners.len() >= self.particle.len()
+    }
+
+    /// Whether the candidate lists were built for these spheres (at `built_at`).
+    fn lists_built(&self) -> bool {
+        self.built && self.built_at.len() == self.particle.len()
+    }
+
+    /// The narrow phase's record of every partner of a candidate, from `state`; serial: it
+    /// runs only when fewer than half the spheres were partners (in the read, and once after
+    /// a rebuild of such lists, for the new partners).
     fn read_partners(&mut self, state: &State) {
         for &s in &self.partners {
             let s = s as usize;
@@ -931,8 +942,11 @@ impl Model for DemContacts {
         self.last_time = Some(state.time);
         let moved = self.read_centers(state);
         if self.needs_rebuild(moved, state.time) {
+            let read_every = self.reads_every_sphere();
             self.rebuild(state.time);
-            self.read_partners(state);
+            if !read_every {
+                self.read_partners(state);
+            }
         }
         self.evaluate(state.time, dt);
         self.update_time_delay(state.time);
