@@ -19,6 +19,8 @@ import re
 import subprocess
 import sys
 
+from doc_section import replace_section
+
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 OUT = os.path.join(ROOT, "out")
 STUDY = os.path.join(OUT, "bbm_study")
@@ -161,13 +163,7 @@ def write_tables(rows):
     parts += ["", "**Speed against error** (0.025 m, against the explicit run at ∆t = 1.38e-6 s):",
               "", head, "|" + "---|" * 12]
     parts += [line(r) for r in rows if not r["run"].startswith("preconditioned")]
-    text = open(DOC).read()
-    begin, end = "<!-- bbm-study:begin -->", "<!-- bbm-study:end -->"
-    i, j = text.index(begin) + len(begin), text.index(end)
-    text = text[:i] + "\n" + "\n".join(parts) + "\n" + text[j:]
-    with open(DOC + ".tmp", "w") as f:
-        f.write(text)
-    os.replace(DOC + ".tmp", DOC)
+    replace_section(DOC, "<!-- bbm-study:begin -->", "<!-- bbm-study:end -->", parts)
 
 
 if __name__ == "__main__":

@@ -13,6 +13,8 @@ import json
 import os
 import platform
 
+from doc_section import replace_section
+
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 OUT = os.path.join(ROOT, "out")
 DOC = os.path.join(ROOT, "docs", "bbm.md")
@@ -181,13 +183,7 @@ def main():
             dev = deviation(h, reference[1], first)
             parts.append(f"| {k} {t} | {s['wall_seconds']:.2f} | {fmt(dev, '.2e')} |")
     svg(runs)
-    text = open(DOC).read()
-    begin, end = "<!-- bbm:begin -->", "<!-- bbm:end -->"
-    i, j = text.index(begin) + len(begin), text.index(end)
-    text = text[:i] + "\n" + "\n".join(parts) + "\n" + text[j:]
-    with open(DOC + ".tmp", "w") as f:
-        f.write(text)
-    os.replace(DOC + ".tmp", DOC)
+    replace_section(DOC, "<!-- bbm:begin -->", "<!-- bbm:end -->", parts)
     print(f"wrote {DOC} and {SVG} from {len(runs)} runs")
 
 
