@@ -35,12 +35,12 @@ fn main() -> ExitCode {
     let code = match result {
         Ok(()) => return ExitCode::SUCCESS,
         Err(error @ CliError::Run(RunError::Interrupted { .. })) => {
-            eprintln!("{error}");
+            print_error(&error.to_string());
             return ExitCode::from(130);
         }
         Err(error) => {
             if leader {
-                eprintln!("error: {error}");
+                print_error(&format!("error: {error}"));
             }
             1
         }
@@ -57,4 +57,11 @@ fn main() -> ExitCode {
         ranks.abort(code);
     }
     ExitCode::from(code as u8)
+}
+
+/// Writes the error as one line in a single write: under mpirun, a message written in pieces
+/// can be split by the launcher's own abort notice, which it prints while it forwards ours.
+fn print_error(message: &str) {
+    use std::io::Write;
+    let _ = std::io::stderr().write_all(format!("{message}\n").as_bytes());
 }
