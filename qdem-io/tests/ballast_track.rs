@@ -188,6 +188,31 @@ fn a_run_starts_from_another_scenes_checkpoint_and_refuses_one_of_other_bodies()
             first.world.state.velocity[i].map(f64::to_bits)
         );
     }
+    // A fix that the deposit did not have holds from the first step: the falling stones get
+    // zero vertical velocity instead of keeping the checkpoint's for the whole run.
+    let falling = (0..first.world.state.len())
+        .map(|i| first.world.state.velocity[i].z.abs())
+        .fold(0.0, f64::max);
+    assert!(falling > 0.1, "the stones still fall at {falling} m/s");
+    let held = [
+        ("[[material]]", checkpoint.as_str()),
+        (
+            "[output]",
+            "[[fix]]\nbody = \"ballast\"\nbox = [[-1, -1, -1], [1, 1, 1]]\ndofs = \"z\"\n\n[output]",
+        ),
+    ];
+    let fixed = build(&stones_scene(&dir, "held.toml", &held)).unwrap();
+    for (v, before) in fixed
+        .world
+        .state
+        .velocity
+        .iter()
+        .zip(&first.world.state.velocity)
+    {
+        assert_eq!(v.z, 0.0);
+        assert_eq!(v.x.to_bits(), before.x.to_bits());
+        assert_eq!(v.y.to_bits(), before.y.to_bits());
+    }
     // The probe is resolved where the stones are now, not where they started.
     let b = &second.probes[0];
     let nearest = (0..second.world.state.len())
