@@ -7,8 +7,9 @@
 //! particle count must match and every particle's reference position must equal the one in the
 //! checkpoint up to whole periods of the periodic cell (a periodic cell wraps reference and
 //! current positions together). Positions, velocities, accelerations and rigid-body motion are
-//! taken from the checkpoint; time restarts at 0; contact lists are rebuilt at the first step
-//! and tangential springs start unstretched.
+//! taken from the checkpoint, except that the directions this scene fixes start at rest; time
+//! restarts at 0; contact lists are rebuilt at the first step and tangential springs start
+//! unstretched.
 
 use crate::build::BuildError;
 use crate::checkpoint::read_checkpoint;
