@@ -280,10 +280,44 @@ impl State {
     /// acceleration there.
     pub fn fix(&mut self, i: usize, dofs: Dofs) {
         self.fixed[i] = self.fixed[i].union(dofs);
-        for axis in 0..3 {
-            if dofs.contains(axis) {
-                self.velocity[i][axis] = 0.0;
-                self.acceleration[i][axis] = 0.0;
+        at_rest_in(&mut self.velocity[i], &mut self.acceleration[i], dofs);
+    }
+
+    /// Zeroes the velocity and acceleration of every fixed direction: of the particles, of
+    /// their rotations, and of the rigid bodies whose rotation is held. [`State::fix`] does this
+    /// when a direction is fixed; this does it again after motion was written from elsewhere
+    /// (the checkpoint of another scene), so that every fixed direction starts at rest.
+    ///
+    /// ```
+    /// use qdem_core::{Dofs, State, Vec3};
+    ///
+    /// let mut state = State::at_rest(vec![Vec3::zeros()]);
+    /// state.fix(0, Dofs::parse("z").unwrap());
+    /// state.velocity[0] = Vec3::new(1.0, 2.0, 3.0);
+    /// state.hold_fixed();
+    /// assert_eq!(state.velocity[0], Vec3::new(1.0, 2.0, 0.0));
+    /// ```
+    pub fn hold_fixed(&mut self) {
+        for ((v, a), &dofs) in self
+            .velocity
+            .iter_mut()
+            .zip(&mut self.acceleration)
+            .zip(&self.fixed)
+        {
+            at_rest_in(v, a, dofs);
+        }
+        let spin = &mut self.spin;
+        for ((w, a), &dofs) in spin
+            .velocity
+            .iter_mut()
+            .zip(&mut spin.acceleration)
+            .zip(&spin.fixed)
+        {
+            at_rest_in(w, a, dofs);
+        }
+        for b in 0..self.rigid.len() {
+            if self.rigid.spin_fixed[b] {
+                self.rigid.set_angular_velocity(b, Vec3::zeros());
             }
         }
     }
@@ -306,6 +340,15 @@ impl State {
             .iter()
             .zip(&self.velocity)
             .fold(Vec3::zeros(), |p, (m, v)| p + *m * v)
+    }
+}
+
+/// Zeroes `velocity` and `acceleration` in the directions `dofs`.
+#[inline]
+fn at_rest_in(velocity: &mut Vec3, acceleration: &mut Vec3, dofs: Dofs) {
+    for axis in (0..3).filter(|&axis| dofs.contains(axis)) {
+        velocity[axis] = 0.0;
+        acceleration[axis] = 0.0;
     }
 }
 

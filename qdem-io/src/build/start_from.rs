@@ -57,36 +57,11 @@ pub(crate) fn restore_state(
              start from a checkpoint of a scene that builds the same bodies"
         )));
     }
-    hold_fixed(state);
+    // The scene's fixes hold from the first step, even in directions the checkpoint's
+    // scene let move (else those would keep the checkpoint's velocity for the whole run).
+    state.hold_fixed();
     state.time = 0.0;
     Ok(())
-}
-
-/// The scene's fixes hold from the first step: a direction it fixes gets zero velocity and
-/// acceleration, even where the checkpoint's scene let that particle, rotation or rigid body
-/// move (otherwise it would keep the checkpoint's velocity for the whole run).
-fn hold_fixed(state: &mut State) {
-    for i in 0..state.len() {
-        let dofs = state.fixed[i];
-        state.fix(i, dofs);
-    }
-    let spin = &mut state.spin;
-    for ((w, a), dofs) in spin
-        .velocity
-        .iter_mut()
-        .zip(&mut spin.acceleration)
-        .zip(&spin.fixed)
-    {
-        for axis in (0..3).filter(|&axis| dofs.contains(axis)) {
-            w[axis] = 0.0;
-            a[axis] = 0.0;
-        }
-    }
-    for b in 0..state.rigid.len() {
-        if state.rigid.spin_fixed[b] {
-            state.rigid.set_angular_velocity(b, Vec3::zeros());
-        }
-    }
 }
 
 /// The first particle whose reference positions differ by more than [`SAME_PLACE`] after
