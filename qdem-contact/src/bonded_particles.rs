@@ -316,9 +316,12 @@ impl BondedParticles {
     /// Displacement and velocity (x, y, θ) of particle p.
     #[inline]
     fn dofs(state: &State, p: usize) -> (Dof2, Dof2) {
-        let (x, r) = (state.displacement(p), state.spin.angle[p][2]);
-        let (v, w) = (state.velocity[p], state.spin.velocity[p][2]);
-        ([x[0], x[1], r], [v[0], v[1], w])
+        let (v, r, w) = (
+            &state.velocity[p],
+            &state.spin.angle[p],
+            &state.spin.velocity[p],
+        );
+        planar(state.displacement(p), r, v, w)
     }
 
     /// [`BondedParticles::dofs`] of every particle into `motion`, walking the state's arrays
@@ -336,10 +339,7 @@ impl BondedParticles {
             .par_iter_mut()
             .with_min_len(BOND_CHUNK)
             .zip(translation.zip(rotation))
-            .for_each(|(m, (((x, x0), v), (r, w)))| {
-                let u = *x - *x0;
-                *m = ([u[0], u[1], r[2]], [v[0], v[1], w[2]]);
-            });
+            .for_each(|(m, (((x, x0), v), (r, w)))| *m = planar(*x - *x0, r, v, w));
     }
 
     /// Elastic end forces and stress of bond `b` at `state`.
@@ -591,6 +591,13 @@ fn restore_pairs(
             }
         })
         .collect())
+}
+
+/// The in-plane (x, y, θ) parts of a particle's displacement `u` and rotation `r` and of their
+/// rates `v`, `w`: the degrees of freedom of paper 001's particles.
+#[inline]
+fn planar(u: Vec3, r: &Vec3, v: &Vec3, w: &Vec3) -> (Dof2, Dof2) {
+    ([u[0], u[1], r[2]], [v[0], v[1], w[2]])
 }
 
 impl Model for BondedParticles {
