@@ -298,23 +298,9 @@ impl State {
     /// assert_eq!(state.velocity[0], Vec3::new(1.0, 2.0, 0.0));
     /// ```
     pub fn hold_fixed(&mut self) {
-        for ((v, a), &dofs) in self
-            .velocity
-            .iter_mut()
-            .zip(&mut self.acceleration)
-            .zip(&self.fixed)
-        {
-            at_rest_in(v, a, dofs);
-        }
+        all_at_rest_in(&mut self.velocity, &mut self.acceleration, &self.fixed);
         let spin = &mut self.spin;
-        for ((w, a), &dofs) in spin
-            .velocity
-            .iter_mut()
-            .zip(&mut spin.acceleration)
-            .zip(&spin.fixed)
-        {
-            at_rest_in(w, a, dofs);
-        }
+        all_at_rest_in(&mut spin.velocity, &mut spin.acceleration, &spin.fixed);
         for b in 0..self.rigid.len() {
             if self.rigid.spin_fixed[b] {
                 self.rigid.set_angular_velocity(b, Vec3::zeros());
@@ -340,6 +326,13 @@ impl State {
             .iter()
             .zip(&self.velocity)
             .fold(Vec3::zeros(), |p, (m, v)| p + *m * v)
+    }
+}
+
+/// [`at_rest_in`] for every entry of `velocity` and `acceleration` with its `fixed` directions.
+fn all_at_rest_in(velocity: &mut [Vec3], acceleration: &mut [Vec3], fixed: &[Dofs]) {
+    for ((v, a), &dofs) in velocity.iter_mut().zip(acceleration).zip(fixed) {
+        at_rest_in(v, a, dofs);
     }
 }
 
