@@ -131,13 +131,13 @@ pub enum Command {
     /// spectra smoothed by the Parzen window (20 Hz bandwidth by default) and the mobility over
     /// the scene's series loads.
     Analyze(AnalyzeArgs),
-    /// Natural frequencies and mode shapes of the scene's deformable bodies
+    /// Natural frequencies and mode shapes of the scene's deformable and rigid bodies
     ///
-    /// The N lowest modes about the reference configuration (the tetrahedra's linear stiffness,
-    /// the lumped masses, the scene's fixes) by shift-invert Lanczos: DIR/modes.csv (frequency,
-    /// dominant direction, effective mass fractions), DIR/modes.pvd and DIR/vtu/mode_NNNN.vtu.
-    /// A body with no fix reports its six rigid-body modes first. Contacts add no stiffness
-    /// (a note says so); rigid bodies are refused.
+    /// The N lowest modes about the starting state (the tetrahedra's linear stiffness, the
+    /// touching contacts as springs, the lumped masses, the scene's fixes; a rigid body's six
+    /// DOFs) by shift-invert Lanczos: DIR/modes.csv (frequency, dominant direction, effective
+    /// mass fractions), DIR/modes.pvd and DIR/vtu/mode_NNNN.vtu. A body with no fix and
+    /// nothing touching it reports its six rigid-body modes first.
     Modes(ModesArgs),
 }
 

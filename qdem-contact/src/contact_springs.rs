@@ -6,8 +6,12 @@
 //! (constant for the linear law, Hertz–Mindlin's √δ-dependent pair for the other) is the
 //! spring k = kn n nᵀ + kt (I − n nᵀ) between the two spheres' carriers: the tangent
 //! K = −∂f/∂x adds k to both diagonal blocks and −k to the two off-diagonal ones (a wall
-//! contact only to its sphere's). The contacts are taken as sticking (a sliding contact would
-//! give no tangential stiffness) and their damping is left out, as the modes are undamped.
+//! contact only to its sphere's). A sphere that turns (a rigid body's, a rotating particle's)
+//! moves its contact point also by its rotation θ: u = u_p + θ × a = u_p − [a]× θ with a the arm
+//! from the sphere's centre to the contact point, so its side of the spring is J = [I, −[a]×]
+//! over its carrier and its rotation node, and K gains the blocks ± Jᵢᵀ k Jⱼ. The contacts are
+//! taken as sticking (a sliding contact would give no tangential stiffness) and their damping
+//! is left out, as the modes are undamped.
 
 use qdem_core::{Mat3, Tangent, Vec3};
 
@@ -17,14 +21,43 @@ pub(crate) fn spring(normal: &Vec3, kn: f64, kt: f64) -> Mat3 {
     nn * kn + (Mat3::identity() - nn) * kt
 }
 
-/// Adds the spring `k` between particles `a` and `b` (to the ground, a wall, when `b` is
-/// `None`) to `tangent`.
-pub(crate) fn add_spring(tangent: &mut Tangent, a: usize, b: Option<usize>, k: &Mat3) {
-    tangent.add_stiffness(a, a, k);
-    if let Some(b) = b {
-        tangent.add_stiffness(b, b, k);
-        tangent.add_stiffness(a, b, &-k);
-        tangent.add_stiffness(b, a, &-k);
+/// Where one side of a contact's spring attaches.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Attachment {
+    /// The sphere's carrier particle.
+    pub(crate) particle: usize,
+    /// For a sphere that turns: the generalised node of its rotation and the arm from the
+    /// sphere's centre to the contact point.
+    pub(crate) turn: Option<(usize, Vec3)>,
+}
+
+impl Attachment {
+    /// The nodes that move the contact point, with their maps J (u = Σ J u_node).
+    fn terms(&self) -> Vec<(usize, Mat3)> {
+        let mut terms = vec![(self.particle, Mat3::identity())];
+        if let Some((node, arm)) = self.turn {
+            terms.push((node, -arm.cross_matrix()));
+        }
+        terms
+    }
+}
+
+/// Adds the spring `k` between the contact points of `a` and `b` (to the ground, a wall,
+/// when `b` is `None`) to `tangent`: the blocks a–a, b–b, a–b and b–a, in that order.
+pub(crate) fn add_spring(tangent: &mut Tangent, a: Attachment, b: Option<Attachment>, k: &Mat3) {
+    let mut sides = vec![(a.terms(), 1.0)];
+    sides.extend(b.map(|b| (b.terms(), -1.0)));
+    let pairs: &[(usize, usize)] = match sides.len() {
+        1 => &[(0, 0)],
+        _ => &[(0, 0), (1, 1), (0, 1), (1, 0)],
+    };
+    for &(i, j) in pairs {
+        let ((rows, si), (cols, sj)) = (&sides[i], &sides[j]);
+        for (row, ji) in rows {
+            for (col, jj) in cols {
+                tangent.add_stiffness(*row, *col, &((si * sj) * (ji.transpose() * k * jj)));
+            }
+        }
     }
 }
 

@@ -32,7 +32,7 @@
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
 use crate::contact_list::{Contact, ContactList};
-use crate::contact_springs::{add_spring, spring};
+use crate::contact_springs::{add_spring, spring, Attachment};
 use crate::contact_view::{Partner, SphereRecord, TouchingContact};
 use crate::error::ContactError;
 use crate::periodic_boundary::PeriodicBox;
@@ -1030,19 +1030,35 @@ impl Model for DemContacts {
     }
 
     /// The contacts touching at the last evaluation, as sticking springs
-    /// ([`crate::contact_springs`]); none when a sphere turns (a rigid body's, a rotating
-    /// particle's), whose contact springs would couple rotations this leaves out. The contacts
+    /// ([`crate::contact_springs`]), attached through the arm to the contact point to the
+    /// rotation of a sphere that turns (a rigid body's, a rotating particle's). The contacts
     /// give no [`Model::linearized`] facet: an implicit step would need the events of contacts
     /// opening and closing.
     fn modal_stiffness(&self) -> Option<&dyn Linearized> {
-        let turns = self.turn.iter().any(|&t| t != NOT_RIGID);
-        (!turns).then_some(self as &dyn Linearized)
+        Some(self)
+    }
+}
+
+impl DemContacts {
+    /// Where sphere `s`'s side of a contact attaches, the contact point at `arm` from its
+    /// centre.
+    fn attachment(&self, state: &State, s: usize, arm: Vec3) -> Attachment {
+        let bodies = state.rigid.len();
+        let node = match self.turn[s] {
+            NOT_RIGID => None,
+            t if (t as usize) < bodies => Some(state.body_rotation_node(t as usize)),
+            t => Some(state.len() + t as usize - bodies),
+        };
+        Attachment {
+            particle: self.particle[s] as usize,
+            turn: node.map(|n| (n, arm)),
+        }
     }
 }
 
 impl Linearized for DemContacts {
     /// The springs of the contacts touching at the last evaluation, at the geometry it saw.
-    fn add_tangent(&self, _state: &State, tangent: &mut Tangent) {
+    fn add_tangent(&self, state: &State, tangent: &mut Tangent) {
         let law = &self.settings.law;
         for c in &self.pairs.items {
             let (a, b) = (c.first as usize, c.second as usize);
@@ -1053,7 +1069,9 @@ impl Linearized for DemContacts {
             };
             let e = self.elasticity[sa.material as usize * self.materials + sb.material as usize];
             let (kn, kt) = law.stiffness(g.overlap, g.radius, &e);
-            let (pa, pb) = (self.particle[a] as usize, self.particle[b] as usize);
+            let half = 0.5 * g.overlap;
+            let pa = self.attachment(state, a, (sa.radius - half) * g.normal);
+            let pb = self.attachment(state, b, -(sb.radius - half) * g.normal);
             add_spring(tangent, pa, Some(pb), &spring(&g.normal, kn, kt));
         }
         let time = self.last_time.unwrap_or(0.0);
@@ -1063,12 +1081,9 @@ impl Linearized for DemContacts {
                 continue;
             };
             let (kn, kt) = law.stiffness(g.overlap, g.radius, &e);
-            add_spring(
-                tangent,
-                self.particle[s] as usize,
-                None,
-                &spring(&g.normal, kn, kt),
-            );
+            let arm = (self.now[s].radius - 0.5 * g.overlap) * g.normal;
+            let side = self.attachment(state, s, arm);
+            add_spring(tangent, side, None, &spring(&g.normal, kn, kt));
         }
     }
 }

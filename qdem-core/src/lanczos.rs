@@ -9,6 +9,10 @@
 //!   vertex), both over the free DOFs of the deformable bodies' particles (fixed directions
 //!   are eliminated as in the static solve, paper 001 Eq. 23). Models without a modal
 //!   stiffness (loads, gravity) add nothing and are listed in [`Modes::ignored`].
+//! - A rigid body takes part with its six DOFs, its centre's translation and its rotations
+//!   about its principal axes: its members' entries of K are condensed onto them
+//!   ([`crate::rigid_reduction`]), and its members follow in the mode shapes. One that nothing
+//!   touches and nothing fixes reports its six rigid-body modes.
 //! - Shift and invert (Ericsson & Ruhe 1980): with A = K − σM, σ = −(2π · 1 Hz)² < 0 so that A
 //!   is positive definite even for a body free to move rigidly, the eigenvalues θ of the
 //!   operator A⁻¹M, self-adjoint in the M inner product ⟨x, y⟩ = xᵀMy, are θ = 1/(ω² − σ):
@@ -39,13 +43,14 @@
 //!   the free DOFs). The direction with the largest fraction is the mode's dominant direction.
 
 use crate::error::CoreError;
-use crate::mechanisms::{unresisted_motions, SystemDofs};
+use crate::mechanisms::{tet_piece_rows, unresisted_motions, SystemDofs};
 use crate::model::Model;
+use crate::rigid_reduction::RigidReduction;
 use crate::sparse::{unconstrained_bodies, Assembler, FreeDofs, Scales, SparseCholesky, Tangent};
 use crate::state::{Dofs, State};
 use crate::tet_body::TetBody;
 use crate::Vec3;
-use nalgebra::{DMatrix, SymmetricEigen};
+use nalgebra::{DMatrix, SymmetricEigen, Vector6};
 use std::f64::consts::PI;
 use thiserror::Error;
 
@@ -64,7 +69,8 @@ pub enum ModalError {
     /// No model has particles with stiffness (no deformable body).
     #[error(
         "nothing deformable: no model gives a stiffness to particles with mass, so there are no \
-         natural modes to compute (add a deformable [[body]] with a tetrahedral mesh)"
+         natural modes to compute (add a deformable [[body]] with a tetrahedral mesh, or \
+         contacts that hold a rigid one)"
     )]
     NothingDeformable,
     /// Zero modes asked for.
@@ -72,7 +78,7 @@ pub enum ModalError {
     ZeroCount,
     /// More modes than free degrees of freedom.
     #[error(
-        "asked for {count} modes, but the deformable bodies have only {dofs} free degrees of \
+        "asked for {count} modes, but the bodies have only {dofs} free degrees of \
          freedom: give a count of at most {dofs}"
     )]
     TooManyModes {
@@ -81,14 +87,18 @@ pub enum ModalError {
         /// Free DOFs.
         dofs: usize,
     },
-    /// The scene has rigid bodies (6-DOF stones), which the analysis does not take.
+    /// More modes than the free DOFs give once the unresisted motions are left out.
     #[error(
-        "the scene has {count} rigid bodies; modal analysis takes deformable bodies only: \
-         remove them or make them deformable"
+        "asked for {count} modes, but only {modes} are left once the {mechanisms} rigid motions \
+         of single pieces that nothing resists are left out: give a count of at most {modes}"
     )]
-    RigidBodies {
-        /// How many.
+    TooFewResisted {
+        /// Modes asked for.
         count: usize,
+        /// Modes there are.
+        modes: usize,
+        /// Unresisted motions left out.
+        mechanisms: usize,
     },
     /// A body fixed in some directions but still free to move rigidly.
     #[error(
@@ -127,10 +137,12 @@ pub struct Mode {
     pub eigenvalue: f64,
     /// Natural frequency √max(ω², 0) / 2π (Hz).
     pub frequency_hz: f64,
-    /// Whether this is a rigid-body mode of a body with no fixity.
+    /// Whether this is a rigid-body mode of a body with no fixity (and, for a rigid body,
+    /// nothing touching it).
     pub rigid: bool,
-    /// The mode shape, M-normalised (φᵀMφ = 1), one vector per particle (zero where fixed
-    /// and on particles of no deformable body).
+    /// The mode shape, M-normalised (φᵀMφ = 1), one vector per particle: zero where fixed
+    /// and on particles of no body; a rigid body's members move with it, its centre particle
+    /// carries its translation.
     pub shape: Vec<Vec3>,
     /// Effective modal mass fractions along x, y, z and about the axes x, y, z through the mass
     /// centre ([`DIRECTIONS`]).
@@ -202,11 +214,6 @@ pub fn natural_modes(
     models: &[Box<dyn Model>],
     count: usize,
 ) -> Result<Modes, ModalError> {
-    if !state.rigid.is_empty() {
-        return Err(ModalError::RigidBodies {
-            count: state.rigid.len(),
-        });
-    }
     if count == 0 {
         return Err(ModalError::ZeroCount);
     }
@@ -219,13 +226,20 @@ pub fn natural_modes(
     }
     let mut rigid = problem.rigid_basis(state, models)?;
     let mechanisms = problem.add_mechanisms(state, models, &mut rigid);
+    if count > problem.dofs.len() - mechanisms {
+        return Err(ModalError::TooFewResisted {
+            count,
+            modes: problem.dofs.len() - mechanisms,
+            mechanisms,
+        });
+    }
     let start = std::time::Instant::now();
     let mut solver = ShiftInvert::new(&problem)?;
     let factor_seconds = start.elapsed().as_secs_f64();
     let mut modes: Vec<Mode> = rigid[..rigid.len() - mechanisms]
         .iter()
         .take(count)
-        .map(|r| problem.mode(problem.rayleigh(r), r.clone(), true))
+        .map(|r| problem.mode(state, problem.rayleigh(r), r.clone(), true))
         .collect();
     let wanted = count - modes.len();
     let mut steps = 0;
@@ -236,7 +250,7 @@ pub fn natural_modes(
         modes.extend(
             pairs
                 .into_iter()
-                .map(|(theta, x)| problem.mode(1.0 / theta + shift, x, false)),
+                .map(|(theta, x)| problem.mode(state, 1.0 / theta + shift, x, false)),
         );
     }
     Ok(Modes {
@@ -260,16 +274,31 @@ struct Problem {
     global: Vec<usize>,
     /// Particles (not rotations) in the state.
     particles: usize,
+    /// The rigid bodies' six DOFs.
+    reduction: RigidReduction,
     /// Unit rigid motions (6 directions) over the system DOFs.
     directions: Vec<Vec<f64>>,
     ignored: Vec<String>,
 }
 
+/// What a global DOF of the modal problem moves.
+#[derive(Clone, Copy)]
+enum Dof {
+    /// Particle p's translation along an axis.
+    Translation(usize, usize),
+    /// Particle p's rotation about an axis.
+    Spin(usize, usize),
+    /// Scaled principal rotation k of rigid body b ([`crate::rigid_reduction`]).
+    Body(usize, usize),
+}
+
 impl Problem {
     /// Collects K from every model with a linearisation and the free DOFs of their particles.
     fn new(state: &State, models: &[Box<dyn Model>]) -> Result<Problem, ModalError> {
+        let reduction = RigidReduction::new(state);
         let mut tangent = Tangent::new();
         let ignored = collect_stiffness(state, models, &mut tangent);
+        let tangent = reduction.reduce(state, tangent);
         let n = state.len();
         let mut in_body = vec![false; n];
         for l in models.iter().filter_map(|m| m.modal_stiffness()) {
@@ -277,17 +306,22 @@ impl Problem {
                 in_body[p] = true;
             }
         }
+        for &c in &state.rigid.center {
+            in_body[c] = true;
+        }
         let mut fixity = state.node_fixity();
         for (node, fixed) in fixity.iter_mut().enumerate() {
             if !in_body[node % n.max(1)] {
                 *fixed = Dofs::ALL;
             }
         }
+        let fixity = reduction.fixity(state, fixity);
         let dofs = FreeDofs::new(&fixity);
-        if dofs.len() == 0 || tangent.stiffness_entries().is_empty() {
+        let limp = tangent.stiffness_entries().is_empty() && state.rigid.is_empty();
+        if dofs.len() == 0 || limp {
             return Err(ModalError::NothingDeformable);
         }
-        let node_mass = state.node_mass();
+        let node_mass = reduction.node_mass(state.node_mass());
         let global: Vec<usize> = (0..3 * fixity.len())
             .filter(|&d| dofs.index(d).is_some())
             .collect();
@@ -299,6 +333,7 @@ impl Problem {
             mass,
             global,
             particles: n,
+            reduction,
             directions: Vec::new(),
             ignored,
         };
@@ -306,44 +341,59 @@ impl Problem {
         Ok(problem)
     }
 
+    /// What global DOF `d` moves.
+    fn kind(&self, d: usize) -> Dof {
+        let (node, axis) = (d / 3, d % 3);
+        if node < self.particles {
+            return Dof::Translation(node, axis);
+        }
+        match self.reduction.body_of_node(node) {
+            Some(b) => Dof::Body(b, axis),
+            None => Dof::Spin(node - self.particles, axis),
+        }
+    }
+
     /// The six unit rigid motions (translations along x, y, z, rotations about axes through
     /// the mass centre) over the system DOFs, of the particles `only` where given (else of
-    /// all).
+    /// all, the rigid bodies included).
     fn unit_motions(&self, state: &State, only: Option<&[bool]>) -> Vec<Vec<f64>> {
-        let n = self.particles;
-        let node = |d: usize| (d / 3) % n;
-        let included = |d: usize| only.is_none_or(|o| o[node(d)]);
+        let included = |p: usize| only.is_none_or(|o| o[p]);
         let (mut centre, mut total) = (Vec3::zeros(), 0.0);
         for (i, &d) in self.global.iter().enumerate() {
-            if included(d) && d / 3 < n {
-                centre += self.mass[i] * state.position[node(d)];
-                total += self.mass[i];
+            if let Dof::Translation(p, _) = self.kind(d) {
+                if included(p) {
+                    centre += self.mass[i] * state.position[p];
+                    total += self.mass[i];
+                }
             }
         }
         let centre = centre / total.max(f64::MIN_POSITIVE);
-        (0..6)
+        (0..6usize)
             .map(|k| {
+                let omega = Vec3::ith(k.saturating_sub(3), 1.0);
                 self.global
                     .iter()
-                    .map(|&d| {
-                        if !included(d) {
-                            return 0.0;
+                    .map(|&d| match self.kind(d) {
+                        Dof::Translation(p, axis) if included(p) => match k < 3 {
+                            true => f64::from(u8::from(axis == k)),
+                            false => omega.cross(&(state.position[p] - centre))[axis],
+                        },
+                        Dof::Spin(p, axis) if included(p) && k >= 3 => omega[axis],
+                        Dof::Body(b, j) if only.is_none() && k >= 3 => {
+                            self.reduction.psi(b, &omega)[j]
                         }
-                        let axis = d % 3;
-                        let spin = d / 3 >= n;
-                        if k < 3 {
-                            return if axis == k && !spin { 1.0 } else { 0.0 };
-                        }
-                        let omega = Vec3::ith(k - 3, 1.0);
-                        if spin {
-                            omega[axis]
-                        } else {
-                            omega.cross(&(state.position[node(d)] - centre))[axis]
-                        }
+                        _ => 0.0,
                     })
                     .collect()
             })
             .collect()
+    }
+
+    /// The six global DOFs of rigid body `b`: its centre's translations, then its scaled
+    /// principal rotations.
+    fn body_dofs(state: &State, b: usize) -> [usize; 6] {
+        let (c, node) = (state.rigid.center[b], state.body_rotation_node(b));
+        std::array::from_fn(|j| if j < 3 { 3 * c + j } else { 3 * node + j - 3 })
     }
 
     /// The M-orthonormal rigid-body modes of the bodies with no fixity; refuses a body fixed
@@ -378,7 +428,51 @@ impl Problem {
                 }
             }
         }
+        self.free_rigid_bodies(state, &mut basis)?;
         Ok(basis)
+    }
+
+    /// Appends to `basis` the six unit DOFs, M-normalised, of every rigid body that nothing
+    /// touches and nothing fixes; refuses one that nothing touches but something fixes in
+    /// part.
+    fn free_rigid_bodies(
+        &self,
+        state: &State,
+        basis: &mut Vec<Vec<f64>>,
+    ) -> Result<(), ModalError> {
+        let mut touched = vec![false; self.dofs.len()];
+        for e in self.tangent.stiffness_entries() {
+            for d in [e.row, e.col] {
+                if let Some(i) = self.dofs.index(d).filter(|_| e.val != 0.0) {
+                    touched[i] = true;
+                }
+            }
+        }
+        for b in 0..state.rigid.len() {
+            let free: Vec<usize> = Problem::body_dofs(state, b)
+                .iter()
+                .filter_map(|&d| self.dofs.index(d))
+                .collect();
+            if free.is_empty() || free.iter().any(|&i| touched[i]) {
+                continue;
+            }
+            if free.len() < 6 {
+                return Err(ModalError::PartlyConstrained {
+                    body: format!(
+                        "rigid body {} (centre particle {})",
+                        b + 1,
+                        state.rigid.center[b]
+                    ),
+                    modes: free.len(),
+                });
+            }
+            for i in free {
+                let mut r = vec![0.0; self.dofs.len()];
+                r[i] = 1.0 / self.mass[i].sqrt();
+                basis.push(r);
+            }
+        }
+        Ok(())
     }
 
     /// Appends to `basis` the M-orthonormalised motions of single pieces that nothing resists
@@ -396,9 +490,20 @@ impl Problem {
             mass: &self.mass,
             global: &self.global,
         };
+        let mut rows = tet_piece_rows(&state.position, &piece, pieces, &dofs);
+        for b in 0..state.rigid.len() {
+            let body: Option<Vec<usize>> = Problem::body_dofs(state, b)
+                .iter()
+                .map(|&d| self.dofs.index(d))
+                .collect();
+            for (j, i) in body.into_iter().flatten().enumerate() {
+                rows[i] = Some((pieces + b, self.body_row(b, j)));
+            }
+        }
         let stiffness = self.tangent.stiffness_entries();
         let before = basis.len();
-        for mut x in unresisted_motions(&state.position, &piece, pieces, &dofs, stiffness) {
+        let all = pieces + state.rigid.len();
+        for mut x in unresisted_motions(&rows, all, &dofs, stiffness) {
             let scale = self.norm(&x);
             self.orthogonalize(&mut x, basis, &[]);
             let norm = self.norm(&x);
@@ -408,6 +513,20 @@ impl Problem {
             }
         }
         basis.len() - before
+    }
+
+    /// The row of rigid body `b`'s DOF `j` (of [`Problem::body_dofs`]) in its six rigid
+    /// motions (translations, then rotations about world axes through its centre).
+    fn body_row(&self, b: usize, j: usize) -> Vector6<f64> {
+        let mut row = Vector6::zeros();
+        if j < 3 {
+            row[j] = 1.0;
+        } else {
+            for axis in 0..3 {
+                row[3 + axis] = self.reduction.psi(b, &Vec3::ith(axis, 1.0))[j - 3];
+            }
+        }
+        row
     }
 
     /// ⟨x, y⟩_M.
@@ -458,7 +577,7 @@ impl Problem {
     }
 
     /// A [`Mode`] of eigenvalue `lambda` and shape `x` over the system DOFs.
-    fn mode(&self, lambda: f64, mut x: Vec<f64>, rigid: bool) -> Mode {
+    fn mode(&self, state: &State, lambda: f64, mut x: Vec<f64>, rigid: bool) -> Mode {
         let norm = self.norm(&x);
         x.iter_mut().for_each(|v| *v /= norm);
         let mut participation = [0.0; 6];
@@ -471,21 +590,32 @@ impl Problem {
             };
         }
         let mut motion = [0.0; 3];
+        let mut shape = vec![Vec3::zeros(); self.particles];
+        let mut psi = vec![Vec3::zeros(); state.rigid.len()];
         for ((&d, v), m) in self.global.iter().zip(&x).zip(&self.mass) {
-            if d / 3 < self.particles {
-                motion[d % 3] += m * v * v;
+            match self.kind(d) {
+                Dof::Translation(p, axis) => {
+                    motion[axis] += m * v * v;
+                    shape[p][axis] = *v;
+                }
+                Dof::Body(b, k) => psi[b][k] = *v,
+                Dof::Spin(..) => {}
             }
         }
+        let theta: Vec<Vec3> = psi
+            .iter()
+            .enumerate()
+            .map(|(b, p)| self.reduction.rotation(b, p))
+            .collect();
+        for (b, t) in theta.iter().enumerate() {
+            let energy = self.reduction.rotation_energy(b, t);
+            motion.iter_mut().zip(energy).for_each(|(e, r)| *e += r);
+        }
+        self.reduction.place_members(state, &theta, &mut shape);
         let total: f64 = motion.iter().sum();
         motion
             .iter_mut()
             .for_each(|e| *e /= total.max(f64::MIN_POSITIVE));
-        let mut shape = vec![Vec3::zeros(); self.particles];
-        for (&d, v) in self.global.iter().zip(&x) {
-            if d / 3 < self.particles {
-                shape[d / 3][d % 3] = *v;
-            }
-        }
         Mode {
             eigenvalue: lambda,
             frequency_hz: lambda.max(0.0).sqrt() / (2.0 * PI),

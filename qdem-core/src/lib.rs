@@ -35,6 +35,7 @@ pub mod model;
 pub mod newmark;
 pub mod nodal_load;
 pub mod rigid_body;
+mod rigid_reduction;
 pub(crate) mod sparse;
 pub mod stable_step;
 pub mod stages;

@@ -6,8 +6,9 @@
 //! directly and deflated, like a free body's rigid-body modes.
 //!
 //! Each connected piece of the deformable bodies' tetrahedra (a stone, the sleeper) moves
-//! rigidly in a mechanism, since its own tetrahedra resist every deformation: the mechanisms
-//! lie in the span of the pieces' rigid motions. With R the six rigid motions of every piece
+//! rigidly in a mechanism, since its own tetrahedra resist every deformation, and so does each
+//! rigid body (whose six DOFs are its rigid motions, [`crate::rigid_reduction`]): the
+//! mechanisms lie in the span of the pieces' rigid motions. With R the six rigid motions of every piece
 //! (translations, small rotations about its centre) over the free DOFs, G = Rᵀ K R (dense,
 //! 6 per piece, coupled through the contacts) and H = Rᵀ M R (block diagonal), the motions R v
 //! with G v = λ H v and λ below [`ZERO`] times the largest λ are the mechanisms, those that
@@ -38,28 +39,46 @@ pub(crate) struct SystemDofs<'a> {
     pub global: &'a [usize],
 }
 
-/// The unresisted rigid motions of the pieces (`piece[p]`: the piece of particle p, `None`
-/// outside every deformable body), each as a vector over the system DOFs (not normalised).
-pub(crate) fn unresisted_motions(
+/// Each system DOF's piece and its row of the piece's six rigid motions (translations, small
+/// rotations about the piece's centre), for the connected pieces of tetrahedra (`piece[p]`:
+/// the piece of particle p, `None` outside every deformable body); `None` for a DOF of no
+/// piece or of a piece with a fixed DOF.
+pub(crate) fn tet_piece_rows(
     position: &[Vec3],
     piece: &[Option<u32>],
     pieces: usize,
     dofs: &SystemDofs<'_>,
-    stiffness: &[Entry],
-) -> Vec<Vec<f64>> {
+) -> Vec<PieceRow> {
     let centre = piece_centres(position, piece, pieces);
     let held = held_pieces(piece, pieces, dofs);
-    let motion = |d: usize| -> Option<(usize, Vector6<f64>)> {
-        let p = d / 3;
-        let c = piece.get(p).copied().flatten()? as usize;
-        let free = !held[c] && (dofs.index)(d).is_some();
-        free.then(|| {
-            (
-                c,
-                rigid_motion(position[p] - centre[c]).row(d % 3).transpose(),
-            )
+    dofs.global
+        .iter()
+        .map(|&d| {
+            let p = d / 3;
+            let c = piece.get(p).copied().flatten()? as usize;
+            (!held[c]).then(|| {
+                (
+                    c,
+                    rigid_motion(position[p] - centre[c]).row(d % 3).transpose(),
+                )
+            })
         })
-    };
+        .collect()
+}
+
+/// A system DOF's piece and its row of the piece's six rigid motions.
+pub(crate) type PieceRow = Option<(usize, Vector6<f64>)>;
+
+/// The unresisted rigid motions of `pieces` pieces whose rigid motions over the system DOFs
+/// are `rows` (one per system DOF, [`tet_piece_rows`] and the rigid bodies' own), each as a
+/// vector over the system DOFs (not normalised).
+pub(crate) fn unresisted_motions(
+    rows: &[PieceRow],
+    pieces: usize,
+    dofs: &SystemDofs<'_>,
+    stiffness: &[Entry],
+) -> Vec<Vec<f64>> {
+    let motion = |d: usize| -> PieceRow { rows[(dofs.index)(d)?] };
     let mut h = vec![Matrix6::zeros(); pieces];
     for &d in dofs.global {
         if let Some((c, r)) = motion(d) {
@@ -188,7 +207,8 @@ mod tests {
             mass: &mass,
             global: &global,
         };
-        let free = unresisted_motions(&position, &piece, 1, &dofs, &stiffness);
+        let rows = tet_piece_rows(&position, &piece, 1, &dofs);
+        let free = unresisted_motions(&rows, 1, &dofs, &stiffness);
         assert_eq!(free.len(), 3);
         for x in &free {
             let vertical: f64 = (0..4).map(|p| x[3 * p + 2].abs()).sum();

@@ -200,6 +200,22 @@ impl State {
         self.fixed.iter().chain(&self.spin.fixed).copied().collect()
     }
 
+    /// The generalised node that stands for the small rotation θ (world axes) of rigid body
+    /// `b` in a modal analysis's tangent ([`crate::lanczos`]): after the particles'
+    /// translations and their rotations ([`State::node_fixity`]). A contact on a sphere of the
+    /// body attaches its spring there through the arm to the contact point; implicit solves
+    /// refuse rigid bodies and never see it.
+    ///
+    /// ```
+    /// use qdem_core::{State, Vec3};
+    ///
+    /// let state = State::at_rest(vec![Vec3::zeros(); 4]);
+    /// assert_eq!(state.body_rotation_node(1), 5);
+    /// ```
+    pub fn body_rotation_node(&self, b: usize) -> usize {
+        self.len() + self.spin.len() + b
+    }
+
     /// Mass of every generalised node: the lumped masses, then the moments of inertia.
     pub fn node_mass(&self) -> Vec<f64> {
         self.mass

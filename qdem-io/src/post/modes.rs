@@ -1,4 +1,4 @@
-//! `qdem modes`: the natural modes of a scene's deformable bodies ([`qdem_core::lanczos`])
+//! `qdem modes`: the natural modes of a scene's deformable and rigid bodies ([`qdem_core::lanczos`])
 //! and their files.
 //!
 //! - `modes.csv`: one row per mode, `mode,frequency_hz,kind,direction,participation,mass_x,
@@ -14,8 +14,9 @@
 //!
 //! All files are written atomically. The contacts touching in the starting state enter as
 //! sticking springs (`qdem_contact`'s contact springs); models without a modal stiffness
-//! (loads, gravity) add none and are listed in [`ModesReport::ignored`]; rigid bodies are
-//! refused.
+//! (loads, gravity) add none and are listed in [`ModesReport::ignored`]. A rigid body takes
+//! part with its six DOFs (`qdem_core`'s lanczos module); its mesh moves rigidly in the mode
+//! shapes.
 
 use crate::build::{BodyKind, Simulation};
 use crate::output::{write_atomic, write_vtu, OutputError, PvdIndex, VtuGrid};
@@ -86,7 +87,7 @@ pub fn compute_and_write(
     let csv = dir.join("modes.csv");
     write_atomic(&csv, |w| write_table(w, &modes))?;
     let pvd = dir.join("modes.pvd");
-    let tets = deformable_tets(sim);
+    let tets = body_tets(sim);
     let mut index = PvdIndex::new();
     for (k, mode) in modes.modes.iter().enumerate() {
         let name = format!("vtu/mode_{:04}.vtu", k + 1);
@@ -126,14 +127,19 @@ fn evaluate_once(sim: &mut Simulation) {
     }
 }
 
-/// The tetrahedra of every deformable body, as state particle indices.
-fn deformable_tets(sim: &Simulation) -> Vec<[u32; 4]> {
-    sim.bodies
+/// The tetrahedra of every body, deformable then rigid, as state particle indices.
+fn body_tets(sim: &Simulation) -> Vec<[u32; 4]> {
+    let deformable = sim
+        .bodies
         .iter()
         .filter(|b| matches!(b.kind, BodyKind::Deformable { .. }))
         .filter_map(|b| sim.tet_body(b))
-        .flat_map(|t| t.tets().iter().copied())
-        .collect()
+        .flat_map(|t| t.tets().iter().copied());
+    let rigid = sim.bodies.iter().flat_map(|b| match &b.kind {
+        BodyKind::Rigid { tets, .. } => tets.as_slice(),
+        BodyKind::Deformable { .. } => &[],
+    });
+    deformable.chain(rigid.copied()).collect()
 }
 
 /// The header of `modes.csv`.
