@@ -90,3 +90,21 @@ fn without_contact_spheres_the_cube_is_free() {
     let rigid = report.modes.modes.iter().filter(|m| m.rigid).count();
     assert_eq!(rigid, 6, "six rigid-body modes of a free cube");
 }
+
+#[test]
+fn a_free_cube_under_gravity_is_refused_and_on_its_springs_it_is_not() {
+    let dir = test_dir("contact-modes-gravity");
+    for (touching, refused) in [(false, true), (true, false)] {
+        let mut scene = scene(&dir, touching);
+        scene.run.gravity = [0.0, 0.0, -9.81];
+        let mut sim = Simulation::build(scene).unwrap();
+        let result = compute_and_write(&mut sim, 6, &dir.join("modes"));
+        match refused {
+            true => assert!(result
+                .unwrap_err()
+                .to_string()
+                .contains("gravity pushes it")),
+            false => assert!(result.is_ok(), "the springs hold it"),
+        }
+    }
+}

@@ -315,3 +315,29 @@ fn two_stacked_rigid_cubes_match_the_dense_twelve_dof_solve() {
         );
     }
 }
+
+/// A body that nothing fixes or holds but a load or gravity pushes is not in equilibrium:
+/// refused, naming the body and what pushes it, and no file is written.
+#[test]
+fn a_free_body_under_a_load_or_gravity_is_refused() {
+    let dir = test_dir("rigid-modes-loaded");
+    let load = "[[load]]\nbody = \"cube\"\nbox = [[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]]\n\
+                total_force = [0.0, 0.0, -10.0]\n";
+    let mut sim = Simulation::build(scene(&dir, false, load)).unwrap();
+    let error = compute_and_write(&mut sim, 6, &dir.join("loaded")).unwrap_err();
+    assert!(
+        matches!(error, ModesError::LoadedFreeBody { .. }),
+        "{error}"
+    );
+    let message = error.to_string();
+    assert!(
+        message.contains("`cube`") && message.contains("[[load]] #1"),
+        "{message}"
+    );
+    assert!(!dir.join("loaded").exists(), "nothing written");
+    let mut falling = scene(&dir, false, "");
+    falling.run.gravity = [0.0, 0.0, -9.81];
+    let mut sim = Simulation::build(falling).unwrap();
+    let error = compute_and_write(&mut sim, 6, &dir.join("falling")).unwrap_err();
+    assert!(error.to_string().contains("gravity pushes it"), "{error}");
+}

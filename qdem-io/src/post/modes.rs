@@ -20,7 +20,7 @@
 
 use crate::build::{BodyKind, Simulation};
 use crate::output::{write_atomic, write_vtu, OutputError, PvdIndex, VtuGrid};
-use qdem_core::lanczos::{natural_modes, ModalError, Modes, DIRECTIONS};
+use qdem_core::lanczos::{natural_modes, ModalError, Mode, Modes, DIRECTIONS};
 use qdem_core::Vec3;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -36,6 +36,22 @@ pub enum ModesError {
         scene: PathBuf,
         /// Why.
         source: ModalError,
+    },
+    /// A body free to move rigidly (no fix, nothing touching it) that a load or gravity
+    /// pushes: it accelerates, so it has no natural modes about the state.
+    #[error(
+        "scene {}: body `{body}` has no fix and nothing holds it, but {load} pushes it: it is \
+         not in equilibrium, so it has no natural modes about this state; fix it with [[fix]], \
+         or remove {load} to get its free-free modes",
+        .scene.display()
+    )]
+    LoadedFreeBody {
+        /// The scene file.
+        scene: PathBuf,
+        /// The body.
+        body: String,
+        /// What pushes it: `[[load]] #k` or `gravity`.
+        load: String,
     },
     /// The output directory could not be created.
     #[error("cannot create the output directory {}: {source}", .path.display())]
@@ -79,6 +95,7 @@ pub fn compute_and_write(
             scene: sim.scene.path.clone(),
             source,
         })?;
+    refuse_loaded_free_bodies(sim, &modes)?;
     let vtu_dir = dir.join("vtu");
     std::fs::create_dir_all(&vtu_dir).map_err(|source| ModesError::CreateDir {
         path: vtu_dir.clone(),
@@ -113,6 +130,30 @@ pub fn compute_and_write(
         csv,
         pvd,
     })
+}
+
+/// Refuses a body that moves in a rigid-body mode (no fix, nothing touching it) and that a
+/// `[[load]]` or gravity pushes: the modes are about an equilibrium it is not in.
+fn refuse_loaded_free_bodies(sim: &Simulation, modes: &Modes) -> Result<(), ModesError> {
+    let rigid: Vec<_> = modes.modes.iter().filter(|m| m.rigid).collect();
+    let gravity = sim.scene.run.gravity != [0.0; 3];
+    for body in &sim.bodies {
+        let moves = |m: &&Mode| body.particles.clone().any(|p| m.shape[p] != Vec3::zeros());
+        if !rigid.iter().any(moves) {
+            continue;
+        }
+        let load = match sim.scene.loads.iter().position(|l| l.body == body.name) {
+            Some(k) => format!("[[load]] #{}", k + 1),
+            None if gravity => "gravity".to_string(),
+            None => continue,
+        };
+        return Err(ModesError::LoadedFreeBody {
+            scene: sim.scene.path.clone(),
+            body: body.name.clone(),
+            load,
+        });
+    }
+    Ok(())
 }
 
 /// Every model's forces once at the starting state, so that the contacts know which of them
