@@ -112,6 +112,18 @@ pub enum ModalError {
         /// Free rigid-body modes.
         modes: usize,
     },
+    /// A rigid body that nothing touches, fixed in some directions but still free to move.
+    #[error(
+        "rigid body {body} (of state.rigid) is fixed in some directions but {modes} of its 6 \
+         DOFs are still free and nothing touches it: fix it whole, or remove its fixes to get \
+         its rigid-body modes"
+    )]
+    PartlyConstrainedRigid {
+        /// Its index in [`State::rigid`].
+        body: usize,
+        /// Its free DOFs.
+        modes: usize,
+    },
     /// Lanczos stopped before the wanted modes converged.
     #[error(
         "Lanczos did not converge: {converged} of {wanted} modes after {steps} steps; ask for \
@@ -457,12 +469,8 @@ impl Problem {
                 continue;
             }
             if free.len() < 6 {
-                return Err(ModalError::PartlyConstrained {
-                    body: format!(
-                        "rigid body {} (centre particle {})",
-                        b + 1,
-                        state.rigid.center[b]
-                    ),
+                return Err(ModalError::PartlyConstrainedRigid {
+                    body: b,
                     modes: free.len(),
                 });
             }

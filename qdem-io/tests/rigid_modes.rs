@@ -182,7 +182,7 @@ fn a_rigid_cube_fixed_in_part_and_touching_nothing_is_refused() {
     };
     let message = error.to_string();
     assert!(
-        message.contains("rigid body 1") && message.contains("5 of its 6 rigid-body modes"),
+        message.contains("body `cube`") && message.contains("5 of its 6 rigid-body modes"),
         "{message}"
     );
 }

@@ -93,7 +93,7 @@ pub fn compute_and_write(
     let modes =
         natural_modes(&world.state, &world.models, count).map_err(|source| ModesError::Modal {
             scene: sim.scene.path.clone(),
-            source,
+            source: named(sim, source),
         })?;
     refuse_loaded_free_bodies(sim, &modes)?;
     let vtu_dir = dir.join("vtu");
@@ -130,6 +130,21 @@ pub fn compute_and_write(
         csv,
         pvd,
     })
+}
+
+/// A refusal of a rigid body by its index, given the body's scene name instead.
+fn named(sim: &Simulation, error: ModalError) -> ModalError {
+    let ModalError::PartlyConstrainedRigid { body, modes } = error else {
+        return error;
+    };
+    let name = sim.bodies.iter().find_map(|b| match b.kind {
+        BodyKind::Rigid { body: r, .. } if r == body => Some(b.name.clone()),
+        _ => None,
+    });
+    match name {
+        Some(body) => ModalError::PartlyConstrained { body, modes },
+        None => ModalError::PartlyConstrainedRigid { body, modes },
+    }
 }
 
 /// Refuses a body that moves in a rigid-body mode (no fix, nothing touching it) and that a
