@@ -27,16 +27,27 @@ struct ShortScene(PathBuf);
 
 impl ShortScene {
     fn new(fixture: &str, t_end: f64, tag: &str) -> ShortScene {
+        ShortScene::edited(fixture, tag, &[("t_end = ", &format!("t_end = {t_end:?}"))])
+    }
+
+    /// A copy with each line that starts with an edit's key (exactly one per key) replaced by
+    /// the edit's text.
+    fn edited(fixture: &str, tag: &str, edits: &[(&str, &str)]) -> ShortScene {
         let path = workspace().join("fixtures").join(fixture);
         let text = std::fs::read_to_string(&path).expect("read the fixture scene");
+        for (key, _) in edits {
+            assert!(
+                text.lines().filter(|l| l.starts_with(key)).count() == 1,
+                "{key}"
+            );
+        }
         let lines: Vec<String> = text
             .lines()
-            .map(|l| match l.starts_with("t_end = ") {
-                true => format!("t_end = {t_end:?}"),
-                false => l.to_string(),
+            .map(|l| match edits.iter().find(|(key, _)| l.starts_with(key)) {
+                Some((_, line)) => line.to_string(),
+                None => l.to_string(),
             })
             .collect();
-        assert!(text.lines().filter(|l| l.starts_with("t_end = ")).count() == 1);
         let name = format!(".mpi-{tag}-{}.toml", std::process::id());
         let copy = path.with_file_name(name);
         std::fs::write(&copy, lines.join("\n") + "\n").expect("write the short scene");
@@ -152,7 +163,11 @@ fn assert_same_outputs(a: &Path, b: &Path, what: &str) {
 
 /// One process, then 2 and 3 ranks of 1 thread and 2 ranks of 2 threads: the same files.
 fn same_for_any_ranks(fixture: &str, t_end: f64, tag: &str) {
-    let scene = ShortScene::new(fixture, t_end, tag);
+    same_scene_for_any_ranks(ShortScene::new(fixture, t_end, tag), fixture, tag);
+}
+
+/// [`same_for_any_ranks`] of a scene already cut.
+fn same_scene_for_any_ranks(scene: ShortScene, fixture: &str, tag: &str) {
     let tmp = TempDir::new(tag);
     let single = tmp.path().join("single");
     run(&scene.0, &single, 0, 1, &[]);
@@ -167,6 +182,15 @@ fn same_for_any_ranks(fixture: &str, t_end: f64, tag: &str) {
 #[test]
 fn the_cantilever_is_byte_identical_on_any_number_of_ranks() {
     same_for_any_ranks("cantilever/cantilever_lc100.toml", 0.02, "cantilever");
+}
+
+#[test]
+fn the_cantilever_stepped_by_explicit_newmark_is_byte_identical_on_any_number_of_ranks() {
+    let fixture = "cantilever/cantilever_lc100.toml";
+    let newmark = "integrator = \"newmark\"\nbeta = 0.0\ngamma = 0.5";
+    let edits = [("t_end = ", "t_end = 0.02"), ("integrator = ", newmark)];
+    let scene = ShortScene::edited(fixture, "newmark", &edits);
+    same_scene_for_any_ranks(scene, fixture, "newmark");
 }
 
 #[test]
@@ -293,7 +317,7 @@ fn an_implicit_run_and_the_other_commands_are_refused_on_two_ranks() {
     let (ok, _, err) = on_two_ranks(&["run", implicit.to_str().unwrap(), "--out", out]);
     assert!(!ok);
     assert!(
-        err.contains("only explicit Verlet runs can be decomposed")
+        err.contains("only explicit runs (Verlet, explicit Newmark) can be decomposed")
             && err.contains("without mpirun"),
         "{err}"
     );

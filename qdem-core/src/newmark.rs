@@ -63,7 +63,7 @@ use crate::stages::{Stage, StageTimes};
 use crate::state::State;
 use crate::stepper::{
     check_finite, check_masses, compute_accelerations, compute_accelerations_timed, refuse_rigid,
-    sum_forces, Stepper, PARTICLE_CHUNK,
+    sum_forces, Completion, Stepper, PARTICLE_CHUNK,
 };
 use crate::Vec3;
 use faer::sparse::SparseColMat;
@@ -594,6 +594,7 @@ impl Newmark {
         models: &mut [Box<dyn Model>],
         span: f64,
         stages: &mut StageTimes,
+        complete: &mut Completion<'_>,
     ) -> Result<f64, CoreError> {
         let mut h = span;
         if self.adaptive || self.is_implicit() {
@@ -606,7 +607,8 @@ impl Newmark {
         let (mut retakes, mut redos) = (0, 0);
         stages.mark(Stage::Events);
         loop {
-            self.advance(state, models, h, stages)?;
+            let advanced = self.advance(state, models, h, stages);
+            complete(state, stages, advanced)?;
             let alpha = models
                 .iter_mut()
                 .filter_map(|m| m.events()?.check_step(state, forces_here))
@@ -894,10 +896,22 @@ impl Stepper for Newmark {
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
     ) -> Result<(), CoreError> {
+        self.step_completed(state, models, stages, &mut |_, _, advanced| advanced)
+    }
+
+    /// [`Stepper::step_timed`], completing each sub-step (before its events are checked and
+    /// before the next one predicts from it).
+    fn step_completed(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        stages: &mut StageTimes,
+        complete: &mut Completion<'_>,
+    ) -> Result<(), CoreError> {
         let end = state.time + self.dt;
         let mut remaining = self.dt;
         while remaining > 1e-9 * self.dt {
-            remaining -= self.advance_adaptively(state, models, remaining, stages)?;
+            remaining -= self.advance_adaptively(state, models, remaining, stages, complete)?;
         }
         state.time = end;
         Ok(())

@@ -18,6 +18,11 @@ use rayon::prelude::*;
 /// longer on 2 threads than on 1), so a loop splits only beyond some 10⁵ particles' work.
 pub(crate) const PARTICLE_CHUNK: usize = 32768;
 
+/// What [`Stepper::step_completed`] calls after each integration: the state, the stage
+/// clock and the integration's outcome in, the outcome to go on with out.
+pub type Completion<'a> =
+    dyn FnMut(&mut State, &mut StageTimes, Result<(), CoreError>) -> Result<(), CoreError> + 'a;
+
 /// Advances a [`State`] by one step under a list of models, without knowing their physics.
 pub trait Stepper: Send {
     /// A short name for messages and summaries.
@@ -47,6 +52,22 @@ pub trait Stepper: Send {
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
     ) -> Result<(), CoreError>;
+
+    /// [`Stepper::step_timed`] with `complete` called after each integration of the step,
+    /// before anything reads the new motion, with the integration's outcome; its answer is
+    /// the outcome the step goes on with. A decomposed run makes every rank's state whole
+    /// there and agrees on failures ([`crate::distributed`]). The default takes the step,
+    /// then calls it once: right for a stepper that integrates once per step.
+    fn step_completed(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        stages: &mut StageTimes,
+        complete: &mut Completion<'_>,
+    ) -> Result<(), CoreError> {
+        let stepped = self.step_timed(state, models, stages);
+        complete(state, stages, stepped)
+    }
 
     /// Size and cost of the sparse factorisation, for steppers that solve a linear system;
     /// `None` for explicit steppers and before the first factorisation.

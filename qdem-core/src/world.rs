@@ -25,7 +25,6 @@ use crate::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
 use crate::model::{find_model, Model, Persistence};
 use crate::stages::{Stage, StageShare, StageTimes};
 use crate::state::State;
-use crate::step_settings::Scheme;
 use crate::step_settings::StepSettings;
 use crate::stepper::{stable_step, Stepper};
 use std::sync::Arc;
@@ -191,13 +190,14 @@ impl World {
     /// Decomposes the run over `comm`'s ranks ([`crate::distributed`]): from now on this
     /// process computes its share of the deformable bodies and every step ends with the
     /// exchange of the particles each rank owns, so that every rank holds the state one
-    /// process would. Call it on every rank, before [`World::initialize`] or
-    /// [`World::restore`]. Only explicit Verlet runs can be decomposed.
+    /// process would (after each sub-step of an adaptive explicit Newmark step too). Call it
+    /// on every rank, before [`World::initialize`] or [`World::restore`]. Only explicit runs
+    /// (Verlet, explicit Newmark) can be decomposed.
     pub fn decompose(&mut self, comm: Arc<dyn Communicator>) -> Result<Decomposition, CoreError> {
-        if self.settings.scheme != Scheme::Verlet {
+        if self.settings.scheme.is_implicit() {
             return Err(CoreError::Decomposition(format!(
-                "only explicit Verlet runs can be decomposed, and this one is stepped by {}; \
-                 run it as one process (without mpirun)",
+                "only explicit runs (Verlet, explicit Newmark) can be decomposed, and this one is \
+                 stepped by {}; run it as one process (without mpirun)",
                 self.stepper.name()
             )));
         }
@@ -228,14 +228,20 @@ impl World {
     /// Advances one step through every stage; `Ok(Some(halt))` when a hook ends the run.
     pub fn step(&mut self) -> Result<Option<Halt>, CoreError> {
         self.stages.begin_step();
-        let stepped = self
-            .stepper
-            .step_timed(&mut self.state, &mut self.models, &mut self.stages);
+        let (state, models, stages) = (&mut self.state, &mut self.models, &mut self.stages);
+        let stepped = match &mut self.share {
+            None => self.stepper.step_timed(state, models, stages),
+            Some((share, _)) => {
+                let mut complete = |state: &mut State, stages: &mut StageTimes, advanced| {
+                    share.share(state);
+                    stages.mark(Stage::Share);
+                    agreed(share, advanced)
+                };
+                self.stepper
+                    .step_completed(state, models, stages, &mut complete)
+            }
+        };
         self.steps_done += 1;
-        if let Some((share, _)) = &mut self.share {
-            share.share(&mut self.state);
-            self.stages.mark(Stage::Share);
-        }
         let checked = self.check(stepped);
         self.stages.mark(Stage::Check);
         checked?;
@@ -345,5 +351,16 @@ fn prepare(models: &mut [Box<dyn Model>], settings: &StepSettings) {
     let stepping = settings.stepping();
     for model in models.iter_mut() {
         model.prepare(&stepping);
+    }
+}
+
+/// The outcome every rank of a decomposed run goes on with after an integration: its own, when
+/// no rank failed or it failed itself; the failure of the lowest failing rank otherwise.
+fn agreed(share: &StateShare, advanced: Result<(), CoreError>) -> Result<(), CoreError> {
+    let local = advanced.as_ref().err().map(|e| e.to_string());
+    match (share.agree(local), advanced) {
+        (None, _) => Ok(()),
+        (Some(_), Err(own)) => Err(own),
+        (Some(failure), Ok(())) => Err(CoreError::Decomposition(failure)),
     }
 }

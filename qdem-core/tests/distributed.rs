@@ -4,7 +4,10 @@
 
 mod common;
 
-use qdem_core::{Communicator, Decomposition, Scheme, State, StepRequest, StepSettings, World};
+use qdem_core::{
+    Communicator, Decomposition, Model, Scheme, State, StepEvents, StepRequest, StepSettings, Vec3,
+    World,
+};
 use std::sync::{Arc, Barrier, Mutex};
 
 /// The ranks' mailboxes: what each rank posted for each rank.
@@ -84,15 +87,72 @@ impl Communicator for ThreadRank {
     }
 }
 
-/// The viscoelastic cantilever of the determinism test as a world stepped by Verlet.
-fn beam_world() -> World {
-    let (state, models) = common::viscoelastic_beam();
+/// An event every time the tip's vertical velocity crosses a multiple of [`BAND`]: a
+/// stand-in for a bond reaching its strength, so that an adaptive Newmark step is retaken and
+/// finished in sub-steps whose predictions read the velocities of the sub-step before.
+struct Tripwire {
+    particle: usize,
+    /// The band of the last accepted step.
+    band: f64,
+}
+
+/// Width of the tripwire's velocity bands (m/s).
+const BAND: f64 = 2e-3;
+
+impl Tripwire {
+    fn band(&self, state: &State) -> f64 {
+        (state.velocity[self.particle].z / BAND).floor()
+    }
+}
+
+impl Model for Tripwire {
+    fn name(&self) -> &str {
+        "tripwire"
+    }
+
+    fn add_forces(&mut self, _: &State, _: &mut [Vec3], _: &mut [Vec3]) {}
+
+    fn events(&mut self) -> Option<&mut dyn StepEvents> {
+        Some(self)
+    }
+}
+
+impl StepEvents for Tripwire {
+    /// Halves the step while it crosses a band boundary, down to the stepper's least fraction.
+    fn check_step(&mut self, state: &State, _: bool) -> Option<f64> {
+        (self.band(state) != self.band).then_some(0.25)
+    }
+
+    fn commit_step(&mut self, state: &State) -> bool {
+        self.band = self.band(state);
+        false
+    }
+}
+
+/// The viscoelastic cantilever of the determinism test as a world stepped by Verlet, or by
+/// adaptive explicit Newmark with a [`Tripwire`] on its tip.
+fn beam_world(newmark: bool) -> World {
+    let (state, mut models) = common::viscoelastic_beam();
+    let scheme = match newmark {
+        false => Scheme::Verlet,
+        true => {
+            let particle = state.len() - 1;
+            models.push(Box::new(Tripwire {
+                particle,
+                band: 0.0,
+            }));
+            Scheme::Newmark {
+                beta: 0.0,
+                gamma: 0.5,
+            }
+        }
+    };
     let request = StepRequest {
-        scheme: Scheme::Verlet,
+        scheme,
         dt: None,
         safety: 0.9,
         local_damping: 0.0,
-        adaptive: false,
+        adaptive: newmark,
         event_solve: Default::default(),
         implicit_default: None,
         fit_to: None,
@@ -103,18 +163,19 @@ fn beam_world() -> World {
 
 const STEPS: usize = 300;
 
-/// The state after [`STEPS`] steps of one process.
-fn one_process() -> State {
-    let mut world = beam_world();
+/// The state after [`STEPS`] steps of one process, and the retakes.
+fn one_process(newmark: bool) -> (State, u64) {
+    let mut world = beam_world(newmark);
     world.initialize().unwrap();
     for _ in 0..STEPS {
         world.step().unwrap();
     }
-    world.state
+    let retakes = world.stepper().counts().retakes;
+    (world.state, retakes)
 }
 
 /// Every rank's state after [`STEPS`] steps over `size` ranks, and the decomposition.
-fn ranks(size: usize) -> (Vec<State>, Decomposition) {
+fn ranks(size: usize, newmark: bool) -> (Vec<State>, Decomposition) {
     let hub = Arc::new(Hub {
         size,
         barrier: Barrier::new(size),
@@ -124,7 +185,7 @@ fn ranks(size: usize) -> (Vec<State>, Decomposition) {
         .map(|rank| {
             let hub = hub.clone();
             std::thread::spawn(move || {
-                let mut world = beam_world();
+                let mut world = beam_world(newmark);
                 let comm = Arc::new(ThreadRank { rank, hub });
                 let figures = world.decompose(comm).unwrap();
                 world.initialize().unwrap();
@@ -147,10 +208,10 @@ fn ranks(size: usize) -> (Vec<State>, Decomposition) {
 
 #[test]
 fn two_and_three_ranks_hold_the_bit_identical_state_of_one_process() {
-    let reference = one_process();
+    let (reference, _) = one_process(false);
     assert!(reference.displacement(reference.len() - 1).norm() > 0.0);
     for size in [2, 3] {
-        let (states, figures) = ranks(size);
+        let (states, figures) = ranks(size, false);
         for (rank, state) in states.iter().enumerate() {
             assert!(
                 common::motion_bits(state) == common::motion_bits(&reference),
@@ -162,5 +223,27 @@ fn two_and_three_ranks_hold_the_bit_identical_state_of_one_process() {
         assert_eq!(figures.owned.iter().sum::<usize>(), reference.len());
         assert!(figures.tets.iter().all(|&t| t > 0), "{figures:?}");
         assert_eq!(figures.cut_bodies, 1);
+    }
+}
+
+/// Adaptive explicit Newmark with retaken steps: each sub-step predicts from the one before,
+/// so the ranks make their state whole after every sub-step, not only at the step's end. The
+/// test fails if they do not (the tip's band crossings then differ between the ranks).
+#[test]
+fn adaptive_explicit_newmark_over_ranks_retakes_the_steps_one_process_retakes() {
+    let (reference, retakes) = one_process(true);
+    eprintln!("{retakes} retakes in {STEPS} steps");
+    assert!(
+        retakes >= 5,
+        "the tripwire makes sub-steps: {retakes} retakes"
+    );
+    for size in [2, 3] {
+        let (states, _) = ranks(size, true);
+        for (rank, state) in states.iter().enumerate() {
+            assert!(
+                common::motion_bits(state) == common::motion_bits(&reference),
+                "rank {rank} of {size} differs from one process"
+            );
+        }
     }
 }
