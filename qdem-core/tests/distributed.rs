@@ -206,18 +206,24 @@ fn ranks(size: usize, newmark: bool) -> (Vec<State>, Decomposition) {
     (states, figures.unwrap())
 }
 
+/// Every rank's state has the bits of one process's.
+fn assert_all_equal(states: &[State], reference: &State) {
+    for (rank, state) in states.iter().enumerate() {
+        assert!(
+            common::motion_bits(state) == common::motion_bits(reference),
+            "rank {rank} of {} differs from one process",
+            states.len()
+        );
+    }
+}
+
 #[test]
 fn two_and_three_ranks_hold_the_bit_identical_state_of_one_process() {
     let (reference, _) = one_process(false);
     assert!(reference.displacement(reference.len() - 1).norm() > 0.0);
     for size in [2, 3] {
         let (states, figures) = ranks(size, false);
-        for (rank, state) in states.iter().enumerate() {
-            assert!(
-                common::motion_bits(state) == common::motion_bits(&reference),
-                "rank {rank} of {size} differs from one process"
-            );
-        }
+        assert_all_equal(&states, &reference);
         let tets: usize = figures.tets.iter().sum();
         assert_eq!(tets, 60 * 6 * 6 * 6, "every tetrahedron is computed once");
         assert_eq!(figures.owned.iter().sum::<usize>(), reference.len());
@@ -239,11 +245,6 @@ fn adaptive_explicit_newmark_over_ranks_retakes_the_steps_one_process_retakes() 
     );
     for size in [2, 3] {
         let (states, _) = ranks(size, true);
-        for (rank, state) in states.iter().enumerate() {
-            assert!(
-                common::motion_bits(state) == common::motion_bits(&reference),
-                "rank {rank} of {size} differs from one process"
-            );
-        }
+        assert_all_equal(&states, &reference);
     }
 }
