@@ -452,6 +452,9 @@ impl Problem {
         state: &State,
         basis: &mut Vec<Vec<f64>>,
     ) -> Result<(), ModalError> {
+        if state.rigid.is_empty() {
+            return Ok(());
+        }
         let mut touched = vec![false; self.dofs.len()];
         for e in self.tangent.stiffness_entries() {
             for d in [e.row, e.col] {

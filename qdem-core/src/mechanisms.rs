@@ -8,11 +8,11 @@
 //! Each connected piece of the deformable bodies' tetrahedra (a stone, the sleeper) moves
 //! rigidly in a mechanism, since its own tetrahedra resist every deformation, and so does each
 //! rigid body (whose six DOFs are its rigid motions, [`crate::rigid_reduction`]): the
-//! mechanisms lie in the span of the pieces' rigid motions. With R the six rigid motions of every piece
-//! (translations, small rotations about its centre) over the free DOFs, G = Rᵀ K R (dense,
-//! 6 per piece, coupled through the contacts) and H = Rᵀ M R (block diagonal), the motions R v
-//! with G v = λ H v and λ below [`ZERO`] times the largest λ are the mechanisms, those that
-//! move several stones together included. Pieces with a fixed DOF are left to the fixity. The
+//! mechanisms lie in the span of the pieces' rigid motions. With R the six rigid motions of
+//! every piece (translations, small rotations about its centre) over the free DOFs,
+//! G = Rᵀ K R (dense, 6 per piece, coupled through the contacts) and H = Rᵀ M R (block
+//! diagonal), the motions R v with G v = λ H v and λ below [`ZERO`] times the largest λ are the
+//! mechanisms, those that move several stones together included. Pieces with a fixed DOF are left to the fixity. The
 //! dense solve bounds the pieces at [`MAX_PIECES`]; beyond, each piece is tested alone (its
 //! own 6 × 6 block), which misses the mechanisms of several pieces.
 

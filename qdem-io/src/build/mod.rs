@@ -209,6 +209,17 @@ impl Simulation {
         TetBody::of(self.world.models[model].as_ref())
     }
 
+    /// The tetrahedra of a body, deformable or rigid, as state particle indices.
+    pub fn body_tets<'a>(&'a self, body: &'a BodyInfo) -> &'a [[u32; 4]] {
+        match &body.kind {
+            BodyKind::Rigid { tets, .. } => tets,
+            BodyKind::Deformable { .. } => self
+                .tet_body(body)
+                .expect("a deformable body has a TetBody")
+                .tets(),
+        }
+    }
+
     /// The mass of a body (kg).
     pub fn body_mass(&self, body: &BodyInfo) -> f64 {
         let mass = &self.world.state.mass;

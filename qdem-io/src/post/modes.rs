@@ -1,5 +1,5 @@
-//! `qdem modes`: the natural modes of a scene's deformable and rigid bodies ([`qdem_core::lanczos`])
-//! and their files.
+//! `qdem modes`: the natural modes of a scene's deformable and rigid bodies
+//! ([`qdem_core::lanczos`]) and their files.
 //!
 //! - `modes.csv`: one row per mode, `mode,frequency_hz,kind,direction,participation,mass_x,
 //!   mass_y,mass_z,mass_rx,mass_ry,mass_rz,motion_x,motion_y,motion_z`: `kind` is `rigid` (a rigid-body mode of a body
@@ -104,7 +104,12 @@ pub fn compute_and_write(
     let csv = dir.join("modes.csv");
     write_atomic(&csv, |w| write_table(w, &modes))?;
     let pvd = dir.join("modes.pvd");
-    let tets = body_tets(sim);
+    let tets: Vec<[u32; 4]> = sim
+        .bodies
+        .iter()
+        .flat_map(|b| sim.body_tets(b))
+        .copied()
+        .collect();
     let mut index = PvdIndex::new();
     for (k, mode) in modes.modes.iter().enumerate() {
         let name = format!("vtu/mode_{:04}.vtu", k + 1);
@@ -181,21 +186,6 @@ fn evaluate_once(sim: &mut Simulation) {
     for model in world.models.iter_mut() {
         model.add_forces(state, &mut force, &mut torque);
     }
-}
-
-/// The tetrahedra of every body, deformable then rigid, as state particle indices.
-fn body_tets(sim: &Simulation) -> Vec<[u32; 4]> {
-    let deformable = sim
-        .bodies
-        .iter()
-        .filter(|b| matches!(b.kind, BodyKind::Deformable { .. }))
-        .filter_map(|b| sim.tet_body(b))
-        .flat_map(|t| t.tets().iter().copied());
-    let rigid = sim.bodies.iter().flat_map(|b| match &b.kind {
-        BodyKind::Rigid { tets, .. } => tets.as_slice(),
-        BodyKind::Deformable { .. } => &[],
-    });
-    deformable.chain(rigid.copied()).collect()
 }
 
 /// The header of `modes.csv`.

@@ -17,7 +17,7 @@ use super::schedule::Schedule;
 use super::spheres_vtu::write_spheres;
 use super::walls_vtu::{walls_move, write_walls};
 use super::{Recorder, RunFigures, StepInfo};
-use crate::build::{BodyKind, Simulation};
+use crate::build::Simulation;
 use crate::output::{write_vtu, OutputError, PvdIndex, VtuGrid};
 use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
 use std::path::{Path, PathBuf};
@@ -174,19 +174,18 @@ fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
     let mut tets = Vec::new();
     let (mut von_mises, mut volumetric) = (Vec::new(), Vec::new());
     for body in &sim.bodies {
-        match (&body.kind, sim.tet_body(body)) {
-            (_, Some(tet_body)) => {
-                tets.extend_from_slice(tet_body.tets());
+        let body_tets = sim.body_tets(body);
+        tets.extend_from_slice(body_tets);
+        match sim.tet_body(body) {
+            Some(tet_body) => {
                 let (vm, vol) = tet_body.tet_fields(s);
                 von_mises.extend(vm);
                 volumetric.extend(vol);
             }
-            (BodyKind::Rigid { tets: rigid, .. }, None) => {
-                tets.extend_from_slice(rigid);
-                von_mises.extend(std::iter::repeat_n(0.0, rigid.len()));
-                volumetric.extend(std::iter::repeat_n(0.0, rigid.len()));
+            None => {
+                von_mises.extend(std::iter::repeat_n(0.0, body_tets.len()));
+                volumetric.extend(std::iter::repeat_n(0.0, body_tets.len()));
             }
-            (BodyKind::Deformable { .. }, None) => unreachable!("a deformable body has a TetBody"),
         }
     }
     let grid = VtuGrid {
