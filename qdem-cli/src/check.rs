@@ -138,7 +138,8 @@ fn print_cost(sim: &Simulation, per_step: f64) {
 }
 
 /// Each rank's share of a decomposed step, gathered to every rank (a collective: every rank
-/// calls it): tetrahedra, owned particles, halo, its step and kernel seconds, and the
+/// calls it): tetrahedra, owned particles, halo (block sums received per step), particles
+/// whose motion it receives per step, its step and kernel seconds, and the
 /// imbalance of the kernel (the slowest rank's kernel time over the mean).
 fn rank_table(
     sim: &Simulation,
@@ -164,13 +165,13 @@ fn rank_table(
     let mut all = vec![0.0; 3 * d.ranks];
     ranks.all_gather(&mine, &mut all, &vec![3; d.ranks]);
     let mut table = format!(
-        "decomposed over {} ranks ({} bodies cut between ranks):\n  rank  tets      owned     halo      step (s)   kernel (s) share (s)\n",
+        "decomposed over {} ranks ({} bodies cut between ranks):\n  rank  tets      owned     halo      received  step (s)   kernel (s) share (s)\n",
         d.ranks, d.cut_bodies
     );
     for (r, row) in all.chunks_exact(3).enumerate() {
         table += &format!(
-            "  {r:<5} {:<9} {:<9} {:<9} {:.3e}  {:.3e}  {:.3e}\n",
-            d.tets[r], d.owned[r], d.halo[r], row[0], row[1], row[2]
+            "  {r:<5} {:<9} {:<9} {:<9} {:<9} {:.3e}  {:.3e}  {:.3e}\n",
+            d.tets[r], d.owned[r], d.halo[r], d.received[r], row[0], row[1], row[2]
         );
     }
     let kernels: Vec<f64> = all.chunks_exact(3).map(|row| row[1]).collect();

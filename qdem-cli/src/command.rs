@@ -428,11 +428,12 @@ fn decomposition_line(d: &qdem_core::Decomposition) -> String {
     };
     format!(
         "decomposed over {} ranks: tets per rank [{}], owned particles [{}], block sums received per step \
-         [{}], {} bodies cut between ranks",
+         [{}], particles received per step [{}], {} bodies cut between ranks",
         d.ranks,
         list(&d.tets),
         list(&d.owned),
         list(&d.halo),
+        list(&d.received),
         d.cut_bodies
     )
 }

@@ -247,6 +247,18 @@ fn a_checkpoint_written_at_two_ranks_resumes_at_one_and_three() {
     resumes_on_other_ranks("contact/collision.toml", 0.01, "resume", "300");
 }
 
+/// The cantilever's ranks exchange only their halo between whole gathers: the stop's gather
+/// must give the checkpoint the whole state.
+#[test]
+fn a_halo_exchanged_cantilever_checkpointed_at_two_ranks_resumes_at_one_and_three() {
+    resumes_on_other_ranks(
+        "cantilever/cantilever_lc100.toml",
+        0.02,
+        "resume-cantilever",
+        "333",
+    );
+}
+
 #[test]
 fn a_periodic_packing_checkpointed_at_two_ranks_resumes_at_one_and_three() {
     resumes_on_other_ranks(

@@ -5,10 +5,11 @@
 //! model order and then block order (their spatial order: recursive bisection), are cut into
 //! one contiguous range per rank of about equal cost; a body whose blocks all fall on one rank
 //! is computed there alone. A particle of a deformable body is **owned** by the rank of the
-//! block of its first entry. Each step:
+//! block of its first entry; its **halo** ranks are the others whose blocks hold it. Each
+//! step:
 //!
-//! 1. every rank predicts every particle (the same arithmetic on the same state everywhere,
-//!    so the predicted positions and half-step velocities agree bit for bit);
+//! 1. each rank predicts the particles it steps (the same arithmetic on the same values
+//!    everywhere, so the predicted positions and half-step velocities agree bit for bit);
 //! 2. each rank computes the tetrahedra of its blocks only; the block sums of a node owned by
 //!    another rank are sent to it ([`Communicator::all_to_all`], only for bodies cut between
 //!    ranks), so that the owner adds **every** block sum of its particle in ascending block
@@ -16,17 +17,30 @@
 //! 3. the other models (contacts, loads, gravity, rigid bodies) are computed whole on every
 //!    rank, from the same state;
 //! 4. after the integration, each rank's owned particles' accelerations and velocities (and
-//!    spins) go to every rank ([`Communicator::all_gather`]), so that every rank holds the one
-//!    state a single process holds; then the failure check agrees across ranks.
+//!    spins) go to the ranks that read them (`state_share.rs`); then the failure check
+//!    agrees across ranks.
 //!
-//! There is no floating-point reduction across ranks: a value is computed by one rank in the
-//! single-process order and copied, so outputs are byte-identical for any number of ranks
-//! and threads. Each rank keeps the whole state (the outputs are written by rank 0 from it);
-//! what is divided is the kernel's work.
+//! What a rank steps and what step 4 sends depend on what the models read:
+//! - **halo exchange**, when every model and hook reads only what a rank steps itself
+//!   ([`crate::ParticleReads::Local`]: deformable bodies, gravity, nodal loads) and the stepper
+//!   can be restricted (Verlet): a rank predicts its own particles and its halo, integrates
+//!   its own, and receives only its halo's motion. The other particles keep the value of the
+//!   last whole gather ([`crate::World::gather`]), which the outputs, checkpoints and
+//!   failure reports ask for before they read the state;
+//! - **whole share** otherwise (contacts, bonded particles, periodic hooks, explicit Newmark):
+//!   every rank steps every particle and receives every other rank's owned particles, so that
+//!   it holds the one state a single process holds after every step.
+//!
+//! There is no floating-point reduction across ranks in the state: a value is computed by one
+//! rank in the single-process order and copied, so outputs are byte-identical for any number
+//! of ranks and threads. (The one sum over ranks is the kinetic energy that the failure check
+//! watches in halo mode; see `state_share.rs`.)
 
 use crate::error::CoreError;
-use crate::model::Model;
+use crate::local_particles::{LocalParticles, ParticleRuns};
+use crate::model::{Model, ParticleReads};
 use crate::state::State;
+use crate::state_share::{Halo, StateShare};
 use crate::tet_body::TetBody;
 use crate::Vec3;
 use std::ops::Range;
@@ -117,6 +131,9 @@ pub struct Decomposition {
     pub owned: Vec<usize>,
     /// Per rank, the block sums it receives per step from the other ranks (its halo).
     pub halo: Vec<usize>,
+    /// Per rank, the particles whose motion it receives per step: its halo's when every
+    /// model reads only what a rank steps itself, else every other rank's particles.
+    pub received: Vec<usize>,
     /// The bodies cut between ranks (an exchange of block sums each step).
     pub cut_bodies: usize,
 }
@@ -306,27 +323,35 @@ fn assign_blocks(bodies: &[&TetBody], ranks: usize) -> Vec<Vec<u32>> {
 }
 
 /// Decomposes `models`' deformable bodies over `comm`'s ranks: tells every body which of its
-/// blocks this rank computes and which particles it owns, and returns the exchange of the
-/// owned particles that ends each step (and the decomposition's figures).
+/// blocks this rank computes and which particles it owns, and returns the exchange that ends
+/// each step, the decomposition's figures and, when every model reads only what a rank steps
+/// itself and `halo_allowed` (no hook reads more), the particles this rank steps.
 pub(crate) fn decompose(
     state: &State,
     models: &mut [Box<dyn Model>],
     comm: Arc<dyn Communicator>,
-) -> Result<(StateShare, Decomposition), CoreError> {
+    halo_allowed: bool,
+) -> Result<(StateShare, Decomposition, Option<LocalParticles>), CoreError> {
     let ranks = comm.size();
     let bodies: Vec<&TetBody> = models
         .iter()
         .filter_map(|m| TetBody::of(m.as_ref()))
         .collect();
     let block_ranks = assign_blocks(&bodies, ranks);
+    let halo = halo_allowed
+        && models
+            .iter()
+            .all(|m| m.particle_reads() == ParticleReads::Local);
     let mut figures = Decomposition {
         ranks,
         tets: vec![0; ranks],
         owned: vec![0; ranks],
         halo: vec![0; ranks],
+        received: vec![0; ranks],
         cut_bodies: 0,
     };
     let mut owner = vec![u32::MAX; state.len()];
+    let mut needs = Vec::new();
     let mut block_ranks = block_ranks.into_iter();
     for model in models.iter_mut() {
         let any: &mut dyn std::any::Any = model.as_mut();
@@ -352,108 +377,84 @@ pub(crate) fn decompose(
         for (total, n) in figures.halo.iter_mut().zip(&split.halo) {
             *total += n;
         }
+        if halo {
+            needs.extend(halo_of(body.body_layout(), &block_rank, &split.owner));
+        }
         body.set_split(split);
     }
-    let share = StateShare::new(owner, values_per_particle(state), comm);
-    Ok((share, figures))
-}
-
-/// The end of a decomposed step: each rank's owned particles' accelerations and velocities
-/// (and rotations) copied to every rank, in rank order; and the agreement of the ranks on
-/// whether the step failed.
-pub(crate) struct StateShare {
-    comm: Arc<dyn Communicator>,
-    /// The particles each rank owns, rank after rank, ascending within a rank.
-    particles: Vec<u32>,
-    /// This rank's part of `particles`.
-    own: Range<usize>,
-    /// Values per particle ([`values_per_particle`]).
-    per: usize,
-    /// Values from each rank.
-    counts: Vec<usize>,
-    mine: Vec<f64>,
-    all: Vec<f64>,
-}
-
-impl StateShare {
-    /// The share of the particles `owner` gives each rank (`u32::MAX`: computed by all), for
-    /// a state with `per` values per particle.
-    fn new(owner: Vec<u32>, per: usize, comm: Arc<dyn Communicator>) -> StateShare {
-        let ranks = comm.size();
-        let mut by_rank = vec![Vec::new(); ranks];
-        for (p, &r) in owner.iter().enumerate() {
-            if r != u32::MAX {
-                by_rank[r as usize].push(p as u32);
+    let (exchange, local) = match halo {
+        true => {
+            needs.sort_unstable();
+            needs.dedup();
+            for &(q, _) in &needs {
+                figures.received[q as usize] += 1;
             }
+            let (exchange, local) = halo_exchange(&owner, &needs, comm.rank() as u32, ranks);
+            (Some(exchange), Some(local))
         }
-        let start: usize = by_rank[..comm.rank()].iter().map(Vec::len).sum();
-        StateShare {
-            own: start..start + by_rank[comm.rank()].len(),
-            per,
-            counts: by_rank.iter().map(|b| per * b.len()).collect(),
-            particles: by_rank.concat(),
-            comm,
-            mine: Vec::new(),
-            all: Vec::new(),
-        }
+        false => (None, None),
+    };
+    let mut share = StateShare::new(&owner, state, exchange, comm);
+    if local.is_none() {
+        share.share_whole_every_step(&mut figures);
     }
-
-    /// Copies every rank's owned particles' motion into `state` on every rank.
-    pub fn share(&mut self, state: &mut State) {
-        self.mine.clear();
-        for &p in &self.particles[self.own.clone()] {
-            pack(state, p as usize, &mut self.mine);
-        }
-        self.all.resize(self.per * self.particles.len(), 0.0);
-        self.comm
-            .all_gather(&self.mine, &mut self.all, &self.counts);
-        for (&p, values) in self.particles.iter().zip(self.all.chunks_exact(self.per)) {
-            unpack(state, p as usize, values);
-        }
-    }
-
-    /// The failure every rank reports: the one of the lowest rank that found one.
-    pub fn agree(&self, local: Option<String>) -> Option<String> {
-        let mine = match local {
-            Some(_) => self.comm.rank() as u64,
-            None => u64::MAX,
-        };
-        let root = self.comm.min(mine);
-        if root == u64::MAX {
-            return None;
-        }
-        let mut bytes = local.map(String::into_bytes).unwrap_or_default();
-        self.comm.broadcast(root as usize, &mut bytes);
-        Some(String::from_utf8_lossy(&bytes).into_owned())
-    }
+    Ok((share, figures, local))
 }
 
-/// Values [`pack`] writes per particle: acceleration and velocity, and the rotation's when the
-/// particles have rotational DOFs.
-fn values_per_particle(state: &State) -> usize {
-    match state.spin.is_empty() {
-        true => 6,
-        false => 12,
-    }
+/// The (rank, particle) pairs of a body's halo: the nodes of each rank's blocks that another
+/// rank owns (`owner`: per particle of the body, from its first).
+fn halo_of<'a>(
+    layout: BodyLayout<'a>,
+    block_rank: &'a [u32],
+    owner: &'a [u32],
+) -> impl Iterator<Item = (u32, u32)> + 'a {
+    layout
+        .node_start
+        .windows(2)
+        .zip(block_rank)
+        .flat_map(move |(w, &q)| {
+            let nodes = &layout.nodes[w[0] as usize..w[1] as usize];
+            nodes
+                .iter()
+                .filter(move |&&n| owner[n as usize - layout.first] != q)
+                .map(move |&n| (q, n))
+        })
 }
 
-/// Appends particle `p`'s motion after the integration.
-fn pack(state: &State, p: usize, out: &mut Vec<f64>) {
-    out.extend_from_slice(state.acceleration[p].as_slice());
-    out.extend_from_slice(state.velocity[p].as_slice());
-    if !state.spin.is_empty() {
-        out.extend_from_slice(state.spin.acceleration[p].as_slice());
-        out.extend_from_slice(state.spin.velocity[p].as_slice());
+/// This rank's halo exchange and local particles, from every rank's halo `needs` ((rank,
+/// particle), sorted) and the particles' owners (`u32::MAX`: computed by all).
+fn halo_exchange(
+    owner: &[u32],
+    needs: &[(u32, u32)],
+    me: u32,
+    ranks: usize,
+) -> (Halo, LocalParticles) {
+    let (mut send, mut recv) = (vec![Vec::new(); ranks], vec![Vec::new(); ranks]);
+    let mut stepped: Vec<bool> = owner.iter().map(|&r| r == me || r == u32::MAX).collect();
+    let computed = ParticleRuns::from_mask(&stepped);
+    for &(q, p) in needs {
+        let from = owner[p as usize];
+        if q == me {
+            recv[from as usize].push(p);
+            stepped[p as usize] = true;
+        } else if from == me {
+            send[q as usize].push(p);
+        }
     }
-}
-
-/// Sets particle `p`'s motion from what [`pack`] wrote.
-fn unpack(state: &mut State, p: usize, v: &[f64]) {
-    let at = |k: usize| Vec3::new(v[k], v[k + 1], v[k + 2]);
-    state.acceleration[p] = at(0);
-    state.velocity[p] = at(3);
-    if !state.spin.is_empty() {
-        state.spin.acceleration[p] = at(6);
-        state.spin.velocity[p] = at(9);
-    }
+    let counted: Vec<bool> = owner
+        .iter()
+        .map(|&r| r == me || (me == 0 && r == u32::MAX))
+        .collect();
+    let halo = Halo {
+        send_counts: send.iter().map(Vec::len).collect(),
+        send: send.concat(),
+        recv_counts: recv.iter().map(Vec::len).collect(),
+        recv: recv.concat(),
+        counted: ParticleRuns::from_mask(&counted),
+    };
+    let local = LocalParticles {
+        computed,
+        stepped: ParticleRuns::from_mask(&stepped),
+    };
+    (halo, local)
 }

@@ -1,6 +1,6 @@
 //! Uniform gravity: the force m g on every particle.
 
-use crate::model::{Linearized, Model, Persistence};
+use crate::model::{Linearized, Model, ParticleReads, Persistence};
 use crate::state::State;
 use crate::tangent::Tangent;
 use crate::Vec3;
@@ -21,6 +21,11 @@ impl Gravity {
 impl Model for Gravity {
     fn name(&self) -> &str {
         "gravity"
+    }
+
+    /// The masses only.
+    fn particle_reads(&self) -> ParticleReads {
+        ParticleReads::Local
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {

@@ -29,6 +29,7 @@ pub mod instability;
 pub mod lanczos;
 pub mod linear_tet;
 pub mod local_damping;
+pub mod local_particles;
 pub mod material;
 mod mechanisms;
 pub mod model;
@@ -40,6 +41,7 @@ pub(crate) mod sparse;
 pub mod stable_step;
 pub mod stages;
 pub mod state;
+mod state_share;
 pub mod static_solve;
 pub mod step_settings;
 pub mod stepper;
@@ -62,7 +64,9 @@ pub use distributed::{Communicator, Decomposition};
 pub use error::CoreError;
 pub use gravity::Gravity;
 pub use material::Material;
-pub use model::{find_model, Linearized, Model, Persistence, Persistent, StepEvents};
+pub use model::{
+    find_model, Linearized, Model, ParticleReads, Persistence, Persistent, StepEvents,
+};
 pub use newmark::{EventSolve, Newmark, StepCounts, TangentUpdate};
 pub use nodal_load::NodalLoad;
 pub use rigid_body::RigidBodies;

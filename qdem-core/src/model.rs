@@ -43,6 +43,14 @@ pub trait Model: std::any::Any + Send + Sync {
         None
     }
 
+    /// Which particles' motion the model reads when it adds its forces, for a run decomposed
+    /// over processes ([`crate::distributed`]): with [`ParticleReads::Local`] from every model
+    /// and hook, a rank keeps only its own particles and its halo current between whole
+    /// gathers. The default, [`ParticleReads::All`], is always right.
+    fn particle_reads(&self) -> ParticleReads {
+        ParticleReads::All
+    }
+
     /// Potential energy (J) if the model is conservative, `None` otherwise.
     fn potential_energy(&self, state: &State) -> Option<f64> {
         let _ = state;
@@ -96,6 +104,25 @@ pub trait Model: std::any::Any + Send + Sync {
     fn persistent_mut(&mut self) -> Option<&mut dyn Persistent> {
         None
     }
+}
+
+/// Which particles' motion a [`Model`] (or a [`crate::PostStep`] hook) reads at each step.
+///
+/// ```
+/// use qdem_core::{Gravity, Model, ParticleReads, Vec3};
+///
+/// // Gravity reads the masses and nothing of the motion.
+/// let g = Gravity::new(Vec3::new(0.0, 0.0, -9.81));
+/// assert_eq!(g.particle_reads(), ParticleReads::Local);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParticleReads {
+    /// Only what a rank steps itself: nothing of the motion for gravity and nodal loads
+    /// (they read the time and the masses), the nodes of its own tetrahedra for a deformable
+    /// body (the decomposition's halo).
+    Local,
+    /// Any particle's.
+    All,
 }
 
 /// The first of `models` of type `M`, if any (models are `Any`: a body's element fields, a

@@ -54,6 +54,7 @@
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::conjugate_gradient::{self, Scratch};
 use crate::error::CoreError;
+use crate::local_particles::ParticleRuns;
 use crate::model::Model;
 use crate::sparse::{
     copy_matrix, explain_failure, restore_matrix, save_matrix, Assembler, DampingRows, FactorStats,
@@ -671,12 +672,26 @@ pub(crate) fn collect_tangent(
 /// The predictor of Eqs. 13–14 (the a_n, b_n of Eq. 22): x ← x + ∆t (v + (½ − β)∆t a),
 /// v ← v + (1 − γ)∆t a, t ← t + ∆t; the same for the particles' rotations.
 pub fn predict(state: &mut State, dt: f64, beta: f64, gamma: f64) {
+    predict_in(state, dt, beta, gamma, None);
+}
+
+/// [`predict`] of `only`'s particles (translations and rotations), or of every particle.
+pub(crate) fn predict_in(
+    state: &mut State,
+    dt: f64,
+    beta: f64,
+    gamma: f64,
+    only: Option<&ParticleRuns>,
+) {
     let (cx, cv) = ((0.5 - beta) * dt, (1.0 - gamma) * dt);
     let update = |((x, v), a): ((&mut Vec3, &mut Vec3), &Vec3)| {
         *x += dt * (*v + cx * a);
         *v += cv * a;
     };
-    for_each_dof(state, update);
+    match only {
+        None => for_each_dof(state, update),
+        Some(runs) => for_each_dof_in(state, runs, update),
+    }
     state.time += dt;
 }
 
@@ -769,6 +784,27 @@ where
             .zip(a.par_iter())
             .with_min_len(PARTICLE_CHUNK)
             .for_each(update);
+    }
+}
+
+/// [`for_each_dof`] over `runs`' particles only, a range to a thread at a time.
+fn for_each_dof_in<F>(state: &mut State, runs: &ParticleRuns, update: F)
+where
+    F: Fn(((&mut Vec3, &mut Vec3), &Vec3)) + Sync + Send + Copy,
+{
+    for (x, v, a) in dof_sets(state) {
+        if x.is_empty() {
+            continue;
+        }
+        let a: &[Vec3] = a;
+        let a_runs = runs.pieces().iter().map(|r| &a[r.clone()]);
+        runs.split(x)
+            .into_par_iter()
+            .zip(runs.split(v))
+            .zip(a_runs.collect::<Vec<_>>())
+            .for_each(|((x, v), a)| {
+                x.iter_mut().zip(v.iter_mut()).zip(a).for_each(update);
+            });
     }
 }
 

@@ -1,7 +1,7 @@
 //! A force shared equally by a set of particles, scaled by a time function (the scene's
 //! `[[load]]`).
 
-use crate::model::{Linearized, Model, Persistence};
+use crate::model::{Linearized, Model, ParticleReads, Persistence};
 use crate::state::State;
 use crate::tangent::Tangent;
 use crate::time_function::TimeFunction;
@@ -32,6 +32,11 @@ impl NodalLoad {
 impl Model for NodalLoad {
     fn name(&self) -> &str {
         &self.name
+    }
+
+    /// The time only.
+    fn particle_reads(&self) -> ParticleReads {
+        ParticleReads::Local
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {

@@ -3,6 +3,7 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
+use crate::local_particles::{LocalParticles, ParticleRuns};
 use crate::model::Model;
 use crate::newmark::StepCounts;
 use crate::rigid_body::reduce_member_forces;
@@ -67,6 +68,15 @@ pub trait Stepper: Send {
     ) -> Result<(), CoreError> {
         let stepped = self.step_timed(state, models, stages);
         complete(state, stages, stepped)
+    }
+
+    /// In a run decomposed with a halo exchange ([`crate::distributed`]): from now on, steps
+    /// only `local`'s particles (predicts `local.stepped`, integrates `local.computed`) and
+    /// leaves the others as they are. Returns whether the stepper can; the default cannot,
+    /// and the run then shares the whole state after every step.
+    fn restrict(&mut self, local: std::sync::Arc<LocalParticles>) -> bool {
+        let _ = local;
+        false
     }
 
     /// Size and cost of the sparse factorisation, for steppers that solve a linear system;
@@ -198,7 +208,7 @@ pub(crate) fn compute_accelerations_timed(
 /// Sets θ̈ = M/J for the particles' rotations (`moment`: one per particle), zero about fixed
 /// axes. Fails on a non-finite value.
 pub(crate) fn set_spin_accelerations(state: &mut State, moment: &[Vec3]) -> Result<(), CoreError> {
-    accelerate_spin(state, moment, None)
+    accelerate_spin(state, moment, None, None)
 }
 
 /// The rates a pass of [`divide_free`] writes: the accelerations, the velocities and the kick
@@ -207,38 +217,55 @@ type Rates<'a> = (&'a mut [Vec3], &'a mut [Vec3], Option<f64>);
 
 /// out_i = load_i / inertia_i with the fixed directions zeroed, and zero where `follows(i)`
 /// (members of rigid bodies, which follow their body), then v_i += h out_i with a kick h; in
-/// parallel, one pass. Returns the first index with a non-finite result, `usize::MAX` if none.
+/// parallel, one pass, over every particle or over `only`'s. Returns the first index with a
+/// non-finite result, `usize::MAX` if none.
 fn divide_free(
     (out, rate, kick): Rates<'_>,
     load: &[Vec3],
     inertia: &[f64],
     fixed: &[Dofs],
     follows: impl Fn(usize) -> bool + Sync,
+    only: Option<&ParticleRuns>,
 ) -> usize {
-    out.par_iter_mut()
-        .zip(rate.par_iter_mut())
-        .with_min_len(PARTICLE_CHUNK)
-        .enumerate()
-        .map(|(i, (a, v))| {
-            if follows(i) {
-                *a = Vec3::zeros();
-                return usize::MAX;
+    let one = |i: usize, a: &mut Vec3, v: &mut Vec3| {
+        if follows(i) {
+            *a = Vec3::zeros();
+            return usize::MAX;
+        }
+        let mut acc = load[i] / inertia[i];
+        for axis in 0..3 {
+            if fixed[i].contains(axis) {
+                acc[axis] = 0.0;
             }
-            let mut acc = load[i] / inertia[i];
-            for axis in 0..3 {
-                if fixed[i].contains(axis) {
-                    acc[axis] = 0.0;
-                }
-            }
-            *a = acc;
-            if let Some(h) = kick {
-                *v += h * acc;
-            }
-            if acc.iter().all(|c| c.is_finite()) {
-                usize::MAX
-            } else {
-                i
-            }
+        }
+        *a = acc;
+        if let Some(h) = kick {
+            *v += h * acc;
+        }
+        if acc.iter().all(|c| c.is_finite()) {
+            usize::MAX
+        } else {
+            i
+        }
+    };
+    let Some(runs) = only else {
+        return out
+            .par_iter_mut()
+            .zip(rate.par_iter_mut())
+            .with_min_len(PARTICLE_CHUNK)
+            .enumerate()
+            .map(|(i, (a, v))| one(i, a, v))
+            .min()
+            .unwrap_or(usize::MAX);
+    };
+    runs.split(out)
+        .into_par_iter()
+        .zip(runs.split(rate))
+        .zip(runs.pieces())
+        .map(|((a, v), r)| {
+            let pairs = a.iter_mut().zip(v.iter_mut());
+            let bad = pairs.zip(r.clone()).map(|((a, v), i)| one(i, a, v));
+            bad.min().unwrap_or(usize::MAX)
         })
         .min()
         .unwrap_or(usize::MAX)
@@ -255,15 +282,16 @@ fn non_finite_at(first_bad: usize, time: f64) -> Result<(), CoreError> {
 /// Sets a = f/m, zero in fixed directions and on members of rigid bodies (which follow their
 /// body). Fails on a non-finite acceleration.
 pub(crate) fn set_accelerations(state: &mut State, force: &[Vec3]) -> Result<(), CoreError> {
-    accelerate(state, force, None)
+    accelerate(state, force, None, None)
 }
 
 /// [`set_accelerations`], then the kick v += h a of every particle with `kick` = `Some(h)`, in
-/// the same pass (the second half kick of a Verlet step).
+/// the same pass (the second half kick of a Verlet step); of `only`'s particles if given.
 pub(crate) fn accelerate(
     state: &mut State,
     force: &[Vec3],
     kick: Option<f64>,
+    only: Option<&ParticleRuns>,
 ) -> Result<(), CoreError> {
     let rigid = &state.rigid;
     let first_bad = divide_free(
@@ -272,16 +300,18 @@ pub(crate) fn accelerate(
         &state.mass,
         &state.fixed,
         |i| rigid.body_of_member(i).is_some(),
+        only,
     );
     non_finite_at(first_bad, state.time)
 }
 
 /// θ̈ = M/J for the particles' rotations, zero about fixed axes, then ω += h θ̈ with `kick`
-/// = `Some(h)`, in one pass. Fails on a non-finite value.
+/// = `Some(h)`, in one pass, of `only`'s particles if given. Fails on a non-finite value.
 pub(crate) fn accelerate_spin(
     state: &mut State,
     moment: &[Vec3],
     kick: Option<f64>,
+    only: Option<&ParticleRuns>,
 ) -> Result<(), CoreError> {
     let spin = &mut state.spin;
     let first_bad = divide_free(
@@ -290,6 +320,7 @@ pub(crate) fn accelerate_spin(
         &spin.inertia,
         &spin.fixed,
         |_| false,
+        only,
     );
     non_finite_at(first_bad, state.time)
 }

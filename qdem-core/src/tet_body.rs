@@ -19,7 +19,7 @@
 use crate::distributed::{BodyLayout, BodySplit};
 use crate::error::CoreError;
 use crate::material::{Lame, Material};
-use crate::model::{Linearized, Model, Persistence};
+use crate::model::{Linearized, Model, ParticleReads, Persistence};
 use crate::stable_step::{critical_step, element_rate_bound};
 use crate::state::State;
 use crate::tangent::Tangent;
@@ -460,6 +460,11 @@ impl Model for TetBody {
 
     fn name(&self) -> &str {
         &self.name
+    }
+
+    /// The nodes of its own blocks: in a decomposed run, the rank's particles and its halo.
+    fn particle_reads(&self) -> ParticleReads {
+        ParticleReads::Local
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {

@@ -13,13 +13,16 @@
 //! ([`crate::local_damping`]) acts on the summed forces before they become accelerations.
 //!
 //! A step is two passes over the particles besides the forces: the first half kick with the
-//! drift, and the accelerations with the second half kick and the finiteness check.
+//! drift, and the accelerations with the second half kick and the finiteness check. In a run
+//! decomposed with a halo exchange ([`Stepper::restrict`]) both passes cover only the
+//! rank's own particles and its halo ([`crate::local_particles`]).
 
 use crate::checkpoint::{same_count, CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::local_damping;
+use crate::local_particles::LocalParticles;
 use crate::model::Model;
-use crate::newmark::predict;
+use crate::newmark::predict_in;
 use crate::rigid_body::place_members;
 use crate::stages::{Stage, StageTimes};
 use crate::state::State;
@@ -27,6 +30,7 @@ use crate::stepper::{
     accelerate, accelerate_spin, check_finite_torque, check_masses, sum_forces, Stepper,
 };
 use crate::Vec3;
+use std::sync::Arc;
 
 /// Velocity Verlet with a fixed step.
 ///
@@ -55,6 +59,8 @@ pub struct Verlet {
     local_damping: f64,
     force: Vec<Vec3>,
     torque: Vec<Vec3>,
+    /// The particles this rank steps, in a run decomposed with a halo exchange.
+    local: Option<Arc<LocalParticles>>,
 }
 
 impl Verlet {
@@ -65,6 +71,7 @@ impl Verlet {
             local_damping: 0.0,
             force: Vec::new(),
             torque: Vec::new(),
+            local: None,
         }
     }
 
@@ -89,9 +96,10 @@ impl Verlet {
             local_damping::apply(state, &mut self.force, &mut self.torque, self.local_damping);
         }
         let (rigid, moment) = self.torque.split_at(state.rigid.len());
-        accelerate(state, &self.force, kick)?;
+        let only = self.local.as_ref().map(|l| &l.computed);
+        accelerate(state, &self.force, kick, only)?;
         if !state.spin.is_empty() {
-            accelerate_spin(state, moment, kick)?;
+            accelerate_spin(state, moment, kick, only)?;
         }
         check_finite_torque(state, rigid)
     }
@@ -157,6 +165,11 @@ impl Stepper for Verlet {
         Ok(())
     }
 
+    fn restrict(&mut self, local: Arc<LocalParticles>) -> bool {
+        self.local = Some(local);
+        true
+    }
+
     fn step_timed(
         &mut self,
         state: &mut State,
@@ -166,7 +179,7 @@ impl Stepper for Verlet {
         let dt = self.dt;
         // The kick and the drift in one pass: Newmark's predictor with β = 0, γ = ½ is
         // x += ∆t (v + ½∆t a), v += ½∆t a, bit for bit.
-        predict(state, dt, 0.0, 0.5);
+        predict_in(state, dt, 0.0, 0.5, self.local.as_ref().map(|l| &l.stepped));
         if !state.rigid.is_empty() {
             state.rigid.kick_and_rotate(&self.torque, dt);
             place_members(state);

@@ -19,12 +19,14 @@
 //! the models learn how they are stepped from [`Model::prepare`].
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
-use crate::distributed::{decompose, Communicator, Decomposition, StateShare};
+use crate::distributed::{decompose, Communicator, Decomposition};
 use crate::error::CoreError;
 use crate::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
-use crate::model::{find_model, Model, Persistence};
+use crate::local_particles::LocalParticles;
+use crate::model::{find_model, Model, ParticleReads, Persistence};
 use crate::stages::{Stage, StageShare, StageTimes};
 use crate::state::State;
+use crate::state_share::StateShare;
 use crate::step_settings::{Scheme, StepSettings};
 use crate::stepper::{stable_step, Stepper};
 use std::sync::Arc;
@@ -37,6 +39,12 @@ pub trait PostStep: std::any::Any + Send + Sync {
 
     /// Acts on the state after a step; returns a [`Halt`] to end the run after this step.
     fn after_step(&mut self, state: &mut State, models: &[Box<dyn Model>]) -> Option<Halt>;
+
+    /// Which particles' motion the hook reads ([`Model::particle_reads`]); the default,
+    /// [`ParticleReads::All`], is always right.
+    fn particle_reads(&self) -> ParticleReads {
+        ParticleReads::All
+    }
 }
 
 /// Why a post-step hook ended a run early (not a failure: the outputs are complete).
@@ -98,6 +106,8 @@ pub struct World {
     energy: EnergyGrowth,
     steps_done: u64,
     share: Option<(StateShare, Decomposition)>,
+    /// The particles this rank steps, when a step shares only the halo.
+    local: Option<Arc<LocalParticles>>,
 }
 
 impl World {
@@ -122,6 +132,7 @@ impl World {
             energy: EnergyGrowth::new(),
             steps_done: 0,
             share: None,
+            local: None,
         })
     }
 
@@ -132,7 +143,22 @@ impl World {
         self.stepper = settings.stepper()?;
         prepare(&mut self.models, &settings);
         self.settings = settings;
+        self.restrict_stepper();
         Ok(())
+    }
+
+    /// In halo mode, has the stepper step only this rank's particles, or, if it cannot, makes
+    /// every step share the whole state (after a whole gather: the stale particles are
+    /// brought up to date first).
+    fn restrict_stepper(&mut self) {
+        let (Some(local), Some((share, figures))) = (&self.local, &mut self.share) else {
+            return;
+        };
+        if !self.stepper.restrict(local.clone()) {
+            share.gather(&mut self.state);
+            share.share_whole_every_step(figures);
+            self.local = None;
+        }
     }
 
     /// Adds a post-step hook, run after the hooks added before it; the stage counters start
@@ -189,10 +215,14 @@ impl World {
 
     /// Decomposes the run over `comm`'s ranks ([`crate::distributed`]): from now on this
     /// process computes its share of the deformable bodies and every step ends with the
-    /// exchange of the particles each rank owns, so that every rank holds the state one
-    /// process would (after each sub-step of an adaptive explicit Newmark step too). Call it
-    /// on every rank, before [`World::initialize`] or [`World::restore`]. Only explicit runs
-    /// (Verlet, explicit Newmark) can be decomposed.
+    /// exchange of the particles each rank owns (after each sub-step of an adaptive explicit
+    /// Newmark step too). When every model and hook reads only what a rank steps itself
+    /// ([`ParticleReads::Local`]) and the stepper can be restricted (Verlet), a rank steps
+    /// only its own particles and its halo, and receives only its halo: call
+    /// [`World::gather`] before reading the whole state. Otherwise every rank holds the state
+    /// one process would after every step. Call it on every rank, before
+    /// [`World::initialize`] or [`World::restore`]. Only explicit runs (Verlet, explicit
+    /// Newmark) can be decomposed.
     pub fn decompose(&mut self, comm: Arc<dyn Communicator>) -> Result<Decomposition, CoreError> {
         if self.settings.scheme.is_implicit() {
             return Err(CoreError::Decomposition(format!(
@@ -201,9 +231,25 @@ impl World {
                 self.stepper.name()
             )));
         }
-        let (share, figures) = decompose(&self.state, &mut self.models, comm)?;
-        self.share = Some((share, figures.clone()));
-        Ok(figures)
+        let halo_allowed = self
+            .hooks
+            .iter()
+            .all(|h| h.particle_reads() == ParticleReads::Local);
+        let (share, figures, local) = decompose(&self.state, &mut self.models, comm, halo_allowed)?;
+        self.share = Some((share, figures));
+        self.local = local.map(Arc::new);
+        self.restrict_stepper();
+        Ok(self.decomposition().expect("decomposed").clone())
+    }
+
+    /// Makes the state whole on every rank of a decomposed run, as one process holds it: a
+    /// collective, which every rank calls after the same step. Needed before reading any
+    /// particle's motion when a step shares only the halo ([`World::decompose`]); a no-op
+    /// otherwise (and in a run of one process).
+    pub fn gather(&mut self) {
+        if let Some((share, _)) = &mut self.share {
+            share.gather(&mut self.state);
+        }
     }
 
     /// How the run is decomposed over processes; `None` for a run of one process.
@@ -219,6 +265,7 @@ impl World {
             return done;
         };
         share.share(&mut self.state);
+        share.gather(&mut self.state);
         match share.agree(done.err().map(|e| e.to_string())) {
             Some(failure) => Err(CoreError::Decomposition(failure)),
             None => Ok(()),
@@ -281,21 +328,24 @@ impl World {
             Some((share, _)) => share.agree(local),
             None => local,
         };
+        let kinetic = match &self.share {
+            Some((share, _)) => share.kinetic_energy(&self.state),
+            None => self.state.kinetic_energy(),
+        };
         let failure = failure.or_else(|| {
-            self.energy
-                .observe(self.state.kinetic_energy())
-                .map(|growth| {
-                    format!(
-                        "the kinetic energy grew by more than {:.0}% at each of the last \
+            self.energy.observe(kinetic).map(|growth| {
+                format!(
+                    "the kinetic energy grew by more than {:.0}% at each of the last \
                          {GROWTH_STEPS} steps (x{growth:.2e} in all), the signature of an \
                          unstable step",
-                        100.0 * (GROWTH_PER_STEP - 1.0)
-                    )
-                })
+                    100.0 * (GROWTH_PER_STEP - 1.0)
+                )
+            })
         });
         let Some(detail) = failure else {
             return Ok(());
         };
+        self.gather();
         let (bound, limiter) = stable_step(&self.state, &self.models)
             .unwrap_or((f64::INFINITY, "nothing".to_string()));
         Err(CoreError::Unstable {

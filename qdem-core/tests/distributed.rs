@@ -174,8 +174,14 @@ fn one_process(newmark: bool) -> (State, u64) {
     (world.state, retakes)
 }
 
-/// Every rank's state after [`STEPS`] steps over `size` ranks, and the decomposition.
-fn ranks(size: usize, newmark: bool) -> (Vec<State>, Decomposition) {
+/// Every rank's state after [`STEPS`] steps over `size` ranks (made whole by a gather at the
+/// end, and also every `gather_every` steps if given), and the decomposition; and per rank
+/// whether the last gather changed its state.
+fn ranks(
+    size: usize,
+    newmark: bool,
+    gather_every: Option<usize>,
+) -> (Vec<State>, Decomposition, Vec<bool>) {
     let hub = Arc::new(Hub {
         size,
         barrier: Barrier::new(size),
@@ -189,21 +195,27 @@ fn ranks(size: usize, newmark: bool) -> (Vec<State>, Decomposition) {
                 let comm = Arc::new(ThreadRank { rank, hub });
                 let figures = world.decompose(comm).unwrap();
                 world.initialize().unwrap();
-                for _ in 0..STEPS {
+                for step in 1..=STEPS {
                     world.step().unwrap();
+                    if gather_every.is_some_and(|n| step % n == 0) {
+                        world.gather();
+                    }
                 }
-                (world.state, figures)
+                let before = common::motion_bits(&world.state);
+                world.gather();
+                let gathered = before != common::motion_bits(&world.state);
+                (world.state, figures, gathered)
             })
         })
         .collect();
-    let mut states = Vec::new();
-    let mut figures = None;
+    let (mut states, mut figures, mut gathered) = (Vec::new(), None, Vec::new());
     for run in runs {
-        let (state, f) = run.join().unwrap();
+        let (state, f, g) = run.join().unwrap();
         states.push(state);
         figures.get_or_insert(f);
+        gathered.push(g);
     }
-    (states, figures.unwrap())
+    (states, figures.unwrap(), gathered)
 }
 
 /// Every rank's state has the bits of one process's.
@@ -222,14 +234,36 @@ fn two_and_three_ranks_hold_the_bit_identical_state_of_one_process() {
     let (reference, _) = one_process(false);
     assert!(reference.displacement(reference.len() - 1).norm() > 0.0);
     for size in [2, 3] {
-        let (states, figures) = ranks(size, false);
+        let (states, figures, _) = ranks(size, false, None);
         assert_all_equal(&states, &reference);
         let tets: usize = figures.tets.iter().sum();
         assert_eq!(tets, 60 * 6 * 6 * 6, "every tetrahedron is computed once");
         assert_eq!(figures.owned.iter().sum::<usize>(), reference.len());
         assert!(figures.tets.iter().all(|&t| t > 0), "{figures:?}");
         assert_eq!(figures.cut_bodies, 1);
+        // The beam's models read only what a rank steps: a rank receives its halo, a few
+        // cross-sections of the beam (7 x 7 nodes each), not the other ranks' particles.
+        for (received, owned) in figures.received.iter().zip(&figures.owned) {
+            assert!(*received <= 2 * 49, "{figures:?}");
+            assert!(*received < reference.len() - owned, "{figures:?}");
+        }
+        assert!(figures.received.iter().sum::<usize>() > 0, "{figures:?}");
     }
+}
+
+/// Whole gathers in the middle of a halo-exchanged run (the outputs' and checkpoints') leave
+/// the stepping as it was; a rank's state differs from one process's before the last gather,
+/// which shows that the halo exchange, not a whole share, kept it going.
+#[test]
+fn gathers_between_halo_exchanged_steps_change_no_bit() {
+    let (reference, _) = one_process(false);
+    let (states, _, gathered) = ranks(2, false, Some(37));
+    assert_all_equal(&states, &reference);
+    assert_eq!(
+        gathered,
+        [true, true],
+        "each rank held only its part before the gather"
+    );
 }
 
 /// Adaptive explicit Newmark with retaken steps: each sub-step predicts from the one before,
@@ -244,7 +278,15 @@ fn adaptive_explicit_newmark_over_ranks_retakes_the_steps_one_process_retakes() 
         "the tripwire makes sub-steps: {retakes} retakes"
     );
     for size in [2, 3] {
-        let (states, _) = ranks(size, true);
+        let (states, figures, gathered) = ranks(size, true, None);
+        assert!(
+            gathered.iter().all(|g| !g),
+            "Newmark shares the whole state every step"
+        );
         assert_all_equal(&states, &reference);
+        // Newmark steps every particle: each rank receives every other rank's particles.
+        for (received, owned) in figures.received.iter().zip(&figures.owned) {
+            assert_eq!(*received, reference.len() - owned, "{figures:?}");
+        }
     }
 }

@@ -143,14 +143,36 @@ impl std::fmt::Debug for RunOptions<'_> {
     }
 }
 
+/// What the ranks of a run agree on after each step.
+#[derive(Clone, Copy, Debug)]
+struct Sync {
+    /// The run stops after this step (a stop was asked for on some rank).
+    stop: bool,
+    /// The state is made whole on every rank first ([`qdem_core::World::gather`]): rank 0
+    /// records or checkpoints it.
+    whole: bool,
+}
+
 impl RunOptions<'_> {
-    /// Whether the run stops after `step`: asked to (on any rank, in a decomposed run).
-    fn stops_after(&self, step: u64) -> bool {
+    /// After `step`: whether the run stops (asked to, on any rank of a decomposed run), and
+    /// whether the state must be made whole first (`whole`: rank 0 reads it; a stop always
+    /// does, for its checkpoint). One agreement of the ranks per step.
+    fn sync_after(&self, step: u64, whole: bool) -> Sync {
         let asked =
             self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) || self.stop_after == Some(step);
-        match self.ranks {
-            Some(ranks) => ranks.min(u64::from(!asked)) == 0,
-            None => asked,
+        let Some(ranks) = self.ranks else {
+            return Sync { stop: asked, whole };
+        };
+        // The smallest wins: 0 stop (and gather), 1 gather, 2 neither.
+        let mine = match (asked, whole) {
+            (true, _) => 0,
+            (false, true) => 1,
+            (false, false) => 2,
+        };
+        let agreed = ranks.min(mine);
+        Sync {
+            stop: agreed == 0,
+            whole: agreed <= 1,
         }
     }
 }
@@ -212,7 +234,12 @@ pub fn run_with(
                 seconds,
                 halt: halt.as_ref(),
             };
-            run.after_step(sim, step, &info)?;
+            let keep_good = run.keeps_good_state(sim, dt);
+            let sync = options.sync_after(step, keep_good || run.reads_state(sim, dt));
+            if sync.whole {
+                sim.world.gather();
+            }
+            run.after_step(sim, step, &info, sync, keep_good)?;
             if step % 64 == 0 && last_report.elapsed().as_secs_f64() > 0.5 {
                 last_report = Instant::now();
                 let time = sim.world.state.time;
@@ -229,6 +256,11 @@ pub fn run_with(
         }
         Ok(())
     })();
+    if outcome.is_ok() {
+        // The other ranks gather too at a run's end, but not after a stop or a failure,
+        // which gathered at their step.
+        sim.world.gather();
+    }
     let wall_seconds = start.elapsed().as_secs_f64();
     run.close(sim, outcome)?;
     let steps = match halt {
@@ -244,8 +276,7 @@ pub fn run_with(
 
 /// A run in progress besides its world: the recorders, the run record, and what checkpoints
 /// need (the file, the scene's fingerprint, the last good state kept in memory).
-struct Run<'a> {
-    options: RunOptions<'a>,
+struct Run {
     recorders: Vec<Box<dyn Recorder>>,
     record: RunRecord,
     checkpoint_path: PathBuf,
@@ -255,15 +286,15 @@ struct Run<'a> {
     good_schedule: Schedule,
 }
 
-impl<'a> Run<'a> {
+impl Run {
     /// Prepares `out_dir` (its folders, no temporary files of killed runs), refuses a run that
     /// must checkpoint but cannot, registers the recorders and, resuming, restores the world
     /// and the recorders from the checkpoint; then opens the recorders' files.
     fn open(
         sim: &mut Simulation,
         out_dir: &Path,
-        options: RunOptions<'a>,
-    ) -> Result<Run<'a>, RunError> {
+        options: RunOptions<'_>,
+    ) -> Result<Run, RunError> {
         create_dir(out_dir)?;
         if sim.scene.output.writes_vtu() {
             create_dir(&out_dir.join("vtu"))?;
@@ -276,7 +307,6 @@ impl<'a> Run<'a> {
             }
         }
         let mut run = Run {
-            options,
             recorders: record::register(sim, out_dir),
             record: RunRecord::new(sim),
             checkpoint_path: out_dir.join(CHECKPOINT_FILE),
@@ -296,35 +326,49 @@ impl<'a> Run<'a> {
         Ok(run)
     }
 
-    /// After the sample at the start (step 0) and after every step: the recorders record,
-    /// then a checkpoint when due or asked for (a stop request ends the run with
-    /// [`RunError::Interrupted`]), else, at a probe interval, the last good state in memory.
+    /// Whether a recorder or a checkpoint reads the state after this step (at `dt`).
+    fn reads_state(&self, sim: &Simulation, dt: f64) -> bool {
+        let time = sim.world.state.time;
+        self.recorders.iter().any(|r| r.due(time, dt)) || self.record.checkpoints.is_due(time, dt)
+    }
+
+    /// Whether the last good state is kept in memory after this step (at `dt`): at a probe
+    /// interval, at most once per [`GOOD_STATE_EVERY`] seconds of wall time.
+    fn keeps_good_state(&self, sim: &Simulation, dt: f64) -> bool {
+        self.can_checkpoint
+            && self.good_schedule.is_due(sim.world.state.time, dt)
+            && self
+                .last_good
+                .as_ref()
+                .is_none_or(|g| g.2.elapsed().as_secs_f64() >= GOOD_STATE_EVERY)
+    }
+
+    /// After the sample at the start (step 0) and after every step, with the state whole
+    /// where `sync` says so: the recorders record, then a checkpoint when due or asked for
+    /// (a stop request ends the run with [`RunError::Interrupted`]), else, with `keep_good`,
+    /// the last good state in memory.
     fn after_step(
         &mut self,
         sim: &Simulation,
         step: u64,
         info: &StepInfo<'_>,
+        sync: Sync,
+        keep_good: bool,
     ) -> Result<(), RunError> {
         for r in self.recorders.iter_mut() {
             r.record(sim, info)?;
         }
         let time = sim.world.state.time;
-        let sampled = self.good_schedule.due(time, info.dt);
+        self.good_schedule.due(time, info.dt);
         self.record.next_step = step + 1;
-        let stop = self.options.stops_after(step);
+        let stop = sync.stop;
         if self.record.checkpoints.due(time, info.dt) || stop {
             for r in self.recorders.iter_mut() {
                 r.publish()?;
             }
             let body = encode(sim, &self.record, &self.recorders)?;
             write_checkpoint(&self.checkpoint_path, &self.fingerprint, &body)?;
-        } else if sampled
-            && self.can_checkpoint
-            && self
-                .last_good
-                .as_ref()
-                .is_none_or(|g| g.2.elapsed().as_secs_f64() >= GOOD_STATE_EVERY)
-        {
+        } else if keep_good {
             let body = encode(sim, &self.record, &self.recorders)?;
             self.last_good = Some((time, body, Instant::now()));
         }
@@ -375,13 +419,22 @@ fn follow(sim: &mut Simulation, options: RunOptions<'_>) -> Result<RunReport, Ru
     };
     let steps = sim.steps();
     let mut halt = None;
+    let mut stopped = false;
     for step in first_step..=steps {
         if step > 0 {
             halt = sim.world.step().map_err(|source| core_error(sim, source))?;
         }
-        if options.stops_after(step) || halt.is_some() {
+        let sync = options.sync_after(step, false);
+        if sync.whole {
+            sim.world.gather();
+        }
+        stopped = sync.stop;
+        if stopped || halt.is_some() {
             break;
         }
+    }
+    if !stopped {
+        sim.world.gather();
     }
     let wall_seconds = start.elapsed().as_secs_f64();
     let steps = sim.world.steps_done();

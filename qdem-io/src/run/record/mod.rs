@@ -75,6 +75,14 @@ pub(crate) trait Recorder {
         Ok(())
     }
 
+    /// Whether [`Recorder::record`] reads the state at `time` (a sample is due), so that a
+    /// decomposed run makes it whole first ([`qdem_core::World::gather`]). The default:
+    /// never.
+    fn due(&self, time: f64, dt: f64) -> bool {
+        let _ = (time, dt);
+        false
+    }
+
     /// Records what is due at the simulation's time: once at the start, then after every
     /// step. The default records nothing (an output written at the end).
     fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {

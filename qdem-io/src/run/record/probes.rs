@@ -66,6 +66,10 @@ impl Recorder for Probes {
         Ok(())
     }
 
+    fn due(&self, time: f64, dt: f64) -> bool {
+        self.schedule.is_due(time, dt)
+    }
+
     fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {
         let time = sim.world.state.time;
         if !self.schedule.due(time, step.dt) {

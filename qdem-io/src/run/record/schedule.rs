@@ -19,9 +19,14 @@ impl Schedule {
         Schedule { every, next: every }
     }
 
+    /// Whether a sample is due at `time`, given the step `dt`, without advancing.
+    pub(crate) fn is_due(&self, time: f64, dt: f64) -> bool {
+        self.every > 0.0 && time >= self.next - 0.5 * dt
+    }
+
     /// Whether a sample is due at `time`, given the step `dt`; advances past it if so.
     pub(crate) fn due(&mut self, time: f64, dt: f64) -> bool {
-        if self.every <= 0.0 || time < self.next - 0.5 * dt {
+        if !self.is_due(time, dt) {
             return false;
         }
         // An interval far below the step (a checkpoint at every step) skips ahead at once,

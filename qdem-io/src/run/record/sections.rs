@@ -42,6 +42,10 @@ impl Recorder for Sections {
         "sections"
     }
 
+    fn due(&self, time: f64, dt: f64) -> bool {
+        self.schedule.is_due(time, dt)
+    }
+
     fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {
         let time = sim.world.state.time;
         if !self.schedule.due(time, step.dt) {

@@ -1,0 +1,244 @@
+//! [`StateShare`]: what ends each integration of a decomposed run ([`crate::distributed`]),
+//! and the whole gathers in between.
+//!
+//! A step's share copies the motion a rank integrated to the ranks that read it: the
+//! acceleration and velocity (and the rotation's) of each owned particle, which is all the
+//! next prediction (paper 000 §2.4: x += ∆t (v + ½∆t a), v += ½∆t a) needs besides the
+//! position, and the position follows bit for bit from them. Two ways:
+//! - **whole**: every owned particle to every rank ([`Communicator::all_gather`]), when some
+//!   model or hook reads any particle ([`crate::ParticleReads::All`]) or the stepper steps
+//!   every particle; every rank then holds the state one process holds after every step;
+//! - **halo**: each owned particle only to the ranks whose tetrahedra touch it
+//!   ([`Communicator::all_to_all`]); a rank steps its own particles and its halo, and the
+//!   others keep the value of the last whole gather. Whoever reads the whole state (the
+//!   outputs, a checkpoint, a failure's report) asks for a [`StateShare::gather`] first,
+//!   which sends the positions too.
+//!
+//! Values are copied, never summed, so any number of ranks gives the same bits. The one sum
+//! over ranks is the kinetic energy of the failure check in halo mode: each rank's part, in
+//! rank order, equal to one process's sum up to its rounding.
+
+use crate::distributed::{Communicator, Decomposition};
+use crate::local_particles::ParticleRuns;
+use crate::state::State;
+use crate::Vec3;
+use std::ops::Range;
+use std::sync::Arc;
+
+/// The exchange that ends each integration of a decomposed run, and the whole gathers.
+pub(crate) struct StateShare {
+    comm: Arc<dyn Communicator>,
+    /// The particles each rank owns, rank after rank, ascending within a rank.
+    particles: Vec<u32>,
+    /// This rank's part of `particles`.
+    own: Range<usize>,
+    /// Owned particles per rank.
+    owned: Vec<usize>,
+    /// Whether the particles have rotational DOFs.
+    spin: bool,
+    /// The halo exchange, when a step shares only the halo.
+    halo: Option<Halo>,
+    mine: Vec<f64>,
+    all: Vec<f64>,
+}
+
+/// The particles a rank sends to and receives from each other rank after each step: grouped
+/// by rank, ascending within a rank, so that both sides list them alike.
+pub(crate) struct Halo {
+    pub send: Vec<u32>,
+    /// Particles sent to each rank.
+    pub send_counts: Vec<usize>,
+    pub recv: Vec<u32>,
+    /// Particles received from each rank.
+    pub recv_counts: Vec<usize>,
+    /// This rank's part of the kinetic energy: the particles it owns, and on rank 0 also
+    /// those every rank computes whole.
+    pub counted: ParticleRuns,
+}
+
+impl StateShare {
+    /// The share of the particles `owner` gives each rank (`u32::MAX`: computed by all), in
+    /// halo mode with `halo`.
+    pub fn new(
+        owner: &[u32],
+        state: &State,
+        halo: Option<Halo>,
+        comm: Arc<dyn Communicator>,
+    ) -> StateShare {
+        let ranks = comm.size();
+        let mut by_rank = vec![Vec::new(); ranks];
+        for (p, &r) in owner.iter().enumerate() {
+            if r != u32::MAX {
+                by_rank[r as usize].push(p as u32);
+            }
+        }
+        let start: usize = by_rank[..comm.rank()].iter().map(Vec::len).sum();
+        StateShare {
+            own: start..start + by_rank[comm.rank()].len(),
+            owned: by_rank.iter().map(Vec::len).collect(),
+            particles: by_rank.concat(),
+            spin: !state.spin.is_empty(),
+            halo,
+            comm,
+            mine: Vec::new(),
+            all: Vec::new(),
+        }
+    }
+
+    /// Shares the whole state after every step from now on (a stepper that cannot step a
+    /// rank's particles alone); `figures` learn what each rank then receives.
+    pub fn share_whole_every_step(&mut self, figures: &mut Decomposition) {
+        self.halo = None;
+        let total: usize = self.owned.iter().sum();
+        for (received, owned) in figures.received.iter_mut().zip(&self.owned) {
+            *received = total - owned;
+        }
+    }
+
+    /// After an integration: copies each rank's owned particles' new motion to the ranks
+    /// that read it.
+    pub fn share(&mut self, state: &mut State) {
+        match &self.halo {
+            Some(_) => self.exchange_halo(state),
+            None => self.all_gather(state, Motion::Rates),
+        }
+    }
+
+    /// Makes the state whole on every rank (positions too); nothing to do unless a step
+    /// shares only the halo. Every rank calls it at the same step.
+    pub fn gather(&mut self, state: &mut State) {
+        if self.halo.is_some() {
+            self.all_gather(state, Motion::Whole);
+        }
+    }
+
+    /// Every rank's owned particles' `what` into `state`, on every rank.
+    fn all_gather(&mut self, state: &mut State, what: Motion) {
+        let per = what.values(self.spin);
+        self.mine.clear();
+        for &p in &self.particles[self.own.clone()] {
+            pack(state, p as usize, what, &mut self.mine);
+        }
+        let counts: Vec<usize> = self.owned.iter().map(|n| per * n).collect();
+        self.all.resize(per * self.particles.len(), 0.0);
+        self.comm.all_gather(&self.mine, &mut self.all, &counts);
+        for (&p, values) in self.particles.iter().zip(self.all.chunks_exact(per)) {
+            unpack(state, p as usize, what, values);
+        }
+    }
+
+    /// The halo's new motion from the ranks that own it.
+    fn exchange_halo(&mut self, state: &mut State) {
+        let halo = self.halo.as_ref().expect("halo mode");
+        let per = Motion::Rates.values(self.spin);
+        self.mine.clear();
+        for &p in &halo.send {
+            pack(state, p as usize, Motion::Rates, &mut self.mine);
+        }
+        self.all.resize(per * halo.recv.len(), 0.0);
+        let send_counts: Vec<usize> = halo.send_counts.iter().map(|n| per * n).collect();
+        let recv_counts: Vec<usize> = halo.recv_counts.iter().map(|n| per * n).collect();
+        self.comm
+            .all_to_all(&self.mine, &send_counts, &mut self.all, &recv_counts);
+        for (&p, values) in halo.recv.iter().zip(self.all.chunks_exact(per)) {
+            unpack(state, p as usize, Motion::Rates, values);
+        }
+    }
+
+    /// The kinetic energy of the whole state (J), the same on every rank: one process's
+    /// [`State::kinetic_energy`] when every rank holds the whole state; in halo mode the sum
+    /// of the ranks' parts in rank order.
+    pub fn kinetic_energy(&self, state: &State) -> f64 {
+        let Some(halo) = &self.halo else {
+            return state.kinetic_energy();
+        };
+        let mut part = 0.0;
+        for p in halo.counted.indices() {
+            part += 0.5 * state.mass[p] * state.velocity[p].norm_squared();
+            if self.spin {
+                part += 0.5 * state.spin.inertia[p] * state.spin.velocity[p].norm_squared();
+            }
+        }
+        if self.comm.rank() == 0 {
+            part += state.rigid.kinetic_energy();
+        }
+        let mut parts = vec![0.0; self.comm.size()];
+        let ones = vec![1; self.comm.size()];
+        self.comm.all_gather(&[part], &mut parts, &ones);
+        parts.iter().sum()
+    }
+
+    /// The failure every rank reports: the one of the lowest rank that found one.
+    pub fn agree(&self, local: Option<String>) -> Option<String> {
+        let mine = match local {
+            Some(_) => self.comm.rank() as u64,
+            None => u64::MAX,
+        };
+        let root = self.comm.min(mine);
+        if root == u64::MAX {
+            return None;
+        }
+        let mut bytes = local.map(String::into_bytes).unwrap_or_default();
+        self.comm.broadcast(root as usize, &mut bytes);
+        Some(String::from_utf8_lossy(&bytes).into_owned())
+    }
+}
+
+/// What of a particle's motion is copied.
+#[derive(Clone, Copy)]
+enum Motion {
+    /// Acceleration and velocity (and the rotation's): after an integration, when the
+    /// position is already the same everywhere.
+    Rates,
+    /// The position too (and the rotation angle): a whole gather.
+    Whole,
+}
+
+impl Motion {
+    /// Values per particle.
+    fn values(self, spin: bool) -> usize {
+        let translation = match self {
+            Motion::Rates => 6,
+            Motion::Whole => 9,
+        };
+        match spin {
+            true => 2 * translation,
+            false => translation,
+        }
+    }
+}
+
+/// Appends particle `p`'s `what`.
+fn pack(state: &State, p: usize, what: Motion, out: &mut Vec<f64>) {
+    out.extend_from_slice(state.acceleration[p].as_slice());
+    out.extend_from_slice(state.velocity[p].as_slice());
+    if let Motion::Whole = what {
+        out.extend_from_slice(state.position[p].as_slice());
+    }
+    if !state.spin.is_empty() {
+        out.extend_from_slice(state.spin.acceleration[p].as_slice());
+        out.extend_from_slice(state.spin.velocity[p].as_slice());
+        if let Motion::Whole = what {
+            out.extend_from_slice(state.spin.angle[p].as_slice());
+        }
+    }
+}
+
+/// Sets particle `p`'s `what` from what [`pack`] wrote.
+fn unpack(state: &mut State, p: usize, what: Motion, v: &[f64]) {
+    let at = |k: usize| Vec3::new(v[k], v[k + 1], v[k + 2]);
+    state.acceleration[p] = at(0);
+    state.velocity[p] = at(3);
+    let mut k = 6;
+    if let Motion::Whole = what {
+        state.position[p] = at(6);
+        k = 9;
+    }
+    if !state.spin.is_empty() {
+        state.spin.acceleration[p] = at(k);
+        state.spin.velocity[p] = at(k + 3);
+        if let Motion::Whole = what {
+            state.spin.angle[p] = at(k + 6);
+        }
+    }
+}
