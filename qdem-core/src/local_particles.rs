@@ -12,8 +12,10 @@
 use crate::stepper::PARTICLE_CHUNK;
 use std::ops::Range;
 
-/// Particle indices as sorted, disjoint ranges, each at most [`PARTICLE_CHUNK`] long, so that
-/// a parallel pass hands one range to a thread at a time.
+/// Particle indices as sorted, disjoint ranges, each at most [`PARTICLE_CHUNK`] long, grouped
+/// into batches of consecutive ranges of about that many particles, so that a parallel pass
+/// hands a thread one batch at a time however short the ranges are (a rank's particles in a
+/// mesh numbered across its cut come in runs of a few dozen).
 ///
 /// ```
 /// use qdem_core::local_particles::ParticleRuns;
@@ -26,6 +28,8 @@ use std::ops::Range;
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ParticleRuns {
     pieces: Vec<Range<usize>>,
+    /// Each batch's places in `pieces`.
+    batches: Vec<Range<usize>>,
     count: usize,
 }
 
@@ -39,8 +43,20 @@ impl ParticleRuns {
                 _ => pieces.push(i..i + 1),
             }
         }
+        let (mut batches, mut start, mut size) = (Vec::new(), 0, 0);
+        for (k, piece) in pieces.iter().enumerate() {
+            size += piece.len();
+            if size >= PARTICLE_CHUNK || k + 1 == pieces.len() {
+                batches.push(start..k + 1);
+                (start, size) = (k + 1, 0);
+            }
+        }
         let count = pieces.iter().map(Range::len).sum();
-        ParticleRuns { pieces, count }
+        ParticleRuns {
+            pieces,
+            batches,
+            count,
+        }
     }
 
     /// The number of particles.
@@ -69,18 +85,29 @@ impl ParticleRuns {
         self.pieces.iter().flat_map(Range::clone)
     }
 
-    /// `slice`'s entries of each range, in order (for a parallel pass over them).
-    pub(crate) fn split<'a, T>(&self, mut slice: &'a mut [T]) -> Vec<&'a mut [T]> {
-        let mut out = Vec::with_capacity(self.pieces.len());
+    /// The ranges of each batch, in order.
+    pub(crate) fn batches(&self) -> Vec<&[Range<usize>]> {
+        self.batches
+            .iter()
+            .map(|b| &self.pieces[b.clone()])
+            .collect()
+    }
+
+    /// `slice`'s entries of each range, batch by batch (for a parallel pass over the
+    /// batches, zipped with [`ParticleRuns::batches`]).
+    pub(crate) fn split<'a, T>(&self, mut slice: &'a mut [T]) -> Vec<Vec<&'a mut [T]>> {
         let mut at = 0;
-        for r in &self.pieces {
+        let mut take = |r: &Range<usize>| {
             let (_, rest) = std::mem::take(&mut slice).split_at_mut(r.start - at);
             let (piece, rest) = rest.split_at_mut(r.len());
-            out.push(piece);
             slice = rest;
             at = r.end;
-        }
-        out
+            piece
+        };
+        self.batches()
+            .into_iter()
+            .map(|batch| batch.iter().map(&mut take).collect())
+            .collect()
     }
 }
 
@@ -104,4 +131,32 @@ pub struct LocalParticles {
     /// The particles it predicts: `computed` and the halo whose motion it receives after
     /// each step.
     pub stepped: ParticleRuns,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn short_runs_are_batched_in_order_and_split_covers_each_particle_once() {
+        // Every third particle of 10⁵: 33,334 runs of one particle.
+        let n = 100_000;
+        let mask: Vec<bool> = (0..n).map(|i| i % 3 == 0).collect();
+        let runs = ParticleRuns::from_mask(&mask);
+        let batches = runs.batches();
+        assert_eq!(batches.len(), 2, "32,768 particles a batch, then the rest");
+        assert_eq!(batches[0].len(), PARTICLE_CHUNK);
+        let mut values: Vec<usize> = (0..n).collect();
+        let mut seen = Vec::new();
+        for (batch, ranges) in runs.split(&mut values).into_iter().zip(runs.batches()) {
+            for (piece, r) in batch.into_iter().zip(ranges) {
+                assert_eq!(piece.len(), r.len());
+                seen.extend(piece.iter().copied());
+            }
+        }
+        assert_eq!(seen, runs.indices().collect::<Vec<_>>());
+        assert_eq!(seen.len(), runs.len());
+        assert!(seen.iter().all(|&i| mask[i]));
+        assert!(runs.contains(99_999) && !runs.contains(99_998));
+    }
 }

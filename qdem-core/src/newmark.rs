@@ -797,13 +797,17 @@ where
             continue;
         }
         let a: &[Vec3] = a;
-        let a_runs = runs.pieces().iter().map(|r| &a[r.clone()]);
         runs.split(x)
             .into_par_iter()
             .zip(runs.split(v))
-            .zip(a_runs.collect::<Vec<_>>())
-            .for_each(|((x, v), a)| {
-                x.iter_mut().zip(v.iter_mut()).zip(a).for_each(update);
+            .zip(runs.batches())
+            .for_each(|((x, v), ranges)| {
+                for ((x, v), r) in x.into_iter().zip(v).zip(ranges) {
+                    x.iter_mut()
+                        .zip(v.iter_mut())
+                        .zip(&a[r.clone()])
+                        .for_each(update);
+                }
             });
     }
 }

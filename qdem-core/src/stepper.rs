@@ -261,11 +261,15 @@ fn divide_free(
     runs.split(out)
         .into_par_iter()
         .zip(runs.split(rate))
-        .zip(runs.pieces())
-        .map(|((a, v), r)| {
-            let pairs = a.iter_mut().zip(v.iter_mut());
-            let bad = pairs.zip(r.clone()).map(|((a, v), i)| one(i, a, v));
-            bad.min().unwrap_or(usize::MAX)
+        .zip(runs.batches())
+        .map(|((a, v), ranges)| {
+            let mut bad = usize::MAX;
+            for ((a, v), r) in a.into_iter().zip(v).zip(ranges) {
+                for ((a, v), i) in a.iter_mut().zip(v.iter_mut()).zip(r.clone()) {
+                    bad = bad.min(one(i, a, v));
+                }
+            }
+            bad
         })
         .min()
         .unwrap_or(usize::MAX)
