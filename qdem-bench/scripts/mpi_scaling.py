@@ -20,6 +20,11 @@ per scene and configuration the median step time, and the efficiencies
     strong (R ranks x 1 thread)  = t(1 x 1) / (R t(R x 1))
     weak (2 ranks, twice the work) = rate(2 x 1, 2N) / (2 rate(1 x 1, N))  (element-steps/s)
     ranks x threads              = t(1 x 2) / t(2 x 1)   (2 ranks of 1 thread against 2 threads)
+
+each of the medians, and also pass by pass (the runs of one pass, taken within a minute of
+each other, against each other), with the median, min and max of the passes under
+"paired": on a machine whose speed drifts by 30% between hours, the paired figures are the
+ones to quote.
 """
 
 from __future__ import annotations
@@ -211,6 +216,21 @@ def measure(qdem: str, work: Path, label: str, runs: list[tuple[str, Path, int, 
             for key, v in times.items()}
 
 
+def paired(m: dict) -> dict:
+    """The efficiencies of each pass (its runs against each other): median, min, max."""
+    passes = range(len(m["1x1"]["all"]))
+    t = {k: v["all"] for k, v in m.items()}
+    size = {k: v["elements"] for k, v in m.items()}
+    figures = {"strong_efficiency_2x1": [t["1x1"][i] / (2 * t["2x1"][i]) for i in passes],
+               "ranks_over_threads": [t["1x2"][i] / t["2x1"][i] for i in passes]}
+    if "2x1_double" in t:
+        figures["weak_efficiency_2x1"] = [
+            size["2x1_double"] * t["1x1"][i] / (2 * size["1x1"] * t["2x1_double"][i])
+            for i in passes]
+    return {k: {"median": statistics.median(v), "min": min(v), "max": max(v), "all": v}
+            for k, v in figures.items()}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--tets", type=int, default=1_000_000)
@@ -248,6 +268,7 @@ def main() -> None:
                "ranks_over_threads": t["1x2"] / t["2x1"]}
         if "2x1_double" in t:
             row["weak_efficiency_2x1"] = rate["2x1_double"] / (2 * rate["1x1"])
+        row["paired"] = paired(m)
         result[label] = row
     text = json.dumps(result, indent=2)
     print(text)

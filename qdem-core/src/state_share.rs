@@ -34,6 +34,8 @@ pub(crate) struct StateShare {
     own: Range<usize>,
     /// Owned particles per rank.
     owned: Vec<usize>,
+    /// Per particle, the rank that owns it (`u32::MAX`: computed by every rank).
+    owner: Vec<u32>,
     /// Whether the particles have rotational DOFs.
     spin: bool,
     /// The halo exchange, when a step shares only the halo.
@@ -76,6 +78,7 @@ impl StateShare {
         StateShare {
             own: start..start + by_rank[comm.rank()].len(),
             owned: by_rank.iter().map(Vec::len).collect(),
+            owner: owner.to_vec(),
             particles: by_rank.concat(),
             spin: !state.spin.is_empty(),
             halo,
@@ -109,6 +112,45 @@ impl StateShare {
     pub fn gather(&mut self, state: &mut State) {
         if self.halo.is_some() {
             self.all_gather(state, Motion::Whole);
+        }
+    }
+
+    /// Makes `particles`' motion whole on every rank (positions too); nothing to do unless a
+    /// step shares only the halo. Every rank calls it at the same step with the same list.
+    pub fn gather_some(&mut self, state: &mut State, particles: &[usize]) {
+        if self.halo.is_none() {
+            return;
+        }
+        let per = Motion::Whole.values(self.spin);
+        let me = self.comm.rank() as u32;
+        let mut counts = vec![0; self.comm.size()];
+        self.mine.clear();
+        for &p in particles {
+            let owner = self.owner[p];
+            if owner == me {
+                pack(state, p, Motion::Whole, &mut self.mine);
+            }
+            if owner != u32::MAX {
+                counts[owner as usize] += per;
+            }
+        }
+        self.all.resize(counts.iter().sum(), 0.0);
+        self.comm.all_gather(&self.mine, &mut self.all, &counts);
+        let mut at: Vec<usize> = counts
+            .iter()
+            .scan(0, |start, n| {
+                let here = *start;
+                *start += n;
+                Some(here)
+            })
+            .collect();
+        for &p in particles {
+            let owner = self.owner[p];
+            if owner != u32::MAX {
+                let k = &mut at[owner as usize];
+                unpack(state, p, Motion::Whole, &self.all[*k..*k + per]);
+                *k += per;
+            }
         }
     }
 

@@ -252,6 +252,15 @@ impl World {
         }
     }
 
+    /// [`World::gather`] of `particles` only (the probes' particles): every rank calls it
+    /// after the same step with the same list, and then holds their position, velocity and
+    /// acceleration as one process would.
+    pub fn gather_particles(&mut self, particles: &[usize]) {
+        if let Some((share, _)) = &mut self.share {
+            share.gather_some(&mut self.state, particles);
+        }
+    }
+
     /// How the run is decomposed over processes; `None` for a run of one process.
     pub fn decomposition(&self) -> Option<&Decomposition> {
         self.share.as_ref().map(|(_, d)| d)

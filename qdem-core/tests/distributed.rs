@@ -165,9 +165,14 @@ const STEPS: usize = 300;
 
 /// The state after [`STEPS`] steps of one process, and the retakes.
 fn one_process(newmark: bool) -> (State, u64) {
+    one_process_for(newmark, STEPS)
+}
+
+/// [`one_process`] after `steps` steps.
+fn one_process_for(newmark: bool, steps: usize) -> (State, u64) {
     let mut world = beam_world(newmark);
     world.initialize().unwrap();
-    for _ in 0..STEPS {
+    for _ in 0..steps {
         world.step().unwrap();
     }
     let retakes = world.stepper().counts().retakes;
@@ -216,6 +221,58 @@ fn ranks(
         gathered.push(g);
     }
     (states, figures.unwrap(), gathered)
+}
+
+/// Each rank's state after `steps` Verlet steps over `size` ranks, ended by `finish` (a
+/// collective every rank calls).
+fn ranks_ending(size: usize, steps: usize, finish: fn(&mut World)) -> Vec<State> {
+    let hub = Arc::new(Hub {
+        size,
+        barrier: Barrier::new(size),
+        posts: Mutex::new(vec![Vec::new(); size]),
+    });
+    let runs: Vec<_> = (0..size)
+        .map(|rank| {
+            let hub = hub.clone();
+            std::thread::spawn(move || {
+                let mut world = beam_world(false);
+                world.decompose(Arc::new(ThreadRank { rank, hub })).unwrap();
+                world.initialize().unwrap();
+                for _ in 0..steps {
+                    world.step().unwrap();
+                }
+                finish(&mut world);
+                world.state
+            })
+        })
+        .collect();
+    runs.into_iter().map(|r| r.join().unwrap()).collect()
+}
+
+/// The particles a probe gather asks for (the beam has 61 x 7 x 7 = 2,989): the last and one
+/// in the middle, the last twice (two probes on one particle).
+const PROBED: [usize; 3] = [2988, 1500, 2988];
+
+/// A probe sample gathers only the probes' particles: on every rank they then hold one
+/// process's bits, which the ranks that do not own them have received.
+#[test]
+fn a_probe_gather_gives_every_rank_the_probed_particles_of_one_process() {
+    let (reference, _) = one_process_for(false, 150);
+    assert_eq!(reference.len(), 2989);
+    let states = ranks_ending(3, 150, |world| world.gather_particles(&PROBED));
+    for (rank, state) in states.iter().enumerate() {
+        for p in PROBED {
+            let bits = |s: &State| {
+                [s.position[p], s.velocity[p], s.acceleration[p]].map(|v| v.map(f64::to_bits))
+            };
+            assert_eq!(bits(state), bits(&reference), "rank {rank}, particle {p}");
+        }
+    }
+    let whole = |s: &State| common::motion_bits(s) == common::motion_bits(&reference);
+    assert!(
+        !states.iter().all(whole),
+        "only the probed particles were gathered"
+    );
 }
 
 /// Every rank's state has the bits of one process's.

@@ -11,7 +11,7 @@ use crate::checkpoint::{
 use crate::output::OutputError;
 use crate::run::inputs::SceneFingerprint;
 use crate::run::record::schedule::{probe_interval, Schedule};
-use crate::run::record::{self, Recorder, RunFigures, StepInfo};
+use crate::run::record::{self, Recorder, RunFigures, StateRead, StepInfo};
 use crate::run::run_record::{decode_run, decode_world, encode_run, RunRecord};
 use qdem_core::{Communicator, CoreError, Halt};
 use std::path::{Path, PathBuf};
@@ -148,31 +148,49 @@ impl std::fmt::Debug for RunOptions<'_> {
 struct Sync {
     /// The run stops after this step (a stop was asked for on some rank).
     stop: bool,
-    /// The state is made whole on every rank first ([`qdem_core::World::gather`]): rank 0
-    /// records or checkpoints it.
-    whole: bool,
+    /// What every rank gathers first ([`qdem_core::World::gather`]): what rank 0 records,
+    /// checkpoints or keeps; the whole state at a stop.
+    read: StateRead,
+}
+
+impl Sync {
+    /// Gathers what the ranks agreed on; `probes`: the probes' particles.
+    fn gather(&self, sim: &mut Simulation, probes: &[usize]) {
+        match self.read {
+            StateRead::Nothing => {}
+            StateRead::Probes => sim.world.gather_particles(probes),
+            StateRead::Whole => sim.world.gather(),
+        }
+    }
 }
 
 impl RunOptions<'_> {
     /// After `step`: whether the run stops (asked to, on any rank of a decomposed run), and
-    /// whether the state must be made whole first (`whole`: rank 0 reads it; a stop always
-    /// does, for its checkpoint). One agreement of the ranks per step.
-    fn sync_after(&self, step: u64, whole: bool) -> Sync {
+    /// what must be gathered first (`read`: what rank 0 reads; the whole state at a stop,
+    /// for its checkpoint). One agreement of the ranks per step.
+    fn sync_after(&self, step: u64, read: StateRead) -> Sync {
         let asked =
             self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) || self.stop_after == Some(step);
         let Some(ranks) = self.ranks else {
-            return Sync { stop: asked, whole };
+            return Sync { stop: asked, read };
         };
-        // The smallest wins: 0 stop (and gather), 1 gather, 2 neither.
-        let mine = match (asked, whole) {
+        // The smallest wins: 0 stop (and the whole state), 1 the whole state, 2 the probes,
+        // 3 nothing.
+        let mine = match (asked, read) {
             (true, _) => 0,
-            (false, true) => 1,
-            (false, false) => 2,
+            (false, StateRead::Whole) => 1,
+            (false, StateRead::Probes) => 2,
+            (false, StateRead::Nothing) => 3,
         };
         let agreed = ranks.min(mine);
+        let read = match agreed {
+            0 | 1 => StateRead::Whole,
+            2 => StateRead::Probes,
+            _ => StateRead::Nothing,
+        };
         Sync {
             stop: agreed == 0,
-            whole: agreed <= 1,
+            read,
         }
     }
 }
@@ -211,6 +229,7 @@ pub fn run_with(
     }
     let mut run = Run::open(sim, out_dir, options)?;
     let steps = sim.steps();
+    let probes = probe_particles(sim);
     let first_step = run.record.next_step;
     let start = Instant::now();
     let mut last_report = start;
@@ -235,10 +254,12 @@ pub fn run_with(
                 halt: halt.as_ref(),
             };
             let keep_good = run.keeps_good_state(sim, dt);
-            let sync = options.sync_after(step, keep_good || run.reads_state(sim, dt));
-            if sync.whole {
-                sim.world.gather();
-            }
+            let read = match keep_good {
+                true => StateRead::Whole,
+                false => run.reads_state(sim, dt),
+            };
+            let sync = options.sync_after(step, read);
+            sync.gather(sim, &probes);
             run.after_step(sim, step, &info, sync, keep_good)?;
             if step % 64 == 0 && last_report.elapsed().as_secs_f64() > 0.5 {
                 last_report = Instant::now();
@@ -326,10 +347,14 @@ impl Run {
         Ok(run)
     }
 
-    /// Whether a recorder or a checkpoint reads the state after this step (at `dt`).
-    fn reads_state(&self, sim: &Simulation, dt: f64) -> bool {
+    /// What the recorders and a checkpoint read of the state after this step (at `dt`).
+    fn reads_state(&self, sim: &Simulation, dt: f64) -> StateRead {
         let time = sim.world.state.time;
-        self.recorders.iter().any(|r| r.due(time, dt)) || self.record.checkpoints.is_due(time, dt)
+        let recorded = self.recorders.iter().map(|r| r.reads(time, dt)).max();
+        match self.record.checkpoints.is_due(time, dt) {
+            true => StateRead::Whole,
+            false => recorded.unwrap_or(StateRead::Nothing),
+        }
     }
 
     /// Whether the last good state is kept in memory after this step (at `dt`): at a probe
@@ -418,16 +443,15 @@ fn follow(sim: &mut Simulation, options: RunOptions<'_>) -> Result<RunReport, Ru
         }
     };
     let steps = sim.steps();
+    let probes = probe_particles(sim);
     let mut halt = None;
     let mut stopped = false;
     for step in first_step..=steps {
         if step > 0 {
             halt = sim.world.step().map_err(|source| core_error(sim, source))?;
         }
-        let sync = options.sync_after(step, false);
-        if sync.whole {
-            sim.world.gather();
-        }
+        let sync = options.sync_after(step, StateRead::Nothing);
+        sync.gather(sim, &probes);
         stopped = sync.stop;
         if stopped || halt.is_some() {
             break;
@@ -465,6 +489,11 @@ fn report(
         halt,
     };
     (report, figures)
+}
+
+/// The probes' particles, which a decomposed run gathers for a probe sample.
+fn probe_particles(sim: &Simulation) -> Vec<usize> {
+    sim.probes.iter().map(|p| p.particle).collect()
 }
 
 /// Creates an output directory.

@@ -3,7 +3,7 @@
 //! right ghost scales.
 
 use super::schedule::{probe_interval, Schedule};
-use super::{Recorder, StepInfo};
+use super::{Recorder, StateRead, StepInfo};
 use crate::build::Simulation;
 use crate::output::{write_atomic, OutputError};
 use qdem_core::{CheckpointError, Decoder, Encoder};
@@ -31,8 +31,11 @@ impl Recorder for Boundary {
         "boundary"
     }
 
-    fn due(&self, time: f64, dt: f64) -> bool {
-        self.schedule.is_due(time, dt)
+    fn reads(&self, time: f64, dt: f64) -> StateRead {
+        match self.schedule.is_due(time, dt) {
+            true => StateRead::Whole,
+            false => StateRead::Nothing,
+        }
     }
 
     fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {

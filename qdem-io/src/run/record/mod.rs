@@ -47,6 +47,18 @@ pub(crate) struct StepInfo<'a> {
     pub halt: Option<&'a Halt>,
 }
 
+/// What a recorder reads of the particles' motion after a step ([`Recorder::reads`]); in a
+/// decomposed run the ranks gather that much first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) enum StateRead {
+    /// Nothing.
+    Nothing,
+    /// The probes' particles.
+    Probes,
+    /// The whole state.
+    Whole,
+}
+
 /// What a finished run did, for the rates in `summary.json`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct RunFigures {
@@ -75,12 +87,12 @@ pub(crate) trait Recorder {
         Ok(())
     }
 
-    /// Whether [`Recorder::record`] reads the state at `time` (a sample is due), so that a
-    /// decomposed run makes it whole first ([`qdem_core::World::gather`]). The default:
-    /// never.
-    fn due(&self, time: f64, dt: f64) -> bool {
+    /// What [`Recorder::record`] reads of the particles' motion at `time` (a sample is due),
+    /// so that a decomposed run gathers it first ([`qdem_core::World::gather`]). The default:
+    /// nothing.
+    fn reads(&self, time: f64, dt: f64) -> StateRead {
         let _ = (time, dt);
-        false
+        StateRead::Nothing
     }
 
     /// Records what is due at the simulation's time: once at the start, then after every

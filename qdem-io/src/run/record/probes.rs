@@ -2,7 +2,7 @@
 //! `probe_every`, streamed) and, at the end, `probes.svg` (the displacements against time).
 
 use super::schedule::{probe_interval, Schedule};
-use super::{Recorder, RunFigures, StepInfo};
+use super::{Recorder, RunFigures, StateRead, StepInfo};
 use crate::build::Simulation;
 use crate::output::{OutputError, ProbeCsv};
 use crate::plot::{line_plot_svg, Labels, Series};
@@ -66,8 +66,11 @@ impl Recorder for Probes {
         Ok(())
     }
 
-    fn due(&self, time: f64, dt: f64) -> bool {
-        self.schedule.is_due(time, dt)
+    fn reads(&self, time: f64, dt: f64) -> StateRead {
+        match self.schedule.is_due(time, dt) {
+            true => StateRead::Probes,
+            false => StateRead::Nothing,
+        }
     }
 
     fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {

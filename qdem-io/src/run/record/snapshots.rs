@@ -16,7 +16,7 @@ use super::contacts_vtu::write_contacts;
 use super::schedule::Schedule;
 use super::spheres_vtu::write_spheres;
 use super::walls_vtu::{walls_move, write_walls};
-use super::{Recorder, RunFigures, StepInfo};
+use super::{Recorder, RunFigures, StateRead, StepInfo};
 use crate::build::Simulation;
 use crate::output::{write_vtu, OutputError, PvdIndex, VtuGrid};
 use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
@@ -120,8 +120,11 @@ impl Recorder for Snapshots {
         "snapshots"
     }
 
-    fn due(&self, time: f64, dt: f64) -> bool {
-        self.schedule.is_due(time, dt)
+    fn reads(&self, time: f64, dt: f64) -> StateRead {
+        match self.schedule.is_due(time, dt) {
+            true => StateRead::Whole,
+            false => StateRead::Nothing,
+        }
     }
 
     fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {
