@@ -11,7 +11,7 @@
 //!   stiffness (loads, gravity) add nothing and are listed in [`Modes::ignored`].
 //! - A rigid body takes part with its six DOFs, its centre's translation and its rotations
 //!   about its principal axes: its members' entries of K are condensed onto them
-//!   ([`crate::rigid_reduction`]), and its members follow in the mode shapes. One that nothing
+//!   (`rigid_reduction.rs`), and its members follow in the mode shapes. One that nothing
 //!   touches and nothing fixes reports its six rigid-body modes.
 //! - Shift and invert (Ericsson & Ruhe 1980): with A = K − σM, σ = −(2π · 1 Hz)² < 0 so that A
 //!   is positive definite even for a body free to move rigidly, the eigenvalues θ of the
@@ -190,7 +190,7 @@ pub struct Modes {
     /// Free degrees of freedom of the eigenproblem.
     pub dofs: usize,
     /// Zero-stiffness rigid motions of single pieces (a stone resting on fewer than three
-    /// contacts) found and left out of the modes ([`crate::mechanisms`]).
+    /// contacts) found and left out of the modes (`mechanisms.rs`).
     pub mechanisms: usize,
     /// Models that gave no stiffness and were left out (contacts, say).
     pub ignored: Vec<String>,
@@ -300,7 +300,7 @@ enum Dof {
     Translation(usize, usize),
     /// Particle p's rotation about an axis.
     Spin(usize, usize),
-    /// Scaled principal rotation k of rigid body b ([`crate::rigid_reduction`]).
+    /// Scaled principal rotation k of rigid body b (`rigid_reduction.rs`).
     Body(usize, usize),
 }
 
@@ -487,7 +487,7 @@ impl Problem {
     }
 
     /// Appends to `basis` the M-orthonormalised motions of single pieces that nothing resists
-    /// ([`crate::mechanisms`]), so that Lanczos iterates without them; returns how many.
+    /// (`mechanisms.rs`), so that Lanczos iterates without them; returns how many.
     fn add_mechanisms(
         &self,
         state: &State,

@@ -12,7 +12,7 @@
 use crate::stepper::PARTICLE_CHUNK;
 use std::ops::Range;
 
-/// Particle indices as sorted, disjoint ranges, each at most [`PARTICLE_CHUNK`] long, grouped
+/// Particle indices as sorted, disjoint ranges, each at most 32,768 (`PARTICLE_CHUNK`) long, grouped
 /// into batches of consecutive ranges of about that many particles, so that a parallel pass
 /// hands a thread one batch at a time however short the ranges are (a rank's particles in a
 /// mesh numbered across its cut come in runs of a few dozen).
