@@ -347,3 +347,54 @@ fn adaptive_explicit_newmark_over_ranks_retakes_the_steps_one_process_retakes() 
         }
     }
 }
+
+/// The cantilever of [`beam_world`] (Verlet) stepped at 2.5 times its stable bound, until it
+/// fails (at most 2,000 steps): the failure's report.
+fn unstable_run(world: &mut World) -> String {
+    world.initialize().unwrap();
+    for _ in 0..2000 {
+        if let Err(e) = world.step() {
+            return e.to_string();
+        }
+    }
+    panic!("the run at 2.5 times the stable step did not fail");
+}
+
+/// [`beam_world`] with its step raised to 2.5 times the stable bound.
+fn unstable_world() -> World {
+    let mut world = beam_world(false);
+    let mut settings = world.settings().clone();
+    settings.dt *= 2.5;
+    world.set_settings(settings).unwrap();
+    world
+}
+
+/// An unstable run stops alike on one process and on every rank of a halo-exchanged run: at
+/// the same step, with the same report, whichever rank computes the tetrahedron that turns
+/// inside out (the ranks agree on its report and gather the whole state before it names the
+/// stable bound at that state).
+#[test]
+fn an_unstable_halo_exchanged_run_fails_as_one_process_does() {
+    let alone = unstable_run(&mut unstable_world());
+    assert!(alone.contains("turned inside out"), "{alone}");
+    for size in [2, 3] {
+        let hub = Arc::new(Hub {
+            size,
+            barrier: Barrier::new(size),
+            posts: Mutex::new(vec![Vec::new(); size]),
+        });
+        let runs: Vec<_> = (0..size)
+            .map(|rank| {
+                let hub = hub.clone();
+                std::thread::spawn(move || {
+                    let mut world = unstable_world();
+                    world.decompose(Arc::new(ThreadRank { rank, hub })).unwrap();
+                    unstable_run(&mut world)
+                })
+            })
+            .collect();
+        for (rank, run) in runs.into_iter().enumerate() {
+            assert_eq!(run.join().unwrap(), alone, "rank {rank} of {size}");
+        }
+    }
+}
