@@ -179,6 +179,25 @@ fn one_process_for(newmark: bool, steps: usize) -> (State, u64) {
     (world.state, retakes)
 }
 
+/// `job`'s results on each of `size` thread ranks sharing one hub, in rank order.
+fn on_ranks<T: Send + 'static>(
+    size: usize,
+    job: impl Fn(Arc<ThreadRank>) -> T + Send + Sync + Clone + 'static,
+) -> Vec<T> {
+    let hub = Arc::new(Hub {
+        size,
+        barrier: Barrier::new(size),
+        posts: Mutex::new(vec![Vec::new(); size]),
+    });
+    let runs: Vec<_> = (0..size)
+        .map(|rank| {
+            let (hub, job) = (hub.clone(), job.clone());
+            std::thread::spawn(move || job(Arc::new(ThreadRank { rank, hub })))
+        })
+        .collect();
+    runs.into_iter().map(|r| r.join().unwrap()).collect()
+}
+
 /// Every rank's state after [`STEPS`] steps over `size` ranks (made whole by a gather at the
 /// end, and also every `gather_every` steps if given), and the decomposition; and per rank
 /// whether the last gather changed its state.
@@ -187,66 +206,43 @@ fn ranks(
     newmark: bool,
     gather_every: Option<usize>,
 ) -> (Vec<State>, Decomposition, Vec<bool>) {
-    let hub = Arc::new(Hub {
-        size,
-        barrier: Barrier::new(size),
-        posts: Mutex::new(vec![Vec::new(); size]),
-    });
-    let runs: Vec<_> = (0..size)
-        .map(|rank| {
-            let hub = hub.clone();
-            std::thread::spawn(move || {
-                let mut world = beam_world(newmark);
-                let comm = Arc::new(ThreadRank { rank, hub });
-                let figures = world.decompose(comm).unwrap();
-                world.initialize().unwrap();
-                for step in 1..=STEPS {
-                    world.step().unwrap();
-                    if gather_every.is_some_and(|n| step % n == 0) {
-                        world.gather();
-                    }
-                }
-                let before = common::motion_bits(&world.state);
+    let runs = on_ranks(size, move |comm| {
+        let mut world = beam_world(newmark);
+        let figures = world.decompose(comm).unwrap();
+        world.initialize().unwrap();
+        for step in 1..=STEPS {
+            world.step().unwrap();
+            if gather_every.is_some_and(|n| step % n == 0) {
                 world.gather();
-                let gathered = before != common::motion_bits(&world.state);
-                (world.state, figures, gathered)
-            })
-        })
-        .collect();
-    let (mut states, mut figures, mut gathered) = (Vec::new(), None, Vec::new());
-    for run in runs {
-        let (state, f, g) = run.join().unwrap();
+            }
+        }
+        let before = common::motion_bits(&world.state);
+        world.gather();
+        let gathered = before != common::motion_bits(&world.state);
+        (world.state, figures, gathered)
+    });
+    let figures = runs[0].1.clone();
+    let (mut states, mut gathered) = (Vec::new(), Vec::new());
+    for (state, _, g) in runs {
         states.push(state);
-        figures.get_or_insert(f);
         gathered.push(g);
     }
-    (states, figures.unwrap(), gathered)
+    (states, figures, gathered)
 }
 
 /// Each rank's state after `steps` Verlet steps over `size` ranks, ended by `finish` (a
 /// collective every rank calls).
 fn ranks_ending(size: usize, steps: usize, finish: fn(&mut World)) -> Vec<State> {
-    let hub = Arc::new(Hub {
-        size,
-        barrier: Barrier::new(size),
-        posts: Mutex::new(vec![Vec::new(); size]),
-    });
-    let runs: Vec<_> = (0..size)
-        .map(|rank| {
-            let hub = hub.clone();
-            std::thread::spawn(move || {
-                let mut world = beam_world(false);
-                world.decompose(Arc::new(ThreadRank { rank, hub })).unwrap();
-                world.initialize().unwrap();
-                for _ in 0..steps {
-                    world.step().unwrap();
-                }
-                finish(&mut world);
-                world.state
-            })
-        })
-        .collect();
-    runs.into_iter().map(|r| r.join().unwrap()).collect()
+    on_ranks(size, move |comm| {
+        let mut world = beam_world(false);
+        world.decompose(comm).unwrap();
+        world.initialize().unwrap();
+        for _ in 0..steps {
+            world.step().unwrap();
+        }
+        finish(&mut world);
+        world.state
+    })
 }
 
 /// The particles a probe gather asks for (the beam has 61 x 7 x 7 = 2,989): the last and one
@@ -378,23 +374,13 @@ fn an_unstable_halo_exchanged_run_fails_as_one_process_does() {
     let alone = unstable_run(&mut unstable_world());
     assert!(alone.contains("turned inside out"), "{alone}");
     for size in [2, 3] {
-        let hub = Arc::new(Hub {
-            size,
-            barrier: Barrier::new(size),
-            posts: Mutex::new(vec![Vec::new(); size]),
+        let runs = on_ranks(size, |comm| {
+            let mut world = unstable_world();
+            world.decompose(comm).unwrap();
+            unstable_run(&mut world)
         });
-        let runs: Vec<_> = (0..size)
-            .map(|rank| {
-                let hub = hub.clone();
-                std::thread::spawn(move || {
-                    let mut world = unstable_world();
-                    world.decompose(Arc::new(ThreadRank { rank, hub })).unwrap();
-                    unstable_run(&mut world)
-                })
-            })
-            .collect();
-        for (rank, run) in runs.into_iter().enumerate() {
-            assert_eq!(run.join().unwrap(), alone, "rank {rank} of {size}");
+        for (rank, report) in runs.iter().enumerate() {
+            assert_eq!(report, &alone, "rank {rank} of {size}");
         }
     }
 }
