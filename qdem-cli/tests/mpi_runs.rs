@@ -208,6 +208,22 @@ fn a_reduced_ballast_deposit_is_byte_identical_on_any_number_of_ranks() {
     same_for_any_ranks("ballast/reduced_deposit.toml", 0.004, "deposit");
 }
 
+/// The grains' contacts are split: each rank evaluates those of the grains it owns.
+#[test]
+fn poured_grains_are_byte_identical_on_any_number_of_ranks() {
+    same_for_any_ranks("contact/grains.toml", 0.1, "grains");
+}
+
+/// With the third cube deformable too, every contact sphere sits on a deformable body's
+/// vertex: the contacts are split along the mesh's decomposition.
+#[test]
+fn the_collision_of_deformable_cubes_is_byte_identical_on_any_number_of_ranks() {
+    let fixture = "contact/collision.toml";
+    let edits = [("t_end = ", "t_end = 0.01"), ("rigid = ", "rigid = false")];
+    let scene = ShortScene::edited(fixture, "deformable", &edits);
+    same_scene_for_any_ranks(scene, fixture, "deformable");
+}
+
 /// A run of `fixture` (cut to `t_end`) stopped after step `stop` on 2 ranks writes the
 /// checkpoint one process writes, byte for byte, and resumed from it on 1 and 3 ranks ends
 /// with the uninterrupted run's files.
@@ -257,6 +273,12 @@ fn a_halo_exchanged_cantilever_checkpointed_at_two_ranks_resumes_at_one_and_thre
         "resume-cantilever",
         "333",
     );
+}
+
+/// Split contacts: the stop's gather merges the ranks' contact lists and springs.
+#[test]
+fn poured_grains_checkpointed_at_two_ranks_resume_at_one_and_three() {
+    resumes_on_other_ranks("contact/grains.toml", 0.06, "resume-grains", "1777");
 }
 
 #[test]

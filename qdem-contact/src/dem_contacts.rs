@@ -32,6 +32,7 @@
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
 use crate::contact_list::{Contact, ContactList};
+use crate::contact_split::ContactSplit;
 use crate::contact_springs::{add_spring, spring, Attachment};
 use crate::contact_view::{Partner, SphereRecord, TouchingContact};
 use crate::error::ContactError;
@@ -41,10 +42,11 @@ use crate::wall::Wall;
 use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
 use qdem_core::{
-    CheckpointError, Decoder, Dofs, Encoder, Linearized, Model, Persistence, Persistent, State,
-    Tangent, Vec3,
+    CheckpointError, Communicator, Decoder, Dofs, Encoder, Linearized, Model, ParticleReads,
+    Persistence, Persistent, SplitModel, State, Tangent, Vec3,
 };
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// Marks a sphere that is no part of a rigid body, or whose moments go nowhere.
 const NOT_RIGID: u32 = u32::MAX;
@@ -215,6 +217,8 @@ pub struct DemContacts {
     rebuilds: u64,
     periodic: Option<PeriodicBox>,
     time_delay: Option<TimeDelay>,
+    /// This rank's part, in a run decomposed with a halo exchange.
+    split: Option<ContactSplit>,
 }
 
 /// A time-delayed periodic boundary along one periodic axis, and its latest state.
@@ -377,6 +381,7 @@ impl DemContacts {
             rebuilds: 0,
             periodic: None,
             time_delay: None,
+            split: None,
         }
     }
 
@@ -689,21 +694,34 @@ impl DemContacts {
             periodic: self.periodic.as_ref(),
         };
         self.pairs.rebuild(find_pairs(&set, skin));
-        let walls = &self.walls;
-        let (radius, center_ref) = (&self.radius, &center);
-        let wall_keys: Vec<(u32, u32)> = (0..center.len())
-            .into_par_iter()
+        let wall_keys = self.wall_keys((0..center.len()).into_par_iter(), time);
+        self.wall_contacts.rebuild(wall_keys);
+        self.finish_build(time);
+    }
+
+    /// The wall candidates of `spheres` (ascending), sorted by sphere then wall.
+    fn wall_keys(
+        &self,
+        spheres: impl IndexedParallelIterator<Item = usize>,
+        time: f64,
+    ) -> Vec<(u32, u32)> {
+        let (walls, skin) = (&self.walls, self.settings.skin);
+        let (radius, center) = (&self.radius, &self.center);
+        spheres
             .with_min_len(CONTACT_CHUNK)
             .flat_map_iter(|s| {
                 walls.iter().enumerate().filter_map(move |(w, wall)| {
-                    wall.is_candidate(&center_ref[s], radius[s], skin, time)
+                    wall.is_candidate(&center[s], radius[s], skin, time)
                         .then_some((s as u32, w as u32))
                 })
             })
-            .collect();
-        self.wall_contacts.rebuild(wall_keys);
+            .collect()
+    }
+
+    /// After new candidate lists: the incidence, and where and when they were built.
+    fn finish_build(&mut self, time: f64) {
         self.build_incidence();
-        self.built_at = center;
+        self.built_at = self.center.clone();
         self.built_time = time;
         self.built = true;
         self.rebuilds += 1;
@@ -845,45 +863,61 @@ impl DemContacts {
     /// spheres that turn (of rigid bodies, rotating particles), in a fixed order; forces from
     /// delayed ghosts scaled.
     fn gather(&mut self) {
-        let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
-        let (start, incidence, wall_start) =
-            (&self.incidence_start, &self.incidence, &self.wall_start);
-        let (radii, turn) = (&self.radius, &self.turn);
-        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
-        self.sphere_force
+        let mut sphere_force = std::mem::take(&mut self.sphere_force);
+        sphere_force
             .par_iter_mut()
             .with_min_len(CONTACT_CHUNK)
             .enumerate()
-            .for_each(|(s, out)| {
-                let (mut f, mut t) = (Vec3::zeros(), Vec3::zeros());
-                let (spins, radius) = (turn[s] != NOT_RIGID, radii[s]);
-                for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
-                    let c = &pairs[(e / 2) as usize];
-                    let first = e % 2 == 0;
-                    let scale = match &delay {
-                        Some((axis, scales)) => {
-                            let (a, b) = pair_scales(c.shift[*axis], scales);
-                            if first {
-                                a
-                            } else {
-                                b
-                            }
-                        }
-                        None => 1.0,
-                    };
-                    f += if first { scale } else { -scale } * c.force;
-                    if spins {
-                        t += c.moment(radius, scale);
+            .for_each(|(s, out)| *out = self.sphere_sum(s));
+        self.sphere_force = sphere_force;
+    }
+
+    /// Sphere `s`'s sum of contact forces, and their moment about its centre if it turns,
+    /// over its incidence in ascending pair order, then its wall contacts.
+    #[inline]
+    fn sphere_sum(&self, s: usize) -> (Vec3, Vec3) {
+        let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
+        let (start, incidence, wall_start) =
+            (&self.incidence_start, &self.incidence, &self.wall_start);
+        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
+        let (mut f, mut t) = (Vec3::zeros(), Vec3::zeros());
+        let (spins, radius) = (self.turn[s] != NOT_RIGID, self.radius[s]);
+        for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
+            let c = &pairs[(e / 2) as usize];
+            let first = e % 2 == 0;
+            let scale = match &delay {
+                Some((axis, scales)) => {
+                    let (a, b) = pair_scales(c.shift[*axis], scales);
+                    if first {
+                        a
+                    } else {
+                        b
                     }
                 }
-                for c in &walls[wall_start[s] as usize..wall_start[s + 1] as usize] {
-                    f += c.force;
-                    if spins {
-                        t += c.moment(radius, 1.0);
-                    }
-                }
-                *out = (f, t);
-            });
+                None => 1.0,
+            };
+            f += if first { scale } else { -scale } * c.force;
+            if spins {
+                t += c.moment(radius, scale);
+            }
+        }
+        for c in &walls[wall_start[s] as usize..wall_start[s + 1] as usize] {
+            f += c.force;
+            if spins {
+                t += c.moment(radius, 1.0);
+            }
+        }
+        (f, t)
+    }
+
+    /// Adds sphere `s`'s contact force `f` to its particle and its moment `t` to the rigid
+    /// body or rotating particle it turns with.
+    #[inline]
+    fn apply(&self, s: usize, f: &Vec3, t: &Vec3, force: &mut [Vec3], torque: &mut [Vec3]) {
+        force[self.particle[s] as usize] += f;
+        if self.turn[s] != NOT_RIGID {
+            torque[self.turn[s] as usize] += t;
+        }
     }
 }
 
@@ -926,6 +960,11 @@ fn read_motion(state: &State, center: Vec3, particle: u32, turn: u32, now: &mut 
     };
 }
 
+/// The entries `indices` of `values`.
+fn pick<T: Copy>(indices: &[u32], values: &[T]) -> Vec<T> {
+    indices.iter().map(|&i| values[i as usize]).collect()
+}
+
 /// r_a r_b / (r_a + r_b).
 #[inline]
 fn reduced(a: f64, b: f64) -> f64 {
@@ -940,6 +979,9 @@ impl Model for DemContacts {
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
         let dt = self.last_time.map_or(0.0, |t| state.time - t);
         self.last_time = Some(state.time);
+        if self.split.is_some() {
+            return self.add_split_forces(state, dt, force, torque);
+        }
         let moved = self.read_centers(state);
         if self.needs_rebuild(moved, state.time) {
             let read_every = self.reads_every_sphere();
@@ -952,10 +994,23 @@ impl Model for DemContacts {
         self.update_time_delay(state.time);
         self.gather();
         for (s, (f, t)) in self.sphere_force.iter().enumerate() {
-            force[self.particle[s] as usize] += f;
-            if self.turn[s] != NOT_RIGID {
-                torque[self.turn[s] as usize] += t;
-            }
+            self.apply(s, f, t, force, torque);
+        }
+    }
+
+    /// Reads only what a rank steps itself once split ([`SplitModel`]): a contact set without
+    /// rigid bodies' spheres, periodic axes or a time delay.
+    fn particle_reads(&self) -> ParticleReads {
+        match self.splittable() {
+            true => ParticleReads::Local,
+            false => ParticleReads::All,
+        }
+    }
+
+    fn split_model(&mut self) -> Option<&mut dyn SplitModel> {
+        match self.splittable() {
+            true => Some(self),
+            false => None,
         }
     }
 
@@ -1056,6 +1111,180 @@ impl DemContacts {
     }
 }
 
+/// One rank's part of the contacts ([`crate::contact_split`]).
+impl DemContacts {
+    /// Whether a rank can compute the contact set in part: no sphere of a rigid body (whose
+    /// moments one rank would have to reduce), no periodic axis and no time delay (whose
+    /// images and boundary force read every rank's spheres).
+    fn splittable(&self) -> bool {
+        self.periodic.is_none()
+            && self.time_delay.is_none()
+            && self.rigid.iter().all(|&r| r == NOT_RIGID)
+    }
+
+    /// [`Model::add_forces`] of one rank's part: its own spheres read, the ghosts received
+    /// (every sphere at a rebuild, which the ranks agree on), the rank's contacts evaluated,
+    /// and each own sphere's sum added.
+    fn add_split_forces(
+        &mut self,
+        state: &State,
+        dt: f64,
+        force: &mut [Vec3],
+        torque: &mut [Vec3],
+    ) {
+        let mut split = self.split.take().expect("a split contact set");
+        if split.whole {
+            self.cut_to_rank(&mut split);
+        }
+        let moved = split.max_over_ranks(self.read_own(state, &split.own));
+        if self.needs_rebuild(moved, state.time) {
+            split.share_all(&mut self.now, &mut self.center);
+            self.rebuild_near(&split, state.time);
+            split.set_ghosts(&self.ghosts(&split));
+        } else {
+            split.share_ghosts(&mut self.now, &mut self.center);
+        }
+        self.evaluate(state.time, dt);
+        let this = &*self;
+        let sums: Vec<(Vec3, Vec3)> = split
+            .own
+            .par_iter()
+            .with_min_len(CONTACT_CHUNK)
+            .map(|&s| this.sphere_sum(s as usize))
+            .collect();
+        for (&s, (f, t)) in split.own.iter().zip(&sums) {
+            self.apply(s as usize, f, t, force, torque);
+            self.sphere_force[s as usize] = (*f, *t);
+        }
+        self.split = Some(split);
+    }
+
+    /// Reads the centres and motion of the spheres `own` from `state`; returns the largest
+    /// distance one has moved since the last build (infinite before it).
+    fn read_own(&mut self, state: &State, own: &[u32]) -> f64 {
+        let (particle, turn) = (&self.particle, &self.turn);
+        let now = &self.now;
+        let read: Vec<SphereNow> = own
+            .par_iter()
+            .with_min_len(SPHERE_CHUNK)
+            .map(|&s| {
+                let (s, p) = (s as usize, particle[s as usize]);
+                let mut record = now[s];
+                read_motion(state, state.position[p as usize], p, turn[s], &mut record);
+                record
+            })
+            .collect();
+        let built = self.lists_built();
+        let mut moved: f64 = if built { 0.0 } else { f64::INFINITY };
+        for (&s, record) in own.iter().zip(read) {
+            let s = s as usize;
+            if built {
+                moved = moved.max((record.center - self.built_at[s]).norm_squared());
+            }
+            self.center[s] = record.center;
+            self.now[s] = record;
+        }
+        moved.sqrt()
+    }
+
+    /// The broad phase of one rank, once it holds every sphere's centre: the pairs that touch
+    /// a sphere it owns, found among the spheres within reach of its own, and its own
+    /// spheres' wall candidates; the springs of the pairs that stay are kept.
+    fn rebuild_near(&mut self, split: &ContactSplit, time: f64) {
+        let skin = self.settings.skin;
+        let reach = 2.0 * self.radius.iter().cloned().fold(0.0, f64::max) + skin;
+        let (mut low, mut high) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
+        for &s in &split.own {
+            low = low.inf(&self.center[s as usize]);
+            high = high.sup(&self.center[s as usize]);
+        }
+        let (low, high) = (low.add_scalar(-reach), high.add_scalar(reach));
+        let near: Vec<u32> = (0..self.center.len() as u32)
+            .filter(|&s| {
+                let x = &self.center[s as usize];
+                (0..3).all(|k| x[k] >= low[k] && x[k] <= high[k])
+            })
+            .collect();
+        let (center, radius, body) = (
+            pick(&near, &self.center),
+            pick(&near, &self.radius),
+            pick(&near, &self.body),
+        );
+        let set = SphereSet {
+            center: &center,
+            radius: &radius,
+            body: &body,
+            periodic: None,
+        };
+        let keys = find_pairs(&set, skin)
+            .into_iter()
+            .map(|(a, b)| (near[a as usize], near[b as usize]))
+            .filter(|&(a, b)| split.owns(a) || split.owns(b))
+            .collect();
+        self.pairs.rebuild(keys);
+        let own = split.own.par_iter().map(|&s| s as usize);
+        let wall_keys = self.wall_keys(own, time);
+        self.wall_contacts.rebuild(wall_keys);
+        self.finish_build(time);
+    }
+
+    /// The partners of this rank's pairs that other ranks own, ascending.
+    fn ghosts(&self, split: &ContactSplit) -> Vec<u32> {
+        let mut ghosts: Vec<u32> = self
+            .pairs
+            .items
+            .iter()
+            .flat_map(|c| [c.first, c.second])
+            .filter(|&s| !split.owns(s))
+            .collect();
+        ghosts.sort_unstable();
+        ghosts.dedup();
+        ghosts
+    }
+
+    /// Cuts lists that hold every rank's contacts (after a merge, a restore) down to this
+    /// rank's, and asks for their ghosts: a collective.
+    fn cut_to_rank(&mut self, split: &mut ContactSplit) {
+        self.pairs.items.retain(|c| split.keeps(c, false));
+        self.wall_contacts.items.retain(|c| split.keeps(c, true));
+        self.build_incidence();
+        split.set_ghosts(&self.ghosts(split));
+        split.whole = false;
+    }
+}
+
+impl SplitModel for DemContacts {
+    /// The particles of every sphere (those of deformable bodies already have owners).
+    fn free_particles(&self) -> Vec<usize> {
+        self.particle.iter().map(|&p| p as usize).collect()
+    }
+
+    fn split(&mut self, split: Option<(Arc<[u32]>, Arc<dyn Communicator>)>) {
+        self.split = split.map(|(owner, comm)| {
+            let mut part = ContactSplit::new(&self.particle, &owner, comm);
+            part.whole = true;
+            part
+        });
+    }
+
+    /// Merges the ranks' lists, receives every sphere's record of the last evaluation, and
+    /// sums every sphere's contacts as one process does.
+    fn gather(&mut self) {
+        let Some(mut split) = self.split.take() else {
+            return;
+        };
+        if !split.whole {
+            self.pairs = split.merge(&self.pairs);
+            self.wall_contacts = split.merge(&self.wall_contacts);
+            split.share_all(&mut self.now, &mut self.center);
+            self.build_incidence();
+            self.gather();
+            split.whole = true;
+        }
+        self.split = Some(split);
+    }
+}
+
 impl Linearized for DemContacts {
     /// The springs of the contacts touching at the last evaluation, at the geometry it saw.
     fn add_tangent(&self, state: &State, tangent: &mut Tangent) {
@@ -1137,6 +1366,9 @@ impl Persistent for DemContacts {
             delay.boundary.restore(input)?;
         }
         self.build_incidence();
+        if let Some(split) = &mut self.split {
+            split.whole = true;
+        }
         Ok(())
     }
 }

@@ -50,6 +50,7 @@ pub mod tet_blocks;
 pub mod tet_body;
 pub mod tet_kernel;
 pub mod tet_subdomain;
+pub mod thread_ranks;
 pub mod time_function;
 pub mod verlet;
 pub mod world;
@@ -65,7 +66,7 @@ pub use error::CoreError;
 pub use gravity::Gravity;
 pub use material::Material;
 pub use model::{
-    find_model, Linearized, Model, ParticleReads, Persistence, Persistent, StepEvents,
+    find_model, Linearized, Model, ParticleReads, Persistence, Persistent, SplitModel, StepEvents,
 };
 pub use newmark::{EventSolve, Newmark, StepCounts, TangentUpdate};
 pub use nodal_load::NodalLoad;

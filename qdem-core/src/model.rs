@@ -12,13 +12,17 @@
 //!   contact opening) that make an adaptive stepper retake it (paper 001 Eqs. 29–30), and
 //!   their commitment;
 //! - [`Persistent`] ([`Model::persistence`]): the history a checkpoint must keep for a resumed
-//!   run to continue bit for bit.
+//!   run to continue bit for bit;
+//! - [`SplitModel`] ([`Model::split_model`]): a model that one rank of a decomposed run
+//!   computes in part (DEM contacts: the contacts that touch the rank's particles).
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
+use crate::distributed::Communicator;
 use crate::state::State;
 use crate::step_settings::Stepping;
 use crate::tangent::Tangent;
 use crate::Vec3;
+use std::sync::Arc;
 
 /// A source of particle forces. Models are `Any` so that the output can reach a body's
 /// element fields by downcasting.
@@ -104,9 +108,38 @@ pub trait Model: std::any::Any + Send + Sync {
     fn persistent_mut(&mut self) -> Option<&mut dyn Persistent> {
         None
     }
+
+    /// The model's part in a run decomposed with a halo exchange, for a model that a rank
+    /// computes in part; `None` (the default): every rank computes it whole, or, with
+    /// [`Model::particle_reads`] = [`ParticleReads::Local`], it reads nothing of other
+    /// ranks' particles.
+    fn split_model(&mut self) -> Option<&mut dyn SplitModel> {
+        None
+    }
+}
+
+/// The facet of a model that one rank of a run decomposed with a halo exchange
+/// ([`crate::distributed`]) computes in part: DEM contacts evaluate only the contacts that
+/// touch a sphere the rank owns, and fetch what they read of the other ranks' spheres
+/// themselves. Such a model says [`ParticleReads::Local`].
+pub trait SplitModel {
+    /// The particles the model moves that no deformable body holds (one-sphere grains): the
+    /// decomposition gives each an owner by its position.
+    fn free_particles(&self) -> Vec<usize>;
+
+    /// From now on, computes the forces on the particles `owner[p] == comm.rank()` only,
+    /// each as one process sums it; `None`: whole again, on a state every rank holds whole
+    /// (after a [`crate::World::gather`]). A collective: every rank calls it at once.
+    fn split(&mut self, split: Option<(Arc<[u32]>, Arc<dyn Communicator>)>);
+
+    /// Makes what the model records (contact lists, forces, histories) whole on every rank,
+    /// as one process holds it after its last force evaluation: a collective that
+    /// [`crate::World::gather`] runs. The next force evaluation goes on in part.
+    fn gather(&mut self);
 }
 
 /// Which particles' motion a [`Model`] (or a [`crate::PostStep`] hook) reads at each step.
+/// A [`SplitModel`] reads its own rank's particles and fetches what it needs of the others.
 ///
 /// ```
 /// use qdem_core::{Gravity, Model, ParticleReads, Vec3};

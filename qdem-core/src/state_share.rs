@@ -88,6 +88,11 @@ impl StateShare {
         }
     }
 
+    /// Per particle, the rank that owns it (`u32::MAX`: computed by every rank).
+    pub fn owner(&self) -> &[u32] {
+        &self.owner
+    }
+
     /// Shares the whole state after every step from now on (a stepper that cannot step a
     /// rank's particles alone); `figures` learn what each rank then receives.
     pub fn share_whole_every_step(&mut self, figures: &mut Decomposition) {

@@ -59,6 +59,8 @@ pub struct Verlet {
     local_damping: f64,
     force: Vec<Vec3>,
     torque: Vec<Vec3>,
+    /// The rigid bodies' share of `torque` (the first entries).
+    rigid_bodies: usize,
     /// The particles this rank steps, in a run decomposed with a halo exchange.
     local: Option<Arc<LocalParticles>>,
 }
@@ -71,6 +73,7 @@ impl Verlet {
             local_damping: 0.0,
             force: Vec::new(),
             torque: Vec::new(),
+            rigid_bodies: 0,
             local: None,
         }
     }
@@ -95,7 +98,8 @@ impl Verlet {
         if self.local_damping > 0.0 {
             local_damping::apply(state, &mut self.force, &mut self.torque, self.local_damping);
         }
-        let (rigid, moment) = self.torque.split_at(state.rigid.len());
+        self.rigid_bodies = state.rigid.len();
+        let (rigid, moment) = self.torque.split_at(self.rigid_bodies);
         let only = self.local.as_ref().map(|l| &l.computed);
         accelerate(state, &self.force, kick, only)?;
         if !state.spin.is_empty() {
@@ -139,11 +143,16 @@ impl Stepper for Verlet {
         self.evaluate(state, models, &mut StageTimes::off(), None)
     }
 
-    /// The torques of the last evaluation (the rigid bodies', which the next step's first
-    /// half kick uses, then the particles' moments).
+    /// The torques of the last evaluation: the rigid bodies', which the next step's first
+    /// half kick uses, then zeros in place of the particles' moments, which the next
+    /// evaluation rewrites before anything reads them (a rank of a decomposed run holds
+    /// only its own particles' moments, so writing them would make its checkpoint differ
+    /// from one process's).
     fn save(&self, out: &mut Encoder) -> Result<(), CheckpointError> {
         out.tag("verlet");
-        out.vec3s(&self.torque);
+        let mut torque = self.torque[..self.rigid_bodies].to_vec();
+        torque.resize(self.torque.len(), Vec3::zeros());
+        out.vec3s(&torque);
         Ok(())
     }
 
@@ -162,6 +171,7 @@ impl Stepper for Verlet {
             torque.len(),
         )?;
         self.torque = torque;
+        self.rigid_bodies = state.rigid.len();
         Ok(())
     }
 

@@ -156,6 +156,10 @@ impl World {
         };
         if !self.stepper.restrict(local.clone()) {
             share.gather(&mut self.state);
+            for model in self.models.iter_mut().filter_map(|m| m.split_model()) {
+                model.gather();
+                model.split(None);
+            }
             share.share_whole_every_step(figures);
             self.local = None;
         }
@@ -218,7 +222,8 @@ impl World {
     /// exchange of the particles each rank owns (after each sub-step of an adaptive explicit
     /// Newmark step too). When every model and hook reads only what a rank steps itself
     /// ([`ParticleReads::Local`]) and the stepper can be restricted (Verlet), a rank steps
-    /// only its own particles and its halo, and receives only its halo: call
+    /// only its own particles and its halo, and receives only its halo, and a split model
+    /// ([`crate::SplitModel`], DEM contacts) computes only what touches its particles: call
     /// [`World::gather`] before reading the whole state. Otherwise every rank holds the state
     /// one process would after every step. Call it on every rank, before
     /// [`World::initialize`] or [`World::restore`]. Only explicit runs (Verlet, explicit
@@ -235,10 +240,17 @@ impl World {
             .hooks
             .iter()
             .all(|h| h.particle_reads() == ParticleReads::Local);
-        let (share, figures, local) = decompose(&self.state, &mut self.models, comm, halo_allowed)?;
+        let (share, figures, local) =
+            decompose(&self.state, &mut self.models, comm.clone(), halo_allowed)?;
+        let owner: Arc<[u32]> = share.owner().into();
         self.share = Some((share, figures));
         self.local = local.map(Arc::new);
         self.restrict_stepper();
+        if self.local.is_some() {
+            for model in self.models.iter_mut().filter_map(|m| m.split_model()) {
+                model.split(Some((owner.clone(), comm.clone())));
+            }
+        }
         Ok(self.decomposition().expect("decomposed").clone())
     }
 
@@ -249,6 +261,11 @@ impl World {
     pub fn gather(&mut self) {
         if let Some((share, _)) = &mut self.share {
             share.gather(&mut self.state);
+        }
+        if self.local.is_some() {
+            for model in self.models.iter_mut().filter_map(|m| m.split_model()) {
+                model.gather();
+            }
         }
     }
 

@@ -1,91 +1,14 @@
 //! A run decomposed over ranks gives the bit-identical state of one process, for 2 and 3
-//! ranks: here the ranks are threads of this process, passing messages through shared
-//! memory ([`Communicator`] over a barrier), so the decomposition itself is tested without MPI.
+//! ranks: here the ranks are threads of this process
+//! ([`qdem_core::thread_ranks::on_thread_ranks`]), so the decomposition itself is tested
+//! without MPI.
 
 mod common;
 
+use qdem_core::thread_ranks::on_thread_ranks;
 use qdem_core::{
-    Communicator, Decomposition, Model, Scheme, State, StepEvents, StepRequest, StepSettings, Vec3,
-    World,
+    Decomposition, Model, Scheme, State, StepEvents, StepRequest, StepSettings, Vec3, World,
 };
-use std::sync::{Arc, Barrier, Mutex};
-
-/// The ranks' mailboxes: what each rank posted for each rank.
-struct Hub {
-    size: usize,
-    barrier: Barrier,
-    posts: Mutex<Vec<Vec<Vec<f64>>>>,
-}
-
-/// One rank of a [`Hub`].
-struct ThreadRank {
-    rank: usize,
-    hub: Arc<Hub>,
-}
-
-impl ThreadRank {
-    /// Posts `parts[q]` for every rank `q`, then returns what every rank posted for this one.
-    fn post(&self, parts: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
-        self.hub.posts.lock().unwrap()[self.rank] = parts;
-        self.hub.barrier.wait();
-        let got = {
-            let posts = self.hub.posts.lock().unwrap();
-            posts.iter().map(|p| p[self.rank].clone()).collect()
-        };
-        self.hub.barrier.wait();
-        got
-    }
-}
-
-impl Communicator for ThreadRank {
-    fn rank(&self) -> usize {
-        self.rank
-    }
-
-    fn size(&self) -> usize {
-        self.hub.size
-    }
-
-    fn all_to_all(
-        &self,
-        send: &[f64],
-        send_counts: &[usize],
-        recv: &mut [f64],
-        recv_counts: &[usize],
-    ) {
-        let mut parts = Vec::new();
-        let mut at = 0;
-        for &n in send_counts {
-            parts.push(send[at..at + n].to_vec());
-            at += n;
-        }
-        let got = self.post(parts);
-        let mut at = 0;
-        for (part, &n) in got.iter().zip(recv_counts) {
-            assert_eq!(part.len(), n, "rank {} expected {n} values", self.rank);
-            recv[at..at + n].copy_from_slice(part);
-            at += n;
-        }
-    }
-
-    fn all_gather(&self, mine: &[f64], all: &mut [f64], counts: &[usize]) {
-        let got = self.post(vec![mine.to_vec(); self.hub.size]);
-        let flat = got.concat();
-        assert_eq!(flat.len(), counts.iter().sum::<usize>());
-        all.copy_from_slice(&flat);
-    }
-
-    fn min(&self, value: u64) -> u64 {
-        let got = self.post(vec![vec![value as f64]; self.hub.size]);
-        got.iter().map(|v| v[0] as u64).min().unwrap()
-    }
-
-    fn broadcast(&self, root: usize, bytes: &mut Vec<u8>) {
-        let mine: Vec<f64> = bytes.iter().map(|&b| f64::from(b)).collect();
-        let got = self.post(vec![mine; self.hub.size]);
-        *bytes = got[root].iter().map(|&b| b as u8).collect();
-    }
-}
 
 /// An event every time the tip's vertical velocity crosses a multiple of [`BAND`]: a
 /// stand-in for a bond reaching its strength, so that an adaptive Newmark step is retaken and
@@ -179,25 +102,6 @@ fn one_process_for(newmark: bool, steps: usize) -> (State, u64) {
     (world.state, retakes)
 }
 
-/// `job`'s results on each of `size` thread ranks sharing one hub, in rank order.
-fn on_ranks<T: Send + 'static>(
-    size: usize,
-    job: impl Fn(Arc<ThreadRank>) -> T + Send + Sync + Clone + 'static,
-) -> Vec<T> {
-    let hub = Arc::new(Hub {
-        size,
-        barrier: Barrier::new(size),
-        posts: Mutex::new(vec![Vec::new(); size]),
-    });
-    let runs: Vec<_> = (0..size)
-        .map(|rank| {
-            let (hub, job) = (hub.clone(), job.clone());
-            std::thread::spawn(move || job(Arc::new(ThreadRank { rank, hub })))
-        })
-        .collect();
-    runs.into_iter().map(|r| r.join().unwrap()).collect()
-}
-
 /// Every rank's state after [`STEPS`] steps over `size` ranks (made whole by a gather at the
 /// end, and also every `gather_every` steps if given), and the decomposition; and per rank
 /// whether the last gather changed its state.
@@ -206,7 +110,7 @@ fn ranks(
     newmark: bool,
     gather_every: Option<usize>,
 ) -> (Vec<State>, Decomposition, Vec<bool>) {
-    let runs = on_ranks(size, move |comm| {
+    let runs = on_thread_ranks(size, move |comm| {
         let mut world = beam_world(newmark);
         let figures = world.decompose(comm).unwrap();
         world.initialize().unwrap();
@@ -233,7 +137,7 @@ fn ranks(
 /// Each rank's state after `steps` Verlet steps over `size` ranks, ended by `finish` (a
 /// collective every rank calls).
 fn ranks_ending(size: usize, steps: usize, finish: fn(&mut World)) -> Vec<State> {
-    on_ranks(size, move |comm| {
+    on_thread_ranks(size, move |comm| {
         let mut world = beam_world(false);
         world.decompose(comm).unwrap();
         world.initialize().unwrap();
@@ -374,7 +278,7 @@ fn an_unstable_halo_exchanged_run_fails_as_one_process_does() {
     let alone = unstable_run(&mut unstable_world());
     assert!(alone.contains("turned inside out"), "{alone}");
     for size in [2, 3] {
-        let runs = on_ranks(size, |comm| {
+        let runs = on_thread_ranks(size, |comm| {
             let mut world = unstable_world();
             world.decompose(comm).unwrap();
             unstable_run(&mut world)

@@ -1,0 +1,266 @@
+//! Contacts decomposed over ranks ([`qdem_contact::DemContacts`] as a split model: each rank
+//! evaluates the contacts that touch the grains it owns and receives its ghosts) give the
+//! bits of one process: the state, every contact record, the per-sphere forces and the
+//! checkpoint, for 2 and 3 ranks (threads of this process,
+//! [`qdem_core::thread_ranks::on_thread_ranks`]); a checkpoint written at 2 ranks resumes
+//! at 1 and 3.
+
+mod common;
+
+use common::contacts;
+use qdem_contact::{
+    ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring, PlaneWall, Wall,
+    WallShape,
+};
+use qdem_core::thread_ranks::on_thread_ranks;
+use qdem_core::{
+    Decoder, Dofs, Encoder, Gravity, Model, Scheme, State, StepRequest, StepSettings, Vec3, World,
+};
+
+const R: f64 = 0.005;
+
+/// Steps of each run, and the steps between the gathers that outputs would ask for.
+const STEPS: usize = 600;
+const GATHER_EVERY: usize = 97;
+
+/// 10 × 6 × 10 rotating grains with jittered radii and velocities above a floor, in a box
+/// longer in x than in y: friction spins them, and they cross the ranks' cut as they fall.
+fn world() -> World {
+    let mut centers = Vec::new();
+    for k in 0..10 {
+        for j in 0..6 {
+            for i in 0..10 {
+                let jitter = ((i * 7 + j * 13 + k * 29) % 17) as f64 / 17.0 - 0.5;
+                centers.push(Vec3::new(
+                    (2.2 * i as f64 + 1.2) * R + 0.1 * R * jitter,
+                    (2.2 * j as f64 + 1.2) * R - 0.1 * R * jitter,
+                    (2.2 * k as f64 + 1.2) * R,
+                ));
+            }
+        }
+    }
+    let mut state = State::at_rest(centers.clone());
+    let mut spheres = Vec::new();
+    let mut inertia = Vec::new();
+    for (i, v) in state.velocity.iter_mut().enumerate() {
+        let f = |m: usize| ((i * m) % 101) as f64 / 101.0 - 0.5;
+        *v = Vec3::new(f(37), f(53), f(71));
+        let radius = R * (0.9 + 0.1 * f(19));
+        let mass = 2500.0 * 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
+        state.mass[i] = mass;
+        inertia.push(0.4 * mass * radius * radius);
+        spheres.push(ContactSphere {
+            particle: i,
+            radius,
+            body: i,
+            material: 0,
+        });
+    }
+    state.add_spin(inertia, Dofs::NONE);
+    let plane = |point: Vec3, normal: Vec3| Wall {
+        shape: WallShape::Plane(PlaneWall::new(point, normal, Vec3::zeros())),
+        friction: 0.4,
+    };
+    let (x, y) = (22.0 * R + 0.4 * R, 13.2 * R + 0.4 * R);
+    let walls = vec![
+        plane(Vec3::zeros(), Vec3::z()),
+        plane(Vec3::zeros(), Vec3::x()),
+        plane(Vec3::zeros(), Vec3::y()),
+        plane(Vec3::new(x, 0.0, 0.0), -Vec3::x()),
+        plane(Vec3::new(0.0, y, 0.0), -Vec3::y()),
+    ];
+    let settings = ContactSettings {
+        law: ContactLaw::Linear(LinearSpring {
+            normal_stiffness: 2e3,
+            tangential_stiffness: 1e3,
+            damping_ratio: 0.2,
+        }),
+        friction: 0.5,
+        skin: 0.2 * R,
+    };
+    let model = contacts(&state, &spheres, (5e7, 0.25), settings, walls);
+    let models: Vec<Box<dyn Model>> = vec![
+        Box::new(model),
+        Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81))),
+    ];
+    let request = StepRequest {
+        scheme: Scheme::Verlet,
+        dt: None,
+        safety: 0.5,
+        local_damping: 0.0,
+        adaptive: false,
+        event_solve: Default::default(),
+        implicit_default: None,
+        fit_to: None,
+    };
+    let settings = StepSettings::resolve(&request, &state, &models).unwrap();
+    World::new(state, models, settings).unwrap()
+}
+
+/// What a run leaves, on one rank after its last gather.
+struct Outcome {
+    /// Positions, velocities and spins, as bits.
+    motion: Vec<u64>,
+    /// Every touching contact: partners and force, as bits.
+    touching: Vec<(usize, String, [u64; 3])>,
+    /// Every sphere's contact force, as bits.
+    sphere_forces: Vec<[u64; 3]>,
+    /// The checkpoint's bytes.
+    checkpoint: Vec<u8>,
+    rebuilds: u64,
+}
+
+impl Outcome {
+    /// Fails naming the first part and index where `self` differs from `alone`.
+    fn assert_same(&self, alone: &Outcome, run: &str) {
+        same(&self.motion, &alone.motion, run, "motion");
+        same(&self.touching, &alone.touching, run, "touching contacts");
+        same(
+            &self.sphere_forces,
+            &alone.sphere_forces,
+            run,
+            "sphere forces",
+        );
+        same(&self.checkpoint, &alone.checkpoint, run, "checkpoint");
+        assert_eq!(self.rebuilds, alone.rebuilds, "{run}: rebuilds");
+    }
+}
+
+/// Fails naming the first index where `a` and `b` differ, or their lengths.
+fn same<T: PartialEq + std::fmt::Debug>(a: &[T], b: &[T], run: &str, what: &str) {
+    assert_eq!(a.len(), b.len(), "{run}: {what}: lengths");
+    if let Some(k) = (0..a.len()).find(|&k| a[k] != b[k]) {
+        panic!(
+            "{run}: {what} differ first at {k}: {:?} vs {:?}",
+            a[k], b[k]
+        );
+    }
+}
+
+fn bits(v: &Vec3) -> [u64; 3] {
+    [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]
+}
+
+fn outcome(world: &World) -> Outcome {
+    let state = &world.state;
+    let contacts = world.model::<DemContacts>().unwrap();
+    let mut checkpoint = Encoder::new();
+    world.save(&mut checkpoint).unwrap();
+    Outcome {
+        motion: state
+            .position
+            .iter()
+            .chain(&state.velocity)
+            .chain(&state.spin.velocity)
+            .flat_map(bits)
+            .collect(),
+        touching: contacts
+            .touching()
+            .map(|c| {
+                let force = c.normal_force + c.tangential_force;
+                (c.first, format!("{:?}", c.second), bits(&force))
+            })
+            .collect(),
+        sphere_forces: contacts
+            .sphere_records(state)
+            .map(|s| bits(&s.force))
+            .collect(),
+        checkpoint: checkpoint.into_bytes(),
+        rebuilds: contacts.rebuilds(),
+    }
+}
+
+/// `steps` steps of `world` (gathered every [`GATHER_EVERY`] steps and at the end when
+/// decomposed), and per gather whether this rank's lists were fewer than the whole.
+fn steps(world: &mut World, steps: usize) -> Vec<bool> {
+    let mut cut = Vec::new();
+    for step in 1..=steps {
+        world.step().unwrap();
+        if step % GATHER_EVERY == 0 || step == steps {
+            let part = world.model::<DemContacts>().unwrap().candidates();
+            world.gather();
+            cut.push(part < world.model::<DemContacts>().unwrap().candidates());
+        }
+    }
+    cut
+}
+
+/// One process's outcome after [`STEPS`] steps, and its checkpoint after `stop`.
+fn one_process(stop: usize) -> (Outcome, Vec<u8>) {
+    let mut world = world();
+    world.initialize().unwrap();
+    steps(&mut world, stop);
+    let saved = outcome(&world).checkpoint;
+    steps(&mut world, STEPS - stop);
+    (outcome(&world), saved)
+}
+
+/// Every rank's outcome over `size` ranks, resumed from `checkpoint` after `stop` steps if
+/// given; and whether each rank's lists were cut at every gather.
+fn on_ranks(size: usize, resume: Option<(Vec<u8>, usize)>) -> Vec<(Outcome, bool)> {
+    on_thread_ranks(size, move |comm| {
+        let mut world = world();
+        world.decompose(comm).unwrap();
+        let done = match &resume {
+            Some((bytes, stop)) => {
+                world
+                    .restore(&mut Decoder::new(bytes), *stop as u64)
+                    .unwrap();
+                *stop
+            }
+            None => {
+                world.initialize().unwrap();
+                0
+            }
+        };
+        let cut = steps(&mut world, STEPS - done);
+        (outcome(&world), cut.iter().all(|&c| c))
+    })
+}
+
+#[test]
+fn split_contacts_give_one_processs_bits_on_two_and_three_ranks() {
+    let (alone, _) = one_process(STEPS);
+    let spin: f64 = alone
+        .motion
+        .chunks(3)
+        .skip(2 * 600)
+        .map(|w| f64::from_bits(w[0]).abs())
+        .sum();
+    assert!(spin > 0.0, "friction spins the grains");
+    assert!(
+        alone.touching.len() > 50,
+        "{} touching",
+        alone.touching.len()
+    );
+    assert!(
+        alone.rebuilds > 3,
+        "the lists are rebuilt as the grains fall"
+    );
+    for size in [2, 3] {
+        for (rank, (outcome, cut)) in on_ranks(size, None).into_iter().enumerate() {
+            assert!(cut, "{size} ranks: rank {rank} evaluates only its part");
+            outcome.assert_same(&alone, &format!("{size} ranks: rank {rank}"));
+        }
+    }
+}
+
+#[test]
+fn a_checkpoint_of_split_contacts_at_two_ranks_resumes_at_one_and_three() {
+    let stop = 250;
+    let (alone, saved_alone) = one_process(stop);
+    let saved = on_thread_ranks(2, move |comm| {
+        let mut world = world();
+        world.decompose(comm).unwrap();
+        world.initialize().unwrap();
+        steps(&mut world, stop);
+        outcome(&world).checkpoint
+    });
+    same(&saved[0], &saved_alone, "2 ranks", "checkpoint");
+    for size in [1, 3] {
+        let resumed = on_ranks(size, Some((saved[0].clone(), stop)));
+        for (rank, (outcome, _)) in resumed.into_iter().enumerate() {
+            outcome.assert_same(&alone, &format!("resumed on {size} ranks: rank {rank}"));
+        }
+    }
+}
