@@ -4,7 +4,7 @@
 Usage (from the workspace root; needs Open MPI and a `--features mpi` build):
 
     python3 qdem-bench/scripts/mpi_scaling.py [--tets 1000000] [--spheres 100000]
-        [--tet-steps 200] [--sphere-steps 100] [--pairs 2] [--work out/mpi_scaling]
+        [--tet-steps 200] [--sphere-steps 500] [--pairs 2] [--work out/mpi_scaling]
         [--qdem target/release/qdem] [--json docs/mpi_scaling.json] [--scenes tets,spheres]
 
 Two scenes are written into WORK: a clamped elastic concrete box of about TETS tetrahedra
@@ -14,7 +14,7 @@ SPHERES single spheres falling onto a floor ([granular], linear law). Each is ru
 configurations (R ranks x T threads) in turn, PAIRS times over, so that the machine's drift
 falls on all of them alike; the step time is `wall_seconds / steps` of summary.json (the
 stepping loop only: no mesh reading, no scene building). Weak scaling runs the box of 2 x TETS
-tetrahedra on 2 ranks against TETS on 1. Prints one JSON document (and writes it to --json):
+tetrahedra (the packing of 2 x SPHERES spheres) on 2 ranks against TETS (SPHERES) on 1. Prints one JSON document (and writes it to --json):
 per scene and configuration the median step time, and the efficiencies
 
     strong (R ranks x 1 thread)  = t(1 x 1) / (R t(R x 1))
@@ -236,7 +236,7 @@ def main() -> None:
     ap.add_argument("--tets", type=int, default=1_000_000)
     ap.add_argument("--spheres", type=int, default=100_000)
     ap.add_argument("--tet-steps", type=int, default=200)
-    ap.add_argument("--sphere-steps", type=int, default=100)
+    ap.add_argument("--sphere-steps", type=int, default=500)
     ap.add_argument("--pairs", type=int, default=2)
     ap.add_argument("--work", type=Path, default=ROOT / "out/mpi_scaling")
     ap.add_argument("--qdem", default=str(ROOT / "target/release/qdem"))
@@ -252,7 +252,9 @@ def main() -> None:
         box2 = box_scene(args.work, 2 * args.tets, args.tet_steps)
         scenes.append(("tets", box, [("2x1_double", box2, 2, 1)]))
     if "spheres" in wanted:
-        scenes.append(("spheres", sphere_scene(args.work, args.spheres, args.sphere_steps), []))
+        packing = sphere_scene(args.work, args.spheres, args.sphere_steps)
+        packing2 = sphere_scene(args.work, 2 * args.spheres, args.sphere_steps)
+        scenes.append(("spheres", packing, [("2x1_double", packing2, 2, 1)]))
     configs = [("1x1", 1, 1), ("2x1", 2, 1), ("1x2", 1, 2)]
     result = {"machine": f"{cpu_model()}, {os.cpu_count()} cores",
               "mpirun": subprocess.run(["mpirun", "--version"], capture_output=True,

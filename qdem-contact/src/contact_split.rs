@@ -49,6 +49,11 @@ pub(crate) struct ContactSplit {
     /// Whether the lists hold every rank's contacts (after a merge or a restore): they are
     /// cut down to this rank's before the next evaluation.
     pub(crate) whole: bool,
+    /// The own spheres that are partners of this rank's candidates, ascending: those whose
+    /// motion the lists read and whose contacts are summed.
+    pub(crate) partners: Vec<u32>,
+    /// Scratch: the partners' sums.
+    pub(crate) sums: Vec<(Vec3, Vec3)>,
     mine: Vec<f64>,
     all: Vec<f64>,
 }
@@ -77,6 +82,8 @@ impl ContactSplit {
             recv: Vec::new(),
             recv_counts: vec![0; ranks],
             whole: false,
+            partners: Vec::new(),
+            sums: Vec::new(),
             comm,
             mine: Vec::new(),
             all: Vec::new(),
@@ -101,9 +108,10 @@ impl ContactSplit {
         f64::from_bits(!self.comm.min(!value.to_bits()))
     }
 
-    /// Every sphere's record, from its owner, into `now` and `center`.
+    /// Every sphere's centre and record, from its owner, into `center` and `now` (the
+    /// velocity and spin are current for the partners of the owner's candidates only).
     pub(crate) fn share_all(&mut self, now: &mut [SphereNow], center: &mut [Vec3]) {
-        pack(now, &self.own, &mut self.mine);
+        pack(now, center, &self.own, &mut self.mine);
         let counts: Vec<usize> = self
             .by_rank_counts
             .iter()
@@ -116,7 +124,7 @@ impl ContactSplit {
 
     /// The ghosts' records, from their owners, into `now` and `center`.
     pub(crate) fn share_ghosts(&mut self, now: &mut [SphereNow], center: &mut [Vec3]) {
-        pack(now, &self.send, &mut self.mine);
+        pack(now, center, &self.send, &mut self.mine);
         let counts = |c: &[usize]| c.iter().map(|n| SPHERE_VALUES * n).collect::<Vec<_>>();
         let (send_counts, recv_counts) = (counts(&self.send_counts), counts(&self.recv_counts));
         self.all.resize(SPHERE_VALUES * self.recv.len(), 0.0);
@@ -206,12 +214,12 @@ impl ContactSplit {
     }
 }
 
-/// Appends the records of `spheres` to `out` (cleared first).
-fn pack(now: &[SphereNow], spheres: &[u32], out: &mut Vec<f64>) {
+/// Appends the centre, velocity and spin of `spheres` to `out` (cleared first).
+fn pack(now: &[SphereNow], center: &[Vec3], spheres: &[u32], out: &mut Vec<f64>) {
     out.clear();
     for &s in spheres {
         let n = &now[s as usize];
-        for v in [n.center, n.velocity, n.spin] {
+        for v in [center[s as usize], n.velocity, n.spin] {
             out.extend_from_slice(v.as_slice());
         }
     }

@@ -1136,55 +1136,63 @@ impl DemContacts {
         if split.whole {
             self.cut_to_rank(&mut split);
         }
-        let moved = split.max_over_ranks(self.read_own(state, &split.own));
+        let moved = split.max_over_ranks(self.read_own_centers(state, &split.own));
         if self.needs_rebuild(moved, state.time) {
             split.share_all(&mut self.now, &mut self.center);
             self.rebuild_near(&split, state.time);
-            split.set_ghosts(&self.ghosts(&split));
-        } else {
-            split.share_ghosts(&mut self.now, &mut self.center);
+            self.learn_partners(&mut split);
         }
+        for &s in &split.partners {
+            let s = s as usize;
+            let (particle, turn) = (self.particle[s], self.turn[s]);
+            read_motion(state, self.center[s], particle, turn, &mut self.now[s]);
+        }
+        split.share_ghosts(&mut self.now, &mut self.center);
         self.evaluate(state.time, dt);
         let this = &*self;
-        let sums: Vec<(Vec3, Vec3)> = split
-            .own
-            .par_iter()
+        let mut sums = std::mem::take(&mut split.sums);
+        sums.resize(split.partners.len(), (Vec3::zeros(), Vec3::zeros()));
+        sums.par_iter_mut()
+            .zip(&split.partners)
             .with_min_len(CONTACT_CHUNK)
-            .map(|&s| this.sphere_sum(s as usize))
-            .collect();
-        for (&s, (f, t)) in split.own.iter().zip(&sums) {
+            .for_each(|(sum, &s)| *sum = this.sphere_sum(s as usize));
+        for (&s, (f, t)) in split.partners.iter().zip(&sums) {
             self.apply(s as usize, f, t, force, torque);
             self.sphere_force[s as usize] = (*f, *t);
         }
+        split.sums = sums;
         self.split = Some(split);
     }
 
-    /// Reads the centres and motion of the spheres `own` from `state`; returns the largest
-    /// distance one has moved since the last build (infinite before it).
-    fn read_own(&mut self, state: &State, own: &[u32]) -> f64 {
-        let (particle, turn) = (&self.particle, &self.turn);
-        let now = &self.now;
-        let read: Vec<SphereNow> = own
-            .par_iter()
-            .with_min_len(SPHERE_CHUNK)
-            .map(|&s| {
-                let (s, p) = (s as usize, particle[s as usize]);
-                let mut record = now[s];
-                read_motion(state, state.position[p as usize], p, turn[s], &mut record);
-                record
-            })
-            .collect();
+    /// Reads the centres of the spheres `own` from `state`; returns the largest distance one
+    /// has moved since the last build (infinite before it).
+    fn read_own_centers(&mut self, state: &State, own: &[u32]) -> f64 {
         let built = self.lists_built();
         let mut moved: f64 = if built { 0.0 } else { f64::INFINITY };
-        for (&s, record) in own.iter().zip(read) {
+        for &s in own {
             let s = s as usize;
+            let center = state.position[self.particle[s] as usize];
             if built {
-                moved = moved.max((record.center - self.built_at[s]).norm_squared());
+                moved = moved.max((center - self.built_at[s]).norm_squared());
             }
-            self.center[s] = record.center;
-            self.now[s] = record;
+            self.center[s] = center;
         }
         moved.sqrt()
+    }
+
+    /// After new lists: the ghosts this rank receives (a collective), the own spheres whose
+    /// motion the lists read, and zero force on the own spheres that touch nothing now.
+    fn learn_partners(&mut self, split: &mut ContactSplit) {
+        split.set_ghosts(&self.ghosts(split));
+        split.partners = self
+            .partners
+            .iter()
+            .copied()
+            .filter(|&s| split.owns(s))
+            .collect();
+        for &s in &split.own {
+            self.sphere_force[s as usize] = (Vec3::zeros(), Vec3::zeros());
+        }
     }
 
     /// The broad phase of one rank, once it holds every sphere's centre: the pairs that touch
@@ -1248,7 +1256,7 @@ impl DemContacts {
         self.pairs.items.retain(|c| split.keeps(c, false));
         self.wall_contacts.items.retain(|c| split.keeps(c, true));
         self.build_incidence();
-        split.set_ghosts(&self.ghosts(split));
+        self.learn_partners(split);
         split.whole = false;
     }
 }

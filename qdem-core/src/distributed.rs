@@ -383,7 +383,7 @@ pub(crate) fn decompose(
         body.set_split(split);
     }
     if halo {
-        own_by_position(state, models, &mut owner, &mut figures.owned);
+        own_in_runs(models, &mut owner, &mut figures.owned);
     }
     let (exchange, local) = match halo {
         true => {
@@ -405,14 +405,11 @@ pub(crate) fn decompose(
 }
 
 /// Gives owners to the particles that split models ([`crate::SplitModel`]) move and no
-/// deformable body holds (`owner` `u32::MAX`), by recursive bisection of their positions,
-/// and counts them in `owned`.
-fn own_by_position(
-    state: &State,
-    models: &mut [Box<dyn Model>],
-    owner: &mut [u32],
-    owned: &mut [usize],
-) {
+/// deformable body holds (`owner` `u32::MAX`): runs of particle order, as many particles per
+/// rank. The builders place grains layer by layer, so a run is a slab of the packing (its
+/// ghosts are one layer at each cut) and a rank streams contiguous memory when it steps its
+/// grains; counts them in `owned`.
+fn own_in_runs(models: &mut [Box<dyn Model>], owner: &mut [u32], owned: &mut [usize]) {
     let mut free: Vec<usize> = models
         .iter_mut()
         .filter_map(|m| m.split_model())
@@ -421,37 +418,12 @@ fn own_by_position(
         .collect();
     free.sort_unstable();
     free.dedup();
-    let mut points: Vec<(Vec3, u32)> = free
-        .iter()
-        .map(|&p| (state.position[p], p as u32))
-        .collect();
-    bisect(&mut points, 0..owned.len() as u32, owner);
-    for &p in &free {
-        owned[owner[p] as usize] += 1;
+    let ranks = owned.len();
+    for (k, &p) in free.iter().enumerate() {
+        let r = k * ranks / free.len();
+        owner[p] = r as u32;
+        owned[r] += 1;
     }
-}
-
-/// Gives `points` (position, particle) to `ranks`: all to one rank, or cut across their
-/// widest extent into two sets of as many points per rank, recursively.
-fn bisect(points: &mut [(Vec3, u32)], ranks: Range<u32>, owner: &mut [u32]) {
-    if ranks.len() == 1 || points.is_empty() {
-        for &(_, p) in points.iter() {
-            owner[p as usize] = ranks.start;
-        }
-        return;
-    }
-    let (mut low, mut high) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
-    for (x, _) in points.iter() {
-        low = low.inf(x);
-        high = high.sup(x);
-    }
-    let axis = (high - low).imax();
-    points.sort_unstable_by(|a, b| a.0[axis].total_cmp(&b.0[axis]).then(a.1.cmp(&b.1)));
-    let left = ranks.len() as u32 / 2;
-    let cut = points.len() * left as usize / ranks.len();
-    let (a, b) = points.split_at_mut(cut);
-    bisect(a, ranks.start..ranks.start + left, owner);
-    bisect(b, ranks.start + left..ranks.end, owner);
 }
 
 /// The (rank, particle) pairs of a body's halo: the nodes of each rank's blocks that another
