@@ -41,6 +41,8 @@ pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<
         if leader {
             print!("{table}");
         }
+        // The whole contact lists for the counts below.
+        sim.world.gather();
     }
     if leader {
         print_cost(&sim, per_step);
@@ -139,8 +141,9 @@ fn print_cost(sim: &Simulation, per_step: f64) {
 
 /// Each rank's share of a decomposed step, gathered to every rank (a collective: every rank
 /// calls it): tetrahedra, owned particles, halo (block sums received per step), particles
-/// whose motion it receives per step, its step and kernel seconds, and the
-/// imbalance of the kernel (the slowest rank's kernel time over the mean).
+/// whose motion it receives per step, the candidate contacts it evaluates and the contact
+/// spheres of other ranks it receives (ghosts) after the measured steps, its step and kernel
+/// seconds, and the imbalance of the kernel (the slowest rank's kernel time over the mean).
 fn rank_table(
     sim: &Simulation,
     ranks: &dyn Communicator,
@@ -159,29 +162,50 @@ fn rank_table(
         .filter(|(_, m)| TetBody::of(m.as_ref()).is_some())
         .map(|(i, _)| world.stages().seconds(Stage::Forces(i)))
         .sum();
-    let kernel = bodies - exchange;
+    let kernel = (bodies - exchange).max(0.0);
     let share = world.stages().seconds(Stage::Share);
-    let mine = [per_step, kernel / steps, share / steps];
-    let mut all = vec![0.0; 3 * d.ranks];
-    ranks.all_gather(&mine, &mut all, &vec![3; d.ranks]);
+    // The contacts this rank evaluates and the ghosts it receives (split contacts).
+    let (contacts, ghosts) = sim
+        .contacts()
+        .map_or((0, 0), |c| (c.candidates(), c.ghosts()));
+    let mine = [
+        per_step,
+        kernel / steps,
+        share / steps,
+        contacts as f64,
+        ghosts as f64,
+    ];
+    let mut all = vec![0.0; 5 * d.ranks];
+    ranks.all_gather(&mine, &mut all, &vec![5; d.ranks]);
     let mut table = format!(
-        "decomposed over {} ranks ({} bodies cut between ranks):\n  rank  tets      owned     halo      received  step (s)   kernel (s) share (s)\n",
+        "decomposed over {} ranks ({} bodies cut between ranks):\n  rank  tets      owned     halo      received  contacts  ghosts    step (s)   kernel (s) share (s)\n",
         d.ranks, d.cut_bodies
     );
-    for (r, row) in all.chunks_exact(3).enumerate() {
+    for (r, row) in all.chunks_exact(5).enumerate() {
         table += &format!(
-            "  {r:<5} {:<9} {:<9} {:<9} {:<9} {:.3e}  {:.3e}  {:.3e}\n",
-            d.tets[r], d.owned[r], d.halo[r], d.received[r], row[0], row[1], row[2]
+            "  {r:<5} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9} {:.3e}  {:.3e}  {:.3e}\n",
+            d.tets[r], d.owned[r], d.halo[r], d.received[r], row[3], row[4], row[0], row[1], row[2]
         );
     }
-    let kernels: Vec<f64> = all.chunks_exact(3).map(|row| row[1]).collect();
-    let mean = kernels.iter().sum::<f64>() / d.ranks as f64;
-    let slowest = kernels.iter().cloned().fold(0.0, f64::max);
-    table += &format!(
-        "  kernel imbalance (slowest / mean): {:.3}\n",
-        slowest / mean.max(f64::MIN_POSITIVE)
-    );
+    let column = |k: usize| all.chunks_exact(5).map(|row| row[k]).collect::<Vec<_>>();
+    match d.tets.iter().sum::<usize>() {
+        0 => {
+            let contacts = imbalance(&column(3));
+            table += &format!("  contact imbalance (most candidates / mean): {contacts:.3}\n");
+        }
+        _ => {
+            let kernel = imbalance(&column(1));
+            table += &format!("  kernel imbalance (slowest / mean): {kernel:.3}\n");
+        }
+    }
     table
+}
+
+/// The largest of `values` over their mean.
+fn imbalance(values: &[f64]) -> f64 {
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    let largest = values.iter().cloned().fold(0.0, f64::max);
+    largest / mean.max(f64::MIN_POSITIVE)
 }
 
 /// Where the measured steps' time went, stage by stage ([`qdem_core::stages`]).

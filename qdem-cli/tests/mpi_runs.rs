@@ -344,6 +344,44 @@ fn check_on_two_ranks_reports_each_ranks_share_of_the_tetrahedra() {
 }
 
 #[test]
+fn check_on_two_ranks_reports_each_ranks_contacts_and_ghosts() {
+    let scene = workspace().join("fixtures/contact/grains.toml");
+    let (ok, out, err) = on_two_ranks(&["check", scene.to_str().unwrap(), "--threads", "1"]);
+    assert!(ok, "{err}");
+    let whole: usize = out
+        .lines()
+        .find_map(|l| l.strip_prefix("  contacts after the measured steps: "))
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("the whole candidate count: {out}"));
+    let rows: Vec<Vec<usize>> = out
+        .lines()
+        .skip_while(|l| !l.starts_with("decomposed over 2 ranks"))
+        .skip(2)
+        .take(2)
+        .map(|l| {
+            l.split_whitespace()
+                .take(7)
+                .map(|v| v.parse().unwrap())
+                .collect()
+        })
+        .collect();
+    assert_eq!(rows.len(), 2, "{out}");
+    let owned: usize = rows.iter().map(|r| r[2]).sum();
+    assert_eq!(owned, 2000, "every grain owned once: {out}");
+    // Each rank evaluates its grains' contacts, fewer than all, and receives ghosts; the
+    // pairs across the cut are evaluated on both.
+    for row in &rows {
+        assert!(row[5] < whole && row[6] > 0, "{out}");
+    }
+    assert!(rows[0][5] + rows[1][5] > whole, "{out}");
+    assert!(
+        out.contains("contact imbalance (most candidates / mean):"),
+        "{out}"
+    );
+}
+
+#[test]
 fn an_implicit_run_and_the_other_commands_are_refused_on_two_ranks() {
     let implicit = workspace().join("fixtures/bbm/beam_implicit_0.025.toml");
     let tmp = TempDir::new("implicit");

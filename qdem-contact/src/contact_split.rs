@@ -90,6 +90,11 @@ impl ContactSplit {
         }
     }
 
+    /// The number of ghosts this rank receives at each evaluation.
+    pub(crate) fn ghosts(&self) -> usize {
+        self.recv.len()
+    }
+
     /// Whether this rank owns sphere `s`.
     #[inline]
     pub(crate) fn owns(&self, s: u32) -> bool {

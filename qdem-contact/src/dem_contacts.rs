@@ -571,6 +571,12 @@ impl DemContacts {
         pairs.chain(walls)
     }
 
+    /// The spheres of other ranks whose motion this rank receives at each evaluation, in a
+    /// run decomposed with split contacts ([`SplitModel`]); 0 otherwise.
+    pub fn ghosts(&self) -> usize {
+        self.split.as_ref().map_or(0, ContactSplit::ghosts)
+    }
+
     /// How many times the candidate lists were rebuilt.
     pub fn rebuilds(&self) -> u64 {
         self.rebuilds
@@ -1183,7 +1189,7 @@ impl DemContacts {
     /// After new lists: the ghosts this rank receives (a collective), the own spheres whose
     /// motion the lists read, and zero force on the own spheres that touch nothing now.
     fn learn_partners(&mut self, split: &mut ContactSplit) {
-        split.set_ghosts(&self.ghosts(split));
+        split.set_ghosts(&self.ghosts_of(split));
         split.partners = self
             .partners
             .iter()
@@ -1237,7 +1243,7 @@ impl DemContacts {
     }
 
     /// The partners of this rank's pairs that other ranks own, ascending.
-    fn ghosts(&self, split: &ContactSplit) -> Vec<u32> {
+    fn ghosts_of(&self, split: &ContactSplit) -> Vec<u32> {
         let mut ghosts: Vec<u32> = self
             .pairs
             .items
