@@ -1120,12 +1120,10 @@ impl DemContacts {
 /// One rank's part of the contacts ([`crate::contact_split`]).
 impl DemContacts {
     /// Whether a rank can compute the contact set in part: no sphere of a rigid body (whose
-    /// moments one rank would have to reduce), no periodic axis and no time delay (whose
-    /// images and boundary force read every rank's spheres).
+    /// moments one rank would have to reduce) and no time delay (whose boundary force is a
+    /// mean over every rank's pairs).
     fn splittable(&self) -> bool {
-        self.periodic.is_none()
-            && self.time_delay.is_none()
-            && self.rigid.iter().all(|&r| r == NOT_RIGID)
+        self.time_delay.is_none() && self.rigid.iter().all(|&r| r == NOT_RIGID)
     }
 
     /// [`Model::add_forces`] of one rank's part: its own spheres read, the ghosts received
@@ -1202,10 +1200,15 @@ impl DemContacts {
     }
 
     /// The broad phase of one rank, once it holds every sphere's centre: the pairs that touch
-    /// a sphere it owns, found among the spheres within reach of its own, and its own
-    /// spheres' wall candidates; the springs of the pairs that stay are kept.
+    /// a sphere it owns, found among the spheres within reach of its own (among all, in a
+    /// periodic cell, where the images of far spheres may be near), and its own spheres'
+    /// wall candidates; the springs of the pairs that stay are kept.
     fn rebuild_near(&mut self, split: &ContactSplit, time: f64) {
         let skin = self.settings.skin;
+        if self.periodic.is_some() {
+            let all: Vec<u32> = (0..self.center.len() as u32).collect();
+            return self.rebuild_among(split, &all, time);
+        }
         let reach = 2.0 * self.radius.iter().cloned().fold(0.0, f64::max) + skin;
         let (mut low, mut high) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
         for &s in &split.own {
@@ -1219,6 +1222,12 @@ impl DemContacts {
                 (0..3).all(|k| x[k] >= low[k] && x[k] <= high[k])
             })
             .collect();
+        self.rebuild_among(split, &near, time);
+    }
+
+    /// [`DemContacts::rebuild_near`] among the spheres `near` (ascending).
+    fn rebuild_among(&mut self, split: &ContactSplit, near: &[u32], time: f64) {
+        let skin = self.settings.skin;
         let (center, radius, body) = (
             pick(&near, &self.center),
             pick(&near, &self.radius),
@@ -1228,7 +1237,7 @@ impl DemContacts {
             center: &center,
             radius: &radius,
             body: &body,
-            periodic: None,
+            periodic: self.periodic.as_ref(),
         };
         let keys = find_pairs(&set, skin)
             .into_iter()

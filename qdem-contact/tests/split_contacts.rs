@@ -2,15 +2,16 @@
 //! evaluates the contacts that touch the grains it owns and receives its ghosts) give the
 //! bits of one process: the state, every contact record, the per-sphere forces and the
 //! checkpoint, for 2 and 3 ranks (threads of this process,
-//! [`qdem_core::thread_ranks::on_thread_ranks`]); a checkpoint written at 2 ranks resumes
-//! at 1 and 3.
+//! [`qdem_core::thread_ranks::on_thread_ranks`]), in a box and in a cell periodic across the
+//! ranks' cut (grains wrapping back into it); a checkpoint written at 2 ranks resumes at 1
+//! and 3.
 
 mod common;
 
 use common::contacts;
 use qdem_contact::{
-    ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring, PlaneWall, Wall,
-    WallShape,
+    ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring, PeriodicBox,
+    PeriodicWrap, PlaneWall, Wall, WallShape, WrapGroup,
 };
 use qdem_core::thread_ranks::on_thread_ranks;
 use qdem_core::{
@@ -25,7 +26,8 @@ const GATHER_EVERY: usize = 97;
 
 /// 10 × 6 × 10 rotating grains with jittered radii and velocities above a floor, in a box
 /// longer in x than in y: friction spins them, and they cross the ranks' cut as they fall.
-fn world() -> World {
+/// `periodic`: the cell is periodic in y instead of walled there, and the grains wrap.
+fn world(periodic: bool) -> World {
     let mut centers = Vec::new();
     for k in 0..10 {
         for j in 0..6 {
@@ -62,13 +64,15 @@ fn world() -> World {
         friction: 0.4,
     };
     let (x, y) = (22.0 * R + 0.4 * R, 13.2 * R + 0.4 * R);
-    let walls = vec![
+    let mut walls = vec![
         plane(Vec3::zeros(), Vec3::z()),
         plane(Vec3::zeros(), Vec3::x()),
-        plane(Vec3::zeros(), Vec3::y()),
         plane(Vec3::new(x, 0.0, 0.0), -Vec3::x()),
-        plane(Vec3::new(0.0, y, 0.0), -Vec3::y()),
     ];
+    if !periodic {
+        walls.push(plane(Vec3::zeros(), Vec3::y()));
+        walls.push(plane(Vec3::new(0.0, y, 0.0), -Vec3::y()));
+    }
     let settings = ContactSettings {
         law: ContactLaw::Linear(LinearSpring {
             normal_stiffness: 2e3,
@@ -78,7 +82,11 @@ fn world() -> World {
         friction: 0.5,
         skin: 0.2 * R,
     };
-    let model = contacts(&state, &spheres, (5e7, 0.25), settings, walls);
+    let mut model = contacts(&state, &spheres, (5e7, 0.25), settings, walls);
+    let cell = PeriodicBox::new(Vec3::zeros(), [None, Some(y), None]).unwrap();
+    if periodic {
+        model = model.with_periodic(cell.clone()).unwrap();
+    }
     let models: Vec<Box<dyn Model>> = vec![
         Box::new(model),
         Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81))),
@@ -94,7 +102,17 @@ fn world() -> World {
         fit_to: None,
     };
     let settings = StepSettings::resolve(&request, &state, &models).unwrap();
-    World::new(state, models, settings).unwrap()
+    let mut world = World::new(state, models, settings).unwrap();
+    if periodic {
+        let groups = (0..centers.len())
+            .map(|p| WrapGroup {
+                anchor: p,
+                particles: vec![p],
+            })
+            .collect();
+        world.add_hook(Box::new(PeriodicWrap::new(cell, groups)));
+    }
+    world
 }
 
 /// What a run leaves, on one rank after its last gather.
@@ -186,8 +204,8 @@ fn steps(world: &mut World, steps: usize) -> Vec<bool> {
 }
 
 /// One process's outcome after [`STEPS`] steps, and its checkpoint after `stop`.
-fn one_process(stop: usize) -> (Outcome, Vec<u8>) {
-    let mut world = world();
+fn one_process(periodic: bool, stop: usize) -> (Outcome, Vec<u8>) {
+    let mut world = world(periodic);
     world.initialize().unwrap();
     steps(&mut world, stop);
     let saved = outcome(&world).checkpoint;
@@ -197,9 +215,9 @@ fn one_process(stop: usize) -> (Outcome, Vec<u8>) {
 
 /// Every rank's outcome over `size` ranks, resumed from `checkpoint` after `stop` steps if
 /// given; and whether each rank's lists were cut at every gather.
-fn on_ranks(size: usize, resume: Option<(Vec<u8>, usize)>) -> Vec<(Outcome, bool)> {
+fn on_ranks(size: usize, periodic: bool, resume: Option<(Vec<u8>, usize)>) -> Vec<(Outcome, bool)> {
     on_thread_ranks(size, move |comm| {
-        let mut world = world();
+        let mut world = world(periodic);
         world.decompose(comm).unwrap();
         let done = match &resume {
             Some((bytes, stop)) => {
@@ -218,9 +236,9 @@ fn on_ranks(size: usize, resume: Option<(Vec<u8>, usize)>) -> Vec<(Outcome, bool
     })
 }
 
-#[test]
-fn split_contacts_give_one_processs_bits_on_two_and_three_ranks() {
-    let (alone, _) = one_process(STEPS);
+/// One process's run against 2 and 3 ranks'.
+fn same_on_ranks(periodic: bool) -> Outcome {
+    let (alone, _) = one_process(periodic, STEPS);
     let spin: f64 = alone
         .motion
         .chunks(3)
@@ -238,19 +256,54 @@ fn split_contacts_give_one_processs_bits_on_two_and_three_ranks() {
         "the lists are rebuilt as the grains fall"
     );
     for size in [2, 3] {
-        for (rank, (outcome, cut)) in on_ranks(size, None).into_iter().enumerate() {
+        for (rank, (outcome, cut)) in on_ranks(size, periodic, None).into_iter().enumerate() {
             assert!(cut, "{size} ranks: rank {rank} evaluates only its part");
             outcome.assert_same(&alone, &format!("{size} ranks: rank {rank}"));
         }
     }
+    alone
+}
+
+#[test]
+fn split_contacts_give_one_processs_bits_on_two_and_three_ranks() {
+    same_on_ranks(false);
+}
+
+#[test]
+fn split_contacts_in_a_periodic_cell_give_one_processs_bits_on_two_and_three_ranks() {
+    let alone = same_on_ranks(true);
+    let y: Vec<f64> = alone.motion[..1800]
+        .chunks(3)
+        .map(|p| f64::from_bits(p[1]))
+        .collect();
+    assert!(
+        y.iter().all(|&y| (0.0..13.6 * R).contains(&y)),
+        "every grain is wrapped into the cell"
+    );
+    let through: usize = alone
+        .touching
+        .iter()
+        .filter(|(first, second, _)| {
+            let b: usize = second
+                .trim_start_matches("Sphere(")
+                .trim_end_matches(')')
+                .parse()
+                .unwrap_or(*first);
+            (y[*first] - y[b]).abs() > 6.8 * R
+        })
+        .count();
+    assert!(
+        through > 0,
+        "some grains touch through the periodic boundary"
+    );
 }
 
 #[test]
 fn a_checkpoint_of_split_contacts_at_two_ranks_resumes_at_one_and_three() {
     let stop = 250;
-    let (alone, saved_alone) = one_process(stop);
+    let (alone, saved_alone) = one_process(false, stop);
     let saved = on_thread_ranks(2, move |comm| {
-        let mut world = world();
+        let mut world = world(false);
         world.decompose(comm).unwrap();
         world.initialize().unwrap();
         steps(&mut world, stop);
@@ -258,7 +311,7 @@ fn a_checkpoint_of_split_contacts_at_two_ranks_resumes_at_one_and_three() {
     });
     same(&saved[0], &saved_alone, "2 ranks", "checkpoint");
     for size in [1, 3] {
-        let resumed = on_ranks(size, Some((saved[0].clone(), stop)));
+        let resumed = on_ranks(size, false, Some((saved[0].clone(), stop)));
         for (rank, (outcome, _)) in resumed.into_iter().enumerate() {
             outcome.assert_same(&alone, &format!("resumed on {size} ranks: rank {rank}"));
         }

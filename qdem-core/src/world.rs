@@ -23,7 +23,7 @@ use crate::distributed::{decompose, Communicator, Decomposition};
 use crate::error::CoreError;
 use crate::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
 use crate::local_particles::LocalParticles;
-use crate::model::{find_model, Model, ParticleReads, Persistence};
+use crate::model::{find_model, Model, ParticleReads, Persistence, SplitModel};
 use crate::stages::{Stage, StageShare, StageTimes};
 use crate::state::State;
 use crate::state_share::StateShare;
@@ -44,6 +44,13 @@ pub trait PostStep: std::any::Any + Send + Sync {
     /// [`ParticleReads::All`], is always right.
     fn particle_reads(&self) -> ParticleReads {
         ParticleReads::All
+    }
+
+    /// The hook's part in a run decomposed with a halo exchange, for a hook that reads only
+    /// what a rank owns and shares what it decides ([`Model::split_model`]); `None` (the
+    /// default) otherwise.
+    fn split_model(&mut self) -> Option<&mut dyn SplitModel> {
+        None
     }
 }
 
@@ -156,9 +163,9 @@ impl World {
         };
         if !self.stepper.restrict(local.clone()) {
             share.gather(&mut self.state);
-            for model in self.models.iter_mut().filter_map(|m| m.split_model()) {
-                model.gather();
-                model.split(None);
+            for part in split_parts(&mut self.models, &mut self.hooks) {
+                part.gather();
+                part.split(None);
             }
             share.share_whole_every_step(figures);
             self.local = None;
@@ -247,8 +254,8 @@ impl World {
         self.local = local.map(Arc::new);
         self.restrict_stepper();
         if self.local.is_some() {
-            for model in self.models.iter_mut().filter_map(|m| m.split_model()) {
-                model.split(Some((owner.clone(), comm.clone())));
+            for part in split_parts(&mut self.models, &mut self.hooks) {
+                part.split(Some((owner.clone(), comm.clone())));
             }
         }
         Ok(self.decomposition().expect("decomposed").clone())
@@ -263,8 +270,8 @@ impl World {
             share.gather(&mut self.state);
         }
         if self.local.is_some() {
-            for model in self.models.iter_mut().filter_map(|m| m.split_model()) {
-                model.gather();
+            for part in split_parts(&mut self.models, &mut self.hooks) {
+                part.gather();
             }
         }
     }
@@ -426,6 +433,15 @@ impl World {
         self.steps_done = steps_done;
         Ok(())
     }
+}
+
+/// The split facets of the models and hooks ([`SplitModel`]), models first.
+fn split_parts<'a>(
+    models: &'a mut [Box<dyn Model>],
+    hooks: &'a mut [Box<dyn PostStep>],
+) -> impl Iterator<Item = &'a mut dyn SplitModel> {
+    let models = models.iter_mut().filter_map(|m| m.split_model());
+    models.chain(hooks.iter_mut().filter_map(|h| h.split_model()))
 }
 
 /// Tells every model how it is stepped.

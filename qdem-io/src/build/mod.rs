@@ -178,7 +178,7 @@ impl Simulation {
             StepSettings::resolve(&step_request(&scene), &state, &models).map_err(core)?;
         let mut world = World::new(state, models, settings).map_err(core)?;
         if let Some((cell, groups)) = periodic {
-            world.add_hook(Box::new(PeriodicWrap { cell, groups }));
+            world.add_hook(Box::new(PeriodicWrap::new(cell, groups)));
         }
         Ok(Simulation {
             scene,
