@@ -1200,27 +1200,28 @@ impl DemContacts {
     }
 
     /// The broad phase of one rank, once it holds every sphere's centre: the pairs that touch
-    /// a sphere it owns, found among the spheres within reach of its own (among all, in a
-    /// periodic cell, where the images of far spheres may be near), and its own spheres'
-    /// wall candidates; the springs of the pairs that stay are kept.
+    /// a sphere it owns, found among the spheres within reach of the box around its own
+    /// (along a periodic axis, those with an image there), and its own spheres' wall
+    /// candidates; the springs of the pairs that stay are kept.
     fn rebuild_near(&mut self, split: &ContactSplit, time: f64) {
-        let skin = self.settings.skin;
-        if self.periodic.is_some() {
-            let all: Vec<u32> = (0..self.center.len() as u32).collect();
-            return self.rebuild_among(split, &all, time);
-        }
-        let reach = 2.0 * self.radius.iter().cloned().fold(0.0, f64::max) + skin;
+        let reach = 2.0 * self.radius.iter().cloned().fold(0.0, f64::max) + self.settings.skin;
         let (mut low, mut high) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
         for &s in &split.own {
             low = low.inf(&self.center[s as usize]);
             high = high.sup(&self.center[s as usize]);
         }
-        let (low, high) = (low.add_scalar(-reach), high.add_scalar(reach));
+        let (start, width) = (
+            low.add_scalar(-reach),
+            high - low + Vec3::repeat(2.0 * reach),
+        );
+        let period = |k: usize| self.periodic.as_ref().and_then(|p| p.length(k));
+        let within = |k: usize, x: f64| match period(k) {
+            Some(l) if width[k] < l => (x - start[k]).rem_euclid(l) <= width[k],
+            Some(_) => true,
+            None => x >= start[k] && x - start[k] <= width[k],
+        };
         let near: Vec<u32> = (0..self.center.len() as u32)
-            .filter(|&s| {
-                let x = &self.center[s as usize];
-                (0..3).all(|k| x[k] >= low[k] && x[k] <= high[k])
-            })
+            .filter(|&s| (0..3).all(|k| within(k, self.center[s as usize][k])))
             .collect();
         self.rebuild_among(split, &near, time);
     }
