@@ -1119,11 +1119,10 @@ impl DemContacts {
 
 /// One rank's part of the contacts ([`crate::contact_split`]).
 impl DemContacts {
-    /// Whether a rank can compute the contact set in part: no sphere of a rigid body (whose
-    /// moments one rank would have to reduce) and no time delay (whose boundary force is a
-    /// mean over every rank's pairs).
+    /// Whether a rank can compute the contact set in part: not with a time delay, whose
+    /// boundary force is a mean over every rank's pairs.
     fn splittable(&self) -> bool {
-        self.time_delay.is_none() && self.rigid.iter().all(|&r| r == NOT_RIGID)
+        self.time_delay.is_none()
     }
 
     /// [`Model::add_forces`] of one rank's part: its own spheres read, the ghosts received

@@ -2,9 +2,9 @@
 //! evaluates the contacts that touch the grains it owns and receives its ghosts) give the
 //! bits of one process: the state, every contact record, the per-sphere forces and the
 //! checkpoint, for 2 and 3 ranks (threads of this process,
-//! [`qdem_core::thread_ranks::on_thread_ranks`]), in a box and in a cell periodic across the
-//! ranks' cut (grains wrapping back into it); a checkpoint written at 2 ranks resumes at 1
-//! and 3.
+//! [`qdem_core::thread_ranks::on_thread_ranks`]), for grains that rotate as particles or as
+//! rigid bodies (owned whole by one rank), in a box and in a cell periodic across the ranks'
+//! cut (grains wrapping back into it); a checkpoint written at 2 ranks resumes at 1 and 3.
 
 mod common;
 
@@ -15,7 +15,8 @@ use qdem_contact::{
 };
 use qdem_core::thread_ranks::on_thread_ranks;
 use qdem_core::{
-    Decoder, Dofs, Encoder, Gravity, Model, Scheme, State, StepRequest, StepSettings, Vec3, World,
+    Decoder, Dofs, Encoder, Gravity, Mat3, Model, Scheme, State, StepRequest, StepSettings, Vec3,
+    World,
 };
 
 const R: f64 = 0.005;
@@ -26,8 +27,20 @@ const GATHER_EVERY: usize = 97;
 
 /// 10 × 6 × 10 rotating grains with jittered radii and velocities above a floor, in a box
 /// longer in x than in y: friction spins them, and they cross the ranks' cut as they fall.
-/// `periodic`: the cell is periodic in x instead of walled there, and the grains wrap.
-fn world(periodic: bool) -> World {
+/// The grains of a test.
+#[derive(Clone, Copy, PartialEq)]
+enum Grains {
+    /// Particles that rotate, in a box.
+    Rotating,
+    /// The same in a cell periodic in x instead of walled there: the grains wrap.
+    Periodic,
+    /// Rigid bodies of one sphere each, in a box.
+    Rigid,
+}
+
+/// The run of `grains`.
+fn world(grains: Grains) -> World {
+    let periodic = grains == Grains::Periodic;
     let mut centers = Vec::new();
     // x slowest: a rank's run of particles is a slab across x, so that in the periodic cell
     // it finds its pairs among the spheres with an image near its slab.
@@ -46,13 +59,17 @@ fn world(periodic: bool) -> World {
     let mut state = State::at_rest(centers.clone());
     let mut spheres = Vec::new();
     let mut inertia = Vec::new();
-    for (i, v) in state.velocity.iter_mut().enumerate() {
+    for i in 0..centers.len() {
         let f = |m: usize| ((i * m) % 101) as f64 / 101.0 - 0.5;
-        *v = Vec3::new(f(37), f(53), f(71));
+        state.velocity[i] = Vec3::new(f(37), f(53), f(71));
         let radius = R * (0.9 + 0.1 * f(19));
         let mass = 2500.0 * 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
         state.mass[i] = mass;
         inertia.push(0.4 * mass * radius * radius);
+        if grains == Grains::Rigid {
+            let moment = Mat3::identity() * (0.4 * mass * radius * radius);
+            state.add_rigid_body("grain", i, &[], moment).unwrap();
+        }
         spheres.push(ContactSphere {
             particle: i,
             radius,
@@ -60,7 +77,9 @@ fn world(periodic: bool) -> World {
             material: 0,
         });
     }
-    state.add_spin(inertia, Dofs::NONE);
+    if grains != Grains::Rigid {
+        state.add_spin(inertia, Dofs::NONE);
+    }
     let plane = |point: Vec3, normal: Vec3| Wall {
         shape: WallShape::Plane(PlaneWall::new(point, normal, Vec3::zeros())),
         friction: 0.4,
@@ -119,8 +138,10 @@ fn world(periodic: bool) -> World {
 
 /// What a run leaves, on one rank after its last gather.
 struct Outcome {
-    /// Positions, velocities and spins, as bits.
+    /// Positions, velocities and spins (and the rigid bodies' orientations), as bits.
     motion: Vec<u64>,
+    /// The sum of the grains' angular speeds (rad/s).
+    spin: f64,
     /// Every touching contact: partners and force, as bits.
     touching: Vec<(usize, String, [u64; 3])>,
     /// Every sphere's contact force, as bits.
@@ -172,8 +193,23 @@ fn outcome(world: &World) -> Outcome {
             .iter()
             .chain(&state.velocity)
             .chain(&state.spin.velocity)
+            .chain(&state.rigid.angular_velocity)
             .flat_map(bits)
+            .chain(state.rigid.orientation.iter().flat_map(|q| {
+                q.as_ref()
+                    .coords
+                    .iter()
+                    .map(|c| c.to_bits())
+                    .collect::<Vec<_>>()
+            }))
             .collect(),
+        spin: state
+            .spin
+            .velocity
+            .iter()
+            .chain(&state.rigid.angular_velocity)
+            .map(|w| w.norm())
+            .sum(),
         touching: contacts
             .touching()
             .map(|c| {
@@ -206,8 +242,8 @@ fn steps(world: &mut World, steps: usize) -> Vec<bool> {
 }
 
 /// One process's outcome after [`STEPS`] steps, and its checkpoint after `stop`.
-fn one_process(periodic: bool, stop: usize) -> (Outcome, Vec<u8>) {
-    let mut world = world(periodic);
+fn one_process(grains: Grains, stop: usize) -> (Outcome, Vec<u8>) {
+    let mut world = world(grains);
     world.initialize().unwrap();
     steps(&mut world, stop);
     let saved = outcome(&world).checkpoint;
@@ -217,9 +253,9 @@ fn one_process(periodic: bool, stop: usize) -> (Outcome, Vec<u8>) {
 
 /// Every rank's outcome over `size` ranks, resumed from `checkpoint` after `stop` steps if
 /// given; and whether each rank's lists were cut at every gather.
-fn on_ranks(size: usize, periodic: bool, resume: Option<(Vec<u8>, usize)>) -> Vec<(Outcome, bool)> {
+fn on_ranks(size: usize, grains: Grains, resume: Option<(Vec<u8>, usize)>) -> Vec<(Outcome, bool)> {
     on_thread_ranks(size, move |comm| {
-        let mut world = world(periodic);
+        let mut world = world(grains);
         world.decompose(comm).unwrap();
         let done = match &resume {
             Some((bytes, stop)) => {
@@ -239,15 +275,9 @@ fn on_ranks(size: usize, periodic: bool, resume: Option<(Vec<u8>, usize)>) -> Ve
 }
 
 /// One process's run against 2 and 3 ranks'.
-fn same_on_ranks(periodic: bool) -> Outcome {
-    let (alone, _) = one_process(periodic, STEPS);
-    let spin: f64 = alone
-        .motion
-        .chunks(3)
-        .skip(2 * 600)
-        .map(|w| f64::from_bits(w[0]).abs())
-        .sum();
-    assert!(spin > 0.0, "friction spins the grains");
+fn same_on_ranks(grains: Grains) -> Outcome {
+    let (alone, _) = one_process(grains, STEPS);
+    assert!(alone.spin > 0.0, "friction spins the grains");
     assert!(
         alone.touching.len() > 50,
         "{} touching",
@@ -258,7 +288,7 @@ fn same_on_ranks(periodic: bool) -> Outcome {
         "the lists are rebuilt as the grains fall"
     );
     for size in [2, 3] {
-        for (rank, (outcome, cut)) in on_ranks(size, periodic, None).into_iter().enumerate() {
+        for (rank, (outcome, cut)) in on_ranks(size, grains, None).into_iter().enumerate() {
             assert!(cut, "{size} ranks: rank {rank} evaluates only its part");
             outcome.assert_same(&alone, &format!("{size} ranks: rank {rank}"));
         }
@@ -268,12 +298,17 @@ fn same_on_ranks(periodic: bool) -> Outcome {
 
 #[test]
 fn split_contacts_give_one_processs_bits_on_two_and_three_ranks() {
-    same_on_ranks(false);
+    same_on_ranks(Grains::Rotating);
+}
+
+#[test]
+fn split_contacts_of_rigid_grains_give_one_processs_bits_on_two_and_three_ranks() {
+    same_on_ranks(Grains::Rigid);
 }
 
 #[test]
 fn split_contacts_in_a_periodic_cell_give_one_processs_bits_on_two_and_three_ranks() {
-    let alone = same_on_ranks(true);
+    let alone = same_on_ranks(Grains::Periodic);
     let x: Vec<f64> = alone.motion[..1800]
         .chunks(3)
         .map(|p| f64::from_bits(p[0]))
@@ -298,12 +333,13 @@ fn split_contacts_in_a_periodic_cell_give_one_processs_bits_on_two_and_three_ran
     );
 }
 
-#[test]
-fn a_checkpoint_of_split_contacts_at_two_ranks_resumes_at_one_and_three() {
+/// A checkpoint of `grains` written at 2 ranks after 250 steps is one process's, and
+/// resumes at 1 and 3 ranks to one process's end.
+fn resumes_on_other_ranks(grains: Grains) {
     let stop = 250;
-    let (alone, saved_alone) = one_process(false, stop);
+    let (alone, saved_alone) = one_process(grains, stop);
     let saved = on_thread_ranks(2, move |comm| {
-        let mut world = world(false);
+        let mut world = world(grains);
         world.decompose(comm).unwrap();
         world.initialize().unwrap();
         steps(&mut world, stop);
@@ -311,9 +347,20 @@ fn a_checkpoint_of_split_contacts_at_two_ranks_resumes_at_one_and_three() {
     });
     same(&saved[0], &saved_alone, "2 ranks", "checkpoint");
     for size in [1, 3] {
-        let resumed = on_ranks(size, false, Some((saved[0].clone(), stop)));
+        let resumed = on_ranks(size, grains, Some((saved[0].clone(), stop)));
         for (rank, (outcome, _)) in resumed.into_iter().enumerate() {
             outcome.assert_same(&alone, &format!("resumed on {size} ranks: rank {rank}"));
         }
     }
+}
+
+#[test]
+fn a_checkpoint_of_split_contacts_at_two_ranks_resumes_at_one_and_three() {
+    resumes_on_other_ranks(Grains::Rotating);
+}
+
+/// The rigid bodies' rotation and the stepper's torques on them come from their owners.
+#[test]
+fn a_checkpoint_of_split_rigid_grains_at_two_ranks_resumes_at_one_and_three() {
+    resumes_on_other_ranks(Grains::Rigid);
 }

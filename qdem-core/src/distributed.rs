@@ -383,7 +383,7 @@ pub(crate) fn decompose(
         body.set_split(split);
     }
     if halo {
-        own_in_runs(models, &mut owner, &mut figures.owned);
+        own_in_runs(state, models, &mut owner, &mut figures.owned);
     }
     let (exchange, local) = match halo {
         true => {
@@ -406,10 +406,15 @@ pub(crate) fn decompose(
 
 /// Gives owners to the particles that split models ([`crate::SplitModel`]) move and no
 /// deformable body holds (`owner` `u32::MAX`): runs of particle order, as many particles per
-/// rank. The builders place grains layer by layer, so a run is a slab of the packing (its
-/// ghosts are one layer at each cut) and a rank streams contiguous memory when it steps its
-/// grains; counts them in `owned`.
-fn own_in_runs(models: &mut [Box<dyn Model>], owner: &mut [u32], owned: &mut [usize]) {
+/// rank, a rigid body (its centre and members) whole to one rank. The builders place grains
+/// layer by layer, so a run is a slab of the packing (its ghosts are one layer at each cut)
+/// and a rank streams contiguous memory when it steps its grains; counts them in `owned`.
+fn own_in_runs(
+    state: &State,
+    models: &mut [Box<dyn Model>],
+    owner: &mut [u32],
+    owned: &mut [usize],
+) {
     let mut free: Vec<usize> = models
         .iter_mut()
         .filter_map(|m| m.split_model())
@@ -418,11 +423,37 @@ fn own_in_runs(models: &mut [Box<dyn Model>], owner: &mut [u32], owned: &mut [us
         .collect();
     free.sort_unstable();
     free.dedup();
-    let ranks = owned.len();
-    for (k, &p) in free.iter().enumerate() {
-        let r = k * ranks / free.len();
-        owner[p] = r as u32;
-        owned[r] += 1;
+    let rigid = &state.rigid;
+    let mut body_of_center = vec![None; state.len()];
+    for (b, &c) in rigid.center.iter().enumerate() {
+        body_of_center[c] = Some(b);
+    }
+    let mut placed = vec![false; rigid.len()];
+    let mut units: Vec<Vec<usize>> = Vec::new();
+    for &p in &free {
+        match rigid.body_of_member(p).or(body_of_center[p]) {
+            Some(b) if !placed[b] => {
+                placed[b] = true;
+                units.push(
+                    [rigid.center[b]]
+                        .into_iter()
+                        .chain(rigid.members(b).iter().copied())
+                        .collect(),
+                );
+            }
+            Some(_) => {}
+            None => units.push(vec![p]),
+        }
+    }
+    let (ranks, total) = (owned.len(), units.iter().map(Vec::len).sum::<usize>());
+    let mut before = 0;
+    for unit in &units {
+        let r = before * ranks / total;
+        for &p in unit {
+            owner[p] = r as u32;
+        }
+        owned[r] += unit.len();
+        before += unit.len();
     }
 }
 

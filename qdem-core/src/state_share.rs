@@ -14,6 +14,11 @@
 //!   outputs, a checkpoint, a failure's report) asks for a [`StateShare::gather`] first,
 //!   which sends the positions too.
 //!
+//! A rigid body is owned, whole, by the rank that owns its centre; in halo mode the other
+//! ranks' copies of its rotation go stale between gathers, and a gather brings its
+//! orientation, angular momentum and velocity and the stepper's torque on it (which the next
+//! step's first half kick reads) from its owner.
+//!
 //! Values are copied, never summed, so any number of ranks gives the same bits. The one sum
 //! over ranks is the kinetic energy of the failure check in halo mode: each rank's part, in
 //! rank order, equal to one process's sum up to its rounding.
@@ -22,6 +27,7 @@ use crate::distributed::{Communicator, Decomposition};
 use crate::local_particles::ParticleRuns;
 use crate::state::State;
 use crate::Vec3;
+use nalgebra::{Quaternion, UnitQuaternion};
 use std::ops::Range;
 use std::sync::Arc;
 
@@ -112,11 +118,66 @@ impl StateShare {
         }
     }
 
-    /// Makes the state whole on every rank (positions too); nothing to do unless a step
-    /// shares only the halo. Every rank calls it at the same step.
-    pub fn gather(&mut self, state: &mut State) {
+    /// Makes the state whole on every rank (positions too, and the rigid bodies' rotation
+    /// with `torque`, the stepper's torques on them); nothing to do unless a step shares
+    /// only the halo. Every rank calls it at the same step.
+    pub fn gather(&mut self, state: &mut State, torque: &mut [Vec3]) {
         if self.halo.is_some() {
             self.all_gather(state, Motion::Whole);
+            self.gather_rigid(state, torque);
+        }
+    }
+
+    /// Every rigid body's orientation, angular momentum and velocity and `torque`, from the
+    /// rank that owns its centre (those every rank computes are whole already).
+    fn gather_rigid(&mut self, state: &mut State, torque: &mut [Vec3]) {
+        let rigid = &mut state.rigid;
+        if rigid.is_empty() {
+            return;
+        }
+        const PER: usize = 13;
+        let (me, ranks) = (self.comm.rank() as u32, self.comm.size());
+        let mut counts = vec![0; ranks];
+        self.mine.clear();
+        for (b, &c) in rigid.center.iter().enumerate() {
+            match self.owner[c] {
+                u32::MAX => continue,
+                r => counts[r as usize] += PER,
+            }
+            if self.owner[c] == me {
+                self.mine
+                    .extend_from_slice(rigid.orientation[b].as_ref().coords.as_slice());
+                for v in [
+                    rigid.angular_momentum[b],
+                    rigid.angular_velocity[b],
+                    torque[b],
+                ] {
+                    self.mine.extend_from_slice(v.as_slice());
+                }
+            }
+        }
+        self.all.resize(counts.iter().sum(), 0.0);
+        self.comm.all_gather(&self.mine, &mut self.all, &counts);
+        let mut at: Vec<usize> = counts
+            .iter()
+            .scan(0, |start, n| {
+                let here = *start;
+                *start += n;
+                Some(here)
+            })
+            .collect();
+        let v3 = |v: &[f64], k: usize| Vec3::new(v[k], v[k + 1], v[k + 2]);
+        for (b, &c) in rigid.center.iter().enumerate() {
+            let Some(k) = at.get_mut(self.owner[c] as usize) else {
+                continue;
+            };
+            let v = &self.all[*k..*k + PER];
+            *k += PER;
+            let q = Quaternion::new(v[3], v[0], v[1], v[2]);
+            rigid.orientation[b] = UnitQuaternion::new_unchecked(q);
+            rigid.angular_momentum[b] = v3(v, 4);
+            rigid.angular_velocity[b] = v3(v, 7);
+            torque[b] = v3(v, 10);
         }
     }
 
@@ -206,8 +267,11 @@ impl StateShare {
                 part += 0.5 * state.spin.inertia[p] * state.spin.velocity[p].norm_squared();
             }
         }
-        if self.comm.rank() == 0 {
-            part += state.rigid.kinetic_energy();
+        let me = self.comm.rank() as u32;
+        for (b, &c) in state.rigid.center.iter().enumerate() {
+            if self.owner[c] == me || (me == 0 && self.owner[c] == u32::MAX) {
+                part += 0.5 * state.rigid.angular_velocity[b].dot(&state.rigid.angular_momentum[b]);
+            }
         }
         let mut parts = vec![0.0; self.comm.size()];
         let ones = vec![1; self.comm.size()];

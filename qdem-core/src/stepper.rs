@@ -79,6 +79,14 @@ pub trait Stepper: Send {
         false
     }
 
+    /// The torques on the rigid bodies that the next step reads (Verlet's first half kick),
+    /// which a run decomposed with a halo exchange gathers from the bodies' owners with the
+    /// state ([`crate::World::gather`]); empty (the default) for a stepper that keeps none
+    /// from one step to the next or cannot be restricted.
+    fn rigid_torques(&mut self) -> &mut [Vec3] {
+        &mut []
+    }
+
     /// Size and cost of the sparse factorisation, for steppers that solve a linear system;
     /// `None` for explicit steppers and before the first factorisation.
     fn factor_stats(&self) -> Option<&FactorStats> {

@@ -175,6 +175,11 @@ impl Stepper for Verlet {
         Ok(())
     }
 
+    fn rigid_torques(&mut self) -> &mut [Vec3] {
+        let bodies = self.rigid_bodies.min(self.torque.len());
+        &mut self.torque[..bodies]
+    }
+
     fn restrict(&mut self, local: Arc<LocalParticles>) -> bool {
         self.local = Some(local);
         true

@@ -162,7 +162,7 @@ impl World {
             return;
         };
         if !self.stepper.restrict(local.clone()) {
-            share.gather(&mut self.state);
+            share.gather(&mut self.state, self.stepper.rigid_torques());
             for part in split_parts(&mut self.models, &mut self.hooks) {
                 part.gather();
                 part.split(None);
@@ -267,7 +267,7 @@ impl World {
     /// otherwise (and in a run of one process).
     pub fn gather(&mut self) {
         if let Some((share, _)) = &mut self.share {
-            share.gather(&mut self.state);
+            share.gather(&mut self.state, self.stepper.rigid_torques());
         }
         if self.local.is_some() {
             for part in split_parts(&mut self.models, &mut self.hooks) {
@@ -298,7 +298,7 @@ impl World {
             return done;
         };
         share.share(&mut self.state);
-        share.gather(&mut self.state);
+        share.gather(&mut self.state, self.stepper.rigid_torques());
         match share.agree(done.err().map(|e| e.to_string())) {
             Some(failure) => Err(CoreError::Decomposition(failure)),
             None => Ok(()),
