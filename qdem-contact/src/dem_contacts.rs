@@ -42,11 +42,10 @@ use crate::wall::Wall;
 use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
 use qdem_core::{
-    CheckpointError, Communicator, Decoder, Dofs, Encoder, Linearized, Model, ParticleReads,
+    CheckpointError, Decoder, Dofs, Encoder, Linearized, Model, Ownership, ParticleReads,
     Persistence, Persistent, SplitModel, State, Tangent, Vec3,
 };
 use rayon::prelude::*;
-use std::sync::Arc;
 
 /// Marks a sphere that is no part of a rigid body, or whose moments go nowhere.
 const NOT_RIGID: u32 = u32::MAX;
@@ -429,7 +428,7 @@ impl DemContacts {
             .map(|t| (t.scales, t.boundary_force))
     }
 
-    /// The average magnitude of the touching pairs' forces across the plane x[axis] = `at`
+    /// The average magnitude of the touching pairs' forces across the plane x\[axis\] = `at`
     /// (serial, in pair order): a pair crosses it when its two sphere centres, the second at
     /// the image it touches, lie on either side. In a periodic cell the plane repeats every
     /// period, so a section at a cell face measures what the boundary force does; in a box
@@ -1091,7 +1090,7 @@ impl Model for DemContacts {
     }
 
     /// The contacts touching at the last evaluation, as sticking springs
-    /// ([`crate::contact_springs`]), attached through the arm to the contact point to the
+    /// (`contact_springs.rs`), attached through the arm to the contact point to the
     /// rotation of a sphere that turns (a rigid body's, a rotating particle's). The contacts
     /// give no [`Model::linearized`] facet: an implicit step would need the events of contacts
     /// opening and closing.
@@ -1229,9 +1228,9 @@ impl DemContacts {
     fn rebuild_among(&mut self, split: &ContactSplit, near: &[u32], time: f64) {
         let skin = self.settings.skin;
         let (center, radius, body) = (
-            pick(&near, &self.center),
-            pick(&near, &self.radius),
-            pick(&near, &self.body),
+            pick(near, &self.center),
+            pick(near, &self.radius),
+            pick(near, &self.body),
         );
         let set = SphereSet {
             center: &center,
@@ -1282,7 +1281,7 @@ impl SplitModel for DemContacts {
         self.particle.iter().map(|&p| p as usize).collect()
     }
 
-    fn split(&mut self, split: Option<(Arc<[u32]>, Arc<dyn Communicator>)>) {
+    fn split(&mut self, split: Option<Ownership>) {
         self.split = split.map(|(owner, comm)| {
             let mut part = ContactSplit::new(&self.particle, &owner, comm);
             part.whole = true;

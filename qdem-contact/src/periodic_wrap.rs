@@ -9,8 +9,9 @@
 //! group (position and reference) by the same period, so all ranks agree with one process.
 
 use crate::periodic_boundary::{PeriodicBox, WrapGroup};
-use qdem_core::{Communicator, Halt, Model, ParticleReads, PostStep, SplitModel, State, Vec3};
-use std::sync::Arc;
+use qdem_core::{
+    Communicator, Halt, Model, Ownership, ParticleReads, PostStep, SplitModel, State, Vec3,
+};
 
 /// Wraps groups of particles (whole bodies) back into a periodic cell after every step.
 ///
@@ -34,7 +35,7 @@ pub struct PeriodicWrap {
     /// The groups that wrap together.
     pub groups: Vec<WrapGroup>,
     /// Per particle, the rank that owns it, and the ranks, in a decomposed run.
-    split: Option<(Arc<[u32]>, Arc<dyn Communicator>)>,
+    split: Option<Ownership>,
 }
 
 impl PeriodicWrap {
@@ -128,7 +129,7 @@ impl SplitModel for PeriodicWrap {
         Vec::new()
     }
 
-    fn split(&mut self, split: Option<(Arc<[u32]>, Arc<dyn Communicator>)>) {
+    fn split(&mut self, split: Option<Ownership>) {
         self.split = split;
     }
 

@@ -66,7 +66,8 @@ pub use error::CoreError;
 pub use gravity::Gravity;
 pub use material::Material;
 pub use model::{
-    find_model, Linearized, Model, ParticleReads, Persistence, Persistent, SplitModel, StepEvents,
+    find_model, Linearized, Model, Ownership, ParticleReads, Persistence, Persistent, SplitModel,
+    StepEvents,
 };
 pub use newmark::{EventSolve, Newmark, StepCounts, TangentUpdate};
 pub use nodal_load::NodalLoad;

@@ -118,6 +118,10 @@ pub trait Model: std::any::Any + Send + Sync {
     }
 }
 
+/// What a [`SplitModel`] learns of a decomposed run: per particle, the rank that owns it
+/// (`u32::MAX`: computed by every rank), and the ranks.
+pub type Ownership = (Arc<[u32]>, Arc<dyn Communicator>);
+
 /// The facet of a model that one rank of a run decomposed with a halo exchange
 /// ([`crate::distributed`]) computes in part: DEM contacts evaluate only the contacts that
 /// touch a sphere the rank owns, and fetch what they read of the other ranks' spheres
@@ -130,7 +134,7 @@ pub trait SplitModel {
     /// From now on, computes the forces on the particles `owner[p] == comm.rank()` only,
     /// each as one process sums it; `None`: whole again, on a state every rank holds whole
     /// (after a [`crate::World::gather`]). A collective: every rank calls it at once.
-    fn split(&mut self, split: Option<(Arc<[u32]>, Arc<dyn Communicator>)>);
+    fn split(&mut self, split: Option<Ownership>);
 
     /// Makes what the model records (contact lists, forces, histories) whole on every rank,
     /// as one process holds it after its last force evaluation: a collective that

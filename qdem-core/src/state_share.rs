@@ -156,16 +156,7 @@ impl StateShare {
                 }
             }
         }
-        self.all.resize(counts.iter().sum(), 0.0);
-        self.comm.all_gather(&self.mine, &mut self.all, &counts);
-        let mut at: Vec<usize> = counts
-            .iter()
-            .scan(0, |start, n| {
-                let here = *start;
-                *start += n;
-                Some(here)
-            })
-            .collect();
+        let mut at = self.gather_mine(&counts);
         let v3 = |v: &[f64], k: usize| Vec3::new(v[k], v[k + 1], v[k + 2]);
         for (b, &c) in rigid.center.iter().enumerate() {
             let Some(k) = at.get_mut(self.owner[c] as usize) else {
@@ -200,16 +191,7 @@ impl StateShare {
                 counts[owner as usize] += per;
             }
         }
-        self.all.resize(counts.iter().sum(), 0.0);
-        self.comm.all_gather(&self.mine, &mut self.all, &counts);
-        let mut at: Vec<usize> = counts
-            .iter()
-            .scan(0, |start, n| {
-                let here = *start;
-                *start += n;
-                Some(here)
-            })
-            .collect();
+        let mut at = self.gather_mine(&counts);
         for &p in particles {
             let owner = self.owner[p];
             if owner != u32::MAX {
@@ -218,6 +200,21 @@ impl StateShare {
                 *k += per;
             }
         }
+    }
+
+    /// Every rank's `mine` (`counts[q]` values from rank `q`) into `all`; returns where each
+    /// rank's part starts.
+    fn gather_mine(&mut self, counts: &[usize]) -> Vec<usize> {
+        self.all.resize(counts.iter().sum(), 0.0);
+        self.comm.all_gather(&self.mine, &mut self.all, counts);
+        counts
+            .iter()
+            .scan(0, |start, n| {
+                let here = *start;
+                *start += n;
+                Some(here)
+            })
+            .collect()
     }
 
     /// Every rank's owned particles' `what` into `state`, on every rank.

@@ -216,7 +216,7 @@ type GoodState = (f64, Vec<u8>, Instant);
 /// probe rows so far are published under `probes.csv`; a resumed run keeps the rows the
 /// checkpoint has seen and appends. A run that fails leaves its last good state in
 /// `checkpoint.qdc` when it can be checkpointed: the state at a probe sample, kept in memory
-/// at most once per [`GOOD_STATE_EVERY`] seconds of wall time so that encoding it costs next
+/// at most once per `GOOD_STATE_EVERY` seconds of wall time so that encoding it costs next
 /// to nothing however often the probes sample.
 pub fn run_with(
     sim: &mut Simulation,
@@ -358,7 +358,7 @@ impl Run {
     }
 
     /// Whether the last good state is kept in memory after this step (at `dt`): at a probe
-    /// interval, at most once per [`GOOD_STATE_EVERY`] seconds of wall time.
+    /// interval, at most once per `GOOD_STATE_EVERY` seconds of wall time.
     fn keeps_good_state(&self, sim: &Simulation, dt: f64) -> bool {
         self.can_checkpoint
             && self.good_schedule.is_due(sim.world.state.time, dt)
