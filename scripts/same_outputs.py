@@ -31,6 +31,7 @@ SCENES = [
     "cantilever/cantilever_lc100.toml",
     "contact/collision.toml",
     "contact/incline.toml",
+    "contact/grains.toml",
     "boxtest/small_deposit_cell_bed.toml",
     "boxtest/small_deposit_cell_crib.toml",
     "boxtest/small_single_fixed.toml",

@@ -2,31 +2,37 @@
 """A model of the paper-size ballasted track (fixtures/ballast/full_deposit.toml) on N nodes.
 
 Usage:
-    python3 qdem-bench/scripts/scaling_model.py [--kernel-core-ms 32.2] [--rest-core-ms 29.2]
-        [--particles 293541] [--cores 64] [--bandwidth-gbs 12.5] [--latency-us 2]
-        [--bed 3.0,0.6,0.55] [--stone 0.055] [--json FILE]
+    python3 qdem-bench/scripts/scaling_model.py [--kernel-core-ms 28.8] [--rest-core-ms 18.5]
+        [--particles 293541] [--spheres 279074] [--cores 64] [--bandwidth-gbs 12.5]
+        [--latency-us 2] [--bed 3.0,0.6,0.55] [--stone 0.055] [--rebuild-every 1000]
+        [--json FILE]
 
 The inputs are measured on this project's 2-core machine (docs/scaling.md says where each
 comes from) except the network, which is stated: one rank per node of CORES cores, nodes
 joined by a link of BANDWIDTH GB/s and LATENCY us (100 Gb/s InfiniBand HDR100: 12.5 GB/s,
 about 2 us). Per step, on P nodes:
 
-  as built (the kernel decomposed, the rest computed whole by every rank, the owned
-  particles' motion all-gathered):
+  as built (everything decomposed, the halo exchanged):
+      t = (kernel + rest) / (P cores) + halo(P) + rebuild(P)
+      halo(P) = 144 B * halo_fraction(P) * particles / bandwidth + 10 * latency  (P > 1)
+        per halo particle: its motion out (48 B), its block sums back (24 B) and, as a
+        contact ghost, its centre, velocity and spin (72 B); ten collectives a step (the
+        block sums, the rebuild decision, the ghosts, the share, the wrap's two, the failure
+        check's two, the kinetic energy, the run loop's agreement)
+      halo_fraction(P): the settled bed (BED, m) cut into P boxes by halving the longest side,
+        each box's shell one stone (STONE, m) thick as a share of the bed's volume
+      rebuild(P) = (P - 1) / P * 72 B * spheres / bandwidth / REBUILD_EVERY: at a rebuild of
+        the contact lists every rank receives every sphere's record
+
+  before this design (the kernel decomposed, the rest computed whole by every rank, the
+  owned particles' motion all-gathered after every step):
       t = kernel / (P cores) + rest / cores + share(P)
       share(P) = (P - 1) / P * 48 B * particles / bandwidth + log2(P) * latency
 
-  with the rest decomposed too and a halo exchange instead of the all-gather (not built):
-      t = (kernel + rest) / (P cores) + halo(P)
-      halo(P) = 2 * 48 B * halo_fraction(P) * particles / bandwidth + 6 * latency  (P > 1)
-      halo_fraction(P): the settled bed (BED, m) cut into P boxes by halving the longest side,
-      each box's shell one stone (STONE, m) thick as a share of the bed's volume (the
-      particles a rank receives), positions and velocities out, forces back
-
-The core-milliseconds assume the work divides perfectly over a node's cores (the measured
-2-thread efficiency of the kernel is about 0.94, docs/BENCHMARKS.md), so the projections are
-lower bounds. Prints JSON: per P of 1, 8 and 64 the step time and the wall time of the 1 s
-deposition (13.7 M steps at dt = 7.30e-8 s) and of the 3.67 s five-car passage (50 M steps).
+The core-milliseconds assume the work divides perfectly over a node's cores, so the
+projections are lower bounds. Prints JSON: per P of 1, 8 and 64 the step time and the wall
+time of the 1 s deposition (13.7 M steps at dt = 7.30e-8 s) and of the 3.67 s five-car
+passage (50 M steps).
 """
 
 from __future__ import annotations
@@ -39,7 +45,7 @@ DEPOSITION_STEPS = 13.7e6
 PASSAGE_STEPS = 50.3e6
 
 
-def step_as_built(a, p: int) -> float:
+def step_replicated(a, p: int) -> float:
     share = 0.0
     if p > 1:
         share = (p - 1) / p * 48 * a.particles / (a.bandwidth_gbs * 1e9) \
@@ -59,21 +65,26 @@ def halo_fraction(a, p: int) -> float:
     return (outer - inner) / math.prod(a.bed)
 
 
-def step_decomposed(a, p: int) -> float:
-    halo = 0.0
+def step_as_built(a, p: int) -> float:
+    exchange = 0.0
     if p > 1:
-        halo = 2 * 48 * halo_fraction(a, p) * a.particles / (a.bandwidth_gbs * 1e9) \
-            + 6 * a.latency_us * 1e-6
-    return (a.kernel_core_ms + a.rest_core_ms) * 1e-3 / (p * a.cores) + halo
+        bandwidth = a.bandwidth_gbs * 1e9
+        exchange = 144 * halo_fraction(a, p) * a.particles / bandwidth \
+            + 10 * a.latency_us * 1e-6 \
+            + (p - 1) / p * 72 * a.spheres / bandwidth / a.rebuild_every
+    return (a.kernel_core_ms + a.rest_core_ms) * 1e-3 / (p * a.cores) + exchange
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--kernel-core-ms", type=float, default=32.2,
+    ap.add_argument("--kernel-core-ms", type=float, default=28.8,
                     help="the sleeper and ballast kernels' core-ms per step")
-    ap.add_argument("--rest-core-ms", type=float, default=29.2,
+    ap.add_argument("--rest-core-ms", type=float, default=18.5,
                     help="contacts, integration, loads: core-ms per step")
     ap.add_argument("--particles", type=int, default=293_541)
+    ap.add_argument("--spheres", type=int, default=279_074)
+    ap.add_argument("--rebuild-every", type=float, default=1000.0,
+                    help="steps between rebuilds of the contact lists")
     ap.add_argument("--cores", type=int, default=64)
     ap.add_argument("--bandwidth-gbs", type=float, default=12.5)
     ap.add_argument("--latency-us", type=float, default=2.0)
@@ -84,10 +95,10 @@ def main() -> None:
     a = ap.parse_args()
     rows = []
     for p in (1, 8, 64):
-        for design, step in (("as built", step_as_built), ("decomposed", step_decomposed)):
+        for design, step in (("as built", step_as_built), ("replicated", step_replicated)):
             t = step(a, p)
             rows.append({"nodes": p, "design": design, "step_ms": 1e3 * t,
-                         "halo_fraction": halo_fraction(a, p) if design == "decomposed" else 1.0,
+                         "halo_fraction": halo_fraction(a, p) if design == "as built" else 1.0,
                          "deposition_h": t * DEPOSITION_STEPS / 3600,
                          "passage_h": t * PASSAGE_STEPS / 3600})
     out = {"inputs": vars(a), "rows": rows}
