@@ -1,12 +1,12 @@
 //! A run decomposed over processes (MPI ranks), bit-identical to one process.
 //!
-//! The continuum kernel (paper 000 Eqs. 1–11) is where an explicit run spends its time, so it
-//! is what is decomposed. Every deformable body's blocks ([`crate::tet_blocks`]), taken in
-//! model order and then block order (their spatial order: recursive bisection), are cut into
-//! one contiguous range per rank of about equal cost; a body whose blocks all fall on one rank
-//! is computed there alone. A particle of a deformable body is **owned** by the rank of the
-//! block of its first entry; its **halo** ranks are the others whose blocks hold it. Each
-//! step:
+//! Every deformable body's blocks ([`crate::tet_blocks`]), taken in model order and then
+//! block order (their spatial order: recursive bisection), are cut into one contiguous range
+//! per rank of about equal cost; a body whose blocks all fall on one rank is computed there
+//! alone. A particle of a deformable body is **owned** by the rank of the block of its first
+//! entry; its **halo** ranks are the others whose blocks hold it. The particles that split
+//! models ([`crate::SplitModel`]: DEM contacts) move and no deformable body holds are given
+//! out in runs of particle order, a rigid body whole to one rank. Each step:
 //!
 //! 1. each rank predicts the particles it steps (the same arithmetic on the same values
 //!    everywhere, so the predicted positions and half-step velocities agree bit for bit);
@@ -14,22 +14,25 @@
 //!    another rank are sent to it ([`Communicator::all_to_all`], only for bodies cut between
 //!    ranks), so that the owner adds **every** block sum of its particle in ascending block
 //!    order, exactly as one process does (Eq. 11);
-//! 3. the other models (contacts, loads, gravity, rigid bodies) are computed whole on every
-//!    rank, from the same state;
+//! 3. a split model computes what touches the rank's particles and fetches what it reads of
+//!    the others itself (the contacts' ghosts); the other models (loads, gravity) act on the
+//!    rank's particles from the time and the masses, or, when some model reads any particle,
+//!    every model is computed whole on every rank from the same state;
 //! 4. after the integration, each rank's owned particles' accelerations and velocities (and
 //!    spins) go to the ranks that read them (`state_share.rs`); then the failure check
 //!    agrees across ranks.
 //!
 //! What a rank steps and what step 4 sends depend on what the models read:
-//! - **halo exchange**, when every model and hook reads only what a rank steps itself
-//!   ([`crate::ParticleReads::Local`]: deformable bodies, gravity, nodal loads) and the stepper
-//!   can be restricted (Verlet): a rank predicts its own particles and its halo, integrates
-//!   its own, and receives only its halo's motion. The other particles keep the value of the
+//! - **halo exchange**, when every model and hook reads only what a rank steps itself or
+//!   fetches the rest itself ([`crate::ParticleReads::Local`]: deformable bodies, contacts
+//!   without a time delay, gravity, nodal loads, the periodic wrap) and the stepper can be
+//!   restricted (Verlet): a rank predicts its own particles and its halo, integrates its
+//!   own, and receives only its halo's motion. The other particles keep the value of the
 //!   last whole gather ([`crate::World::gather`]), which the outputs, checkpoints and
 //!   failure reports ask for before they read the state;
-//! - **whole share** otherwise (contacts, bonded particles, periodic hooks, explicit Newmark):
-//!   every rank steps every particle and receives every other rank's owned particles, so that
-//!   it holds the one state a single process holds after every step.
+//! - **whole share** otherwise (a time-delayed boundary, bonded particles, explicit
+//!   Newmark): every rank steps every particle and receives every other rank's owned
+//!   particles, so that it holds the one state a single process holds after every step.
 //!
 //! There is no floating-point reduction across ranks in the state: a value is computed by one
 //! rank in the single-process order and copied, so outputs are byte-identical for any number
