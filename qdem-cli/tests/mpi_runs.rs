@@ -224,6 +224,29 @@ fn the_collision_of_deformable_cubes_is_byte_identical_on_any_number_of_ranks() 
     same_scene_for_any_ranks(scene, fixture, "deformable");
 }
 
+/// The time-delayed box test (paper 003 §5) on a crib deposit: the ranks measure the force
+/// through the delayed boundary over all their pairs, as one process does over its list.
+#[test]
+fn a_time_delayed_box_test_is_byte_identical_on_any_number_of_ranks() {
+    let tmp = TempDir::new("delayed-crib");
+    let crib = tmp.path().join("crib");
+    let deposit = workspace().join("fixtures/boxtest/small_deposit_cell_crib.toml");
+    run(&deposit, &crib, 0, 2, &[]);
+    let path = |f: &str| format!("{:?}", crib.join(f).to_str().unwrap());
+    let (poses, sample) = (
+        format!("pose_from = {}", path("poses.csv")),
+        format!("sample = {}", path("stones.csv")),
+    );
+    let fixture = "boxtest/small_single_delayed.toml";
+    let edits = [
+        ("t_end = ", "t_end = 0.12"),
+        ("pose_from = ", poses.as_str()),
+        ("sample = ", sample.as_str()),
+    ];
+    let scene = ShortScene::edited(fixture, "delayed", &edits);
+    same_scene_for_any_ranks(scene, fixture, "delayed");
+}
+
 /// A run of `fixture` (cut to `t_end`) stopped after step `stop` on 2 ranks writes the
 /// checkpoint one process writes, byte for byte, and resumed from it on 1 and 3 ranks ends
 /// with the uninterrupted run's files.

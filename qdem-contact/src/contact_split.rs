@@ -175,6 +175,46 @@ impl ContactSplit {
         self.send_counts = send_counts;
     }
 
+    /// The average magnitude of the touching pairs' forces among every rank's pairs `c` for
+    /// which `counted(c)`, as one process measures it over its list: the ranks' pairs merged
+    /// by partners (a pair two ranks hold taken once) and summed in that order. A
+    /// collective.
+    pub(crate) fn mean_force_of(
+        &mut self,
+        list: &ContactList,
+        counted: impl Fn(&Contact) -> bool,
+    ) -> f64 {
+        self.mine.clear();
+        for c in &list.items {
+            if c.force != Vec3::zeros() && counted(c) {
+                self.mine
+                    .extend([c.first as f64, c.second as f64, c.force.norm()]);
+            }
+        }
+        let ranks = self.comm.size();
+        let mut counts = vec![0.0; ranks];
+        self.comm
+            .all_gather(&[self.mine.len() as f64], &mut counts, &vec![1; ranks]);
+        let counts: Vec<usize> = counts.iter().map(|&n| n as usize).collect();
+        self.all.resize(counts.iter().sum(), 0.0);
+        self.comm.all_gather(&self.mine, &mut self.all, &counts);
+        let mut forces: Vec<(u32, u32, f64)> = self
+            .all
+            .chunks_exact(3)
+            .map(|v| (v[0] as u32, v[1] as u32, v[2]))
+            .collect();
+        forces.sort_by_key(|&(a, b, _)| (a, b));
+        forces.dedup_by_key(|&mut (a, b, _)| (a, b));
+        let mut sum = 0.0;
+        for &(_, _, f) in &forces {
+            sum += f;
+        }
+        match forces.len() {
+            0 => 0.0,
+            n => sum / n as f64,
+        }
+    }
+
     /// Every rank's `list` merged into the one list a single process holds: sorted by
     /// partners, a pair that two ranks hold taken once (their records are equal). A
     /// collective.

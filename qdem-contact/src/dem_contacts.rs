@@ -853,12 +853,16 @@ impl DemContacts {
         self.mean_pair_force(|c| c.shift[axis] != 0.0)
     }
 
-    /// Measures the boundary force and updates the ghost scales of a time-delayed boundary.
-    fn update_time_delay(&mut self, time: f64) {
+    /// Measures the boundary force and updates the ghost scales of a time-delayed boundary;
+    /// with `split`, this rank's part, over every rank's pairs (a collective).
+    fn update_time_delay(&mut self, time: f64, split: Option<&mut ContactSplit>) {
         let Some(axis) = self.time_delay.as_ref().map(|t| t.axis) else {
             return;
         };
-        let measured = self.boundary_force(axis);
+        let measured = match split {
+            None => self.boundary_force(axis),
+            Some(split) => split.mean_force_of(&self.pairs, |c| c.shift[axis] != 0.0),
+        };
         let delay = self.time_delay.as_mut().expect("checked above");
         delay.boundary_force = measured;
         delay.scales = delay.boundary.update(time, measured);
@@ -996,27 +1000,21 @@ impl Model for DemContacts {
             }
         }
         self.evaluate(state.time, dt);
-        self.update_time_delay(state.time);
+        self.update_time_delay(state.time, None);
         self.gather();
         for (s, (f, t)) in self.sphere_force.iter().enumerate() {
             self.apply(s, f, t, force, torque);
         }
     }
 
-    /// Reads only what a rank steps itself once split ([`SplitModel`]): a contact set without
-    /// rigid bodies' spheres, periodic axes or a time delay.
+    /// Reads only what a rank steps itself once split ([`SplitModel`]), and fetches its
+    /// ghosts.
     fn particle_reads(&self) -> ParticleReads {
-        match self.splittable() {
-            true => ParticleReads::Local,
-            false => ParticleReads::All,
-        }
+        ParticleReads::Local
     }
 
     fn split_model(&mut self) -> Option<&mut dyn SplitModel> {
-        match self.splittable() {
-            true => Some(self),
-            false => None,
-        }
+        Some(self)
     }
 
     /// The critical step 2/(√(ω² + γ²/4) + γ/2) of Gershgorin's bounds on M⁻¹K and M⁻¹C
@@ -1118,12 +1116,6 @@ impl DemContacts {
 
 /// One rank's part of the contacts ([`crate::contact_split`]).
 impl DemContacts {
-    /// Whether a rank can compute the contact set in part: not with a time delay, whose
-    /// boundary force is a mean over every rank's pairs.
-    fn splittable(&self) -> bool {
-        self.time_delay.is_none()
-    }
-
     /// [`Model::add_forces`] of one rank's part: its own spheres read, the ghosts received
     /// (every sphere at a rebuild, which the ranks agree on), the rank's contacts evaluated,
     /// and each own sphere's sum added.
@@ -1151,6 +1143,7 @@ impl DemContacts {
         }
         split.share_ghosts(&mut self.now, &mut self.center);
         self.evaluate(state.time, dt);
+        self.update_time_delay(state.time, Some(&mut split));
         let this = &*self;
         let mut sums = std::mem::take(&mut split.sums);
         sums.resize(split.partners.len(), (Vec3::zeros(), Vec3::zeros()));

@@ -4,14 +4,15 @@
 //! checkpoint, for 2 and 3 ranks (threads of this process,
 //! [`qdem_core::thread_ranks::on_thread_ranks`]), for grains that rotate as particles or as
 //! rigid bodies (owned whole by one rank), in a box and in a cell periodic across the ranks'
-//! cut (grains wrapping back into it); a checkpoint written at 2 ranks resumes at 1 and 3.
+//! cut (grains wrapping back into it), with and without a time delay on the periodic
+//! boundary; a checkpoint written at 2 ranks resumes at 1 and 3.
 
 mod common;
 
 use common::contacts;
 use qdem_contact::{
-    ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring, PeriodicBox,
-    PeriodicWrap, PlaneWall, Wall, WallShape, WrapGroup,
+    ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring, LoadCycle, PeriodicBox,
+    PeriodicWrap, PlaneWall, TimeDelayedBoundary, Wall, WallShape, WrapGroup,
 };
 use qdem_core::thread_ranks::on_thread_ranks;
 use qdem_core::{
@@ -36,11 +37,13 @@ enum Grains {
     Periodic,
     /// Rigid bodies of one sphere each, in a box.
     Rigid,
+    /// The periodic cell with a time delay on its boundary (paper 003 §5).
+    Delayed,
 }
 
 /// The run of `grains`.
 fn world(grains: Grains) -> World {
-    let periodic = grains == Grains::Periodic;
+    let periodic = matches!(grains, Grains::Periodic | Grains::Delayed);
     let mut centers = Vec::new();
     // x slowest: a rank's run of particles is a slab across x, so that in the periodic cell
     // it finds its pairs among the spheres with an image near its slab.
@@ -108,6 +111,15 @@ fn world(grains: Grains) -> World {
     if periodic {
         model = model.with_periodic(cell.clone()).unwrap();
     }
+    if grains == Grains::Delayed {
+        let cycle = LoadCycle {
+            frequency: 20.0,
+            phase: 0.0,
+            start: 0.0,
+        };
+        let boundary = TimeDelayedBoundary::new(cycle, 0.5 * std::f64::consts::PI);
+        model = model.with_time_delay(0, boundary).unwrap();
+    }
     let models: Vec<Box<dyn Model>> = vec![
         Box::new(model),
         Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81))),
@@ -142,6 +154,8 @@ struct Outcome {
     motion: Vec<u64>,
     /// The sum of the grains' angular speeds (rad/s).
     spin: f64,
+    /// The force through the time-delayed boundary at the last evaluation (N), 0 without.
+    boundary_force: f64,
     /// Every touching contact: partners and force, as bits.
     touching: Vec<(usize, String, [u64; 3])>,
     /// Every sphere's contact force, as bits.
@@ -164,6 +178,11 @@ impl Outcome {
         );
         same(&self.checkpoint, &alone.checkpoint, run, "checkpoint");
         assert_eq!(self.rebuilds, alone.rebuilds, "{run}: rebuilds");
+        let force = (
+            self.boundary_force.to_bits(),
+            alone.boundary_force.to_bits(),
+        );
+        assert_eq!(force.0, force.1, "{run}: boundary force");
     }
 }
 
@@ -223,6 +242,7 @@ fn outcome(world: &World) -> Outcome {
             .collect(),
         checkpoint: checkpoint.into_bytes(),
         rebuilds: contacts.rebuilds(),
+        boundary_force: contacts.time_delay_state().map_or(0.0, |(_, f)| f),
     }
 }
 
@@ -299,6 +319,16 @@ fn same_on_ranks(grains: Grains) -> Outcome {
 #[test]
 fn split_contacts_give_one_processs_bits_on_two_and_three_ranks() {
     same_on_ranks(Grains::Rotating);
+}
+
+/// The ranks measure the force through the boundary over all their pairs, as one process.
+#[test]
+fn split_contacts_with_a_time_delayed_boundary_give_one_processs_bits_on_two_and_three_ranks() {
+    let alone = same_on_ranks(Grains::Delayed);
+    assert!(
+        alone.boundary_force > 0.0,
+        "grains touch through the boundary"
+    );
 }
 
 #[test]
