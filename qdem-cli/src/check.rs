@@ -20,24 +20,22 @@ use std::time::Instant;
 pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<(), CliError> {
     let scene = Scene::load(path)?;
     let mut sim = Simulation::build(scene)?;
-    let decomposition = match &ranks {
-        Some(r) => Some(
-            sim.world
-                .decompose(r.clone())
-                .map_err(|source| CliError::Decompose {
-                    scene: path.to_path_buf(),
-                    source,
-                })?,
-        ),
-        None => None,
-    };
+    if let Some(r) = &ranks {
+        sim.world
+            .decompose(r.clone())
+            .map_err(|source| CliError::Decompose {
+                scene: path.to_path_buf(),
+                source,
+            })?;
+    }
     let leader = ranks.as_ref().is_none_or(|r| r.rank() == 0);
     if leader {
         print_scene(path, &sim);
     }
     let (per_step, exchange) = measure_step_cost(&mut sim, 20)?;
-    if let (Some(ranks), Some(d)) = (&ranks, &decomposition) {
-        let table = rank_table(&sim, ranks.as_ref(), d, per_step, exchange);
+    if let (Some(ranks), Some(d)) = (&ranks, sim.world.decomposition().cloned()) {
+        // The decomposition now: a re-partition moves grains and rigid bodies.
+        let table = rank_table(&sim, ranks.as_ref(), &d, per_step, exchange);
         if leader {
             print!("{table}");
         }
@@ -185,6 +183,12 @@ fn rank_table(
         table += &format!(
             "  {r:<5} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9} {:.3e}  {:.3e}  {:.3e}\n",
             d.tets[r], d.owned[r], d.halo[r], d.received[r], row[3], row[4], row[0], row[1], row[2]
+        );
+    }
+    if world.repartitions() > 0 {
+        table += &format!(
+            "  re-partitioned {} times in the measured steps (grains and rigid bodies by their work)\n",
+            world.repartitions()
         );
     }
     let column = |k: usize| all.chunks_exact(5).map(|row| row[k]).collect::<Vec<_>>();

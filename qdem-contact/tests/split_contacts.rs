@@ -26,6 +26,9 @@ const R: f64 = 0.005;
 const STEPS: usize = 600;
 const GATHER_EVERY: usize = 97;
 
+/// The step after which every run re-partitions (a no-op on one process).
+const REPARTITION_AT: u64 = 300;
+
 /// 10 × 6 × 10 rotating grains with jittered radii and velocities above a floor, in a box
 /// longer in x than in y: friction spins them, and they cross the ranks' cut as they fall.
 /// The grains of a test.
@@ -247,11 +250,15 @@ fn outcome(world: &World) -> Outcome {
 }
 
 /// `steps` steps of `world` (gathered every [`GATHER_EVERY`] steps and at the end when
-/// decomposed), and per gather whether this rank's lists were fewer than the whole.
+/// decomposed, re-partitioned after step [`REPARTITION_AT`]), and per gather whether this
+/// rank's lists were fewer than the whole.
 fn steps(world: &mut World, steps: usize) -> Vec<bool> {
     let mut cut = Vec::new();
     for step in 1..=steps {
         world.step().unwrap();
+        if world.steps_done() == REPARTITION_AT {
+            world.repartition();
+        }
         if step % GATHER_EVERY == 0 || step == steps {
             let part = world.model::<DemContacts>().unwrap().candidates();
             world.gather();
@@ -290,6 +297,7 @@ fn on_ranks(size: usize, grains: Grains, resume: Option<(Vec<u8>, usize)>) -> Ve
             }
         };
         let cut = steps(&mut world, STEPS - done);
+        assert!(world.repartitions() > 0 || size == 1, "re-partitioned");
         (outcome(&world), cut.iter().all(|&c| c))
     })
 }

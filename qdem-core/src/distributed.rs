@@ -141,6 +141,14 @@ pub struct Decomposition {
     pub cut_bodies: usize,
 }
 
+/// What [`decompose`] gives: the exchange, the figures, and in halo mode this rank's
+/// particles and the partition.
+pub(crate) type Decomposed = (
+    StateShare,
+    Decomposition,
+    Option<(LocalParticles, Partition)>,
+);
+
 /// One deformable body's share of the decomposition, for one rank: which of its blocks the
 /// rank computes, which of its particles the rank owns, which block sums go where.
 #[derive(Clone, Debug)]
@@ -328,13 +336,14 @@ fn assign_blocks(bodies: &[&TetBody], ranks: usize) -> Vec<Vec<u32>> {
 /// Decomposes `models`' deformable bodies over `comm`'s ranks: tells every body which of its
 /// blocks this rank computes and which particles it owns, and returns the exchange that ends
 /// each step, the decomposition's figures and, when every model reads only what a rank steps
-/// itself and `halo_allowed` (no hook reads more), the particles this rank steps.
+/// itself and `halo_allowed` (no hook reads more), the particles this rank steps and the
+/// partition to re-assign the free particles by.
 pub(crate) fn decompose(
     state: &State,
     models: &mut [Box<dyn Model>],
     comm: Arc<dyn Communicator>,
     halo_allowed: bool,
-) -> Result<(StateShare, Decomposition, Option<LocalParticles>), CoreError> {
+) -> Result<Decomposed, CoreError> {
     let ranks = comm.size();
     let bodies: Vec<&TetBody> = models
         .iter()
@@ -385,38 +394,71 @@ pub(crate) fn decompose(
         }
         body.set_split(split);
     }
-    if halo {
-        own_in_runs(state, models, &mut owner, &mut figures.owned);
-    }
-    let (exchange, local) = match halo {
-        true => {
-            needs.sort_unstable();
-            needs.dedup();
-            for &(q, _) in &needs {
-                figures.received[q as usize] += 1;
-            }
-            let (exchange, local) = halo_exchange(&owner, &needs, comm.rank() as u32, ranks);
-            (Some(exchange), Some(local))
-        }
-        false => (None, None),
-    };
-    let mut share = StateShare::new(&owner, state, exchange, comm);
-    if local.is_none() {
+    if !halo {
+        let mut share = StateShare::new(&owner, state, None, comm);
         share.share_whole_every_step(&mut figures);
+        return Ok((share, figures, None));
     }
-    Ok((share, figures, local))
+    needs.sort_unstable();
+    needs.dedup();
+    for &(q, _) in &needs {
+        figures.received[q as usize] += 1;
+    }
+    let partition = Partition {
+        comm,
+        body_owner: owner,
+        body_owned: figures.owned.clone(),
+        needs,
+    };
+    let (share, owned, local) = partition.assign(state, models, None);
+    figures.owned = owned;
+    Ok((share, figures, Some((local, partition))))
+}
+
+/// The part of a halo-exchanged decomposition that does not change as bodies move: the
+/// deformable bodies' owners and halo. The rest (the grains' and rigid bodies' owners) is
+/// assigned again at a re-partition ([`crate::World::repartition`]).
+pub(crate) struct Partition {
+    pub comm: Arc<dyn Communicator>,
+    /// Per particle, the rank of the deformable body's block that owns it (`u32::MAX` for
+    /// the others).
+    body_owner: Vec<u32>,
+    /// Per rank, the deformable bodies' particles it owns.
+    body_owned: Vec<usize>,
+    /// Every rank's halo, (rank, particle), sorted.
+    needs: Vec<(u32, u32)>,
+}
+
+impl Partition {
+    /// Owners for the free particles by `cost` ([`own_in_runs`]), and the exchange, the
+    /// particles owned per rank and this rank's particles that follow.
+    pub fn assign(
+        &self,
+        state: &State,
+        models: &mut [Box<dyn Model>],
+        cost: Option<&[f64]>,
+    ) -> (StateShare, Vec<usize>, LocalParticles) {
+        let (mut owner, mut owned) = (self.body_owner.clone(), self.body_owned.clone());
+        own_in_runs(state, models, &mut owner, &mut owned, cost);
+        let me = self.comm.rank() as u32;
+        let (exchange, local) = halo_exchange(&owner, &self.needs, me, self.comm.size());
+        let share = StateShare::new(&owner, state, Some(exchange), self.comm.clone());
+        (share, owned, local)
+    }
 }
 
 /// Gives owners to the particles that split models ([`crate::SplitModel`]) move and no
-/// deformable body holds (`owner` `u32::MAX`): runs of particle order, as many particles per
-/// rank, a rigid body (its centre and members) whole to one rank. The builders place grains
-/// layer by layer, so a run is a slab of the packing (its ghosts are one layer at each cut)
-/// and a rank streams contiguous memory when it steps its grains; counts them in `owned`.
+/// deformable body holds (`owner` `u32::MAX`): runs of particle order of about equal `cost`
+/// (one per particle without it), a rigid body (its centre and members) whole to one rank.
+/// The builders place grains layer by layer, so a run is a slab of the packing (its ghosts
+/// are one layer at each cut) and a rank streams contiguous memory when it steps its
+/// grains; counts them in `owned`.
 fn own_in_runs(
     state: &State,
     models: &mut [Box<dyn Model>],
     owner: &mut [u32],
     owned: &mut [usize],
+    cost: Option<&[f64]>,
 ) {
     let mut free: Vec<usize> = models
         .iter_mut()
@@ -448,15 +490,21 @@ fn own_in_runs(
             None => units.push(vec![p]),
         }
     }
-    let (ranks, total) = (owned.len(), units.iter().map(Vec::len).sum::<usize>());
-    let mut before = 0;
+    let weight = |unit: &[usize]| match cost {
+        Some(cost) => unit.iter().map(|&p| cost[p]).sum(),
+        None => unit.len() as f64,
+    };
+    let ranks = owned.len();
+    let total: f64 = units.iter().map(|u| weight(u)).sum();
+    let mut before = 0.0;
     for unit in &units {
-        let r = before * ranks / total;
+        let w = weight(unit);
+        let r = (((before + 0.5 * w) / total * ranks as f64) as usize).min(ranks - 1);
         for &p in unit {
             owner[p] = r as u32;
         }
         owned[r] += unit.len();
-        before += unit.len();
+        before += w;
     }
 }
 

@@ -140,6 +140,25 @@ pub trait SplitModel {
     /// as one process holds it after its last force evaluation: a collective that
     /// [`crate::World::gather`] runs. The next force evaluation goes on in part.
     fn gather(&mut self);
+
+    /// Whether the model has rebuilt what decides its work (DEM contacts: their candidate
+    /// lists) since the last call, the same on every rank: a decomposed world may then
+    /// re-partition ([`crate::World::repartition`]). The default: never.
+    fn rebuilt(&mut self) -> bool {
+        false
+    }
+
+    /// This rank's work in the model at its last evaluation, in units of one particle's
+    /// step (DEM contacts: two per candidate contact). The default: none.
+    fn work(&self) -> f64 {
+        0.0
+    }
+
+    /// Adds each particle's share of the model's work to `cost` (one entry per particle),
+    /// from the whole records after a [`SplitModel::gather`]. The default adds nothing.
+    fn add_costs(&self, cost: &mut [f64]) {
+        let _ = cost;
+    }
 }
 
 /// Which particles' motion a [`Model`] (or a [`crate::PostStep`] hook) reads at each step.

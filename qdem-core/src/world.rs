@@ -19,7 +19,7 @@
 //! the models learn how they are stepped from [`Model::prepare`].
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
-use crate::distributed::{decompose, Communicator, Decomposition};
+use crate::distributed::{decompose, Communicator, Decomposition, Partition};
 use crate::error::CoreError;
 use crate::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
 use crate::local_particles::LocalParticles;
@@ -115,7 +115,21 @@ pub struct World {
     share: Option<(StateShare, Decomposition)>,
     /// The particles this rank steps, when a step shares only the halo.
     local: Option<Arc<LocalParticles>>,
+    /// What a re-partition keeps, when a step shares only the halo.
+    partition: Option<Partition>,
+    /// Re-partitions so far, and rebuilds of a split model's lists since the last one.
+    repartitions: usize,
+    rebuilds_since: usize,
 }
+
+/// The ratio of the busiest rank's work to the mean above which a rebuild of a split
+/// model's lists re-partitions the free particles ([`World::repartition`]).
+const REPARTITION_IMBALANCE: f64 = 1.1;
+
+/// Rebuilds between two re-partitions at least: a re-partition gathers the whole state, and
+/// an imbalance it cannot mend (one body heavier than a rank's share) must not make every
+/// rebuild pay for it.
+const REPARTITION_REBUILDS: usize = 8;
 
 impl World {
     /// A world stepping `state` under `models` as `settings` say; tells every model how it is
@@ -140,6 +154,9 @@ impl World {
             steps_done: 0,
             share: None,
             local: None,
+            partition: None,
+            repartitions: 0,
+            rebuilds_since: 0,
         })
     }
 
@@ -169,6 +186,7 @@ impl World {
             }
             share.share_whole_every_step(figures);
             self.local = None;
+            self.partition = None;
         }
     }
 
@@ -247,11 +265,13 @@ impl World {
             .hooks
             .iter()
             .all(|h| h.particle_reads() == ParticleReads::Local);
-        let (share, figures, local) =
+        let (share, figures, halo) =
             decompose(&self.state, &mut self.models, comm.clone(), halo_allowed)?;
         let owner: Arc<[u32]> = share.owner().into();
         self.share = Some((share, figures));
+        let (local, partition) = halo.unzip();
         self.local = local.map(Arc::new);
+        self.partition = partition;
         self.restrict_stepper();
         if self.local.is_some() {
             for part in split_parts(&mut self.models, &mut self.hooks) {
@@ -259,6 +279,74 @@ impl World {
             }
         }
         Ok(self.decomposition().expect("decomposed").clone())
+    }
+
+    /// Gives the particles no deformable body holds (grains, rigid bodies) new owners, in
+    /// runs of particle order of about equal measured work (each particle's step, and its
+    /// share of the split models' work, [`SplitModel::add_costs`]): a collective, which
+    /// every rank calls after the same step, in a run decomposed with a halo exchange (a
+    /// no-op otherwise). The state and the split models are gathered first and split again
+    /// by the new owners, so the run goes on bit for bit as before. A step calls it at a
+    /// rebuild of a split model's lists when the busiest rank has more than 1.1 times the
+    /// mean work (at most once every 8 rebuilds).
+    pub fn repartition(&mut self) {
+        if self.partition.is_none() {
+            return;
+        }
+        self.gather();
+        let mut cost = vec![1.0; self.state.len()];
+        for part in split_parts(&mut self.models, &mut self.hooks) {
+            part.add_costs(&mut cost);
+        }
+        let partition = self.partition.as_ref().expect("checked above");
+        let (share, owned, local) = partition.assign(&self.state, &mut self.models, Some(&cost));
+        let (owner, comm): (Arc<[u32]>, _) = (share.owner().into(), partition.comm.clone());
+        let (_, mut figures) = self.share.take().expect("decomposed");
+        figures.owned = owned;
+        self.share = Some((share, figures));
+        self.local = Some(Arc::new(local));
+        self.restrict_stepper();
+        for part in split_parts(&mut self.models, &mut self.hooks) {
+            part.split(Some((owner.clone(), comm.clone())));
+        }
+        self.repartitions += 1;
+        self.rebuilds_since = 0;
+    }
+
+    /// How many times [`World::repartition`] has run.
+    pub fn repartitions(&self) -> usize {
+        self.repartitions
+    }
+
+    /// After a step: re-partitions when a split model rebuilt its lists and the ranks' work
+    /// is out of balance ([`World::repartition`]).
+    fn rebalance(&mut self) {
+        let Some(partition) = &self.partition else {
+            return;
+        };
+        let mut rebuilt = false;
+        let mut work = self.local.as_ref().map_or(0, |l| l.computed.len()) as f64;
+        for part in split_parts(&mut self.models, &mut self.hooks) {
+            rebuilt |= part.rebuilt();
+            work += part.work();
+        }
+        if !rebuilt {
+            return;
+        }
+        self.rebuilds_since += 1;
+        if self.repartitions > 0 && self.rebuilds_since < REPARTITION_REBUILDS {
+            return;
+        }
+        let ranks = partition.comm.size();
+        let mut works = vec![0.0; ranks];
+        partition
+            .comm
+            .all_gather(&[work], &mut works, &vec![1; ranks]);
+        let mean = works.iter().sum::<f64>() / ranks as f64;
+        let busiest = works.iter().cloned().fold(0.0, f64::max);
+        if busiest > REPARTITION_IMBALANCE * mean {
+            self.repartition();
+        }
     }
 
     /// Makes the state whole on every rank of a decomposed run, as one process holds it: a
@@ -337,6 +425,10 @@ impl World {
                 halt.get_or_insert(h);
             }
             self.stages.mark(Stage::Hook(i));
+        }
+        if self.partition.is_some() {
+            self.rebalance();
+            self.stages.mark(Stage::Share);
         }
         Ok(halt)
     }
