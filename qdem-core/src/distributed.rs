@@ -6,7 +6,8 @@
 //! alone. A particle of a deformable body is **owned** by the rank of the block of its first
 //! entry; its **halo** ranks are the others whose blocks hold it. The particles that split
 //! models ([`crate::SplitModel`]: DEM contacts) move and no deformable body holds are given
-//! out in runs of particle order, a rigid body whole to one rank. Each step:
+//! out in runs of particle order, a rigid body whole to one rank, and given out again by
+//! their measured work at a re-partition ([`crate::World::repartition`]). Each step:
 //!
 //! 1. each rank predicts the particles it steps (the same arithmetic on the same values
 //!    everywhere, so the predicted positions and half-step velocities agree bit for bit);
@@ -24,15 +25,15 @@
 //!
 //! What a rank steps and what step 4 sends depend on what the models read:
 //! - **halo exchange**, when every model and hook reads only what a rank steps itself or
-//!   fetches the rest itself ([`crate::ParticleReads::Local`]: deformable bodies, contacts
-//!   without a time delay, gravity, nodal loads, the periodic wrap) and the stepper can be
+//!   fetches the rest itself ([`crate::ParticleReads::Local`]: deformable bodies, contacts,
+//!   gravity, nodal loads, the periodic wrap) and the stepper can be
 //!   restricted (Verlet): a rank predicts its own particles and its halo, integrates its
 //!   own, and receives only its halo's motion. The other particles keep the value of the
 //!   last whole gather ([`crate::World::gather`]), which the outputs, checkpoints and
 //!   failure reports ask for before they read the state;
-//! - **whole share** otherwise (a time-delayed boundary, bonded particles, explicit
-//!   Newmark): every rank steps every particle and receives every other rank's owned
-//!   particles, so that it holds the one state a single process holds after every step.
+//! - **whole share** otherwise (bonded particles, explicit Newmark): every rank steps every
+//!   particle and receives every other rank's owned particles, so that it holds the one
+//!   state a single process holds after every step.
 //!
 //! There is no floating-point reduction across ranks in the state: a value is computed by one
 //! rank in the single-process order and copied, so outputs are byte-identical for any number
