@@ -224,18 +224,32 @@ fn the_collision_of_deformable_cubes_is_byte_identical_on_any_number_of_ranks() 
     same_scene_for_any_ranks(scene, fixture, "deformable");
 }
 
-/// The time-delayed box test (paper 003 §5) on a crib deposit: the ranks measure the force
-/// through the delayed boundary over all their pairs, as one process does over its list.
+/// The time-delayed box test (paper 003 §5) on a crib deposit (itself on the cell's bed,
+/// both run here by one process): the ranks measure the force through the delayed boundary
+/// over all their pairs, as one process does over its list.
 #[test]
 fn a_time_delayed_box_test_is_byte_identical_on_any_number_of_ranks() {
     let tmp = TempDir::new("delayed-crib");
-    let crib = tmp.path().join("crib");
-    let deposit = workspace().join("fixtures/boxtest/small_deposit_cell_crib.toml");
-    run(&deposit, &crib, 0, 2, &[]);
-    let path = |f: &str| format!("{:?}", crib.join(f).to_str().unwrap());
+    let (bed, crib) = (tmp.path().join("bed"), tmp.path().join("crib"));
+    let file = |dir: &Path, f: &str| format!("{:?}", dir.join(f).to_str().unwrap());
+    let fixtures = workspace().join("fixtures");
+    run(
+        &fixtures.join("boxtest/small_deposit_cell_bed.toml"),
+        &bed,
+        0,
+        2,
+        &[],
+    );
+    let bed_sample = format!("sample = {}", file(&bed, "stones.csv"));
+    let deposit = ShortScene::edited(
+        "boxtest/small_deposit_cell_crib.toml",
+        "delayed-crib",
+        &[("sample = ", bed_sample.as_str())],
+    );
+    run(&deposit.0, &crib, 0, 2, &[]);
     let (poses, sample) = (
-        format!("pose_from = {}", path("poses.csv")),
-        format!("sample = {}", path("stones.csv")),
+        format!("pose_from = {}", file(&crib, "poses.csv")),
+        format!("sample = {}", file(&crib, "stones.csv")),
     );
     let fixture = "boxtest/small_single_delayed.toml";
     let edits = [
