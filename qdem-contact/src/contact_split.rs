@@ -191,13 +191,7 @@ impl ContactSplit {
                     .extend([c.first as f64, c.second as f64, c.force.norm()]);
             }
         }
-        let ranks = self.comm.size();
-        let mut counts = vec![0.0; ranks];
-        self.comm
-            .all_gather(&[self.mine.len() as f64], &mut counts, &vec![1; ranks]);
-        let counts: Vec<usize> = counts.iter().map(|&n| n as usize).collect();
-        self.all.resize(counts.iter().sum(), 0.0);
-        self.comm.all_gather(&self.mine, &mut self.all, &counts);
+        self.comm.all_gather_varying(&self.mine, &mut self.all);
         let mut forces: Vec<(u32, u32, f64)> = self
             .all
             .chunks_exact(3)
@@ -219,15 +213,6 @@ impl ContactSplit {
     /// partners, a pair that two ranks hold taken once (their records are equal). A
     /// collective.
     pub(crate) fn merge(&mut self, list: &ContactList) -> ContactList {
-        let ranks = self.comm.size();
-        let mut counts = vec![0.0; ranks];
-        let ones = vec![1; ranks];
-        self.comm
-            .all_gather(&[list.len() as f64], &mut counts, &ones);
-        let counts: Vec<usize> = counts
-            .iter()
-            .map(|&n| CONTACT_VALUES * n as usize)
-            .collect();
         self.mine.clear();
         for c in &list.items {
             self.mine.extend([c.first as f64, c.second as f64]);
@@ -237,8 +222,7 @@ impl ContactSplit {
             self.mine.push(c.half_overlap);
             self.mine.extend_from_slice(c.shift.as_slice());
         }
-        self.all.resize(counts.iter().sum(), 0.0);
-        self.comm.all_gather(&self.mine, &mut self.all, &counts);
+        self.comm.all_gather_varying(&self.mine, &mut self.all);
         let at = |v: &[f64], k: usize| Vec3::new(v[k], v[k + 1], v[k + 2]);
         let mut items: Vec<Contact> = self
             .all

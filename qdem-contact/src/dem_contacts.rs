@@ -680,7 +680,14 @@ impl DemContacts {
     /// runs only when fewer than half the spheres were partners (in the read, and once after
     /// a rebuild of such lists, for the new partners).
     fn read_partners(&mut self, state: &State) {
-        for &s in &self.partners {
+        let partners = std::mem::take(&mut self.partners);
+        self.read_motions(state, &partners);
+        self.partners = partners;
+    }
+
+    /// The narrow phase's record ([`read_motion`]) of `spheres` from `state`.
+    fn read_motions(&mut self, state: &State, spheres: &[u32]) {
+        for &s in spheres {
             let s = s as usize;
             let (particle, turn) = (self.particle[s], self.turn[s]);
             read_motion(state, self.center[s], particle, turn, &mut self.now[s]);
@@ -1147,11 +1154,7 @@ impl DemContacts {
             self.rebuild_near(&split, state.time);
             self.learn_partners(&mut split);
         }
-        for &s in &split.partners {
-            let s = s as usize;
-            let (particle, turn) = (self.particle[s], self.turn[s]);
-            read_motion(state, self.center[s], particle, turn, &mut self.now[s]);
-        }
+        self.read_motions(state, &split.partners);
         split.share_ghosts(&mut self.now, &mut self.center);
         self.evaluate(state.time, dt);
         self.update_time_delay(state.time, Some(&mut split));

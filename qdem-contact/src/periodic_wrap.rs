@@ -72,12 +72,8 @@ impl PeriodicWrap {
                 mine.extend([g as f64, shift.x, shift.y, shift.z]);
             }
         }
-        let ranks = comm.size();
-        let mut counts = vec![0.0; ranks];
-        comm.all_gather(&[mine.len() as f64], &mut counts, &vec![1; ranks]);
-        let counts: Vec<usize> = counts.iter().map(|&n| n as usize).collect();
-        let mut all = vec![0.0; counts.iter().sum()];
-        comm.all_gather(&mine, &mut all, &counts);
+        let mut all = Vec::new();
+        comm.all_gather_varying(&mine, &mut all);
         all.chunks_exact(4)
             .map(|w| (w[0] as usize, Vec3::new(w[1], w[2], w[3])))
             .collect()

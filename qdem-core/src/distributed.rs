@@ -120,6 +120,26 @@ pub trait Communicator: Send + Sync {
 
     /// Rank `root`'s `bytes`, on every rank (resized to the root's length).
     fn broadcast(&self, root: usize, bytes: &mut Vec<u8>);
+
+    /// Every rank's `value`, in rank order.
+    fn all_gather_one(&self, value: f64) -> Vec<f64> {
+        let ranks = self.size();
+        let mut all = vec![0.0; ranks];
+        self.all_gather(&[value], &mut all, &vec![1; ranks]);
+        all
+    }
+
+    /// Every rank's `mine`, of lengths the ranks do not know beforehand, into `all` in rank
+    /// order: two collectives, the lengths and then the values.
+    fn all_gather_varying(&self, mine: &[f64], all: &mut Vec<f64>) {
+        let counts: Vec<usize> = self
+            .all_gather_one(mine.len() as f64)
+            .iter()
+            .map(|&n| n as usize)
+            .collect();
+        all.resize(counts.iter().sum(), 0.0);
+        self.all_gather(mine, all, &counts);
+    }
 }
 
 /// How the deformable bodies' blocks fall on the ranks, the same on every rank: what

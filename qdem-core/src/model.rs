@@ -127,8 +127,9 @@ pub type Ownership = (Arc<[u32]>, Arc<dyn Communicator>);
 /// touch a sphere the rank owns, and fetch what they read of the other ranks' spheres
 /// themselves. Such a model says [`ParticleReads::Local`].
 pub trait SplitModel {
-    /// The particles the model moves that no deformable body holds (one-sphere grains): the
-    /// decomposition gives each an owner by its position.
+    /// The particles the model moves that no deformable body holds (one-sphere grains, rigid
+    /// bodies): the decomposition gives them owners in runs of particle order, a rigid body
+    /// whole to one rank.
     fn free_particles(&self) -> Vec<usize>;
 
     /// From now on, computes the forces on the particles `owner[p] == comm.rank()` only,
@@ -149,7 +150,7 @@ pub trait SplitModel {
     }
 
     /// This rank's work in the model at its last evaluation, in units of one particle's
-    /// step (DEM contacts: two per candidate contact). The default: none.
+    /// step (DEM contacts: three per candidate contact). The default: none.
     fn work(&self) -> f64 {
         0.0
     }

@@ -74,11 +74,12 @@ impl RigidBodies {
 
     /// Rotational kinetic energy ½ Σ ω·L (J).
     pub fn kinetic_energy(&self) -> f64 {
-        self.angular_velocity
-            .iter()
-            .zip(&self.angular_momentum)
-            .map(|(w, l)| 0.5 * w.dot(l))
-            .sum()
+        (0..self.len()).map(|b| self.body_kinetic_energy(b)).sum()
+    }
+
+    /// Body `b`'s rotational kinetic energy ½ ω·L (J).
+    pub fn body_kinetic_energy(&self, b: usize) -> f64 {
+        0.5 * self.angular_velocity[b].dot(&self.angular_momentum[b])
     }
 
     /// Position and velocity of member slot `slot` from its body's pose.

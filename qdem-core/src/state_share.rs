@@ -267,13 +267,10 @@ impl StateShare {
         let me = self.comm.rank() as u32;
         for (b, &c) in state.rigid.center.iter().enumerate() {
             if self.owner[c] == me || (me == 0 && self.owner[c] == u32::MAX) {
-                part += 0.5 * state.rigid.angular_velocity[b].dot(&state.rigid.angular_momentum[b]);
+                part += state.rigid.body_kinetic_energy(b);
             }
         }
-        let mut parts = vec![0.0; self.comm.size()];
-        let ones = vec![1; self.comm.size()];
-        self.comm.all_gather(&[part], &mut parts, &ones);
-        parts.iter().sum()
+        self.comm.all_gather_one(part).iter().sum()
     }
 
     /// The failure every rank reports: the one of the lowest rank that found one.

@@ -267,18 +267,24 @@ impl World {
             .all(|h| h.particle_reads() == ParticleReads::Local);
         let (share, figures, halo) =
             decompose(&self.state, &mut self.models, comm.clone(), halo_allowed)?;
-        let owner: Arc<[u32]> = share.owner().into();
         self.share = Some((share, figures));
         let (local, partition) = halo.unzip();
         self.local = local.map(Arc::new);
         self.partition = partition;
         self.restrict_stepper();
         if self.local.is_some() {
-            for part in split_parts(&mut self.models, &mut self.hooks) {
-                part.split(Some((owner.clone(), comm.clone())));
-            }
+            self.split_by_owners(comm);
         }
         Ok(self.decomposition().expect("decomposed").clone())
+    }
+
+    /// Splits the models and hooks that a rank computes in part by the share's owners.
+    fn split_by_owners(&mut self, comm: Arc<dyn Communicator>) {
+        let (share, _) = self.share.as_ref().expect("decomposed");
+        let owner: Arc<[u32]> = share.owner().into();
+        for part in split_parts(&mut self.models, &mut self.hooks) {
+            part.split(Some((owner.clone(), comm.clone())));
+        }
     }
 
     /// Gives the particles no deformable body holds (grains, rigid bodies) new owners, in
@@ -300,15 +306,13 @@ impl World {
         }
         let partition = self.partition.as_ref().expect("checked above");
         let (share, owned, local) = partition.assign(&self.state, &mut self.models, Some(&cost));
-        let (owner, comm): (Arc<[u32]>, _) = (share.owner().into(), partition.comm.clone());
+        let comm = partition.comm.clone();
         let (_, mut figures) = self.share.take().expect("decomposed");
         figures.owned = owned;
         self.share = Some((share, figures));
         self.local = Some(Arc::new(local));
         self.restrict_stepper();
-        for part in split_parts(&mut self.models, &mut self.hooks) {
-            part.split(Some((owner.clone(), comm.clone())));
-        }
+        self.split_by_owners(comm);
         self.repartitions += 1;
         self.rebuilds_since = 0;
     }
@@ -337,12 +341,8 @@ impl World {
         if self.repartitions > 0 && self.rebuilds_since < REPARTITION_REBUILDS {
             return;
         }
-        let ranks = partition.comm.size();
-        let mut works = vec![0.0; ranks];
-        partition
-            .comm
-            .all_gather(&[work], &mut works, &vec![1; ranks]);
-        let mean = works.iter().sum::<f64>() / ranks as f64;
+        let works = partition.comm.all_gather_one(work);
+        let mean = works.iter().sum::<f64>() / works.len() as f64;
         let busiest = works.iter().cloned().fold(0.0, f64::max);
         if busiest > REPARTITION_IMBALANCE * mean {
             self.repartition();
