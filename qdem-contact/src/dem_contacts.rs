@@ -1317,12 +1317,12 @@ impl SplitModel for DemContacts {
         std::mem::take(&mut self.rebuilt)
     }
 
-    /// [`CANDIDATE_WORK`] per candidate contact this rank evaluates.
+    /// `CANDIDATE_WORK` (three) per candidate contact this rank evaluates.
     fn work(&self) -> f64 {
         CANDIDATE_WORK * self.candidates() as f64
     }
 
-    /// Half of [`CANDIDATE_WORK`] per candidate pair to each partner's particle, all of it
+    /// Half of `CANDIDATE_WORK` per candidate pair to each partner's particle, all of it
     /// per wall candidate.
     fn add_costs(&self, cost: &mut [f64]) {
         let half = 0.5 * CANDIDATE_WORK;
