@@ -36,7 +36,6 @@ pub mod clump_sample;
 pub mod collapse_watch;
 pub mod contact_law;
 mod contact_list;
-mod contact_split;
 mod contact_springs;
 pub mod contact_view;
 pub mod coulomb;

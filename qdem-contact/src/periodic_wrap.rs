@@ -2,16 +2,15 @@
 //! each body whose anchor has left the cell moves back into it whole, by whole periods
 //! ([`PeriodicBox::wrap_bodies`]).
 //!
-//! In a run decomposed with a halo exchange ([`qdem_core::distributed`]) a rank holds only
+//! In a run decomposed with a halo exchange ([`qdem_core::parallel`]) a rank holds only
 //! its own particles' and its halo's positions, so the rank that owns a group's anchor
-//! decides whether the group wraps, from the position one process would read; the ranks
-//! share their decisions after every step and each moves every particle of a wrapping
-//! group (position and reference) by the same period, so all ranks agree with one process.
+//! decides whether the group wraps, from the position one process would read
+//! ([`SplitModel::decide`]); the world's exchange shares the decisions after every step and
+//! each rank moves every particle of a wrapping group (position and reference) by the same
+//! period ([`SplitModel::act`]), so all ranks agree with one process.
 
 use crate::periodic_boundary::{PeriodicBox, WrapGroup};
-use qdem_core::{
-    Communicator, Halt, Model, Ownership, ParticleReads, PostStep, SplitModel, State, Vec3,
-};
+use qdem_core::{Halt, Model, Part, PostStep, Reads, SplitModel, State, Vec3};
 
 /// Wraps groups of particles (whole bodies) back into a periodic cell after every step.
 ///
@@ -34,8 +33,8 @@ pub struct PeriodicWrap {
     pub cell: PeriodicBox,
     /// The groups that wrap together.
     pub groups: Vec<WrapGroup>,
-    /// Per particle, the rank that owns it, and the ranks, in a decomposed run.
-    split: Option<Ownership>,
+    /// Per particle, the rank that owns it, and this rank, in a decomposed run.
+    split: Option<Part>,
 }
 
 impl PeriodicWrap {
@@ -46,37 +45,6 @@ impl PeriodicWrap {
             groups,
             split: None,
         }
-    }
-
-    /// The groups whose anchor this rank owns (rank 0 for an anchor every rank computes)
-    /// and that wrap, with their shifts, shared with every rank in rank order: group index,
-    /// then the shift.
-    fn shared_wraps(
-        &self,
-        state: &State,
-        owner: &[u32],
-        comm: &dyn Communicator,
-    ) -> Vec<(usize, Vec3)> {
-        let me = comm.rank() as u32;
-        let decides = |p: usize| match owner[p] {
-            u32::MAX => me == 0,
-            r => r == me,
-        };
-        let mut mine = Vec::new();
-        for (g, group) in self.groups.iter().enumerate() {
-            if !decides(group.anchor) {
-                continue;
-            }
-            let shift = self.cell.shift_into(&state.position[group.anchor]);
-            if shift != Vec3::zeros() {
-                mine.extend([g as f64, shift.x, shift.y, shift.z]);
-            }
-        }
-        let mut all = Vec::new();
-        comm.all_gather_varying(&mine, &mut all);
-        all.chunks_exact(4)
-            .map(|w| (w[0] as usize, Vec3::new(w[1], w[2], w[3])))
-            .collect()
     }
 }
 
@@ -96,39 +64,56 @@ impl PostStep for PeriodicWrap {
     }
 
     fn after_step(&mut self, state: &mut State, _models: &[Box<dyn Model>]) -> Option<Halt> {
-        let Some((owner, comm)) = &self.split else {
-            self.cell.wrap_bodies(state, &self.groups);
-            return None;
-        };
-        for (g, shift) in self.shared_wraps(state, owner, comm.as_ref()) {
-            for &p in &self.groups[g].particles {
-                state.position[p] += shift;
-                state.reference[p] += shift;
-            }
-        }
+        self.cell.wrap_bodies(state, &self.groups);
         None
     }
 
-    /// A rank reads only the anchors it owns once split.
-    fn particle_reads(&self) -> ParticleReads {
-        ParticleReads::Local
-    }
-
-    fn split_model(&mut self) -> Option<&mut dyn SplitModel> {
-        Some(self)
+    /// A rank decides for the anchors it owns once split.
+    fn reads(&mut self) -> Reads<'_> {
+        Reads::Split(self)
     }
 }
 
 impl SplitModel for PeriodicWrap {
-    /// None: the groups are bodies' particles, which other models place.
-    fn free_particles(&self) -> Vec<usize> {
-        Vec::new()
+    fn split(&mut self, part: Option<Part>) {
+        self.split = part;
     }
 
-    fn split(&mut self, split: Option<Ownership>) {
-        self.split = split;
+    /// The groups whose anchor this rank owns (rank 0 for an anchor every rank computes)
+    /// and that wrap: group index, then the shift.
+    fn decide(&self, state: &State, out: &mut Vec<f64>) {
+        let Some(part) = &self.split else {
+            return;
+        };
+        let decides = |p: usize| match part.owner[p] {
+            u32::MAX => part.rank == 0,
+            r => r == part.rank,
+        };
+        for (g, group) in self.groups.iter().enumerate() {
+            if !decides(group.anchor) {
+                continue;
+            }
+            let shift = self.cell.shift_into(&state.position[group.anchor]);
+            if shift != Vec3::zeros() {
+                out.extend([g as f64, shift.x, shift.y, shift.z]);
+            }
+        }
     }
 
-    /// Nothing to gather: every rank moved every wrapping group.
-    fn gather(&mut self) {}
+    /// Moves every particle of each wrapping group, every rank's decisions in rank order.
+    fn act(&mut self, state: &mut State, all: &[f64]) {
+        for w in all.chunks_exact(4) {
+            let shift = Vec3::new(w[1], w[2], w[3]);
+            for &p in &self.groups[w[0] as usize].particles {
+                state.position[p] += shift;
+                state.reference[p] += shift;
+            }
+        }
+    }
+
+    /// Nothing to compute in a force evaluation: a hook.
+    fn compute(&mut self, _state: &State) {}
+
+    /// Nothing to add: a hook.
+    fn apply(&mut self, _force: &mut [Vec3], _torque: &mut [Vec3]) {}
 }

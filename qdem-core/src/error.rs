@@ -1,7 +1,7 @@
 //! Errors of the core: bad bodies, bad time functions, bad steps and unstable runs.
 
 use crate::checkpoint::CheckpointError;
-use crate::material::MaterialError;
+use crate::continuum::material::MaterialError;
 use thiserror::Error;
 
 /// Everything the core refuses, each message naming the offending item and the fix.

@@ -14,6 +14,13 @@
 //!   explicit (β = 0) or implicit (β > 0, a sparse Cholesky solve per step);
 //!   [`StaticSolver`] the linear static solve K u = f.
 //!
+//! The crate is laid out by area: [`step`] (the model, stepper and world API and the stage
+//! counters), [`continuum`] (the QDEM tetrahedron, its bodies, materials and step bounds,
+//! rigid bodies), [`loads`] (gravity, nodal loads, time functions), [`solvers`] (Verlet,
+//! Newmark-β, the static solve and their sparse algebra), [`modal`] (Lanczos modes),
+//! [`parallel`] (the decomposition over ranks, behind one seam: the [`Exchange`]) and
+//! [`checkpoint`].
+//!
 //! The QDEM tetrahedron (Nishiura, Sakaguchi & Aikawa 2017, Eqs. 1–11) is in [`tet_kernel`],
 //! with the literal 12-triangle subdomain construction kept as its oracle in
 //! [`tet_subdomain`], and the rigorous explicit step bound in [`mod@stable_step`].
@@ -21,39 +28,23 @@
 #![warn(missing_docs)]
 
 pub mod checkpoint;
-pub(crate) mod conjugate_gradient;
-pub mod distributed;
+pub mod continuum;
 pub mod error;
-pub mod gravity;
-pub mod instability;
-pub mod lanczos;
-pub mod linear_tet;
-pub mod local_damping;
-pub mod local_particles;
-pub mod material;
-mod mechanisms;
-pub mod model;
-pub mod newmark;
-pub mod nodal_load;
-pub mod rigid_body;
-mod rigid_reduction;
-pub(crate) mod sparse;
-pub mod stable_step;
-pub mod stages;
+pub mod loads;
+pub mod modal;
+pub mod parallel;
+pub mod solvers;
 pub mod state;
-mod state_share;
-pub mod static_solve;
-pub mod step_settings;
-pub mod stepper;
-pub mod tangent;
-pub mod tet_blocks;
-pub mod tet_body;
-pub mod tet_kernel;
-pub mod tet_subdomain;
-pub mod thread_ranks;
-pub mod time_function;
-pub mod verlet;
-pub mod world;
+pub mod step;
+
+// The modules other crates and embedders reach by path.
+pub use continuum::{linear_tet, material, rigid_body, stable_step, tet_blocks, tet_kernel};
+pub use continuum::tet_subdomain;
+pub use modal::lanczos;
+#[cfg(feature = "thread-ranks")]
+pub use parallel::thread_ranks;
+pub use solvers::tangent;
+pub use step::{stages, stepper};
 
 /// A 3-vector of f64.
 pub type Vec3 = nalgebra::Vector3<f64>;
@@ -61,26 +52,23 @@ pub type Vec3 = nalgebra::Vector3<f64>;
 pub type Mat3 = nalgebra::Matrix3<f64>;
 
 pub use checkpoint::{CheckpointError, Decoder, Encoder};
-pub use distributed::{Communicator, Decomposition};
+pub use parallel::{Communicator, Decomposition, Exchange, Part, PartialSums, Reads, SplitModel};
 pub use error::CoreError;
-pub use gravity::Gravity;
-pub use material::Material;
-pub use model::{
-    find_model, Linearized, Model, Ownership, ParticleReads, Persistence, Persistent, SplitModel,
-    StepEvents,
-};
-pub use newmark::{EventSolve, Newmark, StepCounts, TangentUpdate};
-pub use nodal_load::NodalLoad;
-pub use rigid_body::RigidBodies;
-pub use sparse::FactorStats;
-pub use stages::{Stage, StageShare, StageTimes};
+pub use loads::gravity::Gravity;
+pub use continuum::material::Material;
+pub use step::model::{find_model, Linearized, Model, Persistence, Persistent, StepEvents};
+pub use solvers::newmark::{EventSolve, Newmark, StepCounts, TangentUpdate};
+pub use loads::nodal_load::NodalLoad;
+pub use continuum::rigid_body::RigidBodies;
+pub use solvers::sparse::FactorStats;
+pub use step::stages::{Stage, StageShare, StageTimes};
 pub use state::{Dofs, ParticleSpin, State};
-pub use static_solve::{StaticSolver, StaticSteps};
-pub use step_settings::{Scheme, StepRequest, StepSettings, Stepping};
-pub use stepper::{choose_step, stable_step, Stepper};
-pub use tangent::Tangent;
-pub use tet_blocks::BlockLayout;
-pub use tet_body::TetBody;
-pub use time_function::{Cyclic, TimeFunction};
-pub use verlet::Verlet;
-pub use world::{Halt, PostStep, World};
+pub use solvers::static_solve::{StaticSolver, StaticSteps};
+pub use step::step_settings::{Scheme, StepRequest, StepSettings, Stepping};
+pub use step::stepper::{choose_step, stable_step, Stepper};
+pub use solvers::tangent::Tangent;
+pub use continuum::tet_blocks::BlockLayout;
+pub use continuum::tet_body::TetBody;
+pub use loads::time_function::{Cyclic, TimeFunction};
+pub use solvers::verlet::Verlet;
+pub use step::world::{Halt, PostStep, World};

@@ -5,7 +5,7 @@
 //! shares it, §2.4) and a per-direction fixity mask. Models read the state and write forces;
 //! steppers advance it. All numerical code works on the slices directly.
 
-use crate::rigid_body::RigidBodies;
+use crate::continuum::rigid_body::RigidBodies;
 use crate::Vec3;
 
 /// A subset of the three translational directions, stored as a bit mask (x = 1, y = 2, z = 4).
@@ -201,7 +201,7 @@ impl State {
     }
 
     /// The generalised node that stands for the small rotation θ (world axes) of rigid body
-    /// `b` in a modal analysis's tangent ([`crate::lanczos`]): after the particles'
+    /// `b` in a modal analysis's tangent ([`crate::modal::lanczos`]): after the particles'
     /// translations and their rotations ([`State::node_fixity`]). A contact on a sphere of the
     /// body attaches its spring there through the arm to the contact point; implicit solves
     /// refuse rigid bodies and never see it.

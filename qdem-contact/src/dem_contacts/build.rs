@@ -1,0 +1,211 @@
+//! Building a [`DemContacts`]: its spheres, their carriers and elastic constants, periodic
+//! axes and a time-delayed boundary, and the check of the initial overlaps.
+
+use super::*;
+
+impl DemContacts {
+    /// Contacts between `spheres` (of bodies `body_names`, with elastic constants (E, ν) per
+    /// material) and against `walls`, at the state's current configuration.
+    pub fn new(
+        state: &State,
+        spheres: &[ContactSphere],
+        body_names: Vec<String>,
+        materials: &[(f64, f64)],
+        settings: ContactSettings,
+        walls: Vec<Wall>,
+    ) -> DemContacts {
+        // The rigid body of each sphere: through a member, or at the body's centre.
+        let mut body_of_center = vec![NOT_RIGID; state.len()];
+        for (b, &c) in state.rigid.center.iter().enumerate() {
+            body_of_center[c] = b as u32;
+        }
+        let rigid: Vec<u32> = spheres
+            .iter()
+            .map(|s| {
+                state
+                    .rigid
+                    .body_of_member(s.particle)
+                    .map_or(body_of_center[s.particle], |b| b as u32)
+            })
+            .collect();
+        let carrier = |s: &ContactSphere, r: u32| match r {
+            NOT_RIGID => s.particle,
+            b => state.rigid.center[b as usize],
+        };
+        let mass: Vec<f64> = spheres
+            .iter()
+            .zip(&rigid)
+            .map(|(s, &r)| state.mass[carrier(s, r)])
+            .collect();
+        let turns = |p: usize| state.spin.fixed.get(p).is_some_and(|f| *f != Dofs::ALL);
+        let turn: Vec<u32> = spheres
+            .iter()
+            .zip(&rigid)
+            .map(|(s, &r)| match r {
+                NOT_RIGID if turns(s.particle) => (state.rigid.len() + s.particle) as u32,
+                r => r,
+            })
+            .collect();
+        let lever = spheres
+            .iter()
+            .zip(&rigid)
+            .map(|(s, &r)| match r {
+                NOT_RIGID if turns(s.particle) => {
+                    s.radius * s.radius / state.spin.inertia[s.particle]
+                }
+                NOT_RIGID => 0.0,
+                b if state.rigid.spin_fixed[b as usize] => 0.0,
+                b => {
+                    let arm = state.position[s.particle] - state.position[carrier(s, r)];
+                    (arm.norm() + s.radius).powi(2) / state.rigid.inertia[b as usize].min()
+                }
+            })
+            .collect();
+        let elasticity = materials
+            .iter()
+            .flat_map(|a| materials.iter().map(|b| PairElasticity::new(*a, Some(*b))))
+            .collect();
+        let wall_elasticity = materials
+            .iter()
+            .map(|a| PairElasticity::new(*a, None))
+            .collect();
+        // A carrier held in every direction (and, for a rigid body, in rotation) cannot
+        // oscillate: it does not limit the step (infinite mass in the bound below).
+        let held = |s: &ContactSphere, r: u32| {
+            let c = carrier(s, r);
+            let still = match r {
+                NOT_RIGID => !turns(s.particle),
+                b => state.rigid.spin_fixed[b as usize],
+            };
+            state.fixed[c] == Dofs::ALL && still
+        };
+        let bound_mass: Vec<f64> = spheres
+            .iter()
+            .zip(&rigid)
+            .zip(&mass)
+            .map(|((s, &r), &m)| if held(s, r) { f64::INFINITY } else { m })
+            .collect();
+        let now: Vec<SphereNow> = spheres
+            .iter()
+            .zip(&mass)
+            .map(|(s, &m)| SphereNow {
+                radius: s.radius,
+                mass: m,
+                material: s.material as u32,
+                ..SphereNow::default()
+            })
+            .collect();
+        DemContacts {
+            name: "contact".to_string(),
+            particle: spheres.iter().map(|s| s.particle as u32).collect(),
+            radius: spheres.iter().map(|s| s.radius).collect(),
+            body: spheres.iter().map(|s| s.body as u32).collect(),
+            rigid,
+            turn,
+            lever,
+            bound_mass,
+            body_names,
+            materials: materials.len(),
+            elasticity,
+            wall_elasticity,
+            settings,
+            walls,
+            last_time: None,
+            center: vec![Vec3::zeros(); spheres.len()],
+            now,
+            built_at: Vec::new(),
+            built_time: 0.0,
+            built: false,
+            pairs: ContactList::default(),
+            wall_contacts: ContactList::default(),
+            incidence_start: Vec::new(),
+            incidence: Vec::new(),
+            wall_start: Vec::new(),
+            partners: Vec::new(),
+            sphere_force: vec![(Vec3::zeros(), Vec3::zeros()); spheres.len()],
+            rebuilds: 0,
+            periodic: None,
+            time_delay: None,
+            split: None,
+            rebuilt: false,
+        }
+    }
+
+    /// Makes the contacts periodic along the axes of `periodic`; refused when a period is not
+    /// longer than twice the reach of the largest spheres (two radii plus the skin).
+    pub fn with_periodic(mut self, periodic: PeriodicBox) -> Result<DemContacts, ContactError> {
+        let r_max = self.radius.iter().cloned().fold(0.0, f64::max);
+        periodic.check_reach(2.0 * r_max + self.settings.skin)?;
+        self.periodic = Some(periodic);
+        self.built = false;
+        Ok(self)
+    }
+
+    /// Scales the forces from ghosts beyond the boundaries of periodic `axis` by `boundary`'s
+    /// ghost scales (paper 003 §5). Needs [`DemContacts::with_periodic`] along that axis first.
+    pub fn with_time_delay(
+        mut self,
+        axis: usize,
+        boundary: TimeDelayedBoundary,
+    ) -> Result<DemContacts, ContactError> {
+        if self
+            .periodic
+            .as_ref()
+            .and_then(|p| p.length(axis))
+            .is_none()
+        {
+            return Err(ContactError::TimeDelayNotPeriodic {
+                axis: ['x', 'y', 'z'][axis.min(2)],
+            });
+        }
+        self.time_delay = Some(TimeDelay {
+            axis,
+            boundary,
+            scales: GhostScales::PERIODIC,
+            boundary_force: 0.0,
+        });
+        Ok(self)
+    }
+
+    /// Fails if two bodies, or a body and a wall, overlap at the current configuration by more
+    /// than `tolerance` times the reduced radius (the sphere radius for walls).
+    pub fn check_initial_overlaps(
+        &mut self,
+        state: &State,
+        tolerance: f64,
+    ) -> Result<(), ContactError> {
+        self.read_centers(state);
+        self.rebuild_all(state.time);
+        for c in &self.pairs.items {
+            let (a, b) = (c.first as usize, c.second as usize);
+            let radius = reduced(self.radius[a], self.radius[b]);
+            let overlap = self.radius[a] + self.radius[b] - self.separation(a, b).0.norm();
+            if overlap > tolerance * radius {
+                return Err(ContactError::InitialOverlap {
+                    a: self.body_names[self.body[a] as usize].clone(),
+                    b: self.body_names[self.body[b] as usize].clone(),
+                    overlap,
+                    radius,
+                    tolerance: 100.0 * tolerance,
+                    at_a: self.center[a].into(),
+                    at_b: self.center[b].into(),
+                });
+            }
+        }
+        for c in &self.wall_contacts.items {
+            let (s, w) = (c.first as usize, c.second as usize);
+            let (overlap, _) = self.walls[w].overlap(&self.center[s], self.radius[s], state.time);
+            if overlap > tolerance * self.radius[s] {
+                return Err(ContactError::InitialWallOverlap {
+                    body: self.body_names[self.body[s] as usize].clone(),
+                    wall: w + 1,
+                    overlap,
+                    radius: self.radius[s],
+                    tolerance: 100.0 * tolerance,
+                    at: self.center[s].into(),
+                });
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,351 @@
+//! The single-process pipeline of a [`DemContacts`] evaluation (paper 000 §4): read the
+//! centres, rebuild the candidate lists when a sphere moved more than the skin allows,
+//! narrow phase and law per candidate, and the per-sphere gather in a fixed order.
+
+use super::*;
+
+impl DemContacts {
+    /// x_b − x_a, the minimum image when periodic, and the translation of b's image.
+    #[inline]
+    pub(super) fn separation(&self, a: usize, b: usize) -> (Vec3, Vec3) {
+        let d = self.center[b] - self.center[a];
+        match &self.periodic {
+            Some(p) => {
+                let shift = p.image_shift(&d);
+                (d + shift, shift)
+            }
+            None => (d, Vec3::zeros()),
+        }
+    }
+
+    /// Copies every sphere's centre out of the state, in sphere order, and the narrow phase's
+    /// record ([`read_motion`]) of the partners of candidates: in the same pass when most
+    /// spheres are partners (a packing), else in a pass over the partners alone (most spheres
+    /// of a ballast stone touch nothing); returns the largest distance a sphere has moved
+    /// since the last build (infinite before it).
+    pub(super) fn read_centers(&mut self, state: &State) -> f64 {
+        let (every, built) = (self.reads_every_sphere(), self.lists_built());
+        let (particle, built_at, turn) = (&self.particle, &self.built_at, &self.turn);
+        let moved = self
+            .center
+            .par_iter_mut()
+            .zip(self.now.par_iter_mut())
+            .with_min_len(SPHERE_CHUNK)
+            .enumerate()
+            .map(|(s, (center, now))| {
+                *center = state.position[particle[s] as usize];
+                if every {
+                    read_motion(state, *center, particle[s], turn[s], now);
+                }
+                if built {
+                    (*center - built_at[s]).norm_squared()
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .reduce(|| 0.0, f64::max);
+        if !every {
+            self.read_all_partners(state);
+        }
+        moved.sqrt()
+    }
+
+    /// Whether [`DemContacts::read_centers`] fills every sphere's narrow-phase record in its
+    /// pass: before the first build, and when most spheres are partners of candidates.
+    pub(super) fn reads_every_sphere(&self) -> bool {
+        !self.lists_built() || 2 * self.partners.len() >= self.particle.len()
+    }
+
+    /// Whether the candidate lists were built for these spheres (at `built_at`).
+    pub(super) fn lists_built(&self) -> bool {
+        self.built && self.built_at.len() == self.particle.len()
+    }
+
+    /// The narrow phase's record of every partner of a candidate, from `state`; serial: it
+    /// runs only when fewer than half the spheres were partners (in the read, and once after
+    /// a rebuild of such lists, for the new partners).
+    pub(super) fn read_all_partners(&mut self, state: &State) {
+        let partners = std::mem::take(&mut self.partners);
+        self.read_motions(state, &partners);
+        self.partners = partners;
+    }
+
+    /// The narrow phase's record ([`read_motion`]) of `spheres` from `state`.
+    pub(super) fn read_motions(&mut self, state: &State, spheres: &[u32]) {
+        for &s in spheres {
+            let s = s as usize;
+            let (particle, turn) = (self.particle[s], self.turn[s]);
+            read_motion(state, self.center[s], particle, turn, &mut self.now[s]);
+        }
+    }
+
+    /// Whether some pair outside the lists may have come within reach since the last build,
+    /// given the largest distance a sphere has moved.
+    pub(super) fn outgrew_skin(&self, moved: f64, time: f64) -> bool {
+        let wall_moved = self
+            .walls
+            .iter()
+            .map(|w| w.velocity().norm() * (time - self.built_time).abs())
+            .fold(0.0, f64::max);
+        2.0 * moved >= self.settings.skin || moved + wall_moved >= self.settings.skin
+    }
+
+    /// Broad phase: new candidate lists and the incidence of pairs per sphere.
+    pub(super) fn rebuild_all(&mut self, time: f64) {
+        let skin = self.settings.skin;
+        let center = self.center.clone();
+        let set = SphereSet {
+            center: &center,
+            radius: &self.radius,
+            body: &self.body,
+            periodic: self.periodic.as_ref(),
+        };
+        self.pairs.rebuild(find_pairs(&set, skin));
+        let wall_keys = self.wall_keys((0..center.len()).into_par_iter(), time);
+        self.wall_contacts.rebuild(wall_keys);
+        self.finish_build(time);
+    }
+
+    /// The wall candidates of `spheres` (ascending), sorted by sphere then wall.
+    pub(super) fn wall_keys(
+        &self,
+        spheres: impl IndexedParallelIterator<Item = usize>,
+        time: f64,
+    ) -> Vec<(u32, u32)> {
+        let (walls, skin) = (&self.walls, self.settings.skin);
+        let (radius, center) = (&self.radius, &self.center);
+        spheres
+            .with_min_len(CONTACT_CHUNK)
+            .flat_map_iter(|s| {
+                walls.iter().enumerate().filter_map(move |(w, wall)| {
+                    wall.is_candidate(&center[s], radius[s], skin, time)
+                        .then_some((s as u32, w as u32))
+                })
+            })
+            .collect()
+    }
+
+    /// After new candidate lists: the incidence, and where and when they were built.
+    pub(super) fn finish_build(&mut self, time: f64) {
+        self.build_incidence();
+        self.built_at = self.center.clone();
+        self.built_time = time;
+        self.built = true;
+        self.rebuilds += 1;
+        self.rebuilt = true;
+    }
+
+    /// For each sphere, its pairs (2k for the first partner of pair k, 2k + 1 for the second)
+    /// in ascending pair order, and the start of its run of wall contacts.
+    pub(super) fn build_incidence(&mut self) {
+        let n = self.particle.len();
+        let mut start = vec![0u32; n + 1];
+        for c in &self.pairs.items {
+            start[c.first as usize + 1] += 1;
+            start[c.second as usize + 1] += 1;
+        }
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut incidence = vec![0u32; 2 * self.pairs.len()];
+        for (k, c) in self.pairs.items.iter().enumerate() {
+            let (a, b) = (c.first, c.second);
+            incidence[fill[a as usize] as usize] = 2 * k as u32;
+            fill[a as usize] += 1;
+            incidence[fill[b as usize] as usize] = 2 * k as u32 + 1;
+            fill[b as usize] += 1;
+        }
+        let mut wall_start = vec![0u32; n + 1];
+        for c in &self.wall_contacts.items {
+            wall_start[c.first as usize + 1] += 1;
+        }
+        for i in 0..n {
+            wall_start[i + 1] += wall_start[i];
+        }
+        self.partners = (0..n as u32)
+            .filter(|&s| {
+                let s = s as usize;
+                start[s + 1] > start[s] || wall_start[s + 1] > wall_start[s]
+            })
+            .collect();
+        self.incidence_start = start;
+        self.incidence = incidence;
+        self.wall_start = wall_start;
+    }
+
+    /// The geometry and elasticity of the pair of spheres of `contact`, with the image
+    /// translation of its second sphere (written into `contact`); `None` when apart.
+    #[inline]
+    pub(super) fn pair_contact(&self, contact: &mut Contact) -> Option<(PairGeometry, PairElasticity)> {
+        let (a, b) = (contact.first as usize, contact.second as usize);
+        let (sa, sb) = (&self.now[a], &self.now[b]);
+        contact.shift = self.separation(a, b).1;
+        let geometry = narrow_phase(sa, sb, contact.shift, self.settings.friction)?;
+        let e = self.elasticity[sa.material as usize * self.materials + sb.material as usize];
+        Some((geometry, e))
+    }
+
+    /// The geometry and elasticity of the contact of sphere s with wall w: the contact point
+    /// at x + (r − δ/2) n, its velocity v + (r − δ/2) ω × n against the wall's; `None` when
+    /// apart.
+    #[inline]
+    pub(super) fn wall_contact(
+        &self,
+        time: f64,
+        s: usize,
+        w: usize,
+    ) -> Option<(PairGeometry, PairElasticity)> {
+        let wall = &self.walls[w];
+        let sphere = &self.now[s];
+        let (overlap, normal) = wall.overlap(&sphere.center, sphere.radius, time);
+        if overlap <= 0.0 || normal == Vec3::zeros() {
+            return None;
+        }
+        let lever = sphere.radius - 0.5 * overlap;
+        let geometry = PairGeometry {
+            overlap,
+            normal,
+            velocity: sphere.velocity + lever * sphere.spin.cross(&normal) - wall.velocity(),
+            radius: sphere.radius,
+            mass: sphere.mass,
+            friction: wall.friction,
+        };
+        Some((geometry, self.wall_elasticity[sphere.material as usize]))
+    }
+
+    /// Narrow phase and law over the pairs and the wall contacts, one parallel region: the
+    /// wall contacts are a task beside the pairs' (one record per contact).
+    pub(super) fn evaluate(&mut self, time: f64, dt: f64) {
+        let (mut pairs, mut walls) = (
+            std::mem::take(&mut self.pairs),
+            std::mem::take(&mut self.wall_contacts),
+        );
+        let this = &*self;
+        rayon::join(
+            || this.evaluate_list(&mut pairs, time, dt, false),
+            || this.evaluate_list(&mut walls, time, dt, true),
+        );
+        (self.pairs, self.wall_contacts) = (pairs, walls);
+    }
+
+    /// Narrow phase and law over one list, in parallel, one record per contact.
+    pub(super) fn evaluate_list(&self, list: &mut ContactList, time: f64, dt: f64, walls: bool) {
+        let law = &self.settings.law;
+        list.items
+            .par_iter_mut()
+            .with_min_len(CONTACT_CHUNK)
+            .for_each(|contact| {
+                let touching = if walls {
+                    self.wall_contact(time, contact.first as usize, contact.second as usize)
+                } else {
+                    self.pair_contact(contact)
+                };
+                match touching {
+                    Some((g, e)) => {
+                        let force = law.force(&g, &e, &mut contact.history, dt);
+                        contact.touch(force, &g.normal, g.overlap);
+                    }
+                    None => contact.part(),
+                }
+            });
+    }
+
+    /// The average magnitude of the touching pairs' forces through the boundaries of `axis`.
+    pub(super) fn boundary_force(&self, axis: usize) -> f64 {
+        self.mean_pair_force(|c| c.shift[axis] != 0.0)
+    }
+
+    /// Measures the boundary force over this process's pairs and updates the ghost scales of
+    /// a time-delayed boundary.
+    pub(super) fn update_time_delay(&mut self, time: f64) {
+        if let Some(axis) = self.time_delay.as_ref().map(|t| t.axis) {
+            let measured = self.boundary_force(axis);
+            self.set_boundary_force(time, measured);
+        }
+    }
+
+    /// The measured force through the time-delayed boundary, and the ghost scales that
+    /// follow (paper 003 Eqs. 6–7).
+    pub(super) fn set_boundary_force(&mut self, time: f64, measured: f64) {
+        let delay = self.time_delay.as_mut().expect("a time-delayed boundary");
+        delay.boundary_force = measured;
+        delay.scales = delay.boundary.update(time, measured);
+    }
+
+    /// Per-sphere sums of contact forces, and their moments about the sphere's centre for
+    /// spheres that turn (of rigid bodies, rotating particles), in a fixed order; forces from
+    /// delayed ghosts scaled.
+    pub(super) fn gather(&mut self) {
+        let mut sphere_force = std::mem::take(&mut self.sphere_force);
+        sphere_force
+            .par_iter_mut()
+            .with_min_len(CONTACT_CHUNK)
+            .enumerate()
+            .for_each(|(s, out)| *out = self.sphere_sum(s));
+        self.sphere_force = sphere_force;
+    }
+
+    /// Sphere `s`'s sum of contact forces, and their moment about its centre if it turns,
+    /// over its incidence in ascending pair order, then its wall contacts.
+    #[inline]
+    pub(super) fn sphere_sum(&self, s: usize) -> (Vec3, Vec3) {
+        let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
+        let (start, incidence, wall_start) =
+            (&self.incidence_start, &self.incidence, &self.wall_start);
+        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
+        let (mut f, mut t) = (Vec3::zeros(), Vec3::zeros());
+        let (spins, radius) = (self.turn[s] != NOT_RIGID, self.radius[s]);
+        for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
+            let c = &pairs[(e / 2) as usize];
+            let first = e % 2 == 0;
+            let scale = match &delay {
+                Some((axis, scales)) => {
+                    let (a, b) = pair_scales(c.shift[*axis], scales);
+                    if first {
+                        a
+                    } else {
+                        b
+                    }
+                }
+                None => 1.0,
+            };
+            f += if first { scale } else { -scale } * c.force;
+            if spins {
+                t += c.moment(radius, scale);
+            }
+        }
+        for c in &walls[wall_start[s] as usize..wall_start[s + 1] as usize] {
+            f += c.force;
+            if spins {
+                t += c.moment(radius, 1.0);
+            }
+        }
+        (f, t)
+    }
+
+    /// Adds sphere `s`'s contact force `f` to its particle and its moment `t` to the rigid
+    /// body or rotating particle it turns with.
+    #[inline]
+    pub(super) fn add_sphere(&self, s: usize, f: &Vec3, t: &Vec3, force: &mut [Vec3], torque: &mut [Vec3]) {
+        force[self.particle[s] as usize] += f;
+        if self.turn[s] != NOT_RIGID {
+            torque[self.turn[s] as usize] += t;
+        }
+    }
+}
+
+/// Sets the centre `center`, velocity and spin of `now`, the sphere on `particle` that turns
+/// with `turn` (its rigid body's or its particle's angular velocity, zero for a vertex of a
+/// deformable body), from `state`.
+#[inline]
+fn read_motion(state: &State, center: Vec3, particle: u32, turn: u32, now: &mut SphereNow) {
+    let bodies = state.rigid.len();
+    now.center = center;
+    now.velocity = state.velocity[particle as usize];
+    now.spin = match turn as usize {
+        t if t == NOT_RIGID as usize => Vec3::zeros(),
+        b if b < bodies => state.rigid.angular_velocity[b],
+        t => state.spin.velocity[t - bodies],
+    };
+}

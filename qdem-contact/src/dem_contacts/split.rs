@@ -1,0 +1,421 @@
+//! One rank's part of a [`DemContacts`] in a run decomposed with a halo exchange
+//! ([`qdem_core::parallel`]), bit-identical to one process: its [`SplitModel`] facet, whose
+//! stages the world's [`qdem_core::Exchange`] runs with the collectives in between.
+//!
+//! A sphere belongs to the rank that owns its particle (the mesh's decomposition for a
+//! deformable body's vertices, runs of particle order for one-sphere grains, a rigid body
+//! whole). A rank evaluates every candidate contact that touches a sphere it owns; a pair of
+//! two ranks' spheres is evaluated on both, from the same values, so both hold the same
+//! record. The candidate lists are sorted by partners, so a rank's list is a sub-sequence of
+//! the one a single process holds and each of its spheres sums its contacts in that
+//! process's order (paper 000 §4's gather, in the fixed order of `pipeline.rs`).
+//!
+//! What a rank reads of the other ranks' spheres, the **ghosts** (the partners of its
+//! candidates that it does not own), their owners send at each evaluation: the centre,
+//! velocity and spin ([`SplitModel::pack`]). At a rebuild of the lists, which the ranks
+//! decide on the largest displacement among all spheres, every rank receives every sphere's
+//! record, finds the pairs near its own spheres, and declares its new ghosts. Owners do not
+//! change between re-partitions, so the tangential springs of a rank's pairs are always on
+//! that rank. Before an output or a checkpoint reads the contacts, the ranks' lists are
+//! merged into the one list a single process holds ([`SplitModel::merge`]).
+
+use super::*;
+use qdem_core::{Part, SplitModel};
+
+/// Values per sphere record: centre, velocity, spin.
+const SPHERE_VALUES: usize = 9;
+
+/// Values per contact record in a merge: the list (0 pairs, 1 walls), partners, spring,
+/// force, n × f, δ/2, image shift.
+const CONTACT_VALUES: usize = 16;
+
+/// One rank's part of a contact set.
+pub(super) struct ContactPart {
+    /// Per sphere, the rank that owns it.
+    owner: Vec<u32>,
+    /// This rank.
+    me: u32,
+    /// This rank's spheres, ascending.
+    own: Vec<u32>,
+    /// Whether the lists hold every rank's contacts (after a merge or a restore): they are
+    /// cut down to this rank's before the next evaluation.
+    pub(super) whole: bool,
+    /// Whether the lists changed since the ghosts were last declared.
+    lists_changed: bool,
+    /// The own spheres that are partners of this rank's candidates, ascending: those whose
+    /// motion the lists read and whose contacts are summed.
+    partners: Vec<u32>,
+    /// The spheres of other ranks this rank reads at each evaluation.
+    pub(super) ghosts: usize,
+    /// The time since the previous evaluation.
+    dt: f64,
+    /// Scratch: the partners' sums.
+    sums: Vec<(Vec3, Vec3)>,
+}
+
+impl ContactPart {
+    /// The part of rank `me` when sphere `s` sits on particle `particle[s]` and particle `p`
+    /// is owned by rank `owner[p]`; whole until its first evaluation.
+    fn new(particle: &[u32], owner: &[u32], me: u32) -> ContactPart {
+        let owner: Vec<u32> = particle.iter().map(|&p| owner[p as usize]).collect();
+        ContactPart {
+            own: (0..owner.len() as u32)
+                .filter(|&s| owner[s as usize] == me)
+                .collect(),
+            owner,
+            me,
+            whole: true,
+            lists_changed: false,
+            partners: Vec::new(),
+            ghosts: 0,
+            dt: 0.0,
+            sums: Vec::new(),
+        }
+    }
+
+    /// Whether this rank owns sphere `s`.
+    #[inline]
+    fn owns(&self, s: u32) -> bool {
+        self.owner[s as usize] == self.me
+    }
+
+    /// Whether a contact belongs to this rank's list: a pair touching an own sphere, a wall
+    /// contact of one.
+    fn keeps(&self, c: &Contact, wall: bool) -> bool {
+        self.owns(c.first) || (!wall && self.owns(c.second))
+    }
+}
+
+impl DemContacts {
+    /// Runs `stage` on this rank's part, which it holds for the while.
+    fn with_part<T>(&mut self, stage: impl FnOnce(&mut Self, &mut ContactPart) -> T) -> T {
+        let mut part = self.split.take().expect("a split contact set");
+        let out = stage(self, &mut part);
+        self.split = Some(part);
+        out
+    }
+
+    /// Reads the centres of the spheres `own` from `state`; returns the largest distance one
+    /// has moved since the last build (infinite before it).
+    fn read_own_centers(&mut self, state: &State, own: &[u32]) -> f64 {
+        let built = self.lists_built();
+        let mut moved: f64 = if built { 0.0 } else { f64::INFINITY };
+        for &s in own {
+            let s = s as usize;
+            let center = state.position[self.particle[s] as usize];
+            if built {
+                moved = moved.max((center - self.built_at[s]).norm_squared());
+            }
+            self.center[s] = center;
+        }
+        moved.sqrt()
+    }
+
+    /// After new lists: the own spheres whose motion the lists read, and zero force on the
+    /// own spheres that touch nothing now.
+    fn learn_partners(&mut self, part: &mut ContactPart) {
+        part.partners = self
+            .partners
+            .iter()
+            .copied()
+            .filter(|&s| part.owns(s))
+            .collect();
+        for &s in &part.own {
+            self.sphere_force[s as usize] = (Vec3::zeros(), Vec3::zeros());
+        }
+    }
+
+    /// The broad phase of one rank, once it holds every sphere's centre: the pairs that touch
+    /// a sphere it owns, found among the spheres within reach of the box around its own
+    /// (along a periodic axis, those with an image there), and its own spheres' wall
+    /// candidates; the springs of the pairs that stay are kept.
+    fn rebuild_near(&mut self, part: &ContactPart, time: f64) {
+        let reach = 2.0 * self.radius.iter().cloned().fold(0.0, f64::max) + self.settings.skin;
+        let (mut low, mut high) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
+        for &s in &part.own {
+            low = low.inf(&self.center[s as usize]);
+            high = high.sup(&self.center[s as usize]);
+        }
+        let (start, width) = (
+            low.add_scalar(-reach),
+            high - low + Vec3::repeat(2.0 * reach),
+        );
+        let period = |k: usize| self.periodic.as_ref().and_then(|p| p.length(k));
+        let within = |k: usize, x: f64| match period(k) {
+            Some(l) if width[k] < l => (x - start[k]).rem_euclid(l) <= width[k],
+            Some(_) => true,
+            None => x >= start[k] && x - start[k] <= width[k],
+        };
+        let near: Vec<u32> = (0..self.center.len() as u32)
+            .filter(|&s| (0..3).all(|k| within(k, self.center[s as usize][k])))
+            .collect();
+        self.rebuild_among(part, &near, time);
+    }
+
+    /// [`DemContacts::rebuild_near`] among the spheres `near` (ascending).
+    fn rebuild_among(&mut self, part: &ContactPart, near: &[u32], time: f64) {
+        let skin = self.settings.skin;
+        let (center, radius, body) = (
+            pick(near, &self.center),
+            pick(near, &self.radius),
+            pick(near, &self.body),
+        );
+        let set = SphereSet {
+            center: &center,
+            radius: &radius,
+            body: &body,
+            periodic: self.periodic.as_ref(),
+        };
+        let keys = find_pairs(&set, skin)
+            .into_iter()
+            .map(|(a, b)| (near[a as usize], near[b as usize]))
+            .filter(|&(a, b)| part.owns(a) || part.owns(b))
+            .collect();
+        self.pairs.rebuild(keys);
+        let own = part.own.par_iter().map(|&s| s as usize);
+        let wall_keys = self.wall_keys(own, time);
+        self.wall_contacts.rebuild(wall_keys);
+        self.finish_build(time);
+    }
+
+    /// The partners of this rank's pairs that other ranks own, ascending.
+    fn ghosts_of(&self, part: &ContactPart) -> Vec<u32> {
+        let mut ghosts: Vec<u32> = self
+            .pairs
+            .items
+            .iter()
+            .flat_map(|c| [c.first, c.second])
+            .filter(|&s| !part.owns(s))
+            .collect();
+        ghosts.sort_unstable();
+        ghosts.dedup();
+        ghosts
+    }
+
+    /// Cuts lists that hold every rank's contacts (after a merge, a restore) down to this
+    /// rank's.
+    fn cut_to_rank(&mut self, part: &mut ContactPart) {
+        self.pairs.items.retain(|c| part.keeps(c, false));
+        self.wall_contacts.items.retain(|c| part.keeps(c, true));
+        self.build_incidence();
+        part.whole = false;
+        part.lists_changed = true;
+    }
+}
+
+impl SplitModel for DemContacts {
+    /// The particles of every sphere (those of deformable bodies already have owners).
+    fn free_particles(&self) -> Vec<usize> {
+        self.particle.iter().map(|&p| p as usize).collect()
+    }
+
+    fn split(&mut self, part: Option<Part>) {
+        self.split = part.map(|p| ContactPart::new(&self.particle, &p.owner, p.rank));
+    }
+
+    /// The contact spheres.
+    fn items(&self) -> Vec<usize> {
+        self.particle.iter().map(|&p| p as usize).collect()
+    }
+
+    /// Centre, velocity and spin.
+    fn record_values(&self) -> usize {
+        SPHERE_VALUES
+    }
+
+    fn pack(&self, items: &[u32], out: &mut Vec<f64>) {
+        for &s in items {
+            let n = &self.now[s as usize];
+            for v in [self.center[s as usize], n.velocity, n.spin] {
+                out.extend_from_slice(v.as_slice());
+            }
+        }
+    }
+
+    fn unpack(&mut self, items: &[u32], values: &[f64]) {
+        for (&s, v) in items.iter().zip(values.chunks_exact(SPHERE_VALUES)) {
+            let n = &mut self.now[s as usize];
+            n.center = Vec3::new(v[0], v[1], v[2]);
+            n.velocity = Vec3::new(v[3], v[4], v[5]);
+            n.spin = Vec3::new(v[6], v[7], v[8]);
+            self.center[s as usize] = n.center;
+        }
+    }
+
+    /// Cuts whole lists to this rank's, then reads the own spheres' centres.
+    fn read_own(&mut self, state: &State) -> Option<f64> {
+        let dt = self.last_time.map_or(0.0, |t| state.time - t);
+        self.last_time = Some(state.time);
+        let moved = self.with_part(|this, part| {
+            part.dt = dt;
+            if part.whole {
+                this.cut_to_rank(part);
+            }
+            this.read_own_centers(state, &part.own)
+        });
+        Some(moved)
+    }
+
+    fn needs_rebuild(&self, moved: f64, time: f64) -> bool {
+        self.outgrew_skin(moved, time)
+    }
+
+    fn rebuild(&mut self, time: f64) {
+        self.with_part(|this, part| {
+            this.rebuild_near(part, time);
+            part.lists_changed = true;
+        });
+    }
+
+    fn new_ghosts(&mut self) -> Option<Vec<u32>> {
+        self.with_part(|this, part| {
+            if !std::mem::take(&mut part.lists_changed) {
+                return None;
+            }
+            this.learn_partners(part);
+            let ghosts = this.ghosts_of(part);
+            part.ghosts = ghosts.len();
+            Some(ghosts)
+        })
+    }
+
+    fn read_partners(&mut self, state: &State) {
+        self.with_part(|this, part| this.read_motions(state, &part.partners));
+    }
+
+    fn compute(&mut self, state: &State) {
+        let dt = self.split.as_ref().map_or(0.0, |p| p.dt);
+        self.evaluate(state.time, dt);
+    }
+
+    /// The touching pairs through a time-delayed boundary: partners and force magnitude.
+    fn reduction(&mut self, out: &mut Vec<f64>) -> bool {
+        let Some(axis) = self.time_delay.as_ref().map(|t| t.axis) else {
+            return false;
+        };
+        for c in &self.pairs.items {
+            if c.force != Vec3::zeros() && c.shift[axis] != 0.0 {
+                out.extend([c.first as f64, c.second as f64, c.force.norm()]);
+            }
+        }
+        true
+    }
+
+    /// The average magnitude of the forces through the boundary as one process measures it
+    /// over its list: the ranks' pairs merged by partners (a pair two ranks hold taken once)
+    /// and summed in that order; the ghost scales follow (paper 003 Eqs. 6–7).
+    fn reduced(&mut self, time: f64, all: &[f64]) {
+        let mut forces: Vec<(u32, u32, f64)> = all
+            .chunks_exact(3)
+            .map(|v| (v[0] as u32, v[1] as u32, v[2]))
+            .collect();
+        forces.sort_by_key(|&(a, b, _)| (a, b));
+        forces.dedup_by_key(|&mut (a, b, _)| (a, b));
+        let mut sum = 0.0;
+        for &(_, _, f) in &forces {
+            sum += f;
+        }
+        let measured = match forces.len() {
+            0 => 0.0,
+            n => sum / n as f64,
+        };
+        self.set_boundary_force(time, measured);
+    }
+
+    /// Each own partner's sum, in the single process's order, added to its particle.
+    fn apply(&mut self, force: &mut [Vec3], torque: &mut [Vec3]) {
+        let mut part = self.split.take().expect("a split contact set");
+        let this = &*self;
+        let mut sums = std::mem::take(&mut part.sums);
+        sums.resize(part.partners.len(), (Vec3::zeros(), Vec3::zeros()));
+        sums.par_iter_mut()
+            .zip(&part.partners)
+            .with_min_len(CONTACT_CHUNK)
+            .for_each(|(sum, &s)| *sum = this.sphere_sum(s as usize));
+        for (&s, (f, t)) in part.partners.iter().zip(&sums) {
+            self.add_sphere(s as usize, f, t, force, torque);
+            self.sphere_force[s as usize] = (*f, *t);
+        }
+        part.sums = sums;
+        self.split = Some(part);
+    }
+
+    /// This rank's pairs, then its wall contacts; nothing once whole.
+    fn records(&self, out: &mut Vec<f64>) -> bool {
+        if self.split.as_ref().is_none_or(|p| p.whole) {
+            return false;
+        }
+        for (list, tag) in [(&self.pairs, 0.0), (&self.wall_contacts, 1.0)] {
+            for c in &list.items {
+                out.extend([tag, c.first as f64, c.second as f64]);
+                for v in [c.history, c.force, c.turn] {
+                    out.extend_from_slice(v.as_slice());
+                }
+                out.push(c.half_overlap);
+                out.extend_from_slice(c.shift.as_slice());
+            }
+        }
+        true
+    }
+
+    /// Every rank's lists merged into the ones a single process holds (sorted by partners,
+    /// a pair that two ranks hold taken once: their records are equal), and every sphere's
+    /// contacts summed as one process does.
+    fn merge(&mut self, all: &[f64]) {
+        let at = |v: &[f64], k: usize| Vec3::new(v[k], v[k + 1], v[k + 2]);
+        let (mut pairs, mut walls) = (Vec::new(), Vec::new());
+        for v in all.chunks_exact(CONTACT_VALUES) {
+            let contact = Contact {
+                first: v[1] as u32,
+                second: v[2] as u32,
+                history: at(v, 3),
+                force: at(v, 6),
+                turn: at(v, 9),
+                half_overlap: v[12],
+                shift: at(v, 13),
+            };
+            match v[0] == 0.0 {
+                true => pairs.push(contact),
+                false => walls.push(contact),
+            }
+        }
+        for (items, list) in [(pairs, &mut self.pairs), (walls, &mut self.wall_contacts)] {
+            let mut items = items;
+            items.sort_by_key(|c| (c.first, c.second));
+            items.dedup_by_key(|c| (c.first, c.second));
+            *list = ContactList { items };
+        }
+        self.build_incidence();
+        self.gather();
+        if let Some(part) = &mut self.split {
+            part.whole = true;
+        }
+    }
+
+    fn rebuilt(&mut self) -> bool {
+        std::mem::take(&mut self.rebuilt)
+    }
+
+    /// `CANDIDATE_WORK` (three) per candidate contact this rank evaluates.
+    fn work(&self) -> f64 {
+        CANDIDATE_WORK * self.candidates() as f64
+    }
+
+    /// Half of `CANDIDATE_WORK` per candidate pair to each partner's particle, all of it
+    /// per wall candidate.
+    fn add_costs(&self, cost: &mut [f64]) {
+        let half = 0.5 * CANDIDATE_WORK;
+        for c in &self.pairs.items {
+            cost[self.particle[c.first as usize] as usize] += half;
+            cost[self.particle[c.second as usize] as usize] += half;
+        }
+        for c in &self.wall_contacts.items {
+            cost[self.particle[c.first as usize] as usize] += CANDIDATE_WORK;
+        }
+    }
+}
+
+/// The entries `indices` of `values`.
+fn pick<T: Copy>(indices: &[u32], values: &[T]) -> Vec<T> {
+    indices.iter().map(|&i| values[i as usize]).collect()
+}

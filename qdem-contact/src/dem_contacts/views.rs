@@ -1,0 +1,192 @@
+//! What the outputs read of a [`DemContacts`]: counts, the spheres with their contact
+//! forces, the touching contacts split into normal and tangential parts, the force through
+//! a section or a time-delayed boundary.
+
+use super::*;
+
+impl DemContacts {
+    /// The ghost scales (left, right) of the last evaluation and the average magnitude of the
+    /// contact forces through the delayed boundary it measured; `None` without a time delay.
+    pub fn time_delay_state(&self) -> Option<(GhostScales, f64)> {
+        self.time_delay
+            .as_ref()
+            .map(|t| (t.scales, t.boundary_force))
+    }
+
+    /// The average magnitude of the touching pairs' forces across the plane x\[axis\] = `at`
+    /// (serial, in pair order): a pair crosses it when its two sphere centres, the second at
+    /// the image it touches, lie on either side. In a periodic cell the plane repeats every
+    /// period, so a section at a cell face measures what the boundary force does; in a box
+    /// several cells long it measures the force through an inner face (paper 003's premise
+    /// for Eqs. 4–5 is a statement about that force).
+    pub fn section_force(&self, axis: usize, at: f64) -> f64 {
+        let period = self.periodic.as_ref().and_then(|p| p.length(axis));
+        self.mean_pair_force(|c| {
+            let a = self.center[c.first as usize][axis] - at;
+            let b = self.center[c.second as usize][axis] + c.shift[axis] - at;
+            crosses(a, b, period)
+        })
+    }
+
+    /// The average magnitude of the forces of the touching pairs c for which `counted(c)`
+    /// (serial, in pair order, so it does not depend on the thread count); 0 without any.
+    pub(super) fn mean_pair_force(&self, counted: impl Fn(&Contact) -> bool) -> f64 {
+        let (mut sum, mut count) = (0.0, 0usize);
+        for c in &self.pairs.items {
+            if c.force != Vec3::zeros() && counted(c) {
+                sum += c.force.norm();
+                count += 1;
+            }
+        }
+        if count == 0 {
+            0.0
+        } else {
+            sum / count as f64
+        }
+    }
+
+    /// Number of contact spheres.
+    pub fn spheres(&self) -> usize {
+        self.particle.len()
+    }
+
+    /// Number of walls.
+    pub fn walls(&self) -> usize {
+        self.walls.len()
+    }
+
+    /// Number of candidate pairs and wall candidates in the current lists.
+    pub fn candidates(&self) -> usize {
+        self.pairs.len() + self.wall_contacts.len()
+    }
+
+    /// Number of touching contacts (sphere–sphere and sphere–wall) at the last evaluation.
+    pub fn contacts(&self) -> usize {
+        self.pairs
+            .items
+            .iter()
+            .chain(&self.wall_contacts.items)
+            .filter(|c| c.force != Vec3::zeros())
+            .count()
+    }
+
+    /// The walls.
+    pub fn wall_list(&self) -> &[Wall] {
+        &self.walls
+    }
+
+    /// The names of the bodies the spheres belong to ([`SphereRecord::body`] indexes them).
+    pub fn body_names(&self) -> &[String] {
+        &self.body_names
+    }
+
+    /// Every contact sphere at `state` (the state the last evaluation saw, after the step),
+    /// in sphere order, with the contact force the model applied to it.
+    pub fn sphere_records<'a>(
+        &'a self,
+        state: &'a State,
+    ) -> impl Iterator<Item = SphereRecord> + 'a {
+        let bodies = state.rigid.len();
+        (0..self.particle.len()).map(move |s| {
+            let particle = self.particle[s] as usize;
+            let spin = match self.turn[s] as usize {
+                t if t == NOT_RIGID as usize => None,
+                b if b < bodies => Some(state.rigid.angular_velocity[b]),
+                t => Some(state.spin.velocity[t - bodies]),
+            };
+            SphereRecord {
+                particle,
+                radius: self.radius[s],
+                body: self.body[s] as usize,
+                center: state.position[particle],
+                velocity: state.velocity[particle],
+                spin,
+                force: self.sphere_force[s].0,
+            }
+        })
+    }
+
+    /// Every contact that touched at the last evaluation: the pairs in list order, then the
+    /// wall contacts. Summed per sphere (+f on the first partner times its scale, −f on the
+    /// second times its scale), their forces are [`SphereRecord::force`].
+    pub fn touching(&self) -> impl Iterator<Item = TouchingContact> + '_ {
+        let time = self.last_time.unwrap_or(0.0);
+        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
+        let pairs = self.pairs.items.iter().filter(|c| c.force != Vec3::zeros());
+        let pairs = pairs.map(move |c| {
+            let (a, b) = (c.first as usize, c.second as usize);
+            let (from, to) = (self.center[a], self.center[b] + c.shift);
+            let scales = delay.map_or((1.0, 1.0), |(axis, s)| pair_scales(c.shift[axis], &s));
+            touching_contact(
+                a,
+                Partner::Sphere(b),
+                from,
+                to,
+                (to - from).normalize(),
+                c.force,
+                scales,
+            )
+        });
+        let walls = self
+            .wall_contacts
+            .items
+            .iter()
+            .filter(|c| c.force != Vec3::zeros());
+        let walls = walls.map(move |c| {
+            let (s, w) = (c.first as usize, c.second as usize);
+            let from = self.center[s];
+            let (overlap, normal) = self.walls[w].overlap(&from, self.radius[s], time);
+            let to = from + (self.radius[s] - overlap) * normal;
+            touching_contact(s, Partner::Wall(w), from, to, normal, c.force, (1.0, 1.0))
+        });
+        pairs.chain(walls)
+    }
+
+    /// The spheres of other ranks whose motion this rank receives at each evaluation, in a
+    /// run decomposed with split contacts ([`qdem_core::SplitModel`]); 0 otherwise.
+    pub fn ghosts(&self) -> usize {
+        self.split.as_ref().map_or(0, |p| p.ghosts)
+    }
+
+    /// How many times the candidate lists were rebuilt.
+    pub fn rebuilds(&self) -> u64 {
+        self.rebuilds
+    }
+}
+
+/// A touching contact of sphere `first` with `second` along the segment `from`–`to`, its
+/// force `force` on the first split along the unit normal `normal`.
+fn touching_contact(
+    first: usize,
+    second: Partner,
+    from: Vec3,
+    to: Vec3,
+    normal: Vec3,
+    force: Vec3,
+    scales: (f64, f64),
+) -> TouchingContact {
+    let normal_force = force.dot(&normal) * normal;
+    TouchingContact {
+        first,
+        second,
+        from,
+        to,
+        normal,
+        normal_force,
+        tangential_force: force - normal_force,
+        scales,
+    }
+}
+
+/// Whether the segment from a to b (coordinates relative to a plane) crosses the plane, or,
+/// with a `period`, one of its copies a whole number of periods away.
+#[inline]
+fn crosses(a: f64, b: f64, period: Option<f64>) -> bool {
+    match period {
+        Some(l) => {
+            let below = (a / l).floor() * l;
+            b < below || b >= below + l
+        }
+        None => (a < 0.0) != (b < 0.0),
+    }
+}

@@ -1,0 +1,553 @@
+//! A deformable QDEM body: a set of tetrahedra sharing particles, as a [`Model`].
+//!
+//! Each step computes the Kelvin–Voigt stress and the four particle forces of every
+//! tetrahedron (paper 000 Eqs. 1–10, see [`crate::continuum::tet_kernel`]) block by block: the blocks of
+//! [`crate::continuum::tet_blocks`] run in parallel, each against a cached copy of its nodes' positions,
+//! summing its forces per node; a per-particle gather then adds each particle's block sums in
+//! ascending block order (Eq. 11). Blocks are fixed by the mesh, so every particle sums its
+//! contributions in the same order for any number of threads: results are bit-identical (no
+//! atomics, no reduction-order dependence).
+//! Elastic materials take a path without the viscous stress.
+//!
+//! For implicit and static solves the body adds its tangent (its [`crate::Linearized`] facet):
+//! the small-strain linear-tetrahedron stiffness K_e = V Gᵀ D G per element, with the volume V
+//! and shape-function gradients G of the current configuration, and the same operator with the
+//! viscous Lamé pair for the damping C_e. This is the exact linearisation of Eqs. 1–10 about an
+//! unstrained configuration (it omits the stress-dependent geometric stiffness, of the order of
+//! the strain), so for small strain f(x + ∆x, v) ≈ f(x, v) − K ∆x (paper 001 Eq. 20).
+
+use crate::parallel::decomposition::{BodyLayout, BodySplit};
+use crate::error::CoreError;
+use crate::continuum::material::{Lame, Material};
+use crate::parallel::split::{Part, PartialSums, Reads, SplitModel};
+use crate::step::model::{Linearized, Model, Persistence};
+use crate::continuum::stable_step::{critical_step, element_rate_bound};
+use crate::state::State;
+use crate::solvers::tangent::Tangent;
+use crate::continuum::tet_blocks::{BlockLayout, TetBlocks};
+use crate::continuum::tet_kernel::{
+    deformation_gradient, edge_matrix, strain_energy, tet_forces, tet_stress, von_mises,
+};
+use crate::{Mat3, Vec3};
+use rayon::prelude::*;
+use std::sync::Mutex;
+
+/// Tetrahedra per parallel task in the per-element fields.
+const TET_CHUNK: usize = 512;
+/// Particles per parallel task in the gather.
+const PARTICLE_CHUNK: usize = 1024;
+
+/// A deformable body of linear QDEM tetrahedra.
+///
+/// ```
+/// use qdem_core::{Material, Model, State, TetBody, Vec3};
+///
+/// // One tetrahedron of volume 1/6 m³.
+/// let nodes = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];
+/// let material = Material::elastic(1200.0, 1e6, 0.25);
+/// let mut body = TetBody::new("tet", &nodes, vec![[0, 1, 2, 3]], material)?;
+/// let mut state = State::at_rest(nodes);
+/// body.lump_mass(&mut state.mass);
+/// assert!(state.mass.iter().all(|&m| (m - 1200.0 / 6.0 / 4.0).abs() < 1e-9));
+///
+/// // Stretch one vertex: the body pulls it back, and its internal forces sum to zero.
+/// state.position[1].x += 0.01;
+/// let mut force = vec![Vec3::zeros(); state.len()];
+/// body.add_forces(&state, &mut force, &mut []);
+/// assert!(force[1].x < 0.0);
+/// let total: Vec3 = force.iter().sum();
+/// assert!(total.norm() < 1e-9 * force[1].norm());
+/// # Ok::<(), qdem_core::CoreError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct TetBody {
+    name: String,
+    material: Material,
+    elastic: Lame,
+    viscous: Lame,
+    tets: Vec<[u32; 4]>,
+    volume: Vec<f64>,
+    blocks: TetBlocks,
+    /// Per block node, the sum of its block's tetrahedron forces (laid out like the blocks'
+    /// node lists), written by the block pass and read by the gather.
+    sums: Vec<Vec3>,
+    scratch: ScratchPool,
+    omega_squared: f64,
+    damping_rate: f64,
+    /// The first tetrahedron found inverted at the last force evaluation.
+    inverted: Option<usize>,
+    /// In a run decomposed over processes, this process's share of the body
+    /// ([`crate::parallel::decomposition`]); `None`: the whole body.
+    split: Option<BodySplit>,
+}
+
+impl TetBody {
+    /// Builds a body from tetrahedra given as indices into `reference` (the positions of all
+    /// particles of the scene). Every tetrahedron must have positive reference volume.
+    pub fn new(
+        name: &str,
+        reference: &[Vec3],
+        tets: Vec<[u32; 4]>,
+        material: Material,
+    ) -> Result<TetBody, CoreError> {
+        material.validate().map_err(|source| CoreError::Material {
+            body: name.to_string(),
+            source,
+        })?;
+        if tets.is_empty() {
+            return Err(CoreError::EmptyBody(name.to_string()));
+        }
+        let mut dm_inv = Vec::with_capacity(tets.len());
+        let mut volume = Vec::with_capacity(tets.len());
+        for (index, tet) in tets.iter().enumerate() {
+            for &node in tet {
+                if node as usize >= reference.len() {
+                    return Err(CoreError::NodeOutOfRange {
+                        body: name.to_string(),
+                        tet: index,
+                        node,
+                        count: reference.len(),
+                    });
+                }
+            }
+            let x = tet.map(|n| reference[n as usize]);
+            let dm = edge_matrix(&x);
+            let v = dm.determinant() / 6.0;
+            let scale = dm.norm().powi(3);
+            let inverse = dm.try_inverse().filter(|_| v > 1e-12 * scale);
+            let Some(inverse) = inverse else {
+                return Err(CoreError::BadTet {
+                    body: name.to_string(),
+                    tet: index,
+                    volume: v,
+                });
+            };
+            dm_inv.push(inverse);
+            volume.push(v);
+        }
+        let blocks = TetBlocks::new(reference, &tets, &dm_inv);
+        let elastic = material.elastic_lame();
+        let viscous = material.viscous_lame();
+        let omega_squared = rate_bound(&dm_inv, &material, elastic);
+        let damping_rate = if material.is_elastic() {
+            0.0
+        } else {
+            rate_bound(&dm_inv, &material, viscous)
+        };
+        Ok(TetBody {
+            name: name.to_string(),
+            sums: vec![Vec3::zeros(); blocks.nodes.len()],
+            material,
+            elastic,
+            viscous,
+            tets,
+            volume,
+            blocks,
+            scratch: ScratchPool::default(),
+            omega_squared,
+            damping_rate,
+            inverted: None,
+            split: None,
+        })
+    }
+
+    /// The model as a deformable body, if it is one (models are `Any`).
+    pub fn of(model: &dyn Model) -> Option<&TetBody> {
+        let any: &dyn std::any::Any = model;
+        any.downcast_ref::<TetBody>()
+    }
+
+    /// The body's tetrahedra (indices into the scene's particles).
+    pub fn tets(&self) -> &[[u32; 4]] {
+        &self.tets
+    }
+
+    /// How the tetrahedra are cut into blocks for the force pass ([`crate::continuum::tet_blocks`]).
+    pub fn block_layout(&self) -> BlockLayout {
+        self.blocks.layout()
+    }
+
+    /// Whether the material has no viscosity (the kernel's cheaper path).
+    pub(crate) fn is_elastic(&self) -> bool {
+        self.material.is_elastic()
+    }
+
+    /// The number of tetrahedra of each block, in block order.
+    pub(crate) fn block_tets(&self) -> impl Iterator<Item = usize> + '_ {
+        self.blocks
+            .tet_start
+            .windows(2)
+            .map(|w| (w[1] - w[0]) as usize)
+    }
+
+    /// What a decomposition reads of the blocks.
+    pub(crate) fn body_layout(&self) -> BodyLayout<'_> {
+        let b = &self.blocks;
+        BodyLayout {
+            node_start: &b.node_start,
+            nodes: &b.nodes,
+            first: b.first,
+            entry_start: &b.entry_start,
+            entries: &b.entries,
+        }
+    }
+
+    /// In a run decomposed over processes, the wall seconds this process has spent
+    /// exchanging block sums with the other ranks (waiting for them included); 0 otherwise.
+    pub fn exchange_seconds(&self) -> f64 {
+        let exchange = self.split.as_ref().and_then(|s| s.exchange.as_ref());
+        exchange.map_or(0.0, |e| e.seconds)
+    }
+
+    /// Adds a quarter of each tetrahedron's mass to each of its particles (paper 000 §2.4).
+    pub fn lump_mass(&self, mass: &mut [f64]) {
+        for (tet, v) in self.tets.iter().zip(&self.volume) {
+            let quarter = 0.25 * self.material.density * v;
+            for &n in tet {
+                mass[n as usize] += quarter;
+            }
+        }
+    }
+
+    /// Von Mises stress (Pa) and volumetric strain det F − 1 of every tetrahedron.
+    pub fn tet_fields(&self, state: &State) -> (Vec<f64>, Vec<f64>) {
+        let viscous = !self.material.is_elastic();
+        (0..self.tets.len())
+            .into_par_iter()
+            .with_min_len(TET_CHUNK)
+            .map(|e| {
+                let x = self.tets[e].map(|n| state.position[n as usize]);
+                let v = viscous.then(|| self.tets[e].map(|n| state.velocity[n as usize]));
+                let (t, _) = tet_stress(
+                    &x,
+                    v.as_ref(),
+                    self.blocks.dm_inv(e),
+                    self.pair(),
+                    self.vpair(),
+                );
+                let j = deformation_gradient(&x, self.blocks.dm_inv(e)).determinant();
+                (von_mises(&t), j - 1.0)
+            })
+            .unzip()
+    }
+
+    fn pair(&self) -> (f64, f64) {
+        (self.elastic.lambda, self.elastic.mu)
+    }
+
+    fn vpair(&self) -> (f64, f64) {
+        (self.viscous.lambda, self.viscous.mu)
+    }
+
+    /// Stage 1: every block's tetrahedra (this process's blocks, in a decomposed run), their
+    /// forces summed per block node into `self.sums` ([`crate::continuum::tet_blocks`]), the blocks in
+    /// parallel.
+    fn compute_block_sums<const VISCOUS: bool>(&mut self, state: &State) {
+        let range = self
+            .split
+            .as_ref()
+            .map_or(0..self.blocks.len(), |s| s.mine.clone());
+        self.inverted = None;
+        if range.is_empty() {
+            return;
+        }
+        self.scratch.fit(rayon::current_num_threads());
+        let mut sums = std::mem::take(&mut self.sums);
+        let this = &*self;
+        let start = &self.blocks.node_start;
+        let inverted = for_blocks(
+            &mut sums[start[range.start] as usize..start[range.end] as usize],
+            range,
+            start,
+            &|b, out| {
+                let mut scratch = this.scratch.for_this_thread();
+                this.block_pass::<VISCOUS>(b, state, out, &mut scratch)
+            },
+        );
+        self.sums = sums;
+        self.inverted = (inverted != usize::MAX).then_some(inverted);
+    }
+
+    /// The tetrahedra of block `b` against a local copy of its nodes' positions (and
+    /// velocities), their forces added into `out` (the block's sums, one per node, in tet
+    /// order). Returns the body's index of its first inverted tetrahedron, `usize::MAX` if none.
+    fn block_pass<const VISCOUS: bool>(
+        &self,
+        b: usize,
+        state: &State,
+        out: &mut [Vec3],
+        scratch: &mut Scratch,
+    ) -> usize {
+        let blocks = &self.blocks;
+        let nodes = &blocks.nodes[blocks.node_start[b] as usize..blocks.node_start[b + 1] as usize];
+        scratch.load(
+            nodes,
+            &state.position,
+            VISCOUS.then_some(&state.velocity[..]),
+        );
+        out.fill(Vec3::zeros());
+        let (elastic, viscous) = (self.pair(), self.vpair());
+        let range = blocks.tet_start[b] as usize..blocks.tet_start[b + 1] as usize;
+        let mut first_inverted = usize::MAX;
+        for (k, hot) in range.clone().zip(&blocks.hot[range]) {
+            let x = corners(&scratch.x, hot.local);
+            let v = if VISCOUS {
+                corners(&scratch.v, hot.local)
+            } else {
+                x
+            };
+            let (forces, six_volume) = tet_forces::<VISCOUS>(&x, &v, &hot.dm_inv, elastic, viscous);
+            for (&l, f) in hot.local.iter().zip(forces) {
+                out[l as usize] += f;
+            }
+            // B = FFᵀ cannot tell an inverted tetrahedron from its mirror image, so the sign
+            // of the volume is checked here.
+            if six_volume.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                first_inverted = first_inverted.min(blocks.order[k] as usize);
+            }
+        }
+        first_inverted
+    }
+
+    /// Stage 2: per-particle sums of its block entries, in ascending block order (Eq. 11);
+    /// in a decomposed run, of the particles this process owns only.
+    fn gather(&self, force: &mut [Vec3]) {
+        let blocks = &self.blocks;
+        let count = blocks.entry_start.len() - 1;
+        let (starts, entries, sums) = (&blocks.entry_start, &blocks.entries, &self.sums);
+        // A rank owns a particle only where it computes the particle's first block.
+        if self.split.as_ref().is_some_and(|s| s.mine.is_empty()) {
+            return;
+        }
+        let owner = self.split.as_ref().map(|s| (s.me, &s.owner[..]));
+        force[blocks.first..blocks.first + count]
+            .par_iter_mut()
+            .with_min_len(PARTICLE_CHUNK)
+            .enumerate()
+            .for_each(|(i, f)| {
+                if owner.is_some_and(|(me, owner)| owner[i] != me) {
+                    return;
+                }
+                let range = starts[i] as usize..starts[i + 1] as usize;
+                let mut sum = Vec3::zeros();
+                for &entry in &entries[range] {
+                    sum += sums[entry as usize];
+                }
+                *f += sum;
+            });
+    }
+}
+
+/// The four values of a tetrahedron's corners (written out: `array::map` is not inlined here).
+#[inline(always)]
+fn corners(values: &[Vec3], local: [u16; 4]) -> [Vec3; 4] {
+    let [a, b, c, d] = local.map(usize::from);
+    [values[a], values[b], values[c], values[d]]
+}
+
+/// Runs `pass(b, sums of b)` for the blocks in `range` in parallel, splitting `sums` (laid out
+/// per block by `node_start`) between them; returns the smallest index `pass` returned.
+fn for_blocks(
+    sums: &mut [Vec3],
+    range: std::ops::Range<usize>,
+    node_start: &[u32],
+    pass: &(dyn Fn(usize, &mut [Vec3]) -> usize + Sync),
+) -> usize {
+    if range.len() == 1 {
+        return pass(range.start, sums);
+    }
+    let mid = range.start + range.len() / 2;
+    let (left, right) = sums.split_at_mut((node_start[mid] - node_start[range.start]) as usize);
+    let (a, b) = rayon::join(
+        || for_blocks(left, range.start..mid, node_start, pass),
+        || for_blocks(right, mid..range.end, node_start, pass),
+    );
+    a.min(b)
+}
+
+/// A worker's copy of one block's node positions and velocities.
+#[derive(Debug, Default)]
+struct Scratch {
+    x: Vec<Vec3>,
+    v: Vec<Vec3>,
+}
+
+impl Scratch {
+    /// Copies the positions (and velocities, when given) of `nodes`.
+    fn load(&mut self, nodes: &[u32], position: &[Vec3], velocity: Option<&[Vec3]>) {
+        self.x.clear();
+        self.x.extend(nodes.iter().map(|&n| position[n as usize]));
+        if let Some(velocity) = velocity {
+            self.v.clear();
+            self.v.extend(nodes.iter().map(|&n| velocity[n as usize]));
+        }
+    }
+}
+
+/// One [`Scratch`] per worker thread, kept from step to step (no allocation once warm). A
+/// clone starts empty.
+#[derive(Debug, Default)]
+struct ScratchPool(Vec<Mutex<Scratch>>);
+
+impl Clone for ScratchPool {
+    fn clone(&self) -> ScratchPool {
+        ScratchPool::default()
+    }
+}
+
+impl ScratchPool {
+    /// At least one scratch per thread of a pool of `threads`.
+    fn fit(&mut self, threads: usize) {
+        while self.0.len() < threads.max(1) {
+            self.0.push(Mutex::default());
+        }
+    }
+
+    /// The calling worker's scratch (each worker runs one block at a time, so the lock is
+    /// never contended).
+    fn for_this_thread(&self) -> std::sync::MutexGuard<'_, Scratch> {
+        let i = rayon::current_thread_index().unwrap_or(0) % self.0.len();
+        self.0[i]
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+}
+
+/// Volume and shape-function gradients ∇N₀..∇N₃ of a tetrahedron at positions `x` (zero
+/// gradients for a degenerate one, which then adds no tangent).
+fn current_gradients(x: &[Vec3; 4]) -> (f64, [Vec3; 4]) {
+    let dx = edge_matrix(x);
+    let inverse = dx.try_inverse().unwrap_or_else(Mat3::zeros);
+    let g: [Vec3; 3] = std::array::from_fn(|k| inverse.row(k).transpose());
+    (
+        dx.determinant() / 6.0,
+        [-(g[0] + g[1] + g[2]), g[0], g[1], g[2]],
+    )
+}
+
+/// Block (a, b) of the linear-tet operator V Gᵀ D G with the Lamé pair (λ, μ):
+/// V (λ g_a g_bᵀ + μ g_b g_aᵀ + μ (g_a·g_b) I).
+fn lame_block(volume: f64, ga: &Vec3, gb: &Vec3, (lambda, mu): (f64, f64)) -> Mat3 {
+    (ga * gb.transpose() * lambda
+        + gb * ga.transpose() * mu
+        + Mat3::from_diagonal_element(mu * ga.dot(gb)))
+        * volume
+}
+
+/// Largest element rate bound over all tetrahedra, for an elastic or a viscous Lamé pair.
+fn rate_bound(dm_inv: &[Mat3], material: &Material, lame: Lame) -> f64 {
+    dm_inv
+        .par_iter()
+        .map(|m| element_rate_bound(m, material.density, lame))
+        .reduce(|| 0.0, f64::max)
+}
+
+impl Model for TetBody {
+    fn failure(&self, state: &State) -> Option<CoreError> {
+        let tet = self.inverted?;
+        let x = self.tets[tet].map(|n| state.position[n as usize]);
+        Some(CoreError::Inverted {
+            body: self.name.clone(),
+            tet,
+            det: (edge_matrix(&x) * self.blocks.dm_inv(tet)).determinant(),
+            time: state.time,
+        })
+    }
+
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The nodes of its own blocks: in a decomposed run, the rank's particles and its halo.
+    fn reads(&mut self) -> Reads<'_> {
+        Reads::Split(self)
+    }
+
+    fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
+        self.compute(state);
+        self.gather(force);
+    }
+
+    fn stable_dt(&self, _state: &State) -> Option<f64> {
+        Some(critical_step(self.omega_squared, self.damping_rate))
+    }
+
+    fn potential_energy(&self, state: &State) -> Option<f64> {
+        let (lambda, mu) = self.pair();
+        let energy = (0..self.tets.len())
+            .map(|e| {
+                let x = self.tets[e].map(|n| state.position[n as usize]);
+                let f = deformation_gradient(&x, self.blocks.dm_inv(e));
+                strain_energy(&f, self.volume[e], lambda, mu)
+            })
+            .sum();
+        Some(energy)
+    }
+
+    fn linearized(&self) -> Option<&dyn Linearized> {
+        Some(self)
+    }
+
+    /// No history: the forces follow from the state alone.
+    fn persistence(&self) -> Persistence<'_> {
+        Persistence::Stateless
+    }
+}
+
+/// In a decomposed run a rank computes the blocks the decomposition gives it
+/// ([`crate::parallel::decomposition`]) and sums the particles it owns; the block sums of a
+/// node another rank owns go to the owner in the exchange's reverse stage.
+impl SplitModel for TetBody {
+    fn split(&mut self, part: Option<Part>) {
+        self.split = part.and_then(|p| p.body);
+    }
+
+    /// Stage 1 of Eqs. 9–11: the block sums of this rank's blocks.
+    fn compute(&mut self, state: &State) {
+        if self.material.is_elastic() {
+            self.compute_block_sums::<false>(state);
+        } else {
+            self.compute_block_sums::<true>(state);
+        }
+    }
+
+    fn partial_sums(&mut self) -> Option<PartialSums<'_>> {
+        let plan = self.split.as_mut().and_then(|s| s.exchange.as_mut())?;
+        Some(PartialSums {
+            sums: &mut self.sums,
+            plan,
+        })
+    }
+
+    fn apply(&mut self, force: &mut [Vec3], _torque: &mut [Vec3]) {
+        self.gather(force);
+    }
+}
+
+impl Linearized for TetBody {
+    fn add_tangent(&self, state: &State, tangent: &mut Tangent) {
+        let viscous = !self.material.is_elastic();
+        for tet in &self.tets {
+            let (volume, g) = current_gradients(&tet.map(|n| state.position[n as usize]));
+            for (a, &i) in tet.iter().enumerate() {
+                for (b, &j) in tet.iter().enumerate() {
+                    let (i, j) = (i as usize, j as usize);
+                    tangent.add_stiffness(i, j, &lame_block(volume, &g[a], &g[b], self.pair()));
+                    if viscous {
+                        tangent.add_damping(i, j, &lame_block(volume, &g[a], &g[b], self.vpair()));
+                    }
+                }
+            }
+        }
+    }
+
+    fn particles(&self) -> Vec<usize> {
+        self.blocks
+            .entry_start
+            .windows(2)
+            .enumerate()
+            .filter(|(_, w)| w[1] > w[0])
+            .map(|(i, _)| self.blocks.first + i)
+            .collect()
+    }
+}

@@ -1,0 +1,500 @@
+//! A run decomposed over processes (MPI ranks), bit-identical to one process.
+//!
+//! Every deformable body's blocks ([`crate::continuum::tet_blocks`]), taken in model order and then
+//! block order (their spatial order: recursive bisection), are cut into one contiguous range
+//! per rank of about equal cost; a body whose blocks all fall on one rank is computed there
+//! alone. A particle of a deformable body is **owned** by the rank of the block of its first
+//! entry; its **halo** ranks are the others whose blocks hold it. The particles that split
+//! models ([`crate::SplitModel`]: DEM contacts) move and no deformable body holds are given
+//! out in runs of particle order, a rigid body whole to one rank, and given out again by
+//! their measured work at a re-partition ([`crate::World::repartition`]). Each step:
+//!
+//! 1. each rank predicts the particles it steps (the same arithmetic on the same values
+//!    everywhere, so the predicted positions and half-step velocities agree bit for bit);
+//! 2. each rank computes the tetrahedra of its blocks only; the block sums of a node owned by
+//!    another rank are sent to it ([`Communicator::all_to_all`], only for bodies cut between
+//!    ranks), so that the owner adds **every** block sum of its particle in ascending block
+//!    order, exactly as one process does (Eq. 11);
+//! 3. a split model computes what touches the rank's particles, and the exchange
+//!    ([`crate::parallel::Exchange`]) brings it what it declares it reads of the others (the
+//!    contacts' ghosts); the other models (loads, gravity) act on the
+//!    rank's particles from the time and the masses, or, when some model reads any particle,
+//!    every model is computed whole on every rank from the same state;
+//! 4. after the integration, each rank's owned particles' accelerations and velocities (and
+//!    spins) go to the ranks that read them (`state_share.rs`); then the failure check
+//!    agrees across ranks.
+//!
+//! What a rank steps and what step 4 sends depend on what the models read:
+//! - **halo exchange**, when every model and hook reads only what a rank steps itself or
+//!   declares the rest it reads ([`crate::Reads::Own`]: gravity, nodal loads;
+//!   [`crate::Reads::Split`]: deformable bodies, contacts, the periodic wrap) and the stepper can be
+//!   restricted (Verlet): a rank predicts its own particles and its halo, integrates its
+//!   own, and receives only its halo's motion. The other particles keep the value of the
+//!   last whole gather ([`crate::World::gather`]), which the outputs, checkpoints and
+//!   failure reports ask for before they read the state;
+//! - **whole share** otherwise (bonded particles, explicit Newmark): every rank steps every
+//!   particle and receives every other rank's owned particles, so that it holds the one
+//!   state a single process holds after every step.
+//!
+//! There is no floating-point reduction across ranks in the state: a value is computed by one
+//! rank in the single-process order and copied, so outputs are byte-identical for any number
+//! of ranks and threads. (The one sum over ranks is the kinetic energy that the failure check
+//! watches in halo mode; see `state_share.rs`.)
+
+use crate::continuum::tet_body::TetBody;
+use crate::error::CoreError;
+use crate::parallel::communicator::Communicator;
+use crate::parallel::local_particles::{LocalParticles, ParticleRuns};
+use crate::parallel::split::Reads;
+use crate::parallel::state_share::{Halo, StateShare};
+use crate::state::State;
+use crate::step::model::Model;
+use crate::Vec3;
+use std::ops::Range;
+use std::sync::Arc;
+
+/// How the deformable bodies' blocks fall on the ranks, the same on every rank: what
+/// [`crate::World::decompose`] returns (see the example of [`Communicator`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Decomposition {
+    /// The number of ranks.
+    pub ranks: usize,
+    /// Per rank, the tetrahedra it computes.
+    pub tets: Vec<usize>,
+    /// Per rank, the particles it owns (those of deformable bodies; the others are computed
+    /// by every rank).
+    pub owned: Vec<usize>,
+    /// Per rank, the block sums it receives per step from the other ranks (its halo).
+    pub halo: Vec<usize>,
+    /// Per rank, the particles whose motion it receives per step: its halo's when every
+    /// model reads only what a rank steps itself, else every other rank's particles.
+    pub received: Vec<usize>,
+    /// The bodies cut between ranks (an exchange of block sums each step).
+    pub cut_bodies: usize,
+}
+
+/// What [`decompose`] gives: the exchange, the figures, in halo mode this rank's particles
+/// and the partition, and per model its blocks for this rank if it is a deformable body.
+pub(crate) type Decomposed = (
+    StateShare,
+    Decomposition,
+    Option<(LocalParticles, Partition)>,
+    Vec<Option<BodySplit>>,
+);
+
+/// One deformable body's share of the decomposition, for one rank: which of its blocks the
+/// rank computes, which of its particles the rank owns, which block sums go where.
+#[derive(Clone, Debug)]
+pub(crate) struct BodySplit {
+    /// The blocks this rank computes.
+    pub mine: Range<usize>,
+    /// This rank.
+    pub me: u32,
+    /// The body's first particle.
+    pub first: usize,
+    /// Per particle of the body (from `first`), the rank that owns it and sums its force.
+    pub owner: Vec<u32>,
+    /// The exchange of block sums, for a body cut between ranks.
+    pub exchange: Option<SumExchange>,
+    /// Per rank, the body's block sums it receives per step.
+    pub halo: Vec<usize>,
+}
+
+/// The block sums a rank sends to and receives from the others each step (slots of the
+/// body's sums, grouped by rank, ascending within a rank: both sides list them alike).
+#[derive(Clone)]
+pub(crate) struct SumExchange {
+    send_slots: Vec<u32>,
+    /// Values (three per sum) sent to each rank.
+    send_counts: Vec<usize>,
+    recv_slots: Vec<u32>,
+    /// Values received from each rank.
+    recv_counts: Vec<usize>,
+    send: Vec<f64>,
+    recv: Vec<f64>,
+    /// Wall seconds spent in the exchange so far (waiting for the other ranks included).
+    pub seconds: f64,
+}
+
+impl std::fmt::Debug for SumExchange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SumExchange")
+            .field("send", &self.send_slots.len())
+            .field("recv", &self.recv_slots.len())
+            .finish()
+    }
+}
+
+impl SumExchange {
+    /// Sends the sums this rank computed for other ranks' particles, and writes those the
+    /// others computed for this rank's particles into `sums`: the reverse exchange of
+    /// [`crate::parallel::Exchange`].
+    pub fn run(&mut self, comm: &dyn Communicator, sums: &mut [Vec3]) {
+        let start = std::time::Instant::now();
+        self.send.clear();
+        for &s in &self.send_slots {
+            self.send.extend_from_slice(sums[s as usize].as_slice());
+        }
+        self.recv.resize(3 * self.recv_slots.len(), 0.0);
+        comm.all_to_all(
+            &self.send,
+            &self.send_counts,
+            &mut self.recv,
+            &self.recv_counts,
+        );
+        for (&s, v) in self.recv_slots.iter().zip(self.recv.chunks_exact(3)) {
+            sums[s as usize] = Vec3::new(v[0], v[1], v[2]);
+        }
+        self.seconds += start.elapsed().as_secs_f64();
+    }
+}
+
+/// This rank's [`BodySplit`] of a body whose block `b` is computed by rank `block_rank[b]`.
+pub(crate) fn split_body(
+    layout: BodyLayout<'_>,
+    block_rank: &[u32],
+    comm: &Arc<dyn Communicator>,
+) -> BodySplit {
+    let me = comm.rank() as u32;
+    let ranks = comm.size();
+    let first_mine = block_rank.iter().position(|&r| r == me);
+    let mine = match first_mine {
+        Some(a) => a..a + block_rank[a..].iter().take_while(|&&r| r == me).count(),
+        None => 0..0,
+    };
+    let block_of_slot = slot_blocks(layout.node_start);
+    let owner: Vec<u32> = (0..layout.entry_start.len() - 1)
+        .map(|i| {
+            block_rank
+                [block_of_slot[layout.entries[layout.entry_start[i] as usize] as usize] as usize]
+        })
+        .collect();
+    let mut halo = vec![0; ranks];
+    for (s, &node) in layout.nodes.iter().enumerate() {
+        let (from, to) = (
+            block_rank[block_of_slot[s] as usize],
+            owner[node as usize - layout.first],
+        );
+        halo[to as usize] += usize::from(from != to);
+    }
+    let cut = block_rank.iter().any(|&r| r != block_rank[0]);
+    let exchange = cut.then(|| {
+        let (mut send, mut recv) = (vec![Vec::new(); ranks], vec![Vec::new(); ranks]);
+        for (s, &node) in layout.nodes.iter().enumerate() {
+            let from = block_rank[block_of_slot[s] as usize];
+            let to = owner[node as usize - layout.first];
+            if from == me && to != me {
+                send[to as usize].push(s as u32);
+            } else if to == me && from != me {
+                recv[from as usize].push(s as u32);
+            }
+        }
+        SumExchange {
+            send_counts: send.iter().map(|v| 3 * v.len()).collect(),
+            send_slots: send.concat(),
+            recv_counts: recv.iter().map(|v| 3 * v.len()).collect(),
+            recv_slots: recv.concat(),
+            send: Vec::new(),
+            recv: Vec::new(),
+            seconds: 0.0,
+        }
+    });
+    BodySplit {
+        mine,
+        me,
+        first: layout.first,
+        owner,
+        exchange,
+        halo,
+    }
+}
+
+/// What [`split_body`] reads of a body's blocks.
+#[derive(Clone, Copy)]
+pub(crate) struct BodyLayout<'a> {
+    /// Block `b`'s slots are `node_start[b]..node_start[b + 1]`.
+    pub node_start: &'a [u32],
+    /// The particle of each slot.
+    pub nodes: &'a [u32],
+    /// The body's first particle.
+    pub first: usize,
+    /// Particle `first + i`'s entries are `entries[entry_start[i]..entry_start[i + 1]]`.
+    pub entry_start: &'a [u32],
+    /// Slots, per particle in ascending block order.
+    pub entries: &'a [u32],
+}
+
+/// The block of every slot.
+fn slot_blocks(node_start: &[u32]) -> Vec<u32> {
+    let mut block = Vec::with_capacity(*node_start.last().unwrap_or(&0) as usize);
+    for (b, w) in node_start.windows(2).enumerate() {
+        block.extend(std::iter::repeat_n(b as u32, (w[1] - w[0]) as usize));
+    }
+    block
+}
+
+/// Cost of a block relative to an elastic tetrahedron: the viscous path costs about 1.6 times
+/// the elastic one (docs/BENCHMARKS.md, kernel section).
+const VISCOUS_COST: f64 = 1.6;
+
+/// Cuts the blocks of every deformable body of `models` (model order, then block order) into
+/// `ranks` contiguous ranges of about equal cost; per body, the rank of each block.
+fn assign_blocks(bodies: &[&TetBody], ranks: usize) -> Vec<Vec<u32>> {
+    let weight = |body: &TetBody| match body.is_elastic() {
+        true => 1.0,
+        false => VISCOUS_COST,
+    };
+    let total: f64 = bodies
+        .iter()
+        .map(|b| weight(b) * b.tets().len() as f64)
+        .sum();
+    let mut done = 0.0;
+    bodies
+        .iter()
+        .map(|body| {
+            let w = weight(body);
+            body.block_tets()
+                .map(|tets| {
+                    let cost = w * tets as f64;
+                    let middle = done + 0.5 * cost;
+                    done += cost;
+                    ((middle / total * ranks as f64) as usize).min(ranks - 1) as u32
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Decomposes `models`' deformable bodies over `comm`'s ranks: per model, the blocks of a
+/// deformable body this rank computes and the particles it owns, and the exchange that ends
+/// each step, the decomposition's figures and, when every model reads only what a rank steps
+/// itself and `halo_allowed` (no hook reads more), the particles this rank steps and the
+/// partition to re-assign the free particles by.
+pub(crate) fn decompose(
+    state: &State,
+    models: &mut [Box<dyn Model>],
+    comm: Arc<dyn Communicator>,
+    halo_allowed: bool,
+) -> Result<Decomposed, CoreError> {
+    let ranks = comm.size();
+    let bodies: Vec<&TetBody> = models
+        .iter()
+        .filter_map(|m| TetBody::of(m.as_ref()))
+        .collect();
+    let block_ranks = assign_blocks(&bodies, ranks);
+    let halo = halo_allowed && models.iter_mut().all(|m| !matches!(m.reads(), Reads::All));
+    let mut figures = Decomposition {
+        ranks,
+        tets: vec![0; ranks],
+        owned: vec![0; ranks],
+        halo: vec![0; ranks],
+        received: vec![0; ranks],
+        cut_bodies: 0,
+    };
+    let mut owner = vec![u32::MAX; state.len()];
+    let mut needs = Vec::new();
+    let mut block_ranks = block_ranks.into_iter();
+    let mut splits = Vec::with_capacity(models.len());
+    for model in models.iter() {
+        let Some(body) = TetBody::of(model.as_ref()) else {
+            splits.push(None);
+            continue;
+        };
+        let block_rank = block_ranks.next().expect("one block assignment per body");
+        for (tets, &r) in body.block_tets().zip(&block_rank) {
+            figures.tets[r as usize] += tets;
+        }
+        figures.cut_bodies += usize::from(block_rank.iter().any(|&r| r != block_rank[0]));
+        let split = split_body(body.body_layout(), &block_rank, &comm);
+        for (i, &r) in split.owner.iter().enumerate() {
+            let p = split.first + i;
+            if owner[p] != u32::MAX {
+                return Err(CoreError::Decomposition(format!(
+                    "particle {p} belongs to two deformable bodies"
+                )));
+            }
+            owner[p] = r;
+            figures.owned[r as usize] += 1;
+        }
+        for (total, n) in figures.halo.iter_mut().zip(&split.halo) {
+            *total += n;
+        }
+        if halo {
+            needs.extend(halo_of(body.body_layout(), &block_rank, &split.owner));
+        }
+        splits.push(Some(split));
+    }
+    if !halo {
+        let mut share = StateShare::new(&owner, state, None, comm);
+        share.share_whole_every_step(&mut figures);
+        return Ok((share, figures, None, splits));
+    }
+    needs.sort_unstable();
+    needs.dedup();
+    for &(q, _) in &needs {
+        figures.received[q as usize] += 1;
+    }
+    let partition = Partition {
+        comm,
+        body_owner: owner,
+        body_owned: figures.owned.clone(),
+        needs,
+    };
+    let (share, owned, local) = partition.assign(state, models, None);
+    figures.owned = owned;
+    Ok((share, figures, Some((local, partition)), splits))
+}
+
+/// The part of a halo-exchanged decomposition that does not change as bodies move: the
+/// deformable bodies' owners and halo. The rest (the grains' and rigid bodies' owners) is
+/// assigned again at a re-partition ([`crate::World::repartition`]).
+pub(crate) struct Partition {
+    pub comm: Arc<dyn Communicator>,
+    /// Per particle, the rank of the deformable body's block that owns it (`u32::MAX` for
+    /// the others).
+    body_owner: Vec<u32>,
+    /// Per rank, the deformable bodies' particles it owns.
+    body_owned: Vec<usize>,
+    /// Every rank's halo, (rank, particle), sorted.
+    needs: Vec<(u32, u32)>,
+}
+
+impl Partition {
+    /// Owners for the free particles by `cost` ([`own_in_runs`]), and the exchange, the
+    /// particles owned per rank and this rank's particles that follow.
+    pub fn assign(
+        &self,
+        state: &State,
+        models: &mut [Box<dyn Model>],
+        cost: Option<&[f64]>,
+    ) -> (StateShare, Vec<usize>, LocalParticles) {
+        let (mut owner, mut owned) = (self.body_owner.clone(), self.body_owned.clone());
+        own_in_runs(state, models, &mut owner, &mut owned, cost);
+        let me = self.comm.rank() as u32;
+        let (exchange, local) = halo_exchange(&owner, &self.needs, me, self.comm.size());
+        let share = StateShare::new(&owner, state, Some(exchange), self.comm.clone());
+        (share, owned, local)
+    }
+}
+
+/// Gives owners to the particles that split models ([`crate::SplitModel`]) move and no
+/// deformable body holds (`owner` `u32::MAX`): runs of particle order of about equal `cost`
+/// (one per particle without it), a rigid body (its centre and members) whole to one rank.
+/// The builders place grains layer by layer, so a run is a slab of the packing (its ghosts
+/// are one layer at each cut) and a rank streams contiguous memory when it steps its
+/// grains; counts them in `owned`.
+fn own_in_runs(
+    state: &State,
+    models: &mut [Box<dyn Model>],
+    owner: &mut [u32],
+    owned: &mut [usize],
+    cost: Option<&[f64]>,
+) {
+    let mut free: Vec<usize> = models
+        .iter_mut()
+        .filter_map(|m| match m.reads() {
+            Reads::Split(part) => Some(part.free_particles()),
+            _ => None,
+        })
+        .flatten()
+        .filter(|&p| owner[p] == u32::MAX)
+        .collect();
+    free.sort_unstable();
+    free.dedup();
+    let rigid = &state.rigid;
+    let mut body_of_center = vec![None; state.len()];
+    for (b, &c) in rigid.center.iter().enumerate() {
+        body_of_center[c] = Some(b);
+    }
+    let mut placed = vec![false; rigid.len()];
+    let mut units: Vec<Vec<usize>> = Vec::new();
+    for &p in &free {
+        match rigid.body_of_member(p).or(body_of_center[p]) {
+            Some(b) if !placed[b] => {
+                placed[b] = true;
+                units.push(
+                    [rigid.center[b]]
+                        .into_iter()
+                        .chain(rigid.members(b).iter().copied())
+                        .collect(),
+                );
+            }
+            Some(_) => {}
+            None => units.push(vec![p]),
+        }
+    }
+    let weight = |unit: &[usize]| match cost {
+        Some(cost) => unit.iter().map(|&p| cost[p]).sum(),
+        None => unit.len() as f64,
+    };
+    let ranks = owned.len();
+    let total: f64 = units.iter().map(|u| weight(u)).sum();
+    let mut before = 0.0;
+    for unit in &units {
+        let w = weight(unit);
+        let r = (((before + 0.5 * w) / total * ranks as f64) as usize).min(ranks - 1);
+        for &p in unit {
+            owner[p] = r as u32;
+        }
+        owned[r] += unit.len();
+        before += w;
+    }
+}
+
+/// The (rank, particle) pairs of a body's halo: the nodes of each rank's blocks that another
+/// rank owns (`owner`: per particle of the body, from its first).
+fn halo_of<'a>(
+    layout: BodyLayout<'a>,
+    block_rank: &'a [u32],
+    owner: &'a [u32],
+) -> impl Iterator<Item = (u32, u32)> + 'a {
+    layout
+        .node_start
+        .windows(2)
+        .zip(block_rank)
+        .flat_map(move |(w, &q)| {
+            let nodes = &layout.nodes[w[0] as usize..w[1] as usize];
+            nodes
+                .iter()
+                .filter(move |&&n| owner[n as usize - layout.first] != q)
+                .map(move |&n| (q, n))
+        })
+}
+
+/// This rank's halo exchange and local particles, from every rank's halo `needs` ((rank,
+/// particle), sorted) and the particles' owners (`u32::MAX`: computed by all).
+fn halo_exchange(
+    owner: &[u32],
+    needs: &[(u32, u32)],
+    me: u32,
+    ranks: usize,
+) -> (Halo, LocalParticles) {
+    let (mut send, mut recv) = (vec![Vec::new(); ranks], vec![Vec::new(); ranks]);
+    let mut stepped: Vec<bool> = owner.iter().map(|&r| r == me || r == u32::MAX).collect();
+    let computed = ParticleRuns::from_mask(&stepped);
+    for &(q, p) in needs {
+        let from = owner[p as usize];
+        if q == me {
+            recv[from as usize].push(p);
+            stepped[p as usize] = true;
+        } else if from == me {
+            send[q as usize].push(p);
+        }
+    }
+    let counted: Vec<bool> = owner
+        .iter()
+        .map(|&r| r == me || (me == 0 && r == u32::MAX))
+        .collect();
+    let halo = Halo {
+        send_counts: send.iter().map(Vec::len).collect(),
+        send: send.concat(),
+        recv_counts: recv.iter().map(Vec::len).collect(),
+        recv: recv.concat(),
+        counted: ParticleRuns::from_mask(&counted),
+    };
+    let local = LocalParticles {
+        computed,
+        stepped: ParticleRuns::from_mask(&stepped),
+    };
+    (halo, local)
+}

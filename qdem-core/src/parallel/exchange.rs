@@ -1,0 +1,554 @@
+//! [`Exchange`]: the one place where a step meets the ranks. A [`crate::World`] owns one:
+//! single-process by default, where every call is a plain loop or does nothing, and
+//! decomposed after [`crate::World::decompose`]. The steppers evaluate forces through it
+//! ([`Exchange::sum_forces`]) and end each integration with it ([`Exchange::complete`]); the
+//! world runs its gathers, its failure agreement, the post-step hooks and the re-partitions
+//! through it. Models never call a collective: a split model declares what it exchanges
+//! ([`crate::SplitModel`]) and the exchange runs the collectives between its stages, in the
+//! same order on every rank.
+
+use crate::error::CoreError;
+use crate::parallel::communicator::{max_over_ranks, Communicator};
+use crate::parallel::decomposition::{decompose, Decomposition, Partition};
+use crate::parallel::ghosts::GhostTable;
+use crate::parallel::local_particles::{LocalParticles, ParticleRuns};
+use crate::parallel::split::{Part, Reads, SplitModel};
+use crate::parallel::state_share::StateShare;
+use crate::continuum::rigid_body::reduce_member_forces;
+use crate::state::State;
+use crate::step::model::Model;
+use crate::step::stages::{Stage, StageTimes};
+use crate::step::world::{Halt, PostStep};
+use crate::Vec3;
+use std::sync::Arc;
+
+/// The ratio of the busiest rank's work to the mean above which a rebuild of a split
+/// model's lists re-partitions the free particles ([`crate::World::repartition`]).
+const REPARTITION_IMBALANCE: f64 = 1.1;
+
+/// Rebuilds between two re-partitions at least: a re-partition gathers the whole state, and
+/// an imbalance it cannot mend (one body heavier than a rank's share) must not make every
+/// rebuild pay for it.
+const REPARTITION_REBUILDS: usize = 8;
+
+/// What a step exchanges between the ranks of a decomposed run; nothing in a run of one
+/// process ([`Exchange::default`]), where [`Exchange::sum_forces`] sums the models' forces
+/// and the rest does nothing.
+///
+/// ```
+/// use qdem_core::{Exchange, Gravity, Model, State, StageTimes, Vec3};
+///
+/// let mut state = State::at_rest(vec![Vec3::zeros()]);
+/// state.mass[0] = 2.0;
+/// let mut models: Vec<Box<dyn Model>> = vec![Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81)))];
+/// let (mut force, mut torque) = (Vec::new(), Vec::new());
+/// let mut exchange = Exchange::default();
+/// exchange.sum_forces(&state, &mut models, &mut force, &mut torque, &mut StageTimes::off());
+/// assert_eq!(force[0].z, -19.62);
+/// assert!(exchange.decomposition().is_none());
+/// ```
+#[derive(Default)]
+pub struct Exchange {
+    ranks: Option<Ranks>,
+}
+
+/// The exchange of a decomposed run.
+struct Ranks {
+    comm: Arc<dyn Communicator>,
+    share: StateShare,
+    figures: Decomposition,
+    /// The particles this rank steps, when a step shares only the halo.
+    local: Option<LocalParticles>,
+    /// What a re-partition keeps, when a step shares only the halo.
+    partition: Option<Partition>,
+    /// Per model: whether a deformable body (split by its blocks in any mode).
+    bodies: Vec<bool>,
+    /// Per model, its split state when this rank computes it in part.
+    models: Vec<Option<Ghosts>>,
+    /// Per hook: whether it is split (decides for its own particles).
+    hooks: Vec<bool>,
+    /// Re-partitions so far, and rebuilds of a split model's lists since the last one.
+    repartitions: usize,
+    rebuilds_since: usize,
+    mine: Vec<f64>,
+    all: Vec<f64>,
+}
+
+/// A split model's exchange of item records, if it has items.
+type Ghosts = Option<GhostTable>;
+
+impl Exchange {
+    /// Sums the forces and torques of all `models` at `state` into `force` and `torque`
+    /// (resized and zeroed here; rigid bodies' torques, then particles' moments), then moves
+    /// the forces on members of rigid bodies onto their bodies. A model that this rank
+    /// computes in part is evaluated stage by stage with the ranks' exchanges in between
+    /// ([`crate::parallel::split`]). Each model's force evaluation is marked as its own
+    /// stage on `stages` (the caller marks the stage before).
+    pub fn sum_forces(
+        &mut self,
+        state: &State,
+        models: &mut [Box<dyn Model>],
+        force: &mut Vec<Vec3>,
+        torque: &mut Vec<Vec3>,
+        stages: &mut StageTimes,
+    ) {
+        force.clear();
+        force.resize(state.len(), Vec3::zeros());
+        torque.clear();
+        torque.resize(state.rigid.len() + state.spin.len(), Vec3::zeros());
+        for (i, model) in models.iter_mut().enumerate() {
+            match self.ranks.as_mut() {
+                Some(ranks) if ranks.models[i].is_some() => {
+                    let part = split_facet(model.as_mut()).expect("a split model");
+                    ranks.evaluate(i, part, state, force, torque);
+                }
+                _ => model.add_forces(state, force, torque),
+            }
+            stages.mark(Stage::Forces(i));
+        }
+        if !state.rigid.is_empty() {
+            reduce_member_forces(state, force, torque);
+        }
+    }
+
+    /// In a run decomposed with a halo exchange, the particles a stepper predicts (its own and
+    /// its halo); `None`: every particle.
+    pub fn stepped(&self) -> Option<&ParticleRuns> {
+        self.local().map(|l| &l.stepped)
+    }
+
+    /// In a run decomposed with a halo exchange, the particles a stepper integrates (those
+    /// whose forces this rank sums); `None`: every particle.
+    pub fn computed(&self) -> Option<&ParticleRuns> {
+        self.local().map(|l| &l.computed)
+    }
+
+    fn local(&self) -> Option<&LocalParticles> {
+        self.ranks.as_ref().and_then(|r| r.local.as_ref())
+    }
+
+    /// Ends an integration whose outcome is `outcome`: in a decomposed run, copies each
+    /// rank's owned particles' new motion to the ranks that read it (marked as the share
+    /// stage), and with `agree` (a stepper that reads the outcome before the step ends: the
+    /// sub-steps of an adaptive step) makes every rank go on with the same outcome: its own
+    /// when no rank failed or it failed itself, the failure of the lowest failing rank
+    /// otherwise. A run of one process goes on with `outcome`.
+    pub fn complete(
+        &mut self,
+        state: &mut State,
+        stages: &mut StageTimes,
+        outcome: Result<(), CoreError>,
+        agree: bool,
+    ) -> Result<(), CoreError> {
+        let Some(ranks) = &mut self.ranks else {
+            return outcome;
+        };
+        ranks.share.share(state);
+        stages.mark(Stage::Share);
+        if !agree {
+            return outcome;
+        }
+        let local = outcome.as_ref().err().map(|e| e.to_string());
+        match (ranks.share.agree(local), outcome) {
+            (None, _) => Ok(()),
+            (Some(_), Err(own)) => Err(own),
+            (Some(failure), Ok(())) => Err(CoreError::Decomposition(failure)),
+        }
+    }
+
+    /// How the run is decomposed over processes; `None` for a run of one process.
+    pub fn decomposition(&self) -> Option<&Decomposition> {
+        self.ranks.as_ref().map(|r| &r.figures)
+    }
+
+    /// How many times the free particles were given new owners.
+    pub fn repartitions(&self) -> usize {
+        self.ranks.as_ref().map_or(0, |r| r.repartitions)
+    }
+
+    /// Decomposes the run over `comm`'s ranks (see [`crate::World::decompose`]): a halo
+    /// exchange when every model and hook reads only what a rank steps itself and
+    /// `steps_in_part` (the stepper can step a rank's particles alone), else every rank
+    /// steps every particle and receives the others' after every step.
+    pub(crate) fn decompose(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        hooks: &mut [Box<dyn PostStep>],
+        comm: Arc<dyn Communicator>,
+        steps_in_part: bool,
+    ) -> Result<(), CoreError> {
+        let halo_allowed = hooks
+            .iter_mut()
+            .all(|h| !matches!(h.reads(), Reads::All));
+        let (share, figures, halo, bodies) =
+            decompose(state, models, comm.clone(), halo_allowed)?;
+        let (local, partition) = halo.unzip();
+        let mut ranks = Ranks {
+            comm,
+            share,
+            figures,
+            local,
+            partition,
+            bodies: bodies.iter().map(Option::is_some).collect(),
+            models: (0..models.len()).map(|_| None).collect(),
+            hooks: vec![false; hooks.len()],
+            repartitions: 0,
+            rebuilds_since: 0,
+            mine: Vec::new(),
+            all: Vec::new(),
+        };
+        for ((model, body), slot) in models.iter_mut().zip(bodies).zip(&mut ranks.models) {
+            if let Some(body) = body {
+                let part = split_facet(model.as_mut()).expect("a deformable body splits");
+                part.split(Some(Part {
+                    owner: Arc::from([]),
+                    rank: ranks.comm.rank() as u32,
+                    body: Some(body),
+                }));
+                *slot = Some(None);
+            }
+        }
+        if ranks.local.is_some() && !steps_in_part {
+            ranks.step_whole(state, &mut [], &mut []);
+        }
+        if ranks.local.is_some() {
+            ranks.split_by_owners(models, hooks);
+        }
+        self.ranks = Some(ranks);
+        Ok(())
+    }
+
+    /// A new stepper that cannot step a rank's particles alone: every step shares the whole
+    /// state from now on (after a whole gather, and with the split models whole again).
+    pub(crate) fn restepped(
+        &mut self,
+        steps_in_part: bool,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        hooks: &mut [Box<dyn PostStep>],
+        torques: &mut [Vec3],
+    ) {
+        if let Some(ranks) = &mut self.ranks {
+            if ranks.local.is_some() && !steps_in_part {
+                ranks.gather(state, models, hooks, torques);
+                ranks.step_whole(state, models, hooks);
+            }
+        }
+    }
+
+    /// Makes the state and the split models whole on every rank, as one process holds them
+    /// (see [`crate::World::gather`]); a no-op in a run of one process.
+    pub(crate) fn gather(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        hooks: &mut [Box<dyn PostStep>],
+        torques: &mut [Vec3],
+    ) {
+        if let Some(ranks) = &mut self.ranks {
+            ranks.gather(state, models, hooks, torques);
+        }
+    }
+
+    /// Makes `particles`' motion whole on every rank (see [`crate::World::gather_particles`]).
+    pub(crate) fn gather_particles(&mut self, state: &mut State, particles: &[usize]) {
+        if let Some(ranks) = &mut self.ranks {
+            ranks.share.gather_some(state, particles);
+        }
+    }
+
+    /// After the stepper's initialisation with outcome `done`: the decomposed state made
+    /// whole on every rank, and the ranks agreed on a failure.
+    pub(crate) fn initialized(
+        &mut self,
+        state: &mut State,
+        torques: &mut [Vec3],
+        done: Result<(), CoreError>,
+    ) -> Result<(), CoreError> {
+        let Some(ranks) = &mut self.ranks else {
+            return done;
+        };
+        ranks.share.share(state);
+        ranks.share.gather(state, torques);
+        match ranks.share.agree(done.err().map(|e| e.to_string())) {
+            Some(failure) => Err(CoreError::Decomposition(failure)),
+            None => Ok(()),
+        }
+    }
+
+    /// The failure every rank reports: the one of the lowest rank that found one (`local`
+    /// itself in a run of one process).
+    pub(crate) fn agree(&self, local: Option<String>) -> Option<String> {
+        match &self.ranks {
+            Some(ranks) => ranks.share.agree(local),
+            None => local,
+        }
+    }
+
+    /// The kinetic energy of the whole state (J), the same on every rank.
+    pub(crate) fn kinetic_energy(&self, state: &State) -> f64 {
+        match &self.ranks {
+            Some(ranks) => ranks.share.kinetic_energy(state),
+            None => state.kinetic_energy(),
+        }
+    }
+
+    /// Runs post-step hook `i`: a split hook decides for its own particles, and every rank
+    /// acts on every rank's decisions.
+    pub(crate) fn after_step(
+        &mut self,
+        i: usize,
+        hook: &mut dyn PostStep,
+        state: &mut State,
+        models: &[Box<dyn Model>],
+    ) -> Option<Halt> {
+        let Some(ranks) = self.ranks.as_mut().filter(|r| r.hooks[i]) else {
+            return hook.after_step(state, models);
+        };
+        let Reads::Split(part) = hook.reads() else {
+            unreachable!("a split hook has a split facet");
+        };
+        ranks.mine.clear();
+        part.decide(state, &mut ranks.mine);
+        ranks.comm.all_gather_varying(&ranks.mine, &mut ranks.all);
+        part.act(state, &ranks.all);
+        None
+    }
+
+    /// Whether a step ends with [`Exchange::rebalance`] (a run decomposed with a halo
+    /// exchange).
+    pub(crate) fn rebalances(&self) -> bool {
+        self.ranks.as_ref().is_some_and(|r| r.partition.is_some())
+    }
+
+    /// After a step: re-partitions when a split model rebuilt its lists and the ranks' work
+    /// is out of balance ([`crate::World::repartition`]).
+    pub(crate) fn rebalance(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        hooks: &mut [Box<dyn PostStep>],
+        torques: &mut [Vec3],
+    ) {
+        let Some(ranks) = &mut self.ranks else {
+            return;
+        };
+        if ranks.partition.is_none() {
+            return;
+        }
+        let mut rebuilt = false;
+        let mut work = ranks.local.as_ref().map_or(0, |l| l.computed.len()) as f64;
+        for part in split_parts(models, hooks, &ranks.models, &ranks.hooks) {
+            rebuilt |= part.rebuilt();
+            work += part.work();
+        }
+        if !rebuilt {
+            return;
+        }
+        ranks.rebuilds_since += 1;
+        if ranks.repartitions > 0 && ranks.rebuilds_since < REPARTITION_REBUILDS {
+            return;
+        }
+        let works = ranks.comm.all_gather_one(work);
+        let mean = works.iter().sum::<f64>() / works.len() as f64;
+        let busiest = works.iter().cloned().fold(0.0, f64::max);
+        if busiest > REPARTITION_IMBALANCE * mean {
+            self.repartition(state, models, hooks, torques);
+        }
+    }
+
+    /// Gives the free particles new owners by their measured work (see
+    /// [`crate::World::repartition`]); a no-op unless the run shares only the halo.
+    pub(crate) fn repartition(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        hooks: &mut [Box<dyn PostStep>],
+        torques: &mut [Vec3],
+    ) {
+        let Some(ranks) = &mut self.ranks else {
+            return;
+        };
+        if ranks.partition.is_none() {
+            return;
+        }
+        ranks.gather(state, models, hooks, torques);
+        let mut cost = vec![1.0; state.len()];
+        for part in split_parts(models, hooks, &ranks.models, &ranks.hooks) {
+            part.add_costs(&mut cost);
+        }
+        let partition = ranks.partition.as_ref().expect("checked above");
+        let (share, owned, local) = partition.assign(state, models, Some(&cost));
+        ranks.share = share;
+        ranks.figures.owned = owned;
+        ranks.local = Some(local);
+        ranks.split_by_owners(models, hooks);
+        ranks.repartitions += 1;
+        ranks.rebuilds_since = 0;
+    }
+}
+
+impl Ranks {
+    /// One force evaluation of split model `i` (`part`), its stages with the collectives in
+    /// between ([`crate::parallel::split`]).
+    fn evaluate(
+        &mut self,
+        i: usize,
+        part: &mut dyn SplitModel,
+        state: &State,
+        force: &mut [Vec3],
+        torque: &mut [Vec3],
+    ) {
+        let comm = self.comm.as_ref();
+        let ghosts = self.models[i].as_mut().expect("a split model");
+        if let Some(moved) = part.read_own(state) {
+            let moved = max_over_ranks(comm, moved);
+            if part.needs_rebuild(moved, state.time) {
+                let table = ghosts.as_mut().expect("a model with lists has items");
+                table.borders(comm, part);
+                part.rebuild(state.time);
+            }
+        }
+        if let Some(wanted) = part.new_ghosts() {
+            let table = ghosts.as_mut().expect("a model with ghosts has items");
+            table.set_ghosts(comm, &wanted);
+        }
+        part.read_partners(state);
+        if let Some(table) = ghosts {
+            table.forward(comm, part);
+        }
+        part.compute(state);
+        self.mine.clear();
+        if part.reduction(&mut self.mine) {
+            comm.all_gather_varying(&self.mine, &mut self.all);
+            part.reduced(state.time, &self.all);
+        }
+        if let Some(sums) = part.partial_sums() {
+            sums.plan.run(comm, sums.sums);
+        }
+        part.apply(force, torque);
+    }
+
+    /// Splits the models and hooks that a rank computes in part by the share's owners (the
+    /// deformable bodies keep their blocks).
+    fn split_by_owners(&mut self, models: &mut [Box<dyn Model>], hooks: &mut [Box<dyn PostStep>]) {
+        let owner: Arc<[u32]> = self.share.owner().into();
+        let (me, size) = (self.comm.rank(), self.comm.size());
+        for (i, model) in models.iter_mut().enumerate() {
+            if self.bodies[i] {
+                continue;
+            }
+            let Reads::Split(part) = model.reads() else {
+                continue;
+            };
+            let items = part.items();
+            part.split(Some(Part {
+                owner: owner.clone(),
+                rank: me as u32,
+                body: None,
+            }));
+            let table = (!items.is_empty()).then(|| {
+                let item_owner = items.iter().map(|&p| owner[p]).collect();
+                GhostTable::new(item_owner, me, size)
+            });
+            self.models[i] = Some(table);
+        }
+        for (i, hook) in hooks.iter_mut().enumerate() {
+            if let Reads::Split(part) = hook.reads() {
+                part.split(Some(Part {
+                    owner: owner.clone(),
+                    rank: me as u32,
+                    body: None,
+                }));
+                self.hooks[i] = true;
+            }
+        }
+    }
+
+    /// Every step shares the whole state from now on, the split models (but the deformable
+    /// bodies) whole again.
+    fn step_whole(&mut self, state: &State, models: &mut [Box<dyn Model>], hooks: &mut [Box<dyn PostStep>]) {
+        let _ = state;
+        for (i, model) in models.iter_mut().enumerate() {
+            if self.models[i].is_some() && !self.bodies[i] {
+                if let Reads::Split(part) = model.reads() {
+                    part.split(None);
+                }
+                self.models[i] = None;
+            }
+        }
+        for (i, hook) in hooks.iter_mut().enumerate() {
+            if self.hooks[i] {
+                if let Reads::Split(part) = hook.reads() {
+                    part.split(None);
+                }
+                self.hooks[i] = false;
+            }
+        }
+        self.share.share_whole_every_step(&mut self.figures);
+        self.local = None;
+        self.partition = None;
+    }
+
+    /// The whole state on every rank, and every split model merged.
+    fn gather(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        hooks: &mut [Box<dyn PostStep>],
+        torques: &mut [Vec3],
+    ) {
+        self.share.gather(state, torques);
+        if self.local.is_none() {
+            return;
+        }
+        let comm = self.comm.as_ref();
+        for (i, model) in models.iter_mut().enumerate() {
+            let Some(Some(table)) = self.models[i].as_mut() else {
+                continue;
+            };
+            let Reads::Split(part) = model.reads() else {
+                continue;
+            };
+            self.mine.clear();
+            if part.records(&mut self.mine) {
+                comm.all_gather_varying(&self.mine, &mut self.all);
+                table.borders(comm, part);
+                part.merge(&self.all);
+            }
+        }
+        let _ = hooks;
+    }
+}
+
+/// The split facet of a model.
+fn split_facet(model: &mut dyn Model) -> Option<&mut dyn SplitModel> {
+    match model.reads() {
+        Reads::Split(part) => Some(part),
+        _ => None,
+    }
+}
+
+/// The split facets of the models and hooks that are split, models first.
+fn split_parts<'a>(
+    models: &'a mut [Box<dyn Model>],
+    hooks: &'a mut [Box<dyn PostStep>],
+    split_models: &'a [Option<Ghosts>],
+    split_hooks: &'a [bool],
+) -> impl Iterator<Item = &'a mut dyn SplitModel> {
+    let models = models
+        .iter_mut()
+        .zip(split_models)
+        .filter(|(_, s)| s.is_some())
+        .filter_map(|(m, _)| split_facet(m.as_mut()));
+    let hooks = hooks
+        .iter_mut()
+        .zip(split_hooks)
+        .filter(|(_, &s)| s)
+        .filter_map(|(h, _)| match h.reads() {
+            Reads::Split(part) => Some(part),
+            _ => None,
+        });
+    models.chain(hooks)
+}

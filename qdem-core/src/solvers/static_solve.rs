@@ -1,0 +1,229 @@
+//! Linear static solve K u = f (paper 001 Eq. 17 with the incremental form of Eqs. 19–20 taken
+//! from the reference state in one step, the constraints of Eq. 23 eliminated).
+//!
+//! f is the total force the models give on the reference configuration at the requested time
+//! (loads and gravity; the internal force vanishes there), K the models' tangent stiffness at
+//! the reference configuration ([`crate::Linearized::add_tangent`]). For QDEM tetrahedra this is the
+//! small-strain linear-tetrahedron stiffness, so the answer is the mesh's linear FEM solution.
+//! K is assembled and factorised by `sparse::SparseCholesky` on the first solve (with the fixity of
+//! that moment) and reused for every later load level: one further force evaluation and two
+//! triangular solves per level.
+//!
+//! K alone is singular when a deformable body is free to move rigidly (no or too few fixed
+//! directions), so such a body is refused before factorising with
+//! [`CoreError::Unconstrained`], naming it (`sparse::unconstrained_bodies`); any other
+//! failed factorisation names the particle of the failing pivot and its body
+//! (`sparse::explain_failure`).
+//!
+//! A static run is checkpointed like the others: what a load level depends on beyond the
+//! state and the models is the factorisation of the first solve, so [`StaticSteps`] saves the
+//! tangent it factorised and a resumed run factorises that same matrix again (the models' own
+//! tangent at the resumed moment need not be the first one's), giving the same answers bit
+//! for bit.
+
+use crate::checkpoint::{CheckpointError, Decoder, Encoder};
+use crate::error::CoreError;
+use crate::step::model::Model;
+use crate::solvers::newmark::collect_tangent;
+use crate::solvers::sparse::{
+    explain_failure, unconstrained_bodies, Assembler, FactorStats, FreeDofs, Scales,
+    SparseCholesky, Tangent, FIX_HINT,
+};
+use crate::step::stages::{Stage, StageTimes};
+use crate::state::State;
+use crate::parallel::Exchange;
+use crate::step::stepper::{refuse_rigid, Stepper};
+use crate::Vec3;
+
+/// A linear static solver that keeps the factorisation of K across load levels.
+#[derive(Debug, Default)]
+pub struct StaticSolver {
+    dofs: Option<FreeDofs>,
+    /// The tangent factorised (kept for checkpoints).
+    tangent: Tangent,
+    cholesky: SparseCholesky,
+    force: Vec<Vec3>,
+    torque: Vec<Vec3>,
+    rhs: Vec<f64>,
+}
+
+impl StaticSolver {
+    /// A solver with nothing factorised yet.
+    pub fn new() -> StaticSolver {
+        StaticSolver::default()
+    }
+
+    /// Size, fill and factorisation time of K; `None` before the first solve.
+    pub fn factor_stats(&self) -> Option<&FactorStats> {
+        self.cholesky.is_factored().then(|| self.cholesky.stats())
+    }
+
+    /// Solves K u = f(`time`) and sets `state` to the static answer at `time`: positions
+    /// X + u, rotations θ, zero velocities and accelerations.
+    pub fn solve(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        time: f64,
+    ) -> Result<(), CoreError> {
+        refuse_rigid(state, "static")?;
+        state.time = time;
+        state.position.clone_from(&state.reference);
+        state.velocity.fill(Vec3::zeros());
+        state.acceleration.fill(Vec3::zeros());
+        let spin = &mut state.spin;
+        for v in [&mut spin.angle, &mut spin.velocity, &mut spin.acceleration] {
+            v.fill(Vec3::zeros());
+        }
+        if !self.cholesky.is_factored() {
+            self.factorize(state, models)?;
+        }
+        Exchange::default().sum_forces(
+            state,
+            models,
+            &mut self.force,
+            &mut self.torque,
+            &mut StageTimes::off(),
+        );
+        let dofs = self.dofs.as_ref().expect("factorised above");
+        self.rhs.resize(dofs.len(), 0.0);
+        let moments = &self.torque[state.rigid.len()..];
+        dofs.gather_nodes((&self.force, moments), &mut self.rhs);
+        self.cholesky.solve_in_place(&mut self.rhs);
+        let mut u = vec![Vec3::zeros(); state.len()];
+        dofs.scatter_nodes(&self.rhs, (&mut u, &mut state.spin.angle));
+        for (x, d) in state.position.iter_mut().zip(&u) {
+            *x += d;
+        }
+        Ok(())
+    }
+
+    /// Assembles K at the reference state and factorises it; refuses a body free to move
+    /// rigidly first.
+    fn factorize(&mut self, state: &State, models: &[Box<dyn Model>]) -> Result<(), CoreError> {
+        collect_tangent(state, models, &mut self.tangent)?;
+        self.factorize_tangent(state, models)
+    }
+
+    /// Factorises the stored tangent with the state's fixity and masses.
+    fn factorize_tangent(
+        &mut self,
+        state: &State,
+        models: &[Box<dyn Model>],
+    ) -> Result<(), CoreError> {
+        let tangent = &self.tangent;
+        let dofs = FreeDofs::new(&state.node_fixity());
+        if let Some((body, modes)) = unconstrained_bodies(state, models, tangent, &dofs)
+            .into_iter()
+            .next()
+        {
+            return Err(CoreError::Unconstrained {
+                body,
+                modes,
+                what: "stiffness",
+                fix: FIX_HINT,
+            });
+        }
+        let scales = Scales {
+            mass: 0.0,
+            damping: 0.0,
+            stiffness: 1.0,
+        };
+        let mass = state.node_mass();
+        let mut assembler = Assembler::new();
+        let matrix = assembler.assemble(tangent, &mass, &dofs, scales)?;
+        if let Err(error) = self.cholesky.factorize(matrix, "stiffness") {
+            let pivot = self.cholesky.failed_pivot();
+            return Err(explain_failure(error, pivot, &dofs, state, models, tangent));
+        }
+        self.dofs = Some(dofs);
+        Ok(())
+    }
+}
+
+/// The static solve as a [`Stepper`] (`integrator = "static"`): each step advances the load
+/// time by `dt` and solves K·u = f(t), reusing the factorisation of the first solve.
+#[derive(Debug)]
+pub struct StaticSteps {
+    solver: StaticSolver,
+    dt: f64,
+}
+
+impl StaticSteps {
+    /// Load levels every `dt` seconds of the ramp.
+    pub fn new(dt: f64) -> StaticSteps {
+        StaticSteps {
+            solver: StaticSolver::new(),
+            dt,
+        }
+    }
+}
+
+impl Stepper for StaticSteps {
+    fn name(&self) -> &str {
+        "static"
+    }
+
+    fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// A static solve is never decomposed ([`crate::World::decompose`] refuses it): the
+    /// exchange is a single process's.
+    fn initialize_in(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        _exchange: &mut Exchange,
+    ) -> Result<(), CoreError> {
+        let time = state.time;
+        self.solver.solve(state, models, time)
+    }
+
+    /// The whole solve is one stage, [`Stage::Solve`].
+    fn step_timed(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        stages: &mut StageTimes,
+        _exchange: &mut Exchange,
+    ) -> Result<(), CoreError> {
+        let time = state.time + self.dt;
+        let solved = self.solver.solve(state, models, time);
+        stages.mark(Stage::Solve);
+        solved
+    }
+
+    fn factor_stats(&self) -> Option<&FactorStats> {
+        self.solver.factor_stats()
+    }
+
+    /// Whether K is factorised and, if so, the tangent it was assembled from: the later load
+    /// levels solve with that factorisation. The solver's other buffers are overwritten at
+    /// every solve.
+    fn save(&self, out: &mut Encoder) -> Result<(), CheckpointError> {
+        out.tag("static");
+        let factored = self.solver.cholesky.is_factored();
+        out.bool(factored);
+        if factored {
+            self.solver.tangent.save(out);
+        }
+        Ok(())
+    }
+
+    /// Reads back the factorised tangent and factorises it again, evaluating no force.
+    fn resume(
+        &mut self,
+        state: &mut State,
+        models: &mut [Box<dyn Model>],
+        input: &mut Decoder<'_>,
+    ) -> Result<(), CoreError> {
+        refuse_rigid(state, "static")?;
+        input.tag("static")?;
+        if input.bool("the factorisation flag")? {
+            self.solver.tangent.restore(input, state.dofs())?;
+            self.solver.factorize_tangent(state, models)?;
+        }
+        Ok(())
+    }
+}
