@@ -28,14 +28,14 @@ pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<
                 source,
             })?;
     }
-    let leader = ranks.as_ref().is_none_or(|r| r.rank() == 0);
+    let leader = sim.world.exchange().rank() == 0;
     if leader {
         print_scene(path, &sim);
     }
     let (per_step, exchange) = measure_step_cost(&mut sim, 20)?;
-    if let (Some(ranks), Some(d)) = (&ranks, sim.world.decomposition().cloned()) {
+    if let Some(d) = sim.world.decomposition().cloned() {
         // The decomposition now: a re-partition moves grains and rigid bodies.
-        let table = rank_table(&sim, ranks.as_ref(), &d, per_step, exchange);
+        let table = rank_table(&sim, &d, per_step, exchange);
         if leader {
             print!("{table}");
         }
@@ -144,7 +144,6 @@ fn print_cost(sim: &Simulation, per_step: f64) {
 /// seconds, and the imbalance of the kernel (the slowest rank's kernel time over the mean).
 fn rank_table(
     sim: &Simulation,
-    ranks: &dyn Communicator,
     d: &Decomposition,
     per_step: f64,
     exchange: f64,
@@ -173,8 +172,7 @@ fn rank_table(
         contacts as f64,
         ghosts as f64,
     ];
-    let mut all = vec![0.0; 5 * d.ranks];
-    ranks.all_gather(&mine, &mut all, &vec![5; d.ranks]);
+    let all = world.exchange().gather_values(&mine);
     let mut table = format!(
         "decomposed over {} ranks ({} bodies cut between ranks):\n  rank  tets      owned     halo      received  contacts  ghosts    step (s)   kernel (s) share (s)\n",
         d.ranks, d.cut_bodies

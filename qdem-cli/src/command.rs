@@ -487,7 +487,6 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
             resume,
             stop: Some(&STOP),
             stop_after: args.stop_after,
-            ranks: ranks.as_deref(),
         };
         run_with(&mut sim, &out_dir, options, &mut |_| {})?;
         return Ok(());
@@ -517,7 +516,6 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
         resume,
         stop: Some(&STOP),
         stop_after: args.stop_after,
-        ranks: ranks.as_deref(),
     };
     if let Some(checkpoint) = resume {
         eprintln!("resuming from {}", checkpoint.display());

@@ -161,6 +161,29 @@ impl Exchange {
         self.ranks.as_ref().map(|r| &r.figures)
     }
 
+    /// This process's rank (0 in a run of one process).
+    pub fn rank(&self) -> usize {
+        self.ranks.as_ref().map_or(0, |r| r.comm.rank())
+    }
+
+    /// The smallest of the ranks' `value`s, on every rank (`value` in a run of one process):
+    /// a collective, which every rank calls at the same point of the run.
+    pub fn agree_min(&self, value: u64) -> u64 {
+        self.ranks.as_ref().map_or(value, |r| r.comm.min(value))
+    }
+
+    /// Every rank's `mine` (of one length on every rank), in rank order (`mine` in a run of
+    /// one process): a collective, which every rank calls at the same point of the run.
+    pub fn gather_values(&self, mine: &[f64]) -> Vec<f64> {
+        let Some(ranks) = &self.ranks else {
+            return mine.to_vec();
+        };
+        let size = ranks.comm.size();
+        let mut all = vec![0.0; mine.len() * size];
+        ranks.comm.all_gather(mine, &mut all, &vec![mine.len(); size]);
+        all
+    }
+
     /// How many times the free particles were given new owners.
     pub fn repartitions(&self) -> usize {
         self.ranks.as_ref().map_or(0, |r| r.repartitions)

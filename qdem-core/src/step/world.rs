@@ -273,6 +273,14 @@ impl World {
         self.exchange.decomposition()
     }
 
+    /// The world's exchange with the other ranks: its rank, and the agreements a driver of
+    /// a decomposed run needs besides the steps ([`Exchange::agree_min`],
+    /// [`Exchange::gather_values`]); a run of one process's, where they return the value
+    /// given.
+    pub fn exchange(&self) -> &Exchange {
+        &self.exchange
+    }
+
     /// Makes the accelerations consistent with the forces at the start (and factorises, for
     /// an implicit scheme).
     pub fn initialize(&mut self) -> Result<(), CoreError> {

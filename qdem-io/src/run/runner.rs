@@ -13,7 +13,7 @@ use crate::run::inputs::SceneFingerprint;
 use crate::run::record::schedule::{probe_interval, Schedule};
 use crate::run::record::{self, Recorder, RunFigures, StateRead, StepInfo};
 use crate::run::run_record::{decode_run, decode_world, encode_run, RunRecord};
-use qdem_core::{Communicator, CoreError, Halt};
+use qdem_core::{CoreError, Halt, World};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -126,10 +126,6 @@ pub struct RunOptions<'a> {
     pub stop: Option<&'a AtomicBool>,
     /// Stops as on a stop request once this step is done (a batch slot's last step, a test).
     pub stop_after: Option<u64>,
-    /// The ranks of a run decomposed over processes (its world already
-    /// [`qdem_core::World::decompose`]d): rank 0 writes every output, the others only step;
-    /// all agree at every step on whether to stop.
-    pub ranks: Option<&'a dyn Communicator>,
 }
 
 impl std::fmt::Debug for RunOptions<'_> {
@@ -138,7 +134,6 @@ impl std::fmt::Debug for RunOptions<'_> {
             .field("resume", &self.resume)
             .field("stop", &self.stop)
             .field("stop_after", &self.stop_after)
-            .field("ranks", &self.ranks.map(|r| (r.rank(), r.size())))
             .finish()
     }
 }
@@ -167,13 +162,14 @@ impl Sync {
 impl RunOptions<'_> {
     /// After `step`: whether the run stops (asked to, on any rank of a decomposed run), and
     /// what must be gathered first (`read`: what rank 0 reads; the whole state at a stop,
-    /// for its checkpoint). One agreement of the ranks per step.
-    fn sync_after(&self, step: u64, read: StateRead) -> Sync {
+    /// for its checkpoint). One agreement of `world`'s ranks per step in a decomposed run
+    /// (rank 0 writes every output, the others only step).
+    fn sync_after(&self, world: &World, step: u64, read: StateRead) -> Sync {
         let asked =
             self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) || self.stop_after == Some(step);
-        let Some(ranks) = self.ranks else {
+        if world.decomposition().is_none() {
             return Sync { stop: asked, read };
-        };
+        }
         // The smallest wins: 0 stop (and the whole state), 1 the whole state, 2 the probes,
         // 3 nothing.
         let mine = match (asked, read) {
@@ -182,7 +178,7 @@ impl RunOptions<'_> {
             (false, StateRead::Probes) => 2,
             (false, StateRead::Nothing) => 3,
         };
-        let agreed = ranks.min(mine);
+        let agreed = world.exchange().agree_min(mine);
         let read = match agreed {
             0 | 1 => StateRead::Whole,
             2 => StateRead::Probes,
@@ -224,7 +220,7 @@ pub fn run_with(
     options: RunOptions<'_>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<RunReport, RunError> {
-    if options.ranks.is_some_and(|r| r.rank() != 0) {
+    if sim.world.exchange().rank() != 0 {
         return follow(sim, options);
     }
     let mut run = Run::open(sim, out_dir, options)?;
@@ -258,7 +254,7 @@ pub fn run_with(
                 true => StateRead::Whole,
                 false => run.reads_state(sim, dt),
             };
-            let sync = options.sync_after(step, read);
+            let sync = options.sync_after(&sim.world, step, read);
             sync.gather(sim, &probes);
             run.after_step(sim, step, &info, sync, keep_good)?;
             if step % 64 == 0 && last_report.elapsed().as_secs_f64() > 0.5 {
@@ -450,7 +446,7 @@ fn follow(sim: &mut Simulation, options: RunOptions<'_>) -> Result<RunReport, Ru
         if step > 0 {
             halt = sim.world.step().map_err(|source| core_error(sim, source))?;
         }
-        let sync = options.sync_after(step, StateRead::Nothing);
+        let sync = options.sync_after(&sim.world, step, StateRead::Nothing);
         sync.gather(sim, &probes);
         stopped = sync.stop;
         if stopped || halt.is_some() {
