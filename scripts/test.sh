@@ -7,6 +7,16 @@ cd "$(dirname "$0")/.."
 if ! python3 -c "import meshio" 2>/dev/null; then
     python3 -m pip install --quiet --disable-pip-version-check meshio
 fi
+# Only the seam names the Communicator (docs/architecture.md, "The ranks, behind one seam"):
+# the decomposition lives in qdem-core/src/parallel/, World::decompose takes one, and the CLI's
+# MPI set-up makes it and hands it over. A model that named it would be calling collectives.
+seam='^(qdem-core/src/parallel/|qdem-core/src/lib\.rs|qdem-core/src/step/world\.rs|qdem-cli/src/(main|mpi_ranks|command|check)\.rs)'
+outside=$(grep -rl --include='*.rs' -w Communicator qdem-* | grep -Ev "$seam" || true)
+if [ -n "$outside" ]; then
+    echo "these files name Communicator outside the seam (qdem-core/src/parallel/):" >&2
+    echo "$outside" >&2
+    exit 1
+fi
 # One build from scratch: incremental caches would only double the target folder's size.
 export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
 cargo test --workspace --all-targets

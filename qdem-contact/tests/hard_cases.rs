@@ -244,7 +244,7 @@ fn largest(series: &[f64]) -> f64 {
     series.iter().map(|x| x.abs()).fold(0.0, f64::max)
 }
 
-/// The element rate bound of qdem-core/src/stable_step.rs in closed form for the Kuhn
+/// The element rate bound of qdem-core/src/continuum/stable_step.rs in closed form for the Kuhn
 /// tetrahedra of a cubic cell of edge a (all six congruent): their gradients give
 /// G Gᵀ = tridiag(−1, 2, −1)/a², with largest eigenvalue (2 + √2)/a² and trace 6/a², so
 /// ω² ≤ 4 (2μ (2 + √2) + 6 max(λ, 0))/(ρ a²). With a viscous Lamé pair it is the damping rate.
