@@ -142,12 +142,7 @@ fn print_cost(sim: &Simulation, per_step: f64) {
 /// whose motion it receives per step, the candidate contacts it evaluates and the contact
 /// spheres of other ranks it receives (ghosts) after the measured steps, its step and kernel
 /// seconds, and the imbalance of the kernel (the slowest rank's kernel time over the mean).
-fn rank_table(
-    sim: &Simulation,
-    d: &Decomposition,
-    per_step: f64,
-    exchange: f64,
-) -> String {
+fn rank_table(sim: &Simulation, d: &Decomposition, per_step: f64, exchange: f64) -> String {
     let world = &sim.world;
     let steps = world.stages().steps().max(1) as f64;
     // The bodies' force time without their exchange of block sums (which waits for the

@@ -38,8 +38,8 @@ pub mod state;
 pub mod step;
 
 // The modules other crates and embedders reach by path.
-pub use continuum::{linear_tet, material, rigid_body, stable_step, tet_blocks, tet_kernel};
 pub use continuum::tet_subdomain;
+pub use continuum::{linear_tet, material, rigid_body, stable_step, tet_blocks, tet_kernel};
 pub use modal::lanczos;
 #[cfg(feature = "thread-ranks")]
 pub use parallel::thread_ranks;
@@ -52,23 +52,23 @@ pub type Vec3 = nalgebra::Vector3<f64>;
 pub type Mat3 = nalgebra::Matrix3<f64>;
 
 pub use checkpoint::{CheckpointError, Decoder, Encoder};
-pub use parallel::{Communicator, Decomposition, Exchange, Part, PartialSums, Reads, SplitModel};
-pub use error::CoreError;
-pub use loads::gravity::Gravity;
 pub use continuum::material::Material;
-pub use step::model::{find_model, Linearized, Model, Persistence, Persistent, StepEvents};
-pub use solvers::newmark::{EventSolve, Newmark, StepCounts, TangentUpdate};
-pub use loads::nodal_load::NodalLoad;
 pub use continuum::rigid_body::RigidBodies;
-pub use solvers::sparse::FactorStats;
-pub use step::stages::{Stage, StageShare, StageTimes};
-pub use state::{Dofs, ParticleSpin, State};
-pub use solvers::static_solve::{StaticSolver, StaticSteps};
-pub use step::step_settings::{Scheme, StepRequest, StepSettings, Stepping};
-pub use step::stepper::{choose_step, stable_step, Stepper};
-pub use solvers::tangent::Tangent;
 pub use continuum::tet_blocks::BlockLayout;
 pub use continuum::tet_body::TetBody;
+pub use error::CoreError;
+pub use loads::gravity::Gravity;
+pub use loads::nodal_load::NodalLoad;
 pub use loads::time_function::{Cyclic, TimeFunction};
+pub use parallel::{Communicator, Decomposition, Exchange, Part, PartialSums, Reads, SplitModel};
+pub use solvers::newmark::{EventSolve, Newmark, StepCounts, TangentUpdate};
+pub use solvers::sparse::FactorStats;
+pub use solvers::static_solve::{StaticSolver, StaticSteps};
+pub use solvers::tangent::Tangent;
 pub use solvers::verlet::Verlet;
+pub use state::{Dofs, ParticleSpin, State};
+pub use step::model::{find_model, Linearized, Model, Persistence, Persistent, StepEvents};
+pub use step::stages::{Stage, StageShare, StageTimes};
+pub use step::step_settings::{Scheme, StepRequest, StepSettings, Stepping};
+pub use step::stepper::{choose_step, stable_step, Stepper};
 pub use step::world::{Halt, PostStep, World};

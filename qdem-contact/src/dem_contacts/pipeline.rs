@@ -177,7 +177,10 @@ impl DemContacts {
     /// The geometry and elasticity of the pair of spheres of `contact`, with the image
     /// translation of its second sphere (written into `contact`); `None` when apart.
     #[inline]
-    pub(super) fn pair_contact(&self, contact: &mut Contact) -> Option<(PairGeometry, PairElasticity)> {
+    pub(super) fn pair_contact(
+        &self,
+        contact: &mut Contact,
+    ) -> Option<(PairGeometry, PairElasticity)> {
         let (a, b) = (contact.first as usize, contact.second as usize);
         let (sa, sb) = (&self.now[a], &self.now[b]);
         contact.shift = self.separation(a, b).1;
@@ -327,7 +330,14 @@ impl DemContacts {
     /// Adds sphere `s`'s contact force `f` to its particle and its moment `t` to the rigid
     /// body or rotating particle it turns with.
     #[inline]
-    pub(super) fn add_sphere(&self, s: usize, f: &Vec3, t: &Vec3, force: &mut [Vec3], torque: &mut [Vec3]) {
+    pub(super) fn add_sphere(
+        &self,
+        s: usize,
+        f: &Vec3,
+        t: &Vec3,
+        force: &mut [Vec3],
+        torque: &mut [Vec3],
+    ) {
         force[self.particle[s] as usize] += f;
         if self.turn[s] != NOT_RIGID {
             torque[self.turn[s] as usize] += t;

@@ -8,8 +8,8 @@
 //! conjugate gradients with a Jacobi preconditioner on the free degrees of freedom.
 
 use crate::continuum::material::Lame;
-use crate::state::Dofs;
 use crate::continuum::tet_kernel::edge_matrix;
+use crate::state::Dofs;
 use crate::{Mat3, Vec3};
 
 /// A linear-tetrahedron stiffness operator on a mesh.

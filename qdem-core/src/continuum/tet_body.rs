@@ -16,18 +16,18 @@
 //! unstrained configuration (it omits the stress-dependent geometric stiffness, of the order of
 //! the strain), so for small strain f(x + ∆x, v) ≈ f(x, v) − K ∆x (paper 001 Eq. 20).
 
-use crate::parallel::decomposition::{BodyLayout, BodySplit};
-use crate::error::CoreError;
 use crate::continuum::material::{Lame, Material};
-use crate::parallel::split::{Part, PartialSums, Reads, SplitModel};
-use crate::step::model::{Linearized, Model, Persistence};
 use crate::continuum::stable_step::{critical_step, element_rate_bound};
-use crate::state::State;
-use crate::solvers::tangent::Tangent;
 use crate::continuum::tet_blocks::{BlockLayout, TetBlocks};
 use crate::continuum::tet_kernel::{
     deformation_gradient, edge_matrix, strain_energy, tet_forces, tet_stress, von_mises,
 };
+use crate::error::CoreError;
+use crate::parallel::decomposition::{BodyLayout, BodySplit};
+use crate::parallel::split::{Part, PartialSums, Reads, SplitModel};
+use crate::solvers::tangent::Tangent;
+use crate::state::State;
+use crate::step::model::{Linearized, Model, Persistence};
 use crate::{Mat3, Vec3};
 use rayon::prelude::*;
 use std::sync::Mutex;

@@ -1,11 +1,11 @@
 //! A force shared equally by a set of particles, scaled by a time function (the scene's
 //! `[[load]]`).
 
-use crate::parallel::split::Reads;
-use crate::step::model::{Linearized, Model, Persistence};
-use crate::state::State;
-use crate::solvers::tangent::Tangent;
 use crate::loads::time_function::TimeFunction;
+use crate::parallel::split::Reads;
+use crate::solvers::tangent::Tangent;
+use crate::state::State;
+use crate::step::model::{Linearized, Model, Persistence};
 use crate::Vec3;
 
 /// A total force F·φ(t) divided equally among a set of particles.

@@ -42,13 +42,15 @@
 //!   modes the fractions of each direction sum to 1 (the modes are an M-orthonormal basis of
 //!   the free DOFs). The direction with the largest fraction is the mode's dominant direction.
 
+use crate::continuum::tet_body::TetBody;
 use crate::error::CoreError;
 use crate::modal::mechanisms::{tet_piece_rows, unresisted_motions, SystemDofs};
-use crate::step::model::Model;
 use crate::modal::rigid_reduction::RigidReduction;
-use crate::solvers::sparse::{unconstrained_bodies, Assembler, FreeDofs, Scales, SparseCholesky, Tangent};
+use crate::solvers::sparse::{
+    unconstrained_bodies, Assembler, FreeDofs, Scales, SparseCholesky, Tangent,
+};
 use crate::state::{Dofs, State};
-use crate::continuum::tet_body::TetBody;
+use crate::step::model::Model;
 use crate::Vec3;
 use nalgebra::{DMatrix, SymmetricEigen, Vector6};
 use std::f64::consts::PI;

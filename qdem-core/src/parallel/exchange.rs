@@ -7,6 +7,7 @@
 //! ([`crate::SplitModel`]) and the exchange runs the collectives between its stages, in the
 //! same order on every rank.
 
+use crate::continuum::rigid_body::reduce_member_forces;
 use crate::error::CoreError;
 use crate::parallel::communicator::{max_over_ranks, Communicator};
 use crate::parallel::decomposition::{decompose, Decomposition, Partition};
@@ -14,7 +15,6 @@ use crate::parallel::ghosts::GhostTable;
 use crate::parallel::local_particles::{LocalParticles, ParticleRuns};
 use crate::parallel::split::{Part, Reads, SplitModel};
 use crate::parallel::state_share::StateShare;
-use crate::continuum::rigid_body::reduce_member_forces;
 use crate::state::State;
 use crate::step::model::Model;
 use crate::step::stages::{Stage, StageTimes};
@@ -180,7 +180,9 @@ impl Exchange {
         };
         let size = ranks.comm.size();
         let mut all = vec![0.0; mine.len() * size];
-        ranks.comm.all_gather(mine, &mut all, &vec![mine.len(); size]);
+        ranks
+            .comm
+            .all_gather(mine, &mut all, &vec![mine.len(); size]);
         all
     }
 
@@ -201,11 +203,8 @@ impl Exchange {
         comm: Arc<dyn Communicator>,
         steps_in_part: bool,
     ) -> Result<(), CoreError> {
-        let halo_allowed = hooks
-            .iter_mut()
-            .all(|h| !matches!(h.reads(), Reads::All));
-        let (share, figures, halo, bodies) =
-            decompose(state, models, comm.clone(), halo_allowed)?;
+        let halo_allowed = hooks.iter_mut().all(|h| !matches!(h.reads(), Reads::All));
+        let (share, figures, halo, bodies) = decompose(state, models, comm.clone(), halo_allowed)?;
         let (local, partition) = halo.unzip();
         let mut ranks = Ranks {
             comm,
@@ -491,7 +490,12 @@ impl Ranks {
 
     /// Every step shares the whole state from now on, the split models (but the deformable
     /// bodies) whole again.
-    fn step_whole(&mut self, state: &State, models: &mut [Box<dyn Model>], hooks: &mut [Box<dyn PostStep>]) {
+    fn step_whole(
+        &mut self,
+        state: &State,
+        models: &mut [Box<dyn Model>],
+        hooks: &mut [Box<dyn PostStep>],
+    ) {
         let _ = state;
         for (i, model) in models.iter_mut().enumerate() {
             if self.models[i].is_some() && !self.bodies[i] {

@@ -52,7 +52,6 @@ impl GhostTable {
         }
     }
 
-
     /// Every item's record, from its owner, unpacked into `part`.
     pub fn borders(&mut self, comm: &dyn Communicator, part: &mut dyn SplitModel) {
         let per = part.record_values();

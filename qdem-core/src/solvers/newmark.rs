@@ -52,20 +52,19 @@
 //! the new factor kept in turn. Both answer the same system, to [`ITERATION_TOLERANCE`].
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
-use crate::solvers::conjugate_gradient::{self, Scratch};
 use crate::error::CoreError;
 use crate::parallel::local_particles::ParticleRuns;
 use crate::parallel::Exchange;
-use crate::step::model::Model;
+use crate::solvers::conjugate_gradient::{self, Scratch};
 use crate::solvers::sparse::{
     copy_matrix, explain_failure, restore_matrix, save_matrix, Assembler, DampingRows, FactorStats,
     FreeDofs, Scales, SparseCholesky, Tangent,
 };
-use crate::step::stages::{Stage, StageTimes};
 use crate::state::State;
+use crate::step::model::Model;
+use crate::step::stages::{Stage, StageTimes};
 use crate::step::stepper::{
-    check_finite, check_masses, compute_accelerations_timed, refuse_rigid,
-    Stepper, PARTICLE_CHUNK,
+    check_finite, check_masses, compute_accelerations_timed, refuse_rigid, Stepper, PARTICLE_CHUNK,
 };
 use crate::Vec3;
 use faer::sparse::SparseColMat;

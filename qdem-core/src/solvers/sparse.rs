@@ -18,8 +18,8 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::step::model::Model;
 use crate::state::{Dofs, State};
+use crate::step::model::Model;
 use crate::step::stepper::PARTICLE_CHUNK;
 use crate::{Mat3, Vec3};
 use faer::dyn_stack::{MemBuffer, MemStack};

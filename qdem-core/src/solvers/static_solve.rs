@@ -23,15 +23,15 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::step::model::Model;
+use crate::parallel::Exchange;
 use crate::solvers::newmark::collect_tangent;
 use crate::solvers::sparse::{
     explain_failure, unconstrained_bodies, Assembler, FactorStats, FreeDofs, Scales,
     SparseCholesky, Tangent, FIX_HINT,
 };
-use crate::step::stages::{Stage, StageTimes};
 use crate::state::State;
-use crate::parallel::Exchange;
+use crate::step::model::Model;
+use crate::step::stages::{Stage, StageTimes};
 use crate::step::stepper::{refuse_rigid, Stepper};
 use crate::Vec3;
 

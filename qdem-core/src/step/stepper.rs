@@ -5,11 +5,11 @@ use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::parallel::local_particles::ParticleRuns;
 use crate::parallel::Exchange;
-use crate::step::model::Model;
 use crate::solvers::newmark::StepCounts;
 use crate::solvers::sparse::FactorStats;
-use crate::step::stages::{Stage, StageTimes};
 use crate::state::{Dofs, State};
+use crate::step::model::Model;
+use crate::step::stages::{Stage, StageTimes};
 use crate::Vec3;
 use rayon::prelude::*;
 
@@ -48,7 +48,12 @@ pub trait Stepper: Send {
 
     /// Advances `state` by one step.
     fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {
-        self.step_timed(state, models, &mut StageTimes::off(), &mut Exchange::default())
+        self.step_timed(
+            state,
+            models,
+            &mut StageTimes::off(),
+            &mut Exchange::default(),
+        )
     }
 
     /// [`Stepper::step`], marking the end of each of its stages on `stages` (predict, each

@@ -285,7 +285,9 @@ impl World {
     /// an implicit scheme).
     pub fn initialize(&mut self) -> Result<(), CoreError> {
         let (state, models) = (&mut self.state, &mut self.models);
-        let done = self.stepper.initialize_in(state, models, &mut self.exchange);
+        let done = self
+            .stepper
+            .initialize_in(state, models, &mut self.exchange);
         let torques = self.stepper.rigid_torques();
         self.exchange.initialized(&mut self.state, torques, done)
     }
