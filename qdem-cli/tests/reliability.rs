@@ -415,3 +415,35 @@ fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
     }
     x
 }
+
+#[test]
+fn stop_after_a_step_a_resumed_checkpoint_has_passed_is_refused() {
+    let tmp = TempDir::new("stop-after");
+    let out = tmp.path().join("out");
+    let scene = workspace().join("fixtures/contact/collision.toml");
+    let with = |extra: &[&str]| {
+        let mut args = vec![
+            OsStr::new("run"),
+            scene.as_os_str(),
+            OsStr::new("--out"),
+            out.as_os_str(),
+        ];
+        args.extend(extra.iter().map(OsStr::new));
+        qdem(&args)
+    };
+    let checkpoint = out.join("checkpoint.qdc");
+    let checkpoint = checkpoint.to_str().expect("a UTF-8 path");
+    assert_eq!(with(&["--stop-after", "100"]).status.code(), Some(130));
+    refused(
+        &with(&["--resume", checkpoint, "--stop-after", "50"]),
+        &[
+            "--stop-after 50 counts steps from the run's start",
+            "the checkpoint is at step 100",
+            "fix: give a step after 100, e.g. --stop-after 150",
+        ],
+    );
+    let resumed = with(&["--resume", checkpoint, "--stop-after", "150"]);
+    let stderr = String::from_utf8_lossy(&resumed.stderr);
+    assert_eq!(resumed.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("(step 150)"), "{stderr}");
+}
