@@ -4,7 +4,7 @@
 //! or `stones.csv` of another scene). Only files with the names a run writes are touched:
 //! `results.pvd`, `probes.csv`, `probes.svg`, `boundary.csv`, `sections.csv`, `crack.svg`,
 //! `stones.csv`, `poses.csv`, `summary.json`, and in `vtu/` the numbered `state_`,
-//! `spheres_`, `contacts_` and `bonds_` VTUs and `walls.vtu`. A file the scene reads (a
+//! `spheres_`, `contacts_`, `bonds_` and `walls_` VTUs and `walls.vtu`. A file the scene reads (a
 //! sample's `stones.csv`, a `pose_from`'s `poses.csv`) is kept, and so is `checkpoint.qdc`:
 //! a resume checks that it belongs to the scene and its files, and the run's first checkpoint
 //! replaces it.
@@ -26,7 +26,7 @@ const TOP_FILES: [&str; 9] = [
 ];
 
 /// The prefixes of the numbered VTUs a run writes in `vtu/` (`state_00012.vtu`).
-const NUMBERED_VTU: [&str; 4] = ["state_", "spheres_", "contacts_", "bonds_"];
+const NUMBERED_VTU: [&str; 5] = ["state_", "spheres_", "contacts_", "bonds_", "walls_"];
 
 /// Whether `name` is one of the VTU files a run writes in `vtu/`.
 fn run_vtu(name: &str) -> bool {
