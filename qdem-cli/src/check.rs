@@ -1,13 +1,14 @@
-//! `qdem check SCENE`: validates a scene and prints its meshes, mass, stable step, checkpoint
-//! support, the measured cost of a step with the projected run time, and where a step's time
-//! goes, stage by stage of the world's step ([`qdem_core::stages`]). Under `mpirun` (N > 1)
-//! the run is decomposed as `qdem run` decomposes it, and rank 0 also prints each rank's
-//! tetrahedra, owned particles, halo and measured step cost, and the imbalance.
+//! `qdem check SCENE`: validates a scene and prints its meshes, mass, stable step, an estimate
+//! of the memory the run keeps, checkpoint support, the measured cost of a step with the
+//! projected run time, and where a step's time goes, stage by stage of the world's step
+//! ([`qdem_core::stages`]). Under `mpirun` (N > 1) the run is decomposed as `qdem run`
+//! decomposes it, and rank 0 also prints each rank's tetrahedra, owned particles, halo and
+//! measured step cost, and the imbalance.
 
 use crate::command::CliError;
 use crate::progress;
 use qdem_core::{Communicator, Decomposition, Model as _, Stage, TetBody};
-use qdem_io::build::{BodyKind, Simulation};
+use qdem_io::build::{memory, BodyKind, Simulation};
 use qdem_io::runner::RunError;
 use qdem_io::scene::Scene;
 use std::path::Path;
@@ -111,10 +112,23 @@ fn print_scene(path: &Path, sim: &Simulation) {
         sim.steps(),
         sim.scene.run.t_end
     );
+    print_memory(sim);
     match sim.world.checkpointable() {
         Ok(()) => println!("checkpoints: supported (`checkpoint_every`, Ctrl-C, --resume)"),
         Err(why) => println!("checkpoints: not supported: {why}"),
     }
+}
+
+/// The memory the run will keep, estimated from its particles and tetrahedra as the build
+/// estimated it before allocating them ([`memory`]), against the machine's.
+fn print_memory(sim: &Simulation) {
+    let (particles, tets) = (sim.world.state.len(), sim.tets());
+    let need = memory::estimate(particles as f64, tets as f64);
+    let machine = memory::machine_memory().map_or("unknown".to_string(), memory::human);
+    println!(
+        "memory: about {} for {particles} particles and {tets} tets (the machine has {machine})",
+        memory::human(need)
+    );
 }
 
 /// The measured cost of a step, the projected run time and the stages.

@@ -456,6 +456,11 @@ impl Command {
 }
 
 fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(), CliError> {
+    // Set first, so that a signal while the scene loads and builds stops the run at its first
+    // step, checkpointed, as one later does. A second signal while the checkpoint is being
+    // written is ignored; the handler can only fail if one is already installed, which this
+    // process never does twice.
+    let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed));
     let (path, resume) = (args.scene.as_path(), args.resume.as_deref());
     let scene = Scene::load(path)?;
     let out_dir = match args.out.as_deref() {
@@ -479,9 +484,6 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
             eprintln!("{}", decomposition_line(&figures));
         }
     }
-    // A second signal while the checkpoint is being written is ignored; the handler can
-    // only fail if one is already installed, which this process never does twice.
-    let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed));
     if !leader {
         let options = RunOptions {
             resume,

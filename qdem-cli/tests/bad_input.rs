@@ -6,7 +6,7 @@
 //! relative to the scene file.
 
 mod common;
-use common::{workspace, TempDir};
+use common::{variant, workspace, TempDir};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -550,6 +550,127 @@ fn interpenetrating_bodies_are_refused_before_the_run() {
         &[
             "bodies `left` and `right` overlap by 5.000e-3 m",
             "move them apart",
+        ],
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Values that pass every range check but cannot run (issue 38)
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn a_time_step_that_underflows_to_zero_is_refused_with_its_cause() {
+    let tmp = TempDir::new("zero-dt");
+    for (edit, value) in [
+        (("density = -2350.0", "density = 1e-295"), "density 1e-295"),
+        (("young = 45e9", "young = 1e308"), "young 1e308"),
+    ] {
+        let mut edits = vec![edit];
+        if edit.0 != "density = -2350.0" {
+            edits.push(("density = -2350.0", "density = 2350.0"));
+        }
+        let scene = variant("bad/negative_density.toml", &edits, &tmp);
+        check_and_run(
+            &scene,
+            &[
+                "dt = 0e0 s",
+                "zero, subnormal or not finite",
+                value,
+                "fix: check the materials' density and young",
+            ],
+        );
+    }
+}
+
+#[test]
+fn a_step_count_that_does_not_fit_or_a_step_that_does_not_advance_t_is_refused() {
+    let tmp = TempDir::new("steps");
+    let good = ("density = -2350.0", "density = 2350.0");
+    let huge_end = variant(
+        "bad/negative_density.toml",
+        &[good, ("t_end = 0.01", "t_end = 1e300")],
+        &tmp,
+    );
+    check_and_run(
+        &huge_end,
+        &["t_end = 1e300 s", "more than 2^53", "t + dt == t", "fix:"],
+    );
+    let tiny_step = variant(
+        "bad/negative_density.toml",
+        &[good, ("dt = \"auto\"", "dt = 1e-300")],
+        &tmp,
+    );
+    check_and_run(
+        &tiny_step,
+        &[
+            "dt = 1.0000e-300 s (as given in [run] dt)",
+            "1.000e298 steps",
+            "fix: give a shorter t_end or a larger dt (at least 1.110e-18 s)",
+        ],
+    );
+}
+
+#[test]
+fn counts_of_ten_to_the_twelve_are_refused_with_the_memory_they_need() {
+    let tmp = TempDir::new("counts");
+    let cases = [
+        (
+            "contact/grains.toml",
+            ("count = 2000", "count = 1000000000000"),
+            "[granular] count = 1000000000000 stones",
+            "fix: lower count",
+        ),
+        (
+            "ballast/reduced_deposit.toml",
+            ("count = 170", "count = 1000000000000"),
+            "[ballast] count = 1000000000000 stones",
+            "fix: lower count",
+        ),
+        (
+            "bbm/small_beam.toml",
+            ("element_size = 0.05", "element_size = 1e-9"),
+            "element_size = 1e-9 m",
+            "fix: give a smaller size or a larger element_size",
+        ),
+        (
+            "bbm/small_beam.toml",
+            ("size = [1.0, 0.2]", "size = [1e300, 0.2]"),
+            "size = [1e300, 2e-1] m",
+            "fix: give a smaller size or a larger element_size",
+        ),
+    ];
+    for (fixture, edit, what, fix) in cases {
+        let scene = variant(fixture, &[edit], &tmp);
+        let message = check_and_run(
+            &scene,
+            &[what, "particles would need about", "of memory", fix],
+        );
+        // The memory is named with its unit and is far above any machine's.
+        let need = message
+            .split("would need about ")
+            .nth(1)
+            .expect("the memory needed");
+        assert!(need.contains("TiB"), "{message}");
+    }
+}
+
+#[test]
+fn newmark_with_gamma_below_one_half_is_refused_naming_gamma() {
+    let tmp = TempDir::new("gamma");
+    let scene = variant(
+        "bbm/small_beam.toml",
+        &[("gamma = 0.5", "gamma = 0.3")],
+        &tmp,
+    );
+    let line = line_of(&scene, "gamma = 0.3");
+    let at = format!("{}:{line}:", scene.display());
+    check_and_run(
+        &scene,
+        &[
+            &at,
+            "gamma = 0.3 is below 1/2",
+            "negative",
+            "fix: use gamma = 0.5",
         ],
     );
 }

@@ -13,6 +13,10 @@
 //! - rejects degenerate tetrahedra (`|6V| <= 1e-12 · (longest edge)³`),
 //! - keeps exact duplicate tetrahedra once (MSH 2.2 repeats an element per physical group).
 //!
+//! Nodes at the same place that no tetrahedron shares (separately meshed volumes) are found
+//! by [`TetMesh::coincident_nodes`] and merged on request by
+//! [`TetMesh::merge_coincident_nodes`].
+//!
 //! The reader never panics: counts are checked against the bytes left before anything is
 //! allocated, the physical groups' node sets are bounded ([`MAX_GROUP_ENTRIES_PER_NODE`]), so
 //! work and memory grow about linearly with the file's size (see `docs/fuzzing.md`), and every
@@ -40,6 +44,7 @@
 
 #![warn(missing_docs)]
 
+mod coincident;
 mod cursor;
 mod element_types;
 mod error;
@@ -54,6 +59,7 @@ mod validate;
 
 use std::path::Path;
 
+pub use coincident::{CoincidentNodes, COINCIDENT_TOL};
 pub use element_types::element_info;
 pub use error::{Location, MeshError, MeshWarning};
 pub use generate::structured_box;

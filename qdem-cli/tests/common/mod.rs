@@ -70,3 +70,31 @@ pub fn run(scene: &Path, out: &Path, threads: usize) -> Output {
     assert!(!stderr.contains("panicked"), "{stderr}");
     output
 }
+
+/// A fixture scene with each `(from, to)` of `edits` replaced once (each must be there), its
+/// relative file paths made absolute, written into `tmp`: a variant of a good scene that
+/// reads the fixture's files.
+pub fn variant(fixture: &str, edits: &[(&str, &str)], tmp: &TempDir) -> PathBuf {
+    let path = workspace().join("fixtures").join(fixture);
+    let dir = path.parent().expect("a fixture lies in a folder");
+    let mut text = std::fs::read_to_string(&path).expect("read the fixture");
+    for (from, to) in edits {
+        assert!(text.contains(from), "{fixture} has no {from:?}");
+        text = text.replacen(from, to, 1);
+    }
+    // Quoted relative paths of files become absolute (odd pieces are inside quotes).
+    let pieces: Vec<String> = text
+        .split('"')
+        .enumerate()
+        .map(|(i, piece)| {
+            let file = [".msh", ".csv", ".qdc"].iter().any(|e| piece.ends_with(e));
+            match i % 2 == 1 && file && !piece.starts_with('/') {
+                true => dir.join(piece).display().to_string(),
+                false => piece.to_string(),
+            }
+        })
+        .collect();
+    let out = tmp.path().join(path.file_name().expect("a file name"));
+    std::fs::write(&out, pieces.join("\"")).expect("write the variant");
+    out
+}

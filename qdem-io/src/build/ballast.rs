@@ -79,6 +79,17 @@ pub(crate) fn place_ballast(
     material: usize,
 ) -> Result<(PlacedMesh, BallastInfo, Vec<String>), BuildError> {
     let (shapes, warnings) = read_shapes(scene, ballast)?;
+    let largest = |size: fn(&Shape) -> usize| shapes.iter().map(size).max().unwrap_or(0) as f64;
+    let count = ballast.count as f64;
+    super::memory::check(
+        &scene.path,
+        format!("[ballast] count = {} stones", ballast.count),
+        (
+            count * largest(|s| s.mesh.nodes.len()),
+            count * largest(|s| s.mesh.tets.len()),
+        ),
+        "lower count",
+    )?;
     let mut rng = SplitMix64(ballast.seed);
     let draws = draw_stones(scene, ballast, &shapes, &mut rng)?;
     let size =

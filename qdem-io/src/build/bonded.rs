@@ -44,6 +44,15 @@ pub(crate) fn build_bonded(
             seed: bonded.packing_seed,
         },
     };
+    // A hexagonal packing of pitch h holds one particle per (√3/2)·h² of the rectangle.
+    let [width, height] = bonded.size;
+    let h = bonded.element_size;
+    super::memory::check(
+        &scene.path,
+        format!("[bonded] size = [{width:e}, {height:e}] m with element_size = {h:e} m"),
+        (width * height / (h * h * 3f64.sqrt() / 2.0), 0.0),
+        "give a smaller size or a larger element_size",
+    )?;
     let packing = Packing::rectangle(bonded.origin, bonded.size, bonded.element_size, kind)
         .ok_or_else(|| {
             contact(ContactError::TooCoarse {

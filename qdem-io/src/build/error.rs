@@ -163,4 +163,22 @@ pub enum BuildError {
         /// How to fix it.
         fix: &'static str,
     },
+    /// A count whose particles would need more memory than the machine has, refused before
+    /// they are allocated ([`super::memory`]).
+    #[error("{scene}: {message}")]
+    Memory {
+        /// The scene file.
+        scene: PathBuf,
+        /// The key and count, the particles, the memory they need, the machine's, the fix.
+        message: String,
+    },
+    /// A time step that cannot advance the run: zero, subnormal, not finite, or so small
+    /// against `t_end` that the time stops advancing or the step count does not fit.
+    #[error("{scene}: [run]: {message}")]
+    Step {
+        /// The scene file.
+        scene: PathBuf,
+        /// The step, what is wrong with it and how to fix it.
+        message: String,
+    },
 }

@@ -110,6 +110,13 @@ pub(crate) fn stones(scene: &Scene, granular: &Granular) -> Result<Vec<Stone>, B
     if let (Some([lo, hi]), Some(count), Some(grading)) =
         (granular.region, granular.count, &granular.grading)
     {
+        let spheres = granular.spheres_per_stone[1];
+        super::memory::check(
+            &scene.path,
+            format!("[granular] count = {count} stones of up to {spheres} spheres"),
+            (count as f64 * spheres as f64, 0.0),
+            "lower count (or spheres_per_stone)",
+        )?;
         let spec = SampleSpec {
             region: [Vec3::from(lo), Vec3::from(hi)],
             count,

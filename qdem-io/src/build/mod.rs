@@ -18,6 +18,8 @@
 //!   `[ballast]`; `bonded`: a `[bonded]` body (built instead of everything else);
 //! - `periodic`: the `[periodic]` cell, its wrap groups and time delay;
 //! - `rest_on`: bodies laid on a granular sample; `load_series`: a load's CSV time series;
+//! - [`memory`]: the memory a count needs, refused before allocating beyond the machine;
+//!   `step_check`: a time step that cannot advance the run, refused;
 //! - [`BuildError`] (`error`): why a build failed.
 
 pub mod ballast;
@@ -26,15 +28,17 @@ mod contact;
 mod error;
 pub mod granular;
 pub(crate) mod load_series;
+pub mod memory;
 mod periodic;
 pub mod pose_from;
 mod rest_on;
 mod start_from;
+mod step_check;
 
 pub use error::BuildError;
 
 use crate::scene::suggest::did_you_mean;
-use crate::scene::{EventSolveName, Integrator, Scene, Selection, TimeStep};
+use crate::scene::{Body, EventSolveName, Integrator, Scene, Selection, TimeStep};
 use ballast::{place_ballast, BallastInfo};
 use contact::ExtraSpheres;
 use granular::GranularInfo;
@@ -132,8 +136,17 @@ pub(crate) struct PlacedMesh {
 
 impl Simulation {
     /// Reads the meshes and builds every model of `scene`: bodies, then gravity (only if
-    /// non-zero), then loads; fixes go into the state.
+    /// non-zero), then loads; fixes go into the state. Refuses counts that would need more
+    /// memory than the machine has before allocating them ([`memory`]), and a time step that
+    /// cannot advance the run (`step_check`).
     pub fn build(scene: Scene) -> Result<Simulation, BuildError> {
+        let sim = Simulation::build_models(scene)?;
+        step_check::check_step(&sim)?;
+        Ok(sim)
+    }
+
+    /// [`Simulation::build`] before its step is checked.
+    fn build_models(scene: Scene) -> Result<Simulation, BuildError> {
         if let Some((bonded, material)) = scene.bonded.clone().zip(scene.refs().bonded_material) {
             let material = scene.materials[material].clone();
             return bonded::build_bonded(scene, &bonded, &material);
@@ -319,6 +332,7 @@ fn read_meshes(scene: &Scene) -> Result<ReadMeshes, BuildError> {
     for body in &scene.bodies {
         let path = scene.mesh_path(body);
         let mut mesh = read_mesh(&path, &mut warnings)?;
+        coincident_nodes(&mut mesh, body, &path, &mut warnings);
         if body.reorder {
             mesh.reorder_for_locality();
         }
@@ -353,6 +367,30 @@ pub(crate) fn read_mesh(path: &Path, warnings: &mut Vec<String>) -> Result<TetMe
             .map(|w| format!("{}: {w}", path.display())),
     );
     Ok(mesh)
+}
+
+/// Merges the coincident nodes of a body's mesh with `merge_nodes = true`; without it, warns
+/// of them, naming the count and where the first is.
+fn coincident_nodes(mesh: &mut TetMesh, body: &Body, path: &Path, warnings: &mut Vec<String>) {
+    if body.merge_nodes {
+        mesh.merge_coincident_nodes();
+        return;
+    }
+    if let Some(c) = mesh.coincident_nodes() {
+        let [x, y, z] = c.at;
+        warnings.push(format!(
+            "{}: body `{}`: {} nodes coincide with another node (within {:.1e} m), the first \
+             (node {}, with node {}) at ({x}, {y}, {z}) m: no tetrahedron joins them, so the \
+             body is in pieces there; fix: merge_nodes = true on the body, or merge them in \
+             the mesher (gmsh: Coherence)",
+            path.display(),
+            body.name,
+            c.count,
+            c.tolerance,
+            c.first.0 + 1,
+            c.first.1 + 1
+        ));
+    }
 }
 
 /// Rotates the nodes about their centroid by `degrees` about x, then y, then z, then

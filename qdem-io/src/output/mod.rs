@@ -5,7 +5,8 @@
 //! the target. A reader never sees a partial file, and a failed write leaves the previous
 //! content in place and no temporary file behind. A run that is killed mid-write does leave
 //! one: [`remove_stale_temporaries`], called at the start of every run, removes those whose
-//! process is gone.
+//! process is gone. A run holds its folder's [`FolderLock`] from start to end, so that a second
+//! run into the same folder is refused instead of mixing its files with the first's.
 //!
 //! | file | writer |
 //! | --- | --- |
@@ -21,6 +22,7 @@
 
 mod atomic;
 mod error;
+mod folder_lock;
 mod probes_csv;
 mod pvd;
 mod summary;
@@ -28,6 +30,7 @@ mod vtu;
 
 pub use atomic::{remove_stale_temporaries, write_atomic, AtomicFile};
 pub use error::{IoStage, OutputError};
+pub use folder_lock::{FolderLock, LockError, LOCK_FILE};
 pub use probes_csv::{ProbeCsv, PROBE_COLUMNS};
 pub use pvd::PvdIndex;
 pub use summary::write_summary;

@@ -52,6 +52,18 @@ pub enum CheckpointFileError {
         /// The file.
         path: PathBuf,
     },
+    /// A checkpoint cut short before the end of its header (a copy or a disk that ran out).
+    #[error(
+        "the checkpoint `{path}` is cut short: it starts like a qdem checkpoint but has only \
+         {length} bytes, fewer than its header; use an earlier checkpoint or run the scene \
+         from the start"
+    )]
+    Truncated {
+        /// The file.
+        path: PathBuf,
+        /// Its length in bytes.
+        length: usize,
+    },
     /// A checkpoint of another format version.
     #[error(
         "the checkpoint `{path}` has format version {found}, but this qdem reads version \
@@ -169,8 +181,14 @@ pub fn read_checkpoint(
         source,
     })?;
     let path = path.to_path_buf();
-    if bytes.len() < HEADER + 8 + 8 || &bytes[..8] != MAGIC {
+    if bytes.len() < 8 || &bytes[..8] != MAGIC {
         return Err(CheckpointFileError::NotCheckpoint { path });
+    }
+    if bytes.len() < HEADER + 8 + 8 {
+        return Err(CheckpointFileError::Truncated {
+            path,
+            length: bytes.len(),
+        });
     }
     let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().expect("8 bytes"));
     let version = word(8);
@@ -299,5 +317,12 @@ mod tests {
             read_checkpoint(&path, Some(&written)),
             Err(CheckpointFileError::NotCheckpoint { .. })
         ));
+        for cut in [8, 16, 24, 39] {
+            std::fs::write(&path, &bytes[..cut]).unwrap();
+            assert!(matches!(
+                read_checkpoint(&path, Some(&written)),
+                Err(CheckpointFileError::Truncated { length, .. }) if length == cut
+            ));
+        }
     }
 }

@@ -8,7 +8,9 @@ use crate::build::Simulation;
 use crate::checkpoint::{
     read_checkpoint, scene_fingerprint, write_checkpoint, CheckpointFileError, CHECKPOINT_FILE,
 };
-use crate::output::OutputError;
+use crate::output::{FolderLock, LockError, OutputError};
+use crate::run::contact_watch::{ContactWatch, Interpenetration};
+use crate::run::fresh_start;
 use crate::run::inputs::SceneFingerprint;
 use crate::run::record::schedule::{probe_interval, Schedule};
 use crate::run::record::{self, Recorder, RunFigures, StateRead, StepInfo};
@@ -43,9 +45,33 @@ pub enum RunError {
         /// What went wrong.
         source: CoreError,
     },
+    /// The output folder is in use by another run, or its lock cannot be taken.
+    #[error(transparent)]
+    Lock(#[from] LockError),
+    /// Two bodies pass through each other: the interpenetration watch stopped the run.
+    #[error("{scene}: {source}")]
+    Interpenetration {
+        /// The scene file.
+        scene: PathBuf,
+        /// The bodies, the overlap, the speed and the fix.
+        source: Box<Interpenetration>,
+    },
     /// A checkpoint that cannot be resumed from.
     #[error(transparent)]
     Checkpoint(#[from] CheckpointFileError),
+    /// `--stop-after N` on a resume from a checkpoint at or past step N.
+    #[error(
+        "--stop-after {stop_after} counts steps from the run's start, and the checkpoint is at \
+         step {done}, past it, so the run would not stop; fix: give a step after {done}, e.g. \
+         --stop-after {} to stop {stop_after} steps from here",
+        done + stop_after
+    )]
+    StopAfterPassed {
+        /// The step asked for.
+        stop_after: u64,
+        /// The checkpoint's last step.
+        done: u64,
+    },
     /// The run was stopped on request (Ctrl-C, SIGTERM) after writing a checkpoint.
     #[error(
         "interrupted at t = {time:.6e} s (step {step}); the run is checkpointed in {checkpoint}: \
@@ -227,6 +253,11 @@ pub fn run_with(
     let steps = sim.steps();
     let probes = probe_particles(sim);
     let first_step = run.record.next_step;
+    let watch = options
+        .ranks
+        .is_none()
+        .then(|| ContactWatch::new(sim))
+        .flatten();
     let start = Instant::now();
     let mut last_report = start;
     let mut halt = None;
@@ -243,6 +274,14 @@ pub fn run_with(
                 let begin = Instant::now();
                 halt = sim.world.step().map_err(|source| core_error(sim, source))?;
                 seconds = Some(begin.elapsed().as_secs_f64());
+                if let Some(watch) = &watch {
+                    watch
+                        .check(sim, step)
+                        .map_err(|source| RunError::Interpenetration {
+                            scene: sim.scene.path.clone(),
+                            source,
+                        })?;
+                }
             }
             let info = StepInfo {
                 dt,
@@ -301,10 +340,13 @@ struct Run {
     can_checkpoint: bool,
     last_good: Option<GoodState>,
     good_schedule: Schedule,
+    /// The output folder's lock, held until the run (its summary included) is done.
+    _lock: FolderLock,
 }
 
 impl Run {
-    /// Prepares `out_dir` (its folders, no temporary files of killed runs), refuses a run that
+    /// Prepares `out_dir` (its folders and lock, no temporary files of killed runs, and for a
+    /// fresh run no outputs of an earlier one: `fresh_start`), refuses a run that
     /// must checkpoint but cannot, registers the recorders and, resuming, restores the world
     /// and the recorders from the checkpoint; then opens the recorders' files.
     fn open(
@@ -313,6 +355,15 @@ impl Run {
         options: RunOptions<'_>,
     ) -> Result<Run, RunError> {
         create_dir(out_dir)?;
+        let lock = FolderLock::acquire(out_dir)?;
+        let fingerprint = scene_fingerprint(&sim.scene);
+        if options.resume.is_none() {
+            let inputs: Vec<PathBuf> = crate::inputs::input_files(&sim.scene)
+                .iter()
+                .map(|f| fingerprint.resolve(f))
+                .collect();
+            fresh_start::remove_earlier_outputs(out_dir, &inputs);
+        }
         if sim.scene.output.writes_vtu() {
             create_dir(&out_dir.join("vtu"))?;
         }
@@ -327,15 +378,20 @@ impl Run {
             recorders: record::register(sim, out_dir),
             record: RunRecord::new(sim),
             checkpoint_path: out_dir.join(CHECKPOINT_FILE),
-            fingerprint: scene_fingerprint(&sim.scene),
+            fingerprint,
             can_checkpoint: can_checkpoint.is_ok(),
             last_good: None,
             good_schedule: Schedule::new(probe_interval(sim)),
+            _lock: lock,
         };
         if let Some(path) = options.resume {
             let body = read_checkpoint(path, Some(&run.fingerprint))?;
             decode_run(&body, sim, &mut run.record, &mut run.recorders)
                 .map_err(|source| core_error(sim, source))?;
+            let done = run.record.next_step.saturating_sub(1);
+            if let Some(stop_after) = options.stop_after.filter(|&n| n <= done) {
+                return Err(RunError::StopAfterPassed { stop_after, done });
+            }
         }
         for r in run.recorders.iter_mut() {
             r.start(options.resume.is_some())?;
@@ -410,7 +466,10 @@ impl Run {
             r.finish(sim)?;
         }
         match (outcome, self.last_good.take()) {
-            (Err(source @ RunError::Core { .. }), Some((time, body, _))) => {
+            (
+                Err(source @ (RunError::Core { .. } | RunError::Interpenetration { .. })),
+                Some((time, body, _)),
+            ) => {
                 write_checkpoint(&self.checkpoint_path, &self.fingerprint, &body)?;
                 Err(RunError::Failed {
                     source: Box::new(source),

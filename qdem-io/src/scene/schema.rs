@@ -201,6 +201,12 @@ pub struct Body {
     /// Reorder nodes for memory locality after import; default `true`.
     #[serde(default = "default_true")]
     pub reorder: bool,
+    /// Merge the mesh's coincident nodes (nodes at one place, within 1e-9 of the mesh's size,
+    /// that its tetrahedra do not share, as separately meshed volumes leave them) so that the
+    /// tetrahedra on either side connect; default `false`: they are reported in a warning and
+    /// the body stays in pieces there.
+    #[serde(default)]
+    pub merge_nodes: bool,
     /// Radius (m) of the contact spheres put at the body's surface vertices (paper 000 §4);
     /// `None` (the default): the body touches nothing.
     #[serde(default)]

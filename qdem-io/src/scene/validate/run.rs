@@ -1,5 +1,7 @@
 //! `[run]`: a positive end time, time step and probe interval, finite gravity, `dt_safety` in
-//! (0, 1], and Newmark's β and γ in range (with a `dt` an implicit step can use); and
+//! (0, 1], and Newmark's β and γ in range, γ ≥ ½ (below it the scheme's numerical damping is
+//! negative: paper 001 Eq. 16's amplification exceeds one) (with a `dt` an implicit step can
+//! use); and
 //! `[output]`: non-negative intervals.
 
 use super::super::schema::{Integrator, RawScene, TimeStep};
@@ -52,6 +54,17 @@ fn newmark(c: &mut Checker<'_>, raw: &RawScene) {
             format!(
                 "[run]: beta = {beta}, gamma = {gamma}: Newmark needs 0 <= gamma <= 1 and \
                  0 <= 2 beta <= 1 (paper 001 Eq. 16); e.g. beta = 0.25, gamma = 0.5"
+            ),
+        );
+    } else if gamma < 0.5 {
+        c.error(
+            &["run", "gamma"],
+            format!(
+                "[run]: gamma = {gamma} is below 1/2: Newmark's numerical damping is then \
+                 negative, so every step amplifies the motion and the run diverges at any dt \
+                 (an inverted tetrahedron or runaway energy, blamed on the step); fix: use \
+                 gamma = 0.5 (no numerical damping), or gamma > 0.5 to damp the highest modes \
+                 with beta >= (gamma + 0.5)^2 / 4"
             ),
         );
     }

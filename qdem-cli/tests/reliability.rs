@@ -1,0 +1,449 @@
+//! Ways a run went wrong without a word (issue 38), through the `qdem` binary: a second run
+//! into a folder another run holds, a fresh run over an earlier run's files, two bodies that
+//! pass through each other, and a mesh whose volumes share no nodes. The bad values that
+//! cannot run (a zero step, counts of 10¹², Newmark γ < ½) are in `bad_input.rs`.
+
+mod common;
+use common::{variant, workspace, TempDir};
+use std::ffi::OsStr;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// `qdem ARGS` from the workspace root.
+fn qdem<S: AsRef<OsStr>>(args: &[S]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_qdem"))
+        .args(args)
+        .current_dir(workspace())
+        .env("CI", "1")
+        .output()
+        .expect("start the qdem binary")
+}
+
+/// `qdem run SCENE --out OUT`.
+fn run(scene: &Path, out: &Path) -> Output {
+    qdem(&[
+        OsStr::new("run"),
+        scene.as_os_str(),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ])
+}
+
+/// The stderr of a failed run, which must be one clean error (status 1, no panic) with each
+/// of `needles`.
+fn refused(out: &Output, needles: &[&str]) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(1), "expected a refusal:\n{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for needle in needles {
+        assert!(stderr.contains(needle), "no {needle:?} in:\n{stderr}");
+    }
+    stderr
+}
+
+/// The last value of column `column` of a run's `probes.csv`.
+fn last_probe(out: &Path, column: &str) -> f64 {
+    let text = std::fs::read_to_string(out.join("probes.csv")).expect("probes.csv");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let at = header
+        .iter()
+        .position(|h| *h == column)
+        .expect("the column");
+    let last = lines.last().expect("a row");
+    last.split(',')
+        .nth(at)
+        .expect("the value")
+        .parse()
+        .expect("a number")
+}
+
+#[test]
+fn a_second_run_into_a_held_folder_is_refused_and_a_dead_holder_is_taken_over() {
+    let tmp = TempDir::new("lock");
+    let out = tmp.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let scene = workspace().join("fixtures/contact/collision.toml");
+    // A live holder: a process that runs while the second run starts.
+    let mut holder = Command::new("sleep")
+        .arg("60")
+        .spawn()
+        .expect("start sleep");
+    let lock = out.join(".qdem-run.lock");
+    std::fs::write(&lock, format!("{}\n", holder.id())).unwrap();
+    let message = refused(
+        &run(&scene, &out),
+        &[
+            &format!("in use by another qdem run (pid {},", holder.id()),
+            "fix: wait for that run to end, give this one another --out",
+        ],
+    );
+    assert!(message.contains(&lock.display().to_string()), "{message}");
+    assert!(
+        !out.join("probes.csv").exists(),
+        "the refused run wrote into the held folder"
+    );
+    // The holder is gone (killed, as by SIGKILL, and reaped): its lock is taken over.
+    holder.kill().unwrap();
+    holder.wait().unwrap();
+    let done = run(&scene, &out);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert!(!lock.exists(), "the lock outlived the run");
+}
+
+#[test]
+fn a_real_second_run_started_during_the_first_is_refused() {
+    let tmp = TempDir::new("lock-race");
+    let out = tmp.path().join("out");
+    let scene = workspace().join("fixtures/contact/collision.toml");
+    let mut first = Command::new(env!("CARGO_BIN_EXE_qdem"))
+        .args([OsStr::new("run"), scene.as_os_str(), OsStr::new("--out")])
+        .arg(&out)
+        .env("CI", "1")
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("start the first run");
+    let lock = out.join(".qdem-run.lock");
+    let started = std::time::Instant::now();
+    while !lock.exists() && started.elapsed().as_secs() < 30 {
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let second = run(&scene, &out);
+    let finished = first.try_wait().unwrap().is_some();
+    let status = first.wait().unwrap();
+    assert!(status.success());
+    if finished {
+        eprintln!("skipped: the first run ended before the second started");
+        return;
+    }
+    refused(
+        &second,
+        &[&format!("in use by another qdem run (pid {},", first.id())],
+    );
+}
+
+#[test]
+fn a_fresh_run_removes_the_files_of_an_earlier_longer_run() {
+    let tmp = TempDir::new("fresh");
+    let out = tmp.path().join("out");
+    let vtu = out.join("vtu");
+    std::fs::create_dir_all(&vtu).unwrap();
+    // An earlier run's last VTUs (beyond this run's ten), its boundary record and a file of
+    // the user's.
+    for name in [
+        "vtu/state_00030.vtu",
+        "vtu/spheres_00030.vtu",
+        "boundary.csv",
+    ] {
+        std::fs::write(out.join(name), "earlier run").unwrap();
+    }
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let scene = workspace().join("fixtures/contact/collision.toml");
+    let done = run(&scene, &out);
+    assert!(done.status.success());
+    for gone in [
+        "vtu/state_00030.vtu",
+        "vtu/spheres_00030.vtu",
+        "boundary.csv",
+    ] {
+        assert!(!out.join(gone).exists(), "{gone} of the earlier run stayed");
+    }
+    assert!(out.join("notes.txt").exists());
+    let listed = std::fs::read_to_string(out.join("results.pvd")).unwrap();
+    let states = std::fs::read_dir(&vtu)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().starts_with("state_"))
+        .count();
+    assert_eq!(states, listed.matches("state_").count());
+}
+
+#[test]
+fn bodies_thrown_through_each_other_are_stopped_with_a_report() {
+    let tmp = TempDir::new("tunnel");
+    let scene = variant(
+        "contact/collision.toml",
+        &[
+            ("velocity = [4.0, 0.0, 0.0]", "velocity = [40.0, 0.0, 0.0]"),
+            (
+                "velocity = [-1.0, 0.0, 0.0]",
+                "velocity = [-40.0, 0.0, 0.0]",
+            ),
+        ],
+        &tmp,
+    );
+    let message = refused(
+        &run(&scene, &tmp.path().join("out")),
+        &[
+            "pass through each other",
+            "more than the sphere radius 8.000e-3 m",
+            "fix: larger contact spheres (contact_radius), a stiffer contact",
+            "a smaller dt does not help here",
+        ],
+    );
+    assert!(
+        message.contains("`left`") && message.contains("`right`"),
+        "{message}"
+    );
+    // The speed named is the blocks' relative speed, below the 80 m/s they were thrown at
+    // (the contact has slowed them) and well above the fixture's 5 m/s.
+    let speed: f64 = message
+        .split("the bodies move at ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|word| word.parse().ok())
+        .unwrap_or_else(|| panic!("no speed in:\n{message}"));
+    assert!((20.0..80.0).contains(&speed), "{speed} m/s:\n{message}");
+    // At the fixture's own speeds the watch stays silent (same_outputs.py shows the outputs
+    // unchanged).
+    let out = tmp.path().join("fixture");
+    let done = run(&workspace().join("fixtures/contact/collision.toml"), &out);
+    assert!(done.status.success());
+}
+
+/// A bar of four cubes (edge 0.1 m, along x from 0 to 0.4 m) of six tetrahedra each, as
+/// MSH 2.2; with `split`, the nodes at x = 0.2 are written twice, once for each side.
+fn four_cubes(split: bool) -> String {
+    let h = 0.1;
+    let mut nodes: Vec<[f64; 3]> = Vec::new();
+    let mut id = std::collections::HashMap::new();
+    let mut node = |i: usize, j: usize, k: usize, side: usize| -> usize {
+        let key = (i, j, k, if split && i == 2 { side } else { 0 });
+        *id.entry(key).or_insert_with(|| {
+            nodes.push([i as f64 * h, j as f64 * h, k as f64 * h]);
+            nodes.len()
+        })
+    };
+    let mut tets: Vec<[usize; 4]> = Vec::new();
+    // Kuhn's six tetrahedra of a cube: the paths from corner 000 to 111 along the axes.
+    let orders = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    for cube in 0..4 {
+        let side = usize::from(cube >= 2);
+        for order in orders {
+            let mut at = [cube, 0, 0];
+            let mut tet = [node(at[0], at[1], at[2], side); 4];
+            for (n, axis) in order.iter().enumerate() {
+                at[*axis] += 1;
+                tet[n + 1] = node(at[0], at[1], at[2], side);
+            }
+            tets.push(tet);
+        }
+    }
+    let mut msh = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n");
+    msh.push_str("$PhysicalNames\n1\n3 1 \"bar\"\n$EndPhysicalNames\n");
+    writeln!(msh, "$Nodes\n{}", nodes.len()).unwrap();
+    for (n, p) in nodes.iter().enumerate() {
+        writeln!(msh, "{} {} {} {}", n + 1, p[0], p[1], p[2]).unwrap();
+    }
+    writeln!(msh, "$EndNodes\n$Elements\n{}", tets.len()).unwrap();
+    for (e, t) in tets.iter().enumerate() {
+        let [a, b, c, d] = *t;
+        // Positive orientation: det[b - a, c - a, d - a] > 0, else swap the last two.
+        let v = |m: usize| nodes[m - 1];
+        let (p, q, r, s) = (v(a), v(b), v(c), v(d));
+        let e1 = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+        let e2 = [r[0] - p[0], r[1] - p[1], r[2] - p[2]];
+        let e3 = [s[0] - p[0], s[1] - p[1], s[2] - p[2]];
+        let det = e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) - e1[1] * (e2[0] * e3[2] - e2[2] * e3[0])
+            + e1[2] * (e2[0] * e3[1] - e2[1] * e3[0]);
+        let (c, d) = if det > 0.0 { (c, d) } else { (d, c) };
+        writeln!(msh, "{} 4 2 1 1 {a} {b} {c} {d}", e + 1).unwrap();
+    }
+    msh.push_str("$EndElements\n");
+    msh
+}
+
+/// The bar clamped at x = 0 and pulled down at x = 0.4 by 100 N for 10 ms.
+fn bar_scene(merge: bool) -> String {
+    format!(
+        "[run]\nt_end = 0.01\nprobe_every = 1e-3\n\n\
+         [[material]]\nname = \"stiff\"\ndensity = 1000.0\nyoung = 1e9\npoisson = 0.25\n\n\
+         [[body]]\nname = \"bar\"\nmesh = \"bar.msh\"\nmaterial = \"stiff\"\nmerge_nodes = {merge}\n\n\
+         [[fix]]\nbody = \"bar\"\nbox = [[-0.01, -0.01, -0.01], [0.01, 0.11, 0.11]]\ndofs = \"xyz\"\n\n\
+         [[load]]\nbody = \"bar\"\nbox = [[0.39, -0.01, -0.01], [0.41, 0.11, 0.11]]\n\
+         total_force = [0.0, 0.0, -100.0]\nramp = [[0.0, 1.0], [1.0, 1.0]]\n\n\
+         [[probe]]\nname = \"tip\"\nbody = \"bar\"\npoint = [0.4, 0.1, 0.1]\n"
+    )
+}
+
+#[test]
+fn duplicate_nodes_are_reported_and_merged_on_request() {
+    let tmp = TempDir::new("dup-nodes");
+    std::fs::write(tmp.path().join("bar.msh"), four_cubes(true)).unwrap();
+    let detached = tmp.path().join("detached.toml");
+    std::fs::write(&detached, bar_scene(false)).unwrap();
+    let check = qdem(&[OsStr::new("check"), detached.as_os_str()]);
+    let stdout = String::from_utf8_lossy(&check.stdout);
+    assert!(check.status.success(), "{stdout}");
+    let warning = stdout
+        .lines()
+        .find(|l| l.contains("nodes coincide"))
+        .unwrap_or_else(|| panic!("no warning of coincident nodes:\n{stdout}"));
+    for needle in [
+        "bar.msh",
+        "body `bar`: 4 nodes coincide with another node",
+        "at (0.2, ",
+        "fix: merge_nodes = true on the body",
+    ] {
+        assert!(warning.contains(needle), "no {needle:?} in {warning}");
+    }
+    let out = tmp.path().join("out-detached");
+    let done = run(&detached, &out);
+    assert!(String::from_utf8_lossy(&done.stderr).contains("4 nodes coincide"));
+    let loose = last_probe(&out, "tip.uz");
+
+    let merged = tmp.path().join("merged.toml");
+    std::fs::write(&merged, bar_scene(true)).unwrap();
+    let check = qdem(&[OsStr::new("check"), merged.as_os_str()]);
+    assert!(!String::from_utf8_lossy(&check.stdout).contains("nodes coincide"));
+    let out = tmp.path().join("out-merged");
+    let done = run(&merged, &out);
+    assert!(done.status.success());
+    let held = last_probe(&out, "tip.uz");
+
+    // Detached, the outer half is a free body under the tip load: small rigid motion from
+    // rest, with the lumped masses the run uses (a quarter of each tetrahedron's mass at each
+    // node), gives the tip's fall; its elastic part is some 1e-6 m here.
+    let rigid = rigid_tip_fall(100.0, 0.01);
+    assert!(
+        (loose + rigid).abs() < 0.03 * rigid,
+        "detached tip {loose} m, rigid outer half {rigid} m"
+    );
+    // Merged, the bar is one cantilever: below twice (a step load's dynamic overshoot) its
+    // static Timoshenko deflection F L³/(3EI) + F L/(κ G A), which the stiffer coarse
+    // tetrahedra do not reach.
+    let (e, g, area, inertia) = (1e9, 1e9 / 2.5, 0.01, 0.1f64.powi(4) / 12.0);
+    let beam = 100.0 * 0.4f64.powi(3) / (3.0 * e * inertia) + 100.0 * 0.4 / (5.0 / 6.0 * g * area);
+    assert!(
+        held < 0.0 && held.abs() < 2.0 * beam,
+        "merged tip {held} m, beam {beam} m"
+    );
+    assert!(loose.abs() > 10.0 * held.abs());
+}
+
+/// The fall (m) of the probe node (0.4, 0.1, 0.1) of the outer half (x from 0.2 to 0.4) of
+/// the four cubes, moving as a rigid body from rest under `force` (N, down, shared by its
+/// four nodes at x = 0.4) for `time` (s): u = ½ t² (F/m + α × r), α = I⁻¹ τ.
+fn rigid_tip_fall(force: f64, time: f64) -> f64 {
+    let msh = four_cubes(true);
+    let nodes: Vec<[f64; 3]> = section(&msh, "$Nodes")
+        .map(|l| {
+            let v: Vec<f64> = l
+                .split_whitespace()
+                .skip(1)
+                .map(|w| w.parse().unwrap())
+                .collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    let mut mass = vec![0.0; nodes.len()];
+    for line in section(&msh, "$Elements") {
+        let ids: Vec<usize> = line
+            .split_whitespace()
+            .skip(5)
+            .map(|w| w.parse().unwrap())
+            .collect();
+        if ids.iter().all(|&n| nodes[n - 1][0] >= 0.2 - 1e-12) {
+            for n in ids {
+                mass[n - 1] += 1000.0 * 0.1f64.powi(3) / 6.0 / 4.0;
+            }
+        }
+    }
+    let m: f64 = mass.iter().sum();
+    let c: Vec<f64> = (0..3)
+        .map(|k| (0..nodes.len()).map(|i| mass[i] * nodes[i][k]).sum::<f64>() / m)
+        .collect();
+    let mut inertia = [[0.0; 3]; 3];
+    let mut torque = [0.0; 3];
+    for (i, p) in nodes.iter().enumerate() {
+        let r = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        for a in 0..3 {
+            for b in 0..3 {
+                inertia[a][b] += mass[i] * (if a == b { r2 } else { 0.0 } - r[a] * r[b]);
+            }
+        }
+        if p[0] == 0.4 {
+            // r × (0, 0, -F/4)
+            let f = -force / 4.0;
+            torque[0] += r[1] * f;
+            torque[1] -= r[0] * f;
+        }
+    }
+    let alpha = solve3(inertia, torque);
+    let r = [0.4 - c[0], 0.1 - c[1], 0.1 - c[2]];
+    // z of α × r, plus F/m.
+    let accel = -force / m + alpha[0] * r[1] - alpha[1] * r[0];
+    -0.5 * accel * time * time
+}
+
+/// The lines of a MSH 2.2 section after its count line.
+fn section<'a>(msh: &'a str, name: &str) -> impl Iterator<Item = &'a str> {
+    let body = msh.split(name).nth(1).expect("the section");
+    let end = format!("$End{}", &name[1..]);
+    let body = body.split(end.as_str()).next().expect("its end");
+    body.lines().skip(2).filter(|l| !l.trim().is_empty())
+}
+
+/// x with `a` x = `b` (Cramer's rule; `a` symmetric positive definite).
+fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
+    let det = |m: [[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(a);
+    let mut x = [0.0; 3];
+    for (k, xk) in x.iter_mut().enumerate() {
+        let mut m = a;
+        for row in 0..3 {
+            m[row][k] = b[row];
+        }
+        *xk = det(m) / d;
+    }
+    x
+}
+
+#[test]
+fn stop_after_a_step_a_resumed_checkpoint_has_passed_is_refused() {
+    let tmp = TempDir::new("stop-after");
+    let out = tmp.path().join("out");
+    let scene = workspace().join("fixtures/contact/collision.toml");
+    let with = |extra: &[&str]| {
+        let mut args = vec![
+            OsStr::new("run"),
+            scene.as_os_str(),
+            OsStr::new("--out"),
+            out.as_os_str(),
+        ];
+        args.extend(extra.iter().map(OsStr::new));
+        qdem(&args)
+    };
+    let checkpoint = out.join("checkpoint.qdc");
+    let checkpoint = checkpoint.to_str().expect("a UTF-8 path");
+    assert_eq!(with(&["--stop-after", "100"]).status.code(), Some(130));
+    refused(
+        &with(&["--resume", checkpoint, "--stop-after", "50"]),
+        &[
+            "--stop-after 50 counts steps from the run's start",
+            "the checkpoint is at step 100",
+            "fix: give a step after 100, e.g. --stop-after 150",
+        ],
+    );
+    let resumed = with(&["--resume", checkpoint, "--stop-after", "150"]);
+    let stderr = String::from_utf8_lossy(&resumed.stderr);
+    assert_eq!(resumed.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("(step 150)"), "{stderr}");
+}
