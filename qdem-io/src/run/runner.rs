@@ -253,8 +253,9 @@ pub fn run_with(
     let steps = sim.steps();
     let probes = probe_particles(sim);
     let first_step = run.record.next_step;
-    let watch = options
-        .ranks
+    let watch = sim
+        .world
+        .decomposition()
         .is_none()
         .then(|| ContactWatch::new(sim))
         .flatten();
