@@ -148,6 +148,22 @@ impl DemContacts {
         self.split.as_ref().map_or(0, |p| p.ghosts)
     }
 
+    /// The touching pair of spheres whose overlap at the last evaluation is the largest part
+    /// of the smaller radius: (first, second, overlap in m); `None` without touching pairs.
+    /// One pass over the pair records, cheap enough for every step.
+    pub fn deepest_pair(&self) -> Option<(usize, usize, f64)> {
+        let mut deepest: Option<(usize, usize, f64, f64)> = None;
+        for c in self.pairs.items.iter().filter(|c| c.force != Vec3::zeros()) {
+            let (a, b) = (c.first as usize, c.second as usize);
+            let overlap = 2.0 * c.half_overlap;
+            let depth = overlap / self.radius[a].min(self.radius[b]);
+            if deepest.is_none_or(|d| depth > d.3) {
+                deepest = Some((a, b, overlap, depth));
+            }
+        }
+        deepest.map(|(a, b, overlap, _)| (a, b, overlap))
+    }
+
     /// How many times the candidate lists were rebuilt.
     pub fn rebuilds(&self) -> u64 {
         self.rebuilds

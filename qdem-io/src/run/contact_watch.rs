@@ -18,13 +18,13 @@
 //! the test: the deepest overlap of the fixture scenes is a fraction of a radius
 //! (docs/reliability.md). Reading the contacts changes nothing in the state, so outputs stay
 //! the same. It watches the scenes of two or more `[[body]]`s with contact spheres and no
-//! `[granular]` or `[ballast]` stones: reading every touching contact after every step cost
-//! the 2,000 grains of `fixtures/contact/grains.toml` a quarter of their run time (1.24× and
+//! `[granular]` or `[ballast]` stones: reading every touching contact after every step
+//! (through the output view, before [`qdem_contact::DemContacts::deepest_pair`]) cost the
+//! 2,000 grains of `fixtures/contact/grains.toml` a quarter of their run time (1.24× and
 //! 1.29×, A B A B), where stones, not bodies, touch. A run decomposed over MPI ranks has no
 //! watch (each rank sees only its own contacts).
 
 use crate::build::{BodyInfo, Simulation};
-use qdem_contact::Partner;
 use qdem_core::Vec3;
 use thiserror::Error;
 
@@ -96,23 +96,18 @@ impl ContactWatch {
         })
     }
 
-    /// After `step`: the first touching pair of spheres that overlaps by more than the
+    /// After `step`: the touching pair of spheres that overlaps most for its size, if by more than the
     /// smaller radius, as an [`Interpenetration`].
     pub(crate) fn check(&self, sim: &Simulation, step: u64) -> Result<(), Box<Interpenetration>> {
         let Some(contacts) = sim.contacts() else {
             return Ok(());
         };
-        for c in contacts.touching() {
-            let Partner::Sphere(b) = c.second else {
-                continue;
-            };
-            let a = c.first;
-            let overlap = self.radius[a] + self.radius[b] - (c.to - c.from).norm();
-            if overlap > self.radius[a].min(self.radius[b]) {
-                return Err(Box::new(self.report(sim, step, (a, b), overlap)));
+        match contacts.deepest_pair() {
+            Some((a, b, overlap)) if overlap > self.radius[a].min(self.radius[b]) => {
+                Err(Box::new(self.report(sim, step, (a, b), overlap)))
             }
+            _ => Ok(()),
         }
-        Ok(())
     }
 
     /// The `[[body]]` of sphere `s`, if it belongs to one (not to a stone).
