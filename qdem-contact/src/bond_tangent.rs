@@ -7,10 +7,15 @@
 //! the implicit solve) holds, and adding the bonds to a tangent is one copy instead of a
 //! 6×6 transformation per bond at every refactorisation. The price is memory: 42 entries of
 //! 24 bytes, about 1 kB, per bond (200 MB for the 0.005 m benchmark beam's 204,714 bonds).
+//!
+//! The entries go to the tangent as kept entries ([`KeptEntries`]) with the bonds broken
+//! since they were made, so that the implicit solver updates only those entries of its
+//! matrix (issue 44).
 
 use crate::beam_bond::{to_global_matrix, BeamBond};
-use qdem_core::tangent::Entry;
+use qdem_core::tangent::{Entry, KeptEntries};
 use qdem_core::Tangent;
+use std::ops::Range;
 
 /// Entries of one bond's 6×6 block on or below the diagonal (its six DOFs are distinct).
 const PER_BOND: usize = 21;
@@ -21,6 +26,10 @@ pub(crate) struct BondTangent {
     nodes: usize,
     stiffness: Vec<Entry>,
     damping: Vec<Entry>,
+    /// Names these entries for the assemblies ([`KeptEntries::source`]).
+    source: u64,
+    /// The entries of the bonds removed since, in order.
+    removed: Vec<Range<usize>>,
 }
 
 impl BondTangent {
@@ -30,6 +39,8 @@ impl BondTangent {
             nodes,
             stiffness: Vec::with_capacity(PER_BOND * bonds.len()),
             damping: Vec::with_capacity(PER_BOND * bonds.len()),
+            source: KeptEntries::new_source(),
+            removed: Vec::new(),
         };
         for (b, &ok) in bonds.iter().zip(intact) {
             let k = to_global_matrix(&b.local_stiffness(), b.axis);
@@ -52,15 +63,22 @@ impl BondTangent {
         let range = PER_BOND * k..PER_BOND * (k + 1);
         for e in self.stiffness[range.clone()]
             .iter_mut()
-            .chain(&mut self.damping[range])
+            .chain(&mut self.damping[range.clone()])
         {
             e.val = 0.0;
         }
+        self.removed.push(range);
     }
 
-    /// Adds every bond's entries to `tangent`.
+    /// Adds every bond's entries to `tangent`, as kept entries.
     pub(crate) fn add_to(&self, tangent: &mut Tangent) {
-        tangent.extend(&self.stiffness, &self.damping);
+        let kept = KeptEntries {
+            source: self.source,
+            stiffness: self.stiffness.len(),
+            damping: self.damping.len(),
+            changes: self.removed.clone(),
+        };
+        tangent.extend_kept(&self.stiffness, &self.damping, kept);
     }
 }
 

@@ -8,6 +8,8 @@
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::Mat3;
 use faer::sparse::Triplet;
+use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// One stored value of a tangent: (row DOF, column DOF, value).
 pub type Entry = Triplet<usize, usize, f64>;
@@ -18,6 +20,33 @@ pub type Entry = Triplet<usize, usize, f64>;
 pub struct Tangent {
     pub(crate) stiffness: Vec<Entry>,
     pub(crate) damping: Vec<Entry>,
+    /// The leading entries that a model keeps between assemblies ([`Tangent::extend_kept`]).
+    pub(crate) kept: Option<KeptEntries>,
+}
+
+/// A list of tangent entries that a model keeps between assemblies, in the same places, and
+/// whose values change only where it says (a broken bond's entries going to zero): the
+/// implicit solver then updates those entries of the matrix it keeps instead of summing every
+/// entry again (issue 44).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct KeptEntries {
+    /// Names the list for the life of the process ([`KeptEntries::new_source`]).
+    pub source: u64,
+    /// Entries in the stiffness list.
+    pub stiffness: usize,
+    /// Entries in the damping list.
+    pub damping: usize,
+    /// The entries changed since the list was made, one range per change, in order (the same
+    /// indices in both lists); the list's revision is the number of changes.
+    pub changes: Vec<Range<usize>>,
+}
+
+impl KeptEntries {
+    /// A source number that no other call in this process returns.
+    pub fn new_source() -> u64 {
+        static NEXT: AtomicU64 = AtomicU64::new(0);
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    }
 }
 
 impl Tangent {
@@ -30,6 +59,7 @@ impl Tangent {
     pub fn clear(&mut self) {
         self.stiffness.clear();
         self.damping.clear();
+        self.kept = None;
     }
 
     /// Adds the stiffness block K_ij (∂ of the force on particle i by the position of j,
@@ -68,12 +98,25 @@ impl Tangent {
         self.damping.extend_from_slice(damping);
     }
 
+    /// Appends a model's kept entries, as [`Tangent::extend`] does, and marks them kept when
+    /// they lead the tangent (nothing was added before them): `kept` says which they are and
+    /// what changed in them since they were made.
+    pub fn extend_kept(&mut self, stiffness: &[Entry], damping: &[Entry], kept: KeptEntries) {
+        let leading = self.stiffness.is_empty() && self.damping.is_empty();
+        let sized = kept.stiffness == stiffness.len() && kept.damping == damping.len();
+        if leading && sized {
+            self.kept = Some(kept);
+        }
+        self.extend(stiffness, damping);
+    }
+
     /// The stored stiffness entries (lower triangle, global DOFs, duplicates not summed).
     pub fn stiffness_entries(&self) -> &[Entry] {
         &self.stiffness
     }
 
-    /// Writes the entries into a checkpoint (an implicit stepper's factorised tangent).
+    /// Writes the entries into a checkpoint (an implicit stepper's factorised tangent), and
+    /// how many of them are kept: a resumed run sums them per slot as the first run did.
     pub(crate) fn save(&self, out: &mut Encoder) {
         for list in [&self.stiffness, &self.damping] {
             out.u64(list.len() as u64);
@@ -82,6 +125,11 @@ impl Tangent {
                 out.u64(e.col as u64);
                 out.f64(e.val);
             }
+        }
+        out.bool(self.kept.is_some());
+        if let Some(kept) = &self.kept {
+            out.u64(kept.stiffness as u64);
+            out.u64(kept.damping as u64);
         }
     }
 
@@ -107,6 +155,23 @@ impl Tangent {
                 }
                 list.push(Triplet::new(row as usize, col as usize, val));
             }
+        }
+        self.kept = None;
+        if input.bool("whether the tangent has kept entries")? {
+            let stiffness = input.u64("kept stiffness entries")? as usize;
+            let damping = input.u64("kept damping entries")? as usize;
+            if stiffness > self.stiffness.len() || damping > self.damping.len() {
+                return Err(CheckpointError::Invalid {
+                    what: "tangent",
+                    detail: format!("{stiffness} and {damping} kept entries of fewer"),
+                });
+            }
+            self.kept = Some(KeptEntries {
+                source: KeptEntries::new_source(),
+                stiffness,
+                damping,
+                changes: Vec::new(),
+            });
         }
         Ok(())
     }

@@ -29,8 +29,9 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.qdc";
 /// 4: a one-sphere stone is one rotating particle, not a rigid body of a centre and a member,
 /// and the Verlet stepper keeps the particles' moments beside the rigid bodies' torques;
 /// 5: an implicit Newmark stepper keeps, with each factorisation, the matrix it factorised and
-/// the assembler's sparsity pattern, and its step counts include redos and iterative solves).
-pub const FORMAT_VERSION: u64 = 5;
+/// the assembler's sparsity pattern, and its step counts include redos and iterative solves;
+/// 6: its tangent records how many of its leading entries a model keeps).
+pub const FORMAT_VERSION: u64 = 6;
 
 const MAGIC: &[u8; 8] = b"QDEMCKPT";
 const HEADER: usize = 8 + 8 + 8;
