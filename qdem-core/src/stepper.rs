@@ -87,6 +87,13 @@ pub trait Stepper: Send {
         &mut []
     }
 
+    /// The torques on the rigid bodies at the current state (the last evaluation's), from
+    /// which their angular accelerations follow; empty (the default) for a stepper that keeps
+    /// none.
+    fn rigid_torque(&self) -> &[Vec3] {
+        &[]
+    }
+
     /// Size and cost of the sparse factorisation, for steppers that solve a linear system;
     /// `None` for explicit steppers and before the first factorisation.
     fn factor_stats(&self) -> Option<&FactorStats> {

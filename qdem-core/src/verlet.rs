@@ -180,6 +180,10 @@ impl Stepper for Verlet {
         &mut self.torque[..bodies]
     }
 
+    fn rigid_torque(&self) -> &[Vec3] {
+        &self.torque[..self.rigid_bodies.min(self.torque.len())]
+    }
+
     fn restrict(&mut self, local: Arc<LocalParticles>) -> bool {
         self.local = Some(local);
         true
