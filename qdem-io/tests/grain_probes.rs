@@ -231,12 +231,8 @@ point = [0.0, 0.0, 0.0]
     );
     let c = run_scene(&dir, &scene);
     // The centre falls freely.
-    for k in 0..c["t"].len() {
-        assert!(
-            (c["center.az"][k] + 9.81).abs() < 1e-9,
-            "{}",
-            c["center.az"][k]
-        );
+    for az in &c["center.az"] {
+        assert!((az + 9.81).abs() < 1e-9, "{az}");
     }
     // At t = 0 the corner's velocity is v + ω × r, r = (0.05, 0.05, 0.05).
     let r = [0.05, 0.05, 0.05];
