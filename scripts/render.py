@@ -20,8 +20,11 @@ KIND
 OUT_DIR is a run's output directory (its results.pvd and vtu/); PNG the picture to write.
 Run it with python3: it starts itself again under pvpython, through `xvfb-run -a` when there
 is no display and xvfb-run is installed (Debian's ParaView renders offscreen only with an X
-server), else with --force-offscreen-rendering. Without pvpython it says so and exits 77, the
-status a test reads as "skipped".
+server), else with --force-offscreen-rendering. Before the picture it renders a small test
+scene the same way: when pvpython is missing, or cannot render here (Debian's ParaView without
+xvfb-run answers --force-offscreen-rendering with a segmentation fault, exit 245), it says so
+and exits 77, the status a test reads as "skipped"; a failure after a working test render is a
+real one.
 """
 
 import argparse
@@ -35,8 +38,37 @@ import xml.etree.ElementTree as ET
 SKIPPED = 77
 
 
+def launcher(pvpython):
+    """The command line that starts pvpython headless: under `xvfb-run -a` when there is no
+    display and xvfb-run is installed, else with --force-offscreen-rendering."""
+    if os.environ.get("DISPLAY") or not shutil.which("xvfb-run"):
+        return [pvpython, "--force-offscreen-rendering"]
+    return ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24", pvpython]
+
+
+def call(args):
+    """Runs args; retries twice when xvfb-run handed pvpython a display whose server is not up
+    yet (or is still going from the previous run): ParaView then aborts at once with "bad X
+    server connection"."""
+    for _ in range(3):
+        status = subprocess.call(args)
+        if args[0] != "xvfb-run" or (status != -signal.SIGABRT and status != 128 + signal.SIGABRT):
+            break
+    return status
+
+
+def describe(status):
+    """An exit status as words: a signal's name when the process died of one."""
+    number = -status if status < 0 else status - 128 if status > 128 else 0
+    try:
+        return "killed by %s (exit %d)" % (signal.Signals(number).name, status)
+    except ValueError:
+        return "exit %d" % status
+
+
 def relaunch():
-    """Restarts this script under pvpython, or exits SKIPPED when there is none."""
+    """Restarts this script under pvpython, or exits SKIPPED when there is none or when it
+    cannot render a test scene here."""
     pvpython = shutil.which("pvpython")
     if os.environ.get("QDEM_RENDER_UNDER_PVPYTHON"):
         raise ImportError("pvpython started, but paraview.simple or vtk does not import")
@@ -44,19 +76,29 @@ def relaunch():
     if pvpython is None:
         print("render.py: pvpython (ParaView) is not installed; nothing rendered", file=sys.stderr)
         sys.exit(SKIPPED)
-    args = [pvpython, os.path.abspath(__file__)] + sys.argv[1:]
-    if os.environ.get("DISPLAY") or not shutil.which("xvfb-run"):
-        args.insert(1, "--force-offscreen-rendering")
-        sys.exit(subprocess.call(args))
-    # xvfb-run -a now and then hands pvpython a display whose server is not up yet (or is
-    # still going from the previous run): ParaView then aborts at once with "bad X server
-    # connection"; another try gets a working one.
-    args = ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24"] + args
-    for _ in range(3):
-        status = subprocess.call(args)
-        if status != -signal.SIGABRT and status != 128 + signal.SIGABRT:
-            break
-    sys.exit(status)
+    start = launcher(pvpython)
+    script = os.path.abspath(__file__)
+    probe = call(start + [script, "--probe"])
+    if probe != 0:
+        print(
+            "render.py: %s cannot render here (its test render: %s); nothing rendered. "
+            "Install xvfb (Debian: apt-get install xvfb) or run with a display."
+            % (" ".join(start), describe(probe)),
+            file=sys.stderr,
+        )
+        sys.exit(SKIPPED)
+    sys.exit(call(start + [script] + sys.argv[1:]))
+
+
+def probe_render():
+    """The test render: a sphere in a small offscreen view, saved to a temporary PNG."""
+    import tempfile
+
+    view = pv.CreateView("RenderView")
+    view.ViewSize = [64, 64]
+    pv.Show(pv.Sphere(), view)
+    with tempfile.TemporaryDirectory() as tmp:
+        pv.SaveScreenshot(os.path.join(tmp, "probe.png"), view)
 
 
 try:
@@ -264,6 +306,9 @@ def bbm(args):
 
 
 def main():
+    if sys.argv[1:] == ["--probe"]:
+        probe_render()
+        return
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("kind", choices=["boxtest", "ballast", "cantilever", "bbm"])
     p.add_argument("out_dir")

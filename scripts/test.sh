@@ -19,6 +19,10 @@ if [ -n "$outside" ]; then
 fi
 # One build from scratch: incremental caches would only double the target folder's size.
 export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
+# The embedding examples (qdem-core's beam_under_load, qdem-contact's two_bodies_collide and
+# spheres_on_wall) run among these targets (`test = true, harness = false` in their crates'
+# Cargo.toml): each checks a physical quantity and exits non-zero when it is off. Run alone,
+# `cargo run -p CRATE --example` would build the dependencies again for that crate's features.
 cargo test --workspace --all-targets
 cargo test --workspace --doc
 # The MPI runs (`mpirun -np N qdem run`, byte-identical for 1-3 ranks): Open MPI and, for
@@ -30,9 +34,3 @@ if ! dpkg -s openmpi-bin libopenmpi-dev libclang-dev >/dev/null 2>&1; then
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq openmpi-bin libopenmpi-dev libclang-dev >/dev/null
 fi
 cargo test -p qdem-cli --features mpi --test mpi_runs
-# The embedding examples: each checks a physical quantity and exits non-zero when it is off
-# (a few seconds each). The test profile reuses what `cargo test --all-targets` built (the
-# examples are among its targets) instead of a second, release build of every dependency.
-cargo run --profile test -p qdem-core --example beam_under_load
-cargo run --profile test -p qdem-contact --example two_bodies_collide
-cargo run --profile test -p qdem-contact --example spheres_on_wall

@@ -38,16 +38,13 @@
 //! deterministic function of the seed.
 //!
 //! # Mass properties
-//! [`clump_mass_properties`] integrates over the union of the spheres (overlaps counted once)
-//! with the midpoint rule on a regular grid of spacing h = r_max/20, r_max the largest radius,
-//! anchored half a spacing off the first sphere's centre; each grid point is a cube of side h
-//! (its own inertia m·h²/6 included). A point belongs to the first sphere that contains it. At
-//! 20 points per radius a sphere's volume is within about 0.2% and its moment of inertia within
-//! about 0.4%, which the tests check against closed forms at 1% and 2%.
+//! [`clump_mass_properties`] (in [`crate::clump_mass`], re-exported here): exact for a
+//! one-sphere stone, a grid integration with a stated error bound for a clump.
 
+pub use crate::clump_mass::{clump_mass_properties, MassProperties};
 use crate::particle_packing::SplitMix64;
 use nalgebra::{Quaternion, UnitQuaternion};
-use qdem_core::{Mat3, Vec3};
+use qdem_core::Vec3;
 
 /// Long-axis semi-axis over d/2: U(1.0, 1.3).
 const LONG_AXIS: [f64; 2] = [1.0, 1.3];
@@ -63,8 +60,6 @@ const JITTER: f64 = 0.1;
 const EXTENT: f64 = 1.3;
 /// Gap between cells' usable boxes over the largest size.
 const GAP: f64 = 0.02;
-/// Grid points per largest sphere radius in the mass integration.
-const GRID_PER_RADIUS: f64 = 20.0;
 
 /// What [`Grading::new`], [`generate_stones`] and [`clump_mass_properties`] refuse; every
 /// message says what to change.
@@ -319,17 +314,6 @@ pub struct Stone {
     pub radii: Vec<f64>,
 }
 
-/// Mass (kg), centre of mass, inertia tensor about the centre of mass (kg m², world axes).
-#[derive(Clone, Copy, Debug)]
-pub struct MassProperties {
-    /// Mass (kg).
-    pub mass: f64,
-    /// Centre of mass (m).
-    pub center: Vec3,
-    /// Inertia tensor about the centre of mass (kg m², world axes).
-    pub inertia: Mat3,
-}
-
 /// `spec.count` stones of the shape and placement described in the module docs, in cell order
 /// (x fastest, then y, then z); deterministic for a seed.
 pub fn generate_stones(spec: &SampleSpec) -> Result<Vec<Stone>, SampleError> {
@@ -522,141 +506,9 @@ fn random_rotation(rng: &mut SplitMix64) -> UnitQuaternion<f64> {
     ))
 }
 
-/// Mass properties of the union of the stone's spheres at `density`, by integration over a
-/// regular grid of sample points (deterministic; resolution fixed so that the volume of a single
-/// sphere is within 1% and a clump's inertia within ~2%; see the module docs).
-pub fn clump_mass_properties(stone: &Stone, density: f64) -> Result<MassProperties, SampleError> {
-    if !(density.is_finite() && density > 0.0) {
-        return Err(SampleError::Density { density });
-    }
-    check_stone(stone)?;
-    let r_max = stone.radii.iter().copied().fold(0.0, f64::max);
-    let h = r_max / GRID_PER_RADIUS;
-    let anchor = stone.centers[0];
-    // Centres relative to the anchor: the grid points are (n + 1/2)·h, n integer.
-    let spheres: Vec<(Vec3, f64)> = stone
-        .centers
-        .iter()
-        .zip(&stone.radii)
-        .map(|(c, &r)| (c - anchor, r))
-        .collect();
-    let mut moments = GridMoments::default();
-    for (i, &(center, r)) in spheres.iter().enumerate() {
-        let earlier = &spheres[..i];
-        sum_sphere(center, r, h, |p| {
-            if !earlier
-                .iter()
-                .any(|&(c, s)| (p - c).norm_squared() <= s * s)
-            {
-                moments.add(p);
-            }
-        });
-    }
-    Ok(moments.mass_properties(density, h, anchor))
-}
-
-/// The stone has spheres, as many radii as centres, all finite and the radii positive.
-fn check_stone(stone: &Stone) -> Result<(), SampleError> {
-    let reason = if stone.centers.is_empty() {
-        "it has no spheres".to_string()
-    } else if stone.centers.len() != stone.radii.len() {
-        format!(
-            "{} centres but {} radii",
-            stone.centers.len(),
-            stone.radii.len()
-        )
-    } else if let Some(i) = stone
-        .centers
-        .iter()
-        .position(|c| !c.iter().all(|v| v.is_finite()))
-    {
-        format!("centre {i} is {:?}", stone.centers[i].as_slice())
-    } else if let Some(i) = stone
-        .radii
-        .iter()
-        .position(|r| !(r.is_finite() && *r > 0.0))
-    {
-        format!("radius {i} is {}", stone.radii[i])
-    } else {
-        return Ok(());
-    };
-    Err(SampleError::Stone { reason })
-}
-
-/// Calls `visit` with every grid point (n + 1/2)·h inside the sphere (`center`, `r`).
-fn sum_sphere(center: Vec3, r: f64, h: f64, mut visit: impl FnMut(Vec3)) {
-    // Index range whose points lie within [c − reach, c + reach], one wider each way than
-    // needed; the exact test below decides.
-    let range = |c: f64, reach: f64| {
-        let lo = ((c - reach) / h - 0.5).floor() as i64;
-        let hi = ((c + reach) / h - 0.5).ceil() as i64;
-        lo..=hi
-    };
-    let point = |n: i64| (n as f64 + 0.5) * h;
-    let r2 = r * r;
-    for ix in range(center.x, r) {
-        let x = point(ix);
-        let left_x = r2 - (x - center.x).powi(2);
-        if left_x < 0.0 {
-            continue;
-        }
-        for iy in range(center.y, left_x.sqrt()) {
-            let y = point(iy);
-            let left_y = left_x - (y - center.y).powi(2);
-            if left_y < 0.0 {
-                continue;
-            }
-            for iz in range(center.z, left_y.sqrt()) {
-                let p = Vec3::new(x, y, point(iz));
-                if (p - center).norm_squared() <= r2 {
-                    visit(p);
-                }
-            }
-        }
-    }
-}
-
-/// Zeroth, first and second moments of the grid points counted.
-#[derive(Default)]
-struct GridMoments {
-    /// Points counted.
-    count: u64,
-    /// Sum of the points.
-    first: Vec3,
-    /// Sum of the points' outer products.
-    second: Mat3,
-}
-
-impl GridMoments {
-    /// Counts point `p`.
-    fn add(&mut self, p: Vec3) {
-        self.count += 1;
-        self.first += p;
-        self.second += p * p.transpose();
-    }
-
-    /// Mass, centre and inertia about the centre, each point a cube of side `h` at `density`,
-    /// the points relative to `anchor`.
-    fn mass_properties(&self, density: f64, h: f64, anchor: Vec3) -> MassProperties {
-        let n = self.count as f64;
-        let cube = density * h.powi(3);
-        let mean = self.first / n;
-        // Second moment of mass about the centre of mass.
-        let spread = (self.second - n * mean * mean.transpose()) * cube;
-        let mass = cube * n;
-        let inertia = Mat3::identity() * (spread.trace() + mass * h * h / 6.0) - spread;
-        MassProperties {
-            mass,
-            center: anchor + mean,
-            inertia,
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::PI;
 
     /// Railway ballast 31.5/63 (EN 13450-like), sizes in m.
     fn ballast() -> Grading {
@@ -678,93 +530,6 @@ mod tests {
             spheres_per_stone: spheres,
             seed,
         }
-    }
-
-    fn sphere_volume(r: f64) -> f64 {
-        4.0 / 3.0 * PI * r.powi(3)
-    }
-
-    /// Largest entry of |a − b| over the largest entry of |b|.
-    fn relative_matrix_error(a: &Mat3, b: &Mat3) -> f64 {
-        (a - b).amax() / b.amax()
-    }
-
-    #[test]
-    fn single_sphere_has_the_closed_form_mass_properties() {
-        let (r, rho) = (0.03, 2650.0);
-        let center = Vec3::new(1.0, -2.0, 0.5);
-        let stone = Stone {
-            centers: vec![center],
-            radii: vec![r],
-        };
-        let props = clump_mass_properties(&stone, rho).unwrap();
-        let mass = rho * sphere_volume(r);
-        // Midpoint rule at 20 points per radius: ~0.2% on the volume, 1% asked for.
-        assert!((props.mass / mass - 1.0).abs() < 0.01, "{}", props.mass);
-        let j = 0.4 * mass * r * r;
-        for a in 0..3 {
-            assert!(
-                (props.inertia[(a, a)] / j - 1.0).abs() < 0.02,
-                "{}",
-                props.inertia
-            );
-            for b in 0..3 {
-                if a != b {
-                    // The grid is symmetric about the centre: off-diagonals cancel to rounding.
-                    assert!(props.inertia[(a, b)].abs() < 1e-9 * j, "{}", props.inertia);
-                }
-            }
-        }
-        // Likewise the centre, to rounding.
-        assert!((props.center - center).norm() < 1e-9 * r);
-    }
-
-    #[test]
-    fn two_far_spheres_follow_the_parallel_axis_theorem() {
-        let (r, rho) = (0.03, 2650.0);
-        let (c1, c2) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.2, 0.1, -0.05));
-        let stone = Stone {
-            centers: vec![c1, c2],
-            radii: vec![r, r],
-        };
-        let props = clump_mass_properties(&stone, rho).unwrap();
-        let m = rho * sphere_volume(r);
-        assert!(
-            (props.mass / (2.0 * m) - 1.0).abs() < 0.01,
-            "{}",
-            props.mass
-        );
-        let middle = 0.5 * (c1 + c2);
-        // Grid counting errors are near-symmetric: the centre is within 1% of a radius.
-        assert!(
-            (props.center - middle).norm() < 0.01 * r,
-            "{}",
-            props.center
-        );
-        let s = 0.5 * (c2 - c1);
-        let exact = Mat3::identity() * (2.0 * 0.4 * m * r * r)
-            + (Mat3::identity() * s.norm_squared() - s * s.transpose()) * (2.0 * m);
-        let error = relative_matrix_error(&props.inertia, &exact);
-        assert!(
-            error < 0.02,
-            "inertia {} vs {exact}: {error}",
-            props.inertia
-        );
-    }
-
-    #[test]
-    fn overlapping_spheres_have_the_lens_volume() {
-        let (r, d, rho) = (0.03, 0.04, 2000.0);
-        let offset = Vec3::new(1.0, 1.0, 1.0).normalize() * d;
-        let stone = Stone {
-            centers: vec![Vec3::new(0.3, 0.2, 0.1), Vec3::new(0.3, 0.2, 0.1) + offset],
-            radii: vec![r, r],
-        };
-        let props = clump_mass_properties(&stone, rho).unwrap();
-        let volume = 2.0 * sphere_volume(r) - PI * (4.0 * r + d) * (2.0 * r - d).powi(2) / 12.0;
-        // The union is counted once; midpoint rule at 20 points per radius, 1% asked for.
-        let error = props.mass / (rho * volume) - 1.0;
-        assert!(error.abs() < 0.01, "volume error {error}");
     }
 
     #[test]

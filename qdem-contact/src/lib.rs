@@ -32,6 +32,7 @@ pub mod beam_bond;
 mod bond_tangent;
 pub mod bonded_particles;
 pub mod broad_phase;
+pub mod clump_mass;
 pub mod clump_sample;
 pub mod collapse_watch;
 pub mod contact_law;

@@ -963,3 +963,49 @@ fn a_section_needs_one_axis_a_finite_plane_and_contacts() {
         ],
     );
 }
+
+#[test]
+fn initial_motion_keys_and_grain_probes_are_checked_by_name() {
+    // A body's angular velocity: finite, three components.
+    let (_, msg) = error(&with(
+        "reorder = true",
+        "reorder = true\nangular_velocity = [0.0, nan, 1.0]",
+    ));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:22:",
+            "[[body]] \"beam\": `angular_velocity` must be a finite number, not NaN",
+        ],
+    );
+    let (_, msg) = error(&with(
+        "reorder = true",
+        "reorder = true\nangular_velocity = [0.0, 1.0]",
+    ));
+    assert_has(
+        &msg,
+        &["scenes/scene.toml:22:", "angular_velocity", "length"],
+    );
+    // [granular]: finite motion, the region_ forms only with a generation.
+    let granular = format!(
+        "{BASE}\n[contact]\nnormal_stiffness = 1e6\ntangential_stiffness = 1e6\n\n[granular]\n\
+         name = \"grains\"\nmaterial = \"concrete\"\nsample = \"stones.csv\"\n\
+         velocity = [inf, 0.0, 0.0]\nangular_velocity = [0.0, 0.0, nan]\n\
+         region_velocity = [0.0, 0.0, -1.0]\n\n[[probe]]\nname = \"grain\"\nbody = \"grains\"\n\
+         stone = 0\nbox = [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]\n\n[[probe]]\nname = \"bad\"\n\
+         body = \"beam\"\nstone = 2\n"
+    );
+    let (_, msg) = error(&granular);
+    assert_has(
+        &msg,
+        &[
+            "[granular] \"grains\": `velocity` must be a finite number, not inf",
+            "[granular] \"grains\": `angular_velocity` must be a finite number, not NaN",
+            "region_velocity sets the generated stones' motion, but nothing is generated",
+            "[[probe]] \"grain\": a probe on the [granular] sample \"grains\" takes one of",
+            "stone = 0: stones are counted from 1",
+            "[[probe]] \"bad\": `stone` picks stones of the [granular] sample",
+            "give `point`, the place on the body to sample",
+        ],
+    );
+}

@@ -122,7 +122,7 @@ fn example_parses_to_expected_values() {
     let p = &scene.probes[0];
     assert_eq!(p.name, "tip");
     assert_eq!(p.body, "beam");
-    assert_eq!(p.point, [2.4, 0.125, 0.11]);
+    assert_eq!(p.point, Some([2.4, 0.125, 0.11]));
 
     assert_eq!(scene.output.dir, PathBuf::from("out"));
     assert_eq!(scene.output.vtu_every, 0.01);

@@ -94,6 +94,28 @@ impl RigidBodies {
         )
     }
 
+    /// α_b = I_w⁻¹ (τ − ω × L): body `b`'s angular acceleration under the torque `torque`
+    /// (Euler's equations in the world frame, I_w = R I Rᵀ); zero when its spin is fixed.
+    pub fn angular_acceleration(&self, b: usize, torque: Vec3) -> Vec3 {
+        if self.spin_fixed[b] {
+            return Vec3::zeros();
+        }
+        let gyroscopic = self.angular_velocity[b].cross(&self.angular_momentum[b]);
+        spin(
+            &self.orientation[b],
+            &self.inertia[b],
+            &(torque - gyroscopic),
+        )
+    }
+
+    /// The acceleration of the point at `arm` from body `b`'s centre (world frame) under the
+    /// torque `torque`, the centre accelerating at `center`: the rigid motion's
+    /// a_c + α × r + ω × (ω × r), the last term −|ω|² r⊥ (r⊥ the part of r across ω).
+    pub fn point_acceleration(&self, b: usize, torque: Vec3, center: Vec3, arm: Vec3) -> Vec3 {
+        let w = self.angular_velocity[b];
+        center + self.angular_acceleration(b, torque).cross(&arm) + w.cross(&w.cross(&arm))
+    }
+
     /// Sets L_b (world frame) and the angular velocity that follows from it.
     pub fn set_angular_momentum(&mut self, b: usize, l: Vec3) {
         self.angular_momentum[b] = l;

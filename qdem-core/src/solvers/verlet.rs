@@ -195,9 +195,13 @@ impl Stepper for Verlet {
         Ok(())
     }
 
-    fn rigid_torques(&mut self) -> &mut [Vec3] {
+    fn rigid_torques_mut(&mut self) -> &mut [Vec3] {
         let bodies = self.rigid_bodies.min(self.torque.len());
         &mut self.torque[..bodies]
+    }
+
+    fn rigid_torques(&self) -> &[Vec3] {
+        &self.torque[..self.rigid_bodies.min(self.torque.len())]
     }
 
     fn steps_in_part(&self) -> bool {

@@ -81,8 +81,15 @@ pub trait Stepper: Send {
     /// which a run decomposed with a halo exchange gathers from the bodies' owners with the
     /// state ([`crate::World::gather`]); empty (the default) for a stepper that keeps none
     /// from one step to the next or cannot step in part.
-    fn rigid_torques(&mut self) -> &mut [Vec3] {
+    fn rigid_torques_mut(&mut self) -> &mut [Vec3] {
         &mut []
+    }
+
+    /// The torques on the rigid bodies at the current state (the last evaluation's), from
+    /// which their angular accelerations follow; empty (the default) for a stepper that keeps
+    /// none.
+    fn rigid_torques(&self) -> &[Vec3] {
+        &[]
     }
 
     /// Size and cost of the sparse factorisation, for steppers that solve a linear system;

@@ -147,7 +147,7 @@ impl World {
         prepare(&mut self.models, &settings);
         self.settings = settings;
         let steps_in_part = self.stepper.steps_in_part();
-        let torques = self.stepper.rigid_torques();
+        let torques = self.stepper.rigid_torques_mut();
         let (state, models, hooks) = (&mut self.state, &mut self.models, &mut self.hooks);
         self.exchange
             .restepped(steps_in_part, state, models, hooks, torques);
@@ -241,7 +241,7 @@ impl World {
     /// a rebuild of a split model's lists when the busiest rank has more than 1.1 times the
     /// mean work (at most once every 8 rebuilds).
     pub fn repartition(&mut self) {
-        let torques = self.stepper.rigid_torques();
+        let torques = self.stepper.rigid_torques_mut();
         let (state, models, hooks) = (&mut self.state, &mut self.models, &mut self.hooks);
         self.exchange.repartition(state, models, hooks, torques);
     }
@@ -256,7 +256,7 @@ impl World {
     /// particle's motion when a step shares only the halo ([`World::decompose`]); a no-op
     /// otherwise (and in a run of one process).
     pub fn gather(&mut self) {
-        let torques = self.stepper.rigid_torques();
+        let torques = self.stepper.rigid_torques_mut();
         let (state, models, hooks) = (&mut self.state, &mut self.models, &mut self.hooks);
         self.exchange.gather(state, models, hooks, torques);
     }
@@ -288,7 +288,7 @@ impl World {
         let done = self
             .stepper
             .initialize_in(state, models, &mut self.exchange);
-        let torques = self.stepper.rigid_torques();
+        let torques = self.stepper.rigid_torques_mut();
         self.exchange.initialized(&mut self.state, torques, done)
     }
 
@@ -312,7 +312,7 @@ impl World {
             self.stages.mark(Stage::Hook(i));
         }
         if self.exchange.rebalances() {
-            let torques = self.stepper.rigid_torques();
+            let torques = self.stepper.rigid_torques_mut();
             let (state, models, hooks) = (&mut self.state, &mut self.models, &mut self.hooks);
             self.exchange.rebalance(state, models, hooks, torques);
             self.stages.mark(Stage::Share);

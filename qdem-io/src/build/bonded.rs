@@ -80,7 +80,10 @@ pub(crate) fn build_bonded(
     let probes = scene
         .probes
         .iter()
-        .map(|p| nearest_particle_in(&state, 0..state.len(), Vec3::from(p.point), &p.name))
+        .map(|p| {
+            let at = Vec3::from(p.point.expect("validated: a probe on a body has a point"));
+            nearest_particle_in(&state, 0..state.len(), at, &p.name)
+        })
         .collect();
     let mut world = World::new(state, models, settings).map_err(core)?;
     let body = world.model::<BondedParticles>().expect("built above");
@@ -91,6 +94,7 @@ pub(crate) fn build_bonded(
         world,
         bodies: Vec::new(),
         probes,
+        regions: Vec::new(),
         warnings,
         granular: None,
         ballast: None,

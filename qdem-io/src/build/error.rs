@@ -63,6 +63,21 @@ pub enum BuildError {
         /// Half that extent.
         limit: f64,
     },
+    /// A `[[probe]] stone` beyond the sample's stones.
+    #[error(
+        "{scene}: [[probe]] {probe:?}: stone = {stone}, but the [granular] sample has {count} \
+         stones; give a number from 1 to {count}, or a point"
+    )]
+    ProbeStone {
+        /// The scene file.
+        scene: PathBuf,
+        /// The probe.
+        probe: String,
+        /// The stone asked for (from 1).
+        stone: usize,
+        /// The stones there are.
+        count: usize,
+    },
     /// A `[granular]` sample or its generation is refused.
     #[error("{scene}: [granular]: {source}")]
     Granular {

@@ -89,8 +89,12 @@ fn copied(stones: &[Stone], copies: &[[f64; 3]]) -> Vec<Stone> {
         .collect()
 }
 
-/// The stones of `granular`: its sample file's, copied and cropped, then the generated ones.
-pub(crate) fn stones(scene: &Scene, granular: &Granular) -> Result<Vec<Stone>, BuildError> {
+/// The stones of `granular`: its sample file's, copied and cropped, then the generated ones;
+/// with the number of the sample's.
+pub(crate) fn stones(
+    scene: &Scene,
+    granular: &Granular,
+) -> Result<(Vec<Stone>, usize), BuildError> {
     let refused = |source: SampleError| BuildError::Granular {
         scene: scene.path.clone(),
         source,
@@ -107,6 +111,7 @@ pub(crate) fn stones(scene: &Scene, granular: &Granular) -> Result<Vec<Stone>, B
                 .all(|(c, &r)| inside_crop(&lo, &hi, c, r))
         });
     }
+    let sampled = stones.len();
     if let (Some([lo, hi]), Some(count), Some(grading)) =
         (granular.region, granular.count, &granular.grading)
     {
@@ -127,17 +132,18 @@ pub(crate) fn stones(scene: &Scene, granular: &Granular) -> Result<Vec<Stone>, B
         };
         stones.extend(generate_stones(&spec).map_err(refused)?);
     }
-    Ok(stones)
+    Ok((stones, sampled))
 }
 
-/// Appends `stones` to `state` as rigid bodies (a one-sphere stone as a rotating particle) and
-/// returns where they went and their contact
-/// spheres (bodies numbered from `first_body`; `(material, density)`: the index of the
+/// Appends `stones` to `state` as rigid bodies (a one-sphere stone as a rotating particle),
+/// moving with the `[granular]` initial velocity and angular velocity (the first `sampled`
+/// stones the sample's, the others the generated ones'), and returns where they went and their
+/// contact spheres (bodies numbered from `first_body`; `(material, density)`: the index of the
 /// `[granular]` material and its density). `scene` is the scene file, for messages.
 pub(crate) fn add_stones(
     scene: &Path,
     granular: &Granular,
-    stones: &[Stone],
+    (stones, sampled): (&[Stone], usize),
     state: &mut State,
     first_body: usize,
     (material, density): (usize, f64),
@@ -150,6 +156,7 @@ pub(crate) fn add_stones(
             radii.push(r);
         }
     }
+    let mut spinning = false;
     let mut info = GranularInfo {
         name: granular.name.clone(),
         stones: Vec::with_capacity(stones.len()),
@@ -165,13 +172,22 @@ pub(crate) fn add_stones(
                 source,
             })?;
         let members: Range<usize> = member..member + stone.centers.len();
+        let (v, w) = granular.motion(k >= sampled);
+        let (v, w) = (Vec3::from(v), Vec3::from(w));
         let center = if members.len() == 1 {
             state.mass[member] = props.mass;
             state.let_turn(member, props.inertia.trace() / 3.0);
+            state.spin.velocity[member] = w;
             member
         } else {
-            add_clump(scene, state, &props, &members, &granular.name, k)?
+            let center = add_clump(scene, state, &props, &members, &granular.name, k)?;
+            let b = state.rigid.len() - 1;
+            state.rigid.set_angular_velocity(b, w);
+            spinning |= w != Vec3::zeros();
+            center
         };
+        state.velocity[center] = v;
+        state.velocity[members.clone()].fill(v);
         for p in members.clone() {
             spheres.push(ContactSphere {
                 particle: p,
@@ -182,6 +198,9 @@ pub(crate) fn add_stones(
         }
         member = members.end;
         info.stones.push((center, members));
+    }
+    if spinning {
+        qdem_core::rigid_body::place_members(state);
     }
     Ok((info, spheres))
 }

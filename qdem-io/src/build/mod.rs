@@ -12,7 +12,9 @@
 //! and probe's body as indices), so no name is looked up again here. One module per part of a
 //! scene, each taking the table it builds and the indices it needs:
 //!
-//! - this module: the `[[body]]` meshes, fixes, loads, probes and the step request;
+//! - this module: the `[[body]]` meshes, fixes, loads and the step request;
+//! - [`probes`]: the `[[probe]]`s on particles, stones and boxes; `initial_motion`: the
+//!   bodies' and stones' initial velocity and angular velocity;
 //! - `contact`: contact spheres, the `[contact]` law and the `[[wall]]`s;
 //! - [`granular`]: the rigid stones of `[granular]`; [`ballast`]: the deformable stones of
 //!   `[ballast]`; `bonded`: a `[bonded]` body (built instead of everything else);
@@ -27,10 +29,12 @@ mod bonded;
 mod contact;
 mod error;
 pub mod granular;
+mod initial_motion;
 pub(crate) mod load_series;
 pub mod memory;
 mod periodic;
 pub mod pose_from;
+pub mod probes;
 mod rest_on;
 mod start_from;
 mod step_check;
@@ -115,8 +119,10 @@ pub struct Simulation {
     pub world: World,
     /// Per-body output information.
     pub bodies: Vec<BodyInfo>,
-    /// Probes in scene order.
+    /// Probes on particles (a body's, a stone's centre) in scene order.
     pub probes: Vec<ProbePoint>,
+    /// Probes on boxes over the `[granular]` sample, in scene order.
+    pub regions: Vec<probes::RegionProbe>,
     /// Mesh warnings, one line each, naming the file.
     pub warnings: Vec<String>,
     /// The stones of `[granular]`.
@@ -156,9 +162,9 @@ impl Simulation {
             source,
         };
         let (mut meshes, warnings, ballast) = read_meshes(&scene)?;
-        let stones = match &scene.granular {
+        let (stones, sampled) = match &scene.granular {
             Some(g) => granular::stones(&scene, g)?,
-            None => Vec::new(),
+            None => (Vec::new(), 0),
         };
         let periodic_box = match &scene.periodic {
             Some(p) => Some(periodic::periodic_box(&scene, p)?),
@@ -172,10 +178,16 @@ impl Simulation {
         let mut state = State::at_rest(reference.collect());
         let mut models: Vec<Box<dyn Model>> = Vec::new();
         let bodies = build_bodies(&scene, &meshes, &mut state, &mut models).map_err(core)?;
+        if let Some((b, info)) = scene.ballast.as_ref().zip(ballast.as_ref()) {
+            for stone in &info.stones {
+                let (v, w) = (Vec3::from(b.velocity), Vec3::from(b.angular_velocity));
+                initial_motion::move_rigidly(&mut state, stone.clone(), v, w);
+            }
+        }
         apply_fixes(&scene, &meshes, &mut state)?;
         fix_rigid_bodies(&scene, &bodies, &mut state);
         let mut extra = ExtraSpheres::of_ballast(ballast.as_ref());
-        let granular = add_granular(&scene, &stones, &mut state, &mut extra)?;
+        let granular = add_granular(&scene, (&stones, sampled), &mut state, &mut extra)?;
         let periodic = periodic_box.map(|p| {
             let groups =
                 periodic::wrap_groups(&state, &bodies, granular.as_ref(), ballast.as_ref());
@@ -186,7 +198,7 @@ impl Simulation {
         if let Some(file) = &scene.run.start_from {
             start_from::restore_state(&scene, file, &mut state, periodic.as_ref())?;
         }
-        let probes = resolve_probes(&scene, &bodies, &state);
+        let (probes, regions) = probes::resolve_probes(&scene, &bodies, granular.as_ref(), &state)?;
         let settings =
             StepSettings::resolve(&step_request(&scene), &state, &models).map_err(core)?;
         let mut world = World::new(state, models, settings).map_err(core)?;
@@ -198,6 +210,7 @@ impl Simulation {
             world,
             bodies,
             probes,
+            regions,
             warnings,
             granular,
             ballast,
@@ -280,7 +293,7 @@ fn add_forces(
 /// ballast stones, their spheres and names added to `extra`.
 fn add_granular(
     scene: &Scene,
-    stones: &[qdem_contact::clump_sample::Stone],
+    stones: (&[qdem_contact::clump_sample::Stone], usize),
     state: &mut State,
     extra: &mut ExtraSpheres,
 ) -> Result<Option<GranularInfo>, BuildError> {
@@ -300,25 +313,6 @@ fn add_granular(
         .names
         .extend((1..=info.len()).map(|k| format!("{} stone {k}", g.name)));
     Ok(Some(info))
-}
-
-/// Each probe at the particle of its body nearest its point at the start of the run (after
-/// `start_from`, the settled positions).
-fn resolve_probes(scene: &Scene, bodies: &[BodyInfo], state: &State) -> Vec<ProbePoint> {
-    scene
-        .probes
-        .iter()
-        .zip(&scene.refs().probe_bodies)
-        .map(|(p, &body)| {
-            let body = &bodies[body];
-            let center = match body.kind {
-                BodyKind::Rigid { center, .. } => Some(center),
-                BodyKind::Deformable { .. } => None,
-            };
-            let candidates = body.particles.clone().chain(center);
-            nearest_particle(state, candidates, Vec3::from(p.point), &p.name)
-        })
-        .collect()
 }
 
 /// The placed meshes, mesh warnings and `[ballast]` stones of a scene.
@@ -415,7 +409,8 @@ fn place(mesh: &mut TetMesh, degrees: [f64; 3], shift: [f64; 3]) {
 }
 
 /// One [`TetBody`] per deformable body, its lumped mass added to the state; one rigid body
-/// (a new centre particle at its centre of mass) per rigid body. Sets initial velocities.
+/// (a new centre particle at its centre of mass) per rigid body. Sets initial velocities and
+/// angular velocities (`initial_motion`).
 fn build_bodies(
     scene: &Scene,
     meshes: &[PlacedMesh],
@@ -428,12 +423,14 @@ fn build_bodies(
         let material = &scene.materials[material];
         let tets = offset_tets(&placed.mesh, placed.particles.start);
         let velocity = Vec3::from(body.velocity);
+        let omega = Vec3::from(body.angular_velocity);
         let kind = if body.rigid {
             let (mass, center, inertia) =
                 tet_mass_properties(&state.reference, &tets, material.density);
             let c = state.push_particle(center, velocity, mass);
             let members: Vec<usize> = placed.particles.clone().collect();
             let index = state.add_rigid_body(&body.name, c, &members, inertia)?;
+            state.rigid.set_angular_velocity(index, omega);
             BodyKind::Rigid {
                 body: index,
                 center: c,
@@ -449,8 +446,11 @@ fn build_bodies(
                 model: models.len() - 1,
             }
         };
-        for i in placed.particles.clone() {
-            state.velocity[i] = velocity;
+        match kind {
+            BodyKind::Rigid { .. } => state.velocity[placed.particles.clone()].fill(velocity),
+            BodyKind::Deformable { .. } => {
+                initial_motion::move_rigidly(state, placed.particles.clone(), velocity, omega)
+            }
         }
         bodies.push(BodyInfo {
             name: body.name.clone(),
@@ -464,6 +464,13 @@ fn build_bodies(
     if let (Some((b, material)), Some(placed)) = (ballast, meshes.get(scene.bodies.len())) {
         let material = core_material(&scene.materials[material]);
         bodies.push(ballast_body(b, material, placed, state, models)?);
+    }
+    if scene
+        .bodies
+        .iter()
+        .any(|b| b.rigid && b.angular_velocity != [0.0; 3])
+    {
+        qdem_core::rigid_body::place_members(state);
     }
     Ok(bodies)
 }
@@ -705,7 +712,7 @@ pub(crate) fn nearest_particle_in(
     nearest_particle(state, candidates, point, name)
 }
 
-fn nearest_particle(
+pub(crate) fn nearest_particle(
     state: &State,
     candidates: impl Iterator<Item = usize>,
     point: Vec3,

@@ -31,7 +31,7 @@ mod vtu;
 pub use atomic::{remove_stale_temporaries, write_atomic, AtomicFile};
 pub use error::{IoStage, OutputError};
 pub use folder_lock::{FolderLock, LockError, LOCK_FILE};
-pub use probes_csv::{ProbeCsv, PROBE_COLUMNS};
+pub use probes_csv::{ProbeCsv, PROBE_COLUMNS, REGION_COLUMNS};
 pub use pvd::PvdIndex;
 pub use summary::write_summary;
 pub use vtu::{write_vtu, write_vtu_mesh, VtuCells, VtuField, VtuGrid, VtuMesh, VTK_TETRA};

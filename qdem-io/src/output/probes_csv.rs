@@ -1,7 +1,9 @@
 //! Probe time histories as CSV, written row by row during a run.
 //!
 //! Layout: a header line `t,P.ux,P.uy,P.uz,P.vx,P.vy,P.vz,P.ax,P.ay,P.az,...` (nine columns
-//! per probe `P`: displacement, velocity, acceleration), then one line per sample time.
+//! per probe `P`: displacement, velocity, acceleration), then five per box probe `R`
+//! (`R.vx,R.vy,R.vz,R.ke,R.count`: mean velocity, kinetic energy, count of the stones inside),
+//! then one line per sample time.
 //! Numbers are written with the shortest decimal form that parses back to the same `f64`
 //! (plain notation for magnitudes in `[1e-5, 1e16)` and zero, scientific `1.5e-7`
 //! otherwise; NaN and infinities as `NaN`, `inf`, `-inf`), so nothing is lost.
@@ -20,6 +22,9 @@ use super::write_f64;
 
 /// The column suffixes written for each probe, in order.
 pub const PROBE_COLUMNS: [&str; 9] = ["ux", "uy", "uz", "vx", "vy", "vz", "ax", "ay", "az"];
+
+/// The column suffixes written for each box probe, in order.
+pub const REGION_COLUMNS: [&str; 5] = ["vx", "vy", "vz", "ke", "count"];
 
 /// A probe CSV being written.
 ///
@@ -42,6 +47,8 @@ pub struct ProbeCsv {
     file: AtomicFile,
     /// The number of probes (columns per row: `1 + 9 * num_probes`).
     num_probes: usize,
+    /// The number of box probes (five columns each, after the probes').
+    num_regions: usize,
     /// The number of data rows written.
     num_rows: usize,
 }
@@ -54,12 +61,26 @@ impl ProbeCsv {
     /// comma, a double quote or a control character (names are written unquoted);
     /// [`OutputError::Io`] (or [`OutputError::NoFileName`]) if the file cannot be created.
     pub fn create(path: &Path, probe_names: &[String]) -> Result<Self, OutputError> {
-        for (i, name) in probe_names.iter().enumerate() {
+        Self::with_regions(path, probe_names, &[])
+    }
+
+    /// [`ProbeCsv::create`] with box probes `region_names` after the probes (five columns
+    /// each, [`REGION_COLUMNS`]); the names of both kinds must differ.
+    ///
+    /// # Errors
+    /// Those of [`ProbeCsv::create`].
+    pub fn with_regions(
+        path: &Path,
+        probe_names: &[String],
+        region_names: &[String],
+    ) -> Result<Self, OutputError> {
+        let names: Vec<&String> = probe_names.iter().chain(region_names).collect();
+        for (i, &name) in names.iter().enumerate() {
             let reason = if name.is_empty() {
                 Some("probe names must not be empty")
             } else if name.contains([',', '"']) || name.chars().any(char::is_control) {
                 Some("probe names must not contain commas, double quotes or control characters")
-            } else if probe_names[..i].contains(name) {
+            } else if names[..i].contains(&name) {
                 Some("the same probe name is used twice")
             } else {
                 None
@@ -75,12 +96,7 @@ impl ProbeCsv {
         let mut file = AtomicFile::create_as(path, "probe CSV")?;
         let header = (|| {
             let w = file.writer();
-            w.write_all(b"t")?;
-            for name in probe_names {
-                for col in PROBE_COLUMNS {
-                    write!(w, ",{name}.{col}")?;
-                }
-            }
+            w.write_all(header(probe_names, region_names).as_bytes())?;
             w.write_all(b"\n")
         })();
         if let Err(source) = header {
@@ -89,6 +105,7 @@ impl ProbeCsv {
         Ok(Self {
             file,
             num_probes: probe_names.len(),
+            num_regions: region_names.len(),
             num_rows: 0,
         })
     }
@@ -120,13 +137,32 @@ impl ProbeCsv {
     /// non-finite: a diverging run should still be visible), [`OutputError::Io`] if writing
     /// fails. Nothing is written on a validation error.
     pub fn row(&mut self, t: f64, samples: &[[Vector3<f64>; 3]]) -> Result<(), OutputError> {
-        if samples.len() != self.num_probes {
-            return Err(OutputError::Length {
-                path: self.file.path().to_path_buf(),
-                name: "probe samples".to_string(),
-                expected: self.num_probes,
-                found: samples.len(),
-            });
+        self.row_with_regions(t, samples, &[])
+    }
+
+    /// [`ProbeCsv::row`] followed by each box probe's five values ([`REGION_COLUMNS`]).
+    ///
+    /// # Errors
+    /// Those of [`ProbeCsv::row`]; [`OutputError::Length`] also if `regions.len()` is not the
+    /// number of box probes.
+    pub fn row_with_regions(
+        &mut self,
+        t: f64,
+        samples: &[[Vector3<f64>; 3]],
+        regions: &[[f64; 5]],
+    ) -> Result<(), OutputError> {
+        for (name, expected, found) in [
+            ("probe samples", self.num_probes, samples.len()),
+            ("box probe samples", self.num_regions, regions.len()),
+        ] {
+            if found != expected {
+                return Err(OutputError::Length {
+                    path: self.file.path().to_path_buf(),
+                    name: name.to_string(),
+                    expected,
+                    found,
+                });
+            }
         }
         if !t.is_finite() {
             return Err(OutputError::NonFinite {
@@ -138,13 +174,10 @@ impl ProbeCsv {
         let result = (|| {
             let w = self.file.writer();
             write_f64(w, t)?;
-            for sample in samples {
-                for v in sample {
-                    for x in v.iter() {
-                        w.write_all(b",")?;
-                        write_f64(w, *x)?;
-                    }
-                }
+            let probes = samples.iter().flat_map(|s| s.iter().flat_map(|v| v.iter()));
+            for x in probes.chain(regions.iter().flatten()) {
+                w.write_all(b",")?;
+                write_f64(w, *x)?;
             }
             w.write_all(b"\n")
         })();
@@ -162,22 +195,28 @@ impl ProbeCsv {
     /// [`OutputError::Resume`] if the file cannot be read, has another header or fewer than
     /// `rows` rows; the errors of [`ProbeCsv::create`].
     pub fn resume(path: &Path, probe_names: &[String], rows: usize) -> Result<Self, OutputError> {
+        Self::resume_with_regions(path, probe_names, &[], rows)
+    }
+
+    /// [`ProbeCsv::resume`] of a file with box probes ([`ProbeCsv::with_regions`]).
+    ///
+    /// # Errors
+    /// Those of [`ProbeCsv::resume`].
+    pub fn resume_with_regions(
+        path: &Path,
+        probe_names: &[String],
+        region_names: &[String],
+        rows: usize,
+    ) -> Result<Self, OutputError> {
         let resume_error = |reason: String| OutputError::Resume {
             path: path.to_path_buf(),
             reason,
         };
         let text = std::fs::read_to_string(path).map_err(|e| resume_error(e.to_string()))?;
-        let mut csv = Self::create(path, probe_names)?;
+        let mut csv = Self::with_regions(path, probe_names, region_names)?;
         let mut lines = text.lines();
         let header = lines.next().unwrap_or("");
-        let expected: String = std::iter::once("t".to_string())
-            .chain(
-                probe_names
-                    .iter()
-                    .flat_map(|n| PROBE_COLUMNS.iter().map(move |c| format!("{n}.{c}"))),
-            )
-            .collect::<Vec<_>>()
-            .join(",");
+        let expected = self::header(probe_names, region_names);
         if header != expected {
             return Err(resume_error(format!(
                 "its header `{header}` is not that of the scene's probes `{expected}`"
@@ -213,4 +252,19 @@ impl ProbeCsv {
     pub fn finish(self) -> Result<(), OutputError> {
         self.file.commit()
     }
+}
+
+/// The header line (without its newline): `t`, each probe's nine columns, each box probe's five.
+fn header(probe_names: &[String], region_names: &[String]) -> String {
+    let columns = |names: &[String], suffixes: &'static [&'static str]| {
+        names
+            .iter()
+            .flat_map(move |n| suffixes.iter().map(move |c| format!("{n}.{c}")))
+            .collect::<Vec<_>>()
+    };
+    std::iter::once("t".to_string())
+        .chain(columns(probe_names, &PROBE_COLUMNS))
+        .chain(columns(region_names, &REGION_COLUMNS))
+        .collect::<Vec<_>>()
+        .join(",")
 }

@@ -44,7 +44,7 @@ pub mod suggest;
 mod validate;
 
 pub use error::{Diagnostic, SceneError};
-pub use refs::Refs;
+pub use refs::{ProbeTarget, Refs};
 pub use schema::{
     Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix, Granular,
     Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section,

@@ -28,8 +28,8 @@ pub struct Refs {
     pub fix_bodies: Vec<usize>,
     /// Per `[[load]]`: the index of its body.
     pub load_bodies: Vec<usize>,
-    /// Per `[[probe]]`: the index of its body.
-    pub probe_bodies: Vec<usize>,
+    /// Per `[[probe]]`: what it samples.
+    pub probe_targets: Vec<ProbeTarget>,
     /// The index of the `[granular]` material.
     pub granular_material: Option<usize>,
     /// The index of the `[ballast]` material.
@@ -39,4 +39,13 @@ pub struct Refs {
     /// The cycle of the load `[periodic.time_delay]` follows: the first `[[load]]` with
     /// `cyclic` on its body.
     pub time_delay_cycle: Option<CyclicLoad>,
+}
+
+/// What a `[[probe]]` names in `body`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProbeTarget {
+    /// A body: its index.
+    Body(usize),
+    /// The `[granular]` sample.
+    Granular,
 }

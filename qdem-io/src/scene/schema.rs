@@ -225,6 +225,11 @@ pub struct Body {
     /// Initial velocity of every particle of the body (m/s); default zero.
     #[serde(default)]
     pub velocity: [f64; 3],
+    /// Initial angular velocity of the body about its centre of mass (rad/s, world axes): a
+    /// rigid body's ω; a deformable body's particles get v + ω × (x − x_c) in addition to
+    /// `velocity`. Default zero.
+    #[serde(default)]
+    pub angular_velocity: [f64; 3],
     /// Name of the `[granular]` sample to lay the body on: after `translate` it is lowered
     /// along −z until its contact spheres touch the stones beneath (`rest_on.rs`); default
     /// none (the body stays where `translate` puts it).
@@ -454,17 +459,37 @@ impl Ramp {
     }
 }
 
-/// `[[probe]]`: a particle whose state is written to `probes.csv`.
+/// `[[probe]]`: what `probes.csv` follows. On a `[[body]]` (or `[ballast]`, `[bonded]`): the
+/// particle nearest `point`, its displacement, velocity and acceleration. On the `[granular]`
+/// sample (`body` names it): one stone, the one whose centre of mass is nearest `point` or
+/// the `stone`-th, followed at its centre of mass; or the stones whose centre of mass lies in
+/// `box` at each sample time, their mean velocity, kinetic energy and count.
+///
+/// ```toml
+/// [[probe]]
+/// name = "ball"
+/// body = "grains"     # the [granular] name
+/// stone = 1           # or point = [x, y, z], or box = [[x0, y0, z0], [x1, y1, z1]]
+/// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Probe {
     /// Unique name (the CSV column prefix).
     pub name: String,
-    /// Name of the `[[body]]`.
+    /// Name of the `[[body]]`, `[ballast]`, `[bonded]` body or `[granular]` sample.
     pub body: String,
-    /// The particle of the body nearest to this point (in the reference configuration) is
-    /// sampled.
-    pub point: [f64; 3],
+    /// The particle of the body nearest to this point (in the reference configuration), or
+    /// the stone whose centre of mass is nearest to it, is sampled.
+    #[serde(default)]
+    pub point: Option<[f64; 3]>,
+    /// `[granular]` only: the stone sampled, counted from 1 in the sample's order (the `stone`
+    /// of `stones.csv`, `NAME stone K` in messages).
+    #[serde(default)]
+    pub stone: Option<usize>,
+    /// `[granular]` only: a box (lower and upper corner, m): the stones whose centre of mass
+    /// lies inside are averaged (columns `vx, vy, vz, ke, count`).
+    #[serde(default, rename = "box")]
+    pub region: Option<[[f64; 3]; 2]>,
 }
 
 /// `[[section]]`: a plane x[axis] = `at` across which the average magnitude of the contact
@@ -644,6 +669,10 @@ pub struct Ballast {
     /// Initial velocity of every stone (m/s), e.g. downward to shorten the fall; default 0.
     #[serde(default)]
     pub velocity: [f64; 3],
+    /// Initial angular velocity of every stone about its own centre of mass (rad/s, world
+    /// axes): its particles get v + ω × (x − x_c); default 0.
+    #[serde(default)]
+    pub angular_velocity: [f64; 3],
 }
 
 /// `[periodic]`: periodic boundaries (paper 003 §4) along `axes`, over `length` (one period
@@ -718,6 +747,10 @@ pub struct TimeDelay {
 /// grading = [[0.0224, 0.0], [0.04, 0.5], [0.0625, 1.0]]  # (size m, fraction passing)
 /// spheres_per_stone = [3, 5]
 /// seed = 1
+/// velocity = [0.0, 0.0, -1.0]          # optional, m/s: every stone
+/// angular_velocity = [0.0, 20.0, 0.0]  # optional, rad/s: every stone about its centre
+/// # region_velocity, region_angular_velocity: the generated stones' instead (a pour onto a
+/// # sample at rest)
 /// # or: sample = "stones.csv", crop = [[0, 0.7, 0], [0.3, 1.4, 0.45]]
 /// # a periodic cell's sample repeated along y:
 /// # sample = "stones.csv", copies = [[0, -0.7, 0], [0, 0, 0], [0, 0.7, 0]]
@@ -756,6 +789,35 @@ pub struct Granular {
     /// Generation: seed; default 1.
     #[serde(default = "default_seed")]
     pub seed: u64,
+    /// Initial velocity of every stone (m/s); default zero.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Initial angular velocity of every stone about its centre of mass (rad/s, world axes);
+    /// default zero.
+    #[serde(default)]
+    pub angular_velocity: [f64; 3],
+    /// Initial velocity of the generated (`region`) stones instead of `velocity` (m/s): grains
+    /// poured onto a sample at rest; default `velocity`.
+    #[serde(default)]
+    pub region_velocity: Option<[f64; 3]>,
+    /// Initial angular velocity of the generated stones instead of `angular_velocity`
+    /// (rad/s); default `angular_velocity`.
+    #[serde(default)]
+    pub region_angular_velocity: Option<[f64; 3]>,
+}
+
+impl Granular {
+    /// The initial velocity and angular velocity of a stone, generated or from the sample.
+    pub fn motion(&self, generated: bool) -> ([f64; 3], [f64; 3]) {
+        match generated {
+            true => (
+                self.region_velocity.unwrap_or(self.velocity),
+                self.region_angular_velocity
+                    .unwrap_or(self.angular_velocity),
+            ),
+            false => (self.velocity, self.angular_velocity),
+        }
+    }
 }
 
 fn default_copies() -> Vec<[f64; 3]> {

@@ -1,8 +1,16 @@
-//! [`Probes`]: `probes.csv` (each probe's displacement, velocity and acceleration every
-//! `probe_every`, streamed) and, at the end, `probes.svg` (the displacements against time).
+//! [`Probes`]: `probes.csv` (each probe's displacement, velocity and acceleration, then each
+//! box probe's mean velocity, kinetic energy and count of stones, every `probe_every`,
+//! streamed) and, at the end, `probes.svg` (the displacements against time).
+//!
+//! A probe on a rigid body's member (a surface vertex, a clump's sphere) reads the rigid
+//! motion's acceleration a_c + α × r + ω × (ω × r) ([`qdem_core::RigidBodies::point_acceleration`]):
+//! a member carries no acceleration of its own. Reading it, or a box probe, needs the rigid
+//! bodies' motion and every stone, so a decomposed run gathers its whole state for such a
+//! sample instead of the probes' particles.
 
 use super::schedule::{probe_interval, Schedule};
 use super::{Recorder, RunFigures, StateRead, StepInfo};
+use crate::build::probes::region_sample;
 use crate::build::Simulation;
 use crate::output::{OutputError, ProbeCsv};
 use crate::plot::{line_plot_svg, Labels, Series};
@@ -14,6 +22,10 @@ use std::path::{Path, PathBuf};
 pub(crate) struct Probes {
     schedule: Schedule,
     names: Vec<String>,
+    /// The box probes' names.
+    regions: Vec<String>,
+    /// Whether a sample needs the whole state (module docs).
+    whole: bool,
     csv_path: PathBuf,
     svg_path: PathBuf,
     csv: Option<ProbeCsv>,
@@ -26,10 +38,17 @@ pub(crate) struct Probes {
 impl Probes {
     pub(crate) fn new(sim: &Simulation, out_dir: &Path) -> Probes {
         let names: Vec<String> = sim.probes.iter().map(|p| p.name.clone()).collect();
+        let rigid = &sim.world.state.rigid;
+        let on_member = sim
+            .probes
+            .iter()
+            .any(|p| rigid.body_of_member(p.particle).is_some());
         Probes {
             schedule: Schedule::new(probe_interval(sim)),
             history: vec![Vec::new(); 3 * names.len()],
             names,
+            regions: sim.regions.iter().map(|r| r.name.clone()).collect(),
+            whole: on_member || !sim.regions.is_empty(),
             csv_path: out_dir.join("probes.csv"),
             svg_path: out_dir.join("probes.svg"),
             csv: None,
@@ -47,9 +66,34 @@ fn samples(sim: &Simulation) -> Vec<[Vec3; 3]> {
             [
                 s.displacement(p.particle),
                 s.velocity[p.particle],
-                s.acceleration[p.particle],
+                acceleration(sim, p.particle),
             ]
         })
+        .collect()
+}
+
+/// The acceleration of particle `p`: its own, or a rigid body's member's from the body's motion.
+fn acceleration(sim: &Simulation, p: usize) -> Vec3 {
+    let s = &sim.world.state;
+    let Some(b) = s.rigid.body_of_member(p) else {
+        return s.acceleration[p];
+    };
+    let torque = sim.world.stepper().rigid_torques();
+    let torque = torque.get(b).copied().unwrap_or_else(Vec3::zeros);
+    let c = s.rigid.center[b];
+    let arm = s.position[p] - s.position[c];
+    s.rigid
+        .point_acceleration(b, torque, s.acceleration[c], arm)
+}
+
+/// Every box probe's five values ([`region_sample`]).
+fn region_samples(sim: &Simulation) -> Vec<[f64; 5]> {
+    let Some(info) = &sim.granular else {
+        return Vec::new();
+    };
+    sim.regions
+        .iter()
+        .map(|r| region_sample(r, info, &sim.world.state))
         .collect()
 }
 
@@ -59,17 +103,19 @@ impl Recorder for Probes {
     }
 
     fn start(&mut self, resumed: bool) -> Result<(), OutputError> {
+        let (path, names, regions) = (&self.csv_path, &self.names, &self.regions);
         self.csv = Some(match resumed {
-            true => ProbeCsv::resume(&self.csv_path, &self.names, self.rows as usize)?,
-            false => ProbeCsv::create(&self.csv_path, &self.names)?,
+            true => ProbeCsv::resume_with_regions(path, names, regions, self.rows as usize)?,
+            false => ProbeCsv::with_regions(path, names, regions)?,
         });
         Ok(())
     }
 
     fn reads(&self, time: f64, dt: f64) -> StateRead {
-        match self.schedule.is_due(time, dt) {
-            true => StateRead::Probes,
-            false => StateRead::Nothing,
+        match (self.schedule.is_due(time, dt), self.whole) {
+            (true, false) => StateRead::Probes,
+            (true, true) => StateRead::Whole,
+            (false, _) => StateRead::Nothing,
         }
     }
 
@@ -87,7 +133,7 @@ impl Recorder for Probes {
         self.csv
             .as_mut()
             .expect("started before recording")
-            .row(time, &samples)?;
+            .row_with_regions(time, &samples, &region_samples(sim))?;
         self.rows += 1;
         Ok(())
     }

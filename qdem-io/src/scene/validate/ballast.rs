@@ -31,6 +31,12 @@ pub(super) fn ballast_table(
         );
     }
     c.finite(&["ballast", "velocity"], &l, "velocity", &b.velocity);
+    c.finite(
+        &["ballast", "angular_velocity"],
+        &l,
+        "angular_velocity",
+        &b.angular_velocity,
+    );
     c.positive(
         &["ballast", "contact_radius"],
         &l,

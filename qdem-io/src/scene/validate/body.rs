@@ -1,6 +1,6 @@
 //! `[[body]]`: at least one body (or a `[bonded]`, `[granular]` or `[ballast]` instead), unique
 //! names, a mesh and a defined material; its placement keys (finite `translate`, `rotate_deg`,
-//! `velocity`, `rest_on` on a `[granular]` sample, `pose_from` for rigid bodies only) and
+//! `velocity`, `angular_velocity`, `rest_on` on a `[granular]` sample, `pose_from` for rigid bodies only) and
 //! `rigid` only with the Verlet integrator. The names it collects (the `[[body]]`s, then the
 //! `[bonded]` or `[ballast]` body) are what `[[fix]]`, `[[load]]` and `[[probe]]` refer to.
 
@@ -25,6 +25,11 @@ impl<'a> Bodies<'a> {
     fn push(&mut self, name: &'a str) {
         self.index.insert(name, self.names.len());
         self.names.push(name);
+    }
+
+    /// Whether a body is called `name`.
+    pub(super) fn defines(&self, name: &str) -> bool {
+        self.index.contains_key(name)
     }
 
     /// Index of the body `body` that `owner` (at `at`) refers to, or an error listing the
@@ -133,7 +138,7 @@ fn body(c: &mut Checker<'_>, i: usize, b: &Body, materials: &Materials<'_>) -> O
 }
 
 /// The placement keys of every `[[body]]`: `contact_radius`, `translate`, `rotate_deg`,
-/// `velocity`, `rest_on`, `pose_from` and its options, `rigid`. Returns whether any body has
+/// `velocity`, `angular_velocity`, `rest_on`, `pose_from` and its options, `rigid`. Returns whether any body has
 /// contact spheres.
 pub(super) fn placement_keys(c: &mut Checker<'_>, raw: &RawScene) -> bool {
     let mut spheres = false;
@@ -158,6 +163,12 @@ pub(super) fn placement_keys(c: &mut Checker<'_>, raw: &RawScene) -> bool {
             &b.rotate_deg,
         );
         c.finite(&["body", &idx, "velocity"], &l, "velocity", &b.velocity);
+        c.finite(
+            &["body", &idx, "angular_velocity"],
+            &l,
+            "angular_velocity",
+            &b.angular_velocity,
+        );
         if let Some(sample) = &b.rest_on {
             rest_on_key(c, raw, &idx, &l, b.contact_radius.is_some(), sample);
         }

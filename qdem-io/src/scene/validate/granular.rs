@@ -1,7 +1,8 @@
 //! `[granular]`: a defined material, a `[contact]` table and no `[bonded]` body (what it shares
 //! with `[ballast]`, [`stone_table`]); a `sample` file or a generation (`region`, `count` and
 //! `grading`, `spheres_per_stone` in order), boxes with the upper corner above the lower one,
-//! and at least one translation in `copies` (more only with a sample).
+//! at least one translation in `copies` (more only with a sample), finite initial velocities
+//! (the `region_` ones only with a generation).
 
 use super::super::schema::{Granular, RawScene};
 use super::checker::{box_corners, quoted_names, Checker};
@@ -55,7 +56,37 @@ pub(super) fn granular_table(
         }
     }
     copies_key(c, &l, g);
+    motion_keys(c, &l, g);
     material
+}
+
+/// `[granular] velocity`, `angular_velocity` and their `region_` forms: finite, and the
+/// `region_` forms only with a generation.
+fn motion_keys(c: &mut Checker<'_>, l: &str, g: &Granular) {
+    c.finite(&["granular", "velocity"], l, "velocity", &g.velocity);
+    c.finite(
+        &["granular", "angular_velocity"],
+        l,
+        "angular_velocity",
+        &g.angular_velocity,
+    );
+    for (key, value) in [
+        ("region_velocity", g.region_velocity),
+        ("region_angular_velocity", g.region_angular_velocity),
+    ] {
+        let Some(value) = value else { continue };
+        c.finite(&["granular", key], l, key, &value);
+        if g.region.is_none() {
+            c.error(
+                &["granular", key],
+                format!(
+                    "{l}: {key} sets the generated stones' motion, but nothing is generated \
+                     (no `region`); use `{}` for the sample's stones",
+                    key.trim_start_matches("region_")
+                ),
+            );
+        }
+    }
 }
 
 /// `[granular] copies`: translations of a sample file's stones, at least one.
