@@ -232,7 +232,7 @@ impl Exchange {
             }
         }
         if ranks.local.is_some() && !steps_in_part {
-            ranks.step_whole(state, &mut [], &mut []);
+            ranks.step_whole(&mut [], &mut []);
         }
         if ranks.local.is_some() {
             ranks.split_by_owners(models, hooks);
@@ -253,8 +253,8 @@ impl Exchange {
     ) {
         if let Some(ranks) = &mut self.ranks {
             if ranks.local.is_some() && !steps_in_part {
-                ranks.gather(state, models, hooks, torques);
-                ranks.step_whole(state, models, hooks);
+                ranks.gather(state, models, torques);
+                ranks.step_whole(models, hooks);
             }
         }
     }
@@ -265,11 +265,10 @@ impl Exchange {
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
-        hooks: &mut [Box<dyn PostStep>],
         torques: &mut [Vec3],
     ) {
         if let Some(ranks) = &mut self.ranks {
-            ranks.gather(state, models, hooks, torques);
+            ranks.gather(state, models, torques);
         }
     }
 
@@ -344,6 +343,11 @@ impl Exchange {
         self.ranks.as_ref().is_some_and(|r| r.partition.is_some())
     }
 
+    /// The ranks of a run decomposed with a halo exchange, the only one that re-partitions.
+    fn halo_ranks(&mut self) -> Option<&mut Ranks> {
+        self.ranks.as_mut().filter(|r| r.partition.is_some())
+    }
+
     /// After a step: re-partitions when a split model rebuilt its lists and the ranks' work
     /// is out of balance ([`crate::World::repartition`]).
     pub(crate) fn rebalance(
@@ -353,12 +357,9 @@ impl Exchange {
         hooks: &mut [Box<dyn PostStep>],
         torques: &mut [Vec3],
     ) {
-        let Some(ranks) = &mut self.ranks else {
+        let Some(ranks) = self.halo_ranks() else {
             return;
         };
-        if ranks.partition.is_none() {
-            return;
-        }
         let mut rebuilt = false;
         let mut work = ranks.local.as_ref().map_or(0, |l| l.computed.len()) as f64;
         for part in split_parts(models, hooks, &ranks.models, &ranks.hooks) {
@@ -389,13 +390,10 @@ impl Exchange {
         hooks: &mut [Box<dyn PostStep>],
         torques: &mut [Vec3],
     ) {
-        let Some(ranks) = &mut self.ranks else {
+        let Some(ranks) = self.halo_ranks() else {
             return;
         };
-        if ranks.partition.is_none() {
-            return;
-        }
-        ranks.gather(state, models, hooks, torques);
+        ranks.gather(state, models, torques);
         let mut cost = vec![1.0; state.len()];
         for part in split_parts(models, hooks, &ranks.models, &ranks.hooks) {
             part.add_costs(&mut cost);
@@ -490,13 +488,7 @@ impl Ranks {
 
     /// Every step shares the whole state from now on, the split models (but the deformable
     /// bodies) whole again.
-    fn step_whole(
-        &mut self,
-        state: &State,
-        models: &mut [Box<dyn Model>],
-        hooks: &mut [Box<dyn PostStep>],
-    ) {
-        let _ = state;
+    fn step_whole(&mut self, models: &mut [Box<dyn Model>], hooks: &mut [Box<dyn PostStep>]) {
         for (i, model) in models.iter_mut().enumerate() {
             if self.models[i].is_some() && !self.bodies[i] {
                 if let Reads::Split(part) = model.reads() {
@@ -519,13 +511,7 @@ impl Ranks {
     }
 
     /// The whole state on every rank, and every split model merged.
-    fn gather(
-        &mut self,
-        state: &mut State,
-        models: &mut [Box<dyn Model>],
-        hooks: &mut [Box<dyn PostStep>],
-        torques: &mut [Vec3],
-    ) {
+    fn gather(&mut self, state: &mut State, models: &mut [Box<dyn Model>], torques: &mut [Vec3]) {
         self.share.gather(state, torques);
         if self.local.is_none() {
             return;
@@ -545,7 +531,6 @@ impl Ranks {
                 part.merge(&self.all);
             }
         }
-        let _ = hooks;
     }
 }
 

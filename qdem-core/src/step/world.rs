@@ -257,8 +257,8 @@ impl World {
     /// otherwise (and in a run of one process).
     pub fn gather(&mut self) {
         let torques = self.stepper.rigid_torques_mut();
-        let (state, models, hooks) = (&mut self.state, &mut self.models, &mut self.hooks);
-        self.exchange.gather(state, models, hooks, torques);
+        let (state, models) = (&mut self.state, &mut self.models);
+        self.exchange.gather(state, models, torques);
     }
 
     /// [`World::gather`] of `particles` only (the probes' particles): every rank calls it
