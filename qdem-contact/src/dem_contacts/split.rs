@@ -206,7 +206,7 @@ impl DemContacts {
 impl SplitModel for DemContacts {
     /// The particles of every sphere (those of deformable bodies already have owners).
     fn free_particles(&self) -> Vec<usize> {
-        self.particle.iter().map(|&p| p as usize).collect()
+        self.items()
     }
 
     fn split(&mut self, part: Option<Part>) {

@@ -74,7 +74,8 @@ struct Ranks {
     all: Vec<f64>,
 }
 
-/// A split model's exchange of item records, if it has items.
+/// A split model's exchange of item records; none for a deformable body, which exchanges
+/// block sums only.
 type Ghosts = Option<GhostTable>;
 
 impl Exchange {
@@ -425,13 +426,17 @@ impl Ranks {
         if let Some(moved) = part.read_own(state) {
             let moved = max_over_ranks(comm, moved);
             if part.needs_rebuild(moved, state.time) {
-                let table = ghosts.as_mut().expect("a model with lists has items");
+                let table = ghosts
+                    .as_mut()
+                    .expect("a split model with lists has a ghost table");
                 table.borders(comm, part);
                 part.rebuild(state.time);
             }
         }
         if let Some(wanted) = part.new_ghosts() {
-            let table = ghosts.as_mut().expect("a model with ghosts has items");
+            let table = ghosts
+                .as_mut()
+                .expect("a split model with ghosts has a ghost table");
             table.set_ghosts(comm, &wanted);
         }
         part.read_partners(state);
@@ -455,32 +460,29 @@ impl Ranks {
     fn split_by_owners(&mut self, models: &mut [Box<dyn Model>], hooks: &mut [Box<dyn PostStep>]) {
         let owner: Arc<[u32]> = self.share.owner().into();
         let (me, size) = (self.comm.rank(), self.comm.size());
+        let part = || {
+            Some(Part {
+                owner: owner.clone(),
+                rank: me as u32,
+                body: None,
+            })
+        };
         for (i, model) in models.iter_mut().enumerate() {
             if self.bodies[i] {
                 continue;
             }
-            let Reads::Split(part) = model.reads() else {
+            let Reads::Split(split) = model.reads() else {
                 continue;
             };
-            let items = part.items();
-            part.split(Some(Part {
-                owner: owner.clone(),
-                rank: me as u32,
-                body: None,
-            }));
-            let table = (!items.is_empty()).then(|| {
-                let item_owner = items.iter().map(|&p| owner[p]).collect();
-                GhostTable::new(item_owner, me, size)
-            });
-            self.models[i] = Some(table);
+            // A table even without items: every rank runs the same exchanges whatever it
+            // holds (an empty contact set still takes part in the max and the forward).
+            let item_owner = split.items().iter().map(|&p| owner[p]).collect();
+            split.split(part());
+            self.models[i] = Some(Some(GhostTable::new(item_owner, me, size)));
         }
         for (i, hook) in hooks.iter_mut().enumerate() {
-            if let Reads::Split(part) = hook.reads() {
-                part.split(Some(Part {
-                    owner: owner.clone(),
-                    rank: me as u32,
-                    body: None,
-                }));
+            if let Reads::Split(split) = hook.reads() {
+                split.split(part());
                 self.hooks[i] = true;
             }
         }
