@@ -123,6 +123,7 @@ impl DemContacts {
             wall_start: Vec::new(),
             partners: Vec::new(),
             sphere_force: vec![(Vec3::zeros(), Vec3::zeros()); spheres.len()],
+            scatter: ScatterPlan::default(),
             rebuilds: 0,
             periodic: None,
             time_delay: None,

@@ -52,12 +52,14 @@ use qdem_core::{
     State, Tangent, Vec3,
 };
 use rayon::prelude::*;
+use scatter::{add_sum, add_to, pair_share, run_of, wall_share, ScatterPlan};
 use split::ContactPart;
 
 mod build;
 mod modal_springs;
 mod persistence;
 mod pipeline;
+mod scatter;
 mod split;
 mod views;
 
@@ -234,6 +236,8 @@ pub struct DemContacts {
     /// The spheres that are partners of some candidate (pair or wall contact), ascending.
     partners: Vec<u32>,
     sphere_force: Vec<(Vec3, Vec3)>,
+    /// The fused pass's plan for the current lists (`scatter.rs`).
+    scatter: ScatterPlan,
     rebuilds: u64,
     periodic: Option<PeriodicBox>,
     time_delay: Option<TimeDelay>,
@@ -283,13 +287,19 @@ impl Model for DemContacts {
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
         let dt = self.last_time.map_or(0.0, |t| state.time - t);
         self.last_time = Some(state.time);
+        let read_every = self.reads_every_sphere();
         let moved = self.read_centers(state);
         if self.outgrew_skin(moved, state.time) {
-            let read_every = self.reads_every_sphere();
+            if !read_every {
+                self.read_every_center(state);
+            }
             self.rebuild_all(state.time);
             if !read_every {
                 self.read_all_partners(state);
             }
+        }
+        if self.fuses() {
+            return self.evaluate_and_add(state.time, dt, force, torque);
         }
         self.evaluate(state.time, dt);
         self.update_time_delay(state.time);

@@ -18,36 +18,52 @@ impl DemContacts {
         }
     }
 
-    /// Copies every sphere's centre out of the state, in sphere order, and the narrow phase's
-    /// record ([`read_motion`]) of the partners of candidates: in the same pass when most
-    /// spheres are partners (a packing), else in a pass over the partners alone (most spheres
-    /// of a ballast stone touch nothing); returns the largest distance a sphere has moved
-    /// since the last build (infinite before it).
+    /// The largest distance a sphere has moved since the last build (infinite before it), and
+    /// the centres and the narrow phase's records ([`read_motion`]) of the spheres the lists
+    /// read: every sphere's in the same pass when most spheres are partners of candidates (a
+    /// packing), else only the partners', in a pass over them alone (most spheres of a
+    /// ballast stone touch nothing: the others' centres are read at the next build).
     pub(super) fn read_centers(&mut self, state: &State) -> f64 {
         let (every, built) = (self.reads_every_sphere(), self.lists_built());
         let (particle, built_at, turn) = (&self.particle, &self.built_at, &self.turn);
-        let moved = self
-            .center
-            .par_iter_mut()
-            .zip(self.now.par_iter_mut())
-            .with_min_len(SPHERE_CHUNK)
-            .enumerate()
-            .map(|(s, (center, now))| {
-                *center = state.position[particle[s] as usize];
-                if every {
+        let moved = if every {
+            self.center
+                .par_iter_mut()
+                .zip(self.now.par_iter_mut())
+                .with_min_len(SPHERE_CHUNK)
+                .enumerate()
+                .map(|(s, (center, now))| {
+                    *center = state.position[particle[s] as usize];
                     read_motion(state, *center, particle[s], turn[s], now);
-                }
-                if built {
-                    (*center - built_at[s]).norm_squared()
-                } else {
-                    f64::INFINITY
-                }
-            })
-            .reduce(|| 0.0, f64::max);
+                    match built {
+                        true => (*center - built_at[s]).norm_squared(),
+                        false => f64::INFINITY,
+                    }
+                })
+                .reduce(|| 0.0, f64::max)
+        } else {
+            built_at
+                .par_iter()
+                .with_min_len(SPHERE_CHUNK)
+                .enumerate()
+                .map(|(s, at)| (state.position[particle[s] as usize] - at).norm_squared())
+                .reduce(|| 0.0, f64::max)
+        };
         if !every {
             self.read_all_partners(state);
         }
         moved.sqrt()
+    }
+
+    /// Copies every sphere's centre out of the state (before a build, when the read passed
+    /// over the partners only).
+    pub(super) fn read_every_center(&mut self, state: &State) {
+        let particle = &self.particle;
+        self.center
+            .par_iter_mut()
+            .with_min_len(SPHERE_CHUNK)
+            .enumerate()
+            .for_each(|(s, center)| *center = state.position[particle[s] as usize]);
     }
 
     /// Whether [`DemContacts::read_centers`] fills every sphere's narrow-phase record in its
@@ -70,11 +86,12 @@ impl DemContacts {
         self.partners = partners;
     }
 
-    /// The narrow phase's record ([`read_motion`]) of `spheres` from `state`.
+    /// The centres and the narrow phase's records ([`read_motion`]) of `spheres` from `state`.
     pub(super) fn read_motions(&mut self, state: &State, spheres: &[u32]) {
         for &s in spheres {
             let s = s as usize;
             let (particle, turn) = (self.particle[s], self.turn[s]);
+            self.center[s] = state.position[particle as usize];
             read_motion(state, self.center[s], particle, turn, &mut self.now[s]);
         }
     }
@@ -172,6 +189,7 @@ impl DemContacts {
         self.incidence_start = start;
         self.incidence = incidence;
         self.wall_start = wall_start;
+        self.plan_scatter();
     }
 
     /// The geometry and elasticity of the pair of spheres of `contact`, with the image
@@ -183,7 +201,9 @@ impl DemContacts {
     ) -> Option<(PairGeometry, PairElasticity)> {
         let (a, b) = (contact.first as usize, contact.second as usize);
         let (sa, sb) = (&self.now[a], &self.now[b]);
-        contact.shift = self.separation(a, b).1;
+        if let Some(p) = &self.periodic {
+            contact.shift = p.image_shift(&(sb.center - sa.center));
+        }
         let geometry = narrow_phase(sa, sb, contact.shift, self.settings.friction)?;
         let e = self.elasticity[sa.material as usize * self.materials + sb.material as usize];
         Some((geometry, e))
@@ -289,19 +309,30 @@ impl DemContacts {
         self.sphere_force = sphere_force;
     }
 
-    /// Sphere `s`'s sum of contact forces, and their moment about its centre if it turns,
-    /// over its incidence in ascending pair order, then its wall contacts.
+    /// Sphere `s`'s sum of contact forces, and their moment about its centre, in the order of
+    /// the fused pass (`scatter.rs`): the pairs of each run of first spheres before its own
+    /// summed apart, in ascending pair order, these partial sums added in run order, its own
+    /// run's partial (its pairs there, then its wall contacts) last; forces from delayed
+    /// ghosts scaled.
     #[inline]
     pub(super) fn sphere_sum(&self, s: usize) -> (Vec3, Vec3) {
         let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
         let (start, incidence, wall_start) =
             (&self.incidence_start, &self.incidence, &self.wall_start);
         let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
-        let (mut f, mut t) = (Vec3::zeros(), Vec3::zeros());
-        let (spins, radius) = (self.turn[s] != NOT_RIGID, self.radius[s]);
+        let radius = self.radius[s];
+        let own = run_of(s as u32);
+        let (mut total, mut partial, mut run) = (None, (Vec3::zeros(), Vec3::zeros()), own);
         for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
             let c = &pairs[(e / 2) as usize];
             let first = e % 2 == 0;
+            let r = run_of(c.first);
+            if r != run {
+                if run != own {
+                    total = Some(add_sum(total, partial));
+                }
+                (partial, run) = ((Vec3::zeros(), Vec3::zeros()), r);
+            }
             let scale = match &delay {
                 Some((axis, scales)) => {
                     let (a, b) = pair_scales(c.shift[*axis], scales);
@@ -313,18 +344,16 @@ impl DemContacts {
                 }
                 None => 1.0,
             };
-            f += if first { scale } else { -scale } * c.force;
-            if spins {
-                t += c.moment(radius, scale);
-            }
+            add_to(&mut partial, pair_share(c, first, radius, scale));
+        }
+        if run != own {
+            total = Some(add_sum(total, partial));
+            partial = (Vec3::zeros(), Vec3::zeros());
         }
         for c in &walls[wall_start[s] as usize..wall_start[s + 1] as usize] {
-            f += c.force;
-            if spins {
-                t += c.moment(radius, 1.0);
-            }
+            add_to(&mut partial, wall_share(c, radius));
         }
-        (f, t)
+        add_sum(total, partial)
     }
 
     /// Adds sphere `s`'s contact force `f` to its particle and its moment `t` to the rigid

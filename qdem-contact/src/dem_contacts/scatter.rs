@@ -1,0 +1,373 @@
+//! The fused pass of a single-process evaluation: narrow phase, law and the per-sphere sums in
+//! one parallel region, with no gather.
+//!
+//! The spheres are cut into fixed runs of [`SCATTER_CHUNK`] (by sphere index, whatever the
+//! number of threads). A run owns the candidate pairs whose first sphere it holds (the lists
+//! are sorted by partners, so these are one slice of the list) and the wall contacts of its
+//! spheres. It evaluates them in list order and adds each contact's force and moment
+//! straight into the sums of its own spheres (pairs, then walls) and, for a second sphere
+//! beyond the run, into a small accumulator of that run's own ("foreign" sums, one slot per
+//! distinct such sphere, planned at each build). A serial pass then adds, for every partner
+//! of a candidate, its foreign sums in ascending run order and its own run's sum last, and
+//! the total to its particle: each sphere's sum is the same sequence of additions for any
+//! thread count, without atomics. The gather of the record path (`pipeline.rs`, the split
+//! ranks and the time-delayed boundary) sums in exactly this order, so both paths agree bit
+//! for bit.
+//!
+//! Per step a candidate pair costs its record (read and written once, as before) and two
+//! additions into sums that are in cache; the gather's two reads of every record, its
+//! incidence list and its pass over every sphere are gone, and the serial add runs over the
+//! partners of candidates only.
+
+use super::*;
+use std::ops::Range;
+
+/// Spheres per run of the fused pass: fixed, so that the order of every sum is.
+pub(crate) const SCATTER_CHUNK: usize = 2048;
+
+/// A force and a moment.
+type Sum = (Vec3, Vec3);
+
+/// The run of sphere `s`.
+#[inline]
+pub(super) fn run_of(s: u32) -> usize {
+    s as usize / SCATTER_CHUNK
+}
+
+/// What the fused pass knows of the lists, made at each build.
+#[derive(Default)]
+pub(super) struct ScatterPlan {
+    /// Per run: its pairs (a slice of the pair list), wall contacts and partners (a slice of
+    /// [`DemContacts::partners`]).
+    runs: Vec<RunPlan>,
+    /// Per pair: where its second sphere's share goes in its run: `s − lo` for a sphere of the
+    /// run, `SCATTER_CHUNK + k` for the run's k-th foreign sphere.
+    slot: Vec<u32>,
+    /// The foreign sums: (sphere, run, slot in that run's accumulator), sorted.
+    receive: Vec<(u32, u32, u32)>,
+    /// Per run, its foreign accumulator (scratch).
+    foreign: Vec<Vec<Sum>>,
+}
+
+/// One run's share of the lists.
+#[derive(Clone, Default)]
+struct RunPlan {
+    pairs: Range<usize>,
+    walls: Range<usize>,
+    partners: Range<usize>,
+}
+
+impl DemContacts {
+    /// Whether this evaluation may use the fused pass: one process (the split ranks gather),
+    /// and no time-delayed boundary (its ghost scales follow from the forces of this very
+    /// evaluation, so they are known only after the law has run over every pair).
+    pub(super) fn fuses(&self) -> bool {
+        self.split.is_none() && self.time_delay.is_none()
+    }
+
+    /// The plan of the fused pass for the current lists.
+    pub(super) fn plan_scatter(&mut self) {
+        let n = self.particle.len();
+        let runs = n.div_ceil(SCATTER_CHUNK);
+        let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
+        let mut plan = std::mem::take(&mut self.scatter);
+        plan.runs.clear();
+        plan.slot.clear();
+        plan.slot.resize(pairs.len(), 0);
+        plan.receive.clear();
+        plan.foreign.resize(runs, Vec::new());
+        let start = |lo: u32| {
+            (
+                pairs.partition_point(|c| c.first < lo),
+                walls.partition_point(|c| c.first < lo),
+                self.partners.partition_point(|&s| s < lo),
+            )
+        };
+        let mut foreign = Vec::new();
+        for r in 0..runs {
+            let (lo, hi) = ((r * SCATTER_CHUNK) as u32, ((r + 1) * SCATTER_CHUNK).min(n) as u32);
+            let (from, to) = (start(lo), start(hi));
+            let run = RunPlan {
+                pairs: from.0..to.0,
+                walls: from.1..to.1,
+                partners: from.2..to.2,
+            };
+            foreign.clear();
+            foreign.extend(pairs[run.pairs.clone()].iter().map(|c| c.second).filter(|&b| b >= hi));
+            foreign.sort_unstable();
+            foreign.dedup();
+            for k in run.pairs.clone() {
+                let b = pairs[k].second;
+                plan.slot[k] = match b < hi {
+                    true => b - lo,
+                    false => {
+                        SCATTER_CHUNK as u32 + foreign.binary_search(&b).expect("planned") as u32
+                    }
+                };
+            }
+            let r32 = r as u32;
+            plan.receive.extend(foreign.iter().enumerate().map(|(k, &b)| (b, r32, k as u32)));
+            plan.foreign[r].resize(foreign.len(), (Vec3::zeros(), Vec3::zeros()));
+            plan.runs.push(run);
+        }
+        plan.receive.sort_unstable();
+        self.scatter = plan;
+        // Spheres that touch nothing keep a zero sum until the next build.
+        self.sphere_force.fill((Vec3::zeros(), Vec3::zeros()));
+    }
+
+    /// Narrow phase, law and per-sphere sums over every run in parallel, then the serial
+    /// add of the partners' sums to their particles (`force`) and rotations (`torque`).
+    pub(super) fn evaluate_and_add(
+        &mut self,
+        time: f64,
+        dt: f64,
+        force: &mut [Vec3],
+        torque: &mut [Vec3],
+    ) {
+        let mut plan = std::mem::take(&mut self.scatter);
+        let mut pairs = std::mem::take(&mut self.pairs.items);
+        let mut walls = std::mem::take(&mut self.wall_contacts.items);
+        let mut sums = std::mem::take(&mut self.sphere_force);
+        {
+            let pair_runs = cut(&mut pairs, plan.runs.iter().map(|r| r.pairs.len()));
+            let wall_runs = cut(&mut walls, plan.runs.iter().map(|r| r.walls.len()));
+            let this = &*self;
+            let (runs, slot) = (&plan.runs, &plan.slot);
+            sums.par_chunks_mut(SCATTER_CHUNK)
+                .zip(plan.foreign.par_iter_mut())
+                .zip(pair_runs.into_par_iter().zip(wall_runs))
+                .enumerate()
+                .for_each(|(r, ((own, foreign), (pairs, walls)))| {
+                    let run = &runs[r];
+                    let lo = (r * SCATTER_CHUNK) as u32;
+                    let slots = &slot[run.pairs.clone()];
+                    let partners = &this.partners[run.partners.clone()];
+                    this.evaluate_run(time, dt, lo, (pairs, slots, walls, partners), own, foreign);
+                });
+        }
+        (self.pairs.items, self.wall_contacts.items) = (pairs, walls);
+        let mut receive = plan.receive.iter().peekable();
+        for &s in &self.partners {
+            let mut total: Option<Sum> = None;
+            while let Some(&(_, r, k)) = receive.next_if(|e| e.0 == s) {
+                total = Some(add_sum(total, plan.foreign[r as usize][k as usize]));
+            }
+            let total = add_sum(total, sums[s as usize]);
+            sums[s as usize] = total;
+            self.add_sphere(s as usize, &total.0, &total.1, force, torque);
+        }
+        self.sphere_force = sums;
+        self.scatter = plan;
+    }
+
+    /// One run: its partners' sums set to zero, then each pair in list order (its shares to
+    /// its first sphere and to its second, in the run or foreign), then each wall contact.
+    fn evaluate_run(
+        &self,
+        time: f64,
+        dt: f64,
+        lo: u32,
+        (pairs, slots, walls, partners): (&mut [Contact], &[u32], &mut [Contact], &[u32]),
+        own: &mut [Sum],
+        foreign: &mut [Sum],
+    ) {
+        let law = &self.settings.law;
+        for &s in partners {
+            own[(s - lo) as usize] = (Vec3::zeros(), Vec3::zeros());
+        }
+        foreign.fill((Vec3::zeros(), Vec3::zeros()));
+        for (contact, &slot) in pairs.iter_mut().zip(slots) {
+            let Some((g, e)) = self.pair_contact(contact) else {
+                contact.part();
+                continue;
+            };
+            let f = law.force(&g, &e, &mut contact.history, dt);
+            contact.touch(f, &g.normal, g.overlap);
+            let (a, b) = (contact.first as usize, contact.second as usize);
+            let (first, second) = (
+                pair_share(contact, true, self.now[a].radius, 1.0),
+                pair_share(contact, false, self.now[b].radius, 1.0),
+            );
+            add_to(&mut own[a - lo as usize], first);
+            match (slot as usize).checked_sub(SCATTER_CHUNK) {
+                None => add_to(&mut own[slot as usize], second),
+                Some(k) => add_to(&mut foreign[k], second),
+            }
+        }
+        for contact in walls.iter_mut() {
+            let s = contact.first as usize;
+            let Some((g, e)) = self.wall_contact(time, s, contact.second as usize) else {
+                contact.part();
+                continue;
+            };
+            let f = law.force(&g, &e, &mut contact.history, dt);
+            contact.touch(f, &g.normal, g.overlap);
+            add_to(&mut own[s - lo as usize], wall_share(contact, self.now[s].radius));
+        }
+    }
+}
+
+/// The share of pair `c` of sphere `first` (else the second), of radius `radius`, with its
+/// ghost scale `scale`: ±`scale` f and the moment (r − δ/2) `scale` n × f.
+#[inline]
+pub(super) fn pair_share(c: &Contact, first: bool, radius: f64, scale: f64) -> Sum {
+    let f = if first { scale } else { -scale } * c.force;
+    (f, c.moment(radius, scale))
+}
+
+/// The share of wall contact `c` of its sphere, of radius `radius`.
+#[inline]
+pub(super) fn wall_share(c: &Contact, radius: f64) -> Sum {
+    (c.force, c.moment(radius, 1.0))
+}
+
+/// `sum += share`.
+#[inline]
+pub(super) fn add_to(sum: &mut Sum, share: Sum) {
+    sum.0 += share.0;
+    sum.1 += share.1;
+}
+
+/// The running total of a sphere's partial sums, in run order: the first partial itself,
+/// then each further one added.
+#[inline]
+pub(super) fn add_sum(total: Option<Sum>, partial: Sum) -> Sum {
+    match total {
+        None => partial,
+        Some((f, t)) => (f + partial.0, t + partial.1),
+    }
+}
+
+/// `items` cut into consecutive slices of `lengths`.
+fn cut<T>(items: &mut [T], lengths: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
+    let mut rest = items;
+    let mut out = Vec::new();
+    for len in lengths {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
+        out.push(head);
+        rest = tail;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hertz_mindlin::HertzMindlin;
+    use crate::plane_wall::PlaneWall;
+    use crate::wall::WallShape;
+
+    /// 18 × 18 × 16 spheres (2.5 runs) on a jittered lattice closer than their diameter,
+    /// turning, with velocities and spins, over a floor: many pairs cross a run boundary.
+    fn packing() -> (State, DemContacts) {
+        let r = 0.005;
+        let mut centers = Vec::new();
+        for k in 0..16 {
+            for j in 0..18 {
+                for i in 0..18 {
+                    let jitter = ((i * 7 + j * 13 + k * 29) % 17) as f64 / 17.0 - 0.5;
+                    centers.push(Vec3::new(
+                        (1.98 * i as f64) * r + 0.02 * r * jitter,
+                        (1.98 * j as f64) * r - 0.02 * r * jitter,
+                        (1.98 * k as f64 + 0.99) * r,
+                    ));
+                }
+            }
+        }
+        let n = centers.len();
+        let mut state = State::at_rest(centers);
+        state.mass = vec![1e-3; n];
+        for p in 0..n {
+            let f = |m: usize| ((p * m) % 101) as f64 / 101.0 - 0.5;
+            state.velocity[p] = Vec3::new(f(37), f(53), f(71));
+            state.let_turn(p, 1e-8);
+            state.spin.velocity[p] = Vec3::new(f(11), f(17), f(23)) * 10.0;
+        }
+        let spheres: Vec<ContactSphere> = (0..n)
+            .map(|p| ContactSphere { particle: p, radius: r, body: p, material: 0 })
+            .collect();
+        let floor = Wall {
+            shape: WallShape::Plane(PlaneWall::new(Vec3::zeros(), Vec3::z(), Vec3::zeros())),
+            friction: 0.4,
+        };
+        let settings = ContactSettings {
+            law: ContactLaw::HertzMindlin(HertzMindlin { damping_ratio: 0.2 }),
+            friction: 0.5,
+            skin: 0.001,
+        };
+        let names = (0..n).map(|p| p.to_string()).collect();
+        let contacts =
+            DemContacts::new(&state, &spheres, names, &[(5e7, 0.25)], settings, vec![floor]);
+        (state, contacts)
+    }
+
+    /// Three evaluations 10 µs apart (the springs grow), by the fused pass or by the record
+    /// path's law and gather: the particle forces and torques of the last.
+    fn forces(fused: bool, threads: usize) -> (Vec<Vec3>, Vec<Vec3>, usize) {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let (mut state, mut contacts) = packing();
+            let n = state.len();
+            let (mut force, mut torque) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
+            for step in 0..3 {
+                state.time = 1e-5 * step as f64;
+                force.fill(Vec3::zeros());
+                torque.fill(Vec3::zeros());
+                if fused {
+                    contacts.add_forces(&state, &mut force, &mut torque);
+                } else {
+                    let dt = contacts.last_time.map_or(0.0, |t| state.time - t);
+                    contacts.last_time = Some(state.time);
+                    contacts.read_centers(&state);
+                    if !contacts.lists_built() {
+                        contacts.rebuild_all(state.time);
+                    }
+                    contacts.evaluate(state.time, dt);
+                    contacts.gather();
+                    for (s, (f, t)) in contacts.sphere_force.iter().enumerate() {
+                        contacts.add_sphere(s, f, t, &mut force, &mut torque);
+                    }
+                }
+            }
+            (force, torque, contacts.contacts())
+        })
+    }
+
+    #[test]
+    fn the_fused_pass_sums_as_the_gather_does_bit_for_bit_on_any_thread_count() {
+        let (_, contacts) = packing();
+        assert!(contacts.spheres() > 2 * SCATTER_CHUNK);
+        let gathered = forces(false, 1);
+        // Most spheres touch: the comparison is not one of zeros.
+        assert!(gathered.2 > 10_000, "{} touching contacts", gathered.2);
+        for threads in [1, 2, 3] {
+            let fused = forces(true, threads);
+            assert_eq!(fused.2, gathered.2);
+            for p in 0..fused.0.len() {
+                assert_eq!(fused.0[p], gathered.0[p], "force on particle {p}, {threads} threads");
+                assert_eq!(fused.1[p], gathered.1[p], "torque on particle {p}, {threads} threads");
+            }
+        }
+    }
+
+    #[test]
+    fn the_plan_routes_second_spheres_beyond_a_run_through_its_foreign_sums() {
+        let (state, mut contacts) = packing();
+        contacts.read_centers(&state);
+        contacts.rebuild_all(0.0);
+        let plan = &contacts.scatter;
+        let mut crossing = 0;
+        for (k, c) in contacts.pairs.items.iter().enumerate() {
+            let slot = plan.slot[k] as usize;
+            if run_of(c.second) == run_of(c.first) {
+                assert_eq!(slot, c.second as usize % SCATTER_CHUNK);
+            } else {
+                crossing += 1;
+                let (r, f) = (run_of(c.first) as u32, (slot - SCATTER_CHUNK) as u32);
+                assert!(plan.receive.binary_search(&(c.second, r, f)).is_ok());
+            }
+        }
+        assert!(crossing > 0);
+    }
+}
