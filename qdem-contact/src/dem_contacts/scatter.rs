@@ -23,7 +23,7 @@ use super::*;
 use std::ops::Range;
 
 /// Spheres per run of the fused pass: fixed, so that the order of every sum is.
-pub(crate) const SCATTER_CHUNK: usize = 2048;
+pub(crate) const SCATTER_CHUNK: usize = 1024;
 
 /// A force and a moment.
 type Sum = (Vec3, Vec3);
@@ -258,7 +258,7 @@ mod tests {
     use crate::plane_wall::PlaneWall;
     use crate::wall::WallShape;
 
-    /// 18 × 18 × 16 spheres (2.5 runs) on a jittered lattice closer than their diameter,
+    /// 18 × 18 × 16 spheres (five runs) on a jittered lattice closer than their diameter,
     /// turning, with velocities and spins, over a floor: many pairs cross a run boundary.
     fn packing() -> (State, DemContacts) {
         let r = 0.005;
