@@ -23,7 +23,7 @@ use super::*;
 use std::ops::Range;
 
 /// Spheres per run of the fused pass: fixed, so that the order of every sum is.
-pub(crate) const SCATTER_CHUNK: usize = 1024;
+pub(crate) const SCATTER_CHUNK: usize = 2048;
 
 /// A force and a moment.
 type Sum = (Vec3, Vec3);
@@ -85,7 +85,10 @@ impl DemContacts {
         };
         let mut foreign = Vec::new();
         for r in 0..runs {
-            let (lo, hi) = ((r * SCATTER_CHUNK) as u32, ((r + 1) * SCATTER_CHUNK).min(n) as u32);
+            let (lo, hi) = (
+                (r * SCATTER_CHUNK) as u32,
+                ((r + 1) * SCATTER_CHUNK).min(n) as u32,
+            );
             let (from, to) = (start(lo), start(hi));
             let run = RunPlan {
                 pairs: from.0..to.0,
@@ -93,7 +96,12 @@ impl DemContacts {
                 partners: from.2..to.2,
             };
             foreign.clear();
-            foreign.extend(pairs[run.pairs.clone()].iter().map(|c| c.second).filter(|&b| b >= hi));
+            foreign.extend(
+                pairs[run.pairs.clone()]
+                    .iter()
+                    .map(|c| c.second)
+                    .filter(|&b| b >= hi),
+            );
             foreign.sort_unstable();
             foreign.dedup();
             for k in run.pairs.clone() {
@@ -106,7 +114,8 @@ impl DemContacts {
                 };
             }
             let r32 = r as u32;
-            plan.receive.extend(foreign.iter().enumerate().map(|(k, &b)| (b, r32, k as u32)));
+            plan.receive
+                .extend(foreign.iter().enumerate().map(|(k, &b)| (b, r32, k as u32)));
             plan.foreign[r].resize(foreign.len(), (Vec3::zeros(), Vec3::zeros()));
             plan.runs.push(run);
         }
@@ -203,7 +212,10 @@ impl DemContacts {
             };
             let f = law.force(&g, &e, &mut contact.history, dt);
             contact.touch(f, &g.normal, g.overlap);
-            add_to(&mut own[s - lo as usize], wall_share(contact, self.now[s].radius));
+            add_to(
+                &mut own[s - lo as usize],
+                wall_share(contact, self.now[s].radius),
+            );
         }
     }
 }
@@ -258,7 +270,7 @@ mod tests {
     use crate::plane_wall::PlaneWall;
     use crate::wall::WallShape;
 
-    /// 18 × 18 × 16 spheres (five runs) on a jittered lattice closer than their diameter,
+    /// 18 × 18 × 16 spheres (2.5 runs) on a jittered lattice closer than their diameter,
     /// turning, with velocities and spins, over a floor: many pairs cross a run boundary.
     fn packing() -> (State, DemContacts) {
         let r = 0.005;
@@ -285,7 +297,12 @@ mod tests {
             state.spin.velocity[p] = Vec3::new(f(11), f(17), f(23)) * 10.0;
         }
         let spheres: Vec<ContactSphere> = (0..n)
-            .map(|p| ContactSphere { particle: p, radius: r, body: p, material: 0 })
+            .map(|p| ContactSphere {
+                particle: p,
+                radius: r,
+                body: p,
+                material: 0,
+            })
             .collect();
         let floor = Wall {
             shape: WallShape::Plane(PlaneWall::new(Vec3::zeros(), Vec3::z(), Vec3::zeros())),
@@ -297,15 +314,24 @@ mod tests {
             skin: 0.001,
         };
         let names = (0..n).map(|p| p.to_string()).collect();
-        let contacts =
-            DemContacts::new(&state, &spheres, names, &[(5e7, 0.25)], settings, vec![floor]);
+        let contacts = DemContacts::new(
+            &state,
+            &spheres,
+            names,
+            &[(5e7, 0.25)],
+            settings,
+            vec![floor],
+        );
         (state, contacts)
     }
 
     /// Three evaluations 10 µs apart (the springs grow), by the fused pass or by the record
     /// path's law and gather: the particle forces and torques of the last.
     fn forces(fused: bool, threads: usize) -> (Vec<Vec3>, Vec<Vec3>, usize) {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let (mut state, mut contacts) = packing();
             let n = state.len();
@@ -345,8 +371,14 @@ mod tests {
             let fused = forces(true, threads);
             assert_eq!(fused.2, gathered.2);
             for p in 0..fused.0.len() {
-                assert_eq!(fused.0[p], gathered.0[p], "force on particle {p}, {threads} threads");
-                assert_eq!(fused.1[p], gathered.1[p], "torque on particle {p}, {threads} threads");
+                assert_eq!(
+                    fused.0[p], gathered.0[p],
+                    "force on particle {p}, {threads} threads"
+                );
+                assert_eq!(
+                    fused.1[p], gathered.1[p],
+                    "torque on particle {p}, {threads} threads"
+                );
             }
         }
     }
