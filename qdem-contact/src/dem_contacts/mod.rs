@@ -9,12 +9,14 @@
 //! 2. rebuilds the pair and wall candidate lists if some sphere (or wall) moved more than the
 //!    skin allows ([`crate::broad_phase`]), carrying the tangential springs of surviving
 //!    pairs over,
-//! 3. evaluates the law of every candidate pair and wall contact in parallel into per-contact
-//!    buffers,
-//! 4. gathers them per sphere over a fixed incidence list (no atomics, so results do not depend
-//!    on the thread count) and adds them, in sphere order, to the particle forces, and the
-//!    moment of each contact force about its sphere's centre to the sphere's rigid body or
-//!    rotating particle.
+//! 3. evaluates the law of every candidate pair and wall contact and adds each force, and its
+//!    moment about the sphere's centre, straight into per-sphere sums, in parallel over fixed
+//!    runs of spheres (`scatter.rs`; no atomics, so results do not depend on the thread
+//!    count),
+//! 4. adds each partner's sum to its particle force and the moment to the sphere's rigid body
+//!    or rotating particle. A split rank, and a time-delayed boundary (whose ghost scales
+//!    follow from this very evaluation's forces), evaluate into per-contact records first and
+//!    gather them per sphere over a fixed incidence list, in the same order.
 //!
 //! The contact point is at x_a + (r_a − δ/2) n; its velocity includes the rigid body's (or
 //! the rotating particle's) spin, v + ω × (x_cp − x). Tangential springs grow by the relative
@@ -31,7 +33,7 @@
 //!
 //! The files: this one holds the model (its records, the narrow phase, the [`Model`] facet
 //! and the stable step); `build.rs` its construction; `pipeline.rs` the single-process
-//! pipeline above; `views.rs` what the outputs read; `persistence.rs` what a checkpoint
+//! pipeline above; `scatter.rs` its fused pass; `views.rs` what the outputs read; `persistence.rs` what a checkpoint
 //! keeps; `modal_springs.rs` the touching contacts as springs for a modal analysis;
 //! `split.rs` one rank's part in a decomposed run, whose stages the world's exchange runs
 //! ([`qdem_core::parallel`]).
