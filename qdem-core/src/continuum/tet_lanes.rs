@@ -82,7 +82,8 @@ pub enum LaneSet {
 impl LaneSet {
     /// The widest set this CPU runs, lowered by the environment variable
     /// `QDEM_KERNEL_LANES` (`scalar`, `avx2` or `avx512`: for comparing the paths in one
-    /// binary; a set the CPU lacks is never chosen). Detected once per process.
+    /// binary; a set the CPU lacks is never chosen, other values are ignored). Detected once
+    /// per process.
     pub fn detected() -> LaneSet {
         static SET: OnceLock<LaneSet> = OnceLock::new();
         *SET.get_or_init(|| {
