@@ -2,9 +2,12 @@
 //! structured meshes, elastic and viscoelastic, for several thread counts, in
 //! tetrahedron-steps per second. A STREAM-like triad measured in the same process gives the
 //! machine's memory bandwidth, the peer against which the kernel's compulsory memory traffic
-//! per tet-step is judged. [`run_and_print`] is `qdem bench`: the measurements as a table or as
+//! per tet-step is judged; the vector peak ([`crate::vector_peak`]) is the peer of its
+//! floating-point operations per tet-step. [`run_and_print`] is `qdem bench`: the measurements as a table or as
 //! one JSON document.
 
+use crate::vector_peak::vector_peak_flops;
+use qdem_core::continuum::tet_lanes::{LaneSet, FLOPS_ELASTIC, FLOPS_VISCOELASTIC};
 use qdem_core::{Material, Model, State, Stepper, TetBody, Vec3, Verlet};
 use qdem_mesh::{structured_box, TetMesh};
 use serde_json::json;
@@ -77,6 +80,16 @@ impl BenchResult {
             + per_block_node * self.block_nodes as f64
             + per_particle * self.particles as f64)
             / self.tets as f64
+    }
+
+    /// Floating-point operations of one tet-step in the kernel (a multiply-add counted as two;
+    /// `qdem_core::continuum::tet_lanes::FLOPS_ELASTIC`): what the vector peak is set against.
+    pub fn flops_per_tet_step(&self) -> usize {
+        if self.viscous {
+            FLOPS_VISCOELASTIC
+        } else {
+            FLOPS_ELASTIC
+        }
     }
 }
 
@@ -242,6 +255,11 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
         .iter()
         .map(|&t| (t, triad_bandwidth(t)))
         .collect();
+    let peak: Vec<(usize, f64)> = plan
+        .threads
+        .iter()
+        .map(|&t| (t, vector_peak_flops(t)))
+        .collect();
     if !as_json {
         println!(
             "machine: {} ({} cores available)",
@@ -251,8 +269,15 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
         for (t, bw) in &bandwidth {
             println!("triad bandwidth, {t} threads: {:.2} GB/s", bw / 1e9);
         }
+        for (t, p) in &peak {
+            println!(
+                "vector peak ({:?}), {t} threads: {:.1} Gflop/s",
+                LaneSet::detected(),
+                p / 1e9
+            );
+        }
         println!(
-            "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14} {:>10} {:>10}",
+            "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14} {:>10} {:>10} {:>10}",
             "tets",
             "particles",
             "material",
@@ -260,7 +285,8 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
             "steps",
             "tet-steps/s",
             "B/tet-step",
-            "% of triad"
+            "% of triad",
+            "% of peak"
         );
     }
     for &tets in &plan.tets {
@@ -272,9 +298,14 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
                     .find(|b| b.0 == threads)
                     .map_or(f64::NAN, |b| b.1);
                 let fraction = r.tet_steps_per_second() * r.bytes_per_tet_step() / bw;
+                let peak = peak
+                    .iter()
+                    .find(|p| p.0 == threads)
+                    .map_or(f64::NAN, |p| p.1);
+                let of_peak = r.tet_steps_per_second() * r.flops_per_tet_step() as f64 / peak;
                 if !as_json {
                     println!(
-                        "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14.4e} {:>10.0} {:>9.0}%",
+                        "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14.4e} {:>10.0} {:>9.0}% {:>9.0}%",
                         r.tets,
                         r.particles,
                         if viscous { "visco" } else { "elastic" },
@@ -282,7 +313,8 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
                         r.steps,
                         r.tet_steps_per_second(),
                         r.bytes_per_tet_step(),
-                        100.0 * fraction
+                        100.0 * fraction,
+                        100.0 * of_peak
                     );
                 }
                 results.push(json!({
@@ -293,6 +325,8 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
                     "particle_steps_per_second": (r.particles * r.steps) as f64 / r.seconds,
                     "bytes_per_tet_step": r.bytes_per_tet_step(),
                     "fraction_of_triad_bandwidth": fraction,
+                    "flops_per_tet_step": r.flops_per_tet_step(),
+                    "fraction_of_vector_peak": of_peak,
                 }));
             }
         }
@@ -302,6 +336,8 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
         let doc = json!({
             "locality": locality,
             "machine": { "cpu": cpu_model(), "cores": std::thread::available_parallelism().map_or(0, |n| n.get()) },
+            "kernel_lanes": format!("{:?}", LaneSet::detected()).to_lowercase(),
+            "vector_peak_flops_per_second": peak.iter().map(|(t, p)| json!({"threads": t, "value": p})).collect::<Vec<_>>(),
             "triad_bandwidth_bytes_per_second": bandwidth.iter().map(|(t, b)| json!({"threads": t, "value": b})).collect::<Vec<_>>(),
             "results": results,
         });

@@ -121,7 +121,8 @@ pub enum Command {
     /// Kernel throughput in tet-steps/s on structured meshes
     ///
     /// Elastic and viscoelastic blocks of about each --tets size on each --threads count, the
-    /// machine's triad bandwidth and the effect of node ordering. --implicit measures the
+    /// machine's triad bandwidth and vector peak (the kernel's share of each) and the effect of
+    /// node ordering. --implicit measures the
     /// sparse Cholesky path instead: assembly, factorisation, solve and implicit step against
     /// the number of unknowns.
     Bench(BenchArgs),

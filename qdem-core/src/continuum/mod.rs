@@ -1,5 +1,5 @@
 //! The bodies and the kernel: the QDEM tetrahedron of paper 000 (Eqs. 1–11) in
-//! [`tet_kernel`], its literal 12-triangle oracle in [`tet_subdomain`], the deformable body
+//! [`tet_kernel`] (across SIMD lanes in [`tet_lanes`]), its literal 12-triangle oracle in [`tet_subdomain`], the deformable body
 //! ([`tet_body::TetBody`]) and its blocks ([`tet_blocks`]), the linear-tet stiffness
 //! ([`linear_tet`]), [`material`]s, the rigorous explicit step bound ([`stable_step`]) and
 //! rigid bodies ([`rigid_body`]).
@@ -11,4 +11,5 @@ pub mod stable_step;
 pub mod tet_blocks;
 pub mod tet_body;
 pub mod tet_kernel;
+pub mod tet_lanes;
 pub mod tet_subdomain;

@@ -16,6 +16,7 @@
 //! buffer: what crosses memory per tetrahedron is its reference data and local corners, and
 //! per node of a block one position in, one sum out and back.
 
+use crate::continuum::tet_lanes::{self, TetPack};
 use crate::{Mat3, Vec3};
 
 /// The most tetrahedra in one block: its nodes (at most four per tetrahedron) must be
@@ -63,6 +64,11 @@ pub(crate) struct TetBlocks {
     pub tet_start: Vec<u32>,
     /// The tetrahedra in block order.
     pub hot: Vec<HotTet>,
+    /// The tetrahedra of each block in packs for the lane kernel
+    /// ([`crate::continuum::tet_lanes`]): block `b`'s are `pack_start[b]..[b+1]`.
+    pub packs: Vec<TetPack>,
+    /// Per block, the range of its packs in `packs`.
+    pub pack_start: Vec<u32>,
     /// The body's index of each tetrahedron in block order.
     pub order: Vec<u32>,
     /// The block order's index of each tetrahedron of the body (the inverse of `order`).
@@ -101,9 +107,16 @@ impl TetBlocks {
         }
         let (node_start, nodes, hot) = block_nodes(tets, dm_inv, &order, &tet_start);
         let (first, entry_start, entries) = entry_lists(&nodes);
+        let (mut packs, mut pack_start) = (Vec::new(), vec![0u32]);
+        for range in tet_start.windows(2) {
+            packs.extend(tet_lanes::packs(&hot[range[0] as usize..range[1] as usize]));
+            pack_start.push(packs.len() as u32);
+        }
         TetBlocks {
             tet_start,
             hot,
+            packs,
+            pack_start,
             order,
             rank,
             node_start,

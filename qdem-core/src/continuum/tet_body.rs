@@ -22,6 +22,7 @@ use crate::continuum::tet_blocks::{BlockLayout, TetBlocks};
 use crate::continuum::tet_kernel::{
     deformation_gradient, edge_matrix, strain_energy, tet_forces, tet_stress, von_mises,
 };
+use crate::continuum::tet_lanes::{block_forces, BlockInput, LaneSet};
 use crate::error::CoreError;
 use crate::parallel::decomposition::{BodyLayout, BodySplit};
 use crate::parallel::split::{Part, PartialSums, Reads, SplitModel};
@@ -288,6 +289,17 @@ impl TetBody {
         out.fill(Vec3::zeros());
         let (elastic, viscous) = (self.pair(), self.vpair());
         let range = blocks.tet_start[b] as usize..blocks.tet_start[b + 1] as usize;
+        let packs = &blocks.packs[blocks.pack_start[b] as usize..blocks.pack_start[b + 1] as usize];
+        let input = BlockInput {
+            x: &scratch.x,
+            v: &scratch.v,
+            elastic,
+            viscous,
+            count: range.len(),
+        };
+        if let Some(inverted) = block_forces::<VISCOUS>(LaneSet::detected(), packs, &input, out) {
+            return inverted.map_or(usize::MAX, |k| blocks.order[range.start + k] as usize);
+        }
         let mut first_inverted = usize::MAX;
         for (k, hot) in range.clone().zip(&blocks.hot[range]) {
             let x = corners(&scratch.x, hot.local);
