@@ -29,6 +29,7 @@ pub(crate) mod snapshots;
 pub(crate) mod spheres_vtu;
 pub(crate) mod stones;
 pub(crate) mod summary;
+pub(crate) mod tet_stress;
 pub(crate) mod walls_vtu;
 
 use crate::build::Simulation;
