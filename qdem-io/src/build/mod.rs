@@ -12,7 +12,8 @@
 //! and probe's body as indices), so no name is looked up again here. One module per part of a
 //! scene, each taking the table it builds and the indices it needs:
 //!
-//! - this module: the `[[body]]` meshes, fixes, loads and the step request;
+//! - this module: the `[[body]]` meshes, fixes, loads and the step request; `area_load`: a
+//!   load's pressure or traction on the selected faces, lumped to their nodes;
 //! - [`probes`]: the `[[probe]]`s on particles, stones and boxes; `initial_motion`: the
 //!   bodies' and stones' initial velocity and angular velocity;
 //! - `contact`: contact spheres, the `[contact]` law and the `[[wall]]`s;
@@ -25,6 +26,7 @@
 //! - [`BuildError`] (`error`): why a build failed.
 
 pub mod ballast;
+mod area_load;
 mod bonded;
 mod contact;
 mod error;
@@ -545,7 +547,8 @@ fn apply_fixes(scene: &Scene, meshes: &[PlacedMesh], state: &mut State) -> Resul
     Ok(())
 }
 
-/// A [`NodalLoad`] per `[[load]]`.
+/// A [`NodalLoad`] per `[[load]]`: its total force shared by the selected particles, or its
+/// pressure or traction lumped to them ([`area_load`]).
 fn build_loads(
     scene: &Scene,
     meshes: &[PlacedMesh],
@@ -573,8 +576,21 @@ fn build_loads(
             scene: scene.path.clone(),
             source,
         })?;
-        let total = Vec3::from(load.total_force);
-        models.push(Box::new(NodalLoad::new(&what, particles, total, ramp)));
+        let model = match load.area {
+            None => NodalLoad::new(&what, particles, Vec3::from(load.total_force), ramp),
+            Some(area) => {
+                let forces = area_load::lumped_forces(
+                    scene,
+                    placed,
+                    &selected,
+                    area,
+                    (&what, &load.body),
+                )?;
+                let forces = forces.into_iter().map(|(n, f)| (n + start as u32, f));
+                NodalLoad::per_particle(&what, forces.collect(), ramp)
+            }
+        };
+        models.push(Box::new(model));
     }
     Ok(())
 }
