@@ -126,3 +126,61 @@ fn base64(text: &str) -> Vec<u8> {
     }
     out
 }
+
+/// The paper's cantilever (2.4 × 0.25 × 0.22 m, clamped at x = 0) solved statically under a
+/// downward traction of 200 N in all on its tip face x = 2.4: the clamp's reaction in
+/// `reactions.csv` is the tip load, +200 N along z, and its moment about the clamp's node
+/// centroid c the tip load's arm: M_y = −200 N × 2.4 m, M_x = 200 N × (0.125 − c_y) (the
+/// lumped traction acts at the face's centroid, (2.4, 0.125, 0.11)), M_z = 0. Measured to
+/// ~10⁻¹² of the load; the CSV's nine digits bound the check at 10⁻⁸.
+#[test]
+fn cantilever_reaction_is_the_tip_load_and_its_moment() {
+    let dir = test_dir("fem-cantilever-reaction");
+    let path = common::short_cantilever(
+        &dir,
+        &[
+            ("integrator = \"verlet\"", "integrator = \"static\""),
+            ("t_end = 0.02", "t_end = 1.0"),
+            ("dt = \"auto\"", "dt = 1.0"),
+            ("probe_every = 1e-4", "probe_every = 1.0"),
+            ("vtu_every = 0.05", "vtu_every = 0.0"),
+            (
+                "total_force = [0.0, 0.0, -200.0]",
+                "traction = [0.0, 0.0, -3636.363636363636]",
+            ),
+            ("ramp = [[0.0, 0.0], [0.01, 1.0], [2.0, 1.0], [2.0, 0.0]]", ""),
+        ],
+    );
+    let mut sim = Simulation::build(Scene::load(&path).unwrap()).unwrap();
+    let load = sim.world.model::<NodalLoad>().unwrap().total();
+    assert!((load.z + 200.0).abs() < 1e-9, "tip load {load}");
+    let clamp = &sim.fix_particles[0];
+    let c_y = clamp
+        .iter()
+        .map(|&i| sim.world.state.reference[i].y)
+        .sum::<f64>()
+        / clamp.len() as f64;
+    let out = dir.join("out");
+    run(&mut sim, &out, &mut |_| {}).unwrap();
+    let csv = std::fs::read_to_string(out.join("reactions.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "time,fix1_fx,fix1_fy,fix1_fz,fix1_mx,fix1_my,fix1_mz"
+    );
+    let last: Vec<f64> = lines
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let want = [1.0, 0.0, 0.0, 200.0, 200.0 * (0.125 - c_y), -480.0, 0.0];
+    let error = |k: usize| (last[k] - want[k]).abs();
+    eprintln!("cantilever reaction {:?} (want {want:?})", &last);
+    for k in 1..4 {
+        assert!(error(k) <= 1e-8 * 200.0, "force {k}: {} vs {}", last[k], want[k]);
+    }
+    for k in 4..7 {
+        assert!(error(k) <= 1e-8 * 480.0, "moment {k}: {} vs {}", last[k], want[k]);
+    }
+}

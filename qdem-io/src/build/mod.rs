@@ -131,6 +131,9 @@ pub struct Simulation {
     pub granular: Option<GranularInfo>,
     /// The stones of `[ballast]`.
     pub ballast: Option<BallastInfo>,
+    /// The particles each `[[fix]]` selects (state indices, increasing), in scene order: what
+    /// `reactions.csv` sums.
+    pub fix_particles: Vec<Vec<usize>>,
 }
 
 /// A body's mesh as read and placed, with its file and its particles' place in the state.
@@ -186,7 +189,7 @@ impl Simulation {
                 initial_motion::move_rigidly(&mut state, stone.clone(), v, w);
             }
         }
-        apply_fixes(&scene, &meshes, &mut state)?;
+        let fix_particles = apply_fixes(&scene, &meshes, &mut state)?;
         fix_rigid_bodies(&scene, &bodies, &mut state);
         let mut extra = ExtraSpheres::of_ballast(ballast.as_ref());
         let granular = add_granular(&scene, (&stones, sampled), &mut state, &mut extra)?;
@@ -216,6 +219,7 @@ impl Simulation {
             warnings,
             granular,
             ballast,
+            fix_particles,
         })
     }
 
@@ -531,20 +535,29 @@ fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], state: &mut State) {
     }
 }
 
-/// Fixes the selected directions of the selected particles of every `[[fix]]`.
-fn apply_fixes(scene: &Scene, meshes: &[PlacedMesh], state: &mut State) -> Result<(), BuildError> {
+/// Fixes the selected directions of the selected particles of every `[[fix]]`; returns each
+/// fix's particles.
+fn apply_fixes(
+    scene: &Scene,
+    meshes: &[PlacedMesh],
+    state: &mut State,
+) -> Result<Vec<Vec<usize>>, BuildError> {
     let on = &scene.refs().fix_bodies;
+    let mut fixed = Vec::with_capacity(scene.fixes.len());
     for (i, (fix, &body)) in scene.fixes.iter().zip(on).enumerate() {
         let placed = &meshes[body];
         let what = format!("[[fix]] #{}", i + 1);
-        for n in select(scene, placed, &fix.selection, &what, &fix.body)? {
-            state.fix(
-                placed.particles.start + n as usize,
-                Dofs::from_mask(fix.dofs),
-            );
+        let selected = select(scene, placed, &fix.selection, &what, &fix.body)?;
+        let particles: Vec<usize> = selected
+            .iter()
+            .map(|&n| placed.particles.start + n as usize)
+            .collect();
+        for &p in &particles {
+            state.fix(p, Dofs::from_mask(fix.dofs));
         }
+        fixed.push(particles);
     }
-    Ok(())
+    Ok(fixed)
 }
 
 /// A [`NodalLoad`] per `[[load]]`: its total force shared by the selected particles, or its
