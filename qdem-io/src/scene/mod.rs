@@ -37,6 +37,7 @@
 use std::path::{Path, PathBuf};
 
 mod error;
+pub mod keys;
 mod refs;
 pub mod schema;
 mod spans;
