@@ -22,10 +22,12 @@
 //! - `periodic`: the `[periodic]` cell, its wrap groups and time delay;
 //! - `rest_on`: bodies laid on a granular sample; `load_series`: a load's CSV time series;
 //! - [`memory`]: the memory a count needs, refused before allocating beyond the machine;
-//!   `step_check`: a time step that cannot advance the run, refused;
+//!   `step_check`: a time step that cannot advance the run, refused; `absurd_inputs`: valid
+//!   inputs that are hardly meant (a tiny dt, a far probe, a soft stone), warned of;
 //! - [`BuildError`] (`error`): why a build failed.
 
 pub mod ballast;
+mod absurd_inputs;
 mod area_load;
 mod bonded;
 mod contact;
@@ -125,7 +127,8 @@ pub struct Simulation {
     pub probes: Vec<ProbePoint>,
     /// Probes on boxes over the `[granular]` sample, in scene order.
     pub regions: Vec<probes::RegionProbe>,
-    /// Mesh warnings, one line each, naming the file.
+    /// Warnings, one line each, naming the file: the meshes', and inputs that are valid but
+    /// hardly meant (`absurd_inputs`).
     pub warnings: Vec<String>,
     /// The stones of `[granular]`.
     pub granular: Option<GranularInfo>,
@@ -149,10 +152,13 @@ impl Simulation {
     /// Reads the meshes and builds every model of `scene`: bodies, then gravity (only if
     /// non-zero), then loads; fixes go into the state. Refuses counts that would need more
     /// memory than the machine has before allocating them ([`memory`]), and a time step that
-    /// cannot advance the run (`step_check`).
+    /// cannot advance the run (`step_check`); warns of inputs that are hardly meant
+    /// (`absurd_inputs`).
     pub fn build(scene: Scene) -> Result<Simulation, BuildError> {
-        let sim = Simulation::build_models(scene)?;
+        let mut sim = Simulation::build_models(scene)?;
         step_check::check_step(&sim)?;
+        let absurd = absurd_inputs::warnings(&sim);
+        sim.warnings.extend(absurd);
         Ok(sim)
     }
 

@@ -337,7 +337,8 @@ fn ramp(c: &mut Checker<'_>, idx: &str, owner: &str, points: &Option<Vec<[f64; 2
     }
 }
 
-/// `cyclic` of a `[[load]]`: finite factors, a positive frequency, not with `ramp`.
+/// `cyclic` of a `[[load]]`: finite factors, `min` not above `max`, a positive frequency,
+/// not with `ramp`.
 fn cyclic_load(c: &mut Checker<'_>, idx: &str, l: &str, cyclic: &CyclicLoad, has_ramp: bool) {
     let at = ["load", idx, "cyclic"];
     let CyclicLoad {
@@ -348,6 +349,16 @@ fn cyclic_load(c: &mut Checker<'_>, idx: &str, l: &str, cyclic: &CyclicLoad, has
         start,
     } = *cyclic;
     c.finite(&at, l, "cyclic", &[min, max, phase_deg, start]);
+    if min > max {
+        c.error(
+            &at,
+            format!(
+                "{l}: cyclic min = {min} is above max = {max}; the factor runs from min up to \
+                 max, each cycle beginning at min: swap them (phase_deg = 180 begins the \
+                 cycles at the maximum)"
+            ),
+        );
+    }
     c.positive(&at, l, "cyclic.frequency", frequency, "Hz");
     if has_ramp {
         c.error(
