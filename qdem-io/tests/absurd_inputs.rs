@@ -19,7 +19,11 @@ fn warnings(name: &str, edits: &[(&str, &str)]) -> Vec<String> {
 fn assert_one_warning(warnings: &[String], parts: &[&str]) {
     assert_eq!(warnings.len(), 1, "{warnings:#?}");
     for part in parts {
-        assert!(warnings[0].contains(part), "{part:?} not in {:?}", warnings[0]);
+        assert!(
+            warnings[0].contains(part),
+            "{part:?} not in {:?}",
+            warnings[0]
+        );
     }
 }
 
@@ -34,7 +38,11 @@ fn a_tiny_step_is_warned_of_with_its_step_count() {
     let w = warnings("absurd-dt", &[("dt = \"auto\"", "dt = 1e-12")]);
     assert_one_warning(
         &w,
-        &["[run] dt = 1e-12 s", "2.00e10 steps", "did you mean dt = \"auto\""],
+        &[
+            "[run] dt = 1e-12 s",
+            "2.00e10 steps",
+            "did you mean dt = \"auto\"",
+        ],
     );
 }
 
@@ -54,7 +62,12 @@ fn a_stone_with_young_of_one_pascal_is_warned_of() {
     let w = warnings("absurd-young", &[("young = 45e9", "young = 1")]);
     assert_one_warning(
         &w,
-        &["young = 1e0 Pa", "density = 2.35e3", "2.06e-2 m/s", "did you mean 1e9 Pa (GPa)"],
+        &[
+            "young = 1e0 Pa",
+            "density = 2.35e3",
+            "2.06e-2 m/s",
+            "did you mean 1e9 Pa (GPa)",
+        ],
     );
 }
 
@@ -70,7 +83,11 @@ fn a_cyclic_load_with_min_above_max_is_refused() {
         )],
     );
     let message = Scene::load(&path).unwrap_err().to_string();
-    for part in ["[[load]] #1", "cyclic min = 1 is above max = 0.075", "swap them"] {
+    for part in [
+        "[[load]] #1",
+        "cyclic min = 1 is above max = 0.075",
+        "swap them",
+    ] {
         assert!(message.contains(part), "{part:?} not in {message:?}");
     }
 }

@@ -56,7 +56,10 @@ fn pressure_and_traction_forces_sum_to_load_times_area() {
     let sim = Simulation::build(pressed_block(&dir, "traction = [0.0, 3.0e5, -1.0e5]")).unwrap();
     let total = sim.world.model::<NodalLoad>().unwrap().total();
     let want = qdem_core::Vec3::new(0.0, 3.0e5, -1.0e5) * AREA;
-    assert!((total - want).norm() <= 1e-12 * want.norm(), "{total} vs {want}");
+    assert!(
+        (total - want).norm() <= 1e-12 * want.norm(),
+        "{total} vs {want}"
+    );
 }
 
 /// The pressed block solved statically: every tetrahedron's stress in the VTU is −p eₓ⊗eₓ to
@@ -82,7 +85,10 @@ fn pressed_block_has_uniform_stress_in_the_vtu() {
         .flat_map(|s| s.iter().zip(want).map(|(a, b)| (a - b).abs()))
         .fold(0.0, f64::max);
     eprintln!("pressed block: largest stress error {:.2e} p", worst / P);
-    assert!(worst <= 1e-9 * P, "largest stress error {worst:e} Pa of p = {P:e}");
+    assert!(
+        worst <= 1e-9 * P,
+        "largest stress error {worst:e} Pa of p = {P:e}"
+    );
     for (name, want) in [
         ("principal_stress_1", 0.0),
         ("principal_stress_2", 0.0),
@@ -148,7 +154,10 @@ fn cantilever_reaction_is_the_tip_load_and_its_moment() {
                 "total_force = [0.0, 0.0, -200.0]",
                 "traction = [0.0, 0.0, -3636.363636363636]",
             ),
-            ("ramp = [[0.0, 0.0], [0.01, 1.0], [2.0, 1.0], [2.0, 0.0]]", ""),
+            (
+                "ramp = [[0.0, 0.0], [0.01, 1.0], [2.0, 1.0], [2.0, 0.0]]",
+                "",
+            ),
         ],
     );
     let mut sim = Simulation::build(Scene::load(&path).unwrap()).unwrap();
@@ -178,9 +187,19 @@ fn cantilever_reaction_is_the_tip_load_and_its_moment() {
     let error = |k: usize| (last[k] - want[k]).abs();
     eprintln!("cantilever reaction {:?} (want {want:?})", &last);
     for k in 1..4 {
-        assert!(error(k) <= 1e-8 * 200.0, "force {k}: {} vs {}", last[k], want[k]);
+        assert!(
+            error(k) <= 1e-8 * 200.0,
+            "force {k}: {} vs {}",
+            last[k],
+            want[k]
+        );
     }
     for k in 4..7 {
-        assert!(error(k) <= 1e-8 * 480.0, "moment {k}: {} vs {}", last[k], want[k]);
+        assert!(
+            error(k) <= 1e-8 * 480.0,
+            "moment {k}: {} vs {}",
+            last[k],
+            want[k]
+        );
     }
 }

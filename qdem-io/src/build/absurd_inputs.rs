@@ -59,9 +59,9 @@ fn far_probes(sim: &Simulation) -> Vec<String> {
     let Some(first) = positions.first() else {
         return Vec::new();
     };
-    let (lo, hi) = positions.iter().fold((*first, *first), |(lo, hi), p| {
-        (lo.inf(p), hi.sup(p))
-    });
+    let (lo, hi) = positions
+        .iter()
+        .fold((*first, *first), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
     let extent = (hi - lo).norm();
     sim.probes
         .iter()

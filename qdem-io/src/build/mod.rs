@@ -26,9 +26,9 @@
 //!   inputs that are hardly meant (a tiny dt, a far probe, a soft stone), warned of;
 //! - [`BuildError`] (`error`): why a build failed.
 
-pub mod ballast;
 mod absurd_inputs;
 mod area_load;
+pub mod ballast;
 mod bonded;
 mod contact;
 mod error;
@@ -598,13 +598,8 @@ fn build_loads(
         let model = match load.area {
             None => NodalLoad::new(&what, particles, Vec3::from(load.total_force), ramp),
             Some(area) => {
-                let forces = area_load::lumped_forces(
-                    scene,
-                    placed,
-                    &selected,
-                    area,
-                    (&what, &load.body),
-                )?;
+                let forces =
+                    area_load::lumped_forces(scene, placed, &selected, area, (&what, &load.body))?;
                 let forces = forces.into_iter().map(|(n, f)| (n + start as u32, f));
                 NodalLoad::per_particle(&what, forces.collect(), ramp)
             }

@@ -47,8 +47,8 @@ mod validate;
 pub use error::{Diagnostic, SceneError};
 pub use refs::{ProbeTarget, Refs};
 pub use schema::{
-    AreaLoad, Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix, Granular,
-    Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section,
+    AreaLoad, Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix,
+    Granular, Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section,
     Selection, Series, Supports, TimeDelay, TimeStep, Wall,
 };
 

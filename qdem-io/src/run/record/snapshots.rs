@@ -16,12 +16,12 @@ use super::bonds_vtu::write_bonds;
 use super::contacts_vtu::write_contacts;
 use super::schedule::Schedule;
 use super::spheres_vtu::write_spheres;
+use super::tet_stress::StressFields;
 use super::walls_vtu::{walls_move, write_walls};
 use super::{Recorder, RunFigures, StateRead, StepInfo};
 use crate::build::Simulation;
-use crate::scene::Integrator;
-use super::tet_stress::StressFields;
 use crate::output::{write_vtu_mesh_at, OutputError, PvdIndex, VtuCells, VtuField, VtuMesh};
+use crate::scene::Integrator;
 use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
 use std::path::{Path, PathBuf};
 
