@@ -14,7 +14,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 /// The files a run writes at the top of its output folder.
-const TOP_FILES: [&str; 9] = [
+const TOP_FILES: [&str; 10] = [
     "results.pvd",
     "probes.csv",
     "probes.svg",
