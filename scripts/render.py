@@ -9,7 +9,9 @@ KIND
               colour and thickness scale for all panels) under the sleeper (grey), seen along x
               (the stones are left out, as in the paper's figure), at
               four phases of the first load cycle after --start (s, default 0.05) of frequency
-              --frequency (Hz, default 3): paper 003 Fig. 13; one panel per phase
+              --frequency (Hz, default 3): paper 003 Fig. 13; one panel per phase, framed on
+              the bodies and force chains of all four (any scene with contacts); a panel
+              without force chains is warned of on stderr
   ballast     the displacement magnitude of the bodies (ballast stones, sleeper) at the last time
               (or --time), warped by --scale (default 1)
   cantilever  von Mises stress on the beam deformed --scale times (default 2000) at --time
@@ -210,11 +212,45 @@ def range_of(source, association, array):
     return data[array].GetRange(-1 if data[array].GetNumberOfComponents() > 1 else 0)
 
 
+def bounds_of(sources):
+    """The box (xmin, xmax, ymin, ymax, zmin, zmax) around the data of `sources`; None when
+    they hold nothing."""
+    boxes = []
+    for s in sources:
+        s.UpdatePipeline()
+        info = s.GetDataInformation()
+        if info.GetNumberOfPoints() > 0:
+            boxes.append(info.GetBounds())
+    if not boxes:
+        return None
+    return [f(b[k] for b in boxes) for k in range(6) for f in [(min, max)[k % 2]]]
+
+
+def warn_empty(kind, t, what):
+    """Says on stderr that the panel at time t would show nothing of `what`."""
+    print("render.py: warning: %s panel at t = %.4f s: %s" % (kind, t, what), file=sys.stderr)
+
+
 def boxtest(args):
     times = series(args.out_dir)
     period = 1.0 / args.frequency
     phases = [at(times, args.start + k * period / 4.0) for k in range(4)]
+    if any("contacts" not in files for _, files in phases):
+        sys.exit("render.py: %s has no contacts VTU (a scene without contact spheres?); "
+                 "use the ballast or cantilever kind" % args.out_dir)
     contacts = [reader(files["contacts"]) for _, files in phases]
+    for (t, _), c in zip(phases, contacts):
+        c.UpdatePipeline()
+        if c.GetDataInformation().GetNumberOfCells() == 0:
+            warn_empty("boxtest", t, "no touching contacts, so no force chains (is --start "
+                       "before the load, or the run shorter than the cycle?)")
+    # Frame on the data (the bodies and every phase's force chains), seen along x.
+    frame = bounds_of([reader(files["state"]) for _, files in phases] + contacts)
+    if frame is None:
+        sys.exit("render.py: nothing to draw in %s: no body and no contact" % args.out_dir)
+    focal = [(frame[2 * k] + frame[2 * k + 1]) / 2.0 for k in range(3)]
+    width, height = frame[3] - frame[2], frame[5] - frame[4]
+    half_height = 0.55 * max(height, width * args.size[1] / args.size[0], 1e-9)
     largest = max(range_of(c, "CELLS", "normal_force_magnitude")[1] for c in contacts)
     radius = range_of(reader(phases[0][1]["spheres"]), "POINTS", "radius")[1]
     panels = []
@@ -238,7 +274,7 @@ def boxtest(args):
         d.SetScalarBarVisibility(v, k == 3)
         label(v, "t = %.3f s, %s" % (t, ["load at its minimum", "load rising", "load at its maximum", "load falling"][k]))
         pv.Render(v)
-        camera(v, (0.15, 1.05, 0.24), (1.0, 0.0, 0.0), 3.0, parallel_scale=0.3)
+        camera(v, focal, (1.0, 0.0, 0.0), 10.0 * half_height, parallel_scale=half_height)
         panel = "%s.panel%d.png" % (args.png, k)
         save(v, panel)
         panels.append(panel)
@@ -246,8 +282,11 @@ def boxtest(args):
 
 
 def bodies(args, array, association, title, direction, scale_default):
-    """The state VTU at --time, warped by its displacement, coloured by `array`."""
+    """The state VTU at --time, warped by its displacement, coloured by `array`, framed on
+    the data."""
     t, files = at(series(args.out_dir), args.time)
+    if bounds_of([reader(files["state"])]) is None:
+        warn_empty(args.kind, t, "the state VTU has no body (a scene of [granular] stones only?)")
     scale = scale_default if args.scale is None else args.scale
     v = view(args.size)
     warped = pv.WarpByVector(Input=reader(files["state"]), Vectors=["POINTS", "displacement"])

@@ -20,7 +20,7 @@ use crate::continuum::material::{Lame, Material};
 use crate::continuum::stable_step::{critical_step, element_rate_bound};
 use crate::continuum::tet_blocks::{BlockLayout, TetBlocks};
 use crate::continuum::tet_kernel::{
-    deformation_gradient, edge_matrix, strain_energy, tet_forces, tet_stress, von_mises,
+    deformation_gradient, edge_matrix, strain_energy, tet_forces, tet_stress,
 };
 use crate::continuum::tet_lanes::{block_forces, BlockInput, LaneSet};
 use crate::error::CoreError;
@@ -210,8 +210,11 @@ impl TetBody {
         }
     }
 
-    /// Von Mises stress (Pa) and volumetric strain det F − 1 of every tetrahedron.
-    pub fn tet_fields(&self, state: &State) -> (Vec<f64>, Vec<f64>) {
+    /// The stress (Pa) of every tetrahedron, the tensor its forces follow from (paper 000
+    /// Eq. 2, with the viscous part when the material has one: the Cauchy stress of the
+    /// kernel, [`crate::continuum::tet_kernel::von_mises`] of it is the equivalent stress), and its volumetric strain
+    /// det F − 1.
+    pub fn tet_fields(&self, state: &State) -> (Vec<Mat3>, Vec<f64>) {
         let viscous = !self.material.is_elastic();
         (0..self.tets.len())
             .into_par_iter()
@@ -227,9 +230,28 @@ impl TetBody {
                     self.vpair(),
                 );
                 let j = deformation_gradient(&x, self.blocks.dm_inv(e)).determinant();
-                (von_mises(&t), j - 1.0)
+                (t, j - 1.0)
             })
             .unzip()
+    }
+
+    /// The small-strain stress σ = λ tr(ε) I + 2μ ε of every tetrahedron, ε = sym(∇u) with
+    /// ∇u = du · dX⁻¹ from the particles' displacements (the linear-tetrahedron stress that
+    /// belongs to a static solve's answer, [`crate::StaticSolver`]: exact for any
+    /// displacement that is linear in space, without the O(ε) of [`TetBody::tet_fields`]'s
+    /// finite-strain tensor).
+    pub fn small_strain_stresses(&self, state: &State) -> Vec<Mat3> {
+        let (lambda, mu) = self.pair();
+        (0..self.tets.len())
+            .into_par_iter()
+            .with_min_len(TET_CHUNK)
+            .map(|e| {
+                let u = self.tets[e].map(|n| state.displacement(n as usize));
+                let grad = edge_matrix(&u) * self.blocks.dm_inv(e);
+                let eps = (grad + grad.transpose()) * 0.5;
+                Mat3::from_diagonal_element(lambda * eps.trace()) + eps * (2.0 * mu)
+            })
+            .collect()
     }
 
     fn pair(&self) -> (f64, f64) {

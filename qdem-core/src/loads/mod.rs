@@ -1,6 +1,7 @@
-//! Loads: [`gravity::Gravity`], [`nodal_load::NodalLoad`] and the [`time_function`]s that
-//! scale them.
+//! Loads: [`gravity::Gravity`], [`nodal_load::NodalLoad`] (with the pressures and tractions
+//! [`surface_load`] lumps to the nodes) and the [`time_function`]s that scale them.
 
 pub mod gravity;
 pub mod nodal_load;
+pub mod surface_load;
 pub mod time_function;

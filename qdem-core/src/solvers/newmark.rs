@@ -853,6 +853,10 @@ impl Stepper for Newmark {
         self.counts
     }
 
+    fn forces(&self) -> &[Vec3] {
+        &self.force
+    }
+
     /// The counts and, for the implicit stepper, the tangent, the assembler's pattern and, for
     /// each kept factorisation, its step, whether it is a preconditioner and the matrix it
     /// factorised, so that a resumed run factorises the same matrices again.

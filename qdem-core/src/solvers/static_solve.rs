@@ -95,7 +95,38 @@ impl StaticSolver {
         for (x, d) in state.position.iter_mut().zip(&u) {
             *x += d;
         }
+        self.subtract_stiffness_times(&u, &state.spin.angle);
         Ok(())
+    }
+
+    /// The force on every particle at the last answer: f − K u (N), zero at the free DOFs up
+    /// to the solver's rounding, minus the reaction at a fixed one.
+    pub fn forces(&self) -> &[Vec3] {
+        &self.force
+    }
+
+    /// Turns the force buffer f (the loads on the reference state) into f − K u for the
+    /// displacements `u` and particle rotations `angles`, K the factorised tangent (its lower
+    /// triangle, each off-diagonal entry acting both ways).
+    fn subtract_stiffness_times(&mut self, u: &[Vec3], angles: &[Vec3]) {
+        let n = u.len();
+        let value = |dof: usize| {
+            let node = dof / 3;
+            let v = if node < n { u[node] } else { angles[node - n] };
+            v[dof % 3]
+        };
+        let force = &mut self.force;
+        let mut subtract = |dof: usize, amount: f64| {
+            if dof / 3 < n {
+                force[dof / 3][dof % 3] -= amount;
+            }
+        };
+        for e in &self.tangent.stiffness {
+            subtract(e.row, e.val * value(e.col));
+            if e.row != e.col {
+                subtract(e.col, e.val * value(e.row));
+            }
+        }
     }
 
     /// Assembles K at the reference state and factorises it; refuses a body free to move
@@ -196,6 +227,10 @@ impl Stepper for StaticSteps {
 
     fn factor_stats(&self) -> Option<&FactorStats> {
         self.solver.factor_stats()
+    }
+
+    fn forces(&self) -> &[Vec3] {
+        self.solver.forces()
     }
 
     /// Whether K is factorised and, if so, the tangent it was assembled from: the later load

@@ -200,6 +200,10 @@ impl Stepper for Verlet {
         &mut self.torque[..bodies]
     }
 
+    fn forces(&self) -> &[Vec3] {
+        &self.force
+    }
+
     fn rigid_torques(&self) -> &[Vec3] {
         &self.torque[..self.rigid_bodies.min(self.torque.len())]
     }

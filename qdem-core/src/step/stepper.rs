@@ -92,6 +92,15 @@ pub trait Stepper: Send {
         &[]
     }
 
+    /// The total force on each particle (N) at the current state, from the step's last force
+    /// evaluation (every model's; local damping leaves a fixed DOF's alone, as it does not
+    /// move): at a fixed DOF, where the fixity
+    /// holds the particle, minus the force the fix carries (its reaction). Empty (the
+    /// default) for a stepper that keeps none.
+    fn forces(&self) -> &[Vec3] {
+        &[]
+    }
+
     /// Size and cost of the sparse factorisation, for steppers that solve a linear system;
     /// `None` for explicit steppers and before the first factorisation.
     fn factor_stats(&self) -> Option<&FactorStats> {

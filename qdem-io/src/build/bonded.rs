@@ -98,6 +98,7 @@ pub(crate) fn build_bonded(
         warnings,
         granular: None,
         ballast: None,
+        fix_particles: Vec::new(),
     })
 }
 

@@ -12,7 +12,8 @@
 //! and probe's body as indices), so no name is looked up again here. One module per part of a
 //! scene, each taking the table it builds and the indices it needs:
 //!
-//! - this module: the `[[body]]` meshes, fixes, loads and the step request;
+//! - this module: the `[[body]]` meshes, fixes, loads and the step request; `area_load`: a
+//!   load's pressure or traction on the selected faces, lumped to their nodes;
 //! - [`probes`]: the `[[probe]]`s on particles, stones and boxes; `initial_motion`: the
 //!   bodies' and stones' initial velocity and angular velocity;
 //! - `contact`: contact spheres, the `[contact]` law and the `[[wall]]`s;
@@ -21,9 +22,12 @@
 //! - `periodic`: the `[periodic]` cell, its wrap groups and time delay;
 //! - `rest_on`: bodies laid on a granular sample; `load_series`: a load's CSV time series;
 //! - [`memory`]: the memory a count needs, refused before allocating beyond the machine;
-//!   `step_check`: a time step that cannot advance the run, refused;
+//!   `step_check`: a time step that cannot advance the run, refused; `absurd_inputs`: valid
+//!   inputs that are hardly meant (a tiny dt, a far probe, a soft stone), warned of;
 //! - [`BuildError`] (`error`): why a build failed.
 
+mod absurd_inputs;
+mod area_load;
 pub mod ballast;
 mod bonded;
 mod contact;
@@ -123,12 +127,16 @@ pub struct Simulation {
     pub probes: Vec<ProbePoint>,
     /// Probes on boxes over the `[granular]` sample, in scene order.
     pub regions: Vec<probes::RegionProbe>,
-    /// Mesh warnings, one line each, naming the file.
+    /// Warnings, one line each, naming the file: the meshes', and inputs that are valid but
+    /// hardly meant (`absurd_inputs`).
     pub warnings: Vec<String>,
     /// The stones of `[granular]`.
     pub granular: Option<GranularInfo>,
     /// The stones of `[ballast]`.
     pub ballast: Option<BallastInfo>,
+    /// The particles each `[[fix]]` selects (state indices, increasing), in scene order: what
+    /// `reactions.csv` sums.
+    pub fix_particles: Vec<Vec<usize>>,
 }
 
 /// A body's mesh as read and placed, with its file and its particles' place in the state.
@@ -144,10 +152,13 @@ impl Simulation {
     /// Reads the meshes and builds every model of `scene`: bodies, then gravity (only if
     /// non-zero), then loads; fixes go into the state. Refuses counts that would need more
     /// memory than the machine has before allocating them ([`memory`]), and a time step that
-    /// cannot advance the run (`step_check`).
+    /// cannot advance the run (`step_check`); warns of inputs that are hardly meant
+    /// (`absurd_inputs`).
     pub fn build(scene: Scene) -> Result<Simulation, BuildError> {
-        let sim = Simulation::build_models(scene)?;
+        let mut sim = Simulation::build_models(scene)?;
         step_check::check_step(&sim)?;
+        let absurd = absurd_inputs::warnings(&sim);
+        sim.warnings.extend(absurd);
         Ok(sim)
     }
 
@@ -184,7 +195,7 @@ impl Simulation {
                 initial_motion::move_rigidly(&mut state, stone.clone(), v, w);
             }
         }
-        apply_fixes(&scene, &meshes, &mut state)?;
+        let fix_particles = apply_fixes(&scene, &meshes, &mut state)?;
         fix_rigid_bodies(&scene, &bodies, &mut state);
         let mut extra = ExtraSpheres::of_ballast(ballast.as_ref());
         let granular = add_granular(&scene, (&stones, sampled), &mut state, &mut extra)?;
@@ -214,6 +225,7 @@ impl Simulation {
             warnings,
             granular,
             ballast,
+            fix_particles,
         })
     }
 
@@ -529,23 +541,33 @@ fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], state: &mut State) {
     }
 }
 
-/// Fixes the selected directions of the selected particles of every `[[fix]]`.
-fn apply_fixes(scene: &Scene, meshes: &[PlacedMesh], state: &mut State) -> Result<(), BuildError> {
+/// Fixes the selected directions of the selected particles of every `[[fix]]`; returns each
+/// fix's particles.
+fn apply_fixes(
+    scene: &Scene,
+    meshes: &[PlacedMesh],
+    state: &mut State,
+) -> Result<Vec<Vec<usize>>, BuildError> {
     let on = &scene.refs().fix_bodies;
+    let mut fixed = Vec::with_capacity(scene.fixes.len());
     for (i, (fix, &body)) in scene.fixes.iter().zip(on).enumerate() {
         let placed = &meshes[body];
         let what = format!("[[fix]] #{}", i + 1);
-        for n in select(scene, placed, &fix.selection, &what, &fix.body)? {
-            state.fix(
-                placed.particles.start + n as usize,
-                Dofs::from_mask(fix.dofs),
-            );
+        let selected = select(scene, placed, &fix.selection, &what, &fix.body)?;
+        let particles: Vec<usize> = selected
+            .iter()
+            .map(|&n| placed.particles.start + n as usize)
+            .collect();
+        for &p in &particles {
+            state.fix(p, Dofs::from_mask(fix.dofs));
         }
+        fixed.push(particles);
     }
-    Ok(())
+    Ok(fixed)
 }
 
-/// A [`NodalLoad`] per `[[load]]`.
+/// A [`NodalLoad`] per `[[load]]`: its total force shared by the selected particles, or its
+/// pressure or traction lumped to them ([`area_load`]).
 fn build_loads(
     scene: &Scene,
     meshes: &[PlacedMesh],
@@ -573,8 +595,16 @@ fn build_loads(
             scene: scene.path.clone(),
             source,
         })?;
-        let total = Vec3::from(load.total_force);
-        models.push(Box::new(NodalLoad::new(&what, particles, total, ramp)));
+        let model = match load.area {
+            None => NodalLoad::new(&what, particles, Vec3::from(load.total_force), ramp),
+            Some(area) => {
+                let forces =
+                    area_load::lumped_forces(scene, placed, &selected, area, (&what, &load.body))?;
+                let forces = forces.into_iter().map(|(n, f)| (n + start as u32, f));
+                NodalLoad::per_particle(&what, forces.collect(), ramp)
+            }
+        };
+        models.push(Box::new(model));
     }
     Ok(())
 }

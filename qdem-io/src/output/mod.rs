@@ -34,7 +34,9 @@ pub use folder_lock::{FolderLock, LockError, LOCK_FILE};
 pub use probes_csv::{ProbeCsv, PROBE_COLUMNS, REGION_COLUMNS};
 pub use pvd::PvdIndex;
 pub use summary::write_summary;
-pub use vtu::{write_vtu, write_vtu_mesh, VtuCells, VtuField, VtuGrid, VtuMesh, VTK_TETRA};
+pub use vtu::{
+    write_vtu, write_vtu_mesh, write_vtu_mesh_at, VtuCells, VtuField, VtuGrid, VtuMesh, VTK_TETRA,
+};
 
 use std::borrow::Cow;
 use std::io::{self, Write};

@@ -144,6 +144,9 @@ pub enum VtuField<'a> {
     Vectors(&'a [Vector3<f64>]),
     /// Integers (`Int64`): indices, flags.
     Integers(&'a [i64]),
+    /// Symmetric tensors (`Float64`, six components in ParaView's order xx, yy, zz, xy, yz,
+    /// xz, which it shows as a symmetric tensor): a Cauchy stress.
+    SymTensors(&'a [[f64; 6]]),
 }
 
 impl VtuField<'_> {
@@ -153,6 +156,7 @@ impl VtuField<'_> {
             VtuField::Scalars(v) => v.len(),
             VtuField::Vectors(v) => v.len(),
             VtuField::Integers(v) => v.len(),
+            VtuField::SymTensors(v) => v.len(),
         }
     }
 }
@@ -284,12 +288,26 @@ pub fn write_vtu(path: &Path, grid: &VtuGrid<'_>) -> Result<(), OutputError> {
 /// [`OutputError::NoFileName`]) if the file cannot be written; the target is then untouched
 /// and no temporary file is left behind.
 pub fn write_vtu_mesh(path: &Path, mesh: &VtuMesh<'_>) -> Result<(), OutputError> {
-    mesh.validate(path)?;
-    write_atomic_as(path, "VTU file", |w| write_vtu_to(w, mesh))
+    write_vtu_mesh_at(path, mesh, None)
 }
 
-/// Writes the XML of an already validated mesh.
-fn write_vtu_to(w: &mut dyn Write, mesh: &VtuMesh<'_>) -> io::Result<()> {
+/// [`write_vtu_mesh`] of one time of a series: with `time` (s), the file carries it as the
+/// `TimeValue` field data that ParaView and VTK read as the dataset's time, so a file opened
+/// on its own (not through `results.pvd`) shows its simulated time.
+///
+/// # Errors
+/// As [`write_vtu_mesh`].
+pub fn write_vtu_mesh_at(
+    path: &Path,
+    mesh: &VtuMesh<'_>,
+    time: Option<f64>,
+) -> Result<(), OutputError> {
+    mesh.validate(path)?;
+    write_atomic_as(path, "VTU file", |w| write_vtu_to(w, mesh, time))
+}
+
+/// Writes the XML of an already validated mesh, with its `TimeValue` if given.
+fn write_vtu_to(w: &mut dyn Write, mesh: &VtuMesh<'_>, time: Option<f64>) -> io::Result<()> {
     let np = mesh.points.len();
     let nc = mesh.cells.len(np);
     writeln!(w, "<?xml version=\"1.0\"?>")?;
@@ -299,6 +317,15 @@ fn write_vtu_to(w: &mut dyn Write, mesh: &VtuMesh<'_>) -> io::Result<()> {
          byte_order=\"LittleEndian\" header_type=\"UInt64\">"
     )?;
     writeln!(w, "  <UnstructuredGrid>")?;
+    if let Some(t) = time {
+        writeln!(w, "    <FieldData>")?;
+        writeln!(
+            w,
+            "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" \
+             format=\"ascii\">{t:?}</DataArray>"
+        )?;
+        writeln!(w, "    </FieldData>")?;
+    }
     writeln!(
         w,
         "    <Piece NumberOfPoints=\"{np}\" NumberOfCells=\"{nc}\">"
@@ -384,6 +411,14 @@ fn fields(w: &mut dyn Write, section: &str, data: &[(&str, VtuField<'_>)]) -> io
                 1,
                 v.len(),
                 v.iter().map(|x| x.to_le_bytes()),
+            )?,
+            VtuField::SymTensors(v) => data_array(
+                w,
+                "Float64",
+                name,
+                6,
+                6 * v.len(),
+                v.iter().flatten().map(|x| x.to_le_bytes()),
             )?,
         }
     }

@@ -2,7 +2,8 @@
 //! removes the earlier run's outputs, which it might otherwise leave beside its own and
 //! unlisted (the VTUs of an earlier, longer run past this run's last one; the `boundary.csv`
 //! or `stones.csv` of another scene). Only files with the names a run writes are touched:
-//! `results.pvd`, `probes.csv`, `probes.svg`, `boundary.csv`, `sections.csv`, `crack.svg`,
+//! `results.pvd`, `probes.csv`, `probes.svg`, `boundary.csv`, `sections.csv`,
+//! `reactions.csv`, `crack.svg`,
 //! `stones.csv`, `poses.csv`, `summary.json`, and in `vtu/` the numbered `state_`,
 //! `spheres_`, `contacts_`, `bonds_` and `walls_` VTUs and `walls.vtu`. A file the scene reads (a
 //! sample's `stones.csv`, a `pose_from`'s `poses.csv`) is kept, and so is `checkpoint.qdc`:
@@ -13,12 +14,13 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 /// The files a run writes at the top of its output folder.
-const TOP_FILES: [&str; 9] = [
+const TOP_FILES: [&str; 10] = [
     "results.pvd",
     "probes.csv",
     "probes.svg",
     "boundary.csv",
     "sections.csv",
+    "reactions.csv",
     "crack.svg",
     "stones.csv",
     "poses.csv",

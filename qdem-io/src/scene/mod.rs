@@ -37,6 +37,7 @@
 use std::path::{Path, PathBuf};
 
 mod error;
+pub mod keys;
 mod refs;
 pub mod schema;
 mod spans;
@@ -46,8 +47,8 @@ mod validate;
 pub use error::{Diagnostic, SceneError};
 pub use refs::{ProbeTarget, Refs};
 pub use schema::{
-    Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix, Granular,
-    Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section,
+    AreaLoad, Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix,
+    Granular, Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section,
     Selection, Series, Supports, TimeDelay, TimeStep, Wall,
 };
 
@@ -93,7 +94,8 @@ use spans::SpanIndex;
 /// [[load]]
 /// body = "beam"
 /// group = "tip"
-/// total_force = [0.0, 0.0, -200.0]
+/// total_force = [0.0, 0.0, -200.0] # or pressure = 1e6 (Pa, on the selected boundary
+///                                  # faces), or traction = [tx, ty, tz] (Pa)
 /// ramp = [[0.0, 0.0], [1.0, 1.0]]  # or cyclic = { min = 0.075, max = 1.0, frequency = 3.0,
 ///                                  #                phase_deg = 0.0, start = 0.0 }
 ///

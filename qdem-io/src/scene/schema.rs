@@ -348,21 +348,39 @@ pub struct Fix {
     pub rotation: bool,
 }
 
-/// `[[load]]`: a total force shared equally by the selected particles, scaled by a ramp.
+/// `[[load]]`: a total force shared equally by the selected particles, or a pressure or
+/// traction on the boundary faces they cover, lumped to the nodes by area; scaled by a ramp,
+/// a cycle or a series.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Load {
     /// Name of the `[[body]]`.
     pub body: String,
     /// The particles that carry the load.
     pub selection: Selection,
-    /// Total force, N, divided equally among the selected particles.
+    /// Total force, N, divided equally among the selected particles; zero for a load with
+    /// `area`.
     pub total_force: [f64; 3],
+    /// `pressure` or `traction` instead of `total_force`: a distributed load on the body's
+    /// boundary triangles whose three nodes are all selected.
+    pub area: Option<AreaLoad>,
     /// Time factor applied to `total_force`.
     pub ramp: Ramp,
     /// A sinusoidal time factor instead of `ramp`.
     pub cyclic: Option<CyclicLoad>,
     /// A time series read from a CSV file instead of `ramp`.
     pub series: Option<Series>,
+}
+
+/// A `[[load]]`'s distributed load on a face (Pa), lumped to the nodes of the face's
+/// triangles by area (each node a third of each triangle's, `qdem_core::loads::surface_load`),
+/// on the reference geometry (a dead load).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AreaLoad {
+    /// `pressure = p`: p along the inward normal (positive pushes into the body).
+    Pressure(f64),
+    /// `traction = [tx, ty, tz]`: a force per unit area in a fixed direction.
+    Traction([f64; 3]),
 }
 
 /// `series = { file, column }` of a `[[load]]`: the time factor on `total_force` is the named
@@ -580,7 +598,12 @@ pub(crate) struct RawLoad {
     pub group: Option<String>,
     #[serde(default, rename = "box")]
     pub bbox: Option<[[f64; 3]; 2]>,
-    pub total_force: [f64; 3],
+    #[serde(default)]
+    pub total_force: Option<[f64; 3]>,
+    #[serde(default)]
+    pub pressure: Option<f64>,
+    #[serde(default)]
+    pub traction: Option<[f64; 3]>,
     #[serde(default)]
     pub ramp: Option<Vec<[f64; 2]>>,
     #[serde(default)]

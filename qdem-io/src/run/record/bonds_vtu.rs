@@ -5,7 +5,7 @@
 //! it broke at) and `stress_ratio` (stress over the bond's strength, 1 at breaking).
 //! ParaView: *Threshold* on `intact` shows the crack (the broken bonds), *Glyph* the discs.
 
-use crate::output::{write_vtu_mesh, OutputError, VtuCells, VtuField, VtuMesh};
+use crate::output::{write_vtu_mesh_at, OutputError, VtuCells, VtuField, VtuMesh};
 use qdem_contact::BondedParticles;
 use qdem_core::State;
 use std::path::Path;
@@ -43,5 +43,5 @@ pub(crate) fn write_bonds(
             ("intact", VtuField::Integers(&intact)),
         ],
     };
-    write_vtu_mesh(path, &mesh)
+    write_vtu_mesh_at(path, &mesh, Some(state.time))
 }

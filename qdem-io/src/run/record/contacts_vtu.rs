@@ -8,7 +8,7 @@
 //! `scale_second` are the ghost scales the model applied to the force on each partner.
 //! ParaView: *Extract Surface*, then *Tube*, coloured by `normal_force_magnitude`.
 
-use crate::output::{write_vtu_mesh, OutputError, VtuCells, VtuField, VtuMesh};
+use crate::output::{write_vtu_mesh_at, OutputError, VtuCells, VtuField, VtuMesh};
 use qdem_contact::{DemContacts, Partner};
 use qdem_core::Vec3;
 use std::path::Path;
@@ -28,8 +28,12 @@ struct Lines {
     scale_second: Vec<f64>,
 }
 
-/// Writes the touching contacts of `contacts`' last evaluation to `path`.
-pub(crate) fn write_contacts(contacts: &DemContacts, path: &Path) -> Result<(), OutputError> {
+/// Writes the touching contacts of `contacts`' last evaluation, at `time` (s), to `path`.
+pub(crate) fn write_contacts(
+    contacts: &DemContacts,
+    time: f64,
+    path: &Path,
+) -> Result<(), OutputError> {
     let mut l = Lines::default();
     for c in contacts.touching() {
         l.ends.extend([c.from, c.to]);
@@ -75,5 +79,5 @@ pub(crate) fn write_contacts(contacts: &DemContacts, path: &Path) -> Result<(), 
         point_data: Vec::new(),
         cell_data,
     };
-    write_vtu_mesh(path, &mesh)
+    write_vtu_mesh_at(path, &mesh, Some(time))
 }

@@ -7,6 +7,7 @@
 //! | [`probes::Probes`] | `probes.csv`, `probes.svg` | every `probe_every` |
 //! | [`boundary::Boundary`] | `boundary.csv` (time-delayed boundary) | every `probe_every` |
 //! | [`sections::Sections`] | `sections.csv` (`[[section]]`s) | every `probe_every` |
+//! | [`reactions::Reactions`] | `reactions.csv` (`[[fix]]`es of deformable bodies) | every `probe_every` |
 //! | [`snapshots::Snapshots`] | `vtu/state_NNNNN.vtu`, `results.pvd`; `vtu/spheres_NNNNN.vtu`, `vtu/contacts_NNNNN.vtu`, `vtu/walls.vtu` (contacts), `vtu/bonds_NNNNN.vtu` (`[bonded]`) | every `vtu_every` (never if 0) |
 //! | [`crack::Crack`] | `crack.svg`, the bonded timings | every step; the picture at the end |
 //! | [`stones::Stones`] | `stones.csv` (`[granular]`) | at the end |
@@ -23,12 +24,14 @@ pub(crate) mod contacts_vtu;
 pub(crate) mod crack;
 pub(crate) mod poses;
 pub(crate) mod probes;
+pub(crate) mod reactions;
 pub(crate) mod schedule;
 pub(crate) mod sections;
 pub(crate) mod snapshots;
 pub(crate) mod spheres_vtu;
 pub(crate) mod stones;
 pub(crate) mod summary;
+pub(crate) mod tet_stress;
 pub(crate) mod walls_vtu;
 
 use crate::build::Simulation;
@@ -141,6 +144,9 @@ pub(crate) fn register(sim: &Simulation, out_dir: &Path) -> Vec<Box<dyn Recorder
     }
     if !sim.scene.sections.is_empty() {
         recorders.push(Box::new(sections::Sections::new(sim, out_dir)));
+    }
+    if let Some(reactions) = reactions::Reactions::new(sim, out_dir) {
+        recorders.push(Box::new(reactions));
     }
     recorders.push(Box::new(snapshots::Snapshots::new(sim, out_dir)));
     if sim.bonded().is_some() {

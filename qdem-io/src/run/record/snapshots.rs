@@ -1,6 +1,7 @@
 //! [`Snapshots`]: every `vtu_every`, `vtu/state_NNNNN.vtu` of all bodies (reference points
-//! with displacement and velocity per particle, von Mises stress and volumetric strain per
-//! tetrahedron; rigid bodies' tetrahedra at zero) and, beside it as further parts of the same
+//! with displacement and velocity per particle, von Mises stress, volumetric strain, the
+//! stress tensor and the principal stresses per tetrahedron; rigid bodies' tetrahedra at
+//! zero), each file carrying its time as `TimeValue` field data and, beside it as further parts of the same
 //! time in `results.pvd`, what else the scene has: the contact spheres
 //! ([`spheres_vtu`](super::spheres_vtu)) and their touching contacts
 //! ([`contacts_vtu`](super::contacts_vtu)), the walls ([`walls_vtu`](super::walls_vtu): one
@@ -15,10 +16,12 @@ use super::bonds_vtu::write_bonds;
 use super::contacts_vtu::write_contacts;
 use super::schedule::Schedule;
 use super::spheres_vtu::write_spheres;
+use super::tet_stress::StressFields;
 use super::walls_vtu::{walls_move, write_walls};
 use super::{Recorder, RunFigures, StateRead, StepInfo};
 use crate::build::Simulation;
-use crate::output::{write_vtu, OutputError, PvdIndex, VtuGrid};
+use crate::output::{write_vtu_mesh_at, OutputError, PvdIndex, VtuCells, VtuField, VtuMesh};
+use crate::scene::Integrator;
 use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -56,8 +59,8 @@ impl Part {
         };
         match self {
             Part::Spheres => write_spheres(contacts(), state, path),
-            Part::Contacts => write_contacts(contacts(), path),
-            Part::Walls { .. } => write_walls(contacts().wall_list(), state, path),
+            Part::Contacts => write_contacts(contacts(), state.time, path),
+            Part::Walls { moving } => write_walls(contacts().wall_list(), state, path, moving),
             Part::Bonds => write_bonds(
                 sim.bonded().expect("registered for a bonded scene"),
                 state,
@@ -174,35 +177,50 @@ impl Recorder for Snapshots {
     }
 }
 
-/// One VTU of all bodies.
+/// One VTU of all bodies at the state's time (its `TimeValue`): the particles' displacement
+/// and velocity, the tetrahedra's stress tensor, principal stresses, von Mises stress and
+/// volumetric strain ([`tet_stress`](super::tet_stress)). A static run's stress is the
+/// small-strain one of its linear solve ([`qdem_core::TetBody::small_strain_stresses`]).
 fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
     let s = &sim.world.state;
     let displacement: Vec<Vec3> = (0..s.len()).map(|i| s.displacement(i)).collect();
     let mut tets = Vec::new();
-    let (mut von_mises, mut volumetric) = (Vec::new(), Vec::new());
+    let mut stress = StressFields::default();
+    let mut volumetric = Vec::new();
     for body in &sim.bodies {
         let body_tets = sim.body_tets(body);
         tets.extend_from_slice(body_tets);
         match sim.tet_body(body) {
             Some(tet_body) => {
-                let (vm, vol) = tet_body.tet_fields(s);
-                von_mises.extend(vm);
+                let (mut sigma, vol) = tet_body.tet_fields(s);
+                if sim.scene.run.integrator == Integrator::Static {
+                    sigma = tet_body.small_strain_stresses(s);
+                }
+                sigma.iter().for_each(|t| stress.push(t));
                 volumetric.extend(vol);
             }
             None => {
-                von_mises.extend(std::iter::repeat_n(0.0, body_tets.len()));
+                stress.push_zeros(body_tets.len());
                 volumetric.extend(std::iter::repeat_n(0.0, body_tets.len()));
             }
         }
     }
-    let grid = VtuGrid {
+    let [p1, p2, p3] = &stress.principal;
+    let mesh = VtuMesh {
         points: &s.reference,
-        tets: &tets,
-        point_vectors: vec![("displacement", &displacement), ("velocity", &s.velocity)],
-        cell_scalars: vec![
-            ("von_mises", &von_mises),
-            ("volumetric_strain", &volumetric),
+        cells: VtuCells::Tets(&tets),
+        point_data: vec![
+            ("displacement", VtuField::Vectors(&displacement)),
+            ("velocity", VtuField::Vectors(&s.velocity)),
+        ],
+        cell_data: vec![
+            ("von_mises", VtuField::Scalars(&stress.von_mises)),
+            ("volumetric_strain", VtuField::Scalars(&volumetric)),
+            ("stress", VtuField::SymTensors(&stress.stress)),
+            ("principal_stress_1", VtuField::Scalars(p1)),
+            ("principal_stress_2", VtuField::Scalars(p2)),
+            ("principal_stress_3", VtuField::Scalars(p3)),
         ],
     };
-    write_vtu(path, &grid)
+    write_vtu_mesh_at(path, &mesh, Some(s.time))
 }

@@ -4,7 +4,7 @@
 //! for spheres that do not turn) when some sphere turns: ParaView's Glyph filter draws them
 //! as spheres scaled by `radius`.
 
-use crate::output::{write_vtu_mesh, OutputError, VtuCells, VtuField, VtuMesh};
+use crate::output::{write_vtu_mesh_at, OutputError, VtuCells, VtuField, VtuMesh};
 use qdem_contact::DemContacts;
 use qdem_core::{State, Vec3};
 use std::path::Path;
@@ -48,5 +48,5 @@ pub(crate) fn write_spheres(
         point_data,
         cell_data: Vec::new(),
     };
-    write_vtu_mesh(path, &mesh)
+    write_vtu_mesh_at(path, &mesh, Some(state.time))
 }

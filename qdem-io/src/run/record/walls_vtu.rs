@@ -4,7 +4,7 @@
 //! widened by a tenth of its diagonal on every side, projected onto the plane. Written once
 //! when no wall moves, else at every `vtu_every` as `vtu/walls_NNNNN.vtu`.
 
-use crate::output::{write_vtu_mesh, OutputError, VtuCells, VtuField, VtuMesh};
+use crate::output::{write_vtu_mesh_at, OutputError, VtuCells, VtuField, VtuMesh};
 use qdem_contact::{PlaneWall, Wall, WallShape};
 use qdem_core::{State, Vec3};
 use std::path::Path;
@@ -15,8 +15,14 @@ pub(crate) fn walls_move(walls: &[Wall]) -> bool {
 }
 
 /// Writes `walls` at `state`'s time, the planes over the extent of `state`'s particles, to
-/// `path`.
-pub(crate) fn write_walls(walls: &[Wall], state: &State, path: &Path) -> Result<(), OutputError> {
+/// `path`; `timed`: with that time as the file's `TimeValue` (walls that move; the file of
+/// walls that stay serves every time).
+pub(crate) fn write_walls(
+    walls: &[Wall],
+    state: &State,
+    path: &Path,
+    timed: bool,
+) -> Result<(), OutputError> {
     let (lower, upper) = extent(&state.position);
     let (mut points, mut triangles, mut index) = (Vec::new(), Vec::new(), Vec::new());
     for (w, wall) in walls.iter().enumerate() {
@@ -35,7 +41,7 @@ pub(crate) fn write_walls(walls: &[Wall], state: &State, path: &Path) -> Result<
         point_data: Vec::new(),
         cell_data: vec![("wall", VtuField::Integers(&index))],
     };
-    write_vtu_mesh(path, &mesh)
+    write_vtu_mesh_at(path, &mesh, timed.then_some(state.time))
 }
 
 /// The box of `points` widened by a tenth of its diagonal (a unit box about the origin

@@ -1,13 +1,13 @@
 //! `[[fix]]` and `[[load]]`: a defined body, particles selected by a physical `group` or a
 //! `box` (one of the two; a box with its lower corner below its upper one), and for a fix
-//! `dofs` (a subset of "xyz") and `rotation` only on a rigid body; for a load a finite
-//! `total_force` and one time factor: a `ramp` (non-decreasing times, at most two points at a
+//! `dofs` (a subset of "xyz") and `rotation` only on a rigid body; for a load one finite
+//! `total_force`, `pressure` or `traction` and one time factor: a `ramp` (non-decreasing times, at most two points at a
 //! time), a `cyclic` factor or a `series` file.
 
 use std::collections::HashSet;
 
 use super::super::schema::{
-    CyclicLoad, Fix, Load, Ramp, RawFix, RawLoad, RawScene, Selection, Series,
+    AreaLoad, CyclicLoad, Fix, Load, Ramp, RawFix, RawLoad, RawScene, Selection, Series,
 };
 use super::body::Bodies;
 use super::checker::{label, Checker};
@@ -99,12 +99,7 @@ fn load(
     let l = label("load", i, None);
     let body = bodies.reference(c, &["load", &idx, "body"], &l, &ld.body);
     let sel = selection(c, "load", &idx, &l, &ld.group, &ld.bbox);
-    c.finite(
-        &["load", &idx, "total_force"],
-        &l,
-        "total_force",
-        &ld.total_force,
-    );
+    let (total_force, area) = load_force(c, &idx, &l, ld);
     let ramp = ramp(c, &idx, &l, &ld.ramp);
     if let Some(cyclic) = &ld.cyclic {
         cyclic_load(c, &idx, &l, cyclic, ld.ramp.is_some());
@@ -121,12 +116,58 @@ fn load(
     let load = sel.map(|selection| Load {
         body: ld.body.clone(),
         selection,
-        total_force: ld.total_force,
+        total_force,
+        area,
         ramp,
         cyclic: ld.cyclic,
         series: ld.series.clone(),
     });
     (body, load)
+}
+
+/// What a `[[load]]` applies: exactly one of `total_force` (finite), `pressure` (finite) and
+/// `traction` (finite); the total force is zero for a pressure or traction.
+fn load_force(
+    c: &mut Checker<'_>,
+    idx: &str,
+    l: &str,
+    ld: &RawLoad,
+) -> ([f64; 3], Option<AreaLoad>) {
+    let given = [
+        ld.total_force.is_some(),
+        ld.pressure.is_some(),
+        ld.traction.is_some(),
+    ];
+    match given.iter().filter(|&&g| g).count() {
+        0 => c.error(
+            &["load", idx],
+            format!(
+                "missing key `total_force` in {l}; give the load as `total_force = [fx, fy, fz]` \
+                 (N, shared equally by the selected particles), `pressure = p` (Pa, on the \
+                 selected boundary faces) or `traction = [tx, ty, tz]` (Pa)"
+            ),
+        ),
+        1 => {}
+        _ => c.error(
+            &["load", idx],
+            format!("{l}: give one of `total_force`, `pressure` and `traction`; drop the others"),
+        ),
+    }
+    if let Some(f) = ld.total_force {
+        c.finite(&["load", idx, "total_force"], l, "total_force", &f);
+    }
+    if let Some(p) = ld.pressure {
+        c.finite(&["load", idx, "pressure"], l, "pressure", &[p]);
+    }
+    if let Some(t) = ld.traction {
+        c.finite(&["load", idx, "traction"], l, "traction", &t);
+    }
+    let area = match (ld.pressure, ld.traction) {
+        (Some(p), _) => Some(AreaLoad::Pressure(p)),
+        (None, Some(t)) => Some(AreaLoad::Traction(t)),
+        (None, None) => None,
+    };
+    (ld.total_force.unwrap_or([0.0; 3]), area)
 }
 
 /// Turn `group`/`box` into a [`Selection`], reporting problems.
@@ -296,7 +337,8 @@ fn ramp(c: &mut Checker<'_>, idx: &str, owner: &str, points: &Option<Vec<[f64; 2
     }
 }
 
-/// `cyclic` of a `[[load]]`: finite factors, a positive frequency, not with `ramp`.
+/// `cyclic` of a `[[load]]`: finite factors, `min` not above `max`, a positive frequency,
+/// not with `ramp`.
 fn cyclic_load(c: &mut Checker<'_>, idx: &str, l: &str, cyclic: &CyclicLoad, has_ramp: bool) {
     let at = ["load", idx, "cyclic"];
     let CyclicLoad {
@@ -307,6 +349,16 @@ fn cyclic_load(c: &mut Checker<'_>, idx: &str, l: &str, cyclic: &CyclicLoad, has
         start,
     } = *cyclic;
     c.finite(&at, l, "cyclic", &[min, max, phase_deg, start]);
+    if min > max {
+        c.error(
+            &at,
+            format!(
+                "{l}: cyclic min = {min} is above max = {max}; the factor runs from min up to \
+                 max, each cycle beginning at min: swap them (phase_deg = 180 begins the \
+                 cycles at the maximum)"
+            ),
+        );
+    }
     c.positive(&at, l, "cyclic.frequency", frequency, "Hz");
     if has_ramp {
         c.error(

@@ -31,7 +31,7 @@ mod run;
 use std::path::Path;
 
 use super::error::SceneError;
-use super::schema::{RawFix, RawLoad, RawScene, Selection};
+use super::schema::{AreaLoad, RawFix, RawLoad, RawScene, Selection};
 use super::spans::SpanIndex;
 use super::{Refs, Scene};
 use checker::Checker;
@@ -126,7 +126,15 @@ pub(crate) fn to_raw(scene: &Scene) -> RawScene {
                     body: l.body.clone(),
                     group,
                     bbox,
-                    total_force: l.total_force,
+                    total_force: l.area.is_none().then_some(l.total_force),
+                    pressure: match l.area {
+                        Some(AreaLoad::Pressure(p)) => Some(p),
+                        _ => None,
+                    },
+                    traction: match l.area {
+                        Some(AreaLoad::Traction(t)) => Some(t),
+                        _ => None,
+                    },
                     ramp: (!l.ramp.points.is_empty()).then(|| l.ramp.points.clone()),
                     cyclic: l.cyclic,
                     series: l.series.clone(),

@@ -1,0 +1,138 @@
+//! [`Reactions`]: `reactions.csv`: every `probe_every`, the force and moment each `[[fix]]` of
+//! a deformable body carries: R = −Σ f_i over its particles, counting each particle's fixed
+//! directions only, f_i the total (internal and external) force on particle i at the state
+//! (the stepper's last evaluation, [`qdem_core::stepper::Stepper::forces`]; a static solve's
+//! f − K u), and the moment M = Σ (X_i − c) × R_i about the centroid c of the fix's particles
+//! in the reference configuration (X_i their reference positions). Columns
+//! `fixK_fx, fixK_fy, fixK_fz, fixK_mx, fixK_my, fixK_mz` (N, N·m) for the K-th `[[fix]]`
+//! (from 1, in scene order). A direction held by two fixes counts in both. Fixes on a rigid
+//! body (which its centre holds) are left out; a run over MPI ranks writes no reactions (each
+//! rank holds only its own particles' forces). A wall's force is `walls.csv`'s.
+
+use super::schedule::{probe_interval, Schedule};
+use super::{Recorder, StateRead, StepInfo};
+use crate::build::{BodyKind, Simulation};
+use crate::output::{write_atomic, OutputError};
+use qdem_core::{CheckpointError, Decoder, Dofs, Encoder, State, Vec3};
+use std::path::{Path, PathBuf};
+
+/// One fix's particles and the point its moment is taken about.
+struct FixGroup {
+    /// The fix's number in the scene (from 1).
+    number: usize,
+    particles: Vec<usize>,
+    /// The centroid of the particles' reference positions.
+    centroid: Vec3,
+}
+
+/// The reactions' record.
+pub(crate) struct Reactions {
+    schedule: Schedule,
+    path: PathBuf,
+    groups: Vec<FixGroup>,
+    /// The rows, flat: the time, then six numbers per group.
+    rows: Vec<f64>,
+}
+
+impl Reactions {
+    /// The record of `sim`'s fixes on deformable bodies; `None` when there is none, or the run
+    /// is decomposed.
+    pub(crate) fn new(sim: &Simulation, out_dir: &Path) -> Option<Reactions> {
+        if sim.world.decomposition().is_some() {
+            return None;
+        }
+        let state = &sim.world.state;
+        let bodies = &sim.scene.refs().fix_bodies;
+        let groups: Vec<FixGroup> = sim
+            .fix_particles
+            .iter()
+            .zip(bodies)
+            .enumerate()
+            .filter(|(_, (_, &b))| matches!(sim.bodies[b].kind, BodyKind::Deformable { .. }))
+            .map(|(k, (particles, _))| FixGroup {
+                number: k + 1,
+                particles: particles.clone(),
+                centroid: particles.iter().map(|&i| state.reference[i]).sum::<Vec3>()
+                    / particles.len() as f64,
+            })
+            .collect();
+        (!groups.is_empty()).then(|| Reactions {
+            schedule: Schedule::new(probe_interval(sim)),
+            path: out_dir.join("reactions.csv"),
+            groups,
+            rows: Vec::new(),
+        })
+    }
+}
+
+/// The force and moment `group` carries, from the particles' total forces `force`.
+fn reaction(state: &State, force: &[Vec3], group: &FixGroup) -> (Vec3, Vec3) {
+    let mut total = (Vec3::zeros(), Vec3::zeros());
+    for &i in &group.particles {
+        let held: Dofs = state.fixed[i];
+        let r = Vec3::from_fn(|k, _| if held.contains(k) { -force[i][k] } else { 0.0 });
+        total.0 += r;
+        total.1 += (state.reference[i] - group.centroid).cross(&r);
+    }
+    total
+}
+
+impl Recorder for Reactions {
+    fn name(&self) -> &'static str {
+        "reactions"
+    }
+
+    fn reads(&self, time: f64, dt: f64) -> StateRead {
+        match self.schedule.is_due(time, dt) {
+            true => StateRead::Whole,
+            false => StateRead::Nothing,
+        }
+    }
+
+    fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {
+        let state = &sim.world.state;
+        if !self.schedule.due(state.time, step.dt) {
+            return Ok(());
+        }
+        let force = sim.world.stepper().forces();
+        self.rows.push(state.time);
+        for group in &self.groups {
+            let (f, m) = match force.len() == state.len() {
+                true => reaction(state, force, group),
+                false => (Vec3::zeros(), Vec3::zeros()),
+            };
+            self.rows.extend(f.iter().chain(m.iter()));
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self, _sim: &Simulation) -> Result<(), OutputError> {
+        if self.rows.is_empty() {
+            return Ok(());
+        }
+        let mut header = vec!["time".to_string()];
+        for g in &self.groups {
+            let k = g.number;
+            header.extend(["fx", "fy", "fz", "mx", "my", "mz"].map(|c| format!("fix{k}_{c}")));
+        }
+        write_atomic(&self.path, |w| {
+            writeln!(w, "{}", header.join(","))?;
+            for row in self.rows.chunks_exact(header.len()) {
+                let cells: Vec<String> = row.iter().map(|v| format!("{v:.9e}")).collect();
+                writeln!(w, "{}", cells.join(","))?;
+            }
+            Ok(())
+        })
+    }
+
+    fn save(&self, out: &mut Encoder) {
+        out.f64(self.schedule.next);
+        out.f64s(&self.rows);
+    }
+
+    fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+        self.schedule.next = input.f64("the reactions schedule")?;
+        self.rows = input.f64s("the reaction rows")?;
+        Ok(())
+    }
+}
