@@ -46,8 +46,8 @@ mod validate;
 pub use error::{Diagnostic, SceneError};
 pub use refs::{ProbeTarget, Refs};
 pub use schema::{
-    Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix, Granular,
-    Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section,
+    Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix, Formulation,
+    Granular, Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section,
     Selection, Series, Supports, TimeDelay, TimeStep, Wall,
 };
 
