@@ -19,7 +19,10 @@ fn seconds_per_step(body: &mut TetBody, state: &State, force: &mut [Vec3], steps
 }
 
 fn main() {
-    let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .filter_map(|a| a.parse().ok())
+        .collect();
     let cells = args.first().copied().unwrap_or(200);
     let threads = args.get(1).copied().unwrap_or(1);
     rayon::ThreadPoolBuilder::new()
@@ -40,10 +43,17 @@ fn main() {
                 .unwrap()
                 .with_formulation(f)
         };
-        let (mut standard, mut averaged) =
-            (make(Formulation::Standard), make(Formulation::AveragedPressure));
+        let (mut standard, mut averaged) = (
+            make(Formulation::Standard),
+            make(Formulation::AveragedPressure),
+        );
         let mut state = State::at_rest(reference.clone());
-        for (i, (x, v)) in state.position.iter_mut().zip(&mut state.velocity).enumerate() {
+        for (i, (x, v)) in state
+            .position
+            .iter_mut()
+            .zip(&mut state.velocity)
+            .enumerate()
+        {
             let t = i as f64;
             *x += Vec3::new(t.sin(), t.cos(), (2.0 * t).sin()) * 1e-5;
             *v = Vec3::new(t.cos(), t.sin(), 0.5) * 1e-3;

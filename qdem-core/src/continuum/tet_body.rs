@@ -183,11 +183,6 @@ impl TetBody {
         }
     }
 
-    /// The body's material.
-    pub fn material(&self) -> &Material {
-        &self.material
-    }
-
     /// The model as a deformable body, if it is one (models are `Any`).
     pub fn of(model: &dyn Model) -> Option<&TetBody> {
         let any: &dyn std::any::Any = model;
