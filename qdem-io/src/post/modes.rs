@@ -166,14 +166,17 @@ fn refuse_loaded_free_bodies(
     let rigid: Vec<_> = modes.modes.iter().filter(|m| m.rigid).collect();
     let gravity = sim.scene.run.gravity != [0.0; 3];
     for body in &sim.bodies {
+        // The work of the pushes along a mode over all particles (a rigid body's centre
+        // carries its translation and its weight).
         let moves = |m: &&Mode| {
+            let moved = body.particles.clone().any(|p| m.shape[p] != Vec3::zeros());
             let (mut work, mut force, mut motion) = (0.0, 0.0, 0.0);
-            for p in body.particles.clone() {
-                work += push[p].dot(&m.shape[p]);
-                force += push[p].norm_squared();
-                motion += m.shape[p].norm_squared();
+            for (f, u) in push.iter().zip(&m.shape) {
+                work += f.dot(u);
+                force += f.norm_squared();
+                motion += u.norm_squared();
             }
-            motion > 0.0 && work.abs() > 1e-9 * (force * motion).sqrt()
+            moved && work.abs() > 1e-9 * (force * motion).sqrt()
         };
         if !rigid.iter().any(moves) {
             continue;
