@@ -16,3 +16,4 @@ pub mod implicit;
 pub mod speed_vs_error;
 pub mod throughput;
 pub mod verify;
+pub mod verify_locking;
