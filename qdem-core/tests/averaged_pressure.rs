@@ -303,3 +303,35 @@ fn explicit_steps_are_bit_identical_for_any_thread_count() {
     assert!(moved.norm() > 0.0, "the load moved the tip");
     assert!(one == three, "1 and 3 threads differ");
 }
+
+/// A run decomposed over ranks refuses an averaged-pressure body by name (its nodal averages
+/// would need an exchange of their own), on every rank.
+#[test]
+fn a_decomposed_run_refuses_the_averaged_pressure_body_by_name() {
+    use qdem_core::thread_ranks::on_thread_ranks;
+    use qdem_core::{Scheme, StepRequest, StepSettings, World};
+    let errors = on_thread_ranks(2, |comm| {
+        let mesh = structured_box([0.0; 3], [1.0, 0.06, 0.1], [20, 2, 3]);
+        let (state, body) = body(&mesh, 0.4999, Formulation::AveragedPressure);
+        let models: Vec<Box<dyn Model>> = vec![Box::new(body)];
+        let request = StepRequest {
+            scheme: Scheme::Verlet,
+            dt: None,
+            safety: 0.9,
+            local_damping: 0.0,
+            adaptive: false,
+            event_solve: Default::default(),
+            implicit_default: None,
+            fit_to: None,
+        };
+        let settings = StepSettings::resolve(&request, &state, &models).unwrap();
+        let mut world = World::new(state, models, settings).unwrap();
+        world.decompose(comm).unwrap_err().to_string()
+    });
+    for error in errors {
+        assert!(
+            error.contains("`body`") && error.contains("averaged-pressure"),
+            "{error}"
+        );
+    }
+}
