@@ -17,3 +17,4 @@ pub mod speed_vs_error;
 pub mod throughput;
 pub mod vector_peak;
 pub mod verify;
+pub mod verify_locking;

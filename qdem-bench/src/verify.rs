@@ -88,7 +88,7 @@ pub struct Row {
 }
 
 impl Row {
-    fn relative(
+    pub(crate) fn relative(
         fixture: &str,
         analytical: f64,
         computed: f64,
@@ -496,6 +496,7 @@ pub fn run_and_print(as_json: bool, full: Option<&Path>) -> Result<(), VerifyErr
         energy_conservation(),
         p_wave_speed(),
     ];
+    rows.extend(crate::verify_locking::lame_rows());
     if let Some(out) = full {
         cantilever_rows(&mut rows, out)?;
     }

@@ -39,7 +39,9 @@ pub mod step;
 
 // The modules other crates and embedders reach by path.
 pub use continuum::tet_subdomain;
-pub use continuum::{linear_tet, material, rigid_body, stable_step, tet_blocks, tet_kernel};
+pub use continuum::{
+    averaged_pressure_tet, linear_tet, material, rigid_body, stable_step, tet_blocks, tet_kernel,
+};
 pub use modal::lanczos;
 #[cfg(feature = "thread-ranks")]
 pub use parallel::thread_ranks;
@@ -52,6 +54,7 @@ pub type Vec3 = nalgebra::Vector3<f64>;
 pub type Mat3 = nalgebra::Matrix3<f64>;
 
 pub use checkpoint::{CheckpointError, Decoder, Encoder};
+pub use continuum::averaged_pressure_tet::Formulation;
 pub use continuum::material::Material;
 pub use continuum::rigid_body::RigidBodies;
 pub use continuum::tet_blocks::BlockLayout;

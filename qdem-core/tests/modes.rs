@@ -227,12 +227,20 @@ fn bad_input_is_refused_with_a_typed_error() {
         natural_modes(&state, &nothing, 1),
         Err(ModalError::NothingDeformable)
     ));
-    // One particle fixed: the body can still rotate about it.
+}
+
+/// One particle pinned: the body still rotates about it, three zero-frequency modes that
+/// leave the pinned particle where it is (issue 43: no longer refused).
+#[test]
+fn a_pinned_body_rotates_about_its_pin_in_three_rigid_modes() {
     let (mut state, models) = prism(0.3, 0.08, 0.11, [3, 1, 1], false);
     state.fixed[0] = Dofs::ALL;
-    let error = natural_modes(&state, &models, 1).unwrap_err();
-    assert!(
-        matches!(error, ModalError::PartlyConstrained { ref body, modes: 3 } if body == "prism"),
-        "{error}"
-    );
+    let modes = natural_modes(&state, &models, 4).unwrap();
+    let rigid: Vec<_> = modes.modes.iter().filter(|m| m.rigid).collect();
+    assert_eq!(rigid.len(), 3);
+    for m in rigid {
+        assert!(m.frequency_hz < 1e-3, "{} Hz", m.frequency_hz);
+        assert_eq!(m.shape[0], Vec3::zeros());
+    }
+    assert!(!modes.modes[3].rigid && modes.modes[3].frequency_hz > 1.0);
 }

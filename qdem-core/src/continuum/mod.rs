@@ -2,8 +2,10 @@
 //! [`tet_kernel`] (across SIMD lanes in [`tet_lanes`]), its literal 12-triangle oracle in [`tet_subdomain`], the deformable body
 //! ([`tet_body::TetBody`]) and its blocks ([`tet_blocks`]), the linear-tet stiffness
 //! ([`linear_tet`]), [`material`]s, the rigorous explicit step bound ([`stable_step`]) and
-//! rigid bodies ([`rigid_body`]).
+//! rigid bodies ([`rigid_body`]); the locking-free average nodal pressure option in
+//! [`averaged_pressure_tet`].
 
+pub mod averaged_pressure_tet;
 pub mod linear_tet;
 pub mod material;
 pub mod rigid_body;

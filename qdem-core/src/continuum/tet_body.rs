@@ -16,6 +16,7 @@
 //! unstrained configuration (it omits the stress-dependent geometric stiffness, of the order of
 //! the strain), so for small strain f(x + ∆x, v) ≈ f(x, v) − K ∆x (paper 001 Eq. 20).
 
+use crate::continuum::averaged_pressure_tet::{AveragedPressure, Formulation};
 use crate::continuum::material::{Lame, Material};
 use crate::continuum::stable_step::{critical_step, element_rate_bound};
 use crate::continuum::tet_blocks::{BlockLayout, TetBlocks};
@@ -80,6 +81,9 @@ pub struct TetBody {
     /// In a run decomposed over processes, this process's share of the body
     /// ([`crate::parallel::decomposition`]); `None`: the whole body.
     split: Option<BodySplit>,
+    /// The averaged-pressure forces ([`crate::continuum::averaged_pressure_tet`]) when the
+    /// body's material asks for them; `None`: the standard kernel.
+    averaged: Option<Box<AveragedPressure>>,
 }
 
 impl TetBody {
@@ -149,7 +153,35 @@ impl TetBody {
             damping_rate,
             inverted: None,
             split: None,
+            averaged: None,
         })
+    }
+
+    /// The body with its tetrahedra's volumetric stress computed by `formulation`
+    /// ([`crate::continuum::averaged_pressure_tet`]); [`Formulation::Standard`] is the default.
+    pub fn with_formulation(mut self, formulation: Formulation) -> TetBody {
+        self.averaged = match formulation {
+            Formulation::Standard => None,
+            Formulation::AveragedPressure => {
+                let dm_inv = (0..self.tets.len()).map(|e| *self.blocks.dm_inv(e));
+                let averaged = AveragedPressure::new(
+                    &self.tets,
+                    dm_inv.collect(),
+                    &self.volume,
+                    &self.material,
+                );
+                Some(Box::new(averaged))
+            }
+        };
+        self
+    }
+
+    /// How the body's tetrahedra compute their volumetric stress.
+    pub fn formulation(&self) -> Formulation {
+        match self.averaged {
+            Some(_) => Formulation::AveragedPressure,
+            None => Formulation::Standard,
+        }
     }
 
     /// The model as a deformable body, if it is one (models are `Any`).
@@ -346,6 +378,9 @@ impl TetBody {
     /// Stage 2: per-particle sums of its block entries, in ascending block order (Eq. 11);
     /// in a decomposed run, of the particles this process owns only.
     fn gather(&self, force: &mut [Vec3]) {
+        if let Some(averaged) = &self.averaged {
+            return averaged.gather(force);
+        }
         let blocks = &self.blocks;
         let count = blocks.entry_start.len() - 1;
         let (starts, entries, sums) = (&blocks.entry_start, &blocks.entries, &self.sums);
@@ -449,7 +484,7 @@ impl ScratchPool {
 
 /// Volume and shape-function gradients ∇N₀..∇N₃ of a tetrahedron at positions `x` (zero
 /// gradients for a degenerate one, which then adds no tangent).
-fn current_gradients(x: &[Vec3; 4]) -> (f64, [Vec3; 4]) {
+pub(crate) fn current_gradients(x: &[Vec3; 4]) -> (f64, [Vec3; 4]) {
     let dx = edge_matrix(x);
     let inverse = dx.try_inverse().unwrap_or_else(Mat3::zeros);
     let g: [Vec3; 3] = std::array::from_fn(|k| inverse.row(k).transpose());
@@ -461,7 +496,7 @@ fn current_gradients(x: &[Vec3; 4]) -> (f64, [Vec3; 4]) {
 
 /// Block (a, b) of the linear-tet operator V Gᵀ D G with the Lamé pair (λ, μ):
 /// V (λ g_a g_bᵀ + μ g_b g_aᵀ + μ (g_a·g_b) I).
-fn lame_block(volume: f64, ga: &Vec3, gb: &Vec3, (lambda, mu): (f64, f64)) -> Mat3 {
+pub(crate) fn lame_block(volume: f64, ga: &Vec3, gb: &Vec3, (lambda, mu): (f64, f64)) -> Mat3 {
     (ga * gb.transpose() * lambda
         + gb * ga.transpose() * mu
         + Mat3::from_diagonal_element(mu * ga.dot(gb)))
@@ -507,6 +542,9 @@ impl Model for TetBody {
     }
 
     fn potential_energy(&self, state: &State) -> Option<f64> {
+        if let Some(averaged) = &self.averaged {
+            return Some(averaged.energy(state));
+        }
         let (lambda, mu) = self.pair();
         let energy = (0..self.tets.len())
             .map(|e| {
@@ -538,7 +576,9 @@ impl SplitModel for TetBody {
 
     /// Stage 1 of Eqs. 9–11: the block sums of this rank's blocks.
     fn compute(&mut self, state: &State) {
-        if self.material.is_elastic() {
+        if let Some(averaged) = &mut self.averaged {
+            self.inverted = averaged.compute(state);
+        } else if self.material.is_elastic() {
             self.compute_block_sums::<false>(state);
         } else {
             self.compute_block_sums::<true>(state);
@@ -560,6 +600,9 @@ impl SplitModel for TetBody {
 
 impl Linearized for TetBody {
     fn add_tangent(&self, state: &State, tangent: &mut Tangent) {
+        if let Some(averaged) = &self.averaged {
+            return averaged.add_tangent(state, tangent);
+        }
         let viscous = !self.material.is_elastic();
         for tet in &self.tets {
             let (volume, g) = current_gradients(&tet.map(|n| state.position[n as usize]));

@@ -33,7 +33,9 @@
 //!   iterated: they are formed directly, M-orthonormalised, reported first (with their
 //!   Rayleigh quotient rᵀKr/rᵀMr, zero to rounding) and projected out of every Lanczos vector,
 //!   which then iterates in their M-orthogonal complement. A body that is fixed in some
-//!   directions but still free to move rigidly is refused ([`ModalError::PartlyConstrained`]).
+//!   directions but still free to move rigidly (a plate simply supported on its edges, free
+//!   in its plane) has the rigid motions its fixes leave free as zero modes alike
+//!   (`partly_fixed.rs`): the shifted operator is positive definite whatever K's null space.
 //!   Other exactly repeated eigenvalues (a square section's two bending planes) are likewise
 //!   found once only: give such test geometries distinct dimensions.
 //! - Participation: for an M-normalised mode φ and a unit rigid motion r_d (translation along
@@ -45,6 +47,7 @@
 use crate::continuum::tet_body::TetBody;
 use crate::error::CoreError;
 use crate::modal::mechanisms::{tet_piece_rows, unresisted_motions, SystemDofs};
+use crate::modal::partly_fixed;
 use crate::modal::rigid_reduction::RigidReduction;
 use crate::solvers::sparse::{
     unconstrained_bodies, Assembler, FreeDofs, Scales, SparseCholesky, Tangent,
@@ -102,7 +105,8 @@ pub enum ModalError {
         /// Unresisted motions left out.
         mechanisms: usize,
     },
-    /// A body fixed in some directions but still free to move rigidly.
+    /// A body fixed in some directions but still free to move rigidly, in motions that its
+    /// fixes alone do not say (something else, a bond or a contact, resists some of them).
     #[error(
         "body `{body}` is fixed in some directions but {modes} of its 6 rigid-body modes are \
          still free: either fix it against rigid motion (at least 3 non-collinear particles or \
@@ -151,8 +155,8 @@ pub struct Mode {
     pub eigenvalue: f64,
     /// Natural frequency √max(ω², 0) / 2π (Hz).
     pub frequency_hz: f64,
-    /// Whether this is a rigid-body mode of a body with no fixity (and, for a rigid body,
-    /// nothing touching it).
+    /// Whether this is a rigid-body mode: a motion of a body that its fixes leave free and no
+    /// stiffness resists (and, for a rigid body, with nothing touching it).
     pub rigid: bool,
     /// The mode shape, M-normalised (φᵀMφ = 1), one vector per particle: zero where fixed
     /// and on particles of no body; a rigid body's members move with it, its centre particle
@@ -427,7 +431,23 @@ impl Problem {
                 .iter()
                 .any(|&p| (0..3).any(|a| self.dofs.index(3 * p + a).is_none()));
             if fixed || modes < 6 {
-                return Err(ModalError::PartlyConstrained { body, modes });
+                // The rigid motions the fixity leaves free: zero-frequency modes as well.
+                let free = partly_fixed::free_rigid_motions(
+                    &state.position,
+                    &particles,
+                    &|d| self.dofs.index(d),
+                    &self.global,
+                );
+                if free.len() != modes {
+                    return Err(ModalError::PartlyConstrained { body, modes });
+                }
+                for mut r in free {
+                    self.orthogonalize(&mut r, &basis, &[]);
+                    let norm = self.norm(&r);
+                    r.iter_mut().for_each(|x| *x /= norm);
+                    basis.push(r);
+                }
+                continue;
             }
             let mut only = vec![false; self.particles];
             for p in particles {

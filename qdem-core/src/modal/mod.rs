@@ -3,4 +3,5 @@
 
 pub mod lanczos;
 mod mechanisms;
+mod partly_fixed;
 mod rigid_reduction;

@@ -35,6 +35,7 @@ mod error;
 pub mod granular;
 mod initial_motion;
 pub(crate) mod load_series;
+pub mod locking;
 pub mod memory;
 mod periodic;
 pub mod pose_from;
@@ -172,7 +173,8 @@ impl Simulation {
             scene: scene.path.clone(),
             source,
         };
-        let (mut meshes, warnings, ballast) = read_meshes(&scene)?;
+        let (mut meshes, mut warnings, ballast) = read_meshes(&scene)?;
+        warnings.extend(locking::warnings(&scene));
         let (stones, sampled) = match &scene.granular {
             Some(g) => granular::stones(&scene, g)?,
             None => (Vec::new(), 0),
@@ -451,7 +453,8 @@ fn build_bodies(
             }
         } else {
             let core = core_material(material);
-            let tet_body = TetBody::new(&body.name, &state.reference, tets, core)?;
+            let tet_body = TetBody::new(&body.name, &state.reference, tets, core)?
+                .with_formulation(material.formulation.core());
             tet_body.lump_mass(&mut state.mass);
             models.push(Box::new(tet_body));
             BodyKind::Deformable {

@@ -3,7 +3,7 @@
 //!
 //! - `modes.csv`: one row per mode, `mode,frequency_hz,kind,direction,participation,mass_x,
 //!   mass_y,mass_z,mass_rx,mass_ry,mass_rz,motion_x,motion_y,motion_z`: `kind` is `rigid` (a rigid-body mode of a body
-//!   with no fixity, frequency zero to rounding) or `elastic`; `mass_*` are the effective
+//!   with no fixity, or one its fixes leave free, frequency zero to rounding) or `elastic`; `mass_*` are the effective
 //!   modal mass fractions along x, y, z and about the axes x, y, z through the mass centre
 //!   (each column sums to 1 over all modes); `direction` and `participation` are the largest
 //!   of them; `motion_*` the shares of the mode's kinetic energy in x, y and z motion (they
@@ -88,14 +88,14 @@ pub fn compute_and_write(
     count: usize,
     dir: &Path,
 ) -> Result<ModesReport, ModesError> {
-    evaluate_once(sim);
+    let push = evaluate_once(sim);
     let world = &sim.world;
     let modes =
         natural_modes(&world.state, &world.models, count).map_err(|source| ModesError::Modal {
             scene: sim.scene.path.clone(),
             source: named(sim, source),
         })?;
-    refuse_loaded_free_bodies(sim, &modes)?;
+    refuse_loaded_free_bodies(sim, &modes, &push)?;
     let vtu_dir = dir.join("vtu");
     std::fs::create_dir_all(&vtu_dir).map_err(|source| ModesError::CreateDir {
         path: vtu_dir.clone(),
@@ -154,11 +154,30 @@ fn named(sim: &Simulation, error: ModalError) -> ModalError {
 
 /// Refuses a body that moves in a rigid-body mode (no fix, nothing touching it) and that a
 /// `[[load]]` or gravity pushes: the modes are about an equilibrium it is not in.
-fn refuse_loaded_free_bodies(sim: &Simulation, modes: &Modes) -> Result<(), ModesError> {
+///
+/// A body fixed in some directions keeps only the rigid motions its fixes leave free (a plate
+/// on its edges, free in its plane): it is refused only when the loads do work along one of
+/// them (a vertical load on that plate does none, the supports take it).
+fn refuse_loaded_free_bodies(
+    sim: &Simulation,
+    modes: &Modes,
+    push: &[Vec3],
+) -> Result<(), ModesError> {
     let rigid: Vec<_> = modes.modes.iter().filter(|m| m.rigid).collect();
     let gravity = sim.scene.run.gravity != [0.0; 3];
     for body in &sim.bodies {
-        let moves = |m: &&Mode| body.particles.clone().any(|p| m.shape[p] != Vec3::zeros());
+        // The work of the pushes along a mode over all particles (a rigid body's centre
+        // carries its translation and its weight).
+        let moves = |m: &&Mode| {
+            let moved = body.particles.clone().any(|p| m.shape[p] != Vec3::zeros());
+            let (mut work, mut force, mut motion) = (0.0, 0.0, 0.0);
+            for (f, u) in push.iter().zip(&m.shape) {
+                work += f.dot(u);
+                force += f.norm_squared();
+                motion += u.norm_squared();
+            }
+            moved && work.abs() > 1e-9 * (force * motion).sqrt()
+        };
         if !rigid.iter().any(moves) {
             continue;
         }
@@ -177,15 +196,20 @@ fn refuse_loaded_free_bodies(sim: &Simulation, modes: &Modes) -> Result<(), Mode
 }
 
 /// Every model's forces once at the starting state, so that the contacts know which of them
-/// touch there (the forces themselves are not used).
-fn evaluate_once(sim: &mut Simulation) {
+/// touch there; returns the forces of all but the deformable bodies (loads, gravity, contacts)
+/// per particle, what pushes a body along a rigid-body mode.
+fn evaluate_once(sim: &mut Simulation) -> Vec<Vec3> {
     let world = &mut sim.world;
     let state = &world.state;
-    let mut force = vec![Vec3::zeros(); state.len()];
+    let mut push = vec![Vec3::zeros(); state.len()];
+    let mut internal = vec![Vec3::zeros(); state.len()];
     let mut torque = vec![Vec3::zeros(); state.rigid.len() + state.spin.len()];
     for model in world.models.iter_mut() {
-        model.add_forces(state, &mut force, &mut torque);
+        let body = qdem_core::TetBody::of(model.as_ref()).is_some();
+        let force = if body { &mut internal } else { &mut push };
+        model.add_forces(state, force, &mut torque);
     }
+    push
 }
 
 /// The header of `modes.csv`.

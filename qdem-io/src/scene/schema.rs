@@ -185,6 +185,31 @@ pub struct Material {
     /// Bulk viscosity λ_D + 2/3 μ_D, Pa·s (≥ 0); default 0.
     #[serde(default)]
     pub bulk_viscosity: f64,
+    /// How its bodies' tetrahedra compute the volumetric stress; default `"standard"`.
+    #[serde(default)]
+    pub formulation: Formulation,
+}
+
+/// `[[material]] formulation`: the standard QDEM tetrahedron, or the average nodal pressure
+/// one (Bonet & Burton 1998) that does not lock as ν → 0.5 ([`qdem_core::Formulation`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Formulation {
+    /// `"standard"`: each tetrahedron its own volumetric strain (paper 000 Eqs. 1–10).
+    #[default]
+    Standard,
+    /// `"averaged-pressure"`: the volumetric strain averaged over each particle's tetrahedra.
+    AveragedPressure,
+}
+
+impl Formulation {
+    /// The core's formulation.
+    pub fn core(self) -> qdem_core::Formulation {
+        match self {
+            Formulation::Standard => qdem_core::Formulation::Standard,
+            Formulation::AveragedPressure => qdem_core::Formulation::AveragedPressure,
+        }
+    }
 }
 
 /// `[[body]]`: a continuum body meshed with tetrahedra.
