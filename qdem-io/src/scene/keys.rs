@@ -137,6 +137,12 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "Bulk viscosity λ_D + 2/3 μ_D, Pa·s (≥ 0); default 0.",
     ),
     key(
+        "[[material]]",
+        "formulation",
+        "string, optional",
+        "`\"standard\"` (default) or `\"averaged-pressure\"`: the average nodal pressure tetrahedron (Bonet & Burton 1998) that does not lock as ν → 0.5; refused under MPI.",
+    ),
+    key(
         "[[body]]",
         "name",
         "string, required",
