@@ -37,6 +37,7 @@
 use std::path::{Path, PathBuf};
 
 mod error;
+mod measure;
 mod refs;
 pub mod schema;
 mod spans;
@@ -44,6 +45,7 @@ pub mod suggest;
 mod validate;
 
 pub use error::{Diagnostic, SceneError};
+pub use measure::{Measure, MeasureRegion};
 pub use refs::{ProbeTarget, Refs};
 pub use schema::{
     Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix, Granular,
@@ -154,6 +156,8 @@ pub struct Scene {
     pub probes: Vec<Probe>,
     /// `[[section]]`, in file order.
     pub sections: Vec<Section>,
+    /// `[[measure]]`, in file order.
+    pub measures: Vec<Measure>,
     /// `[bonded]`: a 2D beam-bonded particle body instead of `[[body]]`s.
     pub bonded: Option<Bonded>,
     /// `[periodic]`: periodic axes and an optional time delay.

@@ -606,6 +606,8 @@ pub(crate) struct RawScene {
     pub probes: Vec<Probe>,
     #[serde(default, rename = "section")]
     pub sections: Vec<Section>,
+    #[serde(default, rename = "measure")]
+    pub measures: Vec<super::measure::Measure>,
     #[serde(default)]
     pub contact: Option<Contact>,
     #[serde(default, rename = "wall")]

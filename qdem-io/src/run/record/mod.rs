@@ -7,6 +7,7 @@
 //! | [`probes::Probes`] | `probes.csv`, `probes.svg` | every `probe_every` |
 //! | [`boundary::Boundary`] | `boundary.csv` (time-delayed boundary) | every `probe_every` |
 //! | [`sections::Sections`] | `sections.csv` (`[[section]]`s) | every `probe_every` |
+//! | [`measures::Measures`] | `measure_NAME.csv`, `measure_NAME.svg`, `measure_NAME_energy.svg` (`[[measure]]`s) | every `every` |
 //! | [`snapshots::Snapshots`] | `vtu/state_NNNNN.vtu`, `results.pvd`; `vtu/spheres_NNNNN.vtu`, `vtu/contacts_NNNNN.vtu`, `vtu/walls.vtu` (contacts), `vtu/bonds_NNNNN.vtu` (`[bonded]`) | every `vtu_every` (never if 0) |
 //! | [`crack::Crack`] | `crack.svg`, the bonded timings | every step; the picture at the end |
 //! | [`stones::Stones`] | `stones.csv` (`[granular]`) | at the end |
@@ -21,6 +22,7 @@ pub(crate) mod bonds_vtu;
 pub(crate) mod boundary;
 pub(crate) mod contacts_vtu;
 pub(crate) mod crack;
+pub(crate) mod measures;
 pub(crate) mod poses;
 pub(crate) mod probes;
 pub(crate) mod schedule;
@@ -141,6 +143,9 @@ pub(crate) fn register(sim: &Simulation, out_dir: &Path) -> Vec<Box<dyn Recorder
     }
     if !sim.scene.sections.is_empty() {
         recorders.push(Box::new(sections::Sections::new(sim, out_dir)));
+    }
+    if !sim.scene.measures.is_empty() {
+        recorders.push(Box::new(measures::Measures::new(sim, out_dir)));
     }
     recorders.push(Box::new(snapshots::Snapshots::new(sim, out_dir)));
     if sim.bonded().is_some() {
