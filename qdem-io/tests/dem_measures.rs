@@ -6,7 +6,7 @@
 //!   −ρ g (1 − n) h, with n the porosity of the column of height h above the layer's middle
 //!   (a second measure from there to above the free surface, so that ρ (1 − n) h A is the
 //!   mass of the stones whose centres lie above): nothing but the floor carries weight, so the contacts through a horizontal plane carry all of it. Over the whole bed the sum
-//!   telescopes exactly: σ_zz V = −g Σ m z. The coordination number is a frictional packing's.
+//!   telescopes exactly: σ_zz V = −g Σ m z; `walls.csv` has the floor carry the weight. The coordination number is a frictional packing's.
 
 mod common;
 
@@ -104,7 +104,12 @@ radius = 1.0
     run(&mut sim, &out, &mut |_| {}).unwrap();
     let all = measure(&out, "all");
     // Settled: the kinetic energy is a ten-millionth of the bed's potential energy scale.
-    let weight_z = stones_weight_moment(&out);
+    let (weight, weight_z) = stones_weight(&out);
+    // walls.csv: the floor carries the bed's weight (nothing else does).
+    let walls = columns(&out.join("walls.csv"));
+    let floor = walls["wall1.fz"][walls["wall1.fz"].len() - 1];
+    eprintln!("floor: {floor:.9} N, weight {weight:.9} N");
+    assert!((floor / -weight - 1.0).abs() < 1e-6, "{floor} vs {weight}");
     let last = all["time"].len() - 1;
     let energy = all["ke_translation"][last] + all["ke_rotation"][last];
     assert!(energy < 1e-7 * weight_z, "not settled: {energy} J");
@@ -154,16 +159,18 @@ radius = 1.0
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// g Σ m z over the stones of `stones.csv` (one-sphere stones, their mass from the radius).
-fn stones_weight_moment(out: &Path) -> f64 {
+/// g Σ m and g Σ m z over the stones of `stones.csv` (one-sphere stones, their mass from the
+/// radius).
+fn stones_weight(out: &Path) -> (f64, f64) {
     let text = std::fs::read_to_string(out.join("stones.csv")).unwrap();
-    let mut moment = 0.0;
+    let (mut weight, mut moment) = (0.0, 0.0);
     for line in text.lines().skip(1) {
         let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
         let mass = DENSITY * 4.0 / 3.0 * std::f64::consts::PI * v[4].powi(3);
+        weight += mass * G;
         moment += mass * G * v[3];
     }
-    moment
+    (weight, moment)
 }
 
 /// `probes.csv` of `out` as columns by name.
