@@ -7,6 +7,7 @@
 //! | [`probes::Probes`] | `probes.csv`, `probes.svg` | every `probe_every` |
 //! | [`boundary::Boundary`] | `boundary.csv` (time-delayed boundary) | every `probe_every` |
 //! | [`sections::Sections`] | `sections.csv` (`[[section]]`s) | every `probe_every` |
+//! | [`settlement::Settlement`] | `settlement.csv`, `settlement.svg` (a `cyclic` load and probes) | at each cycle's minimum and maximum |
 //! | [`walls::Walls`] | `walls.csv` (`[[wall]]`s: force, displacement) | every `probe_every` |
 //! | [`measures::Measures`] | `measure_NAME.csv`, `measure_NAME.svg`, `measure_NAME_energy.svg` (`[[measure]]`s) | every `every` |
 //! | [`snapshots::Snapshots`] | `vtu/state_NNNNN.vtu`, `results.pvd`; `vtu/spheres_NNNNN.vtu`, `vtu/contacts_NNNNN.vtu`, `vtu/walls.vtu` (contacts), `vtu/bonds_NNNNN.vtu` (`[bonded]`) | every `vtu_every` (never if 0) |
@@ -28,6 +29,7 @@ pub(crate) mod poses;
 pub(crate) mod probes;
 pub(crate) mod schedule;
 pub(crate) mod sections;
+pub(crate) mod settlement;
 pub(crate) mod snapshots;
 pub(crate) mod spheres_vtu;
 pub(crate) mod stones;
@@ -145,6 +147,9 @@ pub(crate) fn register(sim: &Simulation, out_dir: &Path) -> Vec<Box<dyn Recorder
     }
     if !sim.scene.sections.is_empty() {
         recorders.push(Box::new(sections::Sections::new(sim, out_dir)));
+    }
+    if let Some(settlement) = settlement::Settlement::new(sim, out_dir) {
+        recorders.push(Box::new(settlement));
     }
     if sim.contacts().is_some_and(|c| c.walls() > 0) {
         recorders.push(Box::new(walls::Walls::new(sim, out_dir)));
