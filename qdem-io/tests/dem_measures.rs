@@ -6,7 +6,8 @@
 //!   −ρ g (1 − n) h, with n the porosity of the column of height h above the layer's middle
 //!   (a second measure from there to above the free surface, so that ρ (1 − n) h A is the
 //!   mass of the stones whose centres lie above): nothing but the floor carries weight, so the contacts through a horizontal plane carry all of it. Over the whole bed the sum
-//!   telescopes exactly: σ_zz V = −g Σ m z; `walls.csv` has the floor carry the weight. The coordination number is a frictional packing's.
+//!   telescopes exactly: σ_zz V = −g Σ m z; `walls.csv` has the floor carry the weight;
+//!   `grading.csv` sieves each grain at its diameter. The coordination number is a frictional packing's.
 
 mod common;
 
@@ -105,6 +106,16 @@ radius = 1.0
     let all = measure(&out, "all");
     // Settled: the kinetic energy is a ten-millionth of the bed's potential energy scale.
     let (weight, weight_z) = stones_weight(&out);
+    // grading.csv: one-sphere stones sieve at their diameter, each its sphere's mass, the
+    // curve by mass ending at 1.
+    let grading = columns(&out.join("grading.csv"));
+    for (d, m) in grading["sieve_size"].iter().zip(&grading["mass"]) {
+        assert!((0.010..=0.014).contains(d), "sieve size {d}");
+        let sphere = DENSITY * std::f64::consts::PI * d.powi(3) / 6.0;
+        assert!((m / sphere - 1.0).abs() < 1e-8, "{m} vs {sphere}");
+    }
+    assert_eq!(grading["mass_passing"].last(), Some(&1.0));
+    assert!(grading["sieve_size"].windows(2).all(|w| w[0] <= w[1]));
     // walls.csv: the floor carries the bed's weight (nothing else does).
     let walls = columns(&out.join("walls.csv"));
     let floor = walls["wall1.fz"][walls["wall1.fz"].len() - 1];

@@ -11,4 +11,5 @@ pub mod linear_spectrum;
 pub mod mode_marks;
 pub mod modes;
 pub mod plot;
+pub mod sieve;
 pub mod spectrum;

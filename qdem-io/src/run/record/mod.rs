@@ -12,6 +12,7 @@
 //! | [`measures::Measures`] | `measure_NAME.csv`, `measure_NAME.svg`, `measure_NAME_energy.svg` (`[[measure]]`s) | every `every` |
 //! | [`snapshots::Snapshots`] | `vtu/state_NNNNN.vtu`, `results.pvd`; `vtu/spheres_NNNNN.vtu`, `vtu/contacts_NNNNN.vtu`, `vtu/walls.vtu` (contacts), `vtu/bonds_NNNNN.vtu` (`[bonded]`) | every `vtu_every` (never if 0) |
 //! | [`crack::Crack`] | `crack.svg`, the bonded timings | every step; the picture at the end |
+//! | [`grading::Grading`] | `grading.csv`, `grading.svg` (`[granular]`: sieve curve by mass) | at the start |
 //! | [`stones::Stones`] | `stones.csv` (`[granular]`) | at the end |
 //! | [`poses::Poses`] | `poses.csv` (rigid bodies) | at the end |
 //!
@@ -24,6 +25,7 @@ pub(crate) mod bonds_vtu;
 pub(crate) mod boundary;
 pub(crate) mod contacts_vtu;
 pub(crate) mod crack;
+pub(crate) mod grading;
 pub(crate) mod measures;
 pub(crate) mod poses;
 pub(crate) mod probes;
@@ -163,6 +165,9 @@ pub(crate) fn register(sim: &Simulation, out_dir: &Path) -> Vec<Box<dyn Recorder
     }
     if sim.granular.is_some() {
         recorders.push(Box::new(stones::Stones::new(out_dir)));
+    }
+    if let Some(grading) = grading::Grading::new(sim, out_dir) {
+        recorders.push(Box::new(grading));
     }
     if sim
         .bodies
