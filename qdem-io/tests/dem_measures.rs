@@ -7,7 +7,8 @@
 //!   (a second measure from there to above the free surface, so that ρ (1 − n) h A is the
 //!   mass of the stones whose centres lie above): nothing but the floor carries weight, so the contacts through a horizontal plane carry all of it. Over the whole bed the sum
 //!   telescopes exactly: σ_zz V = −g Σ m z; `walls.csv` has the floor carry the weight;
-//!   `grading.csv` sieves each grain at its diameter. The coordination number is a frictional packing's.
+//!   `grading.csv` sieves each grain at its diameter; a `[[section]]` with an `area` has the
+//!   stress of the weight above it. The coordination number is a frictional packing's.
 
 mod common;
 
@@ -21,6 +22,8 @@ use std::path::Path;
 const DENSITY: f64 = 2600.0;
 const G: f64 = 9.81;
 const WIDTH: f64 = 0.06;
+/// The height of the `[[section]]` through the bed (m).
+const SECTION: f64 = 0.045;
 
 /// A CSV file as columns by name.
 fn columns(path: &Path) -> HashMap<String, Vec<f64>> {
@@ -54,6 +57,7 @@ fn the_contact_stress_of_a_settled_bed_is_its_weight_above() {
              [[measure]]\nname = \"above{k}\"\nbox = [[0.0, 0.0, {mid}], [{WIDTH}, {WIDTH}, {top}]]\n"
         );
     }
+    let area = WIDTH * WIDTH;
     let scene = format!(
         r#"
 [run]
@@ -92,6 +96,12 @@ point = [0.0, 0.0, 0.0]
 normal = [0.0, 0.0, 1.0]
 
 {measures}
+[[section]]
+name = "mid"
+axis = "z"
+at = {SECTION}
+area = {area}
+
 [[measure]]
 name = "all"
 center = [0.02, 0.02, 0.1]
@@ -105,7 +115,16 @@ radius = 1.0
     run(&mut sim, &out, &mut |_| {}).unwrap();
     let all = measure(&out, "all");
     // Settled: the kinetic energy is a ten-millionth of the bed's potential energy scale.
-    let (weight, weight_z) = stones_weight(&out);
+    let (weight, weight_z, above) = stones_weight(&out);
+    // sections.csv: the pairs through a plane carry the weight of the stones above it.
+    let sections = columns(&out.join("sections.csv"));
+    let stress = sections["mid.stress"][sections["mid.stress"].len() - 1];
+    let expected = -above / (WIDTH * WIDTH);
+    eprintln!("section: {stress:.6} Pa, weight above over the area {expected:.6} Pa");
+    assert!(
+        (stress / expected - 1.0).abs() < 1e-6,
+        "{stress} vs {expected}"
+    );
     // grading.csv: one-sphere stones sieve at their diameter, each its sphere's mass, the
     // curve by mass ending at 1.
     let grading = columns(&out.join("grading.csv"));
@@ -170,18 +189,21 @@ radius = 1.0
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// g Σ m and g Σ m z over the stones of `stones.csv` (one-sphere stones, their mass from the
-/// radius).
-fn stones_weight(out: &Path) -> (f64, f64) {
+/// g Σ m, g Σ m z, and g Σ m over those above the section, of the stones of `stones.csv`
+/// (one-sphere stones, their mass from the radius).
+fn stones_weight(out: &Path) -> (f64, f64, f64) {
     let text = std::fs::read_to_string(out.join("stones.csv")).unwrap();
-    let (mut weight, mut moment) = (0.0, 0.0);
+    let (mut weight, mut moment, mut above) = (0.0, 0.0, 0.0);
     for line in text.lines().skip(1) {
         let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
         let mass = DENSITY * 4.0 / 3.0 * std::f64::consts::PI * v[4].powi(3);
         weight += mass * G;
         moment += mass * G * v[3];
+        if v[3] > SECTION {
+            above += mass * G;
+        }
     }
-    (weight, moment)
+    (weight, moment, above)
 }
 
 /// `probes.csv` of `out` as columns by name.

@@ -533,6 +533,10 @@ pub struct Section {
     pub axis: String,
     /// The plane's coordinate along `axis` (m).
     pub at: f64,
+    /// The area of the section (m², a box test's cross-section): `sections.csv` then also has
+    /// `NAME.stress`, the normal stress through the plane (Pa, tension positive).
+    #[serde(default)]
+    pub area: Option<f64>,
 }
 
 /// `[output]`: where and how often to write results.
