@@ -3,8 +3,8 @@
 //! ([`measure`]). The particles are the stones of the `[granular]` sample (clumps and
 //! one-sphere grains); a stone is in V when its centre of mass is (no clipping).
 //!
-//! **Stress** (Love–Weber; Christoffersen, Mehrabadi & Nemat-Nasser 1981, Eq. 2.11 in the
-//! particle form of Bagi 1996):
+//! **Stress** (Love–Weber, in the particle form: Christoffersen, Mehrabadi & Nemat-Nasser
+//! 1981; Bagi 1996):
 //!
 //! σ_ij = (1/V) Σ_{p ∈ V} Σ_{c ∈ p} (x_c − x_p)_i f_j^{c→p}, symmetrised,
 //!
@@ -32,7 +32,7 @@
 
 use crate::scene::MeasureRegion;
 use qdem_contact::{DemContacts, Partner};
-use qdem_core::{Mat3, State, Vec3};
+use qdem_core::{Mat3, State};
 use std::collections::BTreeSet;
 
 /// The stones a measure reads: per stone its centre particle and volume, and per particle
@@ -77,12 +77,12 @@ pub fn measure(
         .iter()
         .map(|&(c, _, _)| region.contains(state.position[c].into()))
         .collect();
-    let stone_of_sphere: Vec<u32> = contacts
-        .sphere_records(state)
-        .map(|s| stones.stone_of.get(s.particle).copied().unwrap_or(u32::MAX))
-        .collect();
-    let radius: Vec<f64> = contacts.sphere_records(state).map(|s| s.radius).collect();
-    let center: Vec<Vec3> = contacts.sphere_records(state).map(|s| s.center).collect();
+    let (mut stone_of_sphere, mut radius, mut center) = (Vec::new(), Vec::new(), Vec::new());
+    for s in contacts.sphere_records(state) {
+        stone_of_sphere.push(stones.stone_of.get(s.particle).copied().unwrap_or(u32::MAX));
+        radius.push(s.radius);
+        center.push(s.center);
+    }
     let mut moment = Mat3::zeros();
     let mut neighbours = BTreeSet::new();
     let mut counted = 0usize;
