@@ -49,8 +49,8 @@ fn settlement_per_cycle_is_the_probe_displacement_at_the_cycles_extrema() {
         let k = probes["t"].iter().position(|&p| (p - t).abs() < 0.5 * dt);
         k.unwrap_or_else(|| panic!("no probe row at t = {t}"))
     };
-    for k in 0..5 {
-        let (t_min, t_max) = (cycles["time_min"][k], cycles["time_max"][k]);
+    let extrema = cycles["time_min"].iter().zip(&cycles["time_max"]);
+    for (k, (&t_min, &t_max)) in extrema.enumerate() {
         assert!((t_min - k as f64 * period).abs() <= 0.5 * dt, "{t_min}");
         assert!(
             (t_max - (k as f64 + 0.5) * period).abs() <= 0.5 * dt,
