@@ -92,6 +92,7 @@ fn a_lone_body_without_walls_gets_no_contact_model() {
         name: "mid".into(),
         axis: "x".into(),
         at: 0.0,
+        area: None,
     });
     let mut alone = Simulation::build(scene).unwrap();
     assert!(

@@ -94,10 +94,10 @@ fn law(contact: &Contact) -> ContactLaw {
         ContactLawName::Linear => ContactLaw::Linear(LinearSpring {
             normal_stiffness: contact.normal_stiffness.expect("validated scene"),
             tangential_stiffness: contact.tangential_stiffness.expect("validated scene"),
-            damping_ratio: contact.damping_ratio,
+            damping_ratio: contact.damping(),
         }),
         ContactLawName::HertzMindlin => ContactLaw::HertzMindlin(HertzMindlin {
-            damping_ratio: contact.damping_ratio,
+            damping_ratio: contact.damping(),
         }),
     }
 }

@@ -5,9 +5,11 @@
 //! and a bonded body's crack picture ([`crack_svg`]).
 
 pub mod analyze;
+pub mod contact_stress;
 pub mod crack_svg;
 pub mod linear_spectrum;
 pub mod mode_marks;
 pub mod modes;
 pub mod plot;
+pub mod sieve;
 pub mod spectrum;

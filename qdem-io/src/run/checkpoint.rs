@@ -30,8 +30,9 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.qdc";
 /// and the Verlet stepper keeps the particles' moments beside the rigid bodies' torques;
 /// 5: an implicit Newmark stepper keeps, with each factorisation, the matrix it factorised and
 /// the assembler's sparsity pattern, and its step counts include redos and iterative solves;
-/// 6: its tangent records how many of its leading entries a model keeps).
-pub const FORMAT_VERSION: u64 = 6;
+/// 6: its tangent records how many of its leading entries a model keeps; 7: the run record
+/// holds `walls.csv`'s rows in a scene with walls and each `[[measure]]`'s rows).
+pub const FORMAT_VERSION: u64 = 7;
 
 const MAGIC: &[u8; 8] = b"QDEMCKPT";
 const HEADER: usize = 8 + 8 + 8;

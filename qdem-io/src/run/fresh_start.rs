@@ -3,8 +3,9 @@
 //! unlisted (the VTUs of an earlier, longer run past this run's last one; the `boundary.csv`
 //! or `stones.csv` of another scene). Only files with the names a run writes are touched:
 //! `results.pvd`, `probes.csv`, `probes.svg`, `boundary.csv`, `sections.csv`,
-//! `reactions.csv`, `crack.svg`,
-//! `stones.csv`, `poses.csv`, `summary.json`, and in `vtu/` the numbered `state_`,
+//! `reactions.csv`, `crack.svg`, `stones.csv`, `poses.csv`, `summary.json`, `walls.csv`,
+//! `settlement.csv`, `settlement.svg`, `grading.csv`, `grading.svg`, every `measure_*.csv`
+//! and `measure_*.svg`, and in `vtu/` the numbered `state_`,
 //! `spheres_`, `contacts_`, `bonds_` and `walls_` VTUs and `walls.vtu`. A file the scene reads (a
 //! sample's `stones.csv`, a `pose_from`'s `poses.csv`) is kept, and so is `checkpoint.qdc`:
 //! a resume checks that it belongs to the scene and its files, and the run's first checkpoint
@@ -14,7 +15,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 /// The files a run writes at the top of its output folder.
-const TOP_FILES: [&str; 10] = [
+const TOP_FILES: [&str; 15] = [
     "results.pvd",
     "probes.csv",
     "probes.svg",
@@ -25,7 +26,17 @@ const TOP_FILES: [&str; 10] = [
     "stones.csv",
     "poses.csv",
     "summary.json",
+    "walls.csv",
+    "settlement.csv",
+    "settlement.svg",
+    "grading.csv",
+    "grading.svg",
 ];
+
+/// Whether `name` is one of a `[[measure]]`'s files (`measure_NAME.csv`, `.svg`).
+fn measure_file(name: &str) -> bool {
+    name.starts_with("measure_") && (name.ends_with(".csv") || name.ends_with(".svg"))
+}
 
 /// The prefixes of the numbered VTUs a run writes in `vtu/` (`state_00012.vtu`).
 const NUMBERED_VTU: [&str; 5] = ["state_", "spheres_", "contacts_", "bonds_", "walls_"];
@@ -53,6 +64,15 @@ pub(crate) fn remove_earlier_outputs(out_dir: &Path, inputs: &[PathBuf]) -> Vec<
         .filter_map(|p| p.canonicalize().ok())
         .collect::<Vec<_>>();
     let mut candidates: Vec<PathBuf> = TOP_FILES.iter().map(|f| out_dir.join(f)).collect();
+    if let Ok(entries) = fs::read_dir(out_dir) {
+        let mut measures: Vec<PathBuf> = entries
+            .flatten()
+            .filter(|e| e.file_name().to_str().is_some_and(measure_file))
+            .map(|e| e.path())
+            .collect();
+        measures.sort();
+        candidates.extend(measures);
+    }
     if let Ok(entries) = fs::read_dir(out_dir.join("vtu")) {
         let mut vtus: Vec<PathBuf> = entries
             .flatten()
@@ -104,15 +124,26 @@ mod tests {
             "checkpoint.qdc",
             "vtu/state_00031.vtu",
             "vtu/mine.vtu",
+            "walls.csv",
+            "measure_bed.csv",
+            "measure_bed_energy.svg",
+            "measure_notes.txt",
         ] {
             fs::write(dir.join(f), "x").unwrap();
         }
         let removed = remove_earlier_outputs(&dir, &[dir.join("stones.csv")]);
         assert_eq!(
             removed,
-            vec![dir.join("probes.csv"), dir.join("vtu/state_00031.vtu")]
+            vec![
+                dir.join("probes.csv"),
+                dir.join("walls.csv"),
+                dir.join("measure_bed.csv"),
+                dir.join("measure_bed_energy.svg"),
+                dir.join("vtu/state_00031.vtu")
+            ]
         );
-        for kept in ["stones.csv", "notes.txt", "checkpoint.qdc", "vtu/mine.vtu"] {
+        let kept = ["stones.csv", "notes.txt", "checkpoint.qdc", "vtu/mine.vtu"];
+        for kept in kept.into_iter().chain(["measure_notes.txt"]) {
             assert!(dir.join(kept).exists(), "{kept} was removed");
         }
         fs::remove_dir_all(&dir).unwrap();

@@ -407,6 +407,42 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "The plane's coordinate along `axis` (m).",
     ),
     key(
+        "[[section]]",
+        "area",
+        "number, optional",
+        "The section's area, m²: `sections.csv` also gives `NAME.stress`, the normal stress through the plane (Pa, tension positive).",
+    ),
+    key(
+        "[[measure]]",
+        "name",
+        "string, required",
+        "Unique name: the files `measure_NAME.csv`, `measure_NAME.svg`, `measure_NAME_energy.svg`.",
+    ),
+    key(
+        "[[measure]]",
+        "box",
+        "[[x, y, z], [x, y, z]], optional",
+        "The region as a box (lower and upper corner, m); or `center` and `radius`. Needs `[granular]` and `[contact]`.",
+    ),
+    key(
+        "[[measure]]",
+        "center",
+        "[x, y, z], optional",
+        "Instead of `box`: the centre of a spherical region (m), with `radius`.",
+    ),
+    key(
+        "[[measure]]",
+        "radius",
+        "number, optional",
+        "With `center`: the spherical region's radius (m).",
+    ),
+    key(
+        "[[measure]]",
+        "every",
+        "number, optional",
+        "Simulated time between two rows of `measure_NAME.csv`, s; default `probe_every`.",
+    ),
+    key(
         "[contact]",
         "law",
         "\"linear\" or \"hertz-mindlin\", optional",
@@ -435,6 +471,12 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "damping_ratio",
         "number, optional",
         "Damping ratio ζ of the contact dashpots, in [0, 1); default 0 (paper 000: the viscosity is in the bulk).",
+    ),
+    key(
+        "[contact]",
+        "restitution",
+        "number, optional",
+        "Coefficient of restitution e of a head-on impact, in (0, 1], instead of `damping_ratio` (refused beside a non-zero one): ζ = −ln e / √(ln² e + π²).",
     ),
     key(
         "[contact]",

@@ -38,6 +38,7 @@ use std::path::{Path, PathBuf};
 
 mod error;
 pub mod keys;
+mod measure;
 mod refs;
 pub mod schema;
 mod spans;
@@ -45,6 +46,7 @@ pub mod suggest;
 mod validate;
 
 pub use error::{Diagnostic, SceneError};
+pub use measure::{Measure, MeasureRegion};
 pub use refs::{ProbeTarget, Refs};
 pub use schema::{
     AreaLoad, Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix,
@@ -157,6 +159,8 @@ pub struct Scene {
     pub probes: Vec<Probe>,
     /// `[[section]]`, in file order.
     pub sections: Vec<Section>,
+    /// `[[measure]]`, in file order.
+    pub measures: Vec<Measure>,
     /// `[bonded]`: a 2D beam-bonded particle body instead of `[[body]]`s.
     pub bonded: Option<Bonded>,
     /// `[periodic]`: periodic axes and an optional time delay.

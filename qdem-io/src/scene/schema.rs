@@ -307,6 +307,10 @@ pub struct Contact {
     /// viscosity is in the bulk).
     #[serde(default)]
     pub damping_ratio: f64,
+    /// Coefficient of restitution e of a head-on impact, in (0, 1], instead of
+    /// `damping_ratio`: ζ = −ln e / √(ln² e + π²) ([`Contact::damping`]).
+    #[serde(default)]
+    pub restitution: Option<f64>,
     /// PFC's local non-viscous damping fraction, in [0, 1) (paper 003: 0.7 for quasi-static
     /// packing); default 0.
     #[serde(default)]
@@ -318,6 +322,23 @@ pub struct Contact {
     /// Largest overlap allowed at the start, as a fraction of the reduced radius; default 0.05.
     #[serde(default = "default_overlap_tolerance")]
     pub overlap_tolerance: f64,
+}
+
+impl Contact {
+    /// The damping ratio ζ of the contact dashpots: `damping_ratio`, or the one that gives
+    /// `restitution` e, ζ = −ln e / √(ln² e + π²). For the linear law this is exact: a head-on
+    /// impact rebounds with e = exp(−ζπ/√(1 − ζ²)); for Hertz–Mindlin it is LIGGGHTS's
+    /// β = −ζ, which gives e as well (Tsuji's damping, γ ∝ √δ: e does not depend on the
+    /// impact speed).
+    pub fn damping(&self) -> f64 {
+        match self.restitution {
+            Some(e) => {
+                let log = e.ln();
+                -log / (log * log + std::f64::consts::PI.powi(2)).sqrt()
+            }
+            None => self.damping_ratio,
+        }
+    }
 }
 
 fn default_overlap_tolerance() -> f64 {
@@ -555,6 +576,10 @@ pub struct Section {
     pub axis: String,
     /// The plane's coordinate along `axis` (m).
     pub at: f64,
+    /// The area of the section (m², a box test's cross-section): `sections.csv` then also has
+    /// `NAME.stress`, the normal stress through the plane (Pa, tension positive).
+    #[serde(default)]
+    pub area: Option<f64>,
 }
 
 /// `[output]`: where and how often to write results.
@@ -654,6 +679,8 @@ pub(crate) struct RawScene {
     pub probes: Vec<Probe>,
     #[serde(default, rename = "section")]
     pub sections: Vec<Section>,
+    #[serde(default, rename = "measure")]
+    pub measures: Vec<super::measure::Measure>,
     #[serde(default)]
     pub contact: Option<Contact>,
     #[serde(default, rename = "wall")]

@@ -8,8 +8,12 @@
 //! | [`boundary::Boundary`] | `boundary.csv` (time-delayed boundary) | every `probe_every` |
 //! | [`sections::Sections`] | `sections.csv` (`[[section]]`s) | every `probe_every` |
 //! | [`reactions::Reactions`] | `reactions.csv` (`[[fix]]`es of deformable bodies) | every `probe_every` |
+//! | [`settlement::Settlement`] | `settlement.csv`, `settlement.svg` (a `cyclic` load and probes) | at each cycle's minimum and maximum |
+//! | [`walls::Walls`] | `walls.csv` (`[[wall]]`s: force, displacement) | every `probe_every` |
+//! | [`measures::Measures`] | `measure_NAME.csv`, `measure_NAME.svg`, `measure_NAME_energy.svg` (`[[measure]]`s) | every `every` |
 //! | [`snapshots::Snapshots`] | `vtu/state_NNNNN.vtu`, `results.pvd`; `vtu/spheres_NNNNN.vtu`, `vtu/contacts_NNNNN.vtu`, `vtu/walls.vtu` (contacts), `vtu/bonds_NNNNN.vtu` (`[bonded]`) | every `vtu_every` (never if 0) |
 //! | [`crack::Crack`] | `crack.svg`, the bonded timings | every step; the picture at the end |
+//! | [`grading::Grading`] | `grading.csv`, `grading.svg` (`[granular]`: sieve curve by mass) | at the start |
 //! | [`stones::Stones`] | `stones.csv` (`[granular]`) | at the end |
 //! | [`poses::Poses`] | `poses.csv` (rigid bodies) | at the end |
 //!
@@ -22,16 +26,20 @@ pub(crate) mod bonds_vtu;
 pub(crate) mod boundary;
 pub(crate) mod contacts_vtu;
 pub(crate) mod crack;
+pub(crate) mod grading;
+pub(crate) mod measures;
 pub(crate) mod poses;
 pub(crate) mod probes;
 pub(crate) mod reactions;
 pub(crate) mod schedule;
 pub(crate) mod sections;
+pub(crate) mod settlement;
 pub(crate) mod snapshots;
 pub(crate) mod spheres_vtu;
 pub(crate) mod stones;
 pub(crate) mod summary;
 pub(crate) mod tet_stress;
+pub(crate) mod walls;
 pub(crate) mod walls_vtu;
 
 use crate::build::Simulation;
@@ -148,12 +156,24 @@ pub(crate) fn register(sim: &Simulation, out_dir: &Path) -> Vec<Box<dyn Recorder
     if let Some(reactions) = reactions::Reactions::new(sim, out_dir) {
         recorders.push(Box::new(reactions));
     }
+    if let Some(settlement) = settlement::Settlement::new(sim, out_dir) {
+        recorders.push(Box::new(settlement));
+    }
+    if sim.contacts().is_some_and(|c| c.walls() > 0) {
+        recorders.push(Box::new(walls::Walls::new(sim, out_dir)));
+    }
+    if !sim.scene.measures.is_empty() {
+        recorders.push(Box::new(measures::Measures::new(sim, out_dir)));
+    }
     recorders.push(Box::new(snapshots::Snapshots::new(sim, out_dir)));
     if sim.bonded().is_some() {
         recorders.push(Box::new(crack::Crack::new(out_dir)));
     }
     if sim.granular.is_some() {
         recorders.push(Box::new(stones::Stones::new(out_dir)));
+    }
+    if let Some(grading) = grading::Grading::new(sim, out_dir) {
+        recorders.push(Box::new(grading));
     }
     if sim
         .bodies

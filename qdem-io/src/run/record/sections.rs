@@ -1,12 +1,16 @@
 //! [`Sections`]: `sections.csv`: every `probe_every`, the time and the average magnitude of
 //! the contact forces across each `[[section]]` plane (N), one column per section
 //! ([`qdem_contact::DemContacts::section_force`]); 0 in a scene where nothing can touch,
-//! which builds no contact model.
+//! which builds no contact model. A section with an `area` also has `NAME.stress`, the
+//! normal stress through the plane (Pa, tension positive): the axis component of the forces
+//! the touching pairs whose centres lie on either side (a periodic cell's plane repeating
+//! every period) put on the partner below the plane, over the area ([`normal_stress`]).
 
 use super::schedule::{probe_interval, Schedule};
 use super::{Recorder, StateRead, StepInfo};
 use crate::build::Simulation;
 use crate::output::{write_atomic, OutputError};
+use qdem_contact::{DemContacts, Partner};
 use qdem_core::{CheckpointError, Decoder, Encoder};
 use std::path::{Path, PathBuf};
 
@@ -15,8 +19,8 @@ pub(crate) struct Sections {
     schedule: Schedule,
     path: PathBuf,
     names: Vec<String>,
-    /// Each section's axis (0, 1, 2) and position.
-    planes: Vec<(usize, f64)>,
+    /// Each section's axis (0, 1, 2), position and area, if it has one.
+    planes: Vec<(usize, f64, Option<f64>)>,
     /// The rows, flat: the time, then each section's force.
     rows: Vec<f64>,
 }
@@ -27,10 +31,19 @@ impl Sections {
         Sections {
             schedule: Schedule::new(probe_interval(sim)),
             path: out_dir.join("sections.csv"),
-            names: sections.iter().map(|s| s.name.clone()).collect(),
+            names: sections
+                .iter()
+                .flat_map(|s| {
+                    let stress = s.area.map(|_| format!("{}.stress", s.name));
+                    std::iter::once(s.name.clone()).chain(stress)
+                })
+                .collect(),
             planes: sections
                 .iter()
-                .map(|s| ("xyz".find(&s.axis).expect("validated: x, y or z"), s.at))
+                .map(|s| {
+                    let axis = "xyz".find(&s.axis).expect("validated: x, y or z");
+                    (axis, s.at, s.area)
+                })
                 .collect(),
             rows: Vec::new(),
         }
@@ -56,9 +69,14 @@ impl Recorder for Sections {
         }
         let contacts = sim.contacts();
         self.rows.push(time);
-        for &(axis, at) in &self.planes {
+        let period = |axis| sim.periodic().and_then(|p| p.length(axis));
+        for &(axis, at, area) in &self.planes {
             self.rows
                 .push(contacts.map_or(0.0, |c| c.section_force(axis, at)));
+            if let Some(area) = area {
+                let force = contacts.map_or(0.0, |c| normal_force(c, axis, at, period(axis)));
+                self.rows.push(force / area);
+            }
         }
         Ok(())
     }
@@ -87,4 +105,34 @@ impl Recorder for Sections {
         self.rows = input.f64s("the section rows")?;
         Ok(())
     }
+}
+
+/// The axis component of the forces the touching sphere pairs of `contacts` that cross the
+/// plane x[axis] = `at` (their centres, the second at the image it touches, on either side;
+/// with a `period`, of the plane or a copy whole periods away) put on their partner below it
+/// (N): negative when the two sides press on each other.
+fn normal_force(contacts: &DemContacts, axis: usize, at: f64, period: Option<f64>) -> f64 {
+    let mut sum = 0.0;
+    for c in contacts.touching() {
+        if !matches!(c.second, Partner::Sphere(_)) {
+            continue;
+        }
+        let (a, b) = (c.from[axis] - at, c.to[axis] - at);
+        // Whether the pair crosses the plane (or the copy just below the first centre and
+        // the one above it), and whether the second centre lies above.
+        let (crosses, second_above) = match period {
+            Some(l) => {
+                let below = (a / l).floor() * l;
+                (b < below || b >= below + l, b >= below + l)
+            }
+            None => ((a < 0.0) != (b < 0.0), b >= 0.0),
+        };
+        if crosses {
+            sum += match second_above {
+                true => c.force()[axis] * c.scales.0,
+                false => -c.force()[axis] * c.scales.1,
+            };
+        }
+    }
+    sum
 }

@@ -101,6 +101,7 @@ fn contact_numbers(c: &mut Checker<'_>, raw: &RawScene, contact: &Contact, spher
         contact.damping_ratio,
         "0 for no dashpot",
     );
+    restitution(c, contact);
     fraction(
         c,
         &["contact", "local_damping"],
@@ -166,4 +167,31 @@ fn wall(c: &mut Checker<'_>, i: usize, w: &Wall) {
         c.non_negative(&["wall", &idx, "friction"], &l, "friction", f, "");
     }
     c.finite(&["wall", &idx, "velocity"], &l, "velocity", &w.velocity);
+}
+
+/// `restitution`: in (0, 1], and not beside a `damping_ratio` (one of them sets the dashpots).
+fn restitution(c: &mut Checker<'_>, contact: &Contact) {
+    let Some(e) = contact.restitution else {
+        return;
+    };
+    let at = ["contact", "restitution"];
+    if c.finite(&at, "[contact]", "restitution", &[e]) && !(e > 0.0 && e <= 1.0) {
+        c.error(
+            &at,
+            format!(
+                "[contact]: restitution = {e}: must be in (0, 1] (1: no dashpot; a rebound \
+                 ratio of 0 would need infinite damping)"
+            ),
+        );
+    }
+    if contact.damping_ratio != 0.0 {
+        c.error(
+            &at,
+            format!(
+                "[contact]: restitution = {e} and damping_ratio = {} both set the dashpots; \
+                 give one of them",
+                contact.damping_ratio
+            ),
+        );
+    }
 }

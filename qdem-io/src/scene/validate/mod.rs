@@ -24,6 +24,7 @@ mod files;
 mod fix_load;
 mod granular;
 mod material;
+mod measure;
 mod periodic;
 mod probe_section;
 mod run;
@@ -55,6 +56,7 @@ pub(crate) fn validate(
     let loads = fix_load::load_tables(&mut c, &raw, &bodies, &mut refs);
     probe_section::probe_tables(&mut c, &raw, &bodies, &mut refs);
     probe_section::section_tables(&mut c, &raw);
+    measure::measure_tables(&mut c, &raw);
     let spheres = body::placement_keys(&mut c, &raw);
     contact::contact_tables(&mut c, &raw, spheres);
     if let Some(g) = &raw.granular {
@@ -73,6 +75,7 @@ pub(crate) fn validate(
         loads,
         probes: raw.probes,
         sections: raw.sections,
+        measures: raw.measures,
         contact: raw.contact,
         walls: raw.walls,
         bonded: raw.bonded,
@@ -143,6 +146,7 @@ pub(crate) fn to_raw(scene: &Scene) -> RawScene {
             .collect(),
         probes: scene.probes.clone(),
         sections: scene.sections.clone(),
+        measures: scene.measures.clone(),
         contact: scene.contact.clone(),
         walls: scene.walls.clone(),
         bonded: scene.bonded.clone(),

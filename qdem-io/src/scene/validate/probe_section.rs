@@ -97,6 +97,9 @@ pub(super) fn section_tables(c: &mut Checker<'_>, raw: &RawScene) {
             );
         }
         c.finite(&["section", &idx, "at"], &l, "at", &[s.at]);
+        if let Some(area) = s.area {
+            c.positive(&["section", &idx, "area"], &l, "area", area, "m²");
+        }
         if raw.contact.is_none() {
             c.error(
                 &["section", &idx],

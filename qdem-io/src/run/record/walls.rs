@@ -1,0 +1,102 @@
+//! [`Walls`]: `walls.csv`: every `probe_every`, each `[[wall]]`'s total contact force (N, the
+//! force the spheres exert on it: the reaction a support measures) and its displacement from
+//! its place at t = 0 (m), columns `wallK.fx, fy, fz, ux, uy, uz` for the K-th `[[wall]]`
+//! (from 1, in scene order), read from the touching contacts of the last evaluation
+//! ([`qdem_contact::DemContacts::touching`]).
+
+use super::schedule::{probe_interval, Schedule};
+use super::{Recorder, StateRead, StepInfo};
+use crate::build::Simulation;
+use crate::output::{write_atomic, OutputError};
+use qdem_contact::{DemContacts, Partner};
+use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
+use std::path::{Path, PathBuf};
+
+/// The walls' record.
+pub(crate) struct Walls {
+    schedule: Schedule,
+    path: PathBuf,
+    walls: usize,
+    /// The rows, flat: the time, then per wall its force and displacement.
+    rows: Vec<f64>,
+}
+
+impl Walls {
+    pub(crate) fn new(sim: &Simulation, out_dir: &Path) -> Walls {
+        Walls {
+            schedule: Schedule::new(probe_interval(sim)),
+            path: out_dir.join("walls.csv"),
+            walls: sim.contacts().map_or(0, DemContacts::walls),
+            rows: Vec::new(),
+        }
+    }
+}
+
+/// The total force the touching spheres exert on each wall of `contacts` (N).
+pub(crate) fn wall_forces(contacts: &DemContacts) -> Vec<Vec3> {
+    let mut forces = vec![Vec3::zeros(); contacts.walls()];
+    for c in contacts.touching() {
+        if let Partner::Wall(w) = c.second {
+            forces[w] -= c.force();
+        }
+    }
+    forces
+}
+
+impl Recorder for Walls {
+    fn name(&self) -> &'static str {
+        "walls"
+    }
+
+    fn reads(&self, time: f64, dt: f64) -> StateRead {
+        match self.schedule.is_due(time, dt) {
+            true => StateRead::Whole,
+            false => StateRead::Nothing,
+        }
+    }
+
+    fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {
+        let time = sim.world.state.time;
+        let Some(contacts) = sim.contacts() else {
+            return Ok(());
+        };
+        if !self.schedule.due(time, step.dt) {
+            return Ok(());
+        }
+        self.rows.push(time);
+        for (force, wall) in wall_forces(contacts).iter().zip(contacts.wall_list()) {
+            let moved = wall.velocity() * time;
+            self.rows.extend(force.iter().chain(moved.iter()));
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self, _sim: &Simulation) -> Result<(), OutputError> {
+        if self.rows.is_empty() {
+            return Ok(());
+        }
+        write_atomic(&self.path, |w| {
+            let mut header = vec!["time".to_string()];
+            for k in 1..=self.walls {
+                header.extend(["fx", "fy", "fz", "ux", "uy", "uz"].map(|c| format!("wall{k}.{c}")));
+            }
+            writeln!(w, "{}", header.join(","))?;
+            for row in self.rows.chunks_exact(6 * self.walls + 1) {
+                let cells: Vec<String> = row.iter().map(|v| format!("{v:.9e}")).collect();
+                writeln!(w, "{}", cells.join(","))?;
+            }
+            Ok(())
+        })
+    }
+
+    fn save(&self, out: &mut Encoder) {
+        out.f64(self.schedule.next);
+        out.f64s(&self.rows);
+    }
+
+    fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+        self.schedule.next = input.f64("the wall schedule")?;
+        self.rows = input.f64s("the wall rows")?;
+        Ok(())
+    }
+}
