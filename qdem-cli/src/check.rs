@@ -60,6 +60,7 @@ fn print_scene(path: &Path, sim: &Simulation) {
         let mass = sim.body_mass(body);
         let kind = match body.kind {
             BodyKind::Rigid { .. } => "rigid",
+            BodyKind::Stones { .. } => "rigid stones",
             BodyKind::Deformable { .. } => "deformable",
         };
         println!(

@@ -80,6 +80,16 @@ pub enum BodyKind {
         /// is measured from it ([`pose_from`]).
         design_frame: UnitQuaternion<f64>,
     },
+    /// The `[ballast]` stones with `rigid = true`: one rigid body per stone, stone `k` being
+    /// rigid body `first + k` with centre particle `centers[k]`.
+    Stones {
+        /// Index into [`State::rigid`] of the first stone.
+        first: usize,
+        /// Each stone's centre particle.
+        centers: Vec<usize>,
+        /// The stones' tetrahedra, as state particle indices (for output).
+        tets: Vec<[u32; 4]>,
+    },
 }
 
 /// What the output needs to know about one body.
@@ -161,7 +171,7 @@ impl Simulation {
             scene: scene.path.clone(),
             source,
         };
-        let (mut meshes, warnings, ballast) = read_meshes(&scene)?;
+        let (mut meshes, warnings, mut ballast) = read_meshes(&scene)?;
         let (stones, sampled) = match &scene.granular {
             Some(g) => granular::stones(&scene, g)?,
             None => (Vec::new(), 0),
@@ -177,8 +187,10 @@ impl Simulation {
             .flat_map(|m| m.mesh.nodes.iter().map(|p| Vec3::from(*p)));
         let mut state = State::at_rest(reference.collect());
         let mut models: Vec<Box<dyn Model>> = Vec::new();
-        let bodies = build_bodies(&scene, &meshes, &mut state, &mut models).map_err(core)?;
-        if let Some((b, info)) = scene.ballast.as_ref().zip(ballast.as_ref()) {
+        let bodies = build_bodies(&scene, &meshes, ballast.as_mut(), &mut state, &mut models)
+            .map_err(core)?;
+        let deformable_ballast = ballast.as_ref().filter(|info| info.centers.is_empty());
+        if let Some((b, info)) = scene.ballast.as_ref().zip(deformable_ballast) {
             for stone in &info.stones {
                 let (v, w) = (Vec3::from(b.velocity), Vec3::from(b.angular_velocity));
                 initial_motion::move_rigidly(&mut state, stone.clone(), v, w);
@@ -238,7 +250,7 @@ impl Simulation {
     /// The tetrahedra of a body, deformable or rigid, as state particle indices.
     pub fn body_tets<'a>(&'a self, body: &'a BodyInfo) -> &'a [[u32; 4]] {
         match &body.kind {
-            BodyKind::Rigid { tets, .. } => tets,
+            BodyKind::Rigid { tets, .. } | BodyKind::Stones { tets, .. } => tets,
             BodyKind::Deformable { .. } => self
                 .tet_body(body)
                 .expect("a deformable body has a TetBody")
@@ -252,6 +264,7 @@ impl Simulation {
         match body.kind {
             BodyKind::Deformable { .. } => mass[body.particles.clone()].iter().sum(),
             BodyKind::Rigid { center, .. } => mass[center],
+            BodyKind::Stones { ref centers, .. } => centers.iter().map(|&c| mass[c]).sum(),
         }
     }
 
@@ -409,11 +422,13 @@ fn place(mesh: &mut TetMesh, degrees: [f64; 3], shift: [f64; 3]) {
 }
 
 /// One [`TetBody`] per deformable body, its lumped mass added to the state; one rigid body
-/// (a new centre particle at its centre of mass) per rigid body. Sets initial velocities and
-/// angular velocities (`initial_motion`).
+/// (a new centre particle at its centre of mass) per rigid body, then the `[ballast]` stones
+/// (one body, or a rigid body per stone). Sets initial velocities and angular velocities
+/// (`initial_motion`) of the bodies and of rigid stones.
 fn build_bodies(
     scene: &Scene,
     meshes: &[PlacedMesh],
+    ballast_info: Option<&mut BallastInfo>,
     state: &mut State,
     models: &mut Vec<Box<dyn Model>>,
 ) -> Result<Vec<BodyInfo>, CoreError> {
@@ -447,7 +462,9 @@ fn build_bodies(
             }
         };
         match kind {
-            BodyKind::Rigid { .. } => state.velocity[placed.particles.clone()].fill(velocity),
+            BodyKind::Rigid { .. } | BodyKind::Stones { .. } => {
+                state.velocity[placed.particles.clone()].fill(velocity)
+            }
             BodyKind::Deformable { .. } => {
                 initial_motion::move_rigidly(state, placed.particles.clone(), velocity, omega)
             }
@@ -461,9 +478,15 @@ fn build_bodies(
         });
     }
     let ballast = scene.ballast.as_ref().zip(scene.refs().ballast_material);
-    if let (Some((b, material)), Some(placed)) = (ballast, meshes.get(scene.bodies.len())) {
+    if let (Some((b, material)), Some(placed), Some(info)) =
+        (ballast, meshes.get(scene.bodies.len()), ballast_info)
+    {
         let material = core_material(&scene.materials[material]);
-        bodies.push(ballast_body(b, material, placed, state, models)?);
+        bodies.push(if b.rigid {
+            rigid_ballast_body(b, material.density, placed, info, state)?
+        } else {
+            ballast_body(b, material, placed, state, models)?
+        });
     }
     if scene
         .bodies
@@ -496,6 +519,31 @@ fn ballast_body(
         particles: placed.particles.clone(),
         kind: BodyKind::Deformable {
             model: models.len() - 1,
+        },
+        stats: placed.mesh.stats(),
+        mesh: placed.path.clone(),
+    })
+}
+
+/// The `[ballast]` stones with `rigid = true`, one rigid body each
+/// ([`ballast::rigid_stones`]), with their initial velocity and angular velocity.
+fn rigid_ballast_body(
+    b: &crate::scene::Ballast,
+    density: f64,
+    placed: &PlacedMesh,
+    info: &mut BallastInfo,
+    state: &mut State,
+) -> Result<BodyInfo, CoreError> {
+    let tets = offset_tets(&placed.mesh, placed.particles.start);
+    let motion = (Vec3::from(b.velocity), Vec3::from(b.angular_velocity));
+    let first = ballast::rigid_stones(info, &tets, density, motion, state)?;
+    Ok(BodyInfo {
+        name: b.name.clone(),
+        particles: placed.particles.clone(),
+        kind: BodyKind::Stones {
+            first,
+            centers: info.centers.clone(),
+            tets,
         },
         stats: placed.mesh.stats(),
         mesh: placed.path.clone(),
