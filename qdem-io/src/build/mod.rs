@@ -20,6 +20,8 @@
 //!   `[ballast]`; `bonded`: a `[bonded]` body (built instead of everything else);
 //! - `periodic`: the `[periodic]` cell, its wrap groups and time delay;
 //! - `rest_on`: bodies laid on a granular sample; `load_series`: a load's CSV time series;
+//! - `start_from`: the state of another scene's checkpoint; `kind_change`: a body rigid there
+//!   and deformable here, or the other way round;
 //! - [`memory`]: the memory a count needs, refused before allocating beyond the machine;
 //!   `step_check`: a time step that cannot advance the run, refused;
 //! - [`BuildError`] (`error`): why a build failed.
@@ -30,6 +32,7 @@ mod contact;
 mod error;
 pub mod granular;
 mod initial_motion;
+mod kind_change;
 pub(crate) mod load_series;
 pub mod memory;
 mod periodic;
@@ -171,7 +174,7 @@ impl Simulation {
             scene: scene.path.clone(),
             source,
         };
-        let (mut meshes, warnings, mut ballast) = read_meshes(&scene)?;
+        let (mut meshes, mut warnings, mut ballast) = read_meshes(&scene)?;
         let (stones, sampled) = match &scene.granular {
             Some(g) => granular::stones(&scene, g)?,
             None => (Vec::new(), 0),
@@ -208,7 +211,11 @@ impl Simulation {
         extra.periodic = periodic.as_ref().map(|p| p.0.clone());
         add_forces(&scene, &meshes, &state, extra, &mut models)?;
         if let Some(file) = &scene.run.start_from {
-            start_from::restore_state(&scene, file, &mut state, periodic.as_ref())?;
+            let units = kind_change::units(&scene, &meshes, &bodies, ballast.as_ref());
+            let p = periodic.as_ref();
+            warnings.extend(start_from::restore_state(
+                &scene, file, &units, &mut state, p,
+            )?);
         }
         let (probes, regions) = probes::resolve_probes(&scene, &bodies, granular.as_ref(), &state)?;
         let settings =
