@@ -11,6 +11,9 @@
 #      with --friction-study),
 #   3. the sleeper's modes on its consolidated bed (qdem modes), and the spectra and mobility of
 #      the stable period with those modes marked (qdem analyze --modes).
+# With --stiff --rigid-forming, step 1 with rigid stones (stiff_deposit_rigid.toml,
+# stiff_consolidate_rigid.toml) and step 2 with deformable ones from that bed
+# (stiff_load_from_rigid.toml; docs/ballast.md, "Forming rigid, loading deformable").
 # Step 1 is skipped when its checkpoint exists, unless --redeposit is given.
 # Outputs: out/ballast/{reduced,stiff}_*/ (probes.csv, vtu/, analysis/*.csv|svg, modes/).
 set -euo pipefail
@@ -21,18 +24,27 @@ dir=fixtures/ballast
 redeposit=false
 track=reduced
 friction=false
+rigid=false
 for arg in "$@"; do
     case "$arg" in
         --redeposit) redeposit=true ;;
         --friction-study) friction=true ;;
         --stiff) track=stiff ;;
-        *) echo "usage: $0 [--stiff] [--redeposit] [--friction-study]" >&2; exit 2 ;;
+        --rigid-forming) rigid=true ;;
+        *) echo "usage: $0 [--stiff [--rigid-forming]] [--redeposit] [--friction-study]" >&2; exit 2 ;;
     esac
 done
 forming=(reduced_deposit)
 if [ $track = stiff ]; then forming=(stiff_deposit stiff_consolidate); fi
 runs=(${track}_load)
 if $friction; then runs+=(${track}_load_mu173); fi
+if $rigid; then
+    if [ $track != stiff ] || $friction; then
+        echo "$0: --rigid-forming goes with --stiff, without --friction-study" >&2; exit 2
+    fi
+    forming=(stiff_deposit_rigid stiff_consolidate_rigid)
+    runs=(stiff_load_from_rigid)
+fi
 if $redeposit || [ ! -f "out/ballast/${forming[-1]}/checkpoint.qdc" ]; then
     for scene in "${forming[@]}"; do $qdem run $dir/$scene.toml; done
 fi
@@ -43,7 +55,7 @@ if [ $track = reduced ]; then
     done
     exit 0
 fi
-python3 $dir/track_profile.py out/ballast/stiff_consolidate 1045
+python3 $dir/track_profile.py out/ballast/${forming[-1]} 1045
 # The loading runs side by side, one thread each (two cores).
 pids=()
 for run in "${runs[@]}"; do
@@ -51,13 +63,13 @@ for run in "${runs[@]}"; do
     pids+=($!)
 done
 for pid in "${pids[@]}"; do wait "$pid"; done
-modes=out/ballast/stiff_load/modes
-$qdem modes $dir/stiff_load.toml --count 80 --out $modes
+modes=out/ballast/${runs[0]}/modes
+$qdem modes $dir/${runs[0]}.toml --count 80 --out $modes
 # Spectra of the stable period: at friction 0.577 the bed fails in bearing under the second
 # bogie (from 0.29 s; docs/ballast.md), at 1.73 it carries all four axles.
 for run in "${runs[@]}"; do
     window=(--from 0.06)
-    if [ "$run" = stiff_load ]; then window+=(--to 0.29); fi
+    if [ "$run" != stiff_load_mu173 ]; then window+=(--to 0.29); fi
     $qdem analyze $dir/$run.toml "${window[@]}" --modes $modes/modes.csv
     python3 $dir/track_profile.py --motion out/ballast/$run
 done

@@ -60,6 +60,7 @@ fn print_scene(path: &Path, sim: &Simulation) {
         let mass = sim.body_mass(body);
         let kind = match body.kind {
             BodyKind::Rigid { .. } => "rigid",
+            BodyKind::Stones { .. } => "rigid stones",
             BodyKind::Deformable { .. } => "deformable",
         };
         println!(
@@ -112,10 +113,37 @@ fn print_scene(path: &Path, sim: &Simulation) {
         sim.steps(),
         sim.scene.run.t_end
     );
+    print_step_limits(sim);
     print_memory(sim);
     match sim.world.checkpointable() {
         Ok(()) => println!("checkpoints: supported (`checkpoint_every`, Ctrl-C, --resume)"),
         Err(why) => println!("checkpoints: not supported: {why}"),
+    }
+}
+
+/// Per body, its kind and the explicit step its own model allows (a deformable body's
+/// tetrahedra; a rigid body has none: its contacts act on its whole mass, in the contacts'
+/// bound), then the contacts' bound: what limits this stage's step.
+fn print_step_limits(sim: &Simulation) {
+    let state = &sim.world.state;
+    for body in &sim.bodies {
+        let limit = match &body.kind {
+            BodyKind::Deformable { model } => match sim.world.models[*model].stable_dt(state) {
+                Some(dt) => format!("deformable, its tetrahedra bound the step at {dt:.4e} s"),
+                None => "deformable, no bound of its own".to_string(),
+            },
+            BodyKind::Rigid { .. } => {
+                "rigid, no bound of its own: its contacts act on its whole mass".to_string()
+            }
+            BodyKind::Stones { centers, .. } => format!(
+                "{} rigid stones, no bound of their own: their contacts act on whole stones",
+                centers.len()
+            ),
+        };
+        println!("step limit of body `{}`: {limit}", body.name);
+    }
+    if let Some(dt) = sim.contacts().and_then(|c| c.stable_dt(state)) {
+        println!("step limit of the contacts: {dt:.4e} s");
     }
 }
 

@@ -131,3 +131,37 @@ fn bench_takes_comma_separated_lists() {
     assert!(threads.contains(&1) && threads.contains(&2), "{doc:#}");
     assert_eq!(doc["locality"].as_array().map(Vec::len), Some(3), "{doc:#}");
 }
+
+#[test]
+fn check_names_each_bodys_kind_and_what_limits_the_step() {
+    let fixtures = concat!(env!("CARGO_MANIFEST_DIR"), "/../fixtures/ballast/");
+    let limit = |line: &str, out: &str| -> f64 {
+        let at = out
+            .find(line)
+            .unwrap_or_else(|| panic!("no `{line}` in\n{out}"));
+        let rest = &out[at + line.len()..];
+        rest.split_whitespace().next().unwrap().parse().unwrap()
+    };
+    let deformable = success(&[
+        "check",
+        &format!("{fixtures}stiff_deposit.toml"),
+        "--threads",
+        "1",
+    ]);
+    let rigid = success(&[
+        "check",
+        &format!("{fixtures}stiff_deposit_rigid.toml"),
+        "--threads",
+        "1",
+    ]);
+    let sleeper = "step limit of body `sleeper`: deformable, its tetrahedra bound the step at ";
+    let stones = "step limit of body `ballast`: deformable, its tetrahedra bound the step at ";
+    let contacts = "step limit of the contacts: ";
+    // The same sleeper either way; rigid stones have no bound of their own, and their
+    // contacts act on whole stones instead of vertex particles, so they allow a longer step.
+    assert_eq!(limit(sleeper, &deformable), limit(sleeper, &rigid));
+    assert!(limit(stones, &deformable) > 0.0);
+    assert!(rigid.contains("step limit of body `ballast`: 105 rigid stones, no bound of their own"));
+    assert!(rigid.contains("rigid stones): 1993 particles"), "{rigid}");
+    assert!(limit(contacts, &rigid) > 5.0 * limit(contacts, &deformable));
+}

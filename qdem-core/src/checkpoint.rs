@@ -358,6 +358,86 @@ impl State {
     }
 }
 
+/// What [`State::save`] wrote, read without a state to fit it into: a scene that starts from
+/// another scene's checkpoint but integrates some bodies differently (rigid or deformable)
+/// lays its particles out differently and maps them itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SavedState {
+    /// Simulated time (s).
+    pub time: f64,
+    /// Reference positions, one per particle of the saved scene (m).
+    pub reference: Vec<Vec3>,
+    /// Positions (m).
+    pub position: Vec<Vec3>,
+    /// Velocities (m/s).
+    pub velocity: Vec<Vec3>,
+    /// Accelerations (m/s²).
+    pub acceleration: Vec<Vec3>,
+    /// Each rigid body's orientation.
+    pub orientation: Vec<UnitQuaternion<f64>>,
+    /// Each rigid body's angular momentum (kg m²/s).
+    pub angular_momentum: Vec<Vec3>,
+    /// Each rigid body's angular velocity (rad/s).
+    pub angular_velocity: Vec<Vec3>,
+    /// The particles' rotations: angle, rate, acceleration (each empty or one per particle).
+    pub spin: [Vec<Vec3>; 3],
+}
+
+impl SavedState {
+    /// Reads what [`State::save`] wrote, checking only that its arrays agree with each other.
+    pub fn read(input: &mut Decoder<'_>) -> Result<SavedState, CheckpointError> {
+        input.tag("state")?;
+        let time = input.f64("time")?;
+        let reference = input.vec3s("reference positions")?;
+        let n = reference.len();
+        let position = input.vec3s_exact(n, "positions")?;
+        let velocity = input.vec3s_exact(n, "velocities")?;
+        let acceleration = input.vec3s_exact(n, "accelerations")?;
+        input.tag("rigid bodies")?;
+        let bodies = input.u64("rigid bodies")? as usize;
+        let orientation = (0..bodies)
+            .map(|_| {
+                let c = input.f64s("an orientation")?;
+                same_count("quaternion components", 4, c.len())?;
+                Ok(UnitQuaternion::new_unchecked(Quaternion::new(
+                    c[3], c[0], c[1], c[2],
+                )))
+            })
+            .collect::<Result<Vec<_>, CheckpointError>>()?;
+        let angular_momentum = input.vec3s_exact(bodies, "angular momenta")?;
+        let angular_velocity = input.vec3s_exact(bodies, "angular velocities")?;
+        input.tag("particle rotations")?;
+        let angle = input.vec3s("particle angles")?;
+        let m = angle.len();
+        let spin = [
+            angle,
+            input.vec3s_exact(m, "particle angular velocities")?,
+            input.vec3s_exact(m, "particle angular accelerations")?,
+        ];
+        Ok(SavedState {
+            time,
+            reference,
+            position,
+            velocity,
+            acceleration,
+            orientation,
+            angular_momentum,
+            angular_velocity,
+            spin,
+        })
+    }
+
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.reference.len()
+    }
+
+    /// Whether the saved scene had no particle.
+    pub fn is_empty(&self) -> bool {
+        self.reference.is_empty()
+    }
+}
+
 fn save_rigid(rigid: &RigidBodies, out: &mut Encoder) {
     out.tag("rigid bodies");
     out.u64(rigid.len() as u64);
@@ -471,6 +551,12 @@ mod tests {
         let mut back = State::at_rest(vec![Vec3::zeros(); 2]);
         back.restore(&mut Decoder::new(&bytes)).unwrap();
         assert_eq!(back, s);
+        let saved = SavedState::read(&mut Decoder::new(&bytes)).unwrap();
+        assert_eq!((saved.time, saved.len()), (0.125, 2));
+        assert_eq!(
+            (saved.velocity, saved.acceleration),
+            (s.velocity.clone(), s.acceleration.clone())
+        );
         let mut other = State::at_rest(vec![Vec3::zeros(); 3]);
         assert!(matches!(
             other.restore(&mut Decoder::new(&bytes)),

@@ -53,7 +53,7 @@ pub type Vec3 = nalgebra::Vector3<f64>;
 /// A 3×3 matrix of f64.
 pub type Mat3 = nalgebra::Matrix3<f64>;
 
-pub use checkpoint::{CheckpointError, Decoder, Encoder};
+pub use checkpoint::{CheckpointError, Decoder, Encoder, SavedState};
 pub use continuum::averaged_pressure_tet::Formulation;
 pub use continuum::material::Material;
 pub use continuum::rigid_body::RigidBodies;

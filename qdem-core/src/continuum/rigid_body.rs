@@ -273,12 +273,7 @@ impl State {
         rigid.angular_momentum.push(Vec3::zeros());
         rigid.angular_velocity.push(Vec3::zeros());
         rigid.spin_fixed.push(false);
-        for slot in rigid.member_start[b]..rigid.member_start[b + 1] {
-            let (x, v) = rigid.placed(slot, &self.position, &self.velocity);
-            let m = rigid.member[slot];
-            self.position[m] = x;
-            self.velocity[m] = v;
-        }
+        place_body_members(self, b);
         Ok(b)
     }
 }
@@ -310,6 +305,23 @@ pub fn place_members(state: &mut State) {
     // allocates nothing).
     for (slot, &m) in rigid.member.iter().enumerate() {
         let (x, v) = rigid.placed(slot, position, velocity);
+        position[m] = x;
+        velocity[m] = v;
+    }
+}
+
+/// Puts the members of body `b` alone at x = c + R s with velocity v = v_c + ω × R s (a body
+/// whose pose was just set, the others untouched).
+pub fn place_body_members(state: &mut State, b: usize) {
+    let State {
+        rigid,
+        position,
+        velocity,
+        ..
+    } = state;
+    for slot in rigid.member_start[b]..rigid.member_start[b + 1] {
+        let (x, v) = rigid.placed(slot, position, velocity);
+        let m = rigid.member[slot];
         position[m] = x;
         velocity[m] = v;
     }

@@ -15,7 +15,10 @@
 //!
 //! All stones together form one deformable body (one [`qdem_core::TetBody`], so the kernel
 //! runs over all their tetrahedra in parallel); in contact each stone is its own body, so its
-//! spheres never touch each other, and a periodic cell wraps each stone whole.
+//! spheres never touch each other, and a periodic cell wraps each stone whole. With
+//! `rigid = true` each stone is instead a rigid body ([`qdem_core::rigid_body`]): a centre
+//! particle at the centre of mass of its tetrahedra with their mass and inertia, its mesh nodes
+//! massless members that carry its contact spheres ([`rigid_stones`]).
 
 use crate::build::{read_mesh, BuildError, PlacedMesh};
 use crate::scene::{Ballast, Scene};
@@ -24,7 +27,8 @@ use qdem_contact::broad_phase::bounds;
 use qdem_contact::clump_sample::Grading;
 use qdem_contact::particle_packing::SplitMix64;
 use qdem_contact::ContactSphere;
-use qdem_core::{Mat3, Vec3};
+use qdem_core::rigid_body::tet_mass_properties;
+use qdem_core::{CoreError, Mat3, State, Vec3};
 use qdem_mesh::TetMesh;
 use std::ops::Range;
 use std::path::PathBuf;
@@ -42,6 +46,11 @@ pub struct BallastInfo {
     pub sizes: Vec<f64>,
     /// The contact spheres at the stones' surface vertices.
     pub spheres: Vec<ContactSphere>,
+    /// Each stone's tetrahedra: a range of the ballast mesh's tetrahedra.
+    pub tets: Vec<Range<usize>>,
+    /// Each stone's centre particle when the stones are rigid (`rigid = true`); empty when
+    /// they are one deformable body.
+    pub centers: Vec<usize>,
 }
 
 /// A stone mesh laid out with its longest bounding-box extent along x, its shortest along y and
@@ -107,6 +116,8 @@ pub(crate) fn place_ballast(
         shapes: Vec::with_capacity(draws.len()),
         sizes: Vec::with_capacity(draws.len()),
         spheres: Vec::new(),
+        tets: Vec::with_capacity(draws.len()),
+        centers: Vec::new(),
     };
     for (draw, centre) in draws.iter().zip(cells) {
         let shape = &shapes[draw.shape];
@@ -114,6 +125,7 @@ pub(crate) fn place_ballast(
         let jitter = Vec3::from_fn(|k, _| (2.0 * rng.uniform() - 1.0) * slack[k].max(0.0));
         let first = mesh.nodes.len();
         let offset = first as u32;
+        let first_tet = mesh.tets.len();
         mesh.tets
             .extend(shape.mesh.tets.iter().map(|t| t.map(|n| n + offset)));
         mesh.nodes.extend(shape.mesh.nodes.iter().map(|p| {
@@ -128,6 +140,7 @@ pub(crate) fn place_ballast(
                 material,
             }));
         info.stones.push(start + first..start + mesh.nodes.len());
+        info.tets.push(first_tet..mesh.tets.len());
         info.shapes.push(draw.shape);
         info.sizes.push(shape.sieve() * draw.scale);
     }
@@ -138,6 +151,32 @@ pub(crate) fn place_ballast(
         rotation: nalgebra::UnitQuaternion::identity(),
     };
     Ok((placed, info, warnings))
+}
+
+/// Turns every stone of `info` into a rigid body (module docs): `tets` are the ballast's
+/// tetrahedra as state particle indices, `density` the material's; each stone starts with the
+/// velocity `v` and the angular velocity `w` about its centre of mass. Returns the rigid-body
+/// index of the first stone and records each stone's centre particle in `info.centers`.
+pub(crate) fn rigid_stones(
+    info: &mut BallastInfo,
+    tets: &[[u32; 4]],
+    density: f64,
+    (v, w): (Vec3, Vec3),
+    state: &mut State,
+) -> Result<usize, CoreError> {
+    let first = state.rigid.len();
+    for (k, (nodes, own)) in info.stones.iter().zip(&info.tets).enumerate() {
+        let (mass, center, inertia) =
+            tet_mass_properties(&state.reference, &tets[own.clone()], density);
+        let c = state.push_particle(center, v, mass);
+        let members: Vec<usize> = nodes.clone().collect();
+        let name = format!("{} stone {}", info.name, k + 1);
+        let b = state.add_rigid_body(&name, c, &members, inertia)?;
+        state.rigid.set_angular_velocity(b, w);
+        info.centers.push(c);
+    }
+    qdem_core::rigid_body::place_members(state);
+    Ok(first)
 }
 
 /// What the output shows as the ballast's mesh: the directory of its first stone mesh.

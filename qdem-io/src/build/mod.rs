@@ -21,6 +21,8 @@
 //!   `[ballast]`; `bonded`: a `[bonded]` body (built instead of everything else);
 //! - `periodic`: the `[periodic]` cell, its wrap groups and time delay;
 //! - `rest_on`: bodies laid on a granular sample; `load_series`: a load's CSV time series;
+//! - `start_from`: the state of another scene's checkpoint; `kind_change`: a body rigid there
+//!   and deformable here, or the other way round;
 //! - [`memory`]: the memory a count needs, refused before allocating beyond the machine;
 //!   `step_check`: a time step that cannot advance the run, refused; `absurd_inputs`: valid
 //!   inputs that are hardly meant (a tiny dt, a far probe, a soft stone), warned of;
@@ -34,6 +36,7 @@ mod contact;
 mod error;
 pub mod granular;
 mod initial_motion;
+mod kind_change;
 pub(crate) mod load_series;
 pub mod locking;
 pub mod memory;
@@ -84,6 +87,16 @@ pub enum BodyKind {
         /// `rotate_deg` and `translate`, before `pose_from`): the pose written to `poses.csv`
         /// is measured from it ([`pose_from`]).
         design_frame: UnitQuaternion<f64>,
+    },
+    /// The `[ballast]` stones with `rigid = true`: one rigid body per stone, stone `k` being
+    /// rigid body `first + k` with centre particle `centers[k]`.
+    Stones {
+        /// Index into [`State::rigid`] of the first stone.
+        first: usize,
+        /// Each stone's centre particle.
+        centers: Vec<usize>,
+        /// The stones' tetrahedra, as state particle indices (for output).
+        tets: Vec<[u32; 4]>,
     },
 }
 
@@ -173,7 +186,7 @@ impl Simulation {
             scene: scene.path.clone(),
             source,
         };
-        let (mut meshes, mut warnings, ballast) = read_meshes(&scene)?;
+        let (mut meshes, mut warnings, mut ballast) = read_meshes(&scene)?;
         warnings.extend(locking::warnings(&scene));
         let (stones, sampled) = match &scene.granular {
             Some(g) => granular::stones(&scene, g)?,
@@ -190,8 +203,10 @@ impl Simulation {
             .flat_map(|m| m.mesh.nodes.iter().map(|p| Vec3::from(*p)));
         let mut state = State::at_rest(reference.collect());
         let mut models: Vec<Box<dyn Model>> = Vec::new();
-        let bodies = build_bodies(&scene, &meshes, &mut state, &mut models).map_err(core)?;
-        if let Some((b, info)) = scene.ballast.as_ref().zip(ballast.as_ref()) {
+        let bodies = build_bodies(&scene, &meshes, ballast.as_mut(), &mut state, &mut models)
+            .map_err(core)?;
+        let deformable_ballast = ballast.as_ref().filter(|info| info.centers.is_empty());
+        if let Some((b, info)) = scene.ballast.as_ref().zip(deformable_ballast) {
             for stone in &info.stones {
                 let (v, w) = (Vec3::from(b.velocity), Vec3::from(b.angular_velocity));
                 initial_motion::move_rigidly(&mut state, stone.clone(), v, w);
@@ -209,7 +224,11 @@ impl Simulation {
         extra.periodic = periodic.as_ref().map(|p| p.0.clone());
         add_forces(&scene, &meshes, &state, extra, &mut models)?;
         if let Some(file) = &scene.run.start_from {
-            start_from::restore_state(&scene, file, &mut state, periodic.as_ref())?;
+            let units = kind_change::units(&scene, &meshes, &bodies, ballast.as_ref());
+            let p = periodic.as_ref();
+            warnings.extend(start_from::restore_state(
+                &scene, file, &units, &mut state, p,
+            )?);
         }
         let (probes, regions) = probes::resolve_probes(&scene, &bodies, granular.as_ref(), &state)?;
         let settings =
@@ -252,7 +271,7 @@ impl Simulation {
     /// The tetrahedra of a body, deformable or rigid, as state particle indices.
     pub fn body_tets<'a>(&'a self, body: &'a BodyInfo) -> &'a [[u32; 4]] {
         match &body.kind {
-            BodyKind::Rigid { tets, .. } => tets,
+            BodyKind::Rigid { tets, .. } | BodyKind::Stones { tets, .. } => tets,
             BodyKind::Deformable { .. } => self
                 .tet_body(body)
                 .expect("a deformable body has a TetBody")
@@ -266,6 +285,7 @@ impl Simulation {
         match body.kind {
             BodyKind::Deformable { .. } => mass[body.particles.clone()].iter().sum(),
             BodyKind::Rigid { center, .. } => mass[center],
+            BodyKind::Stones { ref centers, .. } => centers.iter().map(|&c| mass[c]).sum(),
         }
     }
 
@@ -423,11 +443,13 @@ fn place(mesh: &mut TetMesh, degrees: [f64; 3], shift: [f64; 3]) {
 }
 
 /// One [`TetBody`] per deformable body, its lumped mass added to the state; one rigid body
-/// (a new centre particle at its centre of mass) per rigid body. Sets initial velocities and
-/// angular velocities (`initial_motion`).
+/// (a new centre particle at its centre of mass) per rigid body, then the `[ballast]` stones
+/// (one body, or a rigid body per stone). Sets initial velocities and angular velocities
+/// (`initial_motion`) of the bodies and of rigid stones.
 fn build_bodies(
     scene: &Scene,
     meshes: &[PlacedMesh],
+    ballast_info: Option<&mut BallastInfo>,
     state: &mut State,
     models: &mut Vec<Box<dyn Model>>,
 ) -> Result<Vec<BodyInfo>, CoreError> {
@@ -462,7 +484,9 @@ fn build_bodies(
             }
         };
         match kind {
-            BodyKind::Rigid { .. } => state.velocity[placed.particles.clone()].fill(velocity),
+            BodyKind::Rigid { .. } | BodyKind::Stones { .. } => {
+                state.velocity[placed.particles.clone()].fill(velocity)
+            }
             BodyKind::Deformable { .. } => {
                 initial_motion::move_rigidly(state, placed.particles.clone(), velocity, omega)
             }
@@ -476,9 +500,15 @@ fn build_bodies(
         });
     }
     let ballast = scene.ballast.as_ref().zip(scene.refs().ballast_material);
-    if let (Some((b, material)), Some(placed)) = (ballast, meshes.get(scene.bodies.len())) {
+    if let (Some((b, material)), Some(placed), Some(info)) =
+        (ballast, meshes.get(scene.bodies.len()), ballast_info)
+    {
         let material = core_material(&scene.materials[material]);
-        bodies.push(ballast_body(b, material, placed, state, models)?);
+        bodies.push(if b.rigid {
+            rigid_ballast_body(b, material.density, placed, info, state)?
+        } else {
+            ballast_body(b, material, placed, state, models)?
+        });
     }
     if scene
         .bodies
@@ -511,6 +541,31 @@ fn ballast_body(
         particles: placed.particles.clone(),
         kind: BodyKind::Deformable {
             model: models.len() - 1,
+        },
+        stats: placed.mesh.stats(),
+        mesh: placed.path.clone(),
+    })
+}
+
+/// The `[ballast]` stones with `rigid = true`, one rigid body each
+/// ([`ballast::rigid_stones`]), with their initial velocity and angular velocity.
+fn rigid_ballast_body(
+    b: &crate::scene::Ballast,
+    density: f64,
+    placed: &PlacedMesh,
+    info: &mut BallastInfo,
+    state: &mut State,
+) -> Result<BodyInfo, CoreError> {
+    let tets = offset_tets(&placed.mesh, placed.particles.start);
+    let motion = (Vec3::from(b.velocity), Vec3::from(b.angular_velocity));
+    let first = ballast::rigid_stones(info, &tets, density, motion, state)?;
+    Ok(BodyInfo {
+        name: b.name.clone(),
+        particles: placed.particles.clone(),
+        kind: BodyKind::Stones {
+            first,
+            centers: info.centers.clone(),
+            tets,
         },
         stats: placed.mesh.stats(),
         mesh: placed.path.clone(),

@@ -41,7 +41,7 @@ pub(crate) fn periodic_box(scene: &Scene, periodic: &Periodic) -> Result<Periodi
 
 /// One group per body: a deformable body's nodes anchored at the node nearest its centroid, a
 /// rigid body's members anchored at its centre, each rigid stone at its centre and each ballast
-/// stone (not the ballast as a whole) like a deformable body.
+/// stone (not the ballast as a whole) like a deformable body, or at its centre when rigid.
 pub(crate) fn wrap_groups(
     state: &State,
     bodies: &[BodyInfo],
@@ -62,7 +62,9 @@ pub(crate) fn wrap_groups(
                     particles,
                 }
             }
-            BodyKind::Deformable { .. } => deformable_group(state, body.particles.clone()),
+            BodyKind::Deformable { .. } | BodyKind::Stones { .. } => {
+                deformable_group(state, body.particles.clone())
+            }
         });
     }
     if let Some(g) = granular {
@@ -78,7 +80,14 @@ pub(crate) fn wrap_groups(
         }
     }
     if let Some(b) = ballast {
-        groups.extend(b.stones.iter().map(|s| deformable_group(state, s.clone())));
+        if b.centers.is_empty() {
+            groups.extend(b.stones.iter().map(|s| deformable_group(state, s.clone())));
+        } else {
+            groups.extend(b.stones.iter().zip(&b.centers).map(|(s, &c)| WrapGroup {
+                anchor: c,
+                particles: s.clone().chain([c]).collect(),
+            }));
+        }
     }
     groups
 }

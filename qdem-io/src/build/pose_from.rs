@@ -123,7 +123,7 @@ pub fn poses(sim: &Simulation) -> Vec<Pose> {
                 center: sim.world.state.position[*center],
                 rotation: rigid.orientation[*body] * design_frame.inverse(),
             }),
-            BodyKind::Deformable { .. } => None,
+            BodyKind::Deformable { .. } | BodyKind::Stones { .. } => None,
         })
         .collect()
 }

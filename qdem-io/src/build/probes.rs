@@ -34,7 +34,7 @@ pub(super) fn resolve_probes(
                 let body = &bodies[*body];
                 let center = match body.kind {
                     BodyKind::Rigid { center, .. } => Some(center),
-                    BodyKind::Deformable { .. } => None,
+                    BodyKind::Deformable { .. } | BodyKind::Stones { .. } => None,
                 };
                 let candidates = body.particles.clone().chain(center);
                 let at = point.expect("validated: a probe on a body has a point");

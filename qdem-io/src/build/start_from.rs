@@ -10,13 +10,17 @@
 //! taken from the checkpoint, except that the directions this scene fixes start at rest; time
 //! restarts at 0; contact lists are rebuilt at the first step and tangential springs start
 //! unstretched.
+//!
+//! A body's kind may differ from the checkpoint's scene (`rigid` on a `[[body]]` or on the
+//! `[ballast]`): the particles are then mapped and the bodies turned as `kind_change` says.
 
+use crate::build::kind_change::{self, Unit};
 use crate::build::BuildError;
 use crate::checkpoint::read_checkpoint;
 use crate::scene::Scene;
 use qdem_contact::PeriodicBox;
 use qdem_contact::WrapGroup;
-use qdem_core::checkpoint::Decoder;
+use qdem_core::checkpoint::{Decoder, SavedState};
 use qdem_core::{State, Vec3};
 use std::path::Path;
 
@@ -25,13 +29,15 @@ use std::path::Path;
 const SAME_PLACE: f64 = 1e-9;
 
 /// Replaces the positions, velocities and accelerations of `state` with those of the
-/// checkpoint `file` (relative to the scene), with time 0.
+/// checkpoint `file` (relative to the scene), with time 0; the bodies of `units` may have
+/// another kind there. Returns a line for each body whose kind changed.
 pub(crate) fn restore_state(
     scene: &Scene,
     file: &Path,
+    units: &[Unit],
     state: &mut State,
     periodic: Option<&(PeriodicBox, Vec<WrapGroup>)>,
-) -> Result<(), BuildError> {
+) -> Result<Vec<String>, BuildError> {
     let path = scene.resolve(file);
     let refused = |message: String| BuildError::StartFrom {
         scene: scene.path.clone(),
@@ -39,10 +45,9 @@ pub(crate) fn restore_state(
         message,
     };
     let body = read_checkpoint(&path, None).map_err(|e| refused(e.to_string()))?;
-    let built = state.reference.clone();
     let mut input = Decoder::new(&body);
-    crate::run::run_record::skip_record(&mut input)
-        .and_then(|()| state.restore(&mut input))
+    let saved = crate::run::run_record::skip_record(&mut input)
+        .and_then(|()| SavedState::read(&mut input))
         .map_err(|e| {
             refused(format!(
                 "{e}; the checkpoint must come from a scene with the same bodies, ballast and \
@@ -50,18 +55,211 @@ pub(crate) fn restore_state(
             ))
         })?;
     let cell = periodic.map(|p| &p.0);
-    if let Some((i, d)) = first_misplaced(&built, &state.reference, cell) {
-        return Err(refused(format!(
-            "particle {i} has its reference position {d:.3e} m away from this scene's: the \
-             checkpoint was written by a scene with other meshes, placements, ballast or seeds; \
-             start from a checkpoint of a scene that builds the same bodies"
-        )));
+    let built = state.reference.clone();
+    let mesh_nodes = units
+        .iter()
+        .flat_map(|u| u.pieces.iter().map(|p| p.nodes.end))
+        .max()
+        .unwrap_or(0);
+    let common = mesh_nodes.min(saved.len());
+    if let Some((i, d)) = first_misplaced(&built[..common], &saved.reference[..common], cell) {
+        return Err(refused(misplaced(units, i, d)));
     }
+    let same = |a: Vec3, b: Vec3| distance(a, b, cell) <= SAME_PLACE;
+    let was_rigid = match saved.len() >= mesh_nodes {
+        true => kind_change::saved_kinds(units, &saved, mesh_nodes, same),
+        false => vec![false; units.len()],
+    };
+    let layout = Layout::new(units, &was_rigid, mesh_nodes, state);
+    if let Some(why) = layout.misfit(&saved, state) {
+        return Err(refused(why));
+    }
+    layout.copy(&saved, state);
+    if let Some((i, d)) = first_misplaced(&built, &state.reference, cell) {
+        return Err(refused(misplaced(units, i, d)));
+    }
+    let turned = turn(units, &was_rigid, &layout, &saved, state);
     // The scene's fixes hold from the first step, even in directions the checkpoint's
     // scene let move (else those would keep the checkpoint's velocity for the whole run).
     state.hold_fixed();
     state.time = 0.0;
-    Ok(())
+    let from = path.display();
+    Ok(turned
+        .into_iter()
+        .map(|t| format!("[run] start_from {from}: {t}"))
+        .collect())
+}
+
+/// Where each particle and rigid body of this scene comes from in the checkpoint's (`None`: a
+/// centre the checkpoint's scene did not have), and where each piece's old centre and rigid
+/// body were (`None`: it was deformable).
+struct Layout {
+    particle: Vec<Option<usize>>,
+    rigid: Vec<Option<usize>>,
+    old: Vec<Vec<Option<(usize, usize)>>>,
+    /// The checkpoint's particle and rigid-body counts that this layout expects.
+    expected: (usize, usize),
+}
+
+impl Layout {
+    fn new(units: &[Unit], was_rigid: &[bool], mesh_nodes: usize, state: &State) -> Layout {
+        let mut particle: Vec<Option<usize>> = vec![None; state.len()];
+        let mut rigid: Vec<Option<usize>> = vec![None; state.rigid.len()];
+        (0..mesh_nodes).for_each(|i| particle[i] = Some(i));
+        let (mut old_center, mut old_body, mut here) = (mesh_nodes, 0, 0);
+        let mut old = Vec::with_capacity(units.len());
+        for (u, &was) in units.iter().zip(was_rigid) {
+            let pieces = u.pieces.iter().map(|p| {
+                let from = was.then(|| {
+                    old_center += 1;
+                    old_body += 1;
+                    (old_center - 1, old_body - 1)
+                });
+                if let Some((b, c)) = p.rigid {
+                    here += 1;
+                    particle[c] = from.map(|f| f.0);
+                    rigid[b] = from.map(|f| f.1);
+                }
+                from
+            });
+            old.push(pieces.collect());
+        }
+        // The rest (a [granular] sample) follows the centres in both scenes.
+        let rest = mesh_nodes + here;
+        for (k, p) in particle.iter_mut().enumerate().skip(rest) {
+            *p = Some(old_center + k - rest);
+        }
+        for (k, b) in rigid.iter_mut().enumerate().skip(here) {
+            *b = Some(old_body + k - here);
+        }
+        let expected = (
+            old_center + state.len() - rest,
+            old_body + state.rigid.len() - here,
+        );
+        Layout {
+            particle,
+            rigid,
+            old,
+            expected,
+        }
+    }
+
+    /// Why the checkpoint does not fit this layout, if it does not.
+    fn misfit(&self, saved: &SavedState, state: &State) -> Option<String> {
+        let spins = if state.spin.is_empty() {
+            0
+        } else {
+            self.expected.0
+        };
+        let found = (saved.len(), saved.orientation.len());
+        (found != self.expected || saved.spin[0].len() != spins).then(|| {
+            format!(
+                "the checkpoint has {} particles and {} rigid bodies where this scene, with its \
+                 bodies of the kinds the checkpoint shows, needs {} and {}: it was written by a \
+                 scene with other bodies, a changed stone count or another [granular] sample; \
+                 start from a checkpoint of a scene that builds the same bodies (only `rigid` \
+                 may differ)",
+                found.0, found.1, self.expected.0, self.expected.1
+            )
+        })
+    }
+
+    /// Every particle and rigid body the checkpoint has, copied to its place in `state`.
+    fn copy(&self, saved: &SavedState, state: &mut State) {
+        for (i, from) in self.particle.iter().enumerate() {
+            let Some(o) = *from else { continue };
+            state.reference[i] = saved.reference[o];
+            state.position[i] = saved.position[o];
+            state.velocity[i] = saved.velocity[o];
+            state.acceleration[i] = saved.acceleration[o];
+            if !state.spin.is_empty() {
+                state.spin.angle[i] = saved.spin[0][o];
+                state.spin.velocity[i] = saved.spin[1][o];
+                state.spin.acceleration[i] = saved.spin[2][o];
+            }
+        }
+        for (b, from) in self.rigid.iter().enumerate() {
+            let Some(o) = *from else { continue };
+            state.rigid.orientation[b] = saved.orientation[o];
+            state.rigid.angular_momentum[b] = saved.angular_momentum[o];
+            state.rigid.angular_velocity[b] = saved.angular_velocity[o];
+        }
+    }
+}
+
+/// Turns every unit whose kind changed, with a line saying what was done and dropped.
+fn turn(
+    units: &[Unit],
+    was_rigid: &[bool],
+    layout: &Layout,
+    saved: &SavedState,
+    state: &mut State,
+) -> Vec<String> {
+    let mut lines = Vec::new();
+    for ((u, &was), old) in units.iter().zip(was_rigid).zip(&layout.old) {
+        let count = u.pieces.len();
+        match (was, u.rigid()) {
+            (true, false) => {
+                for (p, from) in u.pieces.iter().zip(old) {
+                    let (center, body) = from.expect("a rigid unit has its centres");
+                    kind_change::to_deformable(p, (center, body), saved, state);
+                }
+                lines.push(format!(
+                    "{}: rigid in the checkpoint, deformable here: {count} bodies placed \
+                     unstressed at their poses, with their momentum and angular momentum",
+                    u.what
+                ));
+            }
+            (false, true) => {
+                let density = u.material.density;
+                let kinetic: f64 = (u.pieces.iter())
+                    .map(|p| kind_change::to_rigid(p, density, saved, state))
+                    .sum();
+                let tets = u
+                    .pieces
+                    .iter()
+                    .flat_map(|p| p.tets.iter().copied())
+                    .collect();
+                let strain = kind_change::strain_energy(&u.what, tets, u.material.clone(), saved);
+                lines.push(format!(
+                    "{}: deformable in the checkpoint, rigid here: {count} bodies at their \
+                     centres of mass and best-fit rotations, with their momentum and angular \
+                     momentum; dropped: strain energy {strain:.4e} J, kinetic energy of the \
+                     deformation {kinetic:.4e} J",
+                    u.what
+                ));
+            }
+            _ => {}
+        }
+    }
+    lines
+}
+
+/// The refusal of a reference position that moved, naming the body (the stone) it is in.
+fn misplaced(units: &[Unit], i: usize, d: f64) -> String {
+    let name = units
+        .iter()
+        .find_map(|u| u.name_of(i))
+        .unwrap_or_else(|| "a particle of no body".to_string());
+    format!(
+        "{name}: particle {i} has its reference position {d:.3e} m away from this scene's: the \
+         checkpoint was written by a scene with another mesh, placement, stone count or seed \
+         for it; start from a checkpoint of a scene that builds the same bodies (only `rigid` \
+         may differ)"
+    )
+}
+
+/// The distance between `a` and `b` after removing whole periods of `cell`.
+fn distance(a: Vec3, b: Vec3, cell: Option<&PeriodicBox>) -> f64 {
+    let mut d = b - a;
+    if let Some(cell) = cell {
+        for k in 0..3 {
+            if let Some(l) = cell.length(k) {
+                d[k] -= l * (d[k] / l).round();
+            }
+        }
+    }
+    d.norm()
 }
 
 /// The first particle whose reference positions differ by more than [`SAME_PLACE`] after
@@ -76,15 +274,7 @@ fn first_misplaced(
         .zip(restored)
         .enumerate()
         .find_map(|(i, (a, b))| {
-            let mut d = b - a;
-            if let Some(cell) = cell {
-                for k in 0..3 {
-                    if let Some(l) = cell.length(k) {
-                        d[k] -= l * (d[k] / l).round();
-                    }
-                }
-            }
-            let distance = d.norm();
+            let distance = distance(*a, *b, cell);
             (distance.is_nan() || distance > SAME_PLACE).then_some((i, distance))
         })
 }

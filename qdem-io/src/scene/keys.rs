@@ -743,6 +743,12 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "Initial angular velocity of every stone about its own centre of mass (rad/s, world axes): its particles get v + ω × (x − x_c); default 0.",
     ),
     key(
+        "[ballast]",
+        "rigid",
+        "bool, optional",
+        "Each stone a rigid body of its contact spheres (mass, centre and inertia from its tetrahedra) instead of a deformable one; default `false`. A scene that `start_from`s a checkpoint may change it: stones become deformable at their pose, unstressed, or rigid at their centre of mass and best-fit rotation.",
+    ),
+    key(
         "[bonded]",
         "name",
         "string, required",

@@ -715,6 +715,7 @@ pub(crate) struct RawScene {
 /// grading = [[0.04, 0.0], [0.05, 0.5], [0.063, 1.0]]  # optional (sieve size m, passing)
 /// seed = 1
 /// velocity = [0.0, 0.0, -2.0]                           # optional (m/s)
+/// rigid = false                                         # optional: rigid stones
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -748,6 +749,11 @@ pub struct Ballast {
     /// axes): its particles get v + ω × (x − x_c); default 0.
     #[serde(default)]
     pub angular_velocity: [f64; 3],
+    /// Integrate each stone as a rigid body of its contact spheres (6 degrees of freedom, mass
+    /// and inertia from its tetrahedra) instead of one deformable body; default `false`. A
+    /// scene that `start_from`s a checkpoint may choose the other kind.
+    #[serde(default)]
+    pub rigid: bool,
 }
 
 /// `[periodic]`: periodic boundaries (paper 003 §4) along `axes`, over `length` (one period
