@@ -273,6 +273,14 @@ impl Exchange {
         }
     }
 
+    /// Makes the stepper's per-particle `forces` whole on every rank (see
+    /// [`crate::World::gather_forces`]).
+    pub(crate) fn gather_forces(&mut self, forces: &mut [Vec3]) {
+        if let Some(ranks) = &mut self.ranks {
+            ranks.share.gather_vectors(forces);
+        }
+    }
+
     /// Makes `particles`' motion whole on every rank (see [`crate::World::gather_particles`]).
     pub(crate) fn gather_particles(&mut self, state: &mut State, particles: &[usize]) {
         if let Some(ranks) = &mut self.ranks {

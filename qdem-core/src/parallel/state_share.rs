@@ -129,6 +129,25 @@ impl StateShare {
         }
     }
 
+    /// Makes `values` (one vector per particle, e.g. the stepper's forces) whole on every
+    /// rank: each owned particle's from the rank that owns it; those every rank computes are
+    /// whole already. Every rank calls it at the same step.
+    pub fn gather_vectors(&mut self, values: &mut [Vec3]) {
+        if values.len() != self.owner.len() {
+            return;
+        }
+        self.mine.clear();
+        for &p in &self.particles[self.own.clone()] {
+            self.mine.extend_from_slice(values[p as usize].as_slice());
+        }
+        let counts: Vec<usize> = self.owned.iter().map(|n| 3 * n).collect();
+        self.all.resize(3 * self.particles.len(), 0.0);
+        self.comm.all_gather(&self.mine, &mut self.all, &counts);
+        for (&p, v) in self.particles.iter().zip(self.all.chunks_exact(3)) {
+            values[p as usize] = Vec3::new(v[0], v[1], v[2]);
+        }
+    }
+
     /// Every rigid body's orientation, angular momentum and velocity and `torque`, from the
     /// rank that owns its centre (those every rank computes are whole already).
     fn gather_rigid(&mut self, state: &mut State, torque: &mut [Vec3]) {

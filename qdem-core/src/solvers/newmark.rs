@@ -857,6 +857,10 @@ impl Stepper for Newmark {
         &self.force
     }
 
+    fn forces_mut(&mut self) -> &mut [Vec3] {
+        &mut self.force
+    }
+
     /// The counts and, for the implicit stepper, the tangent, the assembler's pattern and, for
     /// each kept factorisation, its step, whether it is a preconditioner and the matrix it
     /// factorised, so that a resumed run factorises the same matrices again.

@@ -204,6 +204,10 @@ impl Stepper for Verlet {
         &self.force
     }
 
+    fn forces_mut(&mut self) -> &mut [Vec3] {
+        &mut self.force
+    }
+
     fn rigid_torques(&self) -> &[Vec3] {
         &self.torque[..self.rigid_bodies.min(self.torque.len())]
     }

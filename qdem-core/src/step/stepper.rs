@@ -77,6 +77,12 @@ pub trait Stepper: Send {
         false
     }
 
+    /// The force buffer of [`Stepper::forces`], for a decomposed run's gather
+    /// ([`crate::World::gather_forces`]); empty (the default) for a stepper that keeps none.
+    fn forces_mut(&mut self) -> &mut [Vec3] {
+        &mut []
+    }
+
     /// The torques on the rigid bodies that the next step reads (Verlet's first half kick),
     /// which a run decomposed with a halo exchange gathers from the bodies' owners with the
     /// state ([`crate::World::gather`]); empty (the default) for a stepper that keeps none

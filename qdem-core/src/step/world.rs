@@ -252,14 +252,23 @@ impl World {
         self.exchange.repartitions()
     }
 
-    /// Makes the state whole on every rank of a decomposed run, as one process holds it: a
-    /// collective, which every rank calls after the same step. Needed before reading any
+    /// Makes the state whole on every rank of a decomposed run, as one process holds it (and
+    /// the stepper's forces, [`World::gather_forces`]): a collective, which every rank calls
+    /// after the same step. Needed before reading any
     /// particle's motion when a step shares only the halo ([`World::decompose`]); a no-op
     /// otherwise (and in a run of one process).
     pub fn gather(&mut self) {
         let torques = self.stepper.rigid_torques_mut();
         let (state, models) = (&mut self.state, &mut self.models);
         self.exchange.gather(state, models, torques);
+        self.gather_forces();
+    }
+
+    /// Makes the stepper's force buffer ([`Stepper::forces`]) whole on every rank of a
+    /// decomposed run, each particle's from its owner (a reaction sums fixed particles'
+    /// forces, which only their owners hold whole); every rank calls it after the same step.
+    pub fn gather_forces(&mut self) {
+        self.exchange.gather_forces(self.stepper.forces_mut());
     }
 
     /// [`World::gather`] of `particles` only (the probes' particles): every rank calls it

@@ -6,8 +6,9 @@
 //! in the reference configuration (X_i their reference positions). Columns
 //! `fixK_fx, fixK_fy, fixK_fz, fixK_mx, fixK_my, fixK_mz` (N, N·m) for the K-th `[[fix]]`
 //! (from 1, in scene order). A direction held by two fixes counts in both. Fixes on a rigid
-//! body (which its centre holds) are left out; a run over MPI ranks writes no reactions (each
-//! rank holds only its own particles' forces). A wall's force is `walls.csv`'s.
+//! body (which its centre holds) are left out. In a run over MPI ranks the forces are
+//! gathered from the particles' owners with the state ([`qdem_core::World::gather`]), so the
+//! file is the same for any rank count. A wall's force is `walls.csv`'s.
 
 use super::schedule::{probe_interval, Schedule};
 use super::{Recorder, StateRead, StepInfo};
@@ -35,12 +36,8 @@ pub(crate) struct Reactions {
 }
 
 impl Reactions {
-    /// The record of `sim`'s fixes on deformable bodies; `None` when there is none, or the run
-    /// is decomposed.
+    /// The record of `sim`'s fixes on deformable bodies; `None` when there is none.
     pub(crate) fn new(sim: &Simulation, out_dir: &Path) -> Option<Reactions> {
-        if sim.world.decomposition().is_some() {
-            return None;
-        }
         let state = &sim.world.state;
         let bodies = &sim.scene.refs().fix_bodies;
         let groups: Vec<FixGroup> = sim
