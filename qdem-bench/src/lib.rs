@@ -13,6 +13,7 @@
 pub mod cantilever;
 pub mod granular;
 pub mod implicit;
+pub mod locking_cases;
 pub mod speed_vs_error;
 pub mod throughput;
 pub mod vector_peak;

@@ -1,9 +1,15 @@
-//! Volumetric locking study (issue 43): the standard QDEM tetrahedron and the
-//! averaged-pressure one (Bonet & Burton 1998) against Lamé's thick-walled cylinder in plane
-//! strain and a clamped bar against Timoshenko beam theory, over Poisson's ratios and mesh
-//! refinements; one JSON object per line, the table of docs/verification.md.
+//! The volumetric-locking cases of issue 43, shared by `qdem verify` ([`crate::verify_locking`]),
+//! the `locking_study` example and the tests: Lamé's thick-walled cylinder in plane strain (a
+//! quarter ring, u_z = 0, 1 MPa inside) and the clamped bar (1.0 × 0.06 × 0.10 m, 500 N at the
+//! tip) against Timoshenko beam theory, each solved statically with either tetrahedron
+//! formulation (the standard QDEM kernel or the averaged-pressure one of Bonet & Burton 1998).
 //!
-//! `cargo run --release -p qdem-core --example locking_study`
+//! ```
+//! use qdem_bench::locking_cases::ring_bore;
+//! use qdem_core::Formulation;
+//! let (computed, lame) = ring_bore(0.3, Formulation::AveragedPressure, (4, 8));
+//! assert!((computed / lame - 1.0).abs() < 0.05);
+//! ```
 
 use qdem_core::{
     Dofs, Formulation, Material, Model, NodalLoad, State, StaticSolver, TetBody, TimeFunction, Vec3,
@@ -11,10 +17,11 @@ use qdem_core::{
 use qdem_mesh::{structured_box, TetMesh};
 use std::f64::consts::FRAC_PI_2;
 
-const YOUNG: f64 = 70e9;
+/// Young's modulus of every case (aluminium), Pa.
+pub const YOUNG: f64 = 70e9;
 
 /// A body of `mesh` in `formulation`, with the state at rest and lumped masses.
-fn body(mesh: &TetMesh, poisson: f64, formulation: Formulation) -> (State, TetBody) {
+pub fn body(mesh: &TetMesh, poisson: f64, formulation: Formulation) -> (State, TetBody) {
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let material = Material::elastic(2700.0, YOUNG, poisson);
     let body = TetBody::new("body", &reference, mesh.tets.clone(), material)
@@ -25,32 +32,67 @@ fn body(mesh: &TetMesh, poisson: f64, formulation: Formulation) -> (State, TetBo
     (state, body)
 }
 
+/// The cylinder's inner radius (m).
+pub const A: f64 = 0.1;
+/// The cylinder's outer radius (m).
+pub const B: f64 = 0.2;
+/// The internal pressure (Pa).
+pub const PRESSURE: f64 = 1e6;
+
 /// A quarter of a thick-walled cylinder (radii `A`, `B`), one cell thick: the structured box
 /// (r, θ, z) mapped to (r cos θ, r sin θ, z), which keeps every tetrahedron's orientation.
-const A: f64 = 0.1;
-const B: f64 = 0.2;
-const PRESSURE: f64 = 1e6;
+pub fn quarter_ring(radial: usize, around: usize) -> TetMesh {
+    irregular_ring(radial, around, 1, 0.0)
+}
 
-fn quarter_ring(radial: usize, around: usize) -> TetMesh {
-    let mut mesh = structured_box([A, 0.0, 0.0], [B, FRAC_PI_2, 0.01], [radial, around, 1]);
+/// The quarter ring of `layers` cells in z whose interior nodes (off the bore, the outer
+/// surface and the cut planes) are moved in r and θ by up to ±`jitter`/2 of a cell, by a fixed
+/// pseudo-random sequence: an irregular mesh, on which linear tetrahedra lock harder.
+pub fn irregular_ring(radial: usize, around: usize, layers: usize, jitter: f64) -> TetMesh {
+    let mut mesh = structured_box(
+        [A, 0.0, 0.0],
+        [B, FRAC_PI_2, 0.01],
+        [radial, around, layers],
+    );
+    let (dr, dt) = ((B - A) / radial as f64, FRAC_PI_2 / around as f64);
+    let mut seed: u64 = 0x2545_F491_4F6C_DD1D;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
     for p in &mut mesh.nodes {
-        let (r, t) = (p[0], p[1]);
+        let (mut r, mut t) = (p[0], p[1]);
+        let (u, v) = (next(), next());
+        if r > A && r < B && t > 0.0 && t < FRAC_PI_2 {
+            r += jitter * dr * u;
+            t += jitter * dt * v;
+        }
         *p = [r * t.cos(), r * t.sin(), p[2]];
     }
     mesh
 }
 
 /// Lamé's radial displacement at the bore of the cylinder in plane strain (m).
-fn lame_bore(poisson: f64) -> f64 {
+pub fn lame_bore(poisson: f64) -> f64 {
     let (a2, b2) = (A * A, B * B);
     (1.0 + poisson) * PRESSURE * a2 / (YOUNG * (b2 - a2)) * ((1.0 - 2.0 * poisson) * A + b2 / A)
 }
 
 /// The mean radial displacement of the bore of the quarter ring in plane strain (uz = 0
 /// everywhere, symmetry on the cut planes) under the internal pressure, and Lamé's.
-fn ring_bore(poisson: f64, formulation: Formulation, cells: (usize, usize)) -> (f64, f64) {
+pub fn ring_bore(poisson: f64, formulation: Formulation, cells: (usize, usize)) -> (f64, f64) {
     let mesh = quarter_ring(cells.0, cells.1);
-    let (mut state, body) = body(&mesh, poisson, formulation);
+    (
+        ring_bore_on(&mesh, poisson, formulation),
+        lame_bore(poisson),
+    )
+}
+
+/// The mean radial displacement of the bore of a quarter ring `mesh` (see [`ring_bore`]).
+pub fn ring_bore_on(mesh: &TetMesh, poisson: f64, formulation: Formulation) -> f64 {
+    let (mut state, body) = body(mesh, poisson, formulation);
     let group = |name: &str| mesh.group(name).unwrap().nodes.clone();
     for n in 0..state.len() {
         state.fix(n, Dofs::parse("z").unwrap());
@@ -102,14 +144,14 @@ fn ring_bore(poisson: f64, formulation: Formulation, cells: (usize, usize)) -> (
             u.dot(&x) / x.norm()
         })
         .sum();
-    (radial / bore.len() as f64, lame_bore(poisson))
+    radial / bore.len() as f64
 }
 
 /// The issue's clamped bar, 1.0 × 0.06 × 0.10 m, 500 N down at the tip.
-const LOAD: f64 = 500.0;
+pub const LOAD: f64 = 500.0;
 
 /// The mean tip deflection of the clamped bar (m, downward positive) and Timoshenko's.
-fn bar_tip(poisson: f64, formulation: Formulation, cells: [usize; 3]) -> (f64, f64) {
+pub fn bar_tip(poisson: f64, formulation: Formulation, cells: [usize; 3]) -> (f64, f64) {
     let (length, width, height) = (1.0, 0.06, 0.10);
     let mesh = structured_box([0.0; 3], [length, width, height], cells);
     let (mut state, body) = body(&mesh, poisson, formulation);
@@ -135,27 +177,4 @@ fn bar_tip(poisson: f64, formulation: Formulation, cells: [usize; 3]) -> (f64, f
     let timoshenko = LOAD * length.powi(3) / (3.0 * YOUNG * inertia)
         + LOAD * length / (k * shear * width * height);
     (deflection, timoshenko)
-}
-
-fn main() {
-    for poisson in [0.3, 0.49, 0.4999] {
-        for cells in [(4, 8), (6, 12), (8, 16), (12, 24)] {
-            let (standard, exact) = ring_bore(poisson, Formulation::Standard, cells);
-            let (averaged, _) = ring_bore(poisson, Formulation::AveragedPressure, cells);
-            println!(
-                "{{\"case\": \"lame\", \"poisson\": {poisson}, \"cells\": [{}, {}], \"tets\": {}, \"exact_m\": {exact:.6e}, \"standard_ratio\": {:.4}, \"averaged_ratio\": {:.4}}}",
-                cells.0, cells.1, 6 * cells.0 * cells.1, standard / exact, averaged / exact
-            );
-        }
-    }
-    for poisson in [0.33, 0.45, 0.49, 0.499, 0.4999] {
-        for cells in [[20, 2, 3], [40, 3, 5], [80, 5, 8], [120, 7, 12]] {
-            let (standard, beam) = bar_tip(poisson, Formulation::Standard, cells);
-            let (averaged, _) = bar_tip(poisson, Formulation::AveragedPressure, cells);
-            println!(
-                "{{\"case\": \"bar\", \"poisson\": {poisson}, \"cells\": {cells:?}, \"tets\": {}, \"timoshenko_m\": {beam:.6e}, \"standard_ratio\": {:.4}, \"averaged_ratio\": {:.4}}}",
-                6 * cells[0] * cells[1] * cells[2], standard / beam, averaged / beam
-            );
-        }
-    }
 }
