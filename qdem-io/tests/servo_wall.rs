@@ -122,21 +122,28 @@ fn a_servo_lid_holds_its_target_stress_on_a_bed() {
     // The last quarter of the run, long after the lid reached the bed.
     let last = rows * 3 / 4..rows;
     let area = WIDTH * WIDTH;
-    let lid: Vec<f64> = walls["wall2.fz"][last.clone()].iter().map(|f| f / area).collect();
+    let lid: Vec<f64> = walls["wall2.fz"][last.clone()]
+        .iter()
+        .map(|f| f / area)
+        .collect();
     let stress = mean(&lid);
     let error = stress / TARGET - 1.0;
-    let spread = lid.iter().fold(0.0f64, |m, s| m.max((s / TARGET - 1.0).abs()));
+    let spread = lid
+        .iter()
+        .fold(0.0f64, |m, s| m.max((s / TARGET - 1.0).abs()));
     eprintln!(
-        "lid stress over the last quarter: mean {stress:.2} Pa against {TARGET} Pa (error \
-         {:.3}%), largest sample deviation {:.3}%",
-        100.0 * error,
-        100.0 * spread
+        "lid stress over the last quarter: mean {stress:.4} Pa against {TARGET} Pa (relative \
+         error {error:.2e}), largest sample deviation {spread:.2e}"
     );
     assert!(error.abs() < 0.02, "lid stress {stress} Pa vs {TARGET} Pa");
     // The lid moved down from 0.26 m onto the bed (its top some 0.1 m high) and stays there.
     let uz = &walls["wall2.uz"];
     eprintln!("lid displacement at the end {:.5} m", uz[rows - 1]);
-    assert!((-0.24..-0.1).contains(&uz[rows - 1]), "lid at {}", uz[rows - 1]);
+    assert!(
+        (-0.24..-0.1).contains(&uz[rows - 1]),
+        "lid at {}",
+        uz[rows - 1]
+    );
     assert!((uz[rows - 1] - uz[last.start]).abs() < 1e-3);
     // Statics of the bed: the floor carries the lid's force and the weight.
     let weight = weight(&out);
@@ -206,21 +213,40 @@ fn refusal(name: &str, lid: &str) -> String {
 #[test]
 fn what_a_servo_cannot_have_is_refused_by_name() {
     let moving = refusal("servo-velocity", "velocity = [0.0, 0.0, -0.1]");
-    assert!(moving.contains("[[wall]] #2") && moving.contains("velocity"), "{moving}");
-    let servo = |keys: &str| format!("[[wall]]\npoint = [0.0, 0.0, 0.3]\nnormal = [0.0, 0.0, -1.0]\nservo = {{ {keys} }}");
+    assert!(
+        moving.contains("[[wall]] #2") && moving.contains("velocity"),
+        "{moving}"
+    );
+    let servo = |keys: &str| {
+        format!(
+            "[[wall]]\npoint = [0.0, 0.0, 0.3]\nnormal = [0.0, 0.0, -1.0]\nservo = {{ {keys} }}"
+        )
+    };
     for (keys, bad) in [
         ("stress = 1e3, area = 0.0, max_velocity = 0.1", "servo.area"),
-        ("stress = 1e3, area = 1.0, max_velocity = -1.0", "servo.max_velocity"),
-        ("stress = 1e3, area = 1.0, max_velocity = 0.1, gain = 0.0", "servo.gain"),
+        (
+            "stress = 1e3, area = 1.0, max_velocity = -1.0",
+            "servo.max_velocity",
+        ),
+        (
+            "stress = 1e3, area = 1.0, max_velocity = 0.1, gain = 0.0",
+            "servo.gain",
+        ),
     ] {
         let message = refusal("servo-bad", &servo(keys));
-        assert!(message.contains("[[wall]] #3") && message.contains(bad), "{message}");
+        assert!(
+            message.contains("[[wall]] #3") && message.contains(bad),
+            "{message}"
+        );
     }
     let mesh = refusal(
         "servo-mesh",
         "[[wall]]\nmesh = \"box.msh\"\nservo = { stress = 1e3, area = 1.0, max_velocity = 0.1 }",
     );
-    assert!(mesh.contains("[[wall]] #3") && mesh.contains("mesh wall"), "{mesh}");
+    assert!(
+        mesh.contains("[[wall]] #3") && mesh.contains("mesh wall"),
+        "{mesh}"
+    );
     // A decomposed run: refused before decomposing, naming the wall.
     let dir = test_dir("servo-ranks");
     let sim = build(&bed_scene(&dir, 0.1, ""));

@@ -58,11 +58,11 @@ use scatter::{add_sum, add_to, pair_share, run_of, wall_share, ScatterPlan};
 use split::ContactPart;
 
 mod build;
-mod servo;
 mod modal_springs;
 mod persistence;
 mod pipeline;
 mod scatter;
+mod servo;
 mod split;
 mod views;
 

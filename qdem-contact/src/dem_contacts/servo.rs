@@ -112,7 +112,10 @@ impl DemContacts {
     }
 
     /// Restores what [`DemContacts::save_servos`] saved.
-    pub(super) fn restore_servos(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+    pub(super) fn restore_servos(
+        &mut self,
+        input: &mut Decoder<'_>,
+    ) -> Result<(), CheckpointError> {
         for w in 0..self.walls.len() {
             if self.servo_of(w).is_none() {
                 continue;

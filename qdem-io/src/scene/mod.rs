@@ -50,9 +50,8 @@ pub use measure::{Measure, MeasureRegion};
 pub use refs::{ProbeTarget, Refs};
 pub use schema::{
     AreaLoad, Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix,
-    Formulation,
-    Granular, Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp, Run, Section,
-    Selection, Series, Supports, TimeDelay, TimeStep, Wall,
+    Formulation, Granular, Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp,
+    Run, Section, Selection, Series, Supports, TimeDelay, TimeStep, Wall,
 };
 
 use schema::RawScene;

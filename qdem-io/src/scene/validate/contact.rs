@@ -185,9 +185,7 @@ fn wall_servo(c: &mut Checker<'_>, idx: &str, l: &str, w: &Wall, servo: &WallSer
     if w.velocity != [0.0; 3] {
         c.error(
             &["wall", idx, "velocity"],
-            format!(
-                "{l}: a servo wall's velocity is set by its servo; drop `velocity` or `servo`"
-            ),
+            format!("{l}: a servo wall's velocity is set by its servo; drop `velocity` or `servo`"),
         );
     }
     let at = ["wall", idx, "servo"];
