@@ -22,6 +22,7 @@ pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<
     let scene = Scene::load(path)?;
     let mut sim = Simulation::build(scene)?;
     if let Some(r) = &ranks {
+        sim.refuse_decomposition()?;
         sim.world
             .decompose(r.clone())
             .map_err(|source| CliError::Decompose {

@@ -474,6 +474,7 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
     let mut sim = Simulation::build(scene)?;
     let leader = ranks.as_ref().is_none_or(|r| r.rank() == 0);
     if let Some(ranks) = &ranks {
+        sim.refuse_decomposition()?;
         let figures = sim
             .world
             .decompose(ranks.clone())

@@ -6,6 +6,15 @@ use thiserror::Error;
 /// What the contact model refuses.
 #[derive(Debug, Error)]
 pub enum ContactError {
+    /// Only a plane wall can be stress-controlled.
+    #[error(
+        "wall {wall} (from 1) is not a plane: only a plane wall can be stress-controlled; fix: \
+         give it `point` and `normal`, or drop its `servo`"
+    )]
+    ServoNotPlane {
+        /// The wall, from 1.
+        wall: usize,
+    },
     /// A beam lattice cannot represent the material's Poisson's ratio.
     #[error(
         "bonded body `{body}`: a triangular beam lattice represents Poisson's ratios from about \

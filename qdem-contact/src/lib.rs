@@ -49,6 +49,7 @@ pub mod particle_packing;
 pub mod periodic_boundary;
 pub mod periodic_wrap;
 pub mod plane_wall;
+pub mod servo_wall;
 pub mod time_delayed_boundary;
 pub mod unbonded_contact;
 pub mod wall;
@@ -67,6 +68,7 @@ pub use particle_packing::{lattice_section, LatticeSection, Packing, PackingKind
 pub use periodic_boundary::{PeriodicBox, WrapGroup};
 pub use periodic_wrap::PeriodicWrap;
 pub use plane_wall::PlaneWall;
+pub use servo_wall::Servo;
 pub use time_delayed_boundary::{GhostScales, LoadCycle, TimeDelayedBoundary};
 pub use unbonded_contact::{UnbondedLaw, UnbondedPair};
 pub use wall::{Wall, WallShape};

@@ -129,6 +129,7 @@ impl DemContacts {
             time_delay: None,
             split: None,
             rebuilt: false,
+            servos: Vec::new(),
         }
     }
 

@@ -62,6 +62,7 @@ mod modal_springs;
 mod persistence;
 mod pipeline;
 mod scatter;
+mod servo;
 mod split;
 mod views;
 
@@ -247,6 +248,8 @@ pub struct DemContacts {
     split: Option<ContactPart>,
     /// Whether the lists were rebuilt since [`SplitModel::rebuilt`] last asked.
     rebuilt: bool,
+    /// The stress-controlled walls' servos, by wall (`servo.rs`); empty when none.
+    servos: Vec<Option<servo::ServoWall>>,
 }
 
 /// A time-delayed periodic boundary along one periodic axis, and its latest state.
@@ -301,14 +304,16 @@ impl Model for DemContacts {
             }
         }
         if self.fuses() {
-            return self.evaluate_and_add(state.time, dt, force, torque);
+            self.evaluate_and_add(state.time, dt, force, torque);
+        } else {
+            self.evaluate(state.time, dt);
+            self.update_time_delay(state.time);
+            self.gather();
+            for (s, (f, t)) in self.sphere_force.iter().enumerate() {
+                self.add_sphere(s, f, t, force, torque);
+            }
         }
-        self.evaluate(state.time, dt);
-        self.update_time_delay(state.time);
-        self.gather();
-        for (s, (f, t)) in self.sphere_force.iter().enumerate() {
-            self.add_sphere(s, f, t, force, torque);
-        }
+        self.drive_servos(state.time, dt);
     }
 
     /// Split in a decomposed run ([`qdem_core::SplitModel`], `split.rs`): a rank reads its own spheres

@@ -1,5 +1,7 @@
 //! What a checkpoint keeps of a [`DemContacts`]: the candidate lists with their tangential
-//! springs, where and when they were built, and the time-delayed boundary's estimates.
+//! springs, where and when they were built, the time-delayed boundary's estimates and the
+//! servo walls' planes (none written without servo walls: the layout of a run without them is
+//! unchanged).
 
 use super::*;
 
@@ -23,6 +25,7 @@ impl Persistent for DemContacts {
             out.f64(delay.boundary_force);
             delay.boundary.save(out);
         }
+        self.save_servos(out);
     }
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
         input.tag("contact")?;
@@ -51,6 +54,7 @@ impl Persistent for DemContacts {
             delay.boundary_force = input.f64("the boundary force")?;
             delay.boundary.restore(input)?;
         }
+        self.restore_servos(input)?;
         self.build_incidence();
         if let Some(split) = &mut self.split {
             split.whole = true;

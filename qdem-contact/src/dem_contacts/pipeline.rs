@@ -99,10 +99,8 @@ impl DemContacts {
     /// Whether some pair outside the lists may have come within reach since the last build,
     /// given the largest distance a sphere has moved.
     pub(super) fn outgrew_skin(&self, moved: f64, time: f64) -> bool {
-        let wall_moved = self
-            .walls
-            .iter()
-            .map(|w| w.velocity().norm() * (time - self.built_time).abs())
+        let wall_moved = (0..self.walls.len())
+            .map(|w| self.wall_speed_bound(w) * (time - self.built_time).abs())
             .fold(0.0, f64::max);
         2.0 * moved >= self.settings.skin || moved + wall_moved >= self.settings.skin
     }

@@ -80,12 +80,18 @@ pub(crate) fn build_contacts(
     if let (Some(cell), Some(periodic)) = (extra.periodic, &scene.periodic) {
         model = super::periodic::periodic_contacts(scene, periodic, &cell, model)?;
     }
+    let contact_error = |source| BuildError::Contact {
+        scene: scene.path.clone(),
+        source: Box::new(source),
+    };
+    for (w, wall) in scene.walls.iter().enumerate() {
+        if let Some(servo) = &wall.servo {
+            model.set_servo(w, servo.servo()).map_err(contact_error)?;
+        }
+    }
     model
         .check_initial_overlaps(state, contact.overlap_tolerance)
-        .map_err(|source| BuildError::Contact {
-            scene: scene.path.clone(),
-            source: Box::new(source),
-        })?;
+        .map_err(contact_error)?;
     Ok(Some(model))
 }
 

@@ -31,7 +31,9 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.qdc";
 /// 5: an implicit Newmark stepper keeps, with each factorisation, the matrix it factorised and
 /// the assembler's sparsity pattern, and its step counts include redos and iterative solves;
 /// 6: its tangent records how many of its leading entries a model keeps; 7: the run record
-/// holds `walls.csv`'s rows in a scene with walls and each `[[measure]]`'s rows).
+/// holds `walls.csv`'s rows in a scene with walls and each `[[measure]]`'s rows, and the
+/// contacts keep each servo wall's point and velocity after their lists: nothing without a
+/// servo wall, so a version 7 file of a scene without one reads as before).
 pub const FORMAT_VERSION: u64 = 7;
 
 const MAGIC: &[u8; 8] = b"QDEMCKPT";

@@ -527,6 +527,36 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "Constant velocity of the wall (m/s); default zero.",
     ),
     key(
+        "[[wall]]",
+        "servo",
+        "inline table, optional",
+        "Stress control of a plane wall: `{ stress, area, gain, max_velocity }`; after each force evaluation its speed towards the bodies is clamp(G (σ_target − σ), ±v_max), σ the spheres' normal force on it over `area`. Not with `velocity`, a mesh, or MPI ranks.",
+    ),
+    key(
+        "[[wall]] servo",
+        "stress",
+        "number, required",
+        "Target compressive normal stress σ_target (Pa).",
+    ),
+    key(
+        "[[wall]] servo",
+        "area",
+        "number, required",
+        "The area A the wall's normal force is divided by (m², > 0).",
+    ),
+    key(
+        "[[wall]] servo",
+        "gain",
+        "number, optional",
+        "Gain G (m/(s·Pa), > 0); default 0.5 A / Σ (k_n Δt + c_n) over the wall's touching contacts, renewed each step (PFC's servo with the normal dashpots c_n).",
+    ),
+    key(
+        "[[wall]] servo",
+        "max_velocity",
+        "number, required",
+        "Largest speed v_max (m/s, > 0): the servo's clamp and the wall's speed bound for the neighbour lists.",
+    ),
+    key(
         "[periodic]",
         "axes",
         "string, required",

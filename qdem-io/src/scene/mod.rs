@@ -51,7 +51,7 @@ pub use refs::{ProbeTarget, Refs};
 pub use schema::{
     AreaLoad, Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix,
     Formulation, Granular, Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp,
-    Run, Section, Selection, Series, Supports, TimeDelay, TimeStep, Wall,
+    Run, Section, Selection, Series, Supports, TimeDelay, TimeStep, Wall, WallServo,
 };
 
 use schema::RawScene;

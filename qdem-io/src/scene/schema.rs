@@ -364,6 +364,38 @@ pub struct Wall {
     /// Constant velocity of the wall (m/s); default zero.
     #[serde(default)]
     pub velocity: [f64; 3],
+    /// A servo that moves the plane along its normal to hold a compressive stress.
+    #[serde(default)]
+    pub servo: Option<WallServo>,
+}
+
+/// `[[wall]] servo`: a plane wall whose speed along its normal is set after each force
+/// evaluation to clamp(G (σ_target − σ), ±v_max), σ the compressive stress the spheres put on
+/// it (their normal force over `area`), positive towards the bodies.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallServo {
+    /// Target compressive stress σ_target (Pa).
+    pub stress: f64,
+    /// The area A the wall's normal force is divided by (m²).
+    pub area: f64,
+    /// Gain G (m/(s·Pa)); default 0.5 A / (Σ k_n Δt) at each evaluation (PFC's servo).
+    #[serde(default)]
+    pub gain: Option<f64>,
+    /// Largest speed v_max (m/s).
+    pub max_velocity: f64,
+}
+
+impl WallServo {
+    /// The contact model's servo.
+    pub fn servo(&self) -> qdem_contact::Servo {
+        qdem_contact::Servo {
+            stress: self.stress,
+            area: self.area,
+            gain: self.gain,
+            max_velocity: self.max_velocity,
+        }
+    }
 }
 
 fn default_true() -> bool {

@@ -90,7 +90,7 @@ impl Snapshots {
         if let Some(contacts) = sim.contacts().filter(|c| c.spheres() > 0) {
             parts.extend([Part::Spheres, Part::Contacts]);
             if contacts.walls() > 0 {
-                let moving = walls_move(contacts.wall_list());
+                let moving = walls_move(contacts.wall_list()) || contacts.has_servo();
                 parts.push(Part::Walls { moving });
             }
         }

@@ -1,6 +1,6 @@
 //! [`Walls`]: `walls.csv`: every `probe_every`, each `[[wall]]`'s total contact force (N, the
 //! force the spheres exert on it: the reaction a support measures) and its displacement from
-//! its place at t = 0 (m), columns `wallK.fx, fy, fz, ux, uy, uz` for the K-th `[[wall]]`
+//! its place at t = 0 (m: a servo wall's from where its servo moved it), columns `wallK.fx, fy, fz, ux, uy, uz` for the K-th `[[wall]]`
 //! (from 1, in scene order), read from the touching contacts of the last evaluation
 //! ([`qdem_contact::DemContacts::touching`]).
 
@@ -64,8 +64,8 @@ impl Recorder for Walls {
             return Ok(());
         }
         self.rows.push(time);
-        for (force, wall) in wall_forces(contacts).iter().zip(contacts.wall_list()) {
-            let moved = wall.velocity() * time;
+        for (w, force) in wall_forces(contacts).iter().enumerate() {
+            let moved = contacts.wall_displacement(w, time);
             self.rows.extend(force.iter().chain(moved.iter()));
         }
         Ok(())

@@ -2,14 +2,15 @@
 //! in scene order). A mesh wall is its own surface; an infinite plane is drawn as the
 //! rectangle of it that covers the scene: the box of every particle at the time of writing,
 //! widened by a tenth of its diagonal on every side, projected onto the plane. Written once
-//! when no wall moves, else at every `vtu_every` as `vtu/walls_NNNNN.vtu`.
+//! when no wall moves (none has a velocity or a servo), else at every `vtu_every` as `vtu/walls_NNNNN.vtu`.
 
 use crate::output::{write_vtu_mesh_at, OutputError, VtuCells, VtuField, VtuMesh};
 use qdem_contact::{PlaneWall, Wall, WallShape};
 use qdem_core::{State, Vec3};
 use std::path::Path;
 
-/// Whether some wall of `walls` moves (and so needs a file per time).
+/// Whether some wall of `walls` has a velocity (and so needs a file per time; so does a servo
+/// wall's, [`qdem_contact::DemContacts::has_servo`]).
 pub(crate) fn walls_move(walls: &[Wall]) -> bool {
     walls.iter().any(|w| w.velocity() != Vec3::zeros())
 }

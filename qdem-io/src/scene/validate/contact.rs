@@ -2,9 +2,10 @@
 //! `contact_radius`, stones); the linear law's stiffnesses (and none for Hertz–Mindlin), a
 //! non-negative friction, damping in [0, 1), local damping and contacts only with an explicit
 //! integrator, a positive skin and overlap tolerance; each wall a plane (point and non-zero
-//! normal) or a mesh.
+//! normal) or a mesh; a servo only on a plane without a velocity, with a positive area and
+//! maximum speed.
 
-use super::super::schema::{Contact, ContactLawName, Integrator, RawScene, Wall};
+use super::super::schema::{Contact, ContactLawName, Integrator, RawScene, Wall, WallServo};
 use super::checker::{fraction, label, Checker};
 
 /// `[contact]` and every `[[wall]]` (`spheres`: whether a `[[body]]` has contact spheres).
@@ -167,6 +168,33 @@ fn wall(c: &mut Checker<'_>, i: usize, w: &Wall) {
         c.non_negative(&["wall", &idx, "friction"], &l, "friction", f, "");
     }
     c.finite(&["wall", &idx, "velocity"], &l, "velocity", &w.velocity);
+    if let Some(servo) = &w.servo {
+        wall_servo(c, &idx, &l, w, servo);
+    }
+}
+
+/// A `[[wall]] servo`: on a plane without a `velocity`, a finite stress, a positive area and
+/// maximum speed, a positive gain when given.
+fn wall_servo(c: &mut Checker<'_>, idx: &str, l: &str, w: &Wall, servo: &WallServo) {
+    if w.mesh.is_some() {
+        c.error(
+            &["wall", idx, "servo"],
+            format!("{l}: servo is for a plane wall (point and normal), not a mesh wall"),
+        );
+    }
+    if w.velocity != [0.0; 3] {
+        c.error(
+            &["wall", idx, "velocity"],
+            format!("{l}: a servo wall's velocity is set by its servo; drop `velocity` or `servo`"),
+        );
+    }
+    let at = ["wall", idx, "servo"];
+    c.finite(&at, l, "servo.stress", &[servo.stress]);
+    c.positive(&at, l, "servo.area", servo.area, "m²");
+    c.positive(&at, l, "servo.max_velocity", servo.max_velocity, "m/s");
+    if let Some(gain) = servo.gain {
+        c.positive(&at, l, "servo.gain", gain, "m/(s·Pa)");
+    }
 }
 
 /// `restitution`: in (0, 1], and not beside a `damping_ratio` (one of them sets the dashpots).

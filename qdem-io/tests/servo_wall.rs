@@ -1,0 +1,256 @@
+//! `[[wall]] servo`: a lid whose servo holds a target stress on a settled bed of one-sphere
+//! grains in a cell periodic in x and y on a floor. Once the lid has settled, the stress the
+//! grains put on it averages to the target, and the floor carries the lid's force plus the
+//! bed's weight (statics of the bed); a resumed run equals the uninterrupted one bit for bit;
+//! the inputs a servo cannot have are refused by name.
+
+mod common;
+
+use common::test_dir;
+use qdem_io::build::Simulation;
+use qdem_io::checkpoint::CHECKPOINT_FILE;
+use qdem_io::runner::{run_with, RunError, RunOptions};
+use qdem_io::scene::Scene;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+const DENSITY: f64 = 2600.0;
+const G: f64 = 9.81;
+const WIDTH: f64 = 0.06;
+/// The lid's target stress (Pa): about five times the bed's weight over its area (1.6 kPa).
+const TARGET: f64 = 8000.0;
+
+/// A CSV file as columns by name.
+fn columns(path: &Path) -> HashMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let names: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let mut cols: HashMap<String, Vec<f64>> = names.iter().map(|n| (n.clone(), vec![])).collect();
+    for line in lines {
+        for (name, value) in names.iter().zip(line.split(',')) {
+            cols.get_mut(name).unwrap().push(value.parse().unwrap());
+        }
+    }
+    cols
+}
+
+/// The bed under a servo lid that starts at z = 0.26 m, above the grains' region: `t_end`,
+/// and `lid` the extra keys of the lid's `[[wall]]`.
+fn bed_scene(dir: &Path, t_end: f64, lid: &str) -> PathBuf {
+    let area = WIDTH * WIDTH;
+    let text = format!(
+        r#"
+[run]
+t_end = {t_end}
+gravity = [0.0, 0.0, -{G}]
+probe_every = 0.005
+
+[[material]]
+name = "stone"
+density = {DENSITY}
+young = 1e9
+poisson = 0.25
+
+[contact]
+law = "linear"
+normal_stiffness = 5e3
+tangential_stiffness = 2.5e3
+friction = 0.5
+damping_ratio = 0.3
+local_damping = 0.7
+
+[granular]
+name = "bed"
+material = "stone"
+region = [[0.0, 0.0, 0.01], [{WIDTH}, {WIDTH}, 0.25]]
+count = 200
+grading = [[0.010, 0.0], [0.014, 1.0]]
+spheres_per_stone = [1, 1]
+
+[periodic]
+axes = "xy"
+length = [{WIDTH}, {WIDTH}]
+
+[[wall]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+
+[[wall]]
+point = [0.0, 0.0, 0.26]
+normal = [0.0, 0.0, -1.0]
+servo = {{ stress = {TARGET}, area = {area}, max_velocity = 0.5 }}
+{lid}
+"#
+    );
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn build(scene: &Path) -> Simulation {
+    Simulation::build(Scene::load(scene).unwrap()).unwrap()
+}
+
+fn run(sim: &mut Simulation, out: &Path, options: RunOptions<'_>) -> Result<(), RunError> {
+    run_with(sim, out, options, &mut |_| {}).map(|_| ())
+}
+
+/// g Σ m of the one-sphere stones of `stones.csv`.
+fn weight(out: &Path) -> f64 {
+    let text = std::fs::read_to_string(out.join("stones.csv")).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|line| {
+            let r: f64 = line.split(',').nth(4).unwrap().parse().unwrap();
+            DENSITY * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3) * G
+        })
+        .sum()
+}
+
+fn mean(xs: &[f64]) -> f64 {
+    xs.iter().sum::<f64>() / xs.len() as f64
+}
+
+#[test]
+fn a_servo_lid_holds_its_target_stress_on_a_bed() {
+    let dir = test_dir("servo-lid");
+    let scene = bed_scene(&dir, 1.0, "");
+    let out = dir.join("out");
+    run(&mut build(&scene), &out, RunOptions::default()).unwrap();
+    let walls = columns(&out.join("walls.csv"));
+    let rows = walls["time"].len();
+    // The last quarter of the run, long after the lid reached the bed.
+    let last = rows * 3 / 4..rows;
+    let area = WIDTH * WIDTH;
+    let lid: Vec<f64> = walls["wall2.fz"][last.clone()]
+        .iter()
+        .map(|f| f / area)
+        .collect();
+    let stress = mean(&lid);
+    let error = stress / TARGET - 1.0;
+    let spread = lid
+        .iter()
+        .fold(0.0f64, |m, s| m.max((s / TARGET - 1.0).abs()));
+    eprintln!(
+        "lid stress over the last quarter: mean {stress:.4} Pa against {TARGET} Pa (relative \
+         error {error:.2e}), largest sample deviation {spread:.2e}"
+    );
+    assert!(error.abs() < 0.02, "lid stress {stress} Pa vs {TARGET} Pa");
+    // The lid moved down from 0.26 m onto the bed (its top some 0.1 m high) and stays there.
+    let uz = &walls["wall2.uz"];
+    eprintln!("lid displacement at the end {:.5} m", uz[rows - 1]);
+    assert!(
+        (-0.24..-0.1).contains(&uz[rows - 1]),
+        "lid at {}",
+        uz[rows - 1]
+    );
+    assert!((uz[rows - 1] - uz[last.start]).abs() < 1e-3);
+    // Statics of the bed: the floor carries the lid's force and the weight.
+    let weight = weight(&out);
+    let floor = mean(&walls["wall1.fz"][last.clone()]);
+    let lid_force = mean(&walls["wall2.fz"][last]);
+    eprintln!("floor {floor:.4} N, lid {lid_force:.4} N + weight {weight:.4} N");
+    assert!(
+        ((-floor) / (lid_force + weight) - 1.0).abs() < 0.02,
+        "floor {floor} N vs lid {lid_force} N + weight {weight} N"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_resumed_servo_run_equals_the_uninterrupted_one() {
+    let dir = test_dir("servo-resume");
+    let scene = bed_scene(&dir, 0.4, "");
+    let (whole, parts) = (dir.join("whole"), dir.join("parts"));
+    let mut a = build(&scene);
+    run(&mut a, &whole, RunOptions::default()).unwrap();
+    let mut b = build(&scene);
+    let stop_after = b.steps() * 3 / 4;
+    let stop = RunOptions {
+        stop_after: Some(stop_after),
+        ..RunOptions::default()
+    };
+    assert!(matches!(
+        run(&mut b, &parts, stop),
+        Err(RunError::Interrupted { .. })
+    ));
+    let mut c = build(&scene);
+    let checkpoint = parts.join(CHECKPOINT_FILE);
+    let resume = RunOptions {
+        resume: Some(&checkpoint),
+        ..RunOptions::default()
+    };
+    run(&mut c, &parts, resume).unwrap();
+    let bits = |s: &Simulation| -> Vec<u64> {
+        let st = &s.world.state;
+        st.position
+            .iter()
+            .chain(&st.velocity)
+            .flat_map(|x| x.iter().map(|c| c.to_bits()))
+            .collect()
+    };
+    assert!(bits(&a) == bits(&c), "the resumed state differs");
+    for f in ["walls.csv", "stones.csv"] {
+        let (x, y) = (std::fs::read(whole.join(f)), std::fs::read(parts.join(f)));
+        assert!(x.unwrap() == y.unwrap(), "{f} differs after a resume");
+    }
+    // The lid was moving under its servo at the checkpoint.
+    let walls = columns(&whole.join("walls.csv"));
+    assert!(walls["wall2.uz"].last().unwrap() < &-0.1);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The error of loading the bed with `lid` added to the lid's `[[wall]]`, or with `walls`
+/// added to the scene.
+fn refusal(name: &str, lid: &str) -> String {
+    let dir = test_dir(name);
+    let scene = bed_scene(&dir, 0.1, lid);
+    let message = Scene::load(&scene).unwrap_err().to_string();
+    let _ = std::fs::remove_dir_all(&dir);
+    message
+}
+
+#[test]
+fn what_a_servo_cannot_have_is_refused_by_name() {
+    let moving = refusal("servo-velocity", "velocity = [0.0, 0.0, -0.1]");
+    assert!(
+        moving.contains("[[wall]] #2") && moving.contains("velocity"),
+        "{moving}"
+    );
+    let servo = |keys: &str| {
+        format!(
+            "[[wall]]\npoint = [0.0, 0.0, 0.3]\nnormal = [0.0, 0.0, -1.0]\nservo = {{ {keys} }}"
+        )
+    };
+    for (keys, bad) in [
+        ("stress = 1e3, area = 0.0, max_velocity = 0.1", "servo.area"),
+        (
+            "stress = 1e3, area = 1.0, max_velocity = -1.0",
+            "servo.max_velocity",
+        ),
+        (
+            "stress = 1e3, area = 1.0, max_velocity = 0.1, gain = 0.0",
+            "servo.gain",
+        ),
+    ] {
+        let message = refusal("servo-bad", &servo(keys));
+        assert!(
+            message.contains("[[wall]] #3") && message.contains(bad),
+            "{message}"
+        );
+    }
+    let mesh = refusal(
+        "servo-mesh",
+        "[[wall]]\nmesh = \"box.msh\"\nservo = { stress = 1e3, area = 1.0, max_velocity = 0.1 }",
+    );
+    assert!(
+        mesh.contains("[[wall]] #3") && mesh.contains("mesh wall"),
+        "{mesh}"
+    );
+    // A decomposed run: refused before decomposing, naming the wall.
+    let dir = test_dir("servo-ranks");
+    let sim = build(&bed_scene(&dir, 0.1, ""));
+    let message = sim.refuse_decomposition().unwrap_err().to_string();
+    assert!(message.contains("[[wall]] #2 has a servo"), "{message}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
