@@ -12,32 +12,17 @@
 
 mod common;
 
-use common::test_dir;
 use qdem_io::build::Simulation;
 use qdem_io::runner::run;
 use qdem_io::scene::Scene;
 use std::collections::HashMap;
 use std::path::Path;
 
-const DENSITY: f64 = 2600.0;
-const G: f64 = 9.81;
-const WIDTH: f64 = 0.06;
+use common::{
+    columns, grain_bed, test_dir, BED_DENSITY as DENSITY, BED_G as G, BED_WIDTH as WIDTH,
+};
 /// The height of the `[[section]]` through the bed (m).
 const SECTION: f64 = 0.045;
-
-/// A CSV file as columns by name.
-fn columns(path: &Path) -> HashMap<String, Vec<f64>> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let names: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-    let mut cols: HashMap<String, Vec<f64>> = names.iter().map(|n| (n.clone(), vec![])).collect();
-    for line in lines {
-        for (name, value) in names.iter().zip(line.split(',')) {
-            cols.get_mut(name).unwrap().push(value.parse().unwrap());
-        }
-    }
-    cols
-}
 
 /// `measure_NAME.csv` of `out` as columns by name.
 fn measure(out: &Path, name: &str) -> HashMap<String, Vec<f64>> {
@@ -58,43 +43,12 @@ fn the_contact_stress_of_a_settled_bed_is_its_weight_above() {
         );
     }
     let area = WIDTH * WIDTH;
-    let scene = format!(
-        r#"
-[run]
-t_end = 2.0
-gravity = [0.0, 0.0, -{G}]
-probe_every = 0.01
-
-[[material]]
-name = "stone"
-density = {DENSITY}
-young = 1e9
-poisson = 0.25
-
-[contact]
-law = "linear"
-normal_stiffness = 5e3
-tangential_stiffness = 2.5e3
-friction = 0.5
-damping_ratio = 0.3
-local_damping = 0.7
-
-[granular]
-name = "bed"
-material = "stone"
-region = [[0.0, 0.0, 0.01], [{WIDTH}, {WIDTH}, 0.25]]
-count = 250
-grading = [[0.010, 0.0], [0.014, 1.0]]
-spheres_per_stone = [1, 1]
-
-[periodic]
-axes = "xy"
-length = [{WIDTH}, {WIDTH}]
-
-[[wall]]
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-
+    let scene = grain_bed(
+        2.0,
+        0.01,
+        250,
+        &format!(
+            r#"
 {measures}
 [[section]]
 name = "mid"
@@ -107,6 +61,7 @@ name = "all"
 center = [0.02, 0.02, 0.1]
 radius = 1.0
 "#
+        ),
     );
     let path = dir.join("scene.toml");
     std::fs::write(&path, scene).unwrap();

@@ -6,75 +6,24 @@
 
 mod common;
 
-use common::test_dir;
 use qdem_io::build::Simulation;
 use qdem_io::checkpoint::CHECKPOINT_FILE;
 use qdem_io::runner::{run_with, RunError, RunOptions};
 use qdem_io::scene::Scene;
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-const DENSITY: f64 = 2600.0;
-const G: f64 = 9.81;
-const WIDTH: f64 = 0.06;
+use common::{
+    columns, grain_bed, test_dir, BED_DENSITY as DENSITY, BED_G as G, BED_WIDTH as WIDTH,
+};
 /// The lid's target stress (Pa): about five times the bed's weight over its area (1.6 kPa).
 const TARGET: f64 = 8000.0;
-
-/// A CSV file as columns by name.
-fn columns(path: &Path) -> HashMap<String, Vec<f64>> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let names: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-    let mut cols: HashMap<String, Vec<f64>> = names.iter().map(|n| (n.clone(), vec![])).collect();
-    for line in lines {
-        for (name, value) in names.iter().zip(line.split(',')) {
-            cols.get_mut(name).unwrap().push(value.parse().unwrap());
-        }
-    }
-    cols
-}
 
 /// The bed under a servo lid that starts at z = 0.26 m, above the grains' region: `t_end`,
 /// and `lid` the extra keys of the lid's `[[wall]]`.
 fn bed_scene(dir: &Path, t_end: f64, lid: &str) -> PathBuf {
     let area = WIDTH * WIDTH;
-    let text = format!(
+    let walls = format!(
         r#"
-[run]
-t_end = {t_end}
-gravity = [0.0, 0.0, -{G}]
-probe_every = 0.005
-
-[[material]]
-name = "stone"
-density = {DENSITY}
-young = 1e9
-poisson = 0.25
-
-[contact]
-law = "linear"
-normal_stiffness = 5e3
-tangential_stiffness = 2.5e3
-friction = 0.5
-damping_ratio = 0.3
-local_damping = 0.7
-
-[granular]
-name = "bed"
-material = "stone"
-region = [[0.0, 0.0, 0.01], [{WIDTH}, {WIDTH}, 0.25]]
-count = 200
-grading = [[0.010, 0.0], [0.014, 1.0]]
-spheres_per_stone = [1, 1]
-
-[periodic]
-axes = "xy"
-length = [{WIDTH}, {WIDTH}]
-
-[[wall]]
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-
 [[wall]]
 point = [0.0, 0.0, 0.26]
 normal = [0.0, 0.0, -1.0]
@@ -82,6 +31,7 @@ servo = {{ stress = {TARGET}, area = {area}, max_velocity = 0.5 }}
 {lid}
 "#
     );
+    let text = grain_bed(t_end, 0.005, 200, &walls);
     let path = dir.join("scene.toml");
     std::fs::write(&path, text).unwrap();
     path

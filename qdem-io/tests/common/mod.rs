@@ -51,3 +51,70 @@ pub fn short_cantilever(dir: &Path, edits: &[(&str, &str)]) -> PathBuf {
     std::fs::write(&path, text).unwrap();
     path
 }
+
+/// A CSV file as columns by name.
+pub fn columns(path: &Path) -> std::collections::HashMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let names: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let mut cols: std::collections::HashMap<String, Vec<f64>> =
+        names.iter().map(|n| (n.clone(), vec![])).collect();
+    for line in lines {
+        for (name, value) in names.iter().zip(line.split(',')) {
+            cols.get_mut(name).unwrap().push(value.parse().unwrap());
+        }
+    }
+    cols
+}
+
+/// Density (kg/m³), gravity (m/s²) and cell width (m) of [`grain_bed`].
+pub const BED_DENSITY: f64 = 2600.0;
+/// See [`BED_DENSITY`].
+pub const BED_G: f64 = 9.81;
+/// See [`BED_DENSITY`].
+pub const BED_WIDTH: f64 = 0.06;
+
+/// A scene of `count` one-sphere grains of 10–14 mm poured from a 0.01–0.25 m high region
+/// of a cell `BED_WIDTH` wide, periodic in x and y, onto a floor at z = 0 (linear law,
+/// friction 0.5, local damping 0.7), run to `t_end` with `probe_every`; `extra` is appended.
+pub fn grain_bed(t_end: f64, probe_every: f64, count: usize, extra: &str) -> String {
+    let (g, density, width) = (BED_G, BED_DENSITY, BED_WIDTH);
+    format!(
+        r#"
+[run]
+t_end = {t_end}
+gravity = [0.0, 0.0, -{g}]
+probe_every = {probe_every}
+
+[[material]]
+name = "stone"
+density = {density}
+young = 1e9
+poisson = 0.25
+
+[contact]
+law = "linear"
+normal_stiffness = 5e3
+tangential_stiffness = 2.5e3
+friction = 0.5
+damping_ratio = 0.3
+local_damping = 0.7
+
+[granular]
+name = "bed"
+material = "stone"
+region = [[0.0, 0.0, 0.01], [{width}, {width}, 0.25]]
+count = {count}
+grading = [[0.010, 0.0], [0.014, 1.0]]
+spheres_per_stone = [1, 1]
+
+[periodic]
+axes = "xy"
+length = [{width}, {width}]
+
+[[wall]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+{extra}"#
+    )
+}

@@ -43,7 +43,7 @@ pub(crate) mod walls;
 pub(crate) mod walls_vtu;
 
 use crate::build::Simulation;
-use crate::output::OutputError;
+use crate::output::{write_atomic, OutputError};
 use qdem_core::{CheckpointError, Decoder, Encoder, Halt};
 use std::path::Path;
 
@@ -203,4 +203,21 @@ pub(crate) fn restore_all(
         r.restore(input)?;
     }
     Ok(())
+}
+
+/// Writes `rows` (flat, `header.len()` values a row) under `header` to `path` as CSV, each
+/// value to ten significant digits: the time-series files of the sections, walls and fixes.
+/// Writes nothing when there is no row.
+pub(crate) fn write_rows(path: &Path, header: &[String], rows: &[f64]) -> Result<(), OutputError> {
+    if rows.is_empty() {
+        return Ok(());
+    }
+    write_atomic(path, |w| {
+        writeln!(w, "{}", header.join(","))?;
+        for row in rows.chunks_exact(header.len()) {
+            let cells: Vec<String> = row.iter().map(|v| format!("{v:.9e}")).collect();
+            writeln!(w, "{}", cells.join(","))?;
+        }
+        Ok(())
+    })
 }

@@ -11,9 +11,9 @@
 //! file is the same for any rank count. A wall's force is `walls.csv`'s.
 
 use super::schedule::{probe_interval, Schedule};
-use super::{Recorder, StateRead, StepInfo};
+use super::{write_rows, Recorder, StateRead, StepInfo};
 use crate::build::{BodyKind, Simulation};
-use crate::output::{write_atomic, OutputError};
+use crate::output::OutputError;
 use qdem_core::{CheckpointError, Decoder, Dofs, Encoder, State, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -104,22 +104,12 @@ impl Recorder for Reactions {
     }
 
     fn finish(&mut self, _sim: &Simulation) -> Result<(), OutputError> {
-        if self.rows.is_empty() {
-            return Ok(());
-        }
         let mut header = vec!["time".to_string()];
         for g in &self.groups {
             let k = g.number;
             header.extend(["fx", "fy", "fz", "mx", "my", "mz"].map(|c| format!("fix{k}_{c}")));
         }
-        write_atomic(&self.path, |w| {
-            writeln!(w, "{}", header.join(","))?;
-            for row in self.rows.chunks_exact(header.len()) {
-                let cells: Vec<String> = row.iter().map(|v| format!("{v:.9e}")).collect();
-                writeln!(w, "{}", cells.join(","))?;
-            }
-            Ok(())
-        })
+        write_rows(&self.path, &header, &self.rows)
     }
 
     fn save(&self, out: &mut Encoder) {

@@ -7,9 +7,9 @@
 //! every period) put on the partner below the plane, over the area ([`normal_stress`]).
 
 use super::schedule::{probe_interval, Schedule};
-use super::{Recorder, StateRead, StepInfo};
+use super::{write_rows, Recorder, StateRead, StepInfo};
 use crate::build::Simulation;
-use crate::output::{write_atomic, OutputError};
+use crate::output::OutputError;
 use qdem_contact::{DemContacts, Partner};
 use qdem_core::{CheckpointError, Decoder, Encoder};
 use std::path::{Path, PathBuf};
@@ -82,17 +82,11 @@ impl Recorder for Sections {
     }
 
     fn finish(&mut self, _sim: &Simulation) -> Result<(), OutputError> {
-        if self.rows.is_empty() {
-            return Ok(());
-        }
-        write_atomic(&self.path, |w| {
-            writeln!(w, "time,{}", self.names.join(","))?;
-            for row in self.rows.chunks_exact(self.names.len() + 1) {
-                let cells: Vec<String> = row.iter().map(|v| format!("{v:.9e}")).collect();
-                writeln!(w, "{}", cells.join(","))?;
-            }
-            Ok(())
-        })
+        let header: Vec<String> = ["time".to_string()]
+            .into_iter()
+            .chain(self.names.iter().cloned())
+            .collect();
+        write_rows(&self.path, &header, &self.rows)
     }
 
     fn save(&self, out: &mut Encoder) {

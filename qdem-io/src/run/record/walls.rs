@@ -5,9 +5,9 @@
 //! ([`qdem_contact::DemContacts::touching`]).
 
 use super::schedule::{probe_interval, Schedule};
-use super::{Recorder, StateRead, StepInfo};
+use super::{write_rows, Recorder, StateRead, StepInfo};
 use crate::build::Simulation;
-use crate::output::{write_atomic, OutputError};
+use crate::output::OutputError;
 use qdem_contact::{DemContacts, Partner};
 use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
 use std::path::{Path, PathBuf};
@@ -72,21 +72,11 @@ impl Recorder for Walls {
     }
 
     fn finish(&mut self, _sim: &Simulation) -> Result<(), OutputError> {
-        if self.rows.is_empty() {
-            return Ok(());
+        let mut header = vec!["time".to_string()];
+        for k in 1..=self.walls {
+            header.extend(["fx", "fy", "fz", "ux", "uy", "uz"].map(|c| format!("wall{k}.{c}")));
         }
-        write_atomic(&self.path, |w| {
-            let mut header = vec!["time".to_string()];
-            for k in 1..=self.walls {
-                header.extend(["fx", "fy", "fz", "ux", "uy", "uz"].map(|c| format!("wall{k}.{c}")));
-            }
-            writeln!(w, "{}", header.join(","))?;
-            for row in self.rows.chunks_exact(6 * self.walls + 1) {
-                let cells: Vec<String> = row.iter().map(|v| format!("{v:.9e}")).collect();
-                writeln!(w, "{}", cells.join(","))?;
-            }
-            Ok(())
-        })
+        write_rows(&self.path, &header, &self.rows)
     }
 
     fn save(&self, out: &mut Encoder) {
