@@ -32,10 +32,7 @@ impl Recorder for Boundary {
     }
 
     fn reads(&self, time: f64, dt: f64) -> StateRead {
-        match self.schedule.is_due(time, dt) {
-            true => StateRead::Whole,
-            false => StateRead::Nothing,
-        }
+        StateRead::whole_if(self.schedule.is_due(time, dt))
     }
 
     fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {

@@ -106,10 +106,7 @@ impl Recorder for Measures {
     }
 
     fn reads(&self, time: f64, dt: f64) -> StateRead {
-        match self.measures.iter().any(|m| m.schedule.is_due(time, dt)) {
-            true => StateRead::Whole,
-            false => StateRead::Nothing,
-        }
+        StateRead::whole_if(self.measures.iter().any(|m| m.schedule.is_due(time, dt)))
     }
 
     fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {

@@ -70,6 +70,17 @@ pub(crate) enum StateRead {
     Whole,
 }
 
+impl StateRead {
+    /// The whole state when a sample is `due`, else nothing: the read of a recorder that
+    /// samples the whole state on a schedule.
+    pub(crate) fn whole_if(due: bool) -> StateRead {
+        match due {
+            true => StateRead::Whole,
+            false => StateRead::Nothing,
+        }
+    }
+}
+
 /// What a finished run did, for the rates in `summary.json`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct RunFigures {

@@ -91,10 +91,7 @@ impl Recorder for Settlement {
 
     fn reads(&self, time: f64, dt: f64) -> StateRead {
         let due = |l: &Load| time >= l.extremum(l.passed) - 0.5 * dt;
-        match self.loads.iter().any(due) {
-            true => StateRead::Whole,
-            false => StateRead::Nothing,
-        }
+        StateRead::whole_if(self.loads.iter().any(due))
     }
 
     fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {

@@ -49,10 +49,7 @@ impl Recorder for Walls {
     }
 
     fn reads(&self, time: f64, dt: f64) -> StateRead {
-        match self.schedule.is_due(time, dt) {
-            true => StateRead::Whole,
-            false => StateRead::Nothing,
-        }
+        StateRead::whole_if(self.schedule.is_due(time, dt))
     }
 
     fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {
