@@ -4,10 +4,16 @@
 //! load's direction (`total_force` as a unit vector: positive where the load pushes, a
 //! sleeper's settlement under a downward load), to the nearest step. One row per load and
 //! cycle: `load` (the `[[load]]`'s number, from 1), `cycle` (from 1), `time_min`,
-//! `time_max`, then `NAME.at_min` and `NAME.at_max` per probe; the plot draws them against
-//! the cycle number. The displacement at the next cycle's minimum is the permanent
-//! settlement after a cycle; the difference between a cycle's maximum and minimum is its
-//! resilient (elastic) part.
+//! `time_max`, then `NAME.at_min` and `NAME.at_max` per probe, then `body` (the `[[body]]`
+//! the load acts on); the plot draws them against the cycle number. The displacement at the
+//! next cycle's minimum is the permanent settlement after a cycle; the difference between a
+//! cycle's maximum and minimum is its resilient (elastic) part.
+//!
+//! The end of the run: an extremum is taken at the first step within half a step of it, so
+//! one at `t_end` (a run of whole cycles) is taken at the last step. A cycle whose minimum
+//! was taken but whose maximum falls after the last step still gets its row, after every
+//! whole cycle's, with `NaN` for `time_max` and the `at_max` cells: its minimum is the
+//! permanent settlement after the cycle before it.
 
 use super::{Recorder, StateRead, StepInfo};
 use crate::build::Simulation;
@@ -20,6 +26,8 @@ use std::path::{Path, PathBuf};
 struct Load {
     /// The `[[load]]`'s number, from 1.
     number: usize,
+    /// The `[[body]]` it acts on.
+    body: String,
     cycle: Cyclic,
     /// Unit vector along `total_force`.
     direction: Vec3,
@@ -43,7 +51,8 @@ pub(crate) struct Settlement {
     /// Rows, flat: load, cycle, time at the minimum, time at the maximum, then per probe
     /// the displacement at the minimum and at the maximum.
     rows: Vec<f64>,
-    /// The row being filled per load: its minimum's time and displacements.
+    /// The row being filled per load: its minimum's time and displacements (`NaN` at the
+    /// maximum); empty when no minimum waits for its maximum.
     pending: Vec<Vec<f64>>,
 }
 
@@ -60,6 +69,7 @@ impl Settlement {
                 let cycle = l.cyclic?.cycle();
                 (force.norm() > 0.0).then(|| Load {
                     number: k + 1,
+                    body: l.body.clone(),
                     cycle,
                     direction: force.normalize(),
                     passed: 0,
@@ -122,7 +132,8 @@ impl Recorder for Settlement {
     }
 
     fn finish(&mut self, _sim: &Simulation) -> Result<(), OutputError> {
-        if self.rows.is_empty() {
+        let rows = self.all_rows();
+        if rows.is_empty() {
             return Ok(());
         }
         let width = self.width();
@@ -133,15 +144,17 @@ impl Recorder for Settlement {
             for n in &self.names {
                 header.extend([format!("{n}.at_min"), format!("{n}.at_max")]);
             }
+            header.push("body".to_string());
             writeln!(w, "{}", header.join(","))?;
-            for row in self.rows.chunks_exact(width) {
+            for row in rows.chunks_exact(width) {
                 let mut cells = vec![format!("{}", row[0]), format!("{}", row[1])];
                 cells.extend(row[2..].iter().map(|v| format!("{v:.9e}")));
+                cells.push(self.body_of(row[0]).to_string());
                 writeln!(w, "{}", cells.join(","))?;
             }
             Ok(())
         })?;
-        self.plot()
+        self.plot(&rows)
     }
 
     fn save(&self, out: &mut Encoder) {
@@ -163,9 +176,25 @@ impl Recorder for Settlement {
 }
 
 impl Settlement {
+    /// The rows of the whole cycles, then per load the cycle whose minimum waits for its
+    /// maximum, if any (its maximum `NaN`).
+    fn all_rows(&self) -> Vec<f64> {
+        let mut rows = self.rows.clone();
+        for pending in &self.pending {
+            rows.extend_from_slice(pending);
+        }
+        rows
+    }
+
+    /// The body of the load numbered `number` (a row's first cell).
+    fn body_of(&self, number: f64) -> &str {
+        let load = self.loads.iter().find(|l| l.number as f64 == number);
+        load.map_or("", |l| l.body.as_str())
+    }
+
     /// Each probe's displacement at the minima and at the maxima against the cycle number,
     /// per cyclic load.
-    fn plot(&self) -> Result<(), OutputError> {
+    fn plot(&self, rows: &[f64]) -> Result<(), OutputError> {
         let width = self.width();
         let mut labels = Vec::new();
         let mut curves: Vec<Vec<(f64, f64)>> = Vec::new();
@@ -174,9 +203,8 @@ impl Settlement {
                 for (column, at) in [(4 + 2 * k, "min"), (5 + 2 * k, "max")] {
                     labels.push(format!("{name} at load {} {at}", l.number));
                     curves.push(
-                        self.rows
-                            .chunks_exact(width)
-                            .filter(|row| row[0] == l.number as f64)
+                        rows.chunks_exact(width)
+                            .filter(|row| row[0] == l.number as f64 && row[column].is_finite())
                             .map(|row| (row[1], row[column]))
                             .collect(),
                     );
