@@ -1,6 +1,6 @@
 //! What an FEM user measures (issue 40, part A): a pressure on a face lumped to its nodes,
 //! the stress tensor and principal stresses of the tetrahedra's VTU with its `TimeValue`,
-//! and the reactions of the fixes.
+//! the reactions of the fixes, and `qdem analyze`'s input load from a pressure `series`.
 //!
 //! The pressed block: the gmsh box 0.3 × 0.2 × 0.1 m (`fixtures/msh`), its face x = 0.3 under
 //! a pressure p, held on its face x = 0 in x only, at the origin in y and z and at
@@ -14,7 +14,8 @@ mod common;
 
 use common::{fixture, test_dir};
 use qdem_core::NodalLoad;
-use qdem_io::build::Simulation;
+use qdem_io::analyze::{analyze, AnalyzeOptions};
+use qdem_io::build::{load_resultant, Simulation};
 use qdem_io::runner::run;
 use qdem_io::scene::Scene;
 use std::path::Path;
@@ -60,6 +61,56 @@ fn pressure_and_traction_forces_sum_to_load_times_area() {
         (total - want).norm() <= 1e-12 * want.norm(),
         "{total} vs {want}"
     );
+}
+
+/// A pressure or traction `series` load counts in `qdem analyze` as its resultant: the
+/// scene-only [`load_resultant`] is p·A along the inward normal (and t·A for a traction) to
+/// 10⁻¹², and a probe whose velocity is 3e-6 (m/s)/N times p·A times the series has a
+/// mobility of 3e-6 at every frequency, as a `total_force` load of p·A gives (a pressure
+/// load used to count as no load at all).
+#[test]
+fn analyze_sizes_a_pressure_series_by_its_resultant() {
+    let dir = test_dir("fem-analyze-pressure");
+    let (dt, n) = (1e-4, 3000);
+    let factor = |t: f64| 1.0 + (2.0 * std::f64::consts::PI * 37.0 * t).sin();
+    let mut series = String::from("time,p\n");
+    for i in 0..n {
+        let t = i as f64 * dt;
+        series.push_str(&format!("{t},{}\n", factor(t)));
+    }
+    std::fs::write(dir.join("series.csv"), series).unwrap();
+    let traction = pressed_block(&dir, "traction = [0.0, 3.0e5, -1.0e5]");
+    let want = qdem_core::Vec3::new(0.0, 3.0e5, -1.0e5) * AREA;
+    let got = load_resultant(&traction, 0).unwrap();
+    assert!(
+        (got - want).norm() <= 1e-12 * want.norm(),
+        "{got} vs {want}"
+    );
+    let load = format!("pressure = {P:e}\nseries = {{ file = \"series.csv\", column = \"p\" }}");
+    let scene = pressed_block(&dir, &load);
+    let got = load_resultant(&scene, 0).unwrap();
+    let want = qdem_core::Vec3::new(-P * AREA, 0.0, 0.0);
+    assert!((got - want).norm() <= 1e-12 * P * AREA, "{got} vs {want}");
+    let mut probes = String::from("t,c.ux,c.uy,c.uz,c.vx,c.vy,c.vz,c.ax,c.ay,c.az\n");
+    for i in 0..n {
+        let t = i as f64 * dt;
+        let vz = 3e-6 * P * AREA * factor(t);
+        probes.push_str(&format!("{t},0,0,0,0,0,{vz},0,0,0\n"));
+    }
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("probes.csv"), probes).unwrap();
+    let a = analyze(&scene, &out, &AnalyzeOptions::default()).unwrap();
+    assert!(a.mobility);
+    let mobility = std::fs::read_to_string(a.dir.join("mobility.csv")).unwrap();
+    let mut rows = 0;
+    for line in mobility.lines().skip(1) {
+        let m: f64 = line.split(',').nth(1).unwrap().parse().unwrap();
+        assert!((m - 3e-6).abs() < 1e-9 * 3e-6, "{line}");
+        rows += 1;
+    }
+    assert!(rows > 100, "{rows} rows");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The pressed block solved statically: every tetrahedron's stress in the VTU is −p eₓ⊗eₓ to

@@ -47,6 +47,7 @@ mod rest_on;
 mod start_from;
 mod step_check;
 
+pub use area_load::load_resultant;
 pub use error::BuildError;
 
 use crate::scene::suggest::did_you_mean;

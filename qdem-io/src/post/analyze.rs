@@ -1,8 +1,10 @@
 //! `qdem analyze`: the spectra and mobility of a finished run's sensors (paper 000 §4.2).
 //!
 //! Reads `probes.csv` from the run's output directory and the input load from the scene's
-//! `series` loads (their `|total_force|` times the series, summed, evaluated at the probe
-//! times: the rail-seat loads), keeps the rows in a time window, and writes to `analysis/`:
+//! `series` loads (the size of each one's resultant times the series, summed, evaluated at the
+//! probe times: the rail-seat loads; a `total_force`'s size, a pressure's p·A on a plane face,
+//! a traction's |t|·A: [`crate::build::load_resultant`]), keeps the rows in a time window,
+//! and writes to `analysis/`:
 //! - `spectra.csv` and `spectra.svg`: the Parzen-smoothed linear spectra
 //!   ([`crate::linear_spectrum`]) of every probe's vertical acceleration and of the input load;
 //! - `mobility.csv` and `mobility.svg`: every probe's vertical velocity over the input load;
@@ -68,7 +70,7 @@ pub enum AnalyzeError {
         /// What is wrong.
         message: String,
     },
-    /// A load series cannot be read.
+    /// A load series, or the mesh a pressure or traction load acts on, cannot be read.
     #[error(transparent)]
     Series(#[from] BuildError),
     /// The modes to mark cannot be read.
@@ -329,14 +331,14 @@ fn sampling_step(probes: &Probes, path: &Path) -> Result<f64, AnalyzeError> {
 /// The summed series loads at `time`, or `None` when the scene has none.
 fn input_load(scene: &Scene, time: &[f64]) -> Result<Option<Vec<f64>>, AnalyzeError> {
     let mut total: Option<Vec<f64>> = None;
-    for load in &scene.loads {
+    for (k, load) in scene.loads.iter().enumerate() {
         let Some(series) = &load.series else { continue };
         let rows = crate::load_series::read_series(&scene.resolve(&series.file), &series.column)?;
         let f = qdem_core::TimeFunction::new(rows).map_err(|source| BuildError::Core {
             scene: scene.path.clone(),
             source,
         })?;
-        let size = qdem_core::Vec3::from(load.total_force).norm();
+        let size = crate::build::load_resultant(scene, k)?.norm();
         let sum = total.get_or_insert_with(|| vec![0.0; time.len()]);
         for (s, &t) in sum.iter_mut().zip(time) {
             *s += size * f.value(t);
