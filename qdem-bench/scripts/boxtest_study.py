@@ -14,7 +14,8 @@ runs.json (particles, steps, wall time, sphere-steps/s of every run) and the tab
 <!-- boxtest:begin --> and <!-- boxtest:end --> in docs/boxtest.md, then (study size) runs
 boxtest_faces.py: the force through the middle cell's faces over a cycle. Settlement is the
 sleeper's downward displacement at the end of each cycle (its load back at the minimum)
-relative to the start of the cycles (after the settling time under the minimum load).
+relative to the start of the cycles (after the settling time under the minimum load), read
+from each run's settlement.csv (qdem's displacement at every cycle's minimum).
 """
 import argparse
 import csv
@@ -65,17 +66,21 @@ def run(size, name, seed, out):
 
 
 def settlement(out, case, settle, cycles):
-    """Settlement (m, positive down) of the middle sleeper after each cycle."""
-    with open(os.path.join(out, case, "probes.csv")) as f:
-        header, *table = list(csv.reader(f))
-    rows = [[float(v) for v in r] for r in table]
-    col = header.index("sleeper2.uz")
-
-    def uz_at(t):
-        return min(rows, key=lambda r: abs(r[0] - t))[col]
-
-    u0 = uz_at(settle)
-    return [-(uz_at(settle + n / 3.0) - u0) for n in range(1, cycles + 1)]
+    """Settlement (m, positive down) of the middle sleeper after each cycle, from the run's
+    settlement.csv: its displacement along its (downward) load at the minimum that ends each
+    cycle, less the one at the first cycle's start (`settle`, after the settling time). qdem
+    takes each minimum at the step nearest it; the last one, at t_end, is the row with no
+    maximum."""
+    path = os.path.join(out, case, "settlement.csv")
+    with open(path) as f:
+        rows = sorted((r for r in csv.DictReader(f) if r["body"] == "sleeper2"),
+                      key=lambda r: float(r["cycle"]))
+    minima = [(float(r["time_min"]), float(r["sleeper2.at_min"])) for r in rows]
+    if len(minima) != cycles + 1 or abs(minima[0][0] - settle) > 1e-3:
+        sys.exit(f"{path}: {len(minima)} minima of sleeper2's load from t = "
+                 f"{minima[0][0] if minima else 'none'}; the study needs {cycles + 1} from "
+                 f"{settle} s (a qdem older than settlement.csv's last-minimum row?)")
+    return [u - minima[0][1] for _, u in minima[1:]]
 
 
 def svg(path, series, cycles):
