@@ -208,6 +208,39 @@ fn a_reduced_ballast_deposit_is_byte_identical_on_any_number_of_ranks() {
     same_for_any_ranks("ballast/reduced_deposit.toml", 0.004, "deposit");
 }
 
+/// A `[[measure]]` over the packing's clumps (one and two spheres) gathers the whole state and
+/// the contacts before each sample, so `measure_bed.csv` (contact stress, solid fraction,
+/// coordination, kinetic energy) is byte-identical too; by 0.1 s the falling stones touch
+/// (a stress and contacts in the file, so the comparison is not of zeros).
+#[test]
+fn a_measure_over_a_packing_of_clumps_is_byte_identical_on_any_number_of_ranks() {
+    let fixture = "boxtest/small_deposit_cell_bed.toml";
+    let measure = "[[measure]]\nname = \"bed\"\nbox = [[0.0, 0.7, 0.0], [0.3, 1.4, 0.3]]\n\
+                   every = 0.01\n\n[output]";
+    let edits = [("t_end = ", "t_end = 0.1"), ("[output]", measure)];
+    let scene = ShortScene::edited(fixture, "measure", &edits);
+    let tmp = TempDir::new("measure");
+    let single = tmp.path().join("single");
+    run(&scene.0, &single, 0, 1, &[]);
+    let text = std::fs::read_to_string(single.join("measure_bed.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let last: Vec<f64> = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let column = |name: &str| last[header.iter().position(|h| *h == name).unwrap()];
+    assert!(column("contacts") > 0.0 && column("szz") < 0.0, "{text}");
+    for (ranks, threads) in [(2, 1), (3, 1), (2, 2)] {
+        let out = tmp.path().join(format!("r{ranks}t{threads}"));
+        run(&scene.0, &out, ranks, threads, &[]);
+        let what = format!("{fixture} with a measure on {ranks} ranks x {threads} threads");
+        assert_same_outputs(&single, &out, &what);
+    }
+}
+
 /// The grains' contacts are split: each rank evaluates those of the grains it owns.
 #[test]
 fn poured_grains_are_byte_identical_on_any_number_of_ranks() {

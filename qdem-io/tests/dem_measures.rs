@@ -9,6 +9,8 @@
 //!   telescopes exactly: σ_zz V = −g Σ m z; `walls.csv` has the floor carry the weight;
 //!   `grading.csv` sieves each grain at its diameter; a `[[section]]` with an `area` has the
 //!   stress of the weight above it. The coordination number is a frictional packing's.
+//! - A bed of clumps (two and three spheres) settled the same way: the whole-bed identity
+//!   with each clump's mass and centre of mass, and the floor carrying the weight.
 
 mod common;
 
@@ -141,6 +143,62 @@ radius = 1.0
     eprintln!("ratios {ratios:.4?}, mean {mean:.4}");
     assert!(ratios.iter().all(|r| (r - 1.0).abs() < 0.15), "{ratios:?}");
     assert!((mean - 1.0).abs() < 0.06, "mean ratio {mean}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The settled bed again, of clumps of two and three spheres: a clump's contacts count from
+/// its centre of mass (not its spheres' centres), so over the whole bed σ_zz V = −g Σ m z_c
+/// still holds (to the floor's half-overlaps, as for one-sphere grains: 2e-3), with m the
+/// clump's mass (its spheres' union) and z_c its centre of mass from the run's state (from
+/// the spheres' centres instead, each contact force would be weighed at its sphere's height,
+/// a few mm off a centre of mass some 12 mm up: tens of percent); the floor carries
+/// Σ m g. (A bed of 100 clumps is some 2 cm deep, two grains: too shallow for layers.)
+#[test]
+fn the_contact_stress_of_a_settled_bed_of_clumps_is_its_weight() {
+    const T_END: f64 = 2.0;
+    let dir = test_dir("measures-clumps");
+    let extra = "[[measure]]\nname = \"all\"\ncenter = [0.02, 0.02, 0.1]\nradius = 1.0\n";
+    let scene = grain_bed(T_END, 0.01, 100, extra)
+        .replace("spheres_per_stone = [1, 1]", "spheres_per_stone = [2, 3]");
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let mut sim = Simulation::build(Scene::load(&path).unwrap()).unwrap();
+    let out = dir.join("out");
+    run(&mut sim, &out, &mut |_| {}).unwrap();
+    let state = &sim.world.state;
+    let info = sim.granular.as_ref().unwrap();
+    let spheres: usize = info.stones.iter().map(|(_, m)| m.len()).sum();
+    assert!(
+        spheres > info.len(),
+        "clumps: {spheres} spheres, {} stones",
+        info.len()
+    );
+    let (mut weight, mut weight_z) = (0.0, 0.0);
+    for (c, _) in &info.stones {
+        weight += state.mass[*c] * G;
+        weight_z += state.mass[*c] * G * state.position[*c].z;
+    }
+    let walls = columns(&out.join("walls.csv"));
+    let floor = walls["wall1.fz"][walls["wall1.fz"].len() - 1];
+    assert!((floor / -weight - 1.0).abs() < 1e-6, "{floor} vs {weight}");
+    let all = measure(&out, "all");
+    let last = all["time"].len() - 1;
+    let energy = all["ke_translation"][last] + all["ke_rotation"][last];
+    assert!(energy < 1e-7 * weight_z, "not settled: {energy} J");
+    let whole = all["szz"][last] * 4.0 / 3.0 * std::f64::consts::PI;
+    eprintln!(
+        "clumps: {} stones, {spheres} spheres, KE/(g Σ m z) {:.1e}; σzz V = {whole:.6} N m, \
+         −g Σ m z = {:.6} N m, Z = {:.2}",
+        info.len(),
+        energy / weight_z,
+        -weight_z,
+        all["coordination"][last]
+    );
+    assert!(
+        (whole / -weight_z - 1.0).abs() < 2e-3,
+        "{whole} vs {}",
+        -weight_z
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
