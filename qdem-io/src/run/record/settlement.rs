@@ -13,7 +13,8 @@
 //! one at `t_end` (a run of whole cycles) is taken at the last step. A cycle whose minimum
 //! was taken but whose maximum falls after the last step still gets its row, after every
 //! whole cycle's, with `NaN` for `time_max` and the `at_max` cells: its minimum is the
-//! permanent settlement after the cycle before it.
+//! permanent settlement after the cycle before it. A cyclic `pressure` or `traction` load
+//! (no `total_force`) gets no rows.
 
 use super::{Recorder, StateRead, StepInfo};
 use crate::build::Simulation;
