@@ -34,7 +34,7 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.qdc";
 /// holds `walls.csv`'s rows in a scene with walls and each `[[measure]]`'s rows, and the
 /// contacts keep each servo wall's point and velocity after their lists: nothing without a
 /// servo wall, so a version 7 file of a scene without one reads as before).
-pub const FORMAT_VERSION: u64 = 7;
+pub const FORMAT_VERSION: u64 = 8;
 
 const MAGIC: &[u8; 8] = b"QDEMCKPT";
 const HEADER: usize = 8 + 8 + 8;
