@@ -207,3 +207,100 @@ impl Persistent for DemContacts {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{LinearSpring, PlaneWall, WallShape};
+
+    /// Two spheres of bodies 0 and 1 overlapping by 1 mm, the second also 0.5 mm into a floor,
+    /// listed in `order`, with `walls` floors.
+    fn model(state: &State, order: [usize; 2], walls: usize) -> DemContacts {
+        let spheres: Vec<ContactSphere> = order
+            .iter()
+            .map(|&i| ContactSphere {
+                particle: i,
+                radius: 0.01,
+                body: i,
+                material: 0,
+            })
+            .collect();
+        let floor = || Wall {
+            shape: WallShape::Plane(PlaneWall::new(Vec3::zeros(), Vec3::z(), Vec3::zeros())),
+            friction: 0.5,
+        };
+        let law = ContactLaw::Linear(LinearSpring {
+            normal_stiffness: 1e5,
+            tangential_stiffness: 1e5,
+            damping_ratio: 0.0,
+        });
+        let settings = ContactSettings {
+            law,
+            friction: 0.5,
+            skin: 0.001,
+        };
+        let names = order.iter().map(|i| format!("body {i}")).collect();
+        let walls = (0..walls).map(|_| floor()).collect();
+        DemContacts::new(state, &spheres, names, &[(1e9, 0.25)], settings, walls)
+    }
+
+    fn forces(model: &mut DemContacts, state: &State) -> Vec<Vec3> {
+        let mut force = vec![Vec3::zeros(); 2];
+        model.add_forces(state, &mut force, &mut []);
+        force
+    }
+
+    #[test]
+    fn springs_go_to_the_same_spheres_in_any_order_and_a_missing_wall_drops_its_own() {
+        let mut state = State::at_rest(vec![
+            Vec3::new(0.0, 0.0, 0.0285),
+            Vec3::new(0.0, 0.0, 0.0095),
+        ]);
+        state.mass = vec![0.01, 0.01];
+        let mut saved = model(&state, [0, 1], 1);
+        forces(&mut saved, &state);
+        // The lower sphere slides 2 µm along x (a stick well below μ f_n on both contacts).
+        state.time = 1e-3;
+        state.position[1].x = 2e-6;
+        state.velocity[1].x = 2e-3;
+        let before = forces(&mut saved, &state);
+        assert!(before[1].x.abs() > 0.1, "stretched springs: {before:?}");
+        let mut out = Encoder::new();
+        saved.save(&mut out);
+        let springs = SavedSprings::read(out.bytes()).unwrap();
+        assert_eq!((springs.pairs.len(), springs.walls.len()), (1, 1));
+        // The spheres listed the other way round: the pair's spring acts on the new first
+        // sphere (the old second), −ξ; the same forces on the particles, no time elapsed.
+        let mut carried = model(&state, [1, 0], 1);
+        let count = carried.carry_springs(&springs, |p| Some(p as usize));
+        assert_eq!(
+            count,
+            CarriedSprings {
+                carried: 2,
+                dropped: 0
+            }
+        );
+        let after = forces(&mut carried, &state);
+        for (b, a) in before.iter().zip(&after) {
+            assert!((b - a).norm() < 1e-15, "{b:?} vs {a:?}");
+        }
+        let mut no_floor = model(&state, [0, 1], 0);
+        let count = no_floor.carry_springs(&springs, |p| Some(p as usize));
+        assert_eq!(
+            count,
+            CarriedSprings {
+                carried: 1,
+                dropped: 1
+            }
+        );
+        let mut no_sphere = model(&state, [0, 1], 1);
+        let count = no_sphere.carry_springs(&springs, |p| (p == 0).then_some(0));
+        assert_eq!(
+            count,
+            CarriedSprings {
+                carried: 0,
+                dropped: 2
+            }
+        );
+    }
+}
