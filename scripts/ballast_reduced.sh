@@ -14,6 +14,10 @@
 # With --stiff --rigid-forming, step 1 with rigid stones (stiff_deposit_rigid.toml,
 # stiff_consolidate_rigid.toml) and step 2 with deformable ones from that bed
 # (stiff_load_from_rigid.toml; docs/ballast.md, "Forming rigid, loading deformable").
+# With --fine, the reduced layout with 900 stones of the paper's 5 cm size (docs/ballast.md,
+# "A bed of 5 cm stones"): the layer poured rigid (fine_deposit_rigid.toml), then the first
+# axle on it with rigid stones at friction 0.577 and 1.73 side by side (fine_load_rigid.toml,
+# fine_load_rigid_mu173.toml).
 # Step 1 is skipped when its checkpoint exists, unless --redeposit is given.
 # Outputs: out/ballast/{reduced,stiff}_*/ (probes.csv, vtu/, analysis/*.csv|svg, modes/).
 set -euo pipefail
@@ -25,13 +29,15 @@ redeposit=false
 track=reduced
 friction=false
 rigid=false
+fine=false
 for arg in "$@"; do
     case "$arg" in
         --redeposit) redeposit=true ;;
         --friction-study) friction=true ;;
         --stiff) track=stiff ;;
         --rigid-forming) rigid=true ;;
-        *) echo "usage: $0 [--stiff [--rigid-forming]] [--redeposit] [--friction-study]" >&2; exit 2 ;;
+        --fine) fine=true ;;
+        *) echo "usage: $0 [--stiff [--rigid-forming]] [--fine] [--redeposit] [--friction-study]" >&2; exit 2 ;;
     esac
 done
 forming=(reduced_deposit)
@@ -44,6 +50,11 @@ if $rigid; then
     fi
     forming=(stiff_deposit_rigid stiff_consolidate_rigid)
     runs=(stiff_load_from_rigid)
+fi
+if $fine; then
+    track=stiff
+    forming=(fine_deposit_rigid)
+    runs=(fine_load_rigid fine_load_rigid_mu173)
 fi
 if $redeposit || [ ! -f "out/ballast/${forming[-1]}/checkpoint.qdc" ]; then
     for scene in "${forming[@]}"; do $qdem run $dir/$scene.toml; done
@@ -63,6 +74,10 @@ for run in "${runs[@]}"; do
     pids+=($!)
 done
 for pid in "${pids[@]}"; do wait "$pid"; done
+if $fine; then
+    for run in "${runs[@]}"; do python3 $dir/track_profile.py --motion out/ballast/$run; done
+    exit 0
+fi
 modes=out/ballast/${runs[0]}/modes
 $qdem modes $dir/${runs[0]}.toml --count 80 --out $modes
 # Spectra of the stable period: at friction 0.577 the bed fails in bearing under the second

@@ -88,6 +88,30 @@ impl ContactList {
             .collect();
     }
 
+    /// A list of the contacts `springs` (partners sorted, and the spring ξ of each), the
+    /// rest of their records empty: what the next [`ContactList::rebuild`] keeps the springs
+    /// of.
+    pub(crate) fn with_springs(springs: Vec<(u32, u32, Vec3)>) -> ContactList {
+        let items = springs
+            .into_iter()
+            .map(|(first, second, history)| Contact {
+                first,
+                second,
+                history,
+                ..Contact::default()
+            })
+            .collect();
+        ContactList { items }
+    }
+
+    /// The stretched springs: each contact's partners and ξ, where ξ is not zero.
+    pub(crate) fn springs(&self) -> impl Iterator<Item = (u32, u32, Vec3)> + '_ {
+        self.items
+            .iter()
+            .filter(|c| c.history != Vec3::zeros())
+            .map(|c| (c.first, c.second, c.history))
+    }
+
     /// Number of candidates.
     pub(crate) fn len(&self) -> usize {
         self.items.len()

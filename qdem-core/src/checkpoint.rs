@@ -324,6 +324,39 @@ pub fn same_count(
     }
 }
 
+/// The tag before a model's history in a checkpoint ([`crate::World::save`]).
+pub(crate) fn model_tag(name: &str) -> String {
+    format!("model {name}")
+}
+
+/// Fails unless model `name`'s restore read its whole history `block`.
+pub(crate) fn whole_block(name: &str, block: &Decoder<'_>) -> Result<(), CheckpointError> {
+    match block.bytes.len() - block.at {
+        0 => Ok(()),
+        left => Err(CheckpointError::Invalid {
+            what: "model history",
+            detail: format!("model `{name}` left {left} bytes of its history unread"),
+        }),
+    }
+}
+
+/// Each model's name and saved history (empty for a model without one), as
+/// [`crate::World::save`] wrote them after the [`State`], up to the stepper's part: what a
+/// scene that starts from another scene's checkpoint reads of its models (their contact
+/// springs) without the models that wrote them.
+pub fn model_histories<'a>(
+    input: &mut Decoder<'a>,
+) -> Result<Vec<(String, &'a [u8])>, CheckpointError> {
+    let mut histories = Vec::new();
+    loop {
+        let tag = input.str("a part name")?;
+        let Some(name) = tag.strip_prefix("model ") else {
+            return Ok(histories);
+        };
+        histories.push((name.to_string(), input.block("a model's history")?));
+    }
+}
+
 impl State {
     /// Writes what evolves during a run: time, positions (current and the reference, which a
     /// periodic cell shifts), velocities, accelerations, the rigid bodies' orientations and

@@ -57,6 +57,8 @@ use rayon::prelude::*;
 use scatter::{add_sum, add_to, pair_share, run_of, wall_share, ScatterPlan};
 use split::ContactPart;
 
+pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
+
 mod build;
 mod modal_springs;
 mod persistence;

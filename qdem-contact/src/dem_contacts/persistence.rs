@@ -1,16 +1,150 @@
-//! What a checkpoint keeps of a [`DemContacts`]: the candidate lists with their tangential
-//! springs, where and when they were built, the time-delayed boundary's estimates and the
-//! servo walls' planes (none written without servo walls: the layout of a run without them is
-//! unchanged).
+//! What a checkpoint keeps of a [`DemContacts`]: its spheres' particles, the candidate lists
+//! with their tangential springs, where and when they were built, the time-delayed boundary's
+//! estimates and the servo walls' planes (none written without servo walls: the layout of a
+//! run without them is unchanged).
+//!
+//! A scene that starts from another scene's checkpoint (`[run] start_from`) takes the
+//! stretched tangential springs out of it by stable identities ([`SavedSprings`]): a pair by
+//! the particles that carry its spheres, a wall contact by its sphere's particle and the
+//! wall's index. A body's contact spheres sit on its mesh nodes whether it is deformable or
+//! rigid (a rigid body's nodes are its members), so a stone keeps its springs when its kind
+//! changes; [`DemContacts::carry_springs`] puts them on the same spheres of the new stage and
+//! counts those whose sphere or wall the new stage does not have.
 
 use super::*;
+use std::collections::HashMap;
+
+/// One stretched tangential spring of a saved contact, by stable identities.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SavedSpring {
+    /// The particle carrying the first sphere.
+    pub first: u32,
+    /// The particle carrying the second sphere (a pair), or the wall's index (a wall contact).
+    pub second: u32,
+    /// The spring's elongation ξ (m), as it acts on the first sphere.
+    pub spring: Vec3,
+}
+
+/// The stretched tangential springs of the contacts a checkpoint holds.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SavedSprings {
+    /// Between two spheres.
+    pub pairs: Vec<SavedSpring>,
+    /// Between a sphere and a wall.
+    pub walls: Vec<SavedSpring>,
+}
+
+impl SavedSprings {
+    /// Reads the springs out of the `history` a [`DemContacts`] wrote into a checkpoint (its
+    /// block of [`qdem_core::checkpoint::model_histories`]), without the model that wrote it.
+    ///
+    /// # Errors
+    /// [`CheckpointError`] when the history is not a contact model's.
+    pub fn read(history: &[u8]) -> Result<SavedSprings, CheckpointError> {
+        let mut input = Decoder::new(history);
+        input.tag("contact")?;
+        let particle = input.u32s("contact sphere particles")?;
+        input.option_f64("the last evaluation time")?;
+        input.bool("the build flag")?;
+        input.f64("the build time")?;
+        input.vec3s("the build positions")?;
+        input.u64("the rebuild count")?;
+        let spheres = particle.len();
+        let pairs = ContactList::restore(&mut input, spheres, spheres)?;
+        let walls = ContactList::restore(&mut input, spheres, u32::MAX as usize)?;
+        let stretched = |list: &ContactList, second_is_sphere: bool| {
+            list.springs()
+                .map(|(a, b, spring)| SavedSpring {
+                    first: particle[a as usize],
+                    second: match second_is_sphere {
+                        true => particle[b as usize],
+                        false => b,
+                    },
+                    spring,
+                })
+                .collect()
+        };
+        Ok(SavedSprings {
+            pairs: stretched(&pairs, true),
+            walls: stretched(&walls, false),
+        })
+    }
+
+    /// Number of springs.
+    pub fn len(&self) -> usize {
+        self.pairs.len() + self.walls.len()
+    }
+
+    /// Whether there is none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// How many saved springs [`DemContacts::carry_springs`] carried, and how many it dropped
+/// because this model has no sphere on one of their particles, or not their wall.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CarriedSprings {
+    /// Put on the same spheres (and walls) here.
+    pub carried: usize,
+    /// Not matched.
+    pub dropped: usize,
+}
+
+impl DemContacts {
+    /// Starts this model's contacts with the `saved` springs of the same spheres, before its
+    /// first evaluation: `particle_of` maps a particle of the saved scene to this scene's
+    /// (`None`: it has none); walls keep their index. A pair whose spheres come in the other
+    /// order here keeps its spring as it acts on the new first sphere, −ξ. The lists are
+    /// rebuilt at the first evaluation, which keeps the springs of the candidates (a spring
+    /// whose spheres are out of reach there was released anyway). With the time of the last
+    /// evaluation unknown, that first evaluation leaves the springs as they are (no time has
+    /// passed), so the new stage continues the old one's springs where they stood.
+    pub fn carry_springs(
+        &mut self,
+        saved: &SavedSprings,
+        particle_of: impl Fn(u32) -> Option<usize>,
+    ) -> CarriedSprings {
+        let sphere_of: HashMap<usize, u32> = (self.particle.iter().enumerate())
+            .map(|(s, &p)| (p as usize, s as u32))
+            .collect();
+        let sphere = |p: u32| particle_of(p).and_then(|p| sphere_of.get(&p).copied());
+        let mut pairs: Vec<(u32, u32, Vec3)> = (saved.pairs.iter())
+            .filter_map(|c| match (sphere(c.first), sphere(c.second)) {
+                (Some(a), Some(b)) if a < b => Some((a, b, c.spring)),
+                (Some(a), Some(b)) if a > b => Some((b, a, -c.spring)),
+                _ => None,
+            })
+            .collect();
+        let walls = self.walls.len() as u32;
+        let mut wall_contacts: Vec<(u32, u32, Vec3)> = (saved.walls.iter())
+            .filter(|c| c.second < walls)
+            .filter_map(|c| sphere(c.first).map(|a| (a, c.second, c.spring)))
+            .collect();
+        for list in [&mut pairs, &mut wall_contacts] {
+            list.sort_by_key(|c| (c.0, c.1));
+            list.dedup_by_key(|c| (c.0, c.1));
+        }
+        let carried = pairs.len() + wall_contacts.len();
+        self.pairs = ContactList::with_springs(pairs);
+        self.wall_contacts = ContactList::with_springs(wall_contacts);
+        self.built = false;
+        self.build_incidence();
+        CarriedSprings {
+            carried,
+            dropped: saved.len() - carried,
+        }
+    }
+}
 
 impl Persistent for DemContacts {
-    /// The candidate lists with their tangential springs, where and when they were built, and
-    /// the time-delayed boundary's estimates: everything but the sphere centres, which are
-    /// read from the state.
+    /// The spheres' particles (their identities for [`SavedSprings`]), the candidate lists
+    /// with their tangential springs, where and when they were built, and the time-delayed
+    /// boundary's estimates: everything but the sphere centres, which are read from the
+    /// state.
     fn save(&self, out: &mut Encoder) {
         out.tag("contact");
+        out.u32s(&self.particle);
         out.option_f64(self.last_time);
         out.bool(self.built);
         out.f64(self.built_time);
@@ -30,6 +164,17 @@ impl Persistent for DemContacts {
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
         input.tag("contact")?;
         let spheres = self.particle.len();
+        let particle = input.u32s("contact sphere particles")?;
+        if particle != self.particle {
+            return Err(CheckpointError::Invalid {
+                what: "contact spheres",
+                detail: format!(
+                    "the checkpoint's {} spheres sit on other particles than the scene's {}",
+                    particle.len(),
+                    spheres
+                ),
+            });
+        }
         self.last_time = input.option_f64("the last evaluation time")?;
         self.built = input.bool("the build flag")?;
         self.built_time = input.f64("the build time")?;
@@ -60,5 +205,102 @@ impl Persistent for DemContacts {
             split.whole = true;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{LinearSpring, PlaneWall, WallShape};
+
+    /// Two spheres of bodies 0 and 1 overlapping by 1 mm, the second also 0.5 mm into a floor,
+    /// listed in `order`, with `walls` floors.
+    fn model(state: &State, order: [usize; 2], walls: usize) -> DemContacts {
+        let spheres: Vec<ContactSphere> = order
+            .iter()
+            .map(|&i| ContactSphere {
+                particle: i,
+                radius: 0.01,
+                body: i,
+                material: 0,
+            })
+            .collect();
+        let floor = || Wall {
+            shape: WallShape::Plane(PlaneWall::new(Vec3::zeros(), Vec3::z(), Vec3::zeros())),
+            friction: 0.5,
+        };
+        let law = ContactLaw::Linear(LinearSpring {
+            normal_stiffness: 1e5,
+            tangential_stiffness: 1e5,
+            damping_ratio: 0.0,
+        });
+        let settings = ContactSettings {
+            law,
+            friction: 0.5,
+            skin: 0.001,
+        };
+        let names = order.iter().map(|i| format!("body {i}")).collect();
+        let walls = (0..walls).map(|_| floor()).collect();
+        DemContacts::new(state, &spheres, names, &[(1e9, 0.25)], settings, walls)
+    }
+
+    fn forces(model: &mut DemContacts, state: &State) -> Vec<Vec3> {
+        let mut force = vec![Vec3::zeros(); 2];
+        model.add_forces(state, &mut force, &mut []);
+        force
+    }
+
+    #[test]
+    fn springs_go_to_the_same_spheres_in_any_order_and_a_missing_wall_drops_its_own() {
+        let mut state = State::at_rest(vec![
+            Vec3::new(0.0, 0.0, 0.0285),
+            Vec3::new(0.0, 0.0, 0.0095),
+        ]);
+        state.mass = vec![0.01, 0.01];
+        let mut saved = model(&state, [0, 1], 1);
+        forces(&mut saved, &state);
+        // The lower sphere slides 2 µm along x (a stick well below μ f_n on both contacts).
+        state.time = 1e-3;
+        state.position[1].x = 2e-6;
+        state.velocity[1].x = 2e-3;
+        let before = forces(&mut saved, &state);
+        assert!(before[1].x.abs() > 0.1, "stretched springs: {before:?}");
+        let mut out = Encoder::new();
+        saved.save(&mut out);
+        let springs = SavedSprings::read(out.bytes()).unwrap();
+        assert_eq!((springs.pairs.len(), springs.walls.len()), (1, 1));
+        // The spheres listed the other way round: the pair's spring acts on the new first
+        // sphere (the old second), −ξ; the same forces on the particles, no time elapsed.
+        let mut carried = model(&state, [1, 0], 1);
+        let count = carried.carry_springs(&springs, |p| Some(p as usize));
+        assert_eq!(
+            count,
+            CarriedSprings {
+                carried: 2,
+                dropped: 0
+            }
+        );
+        let after = forces(&mut carried, &state);
+        for (b, a) in before.iter().zip(&after) {
+            assert!((b - a).norm() < 1e-15, "{b:?} vs {a:?}");
+        }
+        let mut no_floor = model(&state, [0, 1], 0);
+        let count = no_floor.carry_springs(&springs, |p| Some(p as usize));
+        assert_eq!(
+            count,
+            CarriedSprings {
+                carried: 1,
+                dropped: 1
+            }
+        );
+        let mut no_sphere = model(&state, [0, 1], 1);
+        let count = no_sphere.carry_springs(&springs, |p| (p == 0).then_some(0));
+        assert_eq!(
+            count,
+            CarriedSprings {
+                carried: 0,
+                dropped: 2
+            }
+        );
     }
 }

@@ -24,7 +24,7 @@
 //! `summary.json` report. The step itself is chosen once, by [`StepSettings::resolve`], and
 //! the models learn how they are stepped from [`Model::prepare`].
 
-use crate::checkpoint::{CheckpointError, Decoder, Encoder};
+use crate::checkpoint::{model_tag, whole_block, CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::parallel::{Communicator, Decomposition, Exchange, Reads};
 use crate::state::State;
@@ -388,14 +388,18 @@ impl World {
         self.stepper.save(&mut Encoder::new())
     }
 
-    /// Writes the state, every model's history and the stepper's into a checkpoint.
+    /// Writes the state, every model's history (each a block of its own, empty for a model
+    /// without history, so that a reader may skip it: [`crate::checkpoint::model_histories`])
+    /// and the stepper's into a checkpoint.
     pub fn save(&self, out: &mut Encoder) -> Result<(), CheckpointError> {
         self.state.save(out);
         for m in &self.models {
-            out.tag(&format!("model {}", m.name()));
-            if let Persistence::Saved(history) = m.persistence() {
-                history.save(out);
+            out.tag(&model_tag(m.name()));
+            let mut history = Encoder::new();
+            if let Persistence::Saved(saved) = m.persistence() {
+                saved.save(&mut history);
             }
+            out.block(history.bytes());
         }
         self.stepper.save(out)
     }
@@ -406,10 +410,12 @@ impl World {
     pub fn restore(&mut self, input: &mut Decoder<'_>, steps_done: u64) -> Result<(), CoreError> {
         self.state.restore(input)?;
         for m in self.models.iter_mut() {
-            input.tag(&format!("model {}", m.name()))?;
+            input.tag(&model_tag(m.name()))?;
+            let mut block = Decoder::new(input.block("a model's history")?);
             if let Some(history) = m.persistent_mut() {
-                history.restore(input)?;
+                history.restore(&mut block)?;
             }
+            whole_block(m.name(), &block)?;
         }
         self.stepper
             .resume(&mut self.state, &mut self.models, input)?;

@@ -240,8 +240,16 @@ impl Simulation {
         if let Some(file) = &scene.run.start_from {
             let units = kind_change::units(&scene, &meshes, &bodies, ballast.as_ref());
             let p = periodic.as_ref();
+            let contacts = models.iter_mut().find_map(|m| {
+                let m: &mut dyn std::any::Any = m.as_mut();
+                m.downcast_mut::<DemContacts>()
+            });
             warnings.extend(start_from::restore_state(
-                &scene, file, &units, &mut state, p,
+                &scene,
+                file,
+                &units,
+                (&mut state, contacts),
+                p,
             )?);
         }
         let (probes, regions) = probes::resolve_probes(&scene, &bodies, granular.as_ref(), &state)?;

@@ -8,8 +8,10 @@
 //! checkpoint up to whole periods of the periodic cell (a periodic cell wraps reference and
 //! current positions together). Positions, velocities, accelerations and rigid-body motion are
 //! taken from the checkpoint, except that the directions this scene fixes start at rest; time
-//! restarts at 0; contact lists are rebuilt at the first step and tangential springs start
-//! unstretched.
+//! restarts at 0; contact lists are rebuilt at the first step, with the tangential springs of
+//! the checkpoint's contacts between the same spheres (and walls, by their order in the scene):
+//! a sphere is known by the particle that carries it, so a spring whose sphere or wall this
+//! scene does not have is dropped, and counted in a line ([`carry_springs`]).
 //!
 //! A body's kind may differ from the checkpoint's scene (`rigid` on a `[[body]]` or on the
 //! `[ballast]`): the particles are then mapped and the bodies turned as `kind_change` says.
@@ -18,9 +20,9 @@ use crate::build::kind_change::{self, Unit};
 use crate::build::BuildError;
 use crate::checkpoint::read_checkpoint;
 use crate::scene::Scene;
-use qdem_contact::PeriodicBox;
-use qdem_contact::WrapGroup;
-use qdem_core::checkpoint::{Decoder, SavedState};
+use qdem_contact::{DemContacts, PeriodicBox, SavedSprings, WrapGroup};
+use qdem_core::checkpoint::{model_histories, Decoder, SavedState};
+use qdem_core::CheckpointError;
 use qdem_core::{State, Vec3};
 use std::path::Path;
 
@@ -29,13 +31,14 @@ use std::path::Path;
 const SAME_PLACE: f64 = 1e-9;
 
 /// Replaces the positions, velocities and accelerations of `state` with those of the
-/// checkpoint `file` (relative to the scene), with time 0; the bodies of `units` may have
-/// another kind there. Returns a line for each body whose kind changed.
+/// checkpoint `file` (relative to the scene), with time 0, and starts `contacts` with the
+/// checkpoint's tangential springs; the bodies of `units` may have another kind there. Returns
+/// a line for each body whose kind changed, and one for springs that could not be carried.
 pub(crate) fn restore_state(
     scene: &Scene,
     file: &Path,
     units: &[Unit],
-    state: &mut State,
+    (state, contacts): (&mut State, Option<&mut DemContacts>),
     periodic: Option<&(PeriodicBox, Vec<WrapGroup>)>,
 ) -> Result<Vec<String>, BuildError> {
     let path = scene.resolve(file);
@@ -78,16 +81,70 @@ pub(crate) fn restore_state(
     if let Some((i, d)) = first_misplaced(&built, &state.reference, cell) {
         return Err(refused(misplaced(units, i, d)));
     }
-    let turned = turn(units, &was_rigid, &layout, &saved, state);
+    let mut lines = turn(units, &was_rigid, &layout, &saved, state);
     // The scene's fixes hold from the first step, even in directions the checkpoint's
     // scene let move (else those would keep the checkpoint's velocity for the whole run).
     state.hold_fixed();
     state.time = 0.0;
+    let springs = saved_springs(&mut input).map_err(|e| {
+        refused(format!(
+            "{e}; its contact springs cannot be read: start from a checkpoint this qdem wrote"
+        ))
+    })?;
+    lines.extend(carry_springs(&springs, &layout, saved.len(), contacts));
     let from = path.display();
-    Ok(turned
+    Ok(lines
         .into_iter()
         .map(|t| format!("[run] start_from {from}: {t}"))
         .collect())
+}
+
+/// The name of the contact model ([`DemContacts`]) in a checkpoint.
+const CONTACT_MODEL: &str = "contact";
+
+/// The stretched tangential springs of the checkpoint's contact model (none without one),
+/// read after its state.
+fn saved_springs(input: &mut Decoder<'_>) -> Result<SavedSprings, CheckpointError> {
+    let histories = model_histories(input)?;
+    match histories.iter().find(|(name, _)| name == CONTACT_MODEL) {
+        Some((_, history)) => SavedSprings::read(history),
+        None => Ok(SavedSprings::default()),
+    }
+}
+
+/// Puts the `saved` springs on the same spheres of `contacts` (a sphere is known by its
+/// particle: `layout` maps the checkpoint's `old_particles` particles to this scene's); a line
+/// when some could not be carried.
+fn carry_springs(
+    saved: &SavedSprings,
+    layout: &Layout,
+    old_particles: usize,
+    contacts: Option<&mut DemContacts>,
+) -> Option<String> {
+    let mut new_of_old = vec![None; old_particles];
+    for (new, old) in layout.particle.iter().enumerate() {
+        if let Some(old) = *old {
+            new_of_old[old] = Some(new);
+        }
+    }
+    let total = saved.len();
+    let Some(contacts) = contacts else {
+        return (total > 0).then(|| {
+            format!(
+                "its {total} stretched tangential contact springs dropped: this scene has no \
+                 contacts"
+            )
+        });
+    };
+    let carried = contacts.carry_springs(saved, |p| new_of_old.get(p as usize).copied().flatten());
+    (carried.dropped > 0).then(|| {
+        format!(
+            "{} of its {total} stretched tangential contact springs dropped: a sphere or wall \
+             of theirs is not in this scene (a body without `contact_radius` here, or fewer \
+             [[wall]]s); the other {} carried",
+            carried.dropped, carried.carried
+        )
+    })
 }
 
 /// Where each particle and rigid body of this scene comes from in the checkpoint's (`None`: a

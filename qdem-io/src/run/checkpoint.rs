@@ -33,8 +33,10 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.qdc";
 /// 6: its tangent records how many of its leading entries a model keeps; 7: the run record
 /// holds `walls.csv`'s rows in a scene with walls and each `[[measure]]`'s rows, and the
 /// contacts keep each servo wall's point and velocity after their lists: nothing without a
-/// servo wall, so a version 7 file of a scene without one reads as before).
-pub const FORMAT_VERSION: u64 = 7;
+/// servo wall, so a version 7 file of a scene without one reads as before; 8: each model's history is a
+/// block (a reader may skip it) and the contacts' history starts with their spheres'
+/// particles, by which `[run] start_from` carries their springs).
+pub const FORMAT_VERSION: u64 = 8;
 
 const MAGIC: &[u8; 8] = b"QDEMCKPT";
 const HEADER: usize = 8 + 8 + 8;

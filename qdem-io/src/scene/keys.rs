@@ -98,7 +98,7 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "[run]",
         "start_from",
         "path, optional",
-        "Start from the state in this checkpoint (written by another scene with the same bodies, e.g. a deposition run), relative to the scene file: positions, velocities and reference positions are taken from it, time restarts at 0, contact histories start empty.",
+        "Start from the state in this checkpoint (written by another scene with the same bodies, e.g. a deposition run), relative to the scene file: positions, velocities and reference positions are taken from it, time restarts at 0, and the tangential contact springs are carried between the same spheres and walls (a spring whose sphere or wall this scene lacks is dropped and counted).",
     ),
     key(
         "[[material]]",

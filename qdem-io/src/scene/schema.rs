@@ -46,7 +46,8 @@ pub struct Run {
     pub gamma: f64,
     /// Start from the state in this checkpoint (written by another scene with the same bodies,
     /// e.g. a deposition run), relative to the scene file: positions, velocities and reference
-    /// positions are taken from it, time restarts at 0, contact histories start empty.
+    /// positions are taken from it, time restarts at 0, the tangential contact springs carry
+    /// over between the same spheres and walls.
     #[serde(default)]
     pub start_from: Option<PathBuf>,
 }
