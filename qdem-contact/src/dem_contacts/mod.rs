@@ -215,6 +215,8 @@ pub struct DemContacts {
     body: Vec<u32>,
     rigid: Vec<u32>,
     turn: Vec<u32>,
+    /// Per sphere, whether its particle and rotation are its alone (`scatter.rs`).
+    exclusive: Vec<bool>,
     lever: Vec<f64>,
     bound_mass: Vec<f64>,
     body_names: Vec<String>,

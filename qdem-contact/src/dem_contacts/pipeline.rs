@@ -192,7 +192,7 @@ impl DemContacts {
 
     /// The geometry and elasticity of the pair of spheres of `contact`, with the image
     /// translation of its second sphere (written into `contact`); `None` when apart.
-    #[inline]
+    #[inline(always)]
     pub(super) fn pair_contact(
         &self,
         contact: &mut Contact,

@@ -10,7 +10,10 @@
 //! distinct such sphere, planned at each build). A serial pass then adds, for every partner
 //! of a candidate, its foreign sums in ascending run order and its own run's sum last, and
 //! the total to its particle: each sphere's sum is the same sequence of additions for any
-//! thread count, without atomics. The gather of the record path (`pipeline.rs`, the split
+//! thread count, without atomics. A sphere that receives no foreign sums and whose particle
+//! and rotation no other sphere shares (a one-sphere grain, a vertex of a deformable body) is
+//! complete when its run ends: the run adds it to its particle itself, so the serial pass
+//! runs over the spheres near a run's start alone. The gather of the record path (`pipeline.rs`, the split
 //! ranks and the time-delayed boundary) sums in exactly this order, so both paths agree bit
 //! for bit.
 //!
@@ -47,6 +50,10 @@ pub(super) struct ScatterPlan {
     receive: Vec<(u32, u32, u32)>,
     /// Per run, its foreign accumulator (scratch).
     foreign: Vec<Vec<Sum>>,
+    /// Per partner (as [`DemContacts::partners`]), whether its run adds it to its particle.
+    early: Vec<bool>,
+    /// The partners the serial pass adds, ascending.
+    late: Vec<u32>,
 }
 
 /// One run's share of the lists.
@@ -120,6 +127,18 @@ impl DemContacts {
             plan.runs.push(run);
         }
         plan.receive.sort_unstable();
+        plan.early.clear();
+        plan.late.clear();
+        let mut receive = plan.receive.iter().map(|e| e.0).peekable();
+        for &s in &self.partners {
+            let receives = receive.next_if_eq(&s).is_some();
+            while receive.next_if_eq(&s).is_some() {}
+            let early = self.exclusive[s as usize] && !receives;
+            plan.early.push(early);
+            if !early {
+                plan.late.push(s);
+            }
+        }
         self.scatter = plan;
         // Spheres that touch nothing keep a zero sum until the next build.
         self.sphere_force.fill((Vec3::zeros(), Vec3::zeros()));
@@ -139,10 +158,11 @@ impl DemContacts {
         let mut walls = std::mem::take(&mut self.wall_contacts.items);
         let mut sums = std::mem::take(&mut self.sphere_force);
         {
+            let carriers = (Carriers::new(force), Carriers::new(torque));
             let pair_runs = cut(&mut pairs, plan.runs.iter().map(|r| r.pairs.len()));
             let wall_runs = cut(&mut walls, plan.runs.iter().map(|r| r.walls.len()));
             let this = &*self;
-            let (runs, slot) = (&plan.runs, &plan.slot);
+            let (runs, slot, early) = (&plan.runs, &plan.slot, &plan.early);
             sums.par_chunks_mut(SCATTER_CHUNK)
                 .zip(plan.foreign.par_iter_mut())
                 .zip(pair_runs.into_par_iter().zip(wall_runs))
@@ -153,11 +173,18 @@ impl DemContacts {
                     let slots = &slot[run.pairs.clone()];
                     let partners = &this.partners[run.partners.clone()];
                     this.evaluate_run(time, dt, lo, (pairs, slots, walls, partners), own, foreign);
+                    let early = &early[run.partners.clone()];
+                    for (&s, _) in partners.iter().zip(early).filter(|(_, &e)| e) {
+                        let (f, t) = &own[(s - lo) as usize];
+                        // SAFETY: an early sphere's particle and rotation are its own
+                        // (`exclusive_carriers`), and each sphere is in one run.
+                        unsafe { this.add_exclusive(s as usize, f, t, &carriers) };
+                    }
                 });
         }
         (self.pairs.items, self.wall_contacts.items) = (pairs, walls);
         let mut receive = plan.receive.iter().peekable();
-        for &s in &self.partners {
+        for &s in &plan.late {
             let mut total: Option<Sum> = None;
             while let Some(&(_, r, k)) = receive.next_if(|e| e.0 == s) {
                 total = Some(add_sum(total, plan.foreign[r as usize][k as usize]));
@@ -216,6 +243,71 @@ impl DemContacts {
                 &mut own[s - lo as usize],
                 wall_share(contact, self.now[s].radius),
             );
+        }
+    }
+}
+
+/// Force or torque sums that the runs of the fused pass add to in parallel, each element
+/// from one sphere only.
+struct Carriers {
+    at: *mut Vec3,
+    len: usize,
+}
+
+// SAFETY: the runs write disjoint elements (`DemContacts::add_exclusive`).
+unsafe impl Sync for Carriers {}
+
+impl Carriers {
+    fn new(sums: &mut [Vec3]) -> Carriers {
+        Carriers {
+            at: sums.as_mut_ptr(),
+            len: sums.len(),
+        }
+    }
+
+    /// `sums[i] += v`.
+    ///
+    /// # Safety
+    /// No other thread reads or writes element `i` while the `Carriers` lives.
+    #[inline]
+    unsafe fn add(&self, i: usize, v: &Vec3) {
+        assert!(i < self.len, "carrier {i} beyond {}", self.len);
+        *self.at.add(i) += v;
+    }
+}
+
+/// Per sphere on `particle` adding its moment to `turn`, whether no other sphere shares its
+/// particle or the rotation it adds to (always so for one-sphere grains and the vertices of
+/// deformable bodies; not for the spheres of a rigid body).
+pub(super) fn exclusive_carriers(particle: &[u32], turn: &[u32]) -> Vec<bool> {
+    let mut count = std::collections::HashMap::<(bool, u32), u32>::new();
+    let keys = |s: usize| [(false, particle[s]), (true, turn[s])];
+    for s in 0..particle.len() {
+        for key in keys(s).into_iter().filter(|k| k.1 != NOT_RIGID) {
+            *count.entry(key).or_default() += 1;
+        }
+    }
+    (0..particle.len())
+        .map(|s| keys(s).iter().all(|k| k.1 == NOT_RIGID || count[k] == 1))
+        .collect()
+}
+
+impl DemContacts {
+    /// [`DemContacts::add_sphere`] from a run of the fused pass.
+    ///
+    /// # Safety
+    /// No other sphere adds to sphere `s`'s particle or rotation at the same time.
+    #[inline]
+    unsafe fn add_exclusive(
+        &self,
+        s: usize,
+        f: &Vec3,
+        t: &Vec3,
+        (force, torque): &(Carriers, Carriers),
+    ) {
+        force.add(self.particle[s] as usize, f);
+        if self.turn[s] != NOT_RIGID {
+            torque.add(self.turn[s] as usize, t);
         }
     }
 }
