@@ -54,7 +54,7 @@ use qdem_core::{
     State, Tangent, Vec3,
 };
 use rayon::prelude::*;
-use scatter::{add_sum, add_to, pair_share, run_of, wall_share, ScatterPlan};
+use scatter::{add_sum, add_to, pair_share, wall_share, ScatterPlan};
 use split::ContactPart;
 
 mod build;

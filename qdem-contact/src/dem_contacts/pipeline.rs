@@ -319,12 +319,12 @@ impl DemContacts {
             (&self.incidence_start, &self.incidence, &self.wall_start);
         let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
         let radius = self.radius[s];
-        let own = run_of(s as u32);
+        let own = self.run_of(s as u32);
         let (mut total, mut partial, mut run) = (None, (Vec3::zeros(), Vec3::zeros()), own);
         for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
             let c = &pairs[(e / 2) as usize];
             let first = e % 2 == 0;
-            let r = run_of(c.first);
+            let r = self.run_of(c.first);
             if r != run {
                 if run != own {
                     total = Some(add_sum(total, partial));

@@ -1,8 +1,9 @@
 //! The fused pass of a single-process evaluation: narrow phase, law and the per-sphere sums in
 //! one parallel region, with no gather.
 //!
-//! The spheres are cut into fixed runs of [`SCATTER_CHUNK`] (by sphere index, whatever the
-//! number of threads). A run owns the candidate pairs whose first sphere it holds (the lists
+//! The spheres are cut into fixed runs ([`run_length`]: by sphere index, whatever the number
+//! of threads; an even number of runs of at most [`SCATTER_CHUNK`], so that two threads share
+//! them equally). A run owns the candidate pairs whose first sphere it holds (the lists
 //! are sorted by partners, so these are one slice of the list) and the wall contacts of its
 //! spheres. It evaluates them in list order and adds each contact's force and moment
 //! straight into the sums of its own spheres (pairs, then walls) and, for a second sphere
@@ -25,16 +26,28 @@
 use super::*;
 use std::ops::Range;
 
-/// Spheres per run of the fused pass: fixed, so that the order of every sum is.
+/// The most spheres in a run of the fused pass.
 pub(crate) const SCATTER_CHUNK: usize = 2048;
 
 /// A force and a moment.
 type Sum = (Vec3, Vec3);
 
-/// The run of sphere `s`.
-#[inline]
-pub(super) fn run_of(s: u32) -> usize {
-    s as usize / SCATTER_CHUNK
+/// Spheres per run of `n` spheres: one run of up to [`SCATTER_CHUNK`], else an even number
+/// of runs of at most [`SCATTER_CHUNK`], as equal as can be. It depends on `n` alone, so the
+/// order of every sum does not depend on the number of threads or ranks.
+pub(super) fn run_length(n: usize) -> usize {
+    match n <= SCATTER_CHUNK {
+        true => SCATTER_CHUNK,
+        false => n.div_ceil(2 * n.div_ceil(2 * SCATTER_CHUNK)),
+    }
+}
+
+impl DemContacts {
+    /// The run of sphere `s`.
+    #[inline]
+    pub(super) fn run_of(&self, s: u32) -> usize {
+        s as usize / run_length(self.particle.len())
+    }
 }
 
 /// What the fused pass knows of the lists, made at each build.
@@ -75,7 +88,8 @@ impl DemContacts {
     /// The plan of the fused pass for the current lists.
     pub(super) fn plan_scatter(&mut self) {
         let n = self.particle.len();
-        let runs = n.div_ceil(SCATTER_CHUNK);
+        let length = run_length(n);
+        let runs = n.div_ceil(length);
         let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
         let mut plan = std::mem::take(&mut self.scatter);
         plan.runs.clear();
@@ -93,8 +107,8 @@ impl DemContacts {
         let mut foreign = Vec::new();
         for r in 0..runs {
             let (lo, hi) = (
-                (r * SCATTER_CHUNK) as u32,
-                ((r + 1) * SCATTER_CHUNK).min(n) as u32,
+                (r * length) as u32,
+                ((r + 1) * length).min(n) as u32,
             );
             let (from, to) = (start(lo), start(hi));
             let run = RunPlan {
@@ -163,13 +177,14 @@ impl DemContacts {
             let wall_runs = cut(&mut walls, plan.runs.iter().map(|r| r.walls.len()));
             let this = &*self;
             let (runs, slot, early) = (&plan.runs, &plan.slot, &plan.early);
-            sums.par_chunks_mut(SCATTER_CHUNK)
+            let length = run_length(sums.len());
+            sums.par_chunks_mut(length)
                 .zip(plan.foreign.par_iter_mut())
                 .zip(pair_runs.into_par_iter().zip(wall_runs))
                 .enumerate()
                 .for_each(|(r, ((own, foreign), (pairs, walls)))| {
                     let run = &runs[r];
-                    let lo = (r * SCATTER_CHUNK) as u32;
+                    let lo = (r * length) as u32;
                     let slots = &slot[run.pairs.clone()];
                     let partners = &this.partners[run.partners.clone()];
                     this.evaluate_run(time, dt, lo, (pairs, slots, walls, partners), own, foreign);
@@ -484,11 +499,12 @@ mod tests {
         let mut crossing = 0;
         for (k, c) in contacts.pairs.items.iter().enumerate() {
             let slot = plan.slot[k] as usize;
-            if run_of(c.second) == run_of(c.first) {
-                assert_eq!(slot, c.second as usize % SCATTER_CHUNK);
+            let length = run_length(contacts.spheres());
+            if contacts.run_of(c.second) == contacts.run_of(c.first) {
+                assert_eq!(slot, c.second as usize % length);
             } else {
                 crossing += 1;
-                let (r, f) = (run_of(c.first) as u32, (slot - SCATTER_CHUNK) as u32);
+                let (r, f) = (contacts.run_of(c.first) as u32, (slot - SCATTER_CHUNK) as u32);
                 assert!(plan.receive.binary_search(&(c.second, r, f)).is_ok());
             }
         }
