@@ -375,8 +375,8 @@ impl Model for DemContacts {
 
     fn potential_energy(&self, state: &State) -> Option<f64> {
         let law = &self.settings.law;
-        let pairs = self.pairs.items.iter().filter_map(|c| {
-            self.pair_contact(&mut c.clone())
+        let pairs = self.pairs.with_shifts().filter_map(|(c, mut shift)| {
+            self.pair_contact(c, &mut shift)
                 .map(|(g, e)| law.energy(&g, &e, &c.history))
         });
         let walls = self.wall_contacts.items.iter().filter_map(|c| {

@@ -106,10 +106,7 @@ impl DemContacts {
         };
         let mut foreign = Vec::new();
         for r in 0..runs {
-            let (lo, hi) = (
-                (r * length) as u32,
-                ((r + 1) * length).min(n) as u32,
-            );
+            let (lo, hi) = ((r * length) as u32, ((r + 1) * length).min(n) as u32);
             let (from, to) = (start(lo), start(hi));
             let run = RunPlan {
                 pairs: from.0..to.0,
@@ -169,25 +166,36 @@ impl DemContacts {
     ) {
         let mut plan = std::mem::take(&mut self.scatter);
         let mut pairs = std::mem::take(&mut self.pairs.items);
+        let mut shifts = std::mem::take(&mut self.pairs.shift);
         let mut walls = std::mem::take(&mut self.wall_contacts.items);
+        self.pairs.turn.clear();
+        self.wall_contacts.turn.clear();
         let mut sums = std::mem::take(&mut self.sphere_force);
         {
             let carriers = (Carriers::new(force), Carriers::new(torque));
             let pair_runs = cut(&mut pairs, plan.runs.iter().map(|r| r.pairs.len()));
+            let periodic = self.periodic.is_some();
+            let shift_runs = cut(
+                &mut shifts,
+                plan.runs
+                    .iter()
+                    .map(|r| if periodic { r.pairs.len() } else { 0 }),
+            );
             let wall_runs = cut(&mut walls, plan.runs.iter().map(|r| r.walls.len()));
             let this = &*self;
             let (runs, slot, early) = (&plan.runs, &plan.slot, &plan.early);
             let length = run_length(sums.len());
             sums.par_chunks_mut(length)
                 .zip(plan.foreign.par_iter_mut())
-                .zip(pair_runs.into_par_iter().zip(wall_runs))
+                .zip(pair_runs.into_par_iter().zip(shift_runs).zip(wall_runs))
                 .enumerate()
-                .for_each(|(r, ((own, foreign), (pairs, walls)))| {
+                .for_each(|(r, ((own, foreign), ((pairs, shifts), walls)))| {
                     let run = &runs[r];
                     let lo = (r * length) as u32;
                     let slots = &slot[run.pairs.clone()];
                     let partners = &this.partners[run.partners.clone()];
-                    this.evaluate_run(time, dt, lo, (pairs, slots, walls, partners), own, foreign);
+                    let lists = (pairs, shifts, slots, walls, partners);
+                    this.evaluate_run(time, dt, lo, lists, own, foreign);
                     let early = &early[run.partners.clone()];
                     for (&s, _) in partners.iter().zip(early).filter(|(_, &e)| e) {
                         let (f, t) = &own[(s - lo) as usize];
@@ -197,7 +205,8 @@ impl DemContacts {
                     }
                 });
         }
-        (self.pairs.items, self.wall_contacts.items) = (pairs, walls);
+        (self.pairs.items, self.pairs.shift) = (pairs, shifts);
+        self.wall_contacts.items = walls;
         let mut receive = plan.receive.iter().peekable();
         for &s in &plan.late {
             let mut total: Option<Sum> = None;
@@ -214,12 +223,13 @@ impl DemContacts {
 
     /// One run: its partners' sums set to zero, then each pair in list order (its shares to
     /// its first sphere and to its second, in the run or foreign), then each wall contact.
+    /// `shifts` are the pairs' image translations with periodic axes, else empty.
     fn evaluate_run(
         &self,
         time: f64,
         dt: f64,
         lo: u32,
-        (pairs, slots, walls, partners): (&mut [Contact], &[u32], &mut [Contact], &[u32]),
+        (pairs, shifts, slots, walls, partners): RunLists<'_>,
         own: &mut [Sum],
         foreign: &mut [Sum],
     ) {
@@ -228,17 +238,22 @@ impl DemContacts {
             own[(s - lo) as usize] = (Vec3::zeros(), Vec3::zeros());
         }
         foreign.fill((Vec3::zeros(), Vec3::zeros()));
-        for (contact, &slot) in pairs.iter_mut().zip(slots) {
-            let Some((g, e)) = self.pair_contact(contact) else {
+        for (k, (contact, &slot)) in pairs.iter_mut().zip(slots).enumerate() {
+            let mut shift = shifts.get(k).copied().unwrap_or_default();
+            let touching = self.pair_contact(contact, &mut shift);
+            if let Some(at) = shifts.get_mut(k) {
+                *at = shift;
+            }
+            let Some((g, e)) = touching else {
                 contact.part();
                 continue;
             };
             let f = law.force(&g, &e, &mut contact.history, dt);
-            contact.touch(f, &g.normal, g.overlap);
+            let turn = contact.touch(f, &g.normal, g.overlap);
             let (a, b) = (contact.first as usize, contact.second as usize);
             let (first, second) = (
-                pair_share(contact, true, self.now[a].radius, 1.0),
-                pair_share(contact, false, self.now[b].radius, 1.0),
+                pair_share(contact, &turn, true, self.now[a].radius, 1.0),
+                pair_share(contact, &turn, false, self.now[b].radius, 1.0),
             );
             add_to(&mut own[a - lo as usize], first);
             match (slot as usize).checked_sub(SCATTER_CHUNK) {
@@ -253,10 +268,10 @@ impl DemContacts {
                 continue;
             };
             let f = law.force(&g, &e, &mut contact.history, dt);
-            contact.touch(f, &g.normal, g.overlap);
+            let turn = contact.touch(f, &g.normal, g.overlap);
             add_to(
                 &mut own[s - lo as usize],
-                wall_share(contact, self.now[s].radius),
+                wall_share(contact, &turn, self.now[s].radius),
             );
         }
     }
@@ -327,19 +342,29 @@ impl DemContacts {
     }
 }
 
-/// The share of pair `c` of sphere `first` (else the second), of radius `radius`, with its
-/// ghost scale `scale`: ±`scale` f and the moment (r − δ/2) `scale` n × f.
+/// The share of pair `c` (with n × f `turn`) of sphere `first` (else the second), of radius
+/// `radius`, with its ghost scale `scale`: ±`scale` f and the moment (r − δ/2) `scale` n × f.
 #[inline]
-pub(super) fn pair_share(c: &Contact, first: bool, radius: f64, scale: f64) -> Sum {
+pub(super) fn pair_share(c: &Contact, turn: &Vec3, first: bool, radius: f64, scale: f64) -> Sum {
     let f = if first { scale } else { -scale } * c.force;
-    (f, c.moment(radius, scale))
+    (f, c.moment(turn, radius, scale))
 }
 
-/// The share of wall contact `c` of its sphere, of radius `radius`.
+/// The share of wall contact `c` (with n × f `turn`) of its sphere, of radius `radius`.
 #[inline]
-pub(super) fn wall_share(c: &Contact, radius: f64) -> Sum {
-    (c.force, c.moment(radius, 1.0))
+pub(super) fn wall_share(c: &Contact, turn: &Vec3, radius: f64) -> Sum {
+    (c.force, c.moment(turn, radius, 1.0))
 }
+
+/// What a run of the fused pass evaluates: its pairs, their image translations (or none),
+/// their slots in its sums, its wall contacts and its partners.
+type RunLists<'a> = (
+    &'a mut [Contact],
+    &'a mut [Vec3],
+    &'a [u32],
+    &'a mut [Contact],
+    &'a [u32],
+);
 
 /// `sum += share`.
 #[inline]
@@ -491,6 +516,17 @@ mod tests {
     }
 
     #[test]
+    fn the_runs_are_an_even_number_of_at_most_scatter_chunk_spheres_beyond_one_run() {
+        assert_eq!(run_length(SCATTER_CHUNK), SCATTER_CHUNK);
+        for n in [2049, 4096, 4097, 10_000, 100_000, 279_074] {
+            let length = run_length(n);
+            assert!(length <= SCATTER_CHUNK, "{n} spheres: runs of {length}");
+            assert_eq!(n.div_ceil(length) % 2, 0, "{n} spheres: runs of {length}");
+        }
+        assert_eq!(run_length(10_000), 1667);
+    }
+
+    #[test]
     fn the_plan_routes_second_spheres_beyond_a_run_through_its_foreign_sums() {
         let (state, mut contacts) = packing();
         contacts.read_centers(&state);
@@ -504,7 +540,10 @@ mod tests {
                 assert_eq!(slot, c.second as usize % length);
             } else {
                 crossing += 1;
-                let (r, f) = (contacts.run_of(c.first) as u32, (slot - SCATTER_CHUNK) as u32);
+                let (r, f) = (
+                    contacts.run_of(c.first) as u32,
+                    (slot - SCATTER_CHUNK) as u32,
+                );
                 assert!(plan.receive.binary_search(&(c.second, r, f)).is_ok());
             }
         }
