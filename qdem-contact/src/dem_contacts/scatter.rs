@@ -239,7 +239,7 @@ impl DemContacts {
         }
         foreign.fill((Vec3::zeros(), Vec3::zeros()));
         for (k, (contact, &slot)) in pairs.iter_mut().zip(slots).enumerate() {
-            let mut shift = shifts.get(k).copied().unwrap_or_default();
+            let mut shift = Vec3::zeros();
             let touching = self.pair_contact(contact, &mut shift);
             if let Some(at) = shifts.get_mut(k) {
                 *at = shift;
