@@ -43,16 +43,12 @@ impl Contact {
         normal.cross(&force)
     }
 
-    /// Records a contact that is apart: no force, the spring released (a record already
-    /// apart is left unwritten).
+    /// Records a contact that is apart: no force, the spring released.
     #[inline]
     pub(crate) fn part(&mut self) {
-        if self.force != Vec3::zeros() || self.history != Vec3::zeros() || self.half_overlap != 0.0
-        {
-            self.history = Vec3::zeros();
-            self.force = Vec3::zeros();
-            self.half_overlap = 0.0;
-        }
+        self.history = Vec3::zeros();
+        self.force = Vec3::zeros();
+        self.half_overlap = 0.0;
     }
 
     /// The moment about the centre of a partner of radius `radius` of the force `scale` f (or
