@@ -374,14 +374,15 @@ impl Packing {
 /// contacts (pairs and wall contacts) per sphere, each array read or written once per pass:
 /// the kick and drift of x, v, a and θ, ω, θ̈ (240 B), the sphere read (x, v, ω and the
 /// build position in, a 96-byte sphere record out: 192 B), zeroing the forces and moments
-/// (48 B), per candidate its 112-byte record read and written by the fused pass of narrow
-/// phase, law and sums, with the slot of its second sphere (228 B; the partners' records and
+/// (48 B), per candidate its 64-byte record read and written by the fused pass of narrow
+/// phase, law and sums, with the slot of its second sphere (132 B; the partners' records and
 /// the per-sphere sums stay in cache within a run), the sums out and into the particle forces
 /// and moments (48 + 144 B), gravity (56 B), and a = f/m, θ̈ = M/J with the second half kick
-/// (210 B). Before the fused pass (issue 37) each record was also read twice by a gather,
-/// with two incidence entries: 456 B per candidate.
+/// (210 B). Before the fused pass (issue 37) each 112-byte record was also read twice by a
+/// gather, with two incidence entries: 456 B per candidate; with the fused pass and that
+/// record, 228 B.
 pub fn bytes_per_sphere_step(candidates: f64) -> f64 {
-    240.0 + 192.0 + 48.0 + 228.0 * candidates + 192.0 + 56.0 + 210.0
+    240.0 + 192.0 + 48.0 + 132.0 * candidates + 192.0 + 56.0 + 210.0
 }
 
 /// Initialises a Verlet stepper of step `dt` and times `steps` steps (the initial force

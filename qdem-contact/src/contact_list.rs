@@ -2,12 +2,15 @@
 //! a sphere and a wall) holding everything a step reads and writes of it, so that the pair
 //! loop streams through one array and the gather touches one record per contact.
 //!
-//! A record keeps its partners, its tangential spring ξ, and this evaluation's results: the
-//! force f on the first partner, n × f and δ/2. The moment of the contact force about a
-//! partner's centre follows from them: the contact point lies at x_a + (r_a − δ/2) n, at a
-//! distance r − δ/2 from either centre along ∓n, so the moment on a is (r_a − δ/2) n × f and
-//! the moment on b, which feels −f, is (r_b − δ/2) n × f. The image translation of the second
-//! partner is kept for contacts through a periodic boundary (zero otherwise).
+//! A record keeps what a step reads and writes of a contact, in 64 bytes: its partners, its
+//! tangential spring ξ and this evaluation's results, the force f on the first partner and
+//! δ/2. The moment of the contact force about a partner's centre follows from them and the
+//! normal: the contact point lies at x_a + (r_a − δ/2) n, at a distance r − δ/2 from either
+//! centre along ∓n, so the moment on a is (r_a − δ/2) n × f and the moment on b, which feels
+//! −f, is (r_b − δ/2) n × f. The fused pass adds the moments as it evaluates; the record path
+//! (split ranks, a time-delayed boundary) keeps n × f in a column beside the records for its
+//! gather. The image translation of the second partner, only through a periodic boundary, is
+//! a column too.
 
 use qdem_core::checkpoint::same_count;
 use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
@@ -23,21 +26,21 @@ pub(crate) struct Contact {
     pub(crate) history: Vec3,
     /// Force on the first partner at the last evaluation (N), zero when apart.
     pub(crate) force: Vec3,
-    /// n × f (N): the moment about a partner's centre per metre of lever.
-    pub(crate) turn: Vec3,
     /// Half the overlap, δ/2 (m).
     pub(crate) half_overlap: f64,
-    /// Image translation of the second partner (m).
-    pub(crate) shift: Vec3,
 }
 
+// A record is one cache line of the pair loop's stream.
+const _: () = assert!(std::mem::size_of::<Contact>() == 64);
+
 impl Contact {
-    /// Records a touching contact's force `force` with its normal and overlap.
+    /// Records a touching contact's force `force` with its normal and overlap; returns n × f,
+    /// the moment about a partner's centre per metre of lever.
     #[inline]
-    pub(crate) fn touch(&mut self, force: Vec3, normal: &Vec3, overlap: f64) {
+    pub(crate) fn touch(&mut self, force: Vec3, normal: &Vec3, overlap: f64) -> Vec3 {
         self.force = force;
-        self.turn = normal.cross(&force);
         self.half_overlap = 0.5 * overlap;
+        normal.cross(&force)
     }
 
     /// Records a contact that is apart: no force, the spring released.
@@ -45,28 +48,34 @@ impl Contact {
     pub(crate) fn part(&mut self) {
         self.history = Vec3::zeros();
         self.force = Vec3::zeros();
-        self.turn = Vec3::zeros();
         self.half_overlap = 0.0;
     }
 
     /// The moment about the centre of a partner of radius `radius` of the force `scale` f (or
-    /// −`scale` f on the second partner): (r − δ/2) `scale` n × f.
+    /// −`scale` f on the second partner), given `turn` = n × f: (r − δ/2) `scale` n × f.
     #[inline]
-    pub(crate) fn moment(&self, radius: f64, scale: f64) -> Vec3 {
-        ((radius - self.half_overlap) * scale) * self.turn
+    pub(crate) fn moment(&self, turn: &Vec3, radius: f64, scale: f64) -> Vec3 {
+        ((radius - self.half_overlap) * scale) * turn
     }
 }
 
-/// The records of a candidate list, sorted by partners.
+/// The records of a candidate list, sorted by partners, and their columns.
 #[derive(Default)]
 pub(crate) struct ContactList {
     /// The records.
     pub(crate) items: Vec<Contact>,
+    /// Image translation of each contact's second partner (m): one per record with periodic
+    /// axes, else none (all zero).
+    pub(crate) shift: Vec<Vec3>,
+    /// n × f of each contact at the last evaluation by the record path, for its gather (N);
+    /// none after the fused pass.
+    pub(crate) turn: Vec<Vec3>,
 }
 
 impl ContactList {
-    /// Replaces the list by `keys`, sorted, keeping the springs of contacts that stay.
-    pub(crate) fn rebuild(&mut self, keys: Vec<(u32, u32)>) {
+    /// Replaces the list by `keys`, sorted, keeping the springs of contacts that stay; with
+    /// an image translation per record when `periodic`.
+    pub(crate) fn rebuild(&mut self, keys: Vec<(u32, u32)>, periodic: bool) {
         let old = std::mem::take(&mut self.items);
         let mut at = 0;
         self.items = keys
@@ -86,6 +95,22 @@ impl ContactList {
                 }
             })
             .collect();
+        self.shift.clear();
+        if periodic {
+            self.shift.resize(self.items.len(), Vec3::zeros());
+        }
+        self.turn.clear();
+    }
+
+    /// Keeps the records (and their image translations) for which `keep` holds; the n × f
+    /// column is dropped (the next evaluation rewrites it).
+    pub(crate) fn retain(&mut self, keep: impl Fn(&Contact) -> bool) {
+        let kept: Vec<bool> = self.items.iter().map(keep).collect();
+        retain_by(&mut self.items, &kept);
+        if !self.shift.is_empty() {
+            retain_by(&mut self.shift, &kept);
+        }
+        self.turn.clear();
     }
 
     /// A list of the contacts `springs` (partners sorted, and the spring ξ of each), the
@@ -117,6 +142,20 @@ impl ContactList {
         self.items.len()
     }
 
+    /// The image translation of contact `k`'s second partner.
+    #[inline]
+    pub(crate) fn shift(&self, k: usize) -> Vec3 {
+        self.shift.get(k).copied().unwrap_or_default()
+    }
+
+    /// The records with their image translations.
+    pub(crate) fn with_shifts(&self) -> impl Iterator<Item = (&Contact, Vec3)> {
+        self.items
+            .iter()
+            .enumerate()
+            .map(|(k, c)| (c, self.shift(k)))
+    }
+
     /// Writes the list into a checkpoint: partners, springs, forces and image translations
     /// (n × f and δ/2 are rewritten by every evaluation before they are read).
     pub(crate) fn save(&self, out: &mut Encoder) {
@@ -125,7 +164,7 @@ impl ContactList {
         out.u32s(&self.items.iter().map(|c| c.second).collect::<Vec<_>>());
         out.vec3s(&column(|c| c.history));
         out.vec3s(&column(|c| c.force));
-        out.vec3s(&column(|c| c.shift));
+        out.vec3s(&(0..self.len()).map(|k| self.shift(k)).collect::<Vec<_>>());
     }
 
     /// Reads back a list whose first partners index `0..firsts` and second partners
@@ -159,12 +198,21 @@ impl ContactList {
                 second: second[k],
                 history: history[k],
                 force: force[k],
-                shift: shift[k],
                 ..Contact::default()
             })
             .collect();
-        Ok(ContactList { items })
+        Ok(ContactList {
+            items,
+            shift,
+            turn: Vec::new(),
+        })
     }
+}
+
+/// Keeps `items[k]` where `kept[k]` (`retain` visits the items once, in order).
+fn retain_by<T>(items: &mut Vec<T>, kept: &[bool]) {
+    let mut kept = kept.iter();
+    items.retain(|_| kept.next() == Some(&true));
 }
 
 #[cfg(test)]
@@ -174,13 +222,28 @@ mod tests {
     #[test]
     fn a_rebuild_keeps_the_springs_of_the_pairs_that_stay() {
         let mut list = ContactList::default();
-        list.rebuild(vec![(0, 1), (0, 2), (1, 2)]);
+        list.rebuild(vec![(0, 1), (0, 2), (1, 2)], false);
         for (k, c) in list.items.iter_mut().enumerate() {
             c.history = Vec3::repeat(k as f64 + 1.0);
         }
-        list.rebuild(vec![(0, 2), (1, 3)]);
+        list.rebuild(vec![(0, 2), (1, 3)], false);
         assert_eq!(list.items[0].history, Vec3::repeat(2.0));
         assert_eq!(list.items[1].history, Vec3::zeros());
+    }
+
+    #[test]
+    fn a_cut_list_keeps_each_records_image_translation() {
+        let mut list = ContactList::default();
+        list.rebuild(vec![(0, 1), (0, 2), (1, 2), (2, 3)], true);
+        for k in 0..list.len() {
+            list.shift[k] = Vec3::repeat(k as f64);
+        }
+        list.retain(|c| c.second != 2);
+        let kept: Vec<_> = list
+            .with_shifts()
+            .map(|(c, s)| (c.first, c.second, s.x))
+            .collect();
+        assert_eq!(kept, [(0, 1, 0.0), (2, 3, 3.0)]);
     }
 
     #[test]
@@ -190,12 +253,13 @@ mod tests {
         // 1.75 x × f and b, which feels −f at 0.75 along −x, the moment 0.75 x × f.
         let mut c = Contact::default();
         let f = Vec3::new(0.0, 3.0, 0.0);
-        c.touch(f, &Vec3::x(), 0.5);
+        let turn = c.touch(f, &Vec3::x(), 0.5);
         let point_from_a = 1.75 * Vec3::x();
         let point_from_b = -0.75 * Vec3::x();
-        assert_eq!(c.moment(2.0, 1.0), point_from_a.cross(&f));
-        assert_eq!(c.moment(1.0, 1.0), point_from_b.cross(&-f));
+        assert_eq!(c.moment(&turn, 2.0, 1.0), point_from_a.cross(&f));
+        assert_eq!(c.moment(&turn, 1.0, 1.0), point_from_b.cross(&-f));
         c.part();
-        assert_eq!(c.moment(2.0, 1.0), Vec3::zeros());
+        assert_eq!(c.force, Vec3::zeros());
+        assert_eq!(c.half_overlap, 0.0);
     }
 }

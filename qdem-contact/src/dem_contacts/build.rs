@@ -95,9 +95,11 @@ impl DemContacts {
                 ..SphereNow::default()
             })
             .collect();
+        let particle: Vec<u32> = spheres.iter().map(|s| s.particle as u32).collect();
         DemContacts {
             name: "contact".to_string(),
-            particle: spheres.iter().map(|s| s.particle as u32).collect(),
+            exclusive: scatter::exclusive_carriers(&particle, &turn),
+            particle,
             radius: spheres.iter().map(|s| s.radius).collect(),
             body: spheres.iter().map(|s| s.body as u32).collect(),
             rigid,

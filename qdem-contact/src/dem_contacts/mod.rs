@@ -54,7 +54,7 @@ use qdem_core::{
     State, Tangent, Vec3,
 };
 use rayon::prelude::*;
-use scatter::{add_sum, add_to, pair_share, run_of, wall_share, ScatterPlan};
+use scatter::{add_sum, add_to, pair_share, wall_share, ScatterPlan};
 use split::ContactPart;
 
 pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
@@ -217,6 +217,8 @@ pub struct DemContacts {
     body: Vec<u32>,
     rigid: Vec<u32>,
     turn: Vec<u32>,
+    /// Per sphere, whether its particle and rotation are its alone (`scatter.rs`).
+    exclusive: Vec<bool>,
     lever: Vec<f64>,
     bound_mass: Vec<f64>,
     body_names: Vec<String>,
@@ -375,8 +377,8 @@ impl Model for DemContacts {
 
     fn potential_energy(&self, state: &State) -> Option<f64> {
         let law = &self.settings.law;
-        let pairs = self.pairs.items.iter().filter_map(|c| {
-            self.pair_contact(&mut c.clone())
+        let pairs = self.pairs.with_shifts().filter_map(|(c, mut shift)| {
+            self.pair_contact(c, &mut shift)
                 .map(|(g, e)| law.energy(&g, &e, &c.history))
         });
         let walls = self.wall_contacts.items.iter().filter_map(|c| {

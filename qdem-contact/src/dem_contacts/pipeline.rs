@@ -115,9 +115,10 @@ impl DemContacts {
             body: &self.body,
             periodic: self.periodic.as_ref(),
         };
-        self.pairs.rebuild(find_pairs(&set, skin));
+        self.pairs
+            .rebuild(find_pairs(&set, skin), self.periodic.is_some());
         let wall_keys = self.wall_keys((0..center.len()).into_par_iter(), time);
-        self.wall_contacts.rebuild(wall_keys);
+        self.wall_contacts.rebuild(wall_keys, false);
         self.finish_build(time);
     }
 
@@ -191,18 +192,20 @@ impl DemContacts {
     }
 
     /// The geometry and elasticity of the pair of spheres of `contact`, with the image
-    /// translation of its second sphere (written into `contact`); `None` when apart.
-    #[inline]
+    /// translation of its second sphere (written into `shift` when periodic, else read from
+    /// it); `None` when apart.
+    #[inline(always)]
     pub(super) fn pair_contact(
         &self,
-        contact: &mut Contact,
+        contact: &Contact,
+        shift: &mut Vec3,
     ) -> Option<(PairGeometry, PairElasticity)> {
         let (a, b) = (contact.first as usize, contact.second as usize);
         let (sa, sb) = (&self.now[a], &self.now[b]);
         if let Some(p) = &self.periodic {
-            contact.shift = p.image_shift(&(sb.center - sa.center));
+            *shift = p.image_shift(&(sb.center - sa.center));
         }
-        let geometry = narrow_phase(sa, sb, contact.shift, self.settings.friction)?;
+        let geometry = narrow_phase(sa, sb, *shift, self.settings.friction)?;
         let e = self.elasticity[sa.material as usize * self.materials + sb.material as usize];
         Some((geometry, e))
     }
@@ -250,31 +253,47 @@ impl DemContacts {
         (self.pairs, self.wall_contacts) = (pairs, walls);
     }
 
-    /// Narrow phase and law over one list, in parallel, one record per contact.
+    /// Narrow phase and law over one list, in parallel, one record and its n × f per
+    /// contact.
     pub(super) fn evaluate_list(&self, list: &mut ContactList, time: f64, dt: f64, walls: bool) {
         let law = &self.settings.law;
-        list.items
-            .par_iter_mut()
-            .with_min_len(CONTACT_CHUNK)
-            .for_each(|contact| {
-                let touching = if walls {
-                    self.wall_contact(time, contact.first as usize, contact.second as usize)
-                } else {
-                    self.pair_contact(contact)
-                };
-                match touching {
-                    Some((g, e)) => {
-                        let force = law.force(&g, &e, &mut contact.history, dt);
-                        contact.touch(force, &g.normal, g.overlap);
-                    }
-                    None => contact.part(),
+        let evaluate = |contact: &mut Contact, shift: &mut Vec3, turn: &mut Vec3| {
+            let touching = if walls {
+                self.wall_contact(time, contact.first as usize, contact.second as usize)
+            } else {
+                self.pair_contact(contact, shift)
+            };
+            *turn = match touching {
+                Some((g, e)) => {
+                    let force = law.force(&g, &e, &mut contact.history, dt);
+                    contact.touch(force, &g.normal, g.overlap)
                 }
-            });
+                None => {
+                    contact.part();
+                    Vec3::zeros()
+                }
+            };
+        };
+        list.turn.resize(list.items.len(), Vec3::zeros());
+        let with_shifts = list.shift.len() == list.items.len();
+        let (items, turn) = (list.items.par_iter_mut(), list.turn.par_iter_mut());
+        if with_shifts {
+            items
+                .zip(turn)
+                .zip(list.shift.par_iter_mut())
+                .with_min_len(CONTACT_CHUNK)
+                .for_each(|((contact, turn), shift)| evaluate(contact, shift, turn));
+        } else {
+            items
+                .zip(turn)
+                .with_min_len(CONTACT_CHUNK)
+                .for_each(|(contact, turn)| evaluate(contact, &mut Vec3::zeros(), turn));
+        }
     }
 
     /// The average magnitude of the touching pairs' forces through the boundaries of `axis`.
     pub(super) fn boundary_force(&self, axis: usize) -> f64 {
-        self.mean_pair_force(|c| c.shift[axis] != 0.0)
+        self.mean_pair_force(|_, shift| shift[axis] != 0.0)
     }
 
     /// Measures the boundary force over this process's pairs and updates the ghost scales of
@@ -314,17 +333,18 @@ impl DemContacts {
     /// ghosts scaled.
     #[inline]
     pub(super) fn sphere_sum(&self, s: usize) -> (Vec3, Vec3) {
-        let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
+        let (pairs, walls) = (&self.pairs, &self.wall_contacts);
         let (start, incidence, wall_start) =
             (&self.incidence_start, &self.incidence, &self.wall_start);
         let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
         let radius = self.radius[s];
-        let own = run_of(s as u32);
+        let own = self.run_of(s as u32);
         let (mut total, mut partial, mut run) = (None, (Vec3::zeros(), Vec3::zeros()), own);
         for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
-            let c = &pairs[(e / 2) as usize];
+            let k = (e / 2) as usize;
+            let c = &pairs.items[k];
             let first = e % 2 == 0;
-            let r = run_of(c.first);
+            let r = self.run_of(c.first);
             if r != run {
                 if run != own {
                     total = Some(add_sum(total, partial));
@@ -333,7 +353,7 @@ impl DemContacts {
             }
             let scale = match &delay {
                 Some((axis, scales)) => {
-                    let (a, b) = pair_scales(c.shift[*axis], scales);
+                    let (a, b) = pair_scales(pairs.shift(k)[*axis], scales);
                     if first {
                         a
                     } else {
@@ -342,14 +362,20 @@ impl DemContacts {
                 }
                 None => 1.0,
             };
-            add_to(&mut partial, pair_share(c, first, radius, scale));
+            add_to(
+                &mut partial,
+                pair_share(c, &pairs.turn[k], first, radius, scale),
+            );
         }
         if run != own {
             total = Some(add_sum(total, partial));
             partial = (Vec3::zeros(), Vec3::zeros());
         }
-        for c in &walls[wall_start[s] as usize..wall_start[s + 1] as usize] {
-            add_to(&mut partial, wall_share(c, radius));
+        for k in wall_start[s] as usize..wall_start[s + 1] as usize {
+            add_to(
+                &mut partial,
+                wall_share(&walls.items[k], &walls.turn[k], radius),
+            );
         }
         add_sum(total, partial)
     }

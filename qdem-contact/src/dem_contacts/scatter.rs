@@ -1,8 +1,9 @@
 //! The fused pass of a single-process evaluation: narrow phase, law and the per-sphere sums in
 //! one parallel region, with no gather.
 //!
-//! The spheres are cut into fixed runs of [`SCATTER_CHUNK`] (by sphere index, whatever the
-//! number of threads). A run owns the candidate pairs whose first sphere it holds (the lists
+//! The spheres are cut into fixed runs ([`run_length`]: by sphere index, whatever the number
+//! of threads; an even number of runs of at most [`SCATTER_CHUNK`], so that two threads share
+//! them equally). A run owns the candidate pairs whose first sphere it holds (the lists
 //! are sorted by partners, so these are one slice of the list) and the wall contacts of its
 //! spheres. It evaluates them in list order and adds each contact's force and moment
 //! straight into the sums of its own spheres (pairs, then walls) and, for a second sphere
@@ -10,7 +11,10 @@
 //! distinct such sphere, planned at each build). A serial pass then adds, for every partner
 //! of a candidate, its foreign sums in ascending run order and its own run's sum last, and
 //! the total to its particle: each sphere's sum is the same sequence of additions for any
-//! thread count, without atomics. The gather of the record path (`pipeline.rs`, the split
+//! thread count, without atomics. A sphere that receives no foreign sums and whose particle
+//! and rotation no other sphere shares (a one-sphere grain, a vertex of a deformable body) is
+//! complete when its run ends: the run adds it to its particle itself, so the serial pass
+//! runs over the spheres near a run's start alone. The gather of the record path (`pipeline.rs`, the split
 //! ranks and the time-delayed boundary) sums in exactly this order, so both paths agree bit
 //! for bit.
 //!
@@ -22,16 +26,28 @@
 use super::*;
 use std::ops::Range;
 
-/// Spheres per run of the fused pass: fixed, so that the order of every sum is.
+/// The most spheres in a run of the fused pass.
 pub(crate) const SCATTER_CHUNK: usize = 2048;
 
 /// A force and a moment.
 type Sum = (Vec3, Vec3);
 
-/// The run of sphere `s`.
-#[inline]
-pub(super) fn run_of(s: u32) -> usize {
-    s as usize / SCATTER_CHUNK
+/// Spheres per run of `n` spheres: one run of up to [`SCATTER_CHUNK`], else an even number
+/// of runs of at most [`SCATTER_CHUNK`], as equal as can be. It depends on `n` alone, so the
+/// order of every sum does not depend on the number of threads or ranks.
+pub(super) fn run_length(n: usize) -> usize {
+    match n <= SCATTER_CHUNK {
+        true => SCATTER_CHUNK,
+        false => n.div_ceil(2 * n.div_ceil(2 * SCATTER_CHUNK)),
+    }
+}
+
+impl DemContacts {
+    /// The run of sphere `s`.
+    #[inline]
+    pub(super) fn run_of(&self, s: u32) -> usize {
+        s as usize / run_length(self.particle.len())
+    }
 }
 
 /// What the fused pass knows of the lists, made at each build.
@@ -47,6 +63,10 @@ pub(super) struct ScatterPlan {
     receive: Vec<(u32, u32, u32)>,
     /// Per run, its foreign accumulator (scratch).
     foreign: Vec<Vec<Sum>>,
+    /// Per partner (as [`DemContacts::partners`]), whether its run adds it to its particle.
+    early: Vec<bool>,
+    /// The partners the serial pass adds, ascending.
+    late: Vec<u32>,
 }
 
 /// One run's share of the lists.
@@ -68,7 +88,8 @@ impl DemContacts {
     /// The plan of the fused pass for the current lists.
     pub(super) fn plan_scatter(&mut self) {
         let n = self.particle.len();
-        let runs = n.div_ceil(SCATTER_CHUNK);
+        let length = run_length(n);
+        let runs = n.div_ceil(length);
         let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
         let mut plan = std::mem::take(&mut self.scatter);
         plan.runs.clear();
@@ -85,10 +106,7 @@ impl DemContacts {
         };
         let mut foreign = Vec::new();
         for r in 0..runs {
-            let (lo, hi) = (
-                (r * SCATTER_CHUNK) as u32,
-                ((r + 1) * SCATTER_CHUNK).min(n) as u32,
-            );
+            let (lo, hi) = ((r * length) as u32, ((r + 1) * length).min(n) as u32);
             let (from, to) = (start(lo), start(hi));
             let run = RunPlan {
                 pairs: from.0..to.0,
@@ -120,6 +138,18 @@ impl DemContacts {
             plan.runs.push(run);
         }
         plan.receive.sort_unstable();
+        plan.early.clear();
+        plan.late.clear();
+        let mut receive = plan.receive.iter().map(|e| e.0).peekable();
+        for &s in &self.partners {
+            let receives = receive.next_if_eq(&s).is_some();
+            while receive.next_if_eq(&s).is_some() {}
+            let early = self.exclusive[s as usize] && !receives;
+            plan.early.push(early);
+            if !early {
+                plan.late.push(s);
+            }
+        }
         self.scatter = plan;
         // Spheres that touch nothing keep a zero sum until the next build.
         self.sphere_force.fill((Vec3::zeros(), Vec3::zeros()));
@@ -136,28 +166,49 @@ impl DemContacts {
     ) {
         let mut plan = std::mem::take(&mut self.scatter);
         let mut pairs = std::mem::take(&mut self.pairs.items);
+        let mut shifts = std::mem::take(&mut self.pairs.shift);
         let mut walls = std::mem::take(&mut self.wall_contacts.items);
+        self.pairs.turn.clear();
+        self.wall_contacts.turn.clear();
         let mut sums = std::mem::take(&mut self.sphere_force);
         {
+            let carriers = (Carriers::new(force), Carriers::new(torque));
             let pair_runs = cut(&mut pairs, plan.runs.iter().map(|r| r.pairs.len()));
+            let periodic = self.periodic.is_some();
+            let shift_runs = cut(
+                &mut shifts,
+                plan.runs
+                    .iter()
+                    .map(|r| if periodic { r.pairs.len() } else { 0 }),
+            );
             let wall_runs = cut(&mut walls, plan.runs.iter().map(|r| r.walls.len()));
             let this = &*self;
-            let (runs, slot) = (&plan.runs, &plan.slot);
-            sums.par_chunks_mut(SCATTER_CHUNK)
+            let (runs, slot, early) = (&plan.runs, &plan.slot, &plan.early);
+            let length = run_length(sums.len());
+            sums.par_chunks_mut(length)
                 .zip(plan.foreign.par_iter_mut())
-                .zip(pair_runs.into_par_iter().zip(wall_runs))
+                .zip(pair_runs.into_par_iter().zip(shift_runs).zip(wall_runs))
                 .enumerate()
-                .for_each(|(r, ((own, foreign), (pairs, walls)))| {
+                .for_each(|(r, ((own, foreign), ((pairs, shifts), walls)))| {
                     let run = &runs[r];
-                    let lo = (r * SCATTER_CHUNK) as u32;
+                    let lo = (r * length) as u32;
                     let slots = &slot[run.pairs.clone()];
                     let partners = &this.partners[run.partners.clone()];
-                    this.evaluate_run(time, dt, lo, (pairs, slots, walls, partners), own, foreign);
+                    let lists = (pairs, shifts, slots, walls, partners);
+                    this.evaluate_run(time, dt, lo, lists, own, foreign);
+                    let early = &early[run.partners.clone()];
+                    for (&s, _) in partners.iter().zip(early).filter(|(_, &e)| e) {
+                        let (f, t) = &own[(s - lo) as usize];
+                        // SAFETY: an early sphere's particle and rotation are its own
+                        // (`exclusive_carriers`), and each sphere is in one run.
+                        unsafe { this.add_exclusive(s as usize, f, t, &carriers) };
+                    }
                 });
         }
-        (self.pairs.items, self.wall_contacts.items) = (pairs, walls);
+        (self.pairs.items, self.pairs.shift) = (pairs, shifts);
+        self.wall_contacts.items = walls;
         let mut receive = plan.receive.iter().peekable();
-        for &s in &self.partners {
+        for &s in &plan.late {
             let mut total: Option<Sum> = None;
             while let Some(&(_, r, k)) = receive.next_if(|e| e.0 == s) {
                 total = Some(add_sum(total, plan.foreign[r as usize][k as usize]));
@@ -172,12 +223,13 @@ impl DemContacts {
 
     /// One run: its partners' sums set to zero, then each pair in list order (its shares to
     /// its first sphere and to its second, in the run or foreign), then each wall contact.
+    /// `shifts` are the pairs' image translations with periodic axes, else empty.
     fn evaluate_run(
         &self,
         time: f64,
         dt: f64,
         lo: u32,
-        (pairs, slots, walls, partners): (&mut [Contact], &[u32], &mut [Contact], &[u32]),
+        (pairs, shifts, slots, walls, partners): RunLists<'_>,
         own: &mut [Sum],
         foreign: &mut [Sum],
     ) {
@@ -186,17 +238,22 @@ impl DemContacts {
             own[(s - lo) as usize] = (Vec3::zeros(), Vec3::zeros());
         }
         foreign.fill((Vec3::zeros(), Vec3::zeros()));
-        for (contact, &slot) in pairs.iter_mut().zip(slots) {
-            let Some((g, e)) = self.pair_contact(contact) else {
+        for (k, (contact, &slot)) in pairs.iter_mut().zip(slots).enumerate() {
+            let mut shift = Vec3::zeros();
+            let touching = self.pair_contact(contact, &mut shift);
+            if let Some(at) = shifts.get_mut(k) {
+                *at = shift;
+            }
+            let Some((g, e)) = touching else {
                 contact.part();
                 continue;
             };
             let f = law.force(&g, &e, &mut contact.history, dt);
-            contact.touch(f, &g.normal, g.overlap);
+            let turn = contact.touch(f, &g.normal, g.overlap);
             let (a, b) = (contact.first as usize, contact.second as usize);
             let (first, second) = (
-                pair_share(contact, true, self.now[a].radius, 1.0),
-                pair_share(contact, false, self.now[b].radius, 1.0),
+                pair_share(contact, &turn, true, self.now[a].radius, 1.0),
+                pair_share(contact, &turn, false, self.now[b].radius, 1.0),
             );
             add_to(&mut own[a - lo as usize], first);
             match (slot as usize).checked_sub(SCATTER_CHUNK) {
@@ -211,28 +268,103 @@ impl DemContacts {
                 continue;
             };
             let f = law.force(&g, &e, &mut contact.history, dt);
-            contact.touch(f, &g.normal, g.overlap);
+            let turn = contact.touch(f, &g.normal, g.overlap);
             add_to(
                 &mut own[s - lo as usize],
-                wall_share(contact, self.now[s].radius),
+                wall_share(contact, &turn, self.now[s].radius),
             );
         }
     }
 }
 
-/// The share of pair `c` of sphere `first` (else the second), of radius `radius`, with its
-/// ghost scale `scale`: ±`scale` f and the moment (r − δ/2) `scale` n × f.
-#[inline]
-pub(super) fn pair_share(c: &Contact, first: bool, radius: f64, scale: f64) -> Sum {
-    let f = if first { scale } else { -scale } * c.force;
-    (f, c.moment(radius, scale))
+/// Force or torque sums that the runs of the fused pass add to in parallel, each element
+/// from one sphere only.
+struct Carriers {
+    at: *mut Vec3,
+    len: usize,
 }
 
-/// The share of wall contact `c` of its sphere, of radius `radius`.
-#[inline]
-pub(super) fn wall_share(c: &Contact, radius: f64) -> Sum {
-    (c.force, c.moment(radius, 1.0))
+// SAFETY: the runs write disjoint elements (`DemContacts::add_exclusive`).
+unsafe impl Sync for Carriers {}
+
+impl Carriers {
+    fn new(sums: &mut [Vec3]) -> Carriers {
+        Carriers {
+            at: sums.as_mut_ptr(),
+            len: sums.len(),
+        }
+    }
+
+    /// `sums[i] += v`.
+    ///
+    /// # Safety
+    /// No other thread reads or writes element `i` while the `Carriers` lives.
+    #[inline]
+    unsafe fn add(&self, i: usize, v: &Vec3) {
+        assert!(i < self.len, "carrier {i} beyond {}", self.len);
+        *self.at.add(i) += v;
+    }
 }
+
+/// Per sphere on `particle` adding its moment to `turn`, whether no other sphere shares its
+/// particle or the rotation it adds to (always so for one-sphere grains and the vertices of
+/// deformable bodies; not for the spheres of a rigid body).
+pub(super) fn exclusive_carriers(particle: &[u32], turn: &[u32]) -> Vec<bool> {
+    let mut count = std::collections::HashMap::<(bool, u32), u32>::new();
+    let keys = |s: usize| [(false, particle[s]), (true, turn[s])];
+    for s in 0..particle.len() {
+        for key in keys(s).into_iter().filter(|k| k.1 != NOT_RIGID) {
+            *count.entry(key).or_default() += 1;
+        }
+    }
+    (0..particle.len())
+        .map(|s| keys(s).iter().all(|k| k.1 == NOT_RIGID || count[k] == 1))
+        .collect()
+}
+
+impl DemContacts {
+    /// [`DemContacts::add_sphere`] from a run of the fused pass.
+    ///
+    /// # Safety
+    /// No other sphere adds to sphere `s`'s particle or rotation at the same time.
+    #[inline]
+    unsafe fn add_exclusive(
+        &self,
+        s: usize,
+        f: &Vec3,
+        t: &Vec3,
+        (force, torque): &(Carriers, Carriers),
+    ) {
+        force.add(self.particle[s] as usize, f);
+        if self.turn[s] != NOT_RIGID {
+            torque.add(self.turn[s] as usize, t);
+        }
+    }
+}
+
+/// The share of pair `c` (with n × f `turn`) of sphere `first` (else the second), of radius
+/// `radius`, with its ghost scale `scale`: ±`scale` f and the moment (r − δ/2) `scale` n × f.
+#[inline]
+pub(super) fn pair_share(c: &Contact, turn: &Vec3, first: bool, radius: f64, scale: f64) -> Sum {
+    let f = if first { scale } else { -scale } * c.force;
+    (f, c.moment(turn, radius, scale))
+}
+
+/// The share of wall contact `c` (with n × f `turn`) of its sphere, of radius `radius`.
+#[inline]
+pub(super) fn wall_share(c: &Contact, turn: &Vec3, radius: f64) -> Sum {
+    (c.force, c.moment(turn, radius, 1.0))
+}
+
+/// What a run of the fused pass evaluates: its pairs, their image translations (or none),
+/// their slots in its sums, its wall contacts and its partners.
+type RunLists<'a> = (
+    &'a mut [Contact],
+    &'a mut [Vec3],
+    &'a [u32],
+    &'a mut [Contact],
+    &'a [u32],
+);
 
 /// `sum += share`.
 #[inline]
@@ -384,6 +516,17 @@ mod tests {
     }
 
     #[test]
+    fn the_runs_are_an_even_number_of_at_most_scatter_chunk_spheres_beyond_one_run() {
+        assert_eq!(run_length(SCATTER_CHUNK), SCATTER_CHUNK);
+        for n in [2049, 4096, 4097, 10_000, 100_000, 279_074] {
+            let length = run_length(n);
+            assert!(length <= SCATTER_CHUNK, "{n} spheres: runs of {length}");
+            assert_eq!(n.div_ceil(length) % 2, 0, "{n} spheres: runs of {length}");
+        }
+        assert_eq!(run_length(10_000), 1667);
+    }
+
+    #[test]
     fn the_plan_routes_second_spheres_beyond_a_run_through_its_foreign_sums() {
         let (state, mut contacts) = packing();
         contacts.read_centers(&state);
@@ -392,11 +535,15 @@ mod tests {
         let mut crossing = 0;
         for (k, c) in contacts.pairs.items.iter().enumerate() {
             let slot = plan.slot[k] as usize;
-            if run_of(c.second) == run_of(c.first) {
-                assert_eq!(slot, c.second as usize % SCATTER_CHUNK);
+            let length = run_length(contacts.spheres());
+            if contacts.run_of(c.second) == contacts.run_of(c.first) {
+                assert_eq!(slot, c.second as usize % length);
             } else {
                 crossing += 1;
-                let (r, f) = (run_of(c.first) as u32, (slot - SCATTER_CHUNK) as u32);
+                let (r, f) = (
+                    contacts.run_of(c.first) as u32,
+                    (slot - SCATTER_CHUNK) as u32,
+                );
                 assert!(plan.receive.binary_search(&(c.second, r, f)).is_ok());
             }
         }

@@ -171,10 +171,10 @@ impl DemContacts {
             .map(|(a, b)| (near[a as usize], near[b as usize]))
             .filter(|&(a, b)| part.owns(a) || part.owns(b))
             .collect();
-        self.pairs.rebuild(keys);
+        self.pairs.rebuild(keys, self.periodic.is_some());
         let own = part.own.par_iter().map(|&s| s as usize);
         let wall_keys = self.wall_keys(own, time);
-        self.wall_contacts.rebuild(wall_keys);
+        self.wall_contacts.rebuild(wall_keys, false);
         self.finish_build(time);
     }
 
@@ -195,8 +195,8 @@ impl DemContacts {
     /// Cuts lists that hold every rank's contacts (after a merge, a restore) down to this
     /// rank's.
     fn cut_to_rank(&mut self, part: &mut ContactPart) {
-        self.pairs.items.retain(|c| part.keeps(c, false));
-        self.wall_contacts.items.retain(|c| part.keeps(c, true));
+        self.pairs.retain(|c| part.keeps(c, false));
+        self.wall_contacts.retain(|c| part.keeps(c, true));
         self.build_incidence();
         part.whole = false;
         part.lists_changed = true;
@@ -293,8 +293,8 @@ impl SplitModel for DemContacts {
         let Some(axis) = self.time_delay.as_ref().map(|t| t.axis) else {
             return false;
         };
-        for c in &self.pairs.items {
-            if c.force != Vec3::zeros() && c.shift[axis] != 0.0 {
+        for (c, shift) in self.pairs.with_shifts() {
+            if c.force != Vec3::zeros() && shift[axis] != 0.0 {
                 out.extend([c.first as f64, c.second as f64, c.force.norm()]);
             }
         }
@@ -346,13 +346,13 @@ impl SplitModel for DemContacts {
             return false;
         }
         for (list, tag) in [(&self.pairs, 0.0), (&self.wall_contacts, 1.0)] {
-            for c in &list.items {
+            for (k, (c, shift)) in list.with_shifts().enumerate() {
                 out.extend([tag, c.first as f64, c.second as f64]);
-                for v in [c.history, c.force, c.turn] {
+                for v in [c.history, c.force, list.turn[k]] {
                     out.extend_from_slice(v.as_slice());
                 }
                 out.push(c.half_overlap);
-                out.extend_from_slice(c.shift.as_slice());
+                out.extend_from_slice(shift.as_slice());
             }
         }
         true
@@ -370,10 +370,9 @@ impl SplitModel for DemContacts {
                 second: v[2] as u32,
                 history: at(v, 3),
                 force: at(v, 6),
-                turn: at(v, 9),
                 half_overlap: v[12],
-                shift: at(v, 13),
             };
+            let contact = (contact, at(v, 9), at(v, 13));
             match v[0] == 0.0 {
                 true => pairs.push(contact),
                 false => walls.push(contact),
@@ -381,9 +380,13 @@ impl SplitModel for DemContacts {
         }
         for (items, list) in [(pairs, &mut self.pairs), (walls, &mut self.wall_contacts)] {
             let mut items = items;
-            items.sort_by_key(|c| (c.first, c.second));
-            items.dedup_by_key(|c| (c.first, c.second));
-            *list = ContactList { items };
+            items.sort_by_key(|(c, _, _)| (c.first, c.second));
+            items.dedup_by_key(|(c, _, _)| (c.first, c.second));
+            *list = ContactList {
+                items: items.iter().map(|e| e.0).collect(),
+                turn: items.iter().map(|e| e.1).collect(),
+                shift: items.iter().map(|e| e.2).collect(),
+            };
         }
         self.build_incidence();
         self.gather();

@@ -21,19 +21,19 @@ impl DemContacts {
     /// for Eqs. 4–5 is a statement about that force).
     pub fn section_force(&self, axis: usize, at: f64) -> f64 {
         let period = self.periodic.as_ref().and_then(|p| p.length(axis));
-        self.mean_pair_force(|c| {
+        self.mean_pair_force(|c, shift| {
             let a = self.center[c.first as usize][axis] - at;
-            let b = self.center[c.second as usize][axis] + c.shift[axis] - at;
+            let b = self.center[c.second as usize][axis] + shift[axis] - at;
             crosses(a, b, period)
         })
     }
 
     /// The average magnitude of the forces of the touching pairs c for which `counted(c)`
     /// (serial, in pair order, so it does not depend on the thread count); 0 without any.
-    pub(super) fn mean_pair_force(&self, counted: impl Fn(&Contact) -> bool) -> f64 {
+    pub(super) fn mean_pair_force(&self, counted: impl Fn(&Contact, Vec3) -> bool) -> f64 {
         let (mut sum, mut count) = (0.0, 0usize);
-        for c in &self.pairs.items {
-            if c.force != Vec3::zeros() && counted(c) {
+        for (c, shift) in self.pairs.with_shifts() {
+            if c.force != Vec3::zeros() && counted(c, shift) {
                 sum += c.force.norm();
                 count += 1;
             }
@@ -112,11 +112,12 @@ impl DemContacts {
     pub fn touching(&self) -> impl Iterator<Item = TouchingContact> + '_ {
         let time = self.last_time.unwrap_or(0.0);
         let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
-        let pairs = self.pairs.items.iter().filter(|c| c.force != Vec3::zeros());
-        let pairs = pairs.map(move |c| {
+        let pairs = self.pairs.with_shifts();
+        let pairs = pairs.filter(|(c, _)| c.force != Vec3::zeros());
+        let pairs = pairs.map(move |(c, shift)| {
             let (a, b) = (c.first as usize, c.second as usize);
-            let (from, to) = (self.center[a], self.center[b] + c.shift);
-            let scales = delay.map_or((1.0, 1.0), |(axis, s)| pair_scales(c.shift[axis], &s));
+            let (from, to) = (self.center[a], self.center[b] + shift);
+            let scales = delay.map_or((1.0, 1.0), |(axis, s)| pair_scales(shift[axis], &s));
             touching_contact(
                 a,
                 Partner::Sphere(b),
