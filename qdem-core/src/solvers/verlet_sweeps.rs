@@ -27,7 +27,7 @@ use std::ops::Range;
 
 /// The fewest particles a sweep hands to a thread of its own: below twice this a sweep runs
 /// on the calling thread alone. A sweep costs 2–5 ns a particle and waking a worker about
-/// 10–20 µs on the 2-core benchmark machine (`fork-join` in qdem-bench measures both), so a
+/// 10–20 µs on the 2-core benchmark machine (qdem-bench's `fork_join` measures both), so a
 /// task of 4,096 particles is about what its wake-up costs.
 pub(crate) const SWEEP_TASK: usize = 4096;
 
