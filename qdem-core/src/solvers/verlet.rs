@@ -13,7 +13,7 @@
 //! ([`crate::solvers::local_damping`]) acts on the summed forces before they become accelerations.
 //!
 //! A step is two sweeps over the particles besides the forces
-//! ([`crate::solvers::verlet_sweeps`]): the first half kick with the drift and the zeroing of
+//! (`qdem-core/src/solvers/verlet_sweeps.rs`): the first half kick with the drift and the zeroing of
 //! the force sums, and, after the forces, a deferred uniform field (gravity), local damping,
 //! the accelerations, the second half kick and the finiteness check. In a run decomposed with
 //! a halo exchange ([`crate::Exchange::stepped`]) the sweeps cover only the rank's own
