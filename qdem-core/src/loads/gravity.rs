@@ -35,6 +35,10 @@ impl Model for Gravity {
         }
     }
 
+    fn uniform_acceleration(&self) -> Option<Vec3> {
+        Some(self.g)
+    }
+
     fn potential_energy(&self, state: &State) -> Option<f64> {
         Some(
             -state

@@ -97,6 +97,19 @@ impl Exchange {
         force.resize(state.len(), Vec3::zeros());
         torque.clear();
         torque.resize(state.rigid.len() + state.spin.len(), Vec3::zeros());
+        self.add_forces(state, models, force, torque, stages);
+    }
+
+    /// [`Exchange::sum_forces`] into `force` and `torque` that the caller has sized and zeroed
+    /// (Verlet zeroes them in its drift sweep).
+    pub(crate) fn add_forces(
+        &mut self,
+        state: &State,
+        models: &mut [Box<dyn Model>],
+        force: &mut [Vec3],
+        torque: &mut [Vec3],
+        stages: &mut StageTimes,
+    ) {
         for (i, model) in models.iter_mut().enumerate() {
             match self.ranks.as_mut() {
                 Some(ranks) if ranks.models[i].is_some() => {

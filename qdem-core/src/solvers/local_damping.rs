@@ -23,7 +23,9 @@ pub fn apply(state: &State, force: &mut [Vec3], torque: &mut [Vec3], alpha: f64)
     }
 }
 
-fn damp(f: &mut Vec3, v: &Vec3, alpha: f64) {
+/// f_k ← f_k − α |f_k| sgn(v_k) for each component k.
+#[inline]
+pub(crate) fn damp(f: &mut Vec3, v: &Vec3, alpha: f64) {
     for k in 0..3 {
         let sign = if v[k] > 0.0 {
             1.0

@@ -10,3 +10,4 @@ pub(crate) mod sparse;
 pub mod static_solve;
 pub mod tangent;
 pub mod verlet;
+pub(crate) mod verlet_sweeps;

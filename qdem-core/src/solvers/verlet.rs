@@ -12,23 +12,25 @@
 //! drift, and their members are placed after each. An optional local damping
 //! ([`crate::solvers::local_damping`]) acts on the summed forces before they become accelerations.
 //!
-//! A step is two passes over the particles besides the forces: the first half kick with the
-//! drift, and the accelerations with the second half kick and the finiteness check. In a run
-//! decomposed with a halo exchange ([`crate::Exchange::stepped`]) both passes cover only the
-//! rank's own particles and its halo ([`crate::parallel::local_particles`]).
+//! A step is two sweeps over the particles besides the forces
+//! (`qdem-core/src/solvers/verlet_sweeps.rs`): the first half kick with the drift and the zeroing of
+//! the force sums, and, after the forces, a deferred uniform field (gravity), local damping,
+//! the accelerations, the second half kick and the finiteness check. In a run decomposed with
+//! a halo exchange ([`crate::Exchange::stepped`]) the sweeps cover only the rank's own
+//! particles and its halo ([`crate::parallel::local_particles`]), and the force sums are
+//! zeroed whole by [`Exchange::sum_forces`].
 
 use crate::checkpoint::{same_count, CheckpointError, Decoder, Encoder};
 use crate::continuum::rigid_body::place_members;
+use crate::continuum::rigid_body::RigidBodies;
 use crate::error::CoreError;
 use crate::parallel::Exchange;
 use crate::solvers::local_damping;
-use crate::solvers::newmark::predict_in;
+use crate::solvers::verlet_sweeps::{self, DofArrays, KickSettings, Particles};
 use crate::state::State;
 use crate::step::model::Model;
 use crate::step::stages::{Stage, StageTimes};
-use crate::step::stepper::{
-    accelerate, accelerate_spin, check_finite_torque, check_masses, Stepper,
-};
+use crate::step::stepper::{check_finite_torque, check_masses, Stepper};
 use crate::Vec3;
 
 /// Velocity Verlet with a fixed step.
@@ -82,31 +84,54 @@ impl Verlet {
     }
 
     /// Forces, local damping, accelerations, and with `kick` = `Some(h)` the kick v += h a
-    /// (ω += h θ̈ for the particles' rotations) in the same pass.
+    /// (ω += h θ̈ for the particles' rotations) in the same sweep
+    /// ([`verlet_sweeps::kick`]); with `zeroed`, into force sums the drift sweep zeroed.
     fn evaluate(
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
         (stages, exchange): (&mut StageTimes, &mut Exchange),
         kick: Option<f64>,
+        zeroed: bool,
     ) -> Result<(), CoreError> {
-        exchange.sum_forces(state, models, &mut self.force, &mut self.torque, stages);
-        if self.local_damping > 0.0 {
-            local_damping::apply(state, &mut self.force, &mut self.torque, self.local_damping);
+        let field = deferred_field(state, models);
+        let summed = match field {
+            Some(_) => models.len() - 1,
+            None => models.len(),
+        };
+        let (force, torque) = (&mut self.force, &mut self.torque);
+        match zeroed {
+            true => exchange.add_forces(state, &mut models[..summed], force, torque, stages),
+            false => exchange.sum_forces(state, &mut models[..summed], force, torque, stages),
         }
         self.rigid_bodies = state.rigid.len();
-        let (rigid, moment) = self.torque.split_at(self.rigid_bodies);
-        let only = exchange.computed();
-        accelerate(state, &self.force, kick, only)?;
-        if !state.spin.is_empty() {
-            accelerate_spin(state, moment, kick, only)?;
+        let (rigid, moment) = self.torque.split_at_mut(self.rigid_bodies);
+        if self.local_damping > 0.0 {
+            for (t, w) in rigid.iter_mut().zip(&state.rigid.angular_velocity) {
+                local_damping::damp(t, w, self.local_damping);
+            }
         }
-        check_finite_torque(state, rigid)
+        let settings = KickSettings {
+            h: kick,
+            field,
+            damping: self.local_damping,
+        };
+        let ranges = verlet_sweeps::cover(state.len(), exchange.computed());
+        let (particles, rigid_bodies) = particles(state, &mut self.force, moment);
+        let (bad, bad_spin) = verlet_sweeps::kick(particles, &ranges, rigid_bodies, settings);
+        let time = state.time;
+        match bad.min(bad_spin) {
+            usize::MAX => check_finite_torque(state, rigid),
+            _ => Err(CoreError::NonFinite {
+                time,
+                particle: if bad != usize::MAX { bad } else { bad_spin },
+            }),
+        }
     }
 
     /// Predicts, evaluates the forces and integrates (paper 000 §2.4): the kick and the drift
-    /// in one pass (Newmark's predictor with β = 0, γ = ½ is x += ∆t (v + ½∆t a),
-    /// v += ½∆t a, bit for bit), then the accelerations with the second half kick.
+    /// in one sweep with the zeroing of the force sums ([`verlet_sweeps::drift`]), the forces,
+    /// then the accelerations with the second half kick.
     fn advance(
         &mut self,
         state: &mut State,
@@ -115,13 +140,27 @@ impl Verlet {
         exchange: &mut Exchange,
     ) -> Result<(), CoreError> {
         let dt = self.dt;
-        predict_in(state, dt, 0.0, 0.5, exchange.stepped());
+        let stepped = exchange.stepped();
+        // After a resume the force sums are not there yet.
+        self.force.resize(state.len(), Vec3::zeros());
+        self.torque
+            .resize(state.rigid.len() + state.spin.len(), Vec3::zeros());
+        // A rank of a decomposed run sums into particles beyond those it steps: its sums are
+        // zeroed whole before the forces.
+        let zero = stepped.is_none();
+        let ranges = verlet_sweeps::cover(state.len(), stepped);
+        let bodies = state.rigid.len().min(self.torque.len());
+        let (rigid, moment) = self.torque.split_at_mut(bodies);
+        let (particles, _) = particles(state, &mut self.force, moment);
+        verlet_sweeps::drift(particles, &ranges, dt, zero);
+        state.time += dt;
         if !state.rigid.is_empty() {
-            state.rigid.kick_and_rotate(&self.torque, dt);
+            state.rigid.kick_and_rotate(rigid, dt);
+            rigid.fill(Vec3::zeros());
             place_members(state);
         }
         stages.mark(Stage::Predict);
-        self.evaluate(state, models, (stages, exchange), Some(0.5 * dt))?;
+        self.evaluate(state, models, (stages, exchange), Some(0.5 * dt), zero)?;
         self.kick_rigid(state);
         stages.mark(Stage::Integrate);
         Ok(())
@@ -160,7 +199,13 @@ impl Stepper for Verlet {
         if !state.rigid.is_empty() {
             place_members(state);
         }
-        self.evaluate(state, models, (&mut StageTimes::off(), exchange), None)
+        self.evaluate(
+            state,
+            models,
+            (&mut StageTimes::off(), exchange),
+            None,
+            false,
+        )
     }
 
     /// The torques of the last evaluation: the rigid bodies', which the next step's first
@@ -230,10 +275,52 @@ impl Stepper for Verlet {
     }
 }
 
+/// The uniform field of the last model ([`Model::uniform_acceleration`]), which the kick
+/// sweep then adds in place of the model: its sum is the same, the field's force coming last,
+/// unless rigid bodies' members add into their centres after the models.
+fn deferred_field(state: &State, models: &[Box<dyn Model>]) -> Option<Vec3> {
+    match models.last() {
+        Some(last) if state.rigid.is_empty() => last.uniform_acceleration(),
+        _ => None,
+    }
+}
+
+/// The state's particles with the force sums `force` and the particles' moment sums
+/// `moment` (empty when they do not rotate), for the sweeps; and the rigid bodies.
+fn particles<'a>(
+    state: &'a mut State,
+    force: &'a mut [Vec3],
+    moment: &'a mut [Vec3],
+) -> (Particles<'a>, &'a RigidBodies) {
+    let translation = DofArrays {
+        x: &mut state.position,
+        v: &mut state.velocity,
+        a: &mut state.acceleration,
+        load: force,
+        inertia: &state.mass,
+        fixed: &state.fixed,
+    };
+    let spin = &mut state.spin;
+    let rotation = (!spin.is_empty()).then(|| DofArrays {
+        x: &mut spin.angle,
+        v: &mut spin.velocity,
+        a: &mut spin.acceleration,
+        load: moment,
+        inertia: &spin.inertia,
+        fixed: &spin.fixed,
+    });
+    let particles = Particles {
+        translation,
+        rotation,
+    };
+    (particles, &state.rigid)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::state::Dofs;
+    use crate::Gravity;
 
     /// A constant moment on particle 0 about z, and a constant force on it along x.
     struct Twist {
@@ -278,5 +365,124 @@ mod tests {
         assert_eq!(state.spin.velocity[1], Vec3::zeros());
         let energy = 0.5 * j * (m * t / j).powi(2) + 0.5 * (f * t).powi(2);
         assert!((state.kinetic_energy() - energy).abs() < 1e-12 * energy);
+    }
+
+    /// Springs of stiffness `k` from every particle to the origin, a damper on its rotation
+    /// and two moments from each spring force (forces and moments that depend on the state,
+    /// so that round-off anywhere shows up).
+    struct Anchors {
+        k: f64,
+    }
+
+    impl Model for Anchors {
+        fn name(&self) -> &str {
+            "anchors"
+        }
+
+        fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
+            let bodies = state.rigid.len();
+            for (i, (f, x)) in force.iter_mut().zip(&state.position).enumerate() {
+                let spring = -self.k * x;
+                *f += spring;
+                torque[bodies + i] += x.cross(&spring) - 0.1 * state.spin.velocity[i];
+            }
+        }
+    }
+
+    /// 9,000 particles (more than two sweep tasks) at scattered places, moving and turning,
+    /// some with fixed directions or axes, under the springs and gravity (deferred to the
+    /// kick sweep when last), with local damping.
+    fn scattered(gravity_last: bool) -> (State, Vec<Box<dyn Model>>) {
+        let n = 9000;
+        let wave = |i: usize, k: f64| (0.37 * i as f64 + k).sin();
+        let points = (0..n).map(|i| Vec3::new(wave(i, 0.0), wave(i, 1.0), wave(i, 2.0)));
+        let mut state = State::at_rest(points.collect());
+        for i in 0..n {
+            state.mass[i] = 1.0 + 0.5 * wave(i, 3.0);
+            state.velocity[i] = Vec3::new(wave(i, 4.0), wave(i, 5.0), wave(i, 6.0));
+            state.let_turn(i, 0.01 * state.mass[i]);
+            state.spin.velocity[i] = Vec3::new(wave(i, 7.0), 0.0, wave(i, 8.0));
+        }
+        for i in (0..n).step_by(7) {
+            state.fix(i, Dofs::parse("z").expect("an axis"));
+            state.spin.fixed[i] = Dofs::parse("x").expect("an axis");
+        }
+        state.hold_fixed();
+        let gravity: Box<dyn Model> = Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81)));
+        let anchors: Box<dyn Model> = Box::new(Anchors { k: 50.0 });
+        let models = match gravity_last {
+            true => vec![anchors, gravity],
+            false => vec![gravity, anchors],
+        };
+        (state, models)
+    }
+
+    fn run(threads: usize, gravity_last: bool, steps: usize) -> (State, Vec<Vec3>) {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a pool");
+        pool.install(|| {
+            let (mut state, mut models) = scattered(gravity_last);
+            let mut verlet = Verlet::new(1e-3).with_local_damping(0.3);
+            verlet.initialize(&mut state, &mut models).expect("finite");
+            for _ in 0..steps {
+                verlet.step(&mut state, &mut models).expect("finite");
+            }
+            (state, verlet.forces().to_vec())
+        })
+    }
+
+    #[test]
+    fn the_sweeps_give_the_same_bits_on_any_thread_count_and_with_gravity_deferred() {
+        // Two threads cut each sweep in two tasks; gravity as the last model is added by the
+        // kick sweep, as the first model by its own add_forces into zeroed sums: for a sum of
+        // two terms both orders give the same bits, so all four runs must agree bit for bit.
+        let (one, forces) = run(1, true, 30);
+        assert!(one.kinetic_energy() > 0.0 && one.kinetic_energy().is_finite());
+        for (threads, last) in [(2, true), (1, false), (2, false)] {
+            let (state, f) = run(threads, last, 30);
+            assert!(state == one, "{threads} threads, gravity last: {last}");
+            assert!(f == forces, "{threads} threads, gravity last: {last}");
+        }
+        // The fixed directions stayed at rest; gravity is in the force sums (the reaction
+        // of a fixed direction included).
+        assert_eq!(one.velocity[7].z, 0.0);
+        assert_eq!(one.spin.velocity[14].x, 0.0);
+        let spring = -50.0 * one.position[3];
+        let free = spring + one.mass[3] * Vec3::new(0.0, 0.0, -9.81);
+        assert!((forces[3] - free).norm() <= 0.3 * free.norm() + 1e-12);
+    }
+
+    /// A force that turns non-finite on one particle.
+    struct Poison(usize);
+
+    impl Model for Poison {
+        fn name(&self) -> &str {
+            "poison"
+        }
+
+        fn add_forces(&mut self, _state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
+            force[self.0].y = f64::NAN;
+        }
+    }
+
+    #[test]
+    fn a_non_finite_acceleration_names_its_particle_on_any_thread_count() {
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            let error = pool.install(|| {
+                let (mut state, mut models) = scattered(true);
+                models.insert(0, Box::new(Poison(8000)));
+                Verlet::new(1e-3).initialize(&mut state, &mut models)
+            });
+            match error {
+                Err(CoreError::NonFinite { particle, .. }) => assert_eq!(particle, 8000),
+                other => panic!("{threads} threads: {other:?}"),
+            }
+        }
     }
 }

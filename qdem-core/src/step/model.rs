@@ -57,6 +57,15 @@ pub trait Model: std::any::Any + Send + Sync {
         Reads::All
     }
 
+    /// `Some(g)` when the model's force on every particle is its mass times the uniform
+    /// acceleration `g` (m/s²) and it exerts no moment (gravity): a stepper may then add m g
+    /// in its own pass over the particles instead of calling [`Model::add_forces`] (Verlet
+    /// does, when the model comes last and no rigid body's members add into their centre).
+    /// The default, `None`, is always right.
+    fn uniform_acceleration(&self) -> Option<Vec3> {
+        None
+    }
+
     /// Potential energy (J) if the model is conservative, `None` otherwise.
     fn potential_energy(&self, state: &State) -> Option<f64> {
         let _ = state;
