@@ -126,7 +126,10 @@ impl ContactList {
                 ..Contact::default()
             })
             .collect();
-        ContactList { items }
+        ContactList {
+            items,
+            ..ContactList::default()
+        }
     }
 
     /// The stretched springs: each contact's partners and ξ, where ξ is not zero.
