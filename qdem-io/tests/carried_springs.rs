@@ -10,12 +10,11 @@
 
 mod common;
 
-use common::{fixture, test_dir};
+use common::{build, fixture, test_dir};
 use qdem_contact::Partner;
 use qdem_core::Vec3;
 use qdem_io::build::{BodyKind, Simulation};
 use qdem_io::runner::{run_with, RunOptions};
-use qdem_io::scene::Scene;
 use std::path::{Path, PathBuf};
 
 /// The block's placement 1 mm lower along the slope's normal (−0.4226, 0, 0.9063) than the
@@ -56,10 +55,6 @@ fn start_from(dir: &Path, name: &str) -> (&'static str, String) {
         "[run]",
         format!("[run]\nstart_from = \"{}\"", file.display()),
     )
-}
-
-fn build(path: &Path) -> Simulation {
-    Simulation::build(Scene::load(path).unwrap()).unwrap()
 }
 
 /// Runs `sim` to its end, writing into `dir/out/<its name>`.

@@ -7,16 +7,11 @@
 
 mod common;
 
-use common::{fixture, short_cantilever, test_dir};
+use common::{build, fixture, short_cantilever, test_dir};
 use qdem_io::build::Simulation;
 use qdem_io::checkpoint::{CheckpointFileError, CHECKPOINT_FILE};
 use qdem_io::runner::{run_with, RunError, RunOptions};
-use qdem_io::scene::Scene;
 use std::path::{Path, PathBuf};
-
-fn build(scene: &Path) -> Simulation {
-    Simulation::build(Scene::load(scene).unwrap()).unwrap()
-}
 
 /// Runs `scene` into `out` and stops it with a checkpoint after `steps` steps.
 fn checkpointed(scene: &Path, out: &Path, steps: u64) -> PathBuf {

@@ -9,11 +9,10 @@
 
 mod common;
 
-use common::{fixture, short_cantilever, test_dir};
+use common::{build, fixture, run, short_cantilever, test_dir};
 use qdem_io::build::Simulation;
 use qdem_io::checkpoint::CHECKPOINT_FILE;
-use qdem_io::runner::{run_with, RunError, RunOptions};
-use qdem_io::scene::Scene;
+use qdem_io::runner::{RunError, RunOptions};
 use std::path::{Path, PathBuf};
 
 /// The short cantilever (5,300 steps), sampled every 1 ms, a VTU every 5 ms.
@@ -124,14 +123,6 @@ vtu_every = 0.1
     let path = dir.join("boxtest.toml");
     std::fs::write(&path, text).unwrap();
     path
-}
-
-fn build(scene: &Path) -> Simulation {
-    Simulation::build(Scene::load(scene).unwrap()).unwrap()
-}
-
-fn run(sim: &mut Simulation, out: &Path, options: RunOptions<'_>) -> Result<(), RunError> {
-    run_with(sim, out, options, &mut |_| {}).map(|_| ())
 }
 
 /// Every evolving array of the state, by bit pattern.

@@ -8,12 +8,13 @@ mod common;
 
 use qdem_io::build::Simulation;
 use qdem_io::checkpoint::CHECKPOINT_FILE;
-use qdem_io::runner::{run_with, RunError, RunOptions};
+use qdem_io::runner::{RunError, RunOptions};
 use qdem_io::scene::Scene;
 use std::path::{Path, PathBuf};
 
 use common::{
-    columns, grain_bed, test_dir, BED_DENSITY as DENSITY, BED_G as G, BED_WIDTH as WIDTH,
+    build, columns, grain_bed, run, test_dir, BED_DENSITY as DENSITY, BED_G as G,
+    BED_WIDTH as WIDTH,
 };
 /// The lid's target stress (Pa): about five times the bed's weight over its area (1.6 kPa).
 const TARGET: f64 = 8000.0;
@@ -35,14 +36,6 @@ servo = {{ stress = {TARGET}, area = {area}, max_velocity = 0.5 }}
     let path = dir.join("scene.toml");
     std::fs::write(&path, text).unwrap();
     path
-}
-
-fn build(scene: &Path) -> Simulation {
-    Simulation::build(Scene::load(scene).unwrap()).unwrap()
-}
-
-fn run(sim: &mut Simulation, out: &Path, options: RunOptions<'_>) -> Result<(), RunError> {
-    run_with(sim, out, options, &mut |_| {}).map(|_| ())
 }
 
 /// g Σ m of the one-sphere stones of `stones.csv`.

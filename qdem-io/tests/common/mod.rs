@@ -2,7 +2,21 @@
 
 #![allow(dead_code)] // each test binary uses a subset
 
+use qdem_io::build::Simulation;
+use qdem_io::runner::{run_with, RunError, RunOptions};
+use qdem_io::scene::Scene;
 use std::path::{Path, PathBuf};
+
+/// The simulation of the scene file `scene` (panics on a bad scene: the tests' scenes are
+/// their own).
+pub fn build(scene: &Path) -> Simulation {
+    Simulation::build(Scene::load(scene).unwrap()).unwrap()
+}
+
+/// [`run_with`] without a progress callback, its summary dropped.
+pub fn run(sim: &mut Simulation, out: &Path, options: RunOptions<'_>) -> Result<(), RunError> {
+    run_with(sim, out, options, &mut |_| {}).map(|_| ())
+}
 
 /// A fresh, empty directory for one test.
 pub fn test_dir(name: &str) -> PathBuf {
