@@ -85,13 +85,30 @@ impl RigidBodies {
     /// Position and velocity of member slot `slot` from its body's pose.
     #[inline]
     fn placed(&self, slot: usize, position: &[Vec3], velocity: &[Vec3]) -> (Vec3, Vec3) {
-        let b = self.member_body[slot] as usize;
-        let c = self.center[b];
-        let arm = self.orientation[b] * self.offset[slot];
+        let arm = self.arm(slot);
         (
-            position[c] + arm,
-            velocity[c] + self.angular_velocity[b].cross(&arm),
+            self.placed_position(slot, &arm, position),
+            self.placed_velocity(slot, &arm, velocity),
         )
+    }
+
+    /// The arm R s of member slot `slot`: its offset turned by its body's orientation.
+    #[inline]
+    fn arm(&self, slot: usize) -> Vec3 {
+        self.orientation[self.member_body[slot] as usize] * self.offset[slot]
+    }
+
+    /// x = c + R s of member slot `slot`, whose arm is `arm`.
+    #[inline]
+    fn placed_position(&self, slot: usize, arm: &Vec3, position: &[Vec3]) -> Vec3 {
+        position[self.center[self.member_body[slot] as usize]] + arm
+    }
+
+    /// v = v_c + ω × R s of member slot `slot`, whose arm is `arm`.
+    #[inline]
+    fn placed_velocity(&self, slot: usize, arm: &Vec3, velocity: &[Vec3]) -> Vec3 {
+        let b = self.member_body[slot] as usize;
+        velocity[self.center[b]] + self.angular_velocity[b].cross(arm)
     }
 
     /// α_b = I_w⁻¹ (τ − ω × L): body `b`'s angular acceleration under the torque `torque`
@@ -310,6 +327,38 @@ pub fn place_members(state: &mut State) {
     }
 }
 
+/// [`place_members`], keeping each member's arm R s in `arms` (by member slot) for
+/// [`place_member_velocities`].
+pub fn place_members_keeping_arms(state: &mut State, arms: &mut Vec<Vec3>) {
+    let State {
+        rigid,
+        position,
+        velocity,
+        ..
+    } = state;
+    arms.resize(rigid.member.len(), Vec3::zeros());
+    for ((slot, &m), kept) in rigid.member.iter().enumerate().zip(arms.iter_mut()) {
+        let arm = rigid.arm(slot);
+        position[m] = rigid.placed_position(slot, &arm, position);
+        velocity[m] = rigid.placed_velocity(slot, &arm, velocity);
+        *kept = arm;
+    }
+}
+
+/// Puts every member's velocity at v = v_c + ω × R s, with the arms R s that
+/// [`place_members_keeping_arms`] kept at the current pose: after a kick, which changes the
+/// bodies' velocities but not their poses, so the members' positions stand. The same bits as
+/// [`place_members`].
+pub fn place_member_velocities(state: &mut State, arms: &[Vec3]) {
+    let State {
+        rigid, velocity, ..
+    } = state;
+    debug_assert_eq!(arms.len(), rigid.member.len(), "arms kept at this pose");
+    for ((slot, &m), arm) in rigid.member.iter().enumerate().zip(arms) {
+        velocity[m] = rigid.placed_velocity(slot, arm, velocity);
+    }
+}
+
 /// Puts the members of body `b` alone at x = c + R s with velocity v = v_c + ω × R s (a body
 /// whose pose was just set, the others untouched).
 pub fn place_body_members(state: &mut State, b: usize) {
@@ -412,6 +461,28 @@ mod tests {
         assert!((s.velocity[1] - Vec3::new(-1.0, 0.0, 0.0)).norm() < 1e-14);
         assert_eq!(s.rigid.body_of_member(2), Some(0));
         assert_eq!(s.rigid.body_of_member(0), None);
+    }
+
+    #[test]
+    fn velocities_from_kept_arms_are_those_of_a_full_placing() {
+        // A turned, moving body placed keeping its arms, then kicked: the velocities from the
+        // kept arms are a full placing's bit for bit, and the positions stand.
+        let mut s = body_with_members();
+        s.velocity[0] = Vec3::new(0.3, -0.2, 0.1);
+        s.rigid.set_angular_velocity(0, Vec3::new(0.7, -1.1, 0.4));
+        s.rigid.rotate(0.37);
+        let mut arms = Vec::new();
+        place_members_keeping_arms(&mut s, &mut arms);
+        let mut full = s.clone();
+        place_members(&mut full);
+        assert!(full == s);
+        s.rigid.kick(&[Vec3::new(0.2, 0.5, -0.3)], 0.01);
+        s.velocity[0] += Vec3::new(0.01, 0.02, 0.03);
+        let mut full = s.clone();
+        place_members(&mut full);
+        place_member_velocities(&mut s, &arms);
+        assert!(full == s);
+        assert_ne!(s.velocity[1], s.velocity[0]);
     }
 
     #[test]
