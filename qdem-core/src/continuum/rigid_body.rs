@@ -85,30 +85,13 @@ impl RigidBodies {
     /// Position and velocity of member slot `slot` from its body's pose.
     #[inline]
     fn placed(&self, slot: usize, position: &[Vec3], velocity: &[Vec3]) -> (Vec3, Vec3) {
-        let arm = self.arm(slot);
-        (
-            self.placed_position(slot, &arm, position),
-            self.placed_velocity(slot, &arm, velocity),
-        )
-    }
-
-    /// The arm R s of member slot `slot`: its offset turned by its body's orientation.
-    #[inline]
-    fn arm(&self, slot: usize) -> Vec3 {
-        self.orientation[self.member_body[slot] as usize] * self.offset[slot]
-    }
-
-    /// x = c + R s of member slot `slot`, whose arm is `arm`.
-    #[inline]
-    fn placed_position(&self, slot: usize, arm: &Vec3, position: &[Vec3]) -> Vec3 {
-        position[self.center[self.member_body[slot] as usize]] + arm
-    }
-
-    /// v = v_c + ω × R s of member slot `slot`, whose arm is `arm`.
-    #[inline]
-    fn placed_velocity(&self, slot: usize, arm: &Vec3, velocity: &[Vec3]) -> Vec3 {
         let b = self.member_body[slot] as usize;
-        velocity[self.center[b]] + self.angular_velocity[b].cross(arm)
+        let c = self.center[b];
+        let arm = self.orientation[b] * self.offset[slot];
+        (
+            position[c] + arm,
+            velocity[c] + self.angular_velocity[b].cross(&arm),
+        )
     }
 
     /// α_b = I_w⁻¹ (τ − ω × L): body `b`'s angular acceleration under the torque `torque`
@@ -328,7 +311,7 @@ pub fn place_members(state: &mut State) {
 }
 
 /// [`place_members`], keeping each member's arm R s in `arms` (by member slot) for
-/// [`place_member_velocities`].
+/// [`place_member_velocities`]; body by body, each body's pose read once.
 pub fn place_members_keeping_arms(state: &mut State, arms: &mut Vec<Vec3>) {
     let State {
         rigid,
@@ -337,11 +320,20 @@ pub fn place_members_keeping_arms(state: &mut State, arms: &mut Vec<Vec3>) {
         ..
     } = state;
     arms.resize(rigid.member.len(), Vec3::zeros());
-    for ((slot, &m), kept) in rigid.member.iter().enumerate().zip(arms.iter_mut()) {
-        let arm = rigid.arm(slot);
-        position[m] = rigid.placed_position(slot, &arm, position);
-        velocity[m] = rigid.placed_velocity(slot, &arm, velocity);
-        *kept = arm;
+    for b in 0..rigid.len() {
+        let c = rigid.center[b];
+        let (q, w) = (rigid.orientation[b], rigid.angular_velocity[b]);
+        let (x_c, v_c) = (position[c], velocity[c]);
+        let slots = rigid.member_start[b]..rigid.member_start[b + 1];
+        let members = rigid.member[slots.clone()]
+            .iter()
+            .zip(&rigid.offset[slots.clone()]);
+        for ((&m, offset), kept) in members.zip(&mut arms[slots]) {
+            let arm = q * offset;
+            position[m] = x_c + arm;
+            velocity[m] = v_c + w.cross(&arm);
+            *kept = arm;
+        }
     }
 }
 
@@ -354,8 +346,12 @@ pub fn place_member_velocities(state: &mut State, arms: &[Vec3]) {
         rigid, velocity, ..
     } = state;
     debug_assert_eq!(arms.len(), rigid.member.len(), "arms kept at this pose");
-    for ((slot, &m), arm) in rigid.member.iter().enumerate().zip(arms) {
-        velocity[m] = rigid.placed_velocity(slot, arm, velocity);
+    for b in 0..rigid.len() {
+        let (w, v_c) = (rigid.angular_velocity[b], velocity[rigid.center[b]]);
+        let slots = rigid.member_start[b]..rigid.member_start[b + 1];
+        for (&m, arm) in rigid.member[slots.clone()].iter().zip(&arms[slots]) {
+            velocity[m] = v_c + w.cross(arm);
+        }
     }
 }
 
