@@ -34,7 +34,8 @@
 //!
 //! The files: this one holds the model (its records, the narrow phase, the [`Model`] facet
 //! and the stable step); `build.rs` its construction; `pipeline.rs` the single-process
-//! pipeline above; `scatter.rs` its fused pass; `views.rs` what the outputs read; `persistence.rs` what a checkpoint
+//! pipeline above; `displacement.rs` its displacement check's bound for rigid bodies;
+//! `scatter.rs` its fused pass; `views.rs` what the outputs read; `persistence.rs` what a checkpoint
 //! keeps; `modal_springs.rs` the touching contacts as springs for a modal analysis;
 //! `split.rs` one rank's part in a decomposed run, whose stages the world's exchange runs
 //! ([`qdem_core::parallel`]).
