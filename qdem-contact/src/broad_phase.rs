@@ -3,7 +3,8 @@
 //! Spheres are binned into cubic cells of side 2 r_max + skin, keyed by their integer cell
 //! coordinates and sorted by key; every occupied cell is then compared with itself and with the
 //! neighbour cells of larger key (13 of the 26 on average), so each candidate pair is visited
-//! once, in parallel over cells. A pair is kept when the gap between its surfaces is below the
+//! once, in parallel over cells; a neighbour is found in a table over the grid's keys when the
+//! grid is not much larger than the spheres, else by a binary search. A pair is kept when the gap between its surfaces is below the
 //! skin and its spheres belong to different bodies. The list is sorted by (a, b), a < b, so it
 //! does not depend on the number of threads. The contact model rebuilds it only when some
 //! sphere has moved more than half the skin since the last build (then no pair outside the list
@@ -99,6 +100,54 @@ impl Grid {
     fn key(&self, c: [u64; 3]) -> u64 {
         c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2])
     }
+
+    /// The number of cells (and of keys).
+    fn cells(&self) -> u64 {
+        self.dims.iter().product()
+    }
+}
+
+/// Finds an occupied cell by its key: in a table over every key of the grid when the grid
+/// has not many more cells than spheres (each of a cell's 13 forward neighbours is then one
+/// read, where a binary search of a ballast's 10⁵ occupied cells takes 17 dependent ones),
+/// else by a binary search of the sorted keys. Either finds the same cell, so the pairs do
+/// not depend on which.
+enum CellLookup<'a> {
+    /// Per key, the occupied cell's index, or `u32::MAX`.
+    Table(Vec<u32>),
+    /// The occupied cells' keys, ascending.
+    Search(&'a [u64]),
+}
+
+impl<'a> CellLookup<'a> {
+    /// The most cells per sphere (plus a fixed allowance) for which a table is made.
+    const CELLS_PER_SPHERE: u64 = 4;
+    const CELLS_ALLOWED: u64 = 1 << 20;
+
+    /// The lookup of the occupied cells of keys `keys` (ascending) in a grid of `cells`
+    /// cells holding `spheres` spheres.
+    fn new(keys: &'a [u64], cells: u64, spheres: usize) -> CellLookup<'a> {
+        if cells > Self::CELLS_PER_SPHERE * spheres as u64 + Self::CELLS_ALLOWED {
+            return CellLookup::Search(keys);
+        }
+        let mut table = vec![u32::MAX; cells as usize];
+        for (c, &key) in keys.iter().enumerate() {
+            table[key as usize] = c as u32;
+        }
+        CellLookup::Table(table)
+    }
+
+    /// The index of the occupied cell of key `key`, if it is occupied.
+    #[inline]
+    fn find(&self, key: u64) -> Option<usize> {
+        match self {
+            CellLookup::Table(table) => match table[key as usize] {
+                u32::MAX => None,
+                c => Some(c as usize),
+            },
+            CellLookup::Search(keys) => keys.binary_search(&key).ok(),
+        }
+    }
 }
 
 /// All pairs (a, b), a < b, of spheres of different bodies whose surfaces are less than `skin`
@@ -123,6 +172,7 @@ pub fn find_pairs(spheres: &SphereSet, skin: f64) -> Vec<(u32, u32)> {
     let cell_keys: Vec<u64> = cell_start.iter().map(|&s| keyed[s].0).collect();
     cell_start.push(n);
     let members = |c: usize| &keyed[cell_start[c]..cell_start[c + 1]];
+    let lookup = CellLookup::new(&cell_keys, grid.cells(), n);
     let mut pairs: Vec<(u32, u32)> = (0..cell_keys.len())
         .into_par_iter()
         .with_min_len(64)
@@ -136,7 +186,7 @@ pub fn find_pairs(spheres: &SphereSet, skin: f64) -> Vec<(u32, u32)> {
                 }
             }
             for neighbour in forward_neighbours(&grid, base) {
-                if let Ok(d) = cell_keys.binary_search(&neighbour) {
+                if let Some(d) = lookup.find(neighbour) {
                     for &(_, i) in here {
                         for &(_, j) in members(d) {
                             push_if_near(spheres, skin, i, j, &mut out);
@@ -207,6 +257,54 @@ mod tests {
             }
         }
         out
+    }
+
+    #[test]
+    fn the_table_and_the_search_find_the_same_cells() {
+        let keys: Vec<u64> = (0..500u64)
+            .map(|k| k * k % 7919)
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        let table = CellLookup::new(&keys, 7919, 100);
+        let search = CellLookup::Search(&keys);
+        assert!(matches!(table, CellLookup::Table(_)));
+        for key in 0..7919 {
+            assert_eq!(table.find(key), search.find(key), "key {key}");
+        }
+        assert!(matches!(
+            CellLookup::new(&keys, 1 << 40, 100),
+            CellLookup::Search(_)
+        ));
+    }
+
+    #[test]
+    fn a_sparse_grid_searches_and_finds_the_brute_force_pairs() {
+        // Clusters 100 km apart: far more cells than spheres, so no table.
+        let mut center = Vec::new();
+        for k in 0..3 {
+            for i in 0..20 {
+                let t = i as f64;
+                center.push(Vec3::new(
+                    1e5 * k as f64 + 0.01 * t,
+                    0.013 * (t * 0.7).sin(),
+                    0.0,
+                ));
+            }
+        }
+        let radius = vec![0.006; center.len()];
+        let body: Vec<u32> = (0..center.len() as u32).map(|i| i / 3).collect();
+        let set = SphereSet {
+            center: &center,
+            radius: &radius,
+            body: &body,
+            periodic: None,
+        };
+        let grid = Grid::new(&center, 0.013, None);
+        assert!(grid.cells() > 4 * 60 + (1 << 20));
+        let pairs = find_pairs(&set, 0.001);
+        assert!(!pairs.is_empty());
+        assert_eq!(pairs, brute_force(&set, 0.001));
     }
 
     proptest! {

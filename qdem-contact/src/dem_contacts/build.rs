@@ -116,6 +116,7 @@ impl DemContacts {
             center: vec![Vec3::zeros(); spheres.len()],
             now,
             built_at: Vec::new(),
+            anchor: None,
             built_time: 0.0,
             built: false,
             pairs: ContactList::default(),

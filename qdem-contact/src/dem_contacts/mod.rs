@@ -8,7 +8,8 @@
 //! 1. reads the sphere centres from their particles,
 //! 2. rebuilds the pair and wall candidate lists if some sphere (or wall) moved more than the
 //!    skin allows ([`crate::broad_phase`]), carrying the tangential springs of surviving
-//!    pairs over,
+//!    pairs over (on rigid bodies, a bound per body spares reading every sphere:
+//!    `displacement.rs`),
 //! 3. evaluates the law of every candidate pair and wall contact and adds each force, and its
 //!    moment about the sphere's centre, straight into per-sphere sums, in parallel over fixed
 //!    runs of spheres (`scatter.rs`; no atomics, so results do not depend on the thread
@@ -33,7 +34,8 @@
 //!
 //! The files: this one holds the model (its records, the narrow phase, the [`Model`] facet
 //! and the stable step); `build.rs` its construction; `pipeline.rs` the single-process
-//! pipeline above; `scatter.rs` its fused pass; `views.rs` what the outputs read; `persistence.rs` what a checkpoint
+//! pipeline above; `displacement.rs` its displacement check's bound for rigid bodies;
+//! `scatter.rs` its fused pass; `views.rs` what the outputs read; `persistence.rs` what a checkpoint
 //! keeps; `modal_springs.rs` the touching contacts as springs for a modal analysis;
 //! `split.rs` one rank's part in a decomposed run, whose stages the world's exchange runs
 //! ([`qdem_core::parallel`]).
@@ -60,6 +62,7 @@ use split::ContactPart;
 pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
 
 mod build;
+mod displacement;
 mod modal_springs;
 mod persistence;
 mod pipeline;
@@ -233,6 +236,9 @@ pub struct DemContacts {
     /// What the narrow phase reads of each sphere, current for the partners of candidates.
     now: Vec<SphereNow>,
     built_at: Vec<Vec3>,
+    /// The rigid bodies' poses at the step the displacement check's bound starts from
+    /// (`displacement.rs`).
+    anchor: Option<displacement::Anchor>,
     built_time: f64,
     built: bool,
     pairs: ContactList,
@@ -303,6 +309,7 @@ impl Model for DemContacts {
                 self.read_every_center(state);
             }
             self.rebuild_all(state.time);
+            self.anchor(state, 0.0);
             if !read_every {
                 self.read_all_partners(state);
             }

@@ -179,6 +179,8 @@ impl Persistent for DemContacts {
         self.built = input.bool("the build flag")?;
         self.built_time = input.f64("the build time")?;
         self.built_at = input.vec3s("the build positions")?;
+        // The displacement bound's anchor is not kept: the next check is exact.
+        self.anchor = None;
         if self.built {
             same_count("contact spheres", spheres, self.built_at.len())?;
         }

@@ -18,11 +18,13 @@ impl DemContacts {
         }
     }
 
-    /// The largest distance a sphere has moved since the last build (infinite before it), and
-    /// the centres and the narrow phase's records ([`read_motion`]) of the spheres the lists
-    /// read: every sphere's in the same pass when most spheres are partners of candidates (a
-    /// packing), else only the partners', in a pass over them alone (most spheres of a
-    /// ballast stone touch nothing: the others' centres are read at the next build).
+    /// The largest distance a sphere has moved since the last build (infinite before it), or
+    /// a bound on it that keeps the lists as that distance would ([`DemContacts::displacement`]),
+    /// and the centres and the narrow phase's records ([`read_motion`]) of the spheres the
+    /// lists read: every sphere's in the same pass when most spheres are partners of
+    /// candidates (a packing), else only the partners', in a pass over them alone (most
+    /// spheres of a ballast stone touch nothing: the others' centres are read at the next
+    /// build).
     pub(super) fn read_centers(&mut self, state: &State) -> f64 {
         let (every, built) = (self.reads_every_sphere(), self.lists_built());
         let (particle, built_at, turn) = (&self.particle, &self.built_at, &self.turn);
@@ -41,18 +43,14 @@ impl DemContacts {
                     }
                 })
                 .reduce(|| 0.0, f64::max)
+                .sqrt()
         } else {
-            built_at
-                .par_iter()
-                .with_min_len(SPHERE_CHUNK)
-                .enumerate()
-                .map(|(s, at)| (state.position[particle[s] as usize] - at).norm_squared())
-                .reduce(|| 0.0, f64::max)
+            self.displacement(state)
         };
         if !every {
             self.read_all_partners(state);
         }
-        moved.sqrt()
+        moved
     }
 
     /// Copies every sphere's centre out of the state (before a build, when the read passed
@@ -143,6 +141,7 @@ impl DemContacts {
 
     /// After new candidate lists: the incidence, and where and when they were built.
     pub(super) fn finish_build(&mut self, time: f64) {
+        self.anchor = None;
         self.build_incidence();
         self.built_at = self.center.clone();
         self.built_time = time;

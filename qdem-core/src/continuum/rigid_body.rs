@@ -310,6 +310,51 @@ pub fn place_members(state: &mut State) {
     }
 }
 
+/// [`place_members`], keeping each member's arm R s in `arms` (by member slot) for
+/// [`place_member_velocities`]; body by body, each body's pose read once.
+pub fn place_members_keeping_arms(state: &mut State, arms: &mut Vec<Vec3>) {
+    let State {
+        rigid,
+        position,
+        velocity,
+        ..
+    } = state;
+    arms.resize(rigid.member.len(), Vec3::zeros());
+    for b in 0..rigid.len() {
+        let c = rigid.center[b];
+        let (q, w) = (rigid.orientation[b], rigid.angular_velocity[b]);
+        let (x_c, v_c) = (position[c], velocity[c]);
+        let slots = rigid.member_start[b]..rigid.member_start[b + 1];
+        let members = rigid.member[slots.clone()]
+            .iter()
+            .zip(&rigid.offset[slots.clone()]);
+        for ((&m, offset), kept) in members.zip(&mut arms[slots]) {
+            let arm = q * offset;
+            position[m] = x_c + arm;
+            velocity[m] = v_c + w.cross(&arm);
+            *kept = arm;
+        }
+    }
+}
+
+/// Puts every member's velocity at v = v_c + ω × R s, with the arms R s that
+/// [`place_members_keeping_arms`] kept at the current pose: after a kick, which changes the
+/// bodies' velocities but not their poses, so the members' positions stand. The same bits as
+/// [`place_members`].
+pub fn place_member_velocities(state: &mut State, arms: &[Vec3]) {
+    let State {
+        rigid, velocity, ..
+    } = state;
+    debug_assert_eq!(arms.len(), rigid.member.len(), "arms kept at this pose");
+    for b in 0..rigid.len() {
+        let (w, v_c) = (rigid.angular_velocity[b], velocity[rigid.center[b]]);
+        let slots = rigid.member_start[b]..rigid.member_start[b + 1];
+        for (&m, arm) in rigid.member[slots.clone()].iter().zip(&arms[slots]) {
+            velocity[m] = v_c + w.cross(arm);
+        }
+    }
+}
+
 /// Puts the members of body `b` alone at x = c + R s with velocity v = v_c + ω × R s (a body
 /// whose pose was just set, the others untouched).
 pub fn place_body_members(state: &mut State, b: usize) {
@@ -412,6 +457,28 @@ mod tests {
         assert!((s.velocity[1] - Vec3::new(-1.0, 0.0, 0.0)).norm() < 1e-14);
         assert_eq!(s.rigid.body_of_member(2), Some(0));
         assert_eq!(s.rigid.body_of_member(0), None);
+    }
+
+    #[test]
+    fn velocities_from_kept_arms_are_those_of_a_full_placing() {
+        // A turned, moving body placed keeping its arms, then kicked: the velocities from the
+        // kept arms are a full placing's bit for bit, and the positions stand.
+        let mut s = body_with_members();
+        s.velocity[0] = Vec3::new(0.3, -0.2, 0.1);
+        s.rigid.set_angular_velocity(0, Vec3::new(0.7, -1.1, 0.4));
+        s.rigid.rotate(0.37);
+        let mut arms = Vec::new();
+        place_members_keeping_arms(&mut s, &mut arms);
+        let mut full = s.clone();
+        place_members(&mut full);
+        assert!(full == s);
+        s.rigid.kick(&[Vec3::new(0.2, 0.5, -0.3)], 0.01);
+        s.velocity[0] += Vec3::new(0.01, 0.02, 0.03);
+        let mut full = s.clone();
+        place_members(&mut full);
+        place_member_velocities(&mut s, &arms);
+        assert!(full == s);
+        assert_ne!(s.velocity[1], s.velocity[0]);
     }
 
     #[test]

@@ -21,8 +21,10 @@
 //! zeroed whole by [`Exchange::sum_forces`].
 
 use crate::checkpoint::{same_count, CheckpointError, Decoder, Encoder};
-use crate::continuum::rigid_body::place_members;
 use crate::continuum::rigid_body::RigidBodies;
+use crate::continuum::rigid_body::{
+    place_member_velocities, place_members, place_members_keeping_arms,
+};
 use crate::error::CoreError;
 use crate::parallel::Exchange;
 use crate::solvers::local_damping;
@@ -62,6 +64,8 @@ pub struct Verlet {
     torque: Vec<Vec3>,
     /// The rigid bodies' share of `torque` (the first entries).
     rigid_bodies: usize,
+    /// The members' arms R s at this step's pose, kept by the prediction for the kick.
+    arms: Vec<Vec3>,
 }
 
 impl Verlet {
@@ -73,6 +77,7 @@ impl Verlet {
             force: Vec::new(),
             torque: Vec::new(),
             rigid_bodies: 0,
+            arms: Vec::new(),
         }
     }
 
@@ -157,7 +162,7 @@ impl Verlet {
         if !state.rigid.is_empty() {
             state.rigid.kick_and_rotate(rigid, dt);
             rigid.fill(Vec3::zeros());
-            place_members(state);
+            place_members_keeping_arms(state, &mut self.arms);
         }
         stages.mark(Stage::Predict);
         self.evaluate(state, models, (stages, exchange), Some(0.5 * dt), zero)?;
@@ -166,11 +171,12 @@ impl Verlet {
         Ok(())
     }
 
-    /// The half kick of the rotations and the placing of the members.
+    /// The half kick of the rotations and the members' new velocities (the kick leaves the
+    /// poses, and so the members' positions and arms, as the prediction placed them).
     fn kick_rigid(&self, state: &mut State) {
         if !state.rigid.is_empty() {
             state.rigid.kick(&self.torque, 0.5 * self.dt);
-            place_members(state);
+            place_member_velocities(state, &self.arms);
         }
     }
 
