@@ -60,7 +60,7 @@ pub enum ContactLaw {
 
 impl ContactLaw {
     /// The force on a, updating the tangential spring `history` over a step `dt`.
-    #[inline]
+    #[inline(always)]
     pub fn force(
         &self,
         g: &PairGeometry,

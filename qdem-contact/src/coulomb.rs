@@ -12,7 +12,7 @@ use qdem_core::Vec3;
 
 /// The tangential force on a for the contact `g` with normal force `normal_force`, spring
 /// `stiffness` and dashpot `damping`, and the updated spring elongation `history`.
-#[inline]
+#[inline(always)]
 pub fn tangential_force(
     g: &PairGeometry,
     normal_force: f64,

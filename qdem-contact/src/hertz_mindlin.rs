@@ -33,7 +33,7 @@ impl HertzMindlin {
     }
 
     /// The force on a.
-    #[inline]
+    #[inline(always)]
     pub fn force(&self, g: &PairGeometry, e: &PairElasticity, history: &mut Vec3, dt: f64) -> Vec3 {
         let (s_n, s_t) = Self::stiffness(g.overlap, g.radius, e);
         let (gamma_n, gamma_t) = if self.damping_ratio > 0.0 {

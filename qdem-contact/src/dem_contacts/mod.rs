@@ -144,7 +144,7 @@ pub(crate) struct SphereNow {
 /// the contact point at x_a + (r_a − δ/2) n, and the velocity of a's contact point relative to
 /// b's, v_a − v_b + (r_a − δ/2) ω_a × n + (r_b − δ/2) ω_b × n; R* = r_a r_b/(r_a + r_b),
 /// m* = m_a m_b/(m_a + m_b).
-#[inline]
+#[inline(always)]
 pub(crate) fn narrow_phase(
     a: &SphereNow,
     b: &SphereNow,

@@ -212,7 +212,7 @@ impl DemContacts {
     /// The geometry and elasticity of the contact of sphere s with wall w: the contact point
     /// at x + (r − δ/2) n, its velocity v + (r − δ/2) ω × n against the wall's; `None` when
     /// apart.
-    #[inline]
+    #[inline(always)]
     pub(super) fn wall_contact(
         &self,
         time: f64,
