@@ -185,10 +185,18 @@ impl DemContacts {
             let this = &*self;
             let (runs, slot, early) = (&plan.runs, &plan.slot, &plan.early);
             let length = run_length(sums.len());
+            // Each run a task of its own on several threads: the runs' costs differ (a
+            // packing's floor layers carry its wall contacts), and rayon's halving split put
+            // them 2 : 1 on two threads at 10⁴ spheres. On one thread the splitting is waste.
+            let per_task = match rayon::current_num_threads() {
+                1 => usize::MAX,
+                _ => 1,
+            };
             sums.par_chunks_mut(length)
                 .zip(plan.foreign.par_iter_mut())
                 .zip(pair_runs.into_par_iter().zip(shift_runs).zip(wall_runs))
                 .enumerate()
+                .with_max_len(per_task)
                 .for_each(|(r, ((own, foreign), ((pairs, shifts), walls)))| {
                     let run = &runs[r];
                     let lo = (r * length) as u32;
