@@ -14,10 +14,10 @@
 # With --stiff --rigid-forming, step 1 with rigid stones (stiff_deposit_rigid.toml,
 # stiff_consolidate_rigid.toml) and step 2 with deformable ones from that bed
 # (stiff_load_from_rigid.toml; docs/ballast.md, "Forming rigid, loading deformable").
-# With --fine, the reduced layout with 900 stones of the paper's 5 cm size (docs/ballast.md,
-# "A bed of 5 cm stones"): the layer poured rigid (fine_deposit_rigid.toml), then the first
-# axle on it with rigid stones at friction 0.577 and 1.73 side by side (fine_load_rigid.toml,
-# fine_load_rigid_mu173.toml).
+# With --fine, the reduced layout with 500 stones of the paper's 5 cm size (docs/ballast.md,
+# "A bed of 5 cm stones"): the layer poured and consolidated rigid (fine_deposit_rigid.toml,
+# fine_consolidate_rigid.toml), then both bogies on it with rigid stones at friction 0.577 and
+# 1.73 side by side (fine_load_rigid.toml, fine_load_rigid_mu173.toml).
 # Step 1 is skipped when its checkpoint exists, unless --redeposit is given.
 # Outputs: out/ballast/{reduced,stiff}_*/ (probes.csv, vtu/, analysis/*.csv|svg, modes/).
 set -euo pipefail
@@ -53,7 +53,7 @@ if $rigid; then
 fi
 if $fine; then
     track=stiff
-    forming=(fine_deposit_rigid)
+    forming=(fine_deposit_rigid fine_consolidate_rigid)
     runs=(fine_load_rigid fine_load_rigid_mu173)
 fi
 if $redeposit || [ ! -f "out/ballast/${forming[-1]}/checkpoint.qdc" ]; then
