@@ -90,10 +90,10 @@ proptest! {
         );
         let oracle = subdomain_forces(&x, &t);
         let scale = oracle.iter().map(|g| g.norm()).fold(0.0, f64::max);
-        // The lanes use fused multiply-adds and the oracle adds 12 triangles' terms that largely
-        // cancel, so their round-off differs: a case seen at 1.0e-12 of the largest force is
-        // kept in kernel_oracle.proptest-regressions. 1e-11 still fails any wrong term, which
-        // moves a force by far more.
+        // The lanes (fused multiply-adds) and the oracle's 12-triangle sum round differently:
+        // a random case differed by 1.0e-12 of the largest force (kept in
+        // kernel_oracle.proptest-regressions). 1e-11 still fails any wrong term, which moves a
+        // force by far more.
         for j in 0..4 {
             prop_assert!((force[j] - oracle[j]).norm() <= 1e-11 * scale,
                 "vertex {}: body {:?} oracle {:?}", j, force[j], oracle[j]);
