@@ -18,7 +18,7 @@
 //! Box tests (paper 003): [`periodic_boundary`] (periodic cells, minimum-image contacts,
 //! bodies wrapped whole), [`time_delayed_boundary`] (Eqs. 2–7: ghost forces scaled by the
 //! neighbour cells' load phase) and [`clump_sample`] (ballast-like stones as rigid clumps with
-//! a grading).
+//! a grading, shaped by [`clump_shape`]).
 //!
 //! Post-step hooks of a [`qdem_core::World`]: [`PeriodicWrap`] (bodies wrapped back into a
 //! periodic cell) and [`CollapseWatch`] (a bonded run ends once its body has failed).
@@ -34,6 +34,7 @@ pub mod bonded_particles;
 pub mod broad_phase;
 pub mod clump_mass;
 pub mod clump_sample;
+pub mod clump_shape;
 pub mod collapse_watch;
 pub mod contact_law;
 mod contact_list;

@@ -32,7 +32,8 @@ use crate::csv_rows::{finite, read_text, rows};
 use crate::output::{write_atomic, OutputError};
 use crate::scene::{Granular, Scene};
 use qdem_contact::clump_sample::{
-    clump_mass_properties, generate_stones, Grading, MassProperties, SampleError, SampleSpec, Stone,
+    clump_mass_properties, generate_stones, ClumpShape, Grading, GradingBasis, MassProperties,
+    SampleError, SampleSpec, Stone,
 };
 use qdem_contact::ContactSphere;
 use qdem_core::{State, Vec3};
@@ -127,7 +128,9 @@ pub(crate) fn stones(
             count,
             grading: Grading::new(grading.iter().map(|p| (p[0], p[1])).collect())
                 .map_err(refused)?,
+            basis: GradingBasis::Number,
             spheres_per_stone: granular.spheres_per_stone,
+            shape: ClumpShape::Elongated,
             seed: granular.seed,
         };
         stones.extend(generate_stones(&spec).map_err(refused)?);
