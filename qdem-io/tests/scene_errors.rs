@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use qdem_io::scene::{Scene, SceneError};
+use qdem_io::scene::{ClumpShapeName, GradingBasisName, Scene, SceneError};
 
 const PATH: &str = "scenes/scene.toml";
 
@@ -882,6 +882,53 @@ fn periodic_and_time_delay_mistakes_are_named() {
     assert_has(
         &msg,
         &["[[load]] #1", "frequency", "either `ramp` or `cyclic`"],
+    );
+}
+
+#[test]
+fn granular_unknown_shape_and_grading_basis_list_the_valid_ones() {
+    let generated = format!(
+        "{BASE}\n[contact]\nnormal_stiffness = 1e6\ntangential_stiffness = 1e6\n\n[granular]\n\
+         name = \"ballast\"\nmaterial = \"concrete\"\nregion = [[0, 0, 0], [0.3, 0.7, 1.0]]\n\
+         count = 10\ngrading = [[0.05, 0.0], [0.1, 1.0]]\n"
+    );
+    let (err, msg) = error(&format!("{generated}shape = \"blocky\"\n"));
+    assert!(matches!(err, SceneError::Schema(_)));
+    assert_has(
+        &msg,
+        &[
+            "`blocky`",
+            "`shape` in [granular]",
+            "valid values: `elongated`, `angular`",
+        ],
+    );
+    let (err, msg) = error(&format!("{generated}grading_basis = \"volume\"\n"));
+    assert!(matches!(err, SceneError::Schema(_)));
+    assert_has(
+        &msg,
+        &[
+            "`volume`",
+            "`grading_basis` in [granular]",
+            "valid values: `number`, `mass`",
+        ],
+    );
+    // The valid values parse, and the defaults are today's.
+    let fine = format!("{generated}shape = \"angular\"\ngrading_basis = \"mass\"\n");
+    let g = Scene::parse(&fine, Path::new(PATH))
+        .unwrap()
+        .granular
+        .unwrap();
+    assert_eq!(
+        (g.shape, g.grading_basis),
+        (ClumpShapeName::Angular, GradingBasisName::Mass)
+    );
+    let g = Scene::parse(&generated, Path::new(PATH))
+        .unwrap()
+        .granular
+        .unwrap();
+    assert_eq!(
+        (g.shape, g.grading_basis),
+        (ClumpShapeName::Elongated, GradingBasisName::Number)
     );
 }
 

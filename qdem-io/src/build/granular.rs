@@ -2,7 +2,8 @@
 //! simulation after its mesh bodies.
 //!
 //! The stones come from a generation ([`qdem_contact::clump_sample::generate_stones`]: a grading
-//! curve, a loose lattice in a region, a seed), to be deposited under gravity, or from a stones
+//! curve sampled by number or by mass (`grading_basis`), stones elongated or angular (`shape`),
+//! a loose lattice in a region, a seed), to be deposited under gravity, or from a stones
 //! file: CSV with the header `stone,x,y,z,radius` and one row per sphere, the rows of a stone
 //! together. A run with `[granular]` writes the stones' final spheres to `stones.csv` in that
 //! format ([`write_stones_csv`]), so a deposition run's output is the next run's sample.
@@ -30,7 +31,7 @@
 use crate::build::BuildError;
 use crate::csv_rows::{finite, read_text, rows};
 use crate::output::{write_atomic, OutputError};
-use crate::scene::{Granular, Scene};
+use crate::scene::{ClumpShapeName, GradingBasisName, Granular, Scene};
 use qdem_contact::clump_sample::{
     clump_mass_properties, generate_stones, ClumpShape, Grading, GradingBasis, MassProperties,
     SampleError, SampleSpec, Stone,
@@ -128,9 +129,15 @@ pub(crate) fn stones(
             count,
             grading: Grading::new(grading.iter().map(|p| (p[0], p[1])).collect())
                 .map_err(refused)?,
-            basis: GradingBasis::Number,
+            basis: match granular.grading_basis {
+                GradingBasisName::Number => GradingBasis::Number,
+                GradingBasisName::Mass => GradingBasis::Mass,
+            },
             spheres_per_stone: granular.spheres_per_stone,
-            shape: ClumpShape::Elongated,
+            shape: match granular.shape {
+                ClumpShapeName::Elongated => ClumpShape::Elongated,
+                ClumpShapeName::Angular => ClumpShape::Angular,
+            },
             seed: granular.seed,
         };
         stones.extend(generate_stones(&spec).map_err(refused)?);

@@ -11,7 +11,7 @@
 //!
 //! **By mass.** The fraction passing a size is the mass of the stones of at most that sieve
 //! size over the sample's mass; `[granular] grading` draws sizes by number, which the curve
-//! by number beside it shows.
+//! by number beside it shows (by mass with `grading_basis = "mass"`).
 
 use nalgebra::SymmetricEigen;
 use qdem_core::{Mat3, Vec3};

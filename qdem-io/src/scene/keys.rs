@@ -672,9 +672,21 @@ pub const SCENE_KEYS: &[SceneKey] = &[
     ),
     key(
         "[granular]",
+        "grading_basis",
+        "\"number\" or \"mass\", optional",
+        "Generation: what `grading`'s fractions passing count: `\"number\"` (default) the fraction of stones finer than a size (the sample is coarser by mass than the curve), `\"mass\"` the fraction of mass, as sieve analyses and ballast standards give it (within a segment the mass is spread uniformly in size, a stone weighing ∝ d³).",
+    ),
+    key(
+        "[granular]",
         "spheres_per_stone",
         "[integer, integer], optional",
         "Generation: smallest and largest number of spheres per stone; default [3, 5].",
+    ),
+    key(
+        "[granular]",
+        "shape",
+        "\"elongated\" or \"angular\", optional",
+        "Generation: the stones' shape: `\"elongated\"` (default) a row of spheres along a long axis, a flaky stone; `\"angular\"` a core sphere with the other spheres as corners out towards an ellipsoid, like crushed ballast. Both stay within 0.65 of the sieve size of the stone's origin; one sphere is a plain sphere of radius d/2.",
     ),
     key(
         "[granular]",

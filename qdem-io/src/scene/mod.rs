@@ -49,9 +49,10 @@ pub use error::{Diagnostic, SceneError};
 pub use measure::{Measure, MeasureRegion};
 pub use refs::{ProbeTarget, Refs};
 pub use schema::{
-    AreaLoad, Ballast, Body, Bonded, Contact, ContactLawName, CyclicLoad, EventSolveName, Fix,
-    Formulation, Granular, Integrator, Load, Material, Output, PackingName, Periodic, Probe, Ramp,
-    Run, Section, Selection, Series, Supports, TimeDelay, TimeStep, Wall, WallServo,
+    AreaLoad, Ballast, Body, Bonded, ClumpShapeName, Contact, ContactLawName, CyclicLoad,
+    EventSolveName, Fix, Formulation, GradingBasisName, Granular, Integrator, Load, Material,
+    Output, PackingName, Periodic, Probe, Ramp, Run, Section, Selection, Series, Supports,
+    TimeDelay, TimeStep, Wall, WallServo,
 };
 
 use schema::RawScene;

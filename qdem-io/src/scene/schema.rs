@@ -859,7 +859,9 @@ pub struct TimeDelay {
 /// region = [[0, 0, 0.05], [0.3, 0.7, 1.2]]
 /// count = 400
 /// grading = [[0.0224, 0.0], [0.04, 0.5], [0.0625, 1.0]]  # (size m, fraction passing)
+/// grading_basis = "mass"               # optional: fractions of mass; default "number"
 /// spheres_per_stone = [3, 5]
+/// shape = "angular"                    # optional: a stone with corners; default "elongated"
 /// seed = 1
 /// velocity = [0.0, 0.0, -1.0]          # optional, m/s: every stone
 /// angular_velocity = [0.0, 20.0, 0.0]  # optional, rad/s: every stone about its centre
@@ -897,9 +899,17 @@ pub struct Granular {
     /// Generation: the grading curve, (sieve size m, fraction passing) points.
     #[serde(default)]
     pub grading: Option<Vec<[f64; 2]>>,
+    /// Generation: whether `grading`'s fractions passing count stones (`"number"`, the
+    /// default) or mass (`"mass"`, as sieve analyses and ballast standards give them).
+    #[serde(default)]
+    pub grading_basis: GradingBasisName,
     /// Generation: smallest and largest number of spheres per stone; default [3, 5].
     #[serde(default = "default_spheres_per_stone")]
     pub spheres_per_stone: [usize; 2],
+    /// Generation: the stones' shape, `"elongated"` (default: a row of spheres along the long
+    /// axis) or `"angular"` (a core sphere with corner spheres, like crushed ballast).
+    #[serde(default)]
+    pub shape: ClumpShapeName,
     /// Generation: seed; default 1.
     #[serde(default = "default_seed")]
     pub seed: u64,
@@ -944,6 +954,30 @@ fn default_spheres_per_stone() -> [usize; 2] {
 
 fn default_seed() -> u64 {
     1
+}
+
+/// `[granular] grading_basis`: what the grading's fractions passing count
+/// (`qdem_contact::clump_sample::GradingBasis`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GradingBasisName {
+    /// The fraction of stones finer than a size: the curve is sampled by number.
+    #[default]
+    Number,
+    /// The fraction of mass finer than a size.
+    Mass,
+}
+
+/// `[granular] shape`: how a generated stone's spheres are arranged
+/// (`qdem_contact::clump_shape::ClumpShape`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ClumpShapeName {
+    /// A row of spheres along the long axis: an elongated, flaky stone.
+    #[default]
+    Elongated,
+    /// A core sphere with corner spheres out towards an ellipsoid: a stone with corners.
+    Angular,
 }
 
 /// `[bonded] packing`: how the rectangle is filled.

@@ -1,13 +1,15 @@
 //! [`Grading`]: `grading.csv` and `grading.svg` of a `[granular]` sample at the start of the
 //! run: per stone in order of sieve size, its size, its mass and the fractions of the
 //! sample's mass and number passing (a sieve curve by mass; [`crate::post::sieve`] for how a
-//! clump's sieve size is measured), with `[granular] grading` (by number) drawn beside.
+//! clump's sieve size is measured), with `[granular] grading` (by number or by mass, as its
+//! `grading_basis` says) drawn beside.
 
 use super::Recorder;
 use crate::build::Simulation;
 use crate::output::{write_atomic, OutputError};
 use crate::plot::{line_plot_svg, Labels, Series};
 use crate::post::sieve::{grading_by_mass, sieve_size};
+use crate::scene::GradingBasisName;
 use qdem_core::Vec3;
 use std::path::{Path, PathBuf};
 
@@ -17,8 +19,10 @@ pub(crate) struct Grading {
     svg: PathBuf,
     /// Per stone by size: size, mass, mass passing, number passing.
     rows: Vec<[f64; 4]>,
-    /// `[granular] grading`, (size, fraction passing by number).
+    /// `[granular] grading`, (size, fraction passing by number or by mass).
     requested: Vec<(f64, f64)>,
+    /// The plot's label of `requested`, naming its `grading_basis`.
+    requested_label: &'static str,
 }
 
 impl Grading {
@@ -34,12 +38,17 @@ impl Grading {
                 (sieve_size(&centers, radii), state.mass[*center])
             })
             .collect();
-        let requested = sim.scene.granular.as_ref()?.grading.as_ref();
+        let granular = sim.scene.granular.as_ref()?;
+        let requested = granular.grading.as_ref();
         Some(Grading {
             csv: out_dir.join("grading.csv"),
             svg: out_dir.join("grading.svg"),
             rows: grading_by_mass(&stones),
             requested: requested.map_or(Vec::new(), |g| g.iter().map(|p| (p[0], p[1])).collect()),
+            requested_label: match granular.grading_basis {
+                GradingBasisName::Number => "[granular] grading (by number)",
+                GradingBasisName::Mass => "[granular] grading (by mass)",
+            },
         })
     }
 }
@@ -75,7 +84,7 @@ impl Recorder for Grading {
         ];
         if !self.requested.is_empty() {
             series.push(Series {
-                label: "[granular] grading (by number)",
+                label: self.requested_label,
                 points: &self.requested,
             });
         }
