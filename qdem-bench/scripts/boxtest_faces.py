@@ -3,7 +3,7 @@
 in the single-sleeper periodic boxes: the premise of paper 003's Eqs. 4-7 checked against the
 reference it is meant to reproduce.
 
-    python3 qdem-bench/scripts/boxtest_faces.py [--study out/boxtest_study] [--seeds 1,2,3]
+    python3 qdem-bench/scripts/boxtest_faces.py [--study out/boxtest_study] [--seeds 1,2,3,4,5] [--size study]
 
 Reads each seed's three_sleeper/sections.csv (the average contact force through y = 0.7 and
 1.4 m, the middle cell's left and right faces), single_periodic/sections.csv (through the
@@ -92,42 +92,53 @@ def svg(path, means, seeds):
     for k in range(5):
         f = top * k / 4
         out.append(f'<text x="{m - 5}" y="{y(f) + 4}" text-anchor="end">{f:.0f}</text>')
+    line = lambda vals: " ".join(f"{x(k):.1f},{y(v):.1f}" for k, v in enumerate(vals) if not math.isnan(v))
     for seed in seeds:
-        dash = {1: "", 2: ' stroke-dasharray="6 3"', 3: ' stroke-dasharray="2 2"'}.get(seed, "")
         for name, vals in means[seed].items():
-            pts = " ".join(f"{x(k):.1f},{y(v):.1f}" for k, v in enumerate(vals) if not math.isnan(v))
-            out.append(f'<polyline fill="none" stroke="{COLOURS[name]}" stroke-width="1.5"{dash} points="{pts}"/>')
+            out.append(f'<polyline fill="none" stroke="{COLOURS[name]}" stroke-width="0.7" stroke-opacity="0.4" points="{line(vals)}"/>')
+    for name, vals in over_samples(means, seeds).items():
+        out.append(f'<polyline fill="none" stroke="{COLOURS[name]}" stroke-width="2.5" points="{line(vals)}"/>')
     for i, name in enumerate(SERIES):
         out.append(f'<rect x="{m + 10}" y="{m + 8 + 16 * i}" width="14" height="3" fill="{COLOURS[name]}"/>'
                    f'<text x="{m + 30}" y="{m + 13 + 16 * i}">{SERIES[name]}</text>')
-    out.append(f'<text x="{w - m}" y="{m - 10}" text-anchor="end">samples {", ".join(map(str, seeds))} (solid, dashed, dotted)</text>')
+    out.append(f'<text x="{w - m}" y="{m - 10}" text-anchor="end">samples {", ".join(map(str, seeds))} (thick: their mean, thin: each)</text>')
     out.append("</svg>")
     with open(path, "w") as f:
         f.write("\n".join(out) + "\n")
 
 
+def over_samples(means, seeds):
+    """{series: mean over the samples of each phase bin's mean}."""
+    return {name: [sum(means[s][name][k] for s in seeds) / len(seeds) for k in range(BINS)]
+            for name in SERIES}
+
+
 def markdown(means, seeds):
     points = [("minimum", 0), ("rising", BINS // 4), ("peak", BINS // 2), ("falling", 3 * BINS // 4)]
-    lines = ["Mean contact force through the face (N), averaged over cycles 2-10 at four phases "
-             "of the middle sleeper's load (the bin starting there, 10° wide):", "",
-             "| sample | series | " + " | ".join(p for p, _ in points) + " |",
-             "|---|---|" + "---|" * len(points)]
-    for seed in seeds:
-        for name, label in SERIES.items():
-            vals = " | ".join(f"{means[seed][name][k]:.1f}" for _, k in points)
-            lines.append(f"| {seed} | {label} | {vals} |")
+    mean = over_samples(means, seeds)
+    lines = ["Mean contact force through the face (N) at four phases of the middle sleeper's load "
+             "(the bin starting there, 10° wide), averaged over cycles 2 to the last and over "
+             f"samples {', '.join(map(str, seeds))} (in brackets: the smallest and largest sample):",
+             "", "| series | " + " | ".join(p for p, _ in points) + " |",
+             "|---|" + "---|" * len(points)]
+    for name, label in SERIES.items():
+        vals = " | ".join(
+            f"{mean[name][k]:.1f} ({min(means[s][name][k] for s in seeds):.0f}–"
+            f"{max(means[s][name][k] for s in seeds):.0f})" for _, k in points)
+        lines.append(f"| {label} | {vals} |")
     return "\n".join(lines)
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--study", default=os.path.join(ROOT, "out", "boxtest_study"))
-    ap.add_argument("--seeds", default="1,2,3")
+    ap.add_argument("--seeds", default="1,2,3,4,5")
+    ap.add_argument("--size", default="study")
     ap.add_argument("--docs", default=os.path.join(ROOT, "docs"))
     args = ap.parse_args()
     seeds = [int(s) for s in args.seeds.split(",")]
     means = {s: {n: phase_means(p) for n, p in
-                 series(os.path.join(args.study, f"study_seed{s}")).items()} for s in seeds}
+                 series(os.path.join(args.study, f"{args.size}_seed{s}")).items()} for s in seeds}
     with open(os.path.join(args.study, "faces.csv"), "w") as f:
         f.write("phase_deg,seed,series,force\n")
         for s in seeds:

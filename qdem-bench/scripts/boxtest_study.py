@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The box-test study of paper 003: for each of 3 samples (seeds 1, 2, 3), deposit the
+"""The box-test study of paper 003: for each sample (seeds 1-5 by default), deposit the
 sample of the periodic single-sleeper cell (bed, then the sleeper and the crib), then load
 it in the three-sleeper box (the cell's sample three times along y), in the single-sleeper
 box with fixed walls, and with ordinary and time-delayed periodic boundaries (paper 003's
@@ -7,23 +7,37 @@ Eqs. 6-7, and qdem's shared faces); collect the middle sleeper's settlement afte
 cycle. All five cases of a seed load the same middle sample from the same sleeper pose.
 
     cargo build --release -p qdem-cli
-    python3 qdem-bench/scripts/boxtest_study.py [--size study|small] [--seeds 1,2,3]
+    python3 qdem-bench/scripts/boxtest_study.py [--size study|small|paper] [--seeds 1-5]
+        [--jobs 2] [--threads 1] [--docs]
+    python3 qdem-bench/scripts/boxtest_study.py --variant stiff4 --young 4e9 --cycles 10
 
-Writes out/boxtest_study/settlement.csv (case, seed, cycle, settlement), settlement.svg,
-runs.json (particles, steps, wall time, sphere-steps/s of every run) and the tables between
-<!-- boxtest:begin --> and <!-- boxtest:end --> in docs/boxtest.md, then (study size) runs
-boxtest_faces.py: the force through the middle cell's faces over a cycle. Settlement is the
-sleeper's downward displacement at the end of each cycle (its load back at the minimum)
-relative to the start of the cycles (after the settling time under the minimum load), read
-from each run's settlement.csv (qdem's displacement at every cycle's minimum).
+The second form loads the samples the first deposited again, here at 4 GPa for 10 cycles
+(out/boxtest_study/SIZE_seedN_stiff4/), and prints its errors beside the first study's after
+as many cycles: does the stiffness change which boundary comes closest? `--tables-only`
+writes the tables and plots again from the last outputs without running anything.
+
+Runs `--jobs` qdem runs at once (`--threads` each; on a 2-core machine two one-thread runs
+beat one two-thread run). Writes out/boxtest_study/settlement.csv (case, seed, cycle,
+settlement), settlement.svg, runs.json (particles, steps, wall time, sphere-steps/s of every
+run) and prints the tables: settlement per sample, the mean error of each boundary against
+the three-sleeper box with its 95% interval over the samples (paired by sample), and which
+boundary is closer, pair by pair. With `--docs` the tables go between <!-- boxtest:begin -->
+and <!-- boxtest:end --> in docs/boxtest.md with the plot beside, then boxtest_faces.py
+writes the force through the middle cell's faces over a cycle. Settlement is the sleeper's
+downward displacement at the end of each cycle (its load back at the minimum) relative to
+the start of the cycles (after the settling time under the minimum load), read from each
+run's settlement.csv (qdem's displacement at every cycle's minimum).
 """
 import argparse
 import csv
 import json
+import math
 import os
 import re
 import subprocess
 import sys
+import threading
+import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FIXTURES = os.path.join(ROOT, "fixtures", "boxtest")
@@ -56,13 +70,89 @@ def scene_for(size, name, seed, out):
     return text
 
 
-def run(size, name, seed, out):
+def run(size, name, seed, out, qdem, threads, variant=None):
+    """One run of `seed` with its samples under `out`; a `variant` (dict of `name`, `young`,
+    `t_end`) loads those samples at another stiffness or for fewer cycles and writes its runs
+    under `out`_NAME."""
+    text = scene_for(size, name, seed, out)
+    if variant:
+        text = re.sub(r'^dir = "(.*)/([a-z_]+)"$', rf'dir = "\1_{variant["name"]}/\2"', text,
+                      flags=re.M)
+        if variant["young"]:
+            text = re.sub(r"^young = .*$", f"young = {variant['young']}", text, flags=re.M)
+        if variant["t_end"]:
+            text = re.sub(r"^t_end = .*$", f"t_end = {variant['t_end']}", text, flags=re.M)
+        out = f"{out}_{variant['name']}"
+        os.makedirs(out, exist_ok=True)
     path = os.path.join(out, f"{name}.toml")
     with open(path, "w") as f:
-        f.write(scene_for(size, name, seed, out))
-    subprocess.run([QDEM, "run", path], check=True, stdout=subprocess.DEVNULL)
+        f.write(text)
+    subprocess.run([qdem, "run", path, "--threads", str(threads)], check=True,
+                   stdout=subprocess.DEVNULL, env=dict(os.environ, CI="true"))
     with open(os.path.join(out, name.replace("deposit_", ""), "summary.json")) as f:
         return json.load(f)
+
+
+def run_all(size, seeds, base, qdem, jobs, threads, variant=None):
+    """Every run of every seed, `jobs` at a time on `threads` threads each: a seed's bed, then
+    its crib, then its five loading cases (the three-sleeper box first, the longest); with a
+    `variant`, only the loading cases, on the samples already deposited. Returns the runs'
+    summaries in a fixed order (seed, then run), whatever order they finished in."""
+    deposits = [] if variant else ["deposit_cell_bed", "deposit_cell_crib"]
+    ready = ([(seed, 0, "deposit_cell_bed") for seed in seeds] if deposits else
+             [(seed, 1 + k, case) for seed in seeds for k, case in enumerate(CASES)])
+    done, failed = {}, []
+    lock = threading.Condition()
+    running = [0]
+
+    def worker():
+        while True:
+            with lock:
+                while not ready and running[0] and not failed:
+                    lock.wait()
+                if not ready or failed:
+                    lock.notify_all()
+                    return
+                seed, rank, name = min(ready, key=lambda t: (t[1], t[0]))
+                ready.remove((seed, rank, name))
+                running[0] += 1
+            out = os.path.join(base, f"{size}_seed{seed}")
+            os.makedirs(out, exist_ok=True)
+            try:
+                s = run(size, name, seed, out, qdem, threads, variant)
+            except Exception as e:  # a failed run stops the study after the running ones
+                with lock:
+                    failed.append(f"seed {seed} {name}: {e}")
+                    running[0] -= 1
+                    lock.notify_all()
+                return
+            print(f"seed {seed} {name}: {s['wall_seconds']:.1f} s", flush=True)
+            with lock:
+                done[(seed, name)] = s
+                running[0] -= 1
+                if name == "deposit_cell_bed":
+                    ready.append((seed, 0, "deposit_cell_crib"))
+                elif name == "deposit_cell_crib":
+                    ready.extend((seed, 1 + k, case) for k, case in enumerate(CASES))
+                lock.notify_all()
+
+    pool = [threading.Thread(target=worker) for _ in range(jobs)]
+    for t in pool:
+        t.start()
+    for t in pool:
+        t.join()
+    if failed:
+        sys.exit("; ".join(failed))
+    runs = []
+    for seed in seeds:
+        for name in deposits + CASES:
+            s = done[(seed, name)]
+            runs.append(dict(seed=seed, run=name, particles=s["particles"],
+                             stones=s["granular"]["stones"], spheres=s["contact"]["spheres"],
+                             steps=s["steps"], dt=s["dt"], wall_seconds=s["wall_seconds"],
+                             sphere_steps_per_second=s["contact"]["sphere_steps_per_second"],
+                             threads=s["threads"]))
+    return runs
 
 
 def settlement(out, case, settle, cycles):
@@ -83,68 +173,102 @@ def settlement(out, case, settle, cycles):
     return [u - minima[0][1] for _, u in minima[1:]]
 
 
-def svg(path, series, cycles):
-    """Settlement against cycle: one polyline per (case, seed)."""
-    w, h, m = 640, 420, 60
+def svg(path, series, cycles, seeds):
+    """Settlement against cycle: each case's mean over the samples (thick) over its samples
+    (thin)."""
+    w, h, m = 680, 440, 60
     top = max(max(v) for _, _, v in series) * 1.1 or 1.0
     x = lambda c: m + (w - 2 * m) * c / cycles
     y = lambda s: h - m - (h - 2 * m) * s / top
     out = svg_frame(w, h, m, "load cycle", "middle-sleeper settlement (mm)")
-    for c in range(cycles + 1):
+    for c in range(0, cycles + 1, 5 if cycles > 10 else 1):
         out.append(f'<text x="{x(c)}" y="{h - m + 16}" text-anchor="middle">{c}</text>')
     for k in range(5):
         s = top * k / 4
         out.append(f'<text x="{m - 6}" y="{y(s) + 4}" text-anchor="end">{1000 * s:.1f}</text>')
-    dashes = {1: "", 2: ' stroke-dasharray="6 3"', 3: ' stroke-dasharray="2 3"'}
-    for case, seed, values in series:
-        pts = " ".join(f"{x(c)},{y(v)}" for c, v in zip(range(cycles + 1), [0.0] + values))
-        out.append(f'<polyline points="{pts}" fill="none" stroke="{COLOURS[case]}" stroke-width="1.5"{dashes.get(seed, "")}/>')
+    line = lambda values: " ".join(f"{x(c):.1f},{y(v):.1f}" for c, v in enumerate([0.0] + values))
+    for case, _, values in series:
+        out.append(f'<polyline points="{line(values)}" fill="none" stroke="{COLOURS[case]}" stroke-width="0.7" stroke-opacity="0.45"/>')
+    for case in CASES:
+        runs = [v for c, _, v in series if c == case]
+        mean = [sum(col) / len(col) for col in zip(*runs)]
+        out.append(f'<polyline points="{line(mean)}" fill="none" stroke="{COLOURS[case]}" stroke-width="2.5"/>')
     for i, case in enumerate(CASES):
-        out.append(f'<line x1="{m + 10}" y1="{m + 10 + 16 * i}" x2="{m + 30}" y2="{m + 10 + 16 * i}" stroke="{COLOURS[case]}" stroke-width="2"/>')
+        out.append(f'<line x1="{m + 10}" y1="{m + 10 + 16 * i}" x2="{m + 30}" y2="{m + 10 + 16 * i}" stroke="{COLOURS[case]}" stroke-width="2.5"/>')
         out.append(f'<text x="{m + 36}" y="{m + 14 + 16 * i}">{LABELS[case]}</text>')
-    out.append(f'<text x="{m + 10}" y="{m + 14 + 16 * len(CASES)}">samples 1, 2, 3: solid, dashed, dotted</text>')
+    out.append(f'<text x="{m + 10}" y="{m + 14 + 16 * len(CASES)}">thick: mean of samples {", ".join(map(str, seeds))}; thin: each sample</text>')
     out.append("</svg>")
     with open(path, "w") as f:
         f.write("\n".join(out))
 
 
+def parse_seeds(text):
+    """"1-5" or "1,2,3"."""
+    if "-" in text:
+        lo, hi = text.split("-")
+        return list(range(int(lo), int(hi) + 1))
+    return [int(s) for s in text.split(",")]
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--size", default="study")
-    ap.add_argument("--seeds", default="1,2,3")
+    ap.add_argument("--seeds", default="1-5")
+    ap.add_argument("--jobs", type=int, default=2, help="runs at once (default 2)")
+    ap.add_argument("--threads", type=int, default=1, help="threads per run (default 1)")
+    ap.add_argument("--qdem", default=QDEM)
+    ap.add_argument("--variant", help="load the samples already deposited again, as NAME: "
+                    "with --young and/or --cycles; runs under out/boxtest_study/SIZE_seedN_NAME")
+    ap.add_argument("--young", type=float, help="the variant's Young's modulus (Pa)")
+    ap.add_argument("--cycles", type=int, help="the variant's load cycles")
+    ap.add_argument("--tables-only", action="store_true",
+                    help="no runs: the tables and plots again from the outputs of the last study")
+    ap.add_argument("--docs", action="store_true",
+                    help="write the tables and plots into docs/ (the study size)")
     args = ap.parse_args()
-    seeds = [int(s) for s in args.seeds.split(",")]
+    seeds = parse_seeds(args.seeds)
     with open(os.path.join(FIXTURES, "generate.py")) as f:
         params = re.search(r'"%s": dict\((.*?)\),\n' % args.size, f.read(), re.S).group(1)
     cycles = int(re.search(r"cycles=(\d+)", params).group(1))
     settle = float(re.search(r"settle=([\d.]+)", params).group(1))
+    variant, suffix = None, ""
+    if args.variant:
+        cycles = args.cycles or cycles
+        variant = dict(name=args.variant, young=args.young, t_end=settle + cycles / 3.0)
+        suffix = f"_{args.variant}"
     base = os.path.join(ROOT, "out", "boxtest_study")
     os.makedirs(base, exist_ok=True)
-    series, runs = [], []
-    for seed in seeds:
-        out = os.path.join(base, f"{args.size}_seed{seed}")
-        os.makedirs(out, exist_ok=True)
-        for name in ["deposit_cell_bed", "deposit_cell_crib"] + CASES:
-            s = run(args.size, name, seed, out)
-            runs.append(dict(seed=seed, run=name, particles=s["particles"],
-                             stones=s["granular"]["stones"], spheres=s["contact"]["spheres"],
-                             steps=s["steps"], dt=s["dt"], wall_seconds=s["wall_seconds"],
-                             sphere_steps_per_second=s["contact"]["sphere_steps_per_second"],
-                             threads=s["threads"]))
-            print(f"seed {seed} {name}: {s['wall_seconds']:.1f} s", flush=True)
-        for case in CASES:
-            series.append((case, seed, settlement(out, case, settle, cycles)))
+    record = os.path.join(base, args.variant or "", "runs.json")
+    if args.tables_only:
+        with open(record) as f:
+            saved = json.load(f)
+        runs, wall = saved["runs"], saved["wall_seconds"]
+        args.jobs, args.threads = saved["jobs"], saved["threads"]
+    else:
+        started = time.time()
+        runs = run_all(args.size, seeds, base, args.qdem, args.jobs, args.threads, variant)
+        wall = time.time() - started
+    series = [(case, seed, settlement(os.path.join(base, f"{args.size}_seed{seed}{suffix}"),
+                                      case, settle, cycles))
+              for seed in seeds for case in CASES]
+    base = os.path.join(base, args.variant) if args.variant else base
+    os.makedirs(base, exist_ok=True)
     with open(os.path.join(base, "settlement.csv"), "w") as f:
         f.write("case,seed,cycle,settlement_m\n")
         for case, seed, values in series:
             for c, v in enumerate(values, 1):
                 f.write(f"{case},{seed},{c},{v:.6e}\n")
     with open(os.path.join(base, "runs.json"), "w") as f:
-        json.dump(runs, f, indent=1)
-    svg(os.path.join(base, "settlement.svg"), series, cycles)
-    table = tables(series, runs, seeds)
+        json.dump(dict(size=args.size, seeds=seeds, jobs=args.jobs, threads=args.threads,
+                       wall_seconds=wall, runs=runs), f, indent=1)
+    svg(os.path.join(base, "settlement.svg"), series, cycles, seeds)
+    table = tables(series, runs, seeds, cycles, wall, args)
+    if args.variant:
+        table += "\n\n" + beside_base(series, seeds, cycles, os.path.dirname(base), args.variant)
+    with open(os.path.join(base, "tables.md"), "w") as f:
+        f.write(table + "\n")
     print(table)
-    if args.size == "study":
+    if args.docs:
         doc = os.path.join(ROOT, "docs", "boxtest.md")
         text = open(doc).read()
         text = re.sub(r"<!-- boxtest:begin -->.*<!-- boxtest:end -->",
@@ -152,23 +276,97 @@ def main():
         open(doc, "w").write(text)
         os.replace(os.path.join(base, "settlement.svg"), os.path.join(ROOT, "docs", "boxtest_settlement.svg"))
         faces = os.path.join(os.path.dirname(os.path.abspath(__file__)), "boxtest_faces.py")
-        subprocess.run([sys.executable, faces, "--seeds", args.seeds], check=True)
+        subprocess.run([sys.executable, faces, "--seeds", ",".join(map(str, seeds)),
+                        "--size", args.size], check=True)
     return 0
 
 
-def tables(series, runs, seeds):
+# Two-sided 95% Student t quantiles by degrees of freedom (1-10; 1.96 beyond).
+T95 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365, 8: 2.306,
+       9: 2.262, 10: 2.228}
+
+
+def mean_ci(values):
+    """Mean and the half-width of its 95% interval (Student t over the samples)."""
+    n = len(values)
+    mean = sum(values) / n
+    if n < 2:
+        return mean, float("nan")
+    sd = math.sqrt(sum((v - mean) ** 2 for v in values) / (n - 1))
+    return mean, T95.get(n - 1, 1.96) * sd / math.sqrt(n)
+
+
+def beside_base(series, seeds, cycles, base, name):
+    """The variant's errors against the three-sleeper box beside the base study's after the
+    same number of cycles (read from the base study's settlement.csv), per boundary: does the
+    variant change which boundary is closest?"""
+    path = os.path.join(base, "settlement.csv")
+    if not os.path.exists(path):
+        return f"(no {path}: run the base study first to compare)"
+    with open(path) as f:
+        at = {(r["case"], int(r["seed"])): float(r["settlement_m"]) for r in csv.DictReader(f)
+              if int(r["cycle"]) == cycles}
+    mine = {(c, s): v[cycles - 1] for c, s, v in series}
+    lines = [f"Error against the three-sleeper box after {cycles} cycles, mean ± 95% interval "
+             f"over samples {', '.join(map(str, seeds))} (mm), the base study beside `{name}`:", "",
+             f"| case | base | {name} | closest on (base / {name}) |", "| --- | --- | --- | --- |"]
+    for c in CASES[1:]:
+        cells = []
+        for d in (at, mine):
+            e, h = mean_ci([d[(c, s)] - d[("three_sleeper", s)] for s in seeds])
+            cells.append(f"{1000 * e:+.2f} ± {1000 * h:.2f}")
+        wins = [sum(min(CASES[1:], key=lambda k: abs(d[(k, s)] - d[("three_sleeper", s)])) == c
+                    for s in seeds) for d in (at, mine)]
+        lines.append(f"| {LABELS[c]} | {cells[0]} | {cells[1]} | {wins[0]} / {wins[1]} |")
+    return "\n".join(lines)
+
+
+def tables(series, runs, seeds, cycles, wall, args):
     last = {(c, s): v[-1] for c, s, v in series}
-    lines = ["| sample | three-sleeper (mm) | fixed walls (mm) | periodic (mm) | time-delayed (mm) | time-delayed, shared faces (mm) | order fixed < periodic < delayed (paper / shared) | closest to three-sleeper |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    # Settlement per cycle over the last five cycles: has the rate settled?
+    rate = {(c, s): (v[-1] - v[-6]) / 5 for c, s, v in series if len(v) >= 6}
+    singles = CASES[1:]
+    mm = lambda v: f"{1000 * v:.2f}"
+    lines = [f"Settlement of the middle sleeper after {cycles} cycles (mm; in brackets the error "
+             "against the same sample's three-sleeper box):", "",
+             "| sample | three-sleeper | fixed walls | periodic | time-delayed | time-delayed, shared faces | closest |",
+             "| --- | --- | --- | --- | --- | --- | --- |"]
     for s in seeds:
         ref = last[("three_sleeper", s)]
-        vals = [last[(c, s)] for c in CASES[1:]]
-        errs = {c: last[(c, s)] - ref for c in CASES[1:]}
+        errs = {c: last[(c, s)] - ref for c in singles}
         closest = min(errs, key=lambda c: abs(errs[c]))
-        order = "/".join("yes" if vals[0] < vals[1] < v else "no" for v in vals[2:])
-        cells = " | ".join(f"{1000 * v:.2f} ({1000 * errs[c]:+.2f})" for c, v in zip(CASES[1:], vals))
-        lines.append(f"| {s} | {1000 * ref:.2f} | {cells} | {order} | {LABELS[closest]} |")
-    lines += ["", "(in brackets: the error against the three-sleeper box's middle sleeper)", "",
+        cells = " | ".join(f"{mm(last[(c, s)])} ({1000 * errs[c]:+.2f})" for c in singles)
+        lines.append(f"| {s} | {mm(ref)} | {cells} | {LABELS[closest]} |")
+    lines += ["", f"Over the {len(seeds)} samples (mean ± half-width of the 95% interval, "
+              "Student t; the error is paired by sample):", "",
+              "| case | settlement (mm) | error (mm) | abs. error (mm) | closest on | rate, last 5 cycles (mm/cycle) |",
+              "| --- | --- | --- | --- | --- | --- |"]
+    closest = [min(singles, key=lambda c: abs(last[(c, s)] - last[("three_sleeper", s)]))
+               for s in seeds]
+    for c in CASES:
+        m, h = mean_ci([last[(c, s)] for s in seeds])
+        r, rh = mean_ci([rate[(c, s)] for s in seeds]) if rate else (float("nan"),) * 2
+        row = f"| {LABELS[c]} | {mm(m)} ± {mm(h)} |"
+        if c == "three_sleeper":
+            row += " | | |"
+        else:
+            e, eh = mean_ci([last[(c, s)] - last[("three_sleeper", s)] for s in seeds])
+            a, ah = mean_ci([abs(last[(c, s)] - last[("three_sleeper", s)]) for s in seeds])
+            row += f" {1000 * e:+.2f} ± {mm(eh)} | {mm(a)} ± {mm(ah)} | {closest.count(c)} of {len(seeds)} |"
+        lines.append(row + f" {1000 * r:.3f} ± {1000 * rh:.3f} |")
+    lines += ["", "Which boundary is closer, paired by sample: the difference of the absolute "
+              "errors, |e_A| − |e_B| (negative: A closer):", "",
+              "| A | B | mean (mm) | 95% interval (mm) | A closer on |", "| --- | --- | --- | --- | --- |"]
+    for a, b in [("single_delayed", "single_periodic"), ("single_shared", "single_periodic"),
+                 ("single_periodic", "single_fixed"), ("single_delayed", "single_fixed"),
+                 ("single_shared", "single_fixed"), ("single_shared", "single_delayed")]:
+        d = [abs(last[(a, s)] - last[("three_sleeper", s)]) - abs(last[(b, s)] - last[("three_sleeper", s)])
+             for s in seeds]
+        m, h = mean_ci(d)
+        lines.append(f"| {LABELS[a]} | {LABELS[b]} | {1000 * m:+.2f} | [{1000 * (m - h):+.2f}, "
+                     f"{1000 * (m + h):+.2f}] | {sum(v < 0 for v in d)} of {len(seeds)} |")
+    lines += ["", f"The runs ({args.jobs} at a time, {args.threads} thread(s) each; the study took "
+              f"{wall:.0f} s of wall time):", "",
               "| sample | run | stones | spheres | steps | dt (s) | wall (s) | sphere-steps/s |",
               "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in runs:
