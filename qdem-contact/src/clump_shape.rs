@@ -102,17 +102,30 @@ fn integer_in(rng: &mut SplitMix64, [lo, hi]: [usize; 2]) -> usize {
     lo + (rng.next_u64() % (hi - lo + 1) as u64) as usize
 }
 
-/// Centres (in the stone's frame) and radii of an elongated clump of sieve size `size` (module
-/// docs).
-fn clump_shape(size: f64, spheres: [usize; 2], rng: &mut SplitMix64) -> (Vec<Vec3>, Vec<f64>) {
+/// The draws both rules start with (module docs): the number of spheres k and the semi-axes
+/// a, b, c; `None` for a one-sphere stone, which draws nothing more.
+fn count_and_axes(
+    size: f64,
+    spheres: [usize; 2],
+    rng: &mut SplitMix64,
+) -> Option<(usize, [f64; 3])> {
     let k = integer_in(rng, spheres);
-    let half = 0.5 * size;
     if k == 1 {
-        return (vec![Vec3::zeros()], vec![half]);
+        return None;
     }
+    let half = 0.5 * size;
     let a = half * uniform_in(rng, LONG_AXIS);
     let b = half * uniform_in(rng, MID_AXIS);
     let c = half * uniform_in(rng, SHORT_AXIS);
+    Some((k, [a, b, c]))
+}
+
+/// Centres (in the stone's frame) and radii of an elongated clump of sieve size `size` (module
+/// docs).
+fn clump_shape(size: f64, spheres: [usize; 2], rng: &mut SplitMix64) -> (Vec<Vec3>, Vec<f64>) {
+    let Some((k, [a, b, c])) = count_and_axes(size, spheres, rng) else {
+        return (vec![Vec3::zeros()], vec![0.5 * size]);
+    };
     let mut centers = Vec::with_capacity(k);
     let mut radii = Vec::with_capacity(k);
     for i in 0..k {
@@ -134,14 +147,9 @@ fn clump_shape(size: f64, spheres: [usize; 2], rng: &mut SplitMix64) -> (Vec<Vec
 /// Centres (in the stone's frame) and radii of an angular clump of sieve size `size`: the core,
 /// then the corners (module docs).
 fn angular_shape(size: f64, spheres: [usize; 2], rng: &mut SplitMix64) -> (Vec<Vec3>, Vec<f64>) {
-    let k = integer_in(rng, spheres);
-    let half = 0.5 * size;
-    if k == 1 {
-        return (vec![Vec3::zeros()], vec![half]);
-    }
-    let a = half * uniform_in(rng, LONG_AXIS);
-    let b = half * uniform_in(rng, MID_AXIS);
-    let c = half * uniform_in(rng, SHORT_AXIS);
+    let Some((k, [a, b, c])) = count_and_axes(size, spheres, rng) else {
+        return (vec![Vec3::zeros()], vec![0.5 * size]);
+    };
     let core = c * uniform_in(rng, RADIUS_FACTOR);
     let turn = random_rotation(rng);
     let mut centers = Vec::with_capacity(k);
