@@ -255,6 +255,7 @@ fn turn(
     let mut lines = Vec::new();
     for ((u, &was), old) in units.iter().zip(was_rigid).zip(&layout.old) {
         let count = u.pieces.len();
+        let bodies = if count == 1 { "body" } else { "bodies" };
         match (was, u.rigid()) {
             (true, false) => {
                 for (p, from) in u.pieces.iter().zip(old) {
@@ -262,8 +263,8 @@ fn turn(
                     kind_change::to_deformable(p, (center, body), saved, state);
                 }
                 lines.push(format!(
-                    "{}: rigid in the checkpoint, deformable here: {count} bodies placed \
-                     unstressed at their poses, with their momentum and angular momentum",
+                    "{}: rigid in the checkpoint, deformable here: {count} {bodies} placed \
+                     unstressed, each at its pose with its momentum and angular momentum",
                     u.what
                 ));
             }
@@ -279,8 +280,8 @@ fn turn(
                     .collect();
                 let strain = kind_change::strain_energy(&u.what, tets, u.material.clone(), saved);
                 lines.push(format!(
-                    "{}: deformable in the checkpoint, rigid here: {count} bodies at their \
-                     centres of mass and best-fit rotations, with their momentum and angular \
+                    "{}: deformable in the checkpoint, rigid here: {count} {bodies}, each at its \
+                     centre of mass and best-fit rotation with its momentum and angular \
                      momentum; dropped: strain energy {strain:.4e} J, kinetic energy of the \
                      deformation {kinetic:.4e} J",
                     u.what
