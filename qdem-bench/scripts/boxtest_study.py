@@ -296,6 +296,16 @@ def mean_ci(values):
     return mean, T95.get(n - 1, 1.96) * sd / math.sqrt(n)
 
 
+def error(values, case, seed):
+    """`case`'s settlement less its sample's three-sleeper box's, from {(case, seed): value}."""
+    return values[(case, seed)] - values[("three_sleeper", seed)]
+
+
+def closest(values, seed):
+    """The single-sleeper box whose settlement is nearest the three-sleeper box's on `seed`."""
+    return min(CASES[1:], key=lambda c: abs(error(values, c, seed)))
+
+
 def beside_base(series, seeds, cycles, base, name):
     """The variant's errors against the three-sleeper box beside the base study's after the
     same number of cycles (read from the base study's settlement.csv), per boundary: does the
@@ -313,10 +323,9 @@ def beside_base(series, seeds, cycles, base, name):
     for c in CASES[1:]:
         cells = []
         for d in (at, mine):
-            e, h = mean_ci([d[(c, s)] - d[("three_sleeper", s)] for s in seeds])
+            e, h = mean_ci([error(d, c, s) for s in seeds])
             cells.append(f"{1000 * e:+.2f} ± {1000 * h:.2f}")
-        wins = [sum(min(CASES[1:], key=lambda k: abs(d[(k, s)] - d[("three_sleeper", s)])) == c
-                    for s in seeds) for d in (at, mine)]
+        wins = [sum(closest(d, s) == c for s in seeds) for d in (at, mine)]
         lines.append(f"| {LABELS[c]} | {cells[0]} | {cells[1]} | {wins[0]} / {wins[1]} |")
     return "\n".join(lines)
 
@@ -332,17 +341,13 @@ def tables(series, runs, seeds, cycles, wall, args):
              "| sample | three-sleeper | fixed walls | periodic | time-delayed | time-delayed, shared faces | closest |",
              "| --- | --- | --- | --- | --- | --- | --- |"]
     for s in seeds:
-        ref = last[("three_sleeper", s)]
-        errs = {c: last[(c, s)] - ref for c in singles}
-        closest = min(errs, key=lambda c: abs(errs[c]))
-        cells = " | ".join(f"{mm(last[(c, s)])} ({1000 * errs[c]:+.2f})" for c in singles)
-        lines.append(f"| {s} | {mm(ref)} | {cells} | {LABELS[closest]} |")
+        cells = " | ".join(f"{mm(last[(c, s)])} ({1000 * error(last, c, s):+.2f})" for c in singles)
+        lines.append(f"| {s} | {mm(last[('three_sleeper', s)])} | {cells} | {LABELS[closest(last, s)]} |")
     lines += ["", f"Over the {len(seeds)} samples (mean ± half-width of the 95% interval, "
               "Student t; the error is paired by sample):", "",
               "| case | settlement (mm) | error (mm) | abs. error (mm) | closest on | rate, last 5 cycles (mm/cycle) |",
               "| --- | --- | --- | --- | --- | --- |"]
-    closest = [min(singles, key=lambda c: abs(last[(c, s)] - last[("three_sleeper", s)]))
-               for s in seeds]
+    nearest = [closest(last, s) for s in seeds]
     for c in CASES:
         m, h = mean_ci([last[(c, s)] for s in seeds])
         r, rh = mean_ci([rate[(c, s)] for s in seeds]) if rate else (float("nan"),) * 2
@@ -350,9 +355,9 @@ def tables(series, runs, seeds, cycles, wall, args):
         if c == "three_sleeper":
             row += " | | |"
         else:
-            e, eh = mean_ci([last[(c, s)] - last[("three_sleeper", s)] for s in seeds])
-            a, ah = mean_ci([abs(last[(c, s)] - last[("three_sleeper", s)]) for s in seeds])
-            row += f" {1000 * e:+.2f} ± {mm(eh)} | {mm(a)} ± {mm(ah)} | {closest.count(c)} of {len(seeds)} |"
+            e, eh = mean_ci([error(last, c, s) for s in seeds])
+            a, ah = mean_ci([abs(error(last, c, s)) for s in seeds])
+            row += f" {1000 * e:+.2f} ± {mm(eh)} | {mm(a)} ± {mm(ah)} | {nearest.count(c)} of {len(seeds)} |"
         lines.append(row + f" {1000 * r:.3f} ± {1000 * rh:.3f} |")
     lines += ["", "Which boundary is closer, paired by sample: the difference of the absolute "
               "errors, |e_A| − |e_B| (negative: A closer):", "",
@@ -360,8 +365,7 @@ def tables(series, runs, seeds, cycles, wall, args):
     for a, b in [("single_delayed", "single_periodic"), ("single_shared", "single_periodic"),
                  ("single_periodic", "single_fixed"), ("single_delayed", "single_fixed"),
                  ("single_shared", "single_fixed"), ("single_shared", "single_delayed")]:
-        d = [abs(last[(a, s)] - last[("three_sleeper", s)]) - abs(last[(b, s)] - last[("three_sleeper", s)])
-             for s in seeds]
+        d = [abs(error(last, a, s)) - abs(error(last, b, s)) for s in seeds]
         m, h = mean_ci(d)
         lines.append(f"| {LABELS[a]} | {LABELS[b]} | {1000 * m:+.2f} | [{1000 * (m - h):+.2f}, "
                      f"{1000 * (m + h):+.2f}] | {sum(v < 0 for v in d)} of {len(seeds)} |")

@@ -86,7 +86,7 @@ impl ClumpShape {
         rng: &mut SplitMix64,
     ) -> (Vec<Vec3>, Vec<f64>) {
         match self {
-            ClumpShape::Elongated => clump_shape(size, spheres, rng),
+            ClumpShape::Elongated => elongated_shape(size, spheres, rng),
             ClumpShape::Angular => angular_shape(size, spheres, rng),
         }
     }
@@ -122,7 +122,7 @@ fn count_and_axes(
 
 /// Centres (in the stone's frame) and radii of an elongated clump of sieve size `size` (module
 /// docs).
-fn clump_shape(size: f64, spheres: [usize; 2], rng: &mut SplitMix64) -> (Vec<Vec3>, Vec<f64>) {
+fn elongated_shape(size: f64, spheres: [usize; 2], rng: &mut SplitMix64) -> (Vec<Vec3>, Vec<f64>) {
     let Some((k, [a, b, c])) = count_and_axes(size, spheres, rng) else {
         return (vec![Vec3::zeros()], vec![0.5 * size]);
     };

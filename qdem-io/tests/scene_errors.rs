@@ -892,44 +892,36 @@ fn granular_unknown_shape_and_grading_basis_list_the_valid_ones() {
          name = \"ballast\"\nmaterial = \"concrete\"\nregion = [[0, 0, 0], [0.3, 0.7, 1.0]]\n\
          count = 10\ngrading = [[0.05, 0.0], [0.1, 1.0]]\n"
     );
-    let (err, msg) = error(&format!("{generated}shape = \"blocky\"\n"));
-    assert!(matches!(err, SceneError::Schema(_)));
-    assert_has(
-        &msg,
-        &[
-            "`blocky`",
-            "`shape` in [granular]",
-            "valid values: `elongated`, `angular`",
-        ],
-    );
-    let (err, msg) = error(&format!("{generated}grading_basis = \"volume\"\n"));
-    assert!(matches!(err, SceneError::Schema(_)));
-    assert_has(
-        &msg,
-        &[
-            "`volume`",
-            "`grading_basis` in [granular]",
-            "valid values: `number`, `mass`",
-        ],
-    );
+    for (key, bad, valid) in [
+        ("shape", "blocky", "`elongated`, `angular`"),
+        ("grading_basis", "volume", "`number`, `mass`"),
+    ] {
+        let (err, msg) = error(&format!("{generated}{key} = \"{bad}\"\n"));
+        assert!(matches!(err, SceneError::Schema(_)));
+        assert_has(
+            &msg,
+            &[
+                &format!("`{bad}`"),
+                &format!("`{key}` in [granular]"),
+                &format!("valid values: {valid}"),
+            ],
+        );
+    }
     // The valid values parse, and the defaults are today's.
     let fine = format!("{generated}shape = \"angular\"\ngrading_basis = \"mass\"\n");
-    let g = Scene::parse(&fine, Path::new(PATH))
-        .unwrap()
-        .granular
-        .unwrap();
-    assert_eq!(
-        (g.shape, g.grading_basis),
-        (ClumpShapeName::Angular, GradingBasisName::Mass)
-    );
-    let g = Scene::parse(&generated, Path::new(PATH))
-        .unwrap()
-        .granular
-        .unwrap();
-    assert_eq!(
-        (g.shape, g.grading_basis),
-        (ClumpShapeName::Elongated, GradingBasisName::Number)
-    );
+    for (text, expected) in [
+        (&fine, (ClumpShapeName::Angular, GradingBasisName::Mass)),
+        (
+            &generated,
+            (ClumpShapeName::Elongated, GradingBasisName::Number),
+        ),
+    ] {
+        let g = Scene::parse(text, Path::new(PATH))
+            .unwrap()
+            .granular
+            .unwrap();
+        assert_eq!((g.shape, g.grading_basis), expected);
+    }
 }
 
 #[test]
