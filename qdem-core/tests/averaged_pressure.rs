@@ -160,3 +160,75 @@ fn a_decomposed_run_refuses_the_averaged_pressure_body_by_name() {
         );
     }
 }
+
+/// The reported stress of an averaged-pressure body is the formulation's own (issue 55: it
+/// was Hooke's law on each element's strain, whose pressure checkerboards as ν → ½). Two
+/// identities that hold to rounding for the formulation's stress and fail by the size of the
+/// load for Hooke's: the finite-strain stress of [`TetBody::tet_fields`] applied to each
+/// tetrahedron's current face areas (Eqs. 9–10) gives the body's forces, and the small-strain
+/// stress of [`TetBody::small_strain_stresses`] assembled as Σ_e V_e σ_e ∇N_a gives K u, the
+/// force of the formulation's tangent. The displacement is irregular, so the elements'
+/// own volumetric strains differ from their corners' averages.
+#[test]
+fn reported_stress_gives_the_bodys_own_forces() {
+    let mesh = structured_box([0.0; 3], [1.0, 0.7, 0.5], [4, 3, 3]);
+    let (mut state, body) = body(&mesh, 0.499, Formulation::AveragedPressure);
+    let u: Vec<Vec3> = (0..state.len())
+        .map(|i| {
+            let t = i as f64;
+            Vec3::new((1.3 * t).sin(), (0.7 * t).cos(), (2.1 * t).sin()) * 1e-7
+        })
+        .collect();
+    for ((x, r), d) in state.position.iter_mut().zip(&state.reference).zip(&u) {
+        *x = r + d;
+    }
+    let mut model = body.clone();
+    let mut forces = vec![Vec3::zeros(); state.len()];
+    model.add_forces(&state, &mut forces, &mut []);
+    let scale = forces.iter().map(|f| f.norm()).fold(0.0, f64::max);
+
+    let (stress, _) = body.tet_fields(&state);
+    let from_stress = assemble(&mesh.tets, &state.position, &stress);
+    for (f, g) in forces.iter().zip(&from_stress) {
+        assert!((f + g).norm() < 1e-9 * scale, "{f} vs {}", -g);
+    }
+
+    let mut tangent = qdem_core::Tangent::new();
+    qdem_core::Linearized::add_tangent(
+        &body,
+        &State::at_rest(state.reference.clone()),
+        &mut tangent,
+    );
+    let mut ku = vec![Vec3::zeros(); state.len()];
+    for e in tangent.stiffness_entries() {
+        let (r, c) = (e.row, e.col);
+        ku[r / 3][r % 3] += e.val * u[c / 3][c % 3];
+        if r != c {
+            ku[c / 3][c % 3] += e.val * u[r / 3][r % 3];
+        }
+    }
+    let small = body.small_strain_stresses(&state);
+    let from_small = assemble(&mesh.tets, &state.reference, &small);
+    let scale = ku.iter().map(|f| f.norm()).fold(0.0, f64::max);
+    for (k, g) in ku.iter().zip(&from_small) {
+        assert!((k - g).norm() < 1e-9 * scale, "K u {k} vs Σ V σ ∇N {g}");
+    }
+}
+
+/// Σ_e V_e σ_e ∇N_a per particle a, the shape functions' gradients and volumes at `x`: the
+/// internal force of the stresses `stress` (the negative of the force on the particles).
+fn assemble(tets: &[[u32; 4]], x: &[Vec3], stress: &[qdem_core::Mat3]) -> Vec<Vec3> {
+    let mut f = vec![Vec3::zeros(); x.len()];
+    for (tet, sigma) in tets.iter().zip(stress) {
+        let p = tet.map(|n| x[n as usize]);
+        let dm = qdem_core::Mat3::from_columns(&[p[1] - p[0], p[2] - p[0], p[3] - p[0]]);
+        let inv = dm.try_inverse().unwrap();
+        let volume = dm.determinant().abs() / 6.0;
+        let g: [Vec3; 3] = std::array::from_fn(|k| inv.row(k).transpose());
+        let g0 = -(g[0] + g[1] + g[2]);
+        for (n, ga) in tet.iter().zip([g0, g[0], g[1], g[2]]) {
+            f[*n as usize] += sigma * ga * volume;
+        }
+    }
+    f
+}

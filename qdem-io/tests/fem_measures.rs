@@ -128,7 +128,7 @@ fn pressed_block_has_uniform_stress_in_the_vtu() {
         "no TimeValue 1.0 in the VTU"
     );
     let tets = sim.tets();
-    let stress = cell_array(&vtu, "stress");
+    let stress = common::vtu_array(&vtu, "stress");
     assert_eq!(stress.len(), 6 * tets);
     let want = [-P, 0.0, 0.0, 0.0, 0.0, 0.0];
     let worst = stress
@@ -146,42 +146,11 @@ fn pressed_block_has_uniform_stress_in_the_vtu() {
         ("principal_stress_3", -P),
         ("von_mises", P),
     ] {
-        let values = cell_array(&vtu, name);
+        let values = common::vtu_array(&vtu, name);
         assert_eq!(values.len(), tets);
         let worst = values.iter().map(|v| (v - want).abs()).fold(0.0, f64::max);
         assert!(worst <= 1e-9 * P, "{name}: largest error {worst:e} Pa");
     }
-}
-
-/// The values of the binary `<DataArray>` called `name` of a VTU written by qdem (base64 of
-/// a u64 byte count, then little-endian f64s).
-fn cell_array(vtu: &str, name: &str) -> Vec<f64> {
-    let start = vtu
-        .find(&format!("Name=\"{name}\""))
-        .unwrap_or_else(|| panic!("no array {name}"));
-    let text = &vtu[start..];
-    let body = &text[text.find('>').unwrap() + 1..text.find("</DataArray>").unwrap()];
-    let bytes = base64(body.trim());
-    bytes[8..]
-        .chunks_exact(8)
-        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
-        .collect()
-}
-
-/// Standard base64 (RFC 4648, `=` padding) decoded.
-fn base64(text: &str) -> Vec<u8> {
-    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let value = |c: u8| ALPHABET.iter().position(|&a| a == c).unwrap() as u32;
-    let mut out = Vec::new();
-    for group in text.as_bytes().chunks(4) {
-        let digits: Vec<u8> = group.iter().copied().filter(|&c| c != b'=').collect();
-        let n = digits
-            .iter()
-            .enumerate()
-            .fold(0u32, |n, (k, &c)| n | value(c) << (18 - 6 * k));
-        out.extend(n.to_be_bytes()[1..digits.len()].iter());
-    }
-    out
 }
 
 /// The paper's cantilever (2.4 × 0.25 × 0.22 m, clamped at x = 0) solved statically under a

@@ -71,12 +71,7 @@ impl Formulation {
 /// the per-step buffers.
 #[derive(Clone, Debug)]
 pub(crate) struct AveragedPressure {
-    /// Bulk and shear moduli κ, μ (Pa).
-    kappa: f64,
-    mu: f64,
-    /// Bulk and shear viscosities κ_D, μ_D (Pa s).
-    kappa_d: f64,
-    mu_d: f64,
+    moduli: Moduli,
     viscous: bool,
     tets: Vec<[u32; 4]>,
     dm_inv: Vec<Mat3>,
@@ -129,10 +124,12 @@ impl AveragedPressure {
             }
         }
         AveragedPressure {
-            kappa: elastic.lambda + 2.0 / 3.0 * elastic.mu,
-            mu: elastic.mu,
-            kappa_d: material.bulk_viscosity,
-            mu_d: viscous.mu,
+            moduli: Moduli {
+                kappa: elastic.lambda + 2.0 / 3.0 * elastic.mu,
+                mu: elastic.mu,
+                kappa_d: material.bulk_viscosity,
+                mu_d: viscous.mu,
+            },
             viscous: !material.is_elastic(),
             tets: tets.to_vec(),
             dm_inv,
@@ -178,21 +175,8 @@ impl AveragedPressure {
             &self.corner_start,
         );
         let inv_volume = &self.inv_nodal_volume;
-        self.nodal
-            .par_iter_mut()
-            .with_min_len(PARTICLE_CHUNK)
-            .enumerate()
-            .for_each(|(i, avg)| {
-                let (mut t, mut r) = (0.0, 0.0);
-                for &k in &corners[starts[i] as usize..starts[i + 1] as usize] {
-                    let e = k as usize / 4;
-                    t += quarter[e] * theta[e].0;
-                    r += quarter[e] * theta[e].1;
-                }
-                *avg = (t * inv_volume[i], r * inv_volume[i]);
-            });
-        let (nodal, first) = (&self.nodal, self.first);
-        let (kappa, mu, kappa_d, mu_d) = (self.kappa, self.mu, self.kappa_d, self.mu_d);
+        average_per_particle(theta, quarter, corners, starts, inv_volume, &mut self.nodal);
+        let (nodal, first, moduli) = (&self.nodal, self.first, &self.moduli);
         let inverted = self
             .forces
             .par_iter_mut()
@@ -211,15 +195,12 @@ impl AveragedPressure {
                         .sum::<f64>()
                 };
                 let eps = green_strain(&(dx * dm_inv[e]));
-                let mut t = Mat3::from_diagonal_element(kappa * mean(|a| a.0))
-                    + deviator(&eps) * (2.0 * mu);
-                if viscous {
+                let rate = viscous.then(|| {
                     let v = tet.map(|n| state.velocity[n as usize]);
                     let l = velocity_gradient(&v, &cof, det);
-                    let d = (l + l.transpose()) * 0.5;
-                    t += Mat3::from_diagonal_element(kappa_d * mean(|a| a.1))
-                        + deviator(&d) * (2.0 * mu_d);
-                }
+                    ((l + l.transpose()) * 0.5, mean(|a| a.1))
+                });
+                let t = moduli.stress(&eps, mean(|a| a.0), rate);
                 *out = vertex_forces(&t, &cof);
                 // B = FFᵀ cannot tell an inverted tetrahedron from its mirror image.
                 if det.partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater) {
@@ -231,6 +212,63 @@ impl AveragedPressure {
             .min()
             .unwrap_or(usize::MAX);
         (inverted != usize::MAX).then_some(inverted)
+    }
+
+    /// The stress (Pa) of every tetrahedron at `state`: the tensor its forces follow from
+    /// ([`AveragedPressure::compute`]: the corners' averaged volumetric strain with the
+    /// element's own deviatoric strain), not Hooke's law on the element's own strain, whose
+    /// pressure checkerboards as ν → ½. With `small_strain`, the linear ε = sym ∇u of a
+    /// static solve in place of Eq. 4's, elastic only (the stress that belongs to the
+    /// small-strain tangent of [`AveragedPressure::add_tangent`]).
+    pub(crate) fn stresses(&self, state: &State, small_strain: bool) -> Vec<Mat3> {
+        let viscous = self.viscous && !small_strain;
+        let strains: Vec<(Mat3, Option<Mat3>)> = (0..self.tets.len())
+            .into_par_iter()
+            .with_min_len(TET_CHUNK)
+            .map(|e| {
+                let tet = self.tets[e];
+                if small_strain {
+                    let u = tet.map(|n| state.displacement(n as usize));
+                    let grad = edge_matrix(&u) * self.dm_inv[e];
+                    return ((grad + grad.transpose()) * 0.5, None);
+                }
+                let dx = edge_matrix(&tet.map(|n| state.position[n as usize]));
+                let rate = viscous.then(|| {
+                    let v = tet.map(|n| state.velocity[n as usize]);
+                    let cof = cofactor(&dx);
+                    let l = velocity_gradient(&v, &cof, dx.determinant());
+                    (l + l.transpose()) * 0.5
+                });
+                (green_strain(&(dx * self.dm_inv[e])), rate)
+            })
+            .collect();
+        let theta: Vec<(f64, f64)> = strains
+            .iter()
+            .map(|(eps, d)| (eps.trace(), d.map_or(0.0, |d| d.trace())))
+            .collect();
+        let mut nodal = vec![(0.0, 0.0); self.nodal.len()];
+        average_per_particle(
+            &theta,
+            &self.quarter,
+            &self.corners,
+            &self.corner_start,
+            &self.inv_nodal_volume,
+            &mut nodal,
+        );
+        let mean = |tet: &[u32; 4], f: fn(&(f64, f64)) -> f64| {
+            0.25 * tet
+                .iter()
+                .map(|&n| f(&nodal[n as usize - self.first]))
+                .sum::<f64>()
+        };
+        self.tets
+            .iter()
+            .zip(strains)
+            .map(|(tet, (eps, rate))| {
+                let rate = rate.map(|d| (d, mean(tet, |a| a.1)));
+                self.moduli.stress(&eps, mean(tet, |a| a.0), rate)
+            })
+            .collect()
     }
 
     /// Adds each particle's tetrahedron forces of the last [`AveragedPressure::compute`] to
@@ -262,7 +300,7 @@ impl AveragedPressure {
         let deviatoric: f64 = eps
             .iter()
             .zip(&self.quarter)
-            .map(|(eps, q)| 4.0 * q * self.mu * deviator(eps).norm_squared())
+            .map(|(eps, q)| 4.0 * q * self.moduli.mu * deviator(eps).norm_squared())
             .sum();
         let volumetric: f64 = (0..self.inv_nodal_volume.len())
             .filter(|&i| self.inv_nodal_volume[i] > 0.0)
@@ -272,7 +310,7 @@ impl AveragedPressure {
                     .iter()
                     .map(|&k| self.quarter[k as usize / 4] * eps[k as usize / 4].trace())
                     .sum();
-                0.5 * self.kappa * sum * sum * self.inv_nodal_volume[i]
+                0.5 * self.moduli.kappa * sum * sum * self.inv_nodal_volume[i]
             })
             .sum();
         deviatoric + volumetric
@@ -287,8 +325,8 @@ impl AveragedPressure {
             .map(|t| current_gradients(&t.map(|n| state.position[n as usize])))
             .collect();
         // D_dev = 2μ (I − ⅓ m mᵀ) is the Lamé law with λ = −⅔μ.
-        let deviatoric = (-2.0 / 3.0 * self.mu, self.mu);
-        let deviatoric_d = (-2.0 / 3.0 * self.mu_d, self.mu_d);
+        let deviatoric = (-2.0 / 3.0 * self.moduli.mu, self.moduli.mu);
+        let deviatoric_d = (-2.0 / 3.0 * self.moduli.mu_d, self.moduli.mu_d);
         for (tet, (volume, g)) in self.tets.iter().zip(&gradients) {
             for (a, &i) in tet.iter().enumerate() {
                 for (b, &j) in tet.iter().enumerate() {
@@ -329,14 +367,68 @@ impl AveragedPressure {
             for &(p, wp) in &b_bar {
                 for &(q, wq) in &b_bar {
                     let outer = wp * wq.transpose() * nodal_volume;
-                    tangent.add_stiffness(p as usize, q as usize, &(outer * self.kappa));
+                    tangent.add_stiffness(p as usize, q as usize, &(outer * self.moduli.kappa));
                     if self.viscous {
-                        tangent.add_damping(p as usize, q as usize, &(outer * self.kappa_d));
+                        tangent.add_damping(p as usize, q as usize, &(outer * self.moduli.kappa_d));
                     }
                 }
             }
         }
     }
+}
+
+/// The moduli of the split stress T = κ θ̄ I + 2μ dev ε + κ_D tr(D)‾ I + 2μ_D dev D.
+#[derive(Clone, Copy, Debug)]
+struct Moduli {
+    /// Bulk and shear moduli κ, μ (Pa).
+    kappa: f64,
+    mu: f64,
+    /// Bulk and shear viscosities κ_D, μ_D (Pa s).
+    kappa_d: f64,
+    mu_d: f64,
+}
+
+impl Moduli {
+    /// The stress of a tetrahedron of strain `eps` whose corners' averaged volumetric strain
+    /// has the mean `theta_bar`, with its rate of deformation D and the mean of its corners'
+    /// averaged tr D when viscous (Bonet & Burton Eq. 11 with the Kelvin–Voigt part of
+    /// paper 000 Eq. 2).
+    #[inline]
+    fn stress(&self, eps: &Mat3, theta_bar: f64, rate: Option<(Mat3, f64)>) -> Mat3 {
+        let mut t =
+            Mat3::from_diagonal_element(self.kappa * theta_bar) + deviator(eps) * (2.0 * self.mu);
+        if let Some((d, rate_bar)) = rate {
+            t += Mat3::from_diagonal_element(self.kappa_d * rate_bar)
+                + deviator(&d) * (2.0 * self.mu_d);
+        }
+        t
+    }
+}
+
+/// Per particle, the reference-volume-weighted averages (Bonet & Burton Eq. 9) of its
+/// tetrahedra's `theta` pairs, into `nodal`: each particle's corners in ascending order, so
+/// the sums are the same bits for any number of threads.
+fn average_per_particle(
+    theta: &[(f64, f64)],
+    quarter: &[f64],
+    corners: &[u32],
+    starts: &[u32],
+    inv_volume: &[f64],
+    nodal: &mut [(f64, f64)],
+) {
+    nodal
+        .par_iter_mut()
+        .with_min_len(PARTICLE_CHUNK)
+        .enumerate()
+        .for_each(|(i, avg)| {
+            let (mut t, mut r) = (0.0, 0.0);
+            for &k in &corners[starts[i] as usize..starts[i + 1] as usize] {
+                let e = k as usize / 4;
+                t += quarter[e] * theta[e].0;
+                r += quarter[e] * theta[e].1;
+            }
+            *avg = (t * inv_volume[i], r * inv_volume[i]);
+        });
 }
 
 /// The strain ε = (F Fᵀ − I)/2 of Eq. 4.

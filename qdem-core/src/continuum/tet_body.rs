@@ -244,9 +244,19 @@ impl TetBody {
 
     /// The stress (Pa) of every tetrahedron, the tensor its forces follow from (paper 000
     /// Eq. 2, with the viscous part when the material has one: the Cauchy stress of the
-    /// kernel, [`crate::continuum::tet_kernel::von_mises`] of it is the equivalent stress), and its volumetric strain
-    /// det F − 1.
+    /// kernel, [`crate::continuum::tet_kernel::von_mises`] of it is the equivalent stress;
+    /// in [`Formulation::AveragedPressure`], with the averaged pressure its forces use), and
+    /// its volumetric strain det F − 1.
     pub fn tet_fields(&self, state: &State) -> (Vec<Mat3>, Vec<f64>) {
+        let (stress, volumetric) = self.standard_fields(state);
+        match &self.averaged {
+            Some(averaged) => (averaged.stresses(state, false), volumetric),
+            None => (stress, volumetric),
+        }
+    }
+
+    /// [`TetBody::tet_fields`] of the standard tetrahedron.
+    fn standard_fields(&self, state: &State) -> (Vec<Mat3>, Vec<f64>) {
         let viscous = !self.material.is_elastic();
         (0..self.tets.len())
             .into_par_iter()
@@ -271,8 +281,13 @@ impl TetBody {
     /// ∇u = du · dX⁻¹ from the particles' displacements (the linear-tetrahedron stress that
     /// belongs to a static solve's answer, [`crate::StaticSolver`]: exact for any
     /// displacement that is linear in space, without the O(ε) of [`TetBody::tet_fields`]'s
-    /// finite-strain tensor).
+    /// finite-strain tensor). In [`Formulation::AveragedPressure`], the deviatoric part of
+    /// each element's own ε with the pressure κ θ̄ of its corners' averaged tr ε, the stress
+    /// of that formulation's small-strain tangent.
     pub fn small_strain_stresses(&self, state: &State) -> Vec<Mat3> {
+        if let Some(averaged) = &self.averaged {
+            return averaged.stresses(state, true);
+        }
         let (lambda, mu) = self.pair();
         (0..self.tets.len())
             .into_par_iter()

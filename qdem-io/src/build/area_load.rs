@@ -3,42 +3,76 @@
 //! area ([`qdem_core::loads::surface_load::lump_traction`]), on the placed reference mesh.
 
 use super::{BuildError, PlacedMesh};
-use crate::scene::{AreaLoad, Scene};
+use crate::scene::{AreaLoad, Scene, Selection};
 use qdem_core::loads::surface_load::lump_traction;
 use qdem_core::Vec3;
 
 /// The mesh-local nodal forces (N, at load factor 1) of `area` on the boundary triangles of
 /// `placed` whose nodes are all in `selected` (sorted mesh-local nodes); refused when no
-/// boundary triangle is wholly selected (`what`, `body`: the load and its body, for the
-/// message).
+/// boundary triangle is wholly selected or when `selection` is a volume group, whose
+/// boundary is the body's whole closed surface (`what`, `body`: the load and its body, for
+/// the message).
 pub(super) fn lumped_forces(
     scene: &Scene,
     placed: &PlacedMesh,
     selected: &[u32],
-    area: AreaLoad,
+    (selection, area): (&Selection, AreaLoad),
     (what, body): (&str, &str),
 ) -> Result<Vec<(u32, Vec3)>, BuildError> {
     let mesh = &placed.mesh;
-    let faces: Vec<[u32; 3]> = mesh
-        .surface_triangles()
+    let not_a_face = |message: String| BuildError::NotAFace {
+        scene: scene.path.clone(),
+        what: what.to_string(),
+        body: body.to_string(),
+        message,
+    };
+    let boundary = mesh.surface_triangles();
+    let points: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
+    if let Some(group) = volume_group(placed, selection) {
+        let area: f64 = boundary.iter().map(|t| triangle_area(&points, t)).sum();
+        return Err(not_a_face(format!(
+            "`{group}` is a volume group: its nodes are all the body's, so the load would act \
+             on the body's whole closed boundary ({} triangles, {area:.6e} m², held faces \
+             included), where a uniform pressure sums to zero; fix: give the physical surface \
+             of the loaded face as `group` (or a `box` around it)",
+            boundary.len()
+        )));
+    }
+    let faces: Vec<[u32; 3]> = boundary
         .into_iter()
         .filter(|t| t.iter().all(|n| selected.binary_search(n).is_ok()))
         .collect();
     if faces.is_empty() {
-        return Err(BuildError::EmptySelection {
-            scene: scene.path.clone(),
-            what: what.to_string(),
-            body: body.to_string(),
-            fix: "a pressure or traction acts on the boundary triangles whose three nodes are \
-                  all selected, and none are; select a whole face (its physical group, or a \
-                  box around it)",
-        });
+        return Err(not_a_face(format!(
+            "the selection holds {} particle(s) but no boundary triangle whose three nodes it \
+             holds, and a pressure or traction acts on such triangles; fix: select a whole face \
+             (its physical surface group, or a box around it), or load a point or a line with \
+             `total_force`",
+            selected.len()
+        )));
     }
-    let points: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     Ok(match area {
         AreaLoad::Pressure(p) => lump_traction(&points, &faces, |n| -p * n),
         AreaLoad::Traction(t) => lump_traction(&points, &faces, |_| Vec3::from(t)),
     })
+}
+
+/// The name of the volume (dimension 3) physical group `selection` names, if it does.
+fn volume_group<'a>(placed: &PlacedMesh, selection: &'a Selection) -> Option<&'a str> {
+    match selection {
+        Selection::Group(name) => placed
+            .mesh
+            .group(name)
+            .is_some_and(|g| g.dim == 3)
+            .then_some(name.as_str()),
+        Selection::Box(_) => None,
+    }
+}
+
+/// The area of triangle `t` of `points`.
+fn triangle_area(points: &[Vec3], t: &[u32; 3]) -> f64 {
+    let [a, b, c] = t.map(|n| points[n as usize]);
+    0.5 * (b - a).cross(&(c - a)).norm()
 }
 
 /// The resultant (N, at load factor 1) of the `[[load]]` numbered `k` (from 0) of `scene`:
@@ -77,6 +111,12 @@ pub fn load_resultant(scene: &Scene, k: usize) -> Result<Vec3, BuildError> {
     };
     let what = format!("[[load]] #{}", k + 1);
     let selected = super::select(scene, &placed, &load.selection, &what, &load.body)?;
-    let forces = lumped_forces(scene, &placed, &selected, area, (&what, &load.body))?;
+    let forces = lumped_forces(
+        scene,
+        &placed,
+        &selected,
+        (&load.selection, area),
+        (&what, &load.body),
+    )?;
     Ok(forces.iter().map(|(_, f)| f).sum())
 }

@@ -190,6 +190,20 @@ pub enum BuildError {
         /// How to fix it.
         fix: &'static str,
     },
+    /// A `pressure` or `traction` whose selection is not a face of the body: a volume group
+    /// (every node of the body, so the whole closed boundary), or nodes with no boundary
+    /// triangle among them (a point or a line).
+    #[error("{scene}: {what} on body `{body}`: {message}")]
+    NotAFace {
+        /// The scene file.
+        scene: PathBuf,
+        /// `[[load]] #N`.
+        what: String,
+        /// The body.
+        body: String,
+        /// What the selection holds, what the load would do, and the fix.
+        message: String,
+    },
     /// A count whose particles would need more memory than the machine has, refused before
     /// they are allocated ([`super::memory`]).
     #[error("{scene}: {message}")]

@@ -678,8 +678,13 @@ fn build_loads(
         let model = match load.area {
             None => NodalLoad::new(&what, particles, Vec3::from(load.total_force), ramp),
             Some(area) => {
-                let forces =
-                    area_load::lumped_forces(scene, placed, &selected, area, (&what, &load.body))?;
+                let forces = area_load::lumped_forces(
+                    scene,
+                    placed,
+                    &selected,
+                    (&load.selection, area),
+                    (&what, &load.body),
+                )?;
                 let forces = forces.into_iter().map(|(n, f)| (n + start as u32, f));
                 NodalLoad::per_particle(&what, forces.collect(), ramp)
             }

@@ -132,3 +132,34 @@ normal = [0.0, 0.0, 1.0]
 {extra}"#
     )
 }
+
+/// The values of the binary `<DataArray>` called `name` of a VTU written by qdem (base64 of
+/// a u64 byte count, then little-endian f64s).
+pub fn vtu_array(vtu: &str, name: &str) -> Vec<f64> {
+    let start = vtu
+        .find(&format!("Name=\"{name}\""))
+        .unwrap_or_else(|| panic!("no array {name}"));
+    let text = &vtu[start..];
+    let body = &text[text.find('>').unwrap() + 1..text.find("</DataArray>").unwrap()];
+    let bytes = base64(body.trim());
+    bytes[8..]
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
+/// Standard base64 (RFC 4648, `=` padding) decoded.
+pub fn base64(text: &str) -> Vec<u8> {
+    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let value = |c: u8| ALPHABET.iter().position(|&a| a == c).unwrap() as u32;
+    let mut out = Vec::new();
+    for group in text.as_bytes().chunks(4) {
+        let digits: Vec<u8> = group.iter().copied().filter(|&c| c != b'=').collect();
+        let n = digits
+            .iter()
+            .enumerate()
+            .fold(0u32, |n, (k, &c)| n | value(c) << (18 - 6 * k));
+        out.extend(n.to_be_bytes()[1..digits.len()].iter());
+    }
+    out
+}

@@ -1,11 +1,14 @@
 //! [`Reactions`]: `reactions.csv`: every `probe_every`, the force and moment each `[[fix]]` of
-//! a deformable body carries: R = −Σ f_i over its particles, counting each particle's fixed
-//! directions only, f_i the total (internal and external) force on particle i at the state
+//! a deformable body carries: R = −Σ f_i over its particles, counting on each particle the
+//! directions that fix holds only (its `dofs`, not those another fix holds there), f_i the total (internal and external) force on particle i at the state
 //! (the stepper's last evaluation, [`qdem_core::stepper::Stepper::forces`]; a static solve's
 //! f − K u), and the moment M = Σ (X_i − c) × R_i about the centroid c of the fix's particles
 //! in the reference configuration (X_i their reference positions). Columns
 //! `fixK_fx, fixK_fy, fixK_fz, fixK_mx, fixK_my, fixK_mz` (N, N·m) for the K-th `[[fix]]`
-//! (from 1, in scene order). A direction held by two fixes counts in both. Fixes on a rigid
+//! (from 1, in scene order). A direction that n fixes hold on one particle is shared equally,
+//! 1/n of its force to each, so the fixes' reactions sum to the supports' total whatever
+//! their overlap (over-constrained in no physical sense: a held direction stays at rest
+//! whichever fix holds it, so no fix has a better claim to its force). Fixes on a rigid
 //! body (which its centre holds) are left out. In a run over MPI ranks the forces are
 //! gathered from the particles' owners with the state ([`qdem_core::World::gather`]), so the
 //! file is the same for any rank count. A wall's force is `walls.csv`'s.
@@ -17,11 +20,15 @@ use crate::output::OutputError;
 use qdem_core::{CheckpointError, Decoder, Dofs, Encoder, State, Vec3};
 use std::path::{Path, PathBuf};
 
-/// One fix's particles and the point its moment is taken about.
+/// One fix's particles, the share of each held direction's force it carries, and the point
+/// its moment is taken about.
 struct FixGroup {
     /// The fix's number in the scene (from 1).
     number: usize,
     particles: Vec<usize>,
+    /// Per particle, the share of each direction's force this fix carries: 1/n for a
+    /// direction it holds with n − 1 other fixes, 0 for one it does not hold.
+    shares: Vec<Vec3>,
     /// The centroid of the particles' reference positions.
     centroid: Vec3,
 }
@@ -39,16 +46,26 @@ impl Reactions {
     /// The record of `sim`'s fixes on deformable bodies; `None` when there is none.
     pub(crate) fn new(sim: &Simulation, out_dir: &Path) -> Option<Reactions> {
         let state = &sim.world.state;
-        let bodies = &sim.scene.refs().fix_bodies;
-        let groups: Vec<FixGroup> = sim
+        let scene = &sim.scene;
+        let held: Vec<(usize, &Vec<usize>, Dofs)> = sim
             .fix_particles
             .iter()
-            .zip(bodies)
+            .zip(&scene.refs().fix_bodies)
+            .zip(&scene.fixes)
             .enumerate()
-            .filter(|(_, (_, &b))| matches!(sim.bodies[b].kind, BodyKind::Deformable { .. }))
-            .map(|(k, (particles, _))| FixGroup {
-                number: k + 1,
+            .filter(|(_, ((_, &b), _))| matches!(sim.bodies[b].kind, BodyKind::Deformable { .. }))
+            .map(|(k, ((particles, _), fix))| (k + 1, particles, Dofs::from_mask(fix.dofs)))
+            .collect();
+        let holders = holders_per_direction(state.len(), &held);
+        let groups: Vec<FixGroup> = held
+            .into_iter()
+            .map(|(number, particles, dofs)| FixGroup {
+                number,
                 particles: particles.clone(),
+                shares: particles
+                    .iter()
+                    .map(|&i| Vec3::from_fn(|k, _| share(dofs, k, holders[i][k])))
+                    .collect(),
                 centroid: particles.iter().map(|&i| state.reference[i]).sum::<Vec3>()
                     / particles.len() as f64,
             })
@@ -62,12 +79,39 @@ impl Reactions {
     }
 }
 
+/// Per particle of a state of `particles`, how many of the fixes `held` (number, particles,
+/// directions) hold each direction.
+fn holders_per_direction(particles: usize, held: &[(usize, &Vec<usize>, Dofs)]) -> Vec<[u32; 3]> {
+    let mut holders = vec![[0u32; 3]; particles];
+    for (_, fix_particles, dofs) in held {
+        for &i in fix_particles.iter() {
+            for (k, count) in holders[i].iter_mut().enumerate() {
+                *count += u32::from(dofs.contains(k));
+            }
+        }
+    }
+    holders
+}
+
+/// The share of direction `k`'s force of a fix holding `dofs`, where `holders` fixes hold it.
+fn share(dofs: Dofs, k: usize, holders: u32) -> f64 {
+    match dofs.contains(k) {
+        true => 1.0 / f64::from(holders),
+        false => 0.0,
+    }
+}
+
 /// The force and moment `group` carries, from the particles' total forces `force`.
 fn reaction(state: &State, force: &[Vec3], group: &FixGroup) -> (Vec3, Vec3) {
     let mut total = (Vec3::zeros(), Vec3::zeros());
-    for &i in &group.particles {
-        let held: Dofs = state.fixed[i];
-        let r = Vec3::from_fn(|k, _| if held.contains(k) { -force[i][k] } else { 0.0 });
+    for (&i, share) in group.particles.iter().zip(&group.shares) {
+        let r = Vec3::from_fn(|k, _| {
+            if share[k] > 0.0 {
+                -force[i][k] * share[k]
+            } else {
+                0.0
+            }
+        });
         total.0 += r;
         total.1 += (state.reference[i] - group.centroid).cross(&r);
     }
