@@ -150,10 +150,12 @@ class Mesh:
 
 
 def physical(dim):
+    """The (dim, tag) of the model's physical groups of dimension `dim`."""
     return [(d, t) for d, t in gmsh.model.getPhysicalGroups() if d == dim]
 
 
 def group_nodes(name):
+    """The node tags of the physical group called `name`."""
     for dim, tag in gmsh.model.getPhysicalGroups():
         if gmsh.model.getPhysicalName(dim, tag) == name:
             return gmsh.model.mesh.getNodesForPhysicalGroup(dim, tag)[0]
@@ -374,6 +376,7 @@ def kirsch_errors(points, disp, nodal):
 
 
 def errors(problem, points, disp, nodal):
+    """The error row of `problem` for one solver's nodal results."""
     if problem == "lame":
         return lame_errors(points, disp, nodal)
     return kirsch_errors(points, disp, nodal)
@@ -387,6 +390,7 @@ def by_coordinates(points_a, points_b):
 
 
 def rounded(row):
+    """`row` with its floats to four significant digits, for the JSON line."""
     return {k: (float(f"{v:.4g}") if isinstance(v, (float, np.floating)) else v)
             for k, v in row.items()}
 
@@ -394,6 +398,8 @@ def rounded(row):
 # ---------------------------------------------------------------- main
 
 def verify(qdem, problem, size, work, elements, reference):
+    """Print the rows of `problem` at `size`: qdem, each CalculiX element of `elements`, and
+    qdem against C3D4; with `reference`, write the coarse C3D4 reference CSV."""
     msh, linear, quadratic, same = make_meshes(problem, size, work)
     points, disp, tets, stress, nodal, source, wall = run_qdem(qdem, problem, msh, work)
     base = {"problem": problem, "mesh": size}
