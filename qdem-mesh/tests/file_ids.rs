@@ -9,8 +9,11 @@ use common::fixture;
 use qdem_mesh::{read_msh, TetMesh};
 use std::collections::HashMap;
 
-/// The box's nodes (id to coordinates) and tetrahedra (id to node ids), from the file.
-fn parse_msh22(text: &str) -> (HashMap<u64, [f64; 3]>, HashMap<u64, [u64; 4]>) {
+/// A mesh file's nodes (id to coordinates) and tetrahedra (id to node ids).
+type MshFile = (HashMap<u64, [f64; 3]>, HashMap<u64, [u64; 4]>);
+
+/// The box's nodes and tetrahedra, from the file.
+fn parse_msh22(text: &str) -> MshFile {
     let section = |name: &str| {
         let start = text.find(&format!("${name}\n")).unwrap() + name.len() + 2;
         let end = text.find(&format!("$End{name}")).unwrap();
@@ -45,7 +48,7 @@ fn parse_msh22(text: &str) -> (HashMap<u64, [f64; 3]>, HashMap<u64, [u64; 4]>) {
 
 /// Every node of `mesh` sits where the file puts its id, and every tetrahedron has the
 /// nodes of its element, in the physical volume `body` (tag 1).
-fn assert_matches_file(mesh: &TetMesh, file: &(HashMap<u64, [f64; 3]>, HashMap<u64, [u64; 4]>)) {
+fn assert_matches_file(mesh: &TetMesh, file: &MshFile) {
     let ids = &mesh.file_ids;
     assert_eq!(ids.nodes.len(), mesh.nodes.len());
     assert_eq!(ids.tets.len(), mesh.tets.len());
