@@ -1,13 +1,13 @@
-//! `qdem check SCENE`: validates a scene and prints its meshes, mass, stable step, an estimate
-//! of the memory the run keeps, checkpoint support, the measured cost of a step with the
-//! projected run time, and where a step's time goes, stage by stage of the world's step
+//! `qdem check SCENE`: validates a scene and prints its meshes, mass, stable step (of an
+//! explicit run), an estimate of the memory the run keeps, checkpoint support, the measured
+//! cost of a step with the projected run time, and where a step's time goes, stage by stage of the world's step
 //! ([`qdem_core::stages`]). Under `mpirun` (N > 1) the run is decomposed as `qdem run`
 //! decomposes it, and rank 0 also prints each rank's tetrahedra, owned particles, halo and
 //! measured step cost, and the imbalance.
 
 use crate::command::CliError;
 use crate::progress;
-use qdem_core::{Communicator, Decomposition, Model as _, Stage, TetBody};
+use qdem_core::{Communicator, Decomposition, Model as _, Scheme, Stage, TetBody};
 use qdem_io::build::{memory, BodyKind, Simulation};
 use qdem_io::runner::RunError;
 use qdem_io::scene::Scene;
@@ -105,20 +105,40 @@ fn print_scene(path: &Path, sim: &Simulation) {
             p.name, p.particle, p.distance
         );
     }
-    let (bound, limiter) = &sim.world.settings().stable_dt;
-    println!(
-        "integrator {}: dt {:.6e} s ({:.3}x the explicit stable bound {bound:.6e} s set by `{limiter}`); {} steps to t_end = {} s",
-        sim.scene.run.integrator.name(),
-        sim.world.dt(),
-        sim.world.dt() / bound,
-        sim.steps(),
-        sim.scene.run.t_end
-    );
-    print_step_limits(sim);
+    println!("{}", integrator_line(sim));
+    if !sim.world.settings().scheme.is_implicit() {
+        print_step_limits(sim);
+    }
     print_memory(sim);
     match sim.world.checkpointable() {
         Ok(()) => println!("checkpoints: supported (`checkpoint_every`, Ctrl-C, --resume)"),
         Err(why) => println!("checkpoints: not supported: {why}"),
+    }
+}
+
+/// The integrator and its step: an explicit step against the stable bound it was chosen
+/// under; an implicit step, or a static run's load levels, without it (no stable bound
+/// applies to them).
+fn integrator_line(sim: &Simulation) -> String {
+    let settings = sim.world.settings();
+    let (dt, steps, t_end) = (sim.world.dt(), sim.steps(), sim.scene.run.t_end);
+    let name = sim.scene.run.integrator.name();
+    match settings.scheme {
+        Scheme::Static => format!(
+            "integrator static: load levels every {dt:.6e} s, {steps} levels to t_end = {t_end} \
+             s, one solve per distinct load level"
+        ),
+        scheme if scheme.is_implicit() => format!(
+            "integrator {name}: dt {dt:.6e} s (implicit); {steps} steps to t_end = {t_end} s"
+        ),
+        _ => {
+            let (bound, limiter) = &settings.stable_dt;
+            format!(
+                "integrator {name}: dt {dt:.6e} s ({:.3}x the explicit stable bound {bound:.6e} s \
+                 set by `{limiter}`); {steps} steps to t_end = {t_end} s",
+                dt / bound
+            )
+        }
     }
 }
 

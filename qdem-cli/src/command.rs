@@ -6,7 +6,7 @@ use crate::{check, progress};
 use clap::{Args, Parser, Subcommand};
 use qdem_bench::throughput::BenchPlan;
 use qdem_bench::{implicit, throughput, verify};
-use qdem_core::{Communicator, CoreError, Halt};
+use qdem_core::{Communicator, CoreError, Halt, Scheme};
 use qdem_io::analyze::AnalyzeOptions;
 use qdem_io::build::{BuildError, Simulation};
 use qdem_io::runner::{run_with, RunError, RunOptions};
@@ -499,14 +499,11 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
         eprintln!("warning: {w}");
     }
     eprintln!(
-        "qdem run {}: {} particles, {} tets, {} with dt = {:.4e} s ({:.3}x the explicit stable bound), {} steps, {} threads",
+        "qdem run {}: {} particles, {} tets, {}, {} threads",
         path.display(),
         sim.world.state.len(),
         sim.tets(),
-        sim.scene.run.integrator.name(),
-        sim.world.dt(),
-        sim.world.dt() / sim.world.settings().stable_dt.0,
-        sim.steps(),
+        stepping_words(&sim),
         rayon::current_num_threads()
     );
     let t_end = sim.scene.run.t_end;
@@ -549,11 +546,32 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
     } else {
         format!("{:.3e} tet-steps/s", report.tet_steps_per_second)
     };
+    let steps = match sim.world.settings().scheme {
+        Scheme::Static => {
+            let solves = sim.world.stepper().counts().solves;
+            format!("{} steps (linear solves: {solves})", report.steps)
+        }
+        _ => format!("{} steps", report.steps),
+    };
     eprintln!(
-        "done: {} steps in {:.2} s ({rate}); outputs in {}",
-        report.steps,
+        "done: {steps} in {:.2} s ({rate}); outputs in {}",
         report.wall_seconds,
         out_dir.display()
     );
     Ok(())
+}
+
+/// How the run steps, for its first line: an explicit step against the stable bound, an
+/// implicit one or a static run's load levels without it (no stable bound applies to them).
+fn stepping_words(sim: &Simulation) -> String {
+    let (dt, steps) = (sim.world.dt(), sim.steps());
+    let name = sim.scene.run.integrator.name();
+    match sim.world.settings().scheme {
+        Scheme::Static => format!("static with load levels every {dt:.4e} s, {steps} levels"),
+        scheme if scheme.is_implicit() => format!("{name} with dt = {dt:.4e} s, {steps} steps"),
+        _ => format!(
+            "{name} with dt = {dt:.4e} s ({:.3}x the explicit stable bound), {steps} steps",
+            dt / sim.world.settings().stable_dt.0
+        ),
+    }
 }

@@ -94,6 +94,30 @@ fn an_averaged_pressure_material_runs_and_has_modes_with_only_its_step_noted() {
     assert!(modes.join("modes.csv").is_file());
 }
 
+/// A static solve takes no explicit step (issue 55): for an averaged-pressure body neither
+/// `qdem check` nor `qdem run` speaks of one, nor of the stable bound, and the run line
+/// names its load levels.
+#[test]
+fn a_static_run_is_told_nothing_of_an_explicit_step() {
+    let dir = TempDir::new("static-averaged");
+    let scene = scene(dir.path(), Some("averaged-pressure"));
+    let text = std::fs::read_to_string(&scene).unwrap().replace(
+        "t_end = 2e-6\ndt = \"auto\"",
+        "t_end = 1.0\nintegrator = \"static\"",
+    );
+    std::fs::write(&scene, text).unwrap();
+    let path = scene.to_str().unwrap();
+    let out = dir.path().join("out");
+    let (check, _) = success(&["check", path]);
+    let (_, run) = success(&["run", path, "--out", out.to_str().unwrap()]);
+    for said in [&check, &run] {
+        for word in ["explicit", "stable bound", "wave"] {
+            assert!(!said.contains(word), "`{word}` in:\n{said}");
+        }
+    }
+    assert!(run.contains("load levels every"), "{run}");
+}
+
 #[test]
 fn an_unknown_formulation_is_refused_with_the_names_it_takes() {
     let dir = TempDir::new("formulation");

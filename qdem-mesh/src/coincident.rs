@@ -80,7 +80,7 @@ impl TetMesh {
 
     /// Merges every node onto the earliest node it coincides with: the tetrahedra and
     /// physical groups then use that node, and the others are removed (the rest keep their
-    /// order). Returns how many nodes were removed.
+    /// order and their file ids). Returns how many nodes were removed.
     pub fn merge_coincident_nodes(&mut self) -> usize {
         let (first, _) = self.representatives();
         let mut new_of_old = vec![0u32; first.len()];
@@ -95,6 +95,11 @@ impl TetMesh {
         }
         let removed = self.nodes.len() - kept.len();
         self.nodes = kept;
+        let ids = &self.file_ids.nodes;
+        if !ids.is_empty() {
+            let roots = (0..first.len()).filter(|&n| first[n] as usize == n);
+            self.file_ids.nodes = roots.map(|n| ids[n]).collect();
+        }
         for tet in &mut self.tets {
             *tet = tet.map(|n| new_of_old[n as usize]);
         }

@@ -1,6 +1,6 @@
 //! Structured generators for tests and benchmarks.
 
-use crate::{PhysicalGroup, TetMesh};
+use crate::{FileIds, PhysicalGroup, TetMesh};
 
 /// The six Kuhn (Freudenthal) tetrahedra of the unit cube: each is the path
 /// `000 → +e_a → +e_b → +e_c = 111` for a permutation `(a, b, c)` of the axes, listed with
@@ -20,7 +20,7 @@ const KUHN: [([usize; 3], bool); 6] = [
 /// Nodes are numbered `i + (nx + 1) * (j + (ny + 1) * k)`; the boundary nodes on the six
 /// faces are the dimension-2 groups `"xmin"`, `"xmax"`, `"ymin"`, `"ymax"`, `"zmin"`,
 /// `"zmax"` (tags 1 to 6). Coordinates on the faces are exactly `min` and `max`. Every
-/// tetrahedron is positively oriented.
+/// tetrahedron is positively oriented. No file numbers it: its [`FileIds`] are empty.
 ///
 /// # Panics
 /// If a cell count is zero, or `min[d] >= max[d]` on some axis, or the node count does not
@@ -110,5 +110,6 @@ pub fn structured_box(min: [f64; 3], max: [f64; 3], cells: [usize; 3]) -> TetMes
         nodes,
         tets,
         groups,
+        file_ids: FileIds::default(),
     }
 }

@@ -11,7 +11,9 @@
 //! - drops nodes used by no tetrahedron and renumbers the rest in file order (warning),
 //! - reorients negative tetrahedra by swapping their last two nodes (warning),
 //! - rejects degenerate tetrahedra (`|6V| <= 1e-12 · (longest edge)³`),
-//! - keeps exact duplicate tetrahedra once (MSH 2.2 repeats an element per physical group).
+//! - keeps exact duplicate tetrahedra once (MSH 2.2 repeats an element per physical group),
+//! - keeps the file's node and element tags and each tetrahedron's physical volume
+//!   ([`FileIds`]), which follow the renumberings.
 //!
 //! Nodes at the same place that no tetrahedron shares (separately meshed volumes) are found
 //! by [`TetMesh::coincident_nodes`] and merged on request by
@@ -79,6 +81,26 @@ pub struct TetMesh {
     pub tets: Vec<[u32; 4]>,
     /// Physical groups of any dimension, as node sets, sorted by (dimension, tag).
     pub groups: Vec<PhysicalGroup>,
+    /// The file's numbering of the nodes and tetrahedra, which follows every renumbering;
+    /// empty for a mesh no file numbers.
+    pub file_ids: FileIds,
+}
+
+/// The numbering of a mesh's nodes and tetrahedra in the file it was read from, and the
+/// physical volume of each tetrahedron: kept in step with [`TetMesh::nodes`] and
+/// [`TetMesh::tets`] by every renumbering ([`TetMesh::renumber_nodes`],
+/// [`TetMesh::reorder_for_locality`], [`TetMesh::merge_coincident_nodes`]), so that results
+/// can be mapped back to the file. Each list is either empty (a mesh no file numbers: a
+/// generated one) or holds one entry per node or tetrahedron.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct FileIds {
+    /// The file's node tag of each node.
+    pub nodes: Vec<u64>,
+    /// The file's element tag of each tetrahedron.
+    pub tets: Vec<u64>,
+    /// The physical volume of each tetrahedron: the lowest tag of the dimension-3 physical
+    /// groups its element is in (over every record of a repeated element), −1 for none.
+    pub volumes: Vec<i32>,
 }
 
 /// A gmsh physical group reduced to the set of mesh nodes of its elements.

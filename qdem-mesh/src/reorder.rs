@@ -171,7 +171,8 @@ impl TetMesh {
     }
 
     /// Renumbers the nodes: node `i` becomes node `new_of_old[i]`. Tetrahedra and group node
-    /// sets are remapped (groups stay sorted); tetrahedron order and orientation are kept.
+    /// sets are remapped (groups stay sorted) and the file's node ids follow
+    /// ([`crate::FileIds`]); tetrahedron order and orientation are kept.
     ///
     /// # Panics
     /// If `new_of_old` is not a permutation of `0..nodes.len()`.
@@ -190,6 +191,14 @@ impl TetMesh {
             nodes[new as usize] = self.nodes[old];
         }
         self.nodes = nodes;
+        let ids = &mut self.file_ids.nodes;
+        if !ids.is_empty() {
+            let mut renumbered = vec![0; n];
+            for (old, &new) in new_of_old.iter().enumerate() {
+                renumbered[new as usize] = ids[old];
+            }
+            *ids = renumbered;
+        }
         for t in &mut self.tets {
             *t = t.map(|k| new_of_old[k as usize]);
         }
@@ -203,7 +212,7 @@ impl TetMesh {
 
     /// Reorders for locality: nodes by reverse Cuthill–McKee on the node graph, then
     /// tetrahedra sorted by their smallest node (ties by their other nodes). Groups are
-    /// remapped; tetrahedron orientation is kept. Returns nothing; use
+    /// remapped and the file ids follow; tetrahedron orientation is kept. Returns nothing; use
     /// [`TetMesh::rcm_permutation`] and [`TetMesh::renumber_nodes`] to keep the permutation.
     ///
     /// # Panics
@@ -211,17 +220,25 @@ impl TetMesh {
     pub fn reorder_for_locality(&mut self) {
         let new_of_old = self.rcm_permutation();
         self.renumber_nodes(&new_of_old);
-        let mut keyed: Vec<([u32; 4], [u32; 4])> = self
+        // Equal keys are equal tetrahedra, so the order of the tetrahedra does not depend on
+        // how ties are broken; the index only carries their file ids along.
+        let mut keyed: Vec<([u32; 4], [u32; 4], usize)> = self
             .tets
             .iter()
-            .map(|t| {
+            .enumerate()
+            .map(|(k, t)| {
                 let mut s = *t;
                 s.sort_unstable();
-                (s, *t)
+                (s, *t, k)
             })
             .collect();
         keyed.sort_unstable();
-        self.tets = keyed.into_iter().map(|(_, t)| t).collect();
+        self.tets = keyed.iter().map(|&(_, t, _)| t).collect();
+        let ids = &mut self.file_ids;
+        if !ids.tets.is_empty() {
+            ids.tets = keyed.iter().map(|&(_, _, k)| ids.tets[k]).collect();
+            ids.volumes = keyed.iter().map(|&(_, _, k)| ids.volumes[k]).collect();
+        }
     }
 
     /// The reverse Cuthill–McKee renumbering as `new_of_old` (see

@@ -1,7 +1,8 @@
 //! From the raw, file-id based parse to a checked [`TetMesh`]: node ids resolved,
 //! duplicate tetrahedra merged, unused nodes dropped and the rest renumbered (file order kept),
 //! negative tetrahedra reoriented, degenerate ones rejected, physical groups turned into
-//! node sets.
+//! node sets; the file's node and element ids and each tetrahedron's physical volume kept
+//! ([`FileIds`]).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -9,7 +10,7 @@ use std::path::Path;
 use crate::error::{MeshError, MeshWarning};
 use crate::msh::RawMesh;
 use crate::quality::{max_edge, signed_volume6};
-use crate::{PhysicalGroup, TetMesh};
+use crate::{FileIds, PhysicalGroup, TetMesh};
 
 /// A tetrahedron is degenerate when `|6V| <= DEGENERATE_TOL * (longest edge)^3`.
 pub const DEGENERATE_TOL: f64 = 1e-12;
@@ -101,8 +102,14 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
         node_id,
     };
 
-    // Exact duplicates (same id and nodes): keep the first.
+    // Exact duplicates (same id and nodes): keep the first, in the lowest physical volume
+    // of them all.
     let mut keep = vec![true; raw.tets.len()];
+    let mut volume: Vec<Option<i32>> = raw
+        .tets
+        .iter()
+        .map(|t| lowest_volume(&raw.sources[t.src as usize]))
+        .collect();
     let mut dups = 0usize;
     let mut first_dup = None;
     let mut order: Vec<u32> = Vec::new();
@@ -113,12 +120,19 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
             (t.id, t.nodes, k)
         });
     }
+    let mut kept = order.first().map_or(0, |&k| k as usize);
     for w in order.windows(2) {
         let (a, b) = (&raw.tets[w[0] as usize], &raw.tets[w[1] as usize]);
         if a.id == b.id && a.nodes == b.nodes {
             keep[w[1] as usize] = false;
+            volume[kept] = [volume[kept], volume[w[1] as usize]]
+                .into_iter()
+                .flatten()
+                .min();
             dups += 1;
             first_dup.get_or_insert(b.id);
+        } else {
+            kept = w[1] as usize;
         }
     }
     if let Some(first_element_id) = first_dup {
@@ -132,7 +146,14 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
     let mut used = vec![false; raw.node_ids.len()];
     let mut tets_raw: Vec<[u32; 4]> = Vec::with_capacity(raw.tets.len());
     let mut tet_ids: Vec<u64> = Vec::with_capacity(raw.tets.len());
-    for (t, _) in raw.tets.iter().zip(&keep).filter(|(_, &k)| k) {
+    let mut volumes: Vec<i32> = Vec::with_capacity(raw.tets.len());
+    for ((t, _), v) in raw
+        .tets
+        .iter()
+        .zip(&keep)
+        .zip(&volume)
+        .filter(|((_, &k), _)| k)
+    {
         let mut r = [0u32; 4];
         for (slot, &id) in r.iter_mut().zip(&t.nodes) {
             *slot = map.get(id).ok_or_else(|| undefined(t.id, id))?;
@@ -140,17 +161,20 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
         }
         tets_raw.push(r);
         tet_ids.push(t.id);
+        volumes.push(v.unwrap_or(-1));
     }
 
     // Renumber in file order.
     let mut new_index = vec![NONE; raw.node_ids.len()];
     let mut nodes = Vec::with_capacity(raw.node_ids.len());
+    let mut node_ids = Vec::with_capacity(raw.node_ids.len());
     let mut dropped = 0usize;
     let mut first_dropped = None;
     for (k, &u) in used.iter().enumerate() {
         if u {
             new_index[k] = nodes.len() as u32;
             nodes.push(raw.coords[k]);
+            node_ids.push(raw.node_ids[k]);
         } else {
             dropped += 1;
             first_dropped.get_or_insert(raw.node_ids[k]);
@@ -203,9 +227,19 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
             nodes,
             tets,
             groups,
+            file_ids: FileIds {
+                nodes: node_ids,
+                tets: tet_ids,
+                volumes,
+            },
         },
         warnings,
     ))
+}
+
+/// The lowest tag of the dimension-3 groups among `groups`, if any.
+fn lowest_volume(groups: &[(u8, i32)]) -> Option<i32> {
+    groups.iter().filter(|g| g.0 == 3).map(|g| g.1).min()
 }
 
 /// Physical groups as sorted node sets (new indices), sorted by (dim, tag).

@@ -6,8 +6,22 @@
 //! the reference configuration ([`crate::Linearized::add_tangent`]). For QDEM tetrahedra this is the
 //! small-strain linear-tetrahedron stiffness, so the answer is the mesh's linear FEM solution.
 //! K is assembled and factorised by `sparse::SparseCholesky` on the first solve (with the fixity of
-//! that moment) and reused for every later load level: one further force evaluation and two
-//! triangular solves per level.
+//! that moment) and reused for every later load level: one further force evaluation per
+//! level and two triangular solves per distinct one.
+//!
+//! One solve per distinct load level: the load vector f of every level is compared, bit for
+//! bit, with that of the last level solved, and a level whose loads are the same (a constant
+//! load, the hold of a ramp or a series, gravity alone) takes that level's answer without
+//! solving again: the same f and the same factorisation give the same u, so the outputs are
+//! those of a solve at every level, and only the work goes. The comparison was chosen over
+//! asking each model whether its time function is constant between two levels: it needs no
+//! knowledge of the models (loads, gravity, a series' flat stretches all count alike) and
+//! can never skip a level whose loads changed. [`StaticSolver::solves`] counts the solves.
+//!
+//! The levels are the multiples k·dt of the step, computed as such rather than summed (a sum
+//! of a hundred 0.01 s steps is not 1 s), and the last one is the run's end exactly when it
+//! lies within rounding of it ([`StaticSteps::ending_at`]): a level's time is printed as
+//! given.
 //!
 //! K alone is singular when a deformable body is free to move rigidly (no or too few fixed
 //! directions), so such a body is refused before factorising with
@@ -24,7 +38,7 @@
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::parallel::Exchange;
-use crate::solvers::newmark::collect_tangent;
+use crate::solvers::newmark::{collect_tangent, StepCounts};
 use crate::solvers::sparse::{
     explain_failure, unconstrained_bodies, Assembler, FactorStats, FreeDofs, Scales,
     SparseCholesky, Tangent, FIX_HINT,
@@ -45,6 +59,36 @@ pub struct StaticSolver {
     force: Vec<Vec3>,
     torque: Vec<Vec3>,
     rhs: Vec<f64>,
+    levels: Levels,
+}
+
+/// The load vector of the last level solved, its answer, and the solves made.
+#[derive(Debug, Default)]
+struct Levels {
+    loads: Vec<f64>,
+    answer: Vec<f64>,
+    solves: u64,
+}
+
+impl Levels {
+    /// Turns the load vector in `rhs` into the answer: by a solve with `cholesky` when it
+    /// differs from the last level solved, else that level's answer.
+    fn solve(&mut self, cholesky: &mut SparseCholesky, rhs: &mut Vec<f64>) {
+        let same = self.loads.len() == rhs.len()
+            && self
+                .loads
+                .iter()
+                .zip(rhs.iter())
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        if same {
+            rhs.clone_from(&self.answer);
+            return;
+        }
+        self.loads.clone_from(rhs);
+        cholesky.solve_in_place(rhs);
+        self.answer.clone_from(rhs);
+        self.solves += 1;
+    }
 }
 
 impl StaticSolver {
@@ -58,8 +102,14 @@ impl StaticSolver {
         self.cholesky.is_factored().then(|| self.cholesky.stats())
     }
 
+    /// The linear solves made: one per distinct load level (see the module docs).
+    pub fn solves(&self) -> u64 {
+        self.levels.solves
+    }
+
     /// Solves K u = f(`time`) and sets `state` to the static answer at `time`: positions
-    /// X + u, rotations θ, zero velocities and accelerations.
+    /// X + u, rotations θ, zero velocities and accelerations. Loads equal bit for bit to
+    /// those of the last solve take its answer without solving again.
     pub fn solve(
         &mut self,
         state: &mut State,
@@ -89,7 +139,7 @@ impl StaticSolver {
         self.rhs.resize(dofs.len(), 0.0);
         let moments = &self.torque[state.rigid.len()..];
         dofs.gather_nodes((&self.force, moments), &mut self.rhs);
-        self.cholesky.solve_in_place(&mut self.rhs);
+        self.levels.solve(&mut self.cholesky, &mut self.rhs);
         let mut u = vec![Vec3::zeros(); state.len()];
         dofs.scatter_nodes(&self.rhs, (&mut u, &mut state.spin.angle));
         for (x, d) in state.position.iter_mut().zip(&u) {
@@ -172,12 +222,14 @@ impl StaticSolver {
     }
 }
 
-/// The static solve as a [`Stepper`] (`integrator = "static"`): each step advances the load
-/// time by `dt` and solves K·u = f(t), reusing the factorisation of the first solve.
+/// The static solve as a [`Stepper`] (`integrator = "static"`): each step moves the load
+/// time to the next level k·dt and solves K·u = f(t), reusing the factorisation of the first
+/// solve (and the answer of the last level whose loads were the same).
 #[derive(Debug)]
 pub struct StaticSteps {
     solver: StaticSolver,
     dt: f64,
+    end: Option<f64>,
 }
 
 impl StaticSteps {
@@ -186,6 +238,23 @@ impl StaticSteps {
         StaticSteps {
             solver: StaticSolver::new(),
             dt,
+            end: None,
+        }
+    }
+
+    /// The levels end at `end` (s): the level within rounding of it (10⁻⁹ dt, the tolerance
+    /// of [`crate::StepSettings::steps_to`]) is solved at `end` itself.
+    pub fn ending_at(mut self, end: Option<f64>) -> StaticSteps {
+        self.end = end;
+        self
+    }
+
+    /// The time of the level after the one at `time`: the next multiple of dt, or the end.
+    fn next_level(&self, time: f64) -> f64 {
+        let next = ((time / self.dt).round() + 1.0) * self.dt;
+        match self.end {
+            Some(end) if (next - end).abs() <= 1e-9 * self.dt => end,
+            _ => next,
         }
     }
 }
@@ -219,7 +288,7 @@ impl Stepper for StaticSteps {
         stages: &mut StageTimes,
         _exchange: &mut Exchange,
     ) -> Result<(), CoreError> {
-        let time = state.time + self.dt;
+        let time = self.next_level(state.time);
         let solved = self.solver.solve(state, models, time);
         stages.mark(Stage::Solve);
         solved
@@ -227,6 +296,16 @@ impl Stepper for StaticSteps {
 
     fn factor_stats(&self) -> Option<&FactorStats> {
         self.solver.factor_stats()
+    }
+
+    /// The linear solves made by this process ([`StaticSolver::solves`]) and the one
+    /// factorisation once made.
+    fn counts(&self) -> StepCounts {
+        StepCounts {
+            solves: self.solver.solves(),
+            factorizations: u64::from(self.solver.cholesky.is_factored()),
+            ..StepCounts::default()
+        }
     }
 
     fn forces(&self) -> &[Vec3] {

@@ -69,7 +69,8 @@ pub struct StepRequest {
     /// missing step an error.
     pub implicit_default: Option<f64>,
     /// An automatic step is shrunk so that a whole number of steps reaches this time (the end
-    /// of the run); `None` keeps it as it is.
+    /// of the run), and a static run's last load level is solved at exactly this time;
+    /// `None` keeps the step as it is.
     pub fit_to: Option<f64>,
 }
 
@@ -91,6 +92,9 @@ pub struct StepSettings {
     /// The rigorous explicit stable bound at the start (s; infinite when no model bounds it)
     /// and the model that sets it.
     pub stable_dt: (f64, String),
+    /// The end of the run the request named ([`StepRequest::fit_to`]), where a static run's
+    /// last load level lands exactly.
+    pub end: Option<f64>,
 }
 
 impl StepSettings {
@@ -128,6 +132,7 @@ impl StepSettings {
             adaptive: request.adaptive,
             event_solve: request.event_solve,
             stable_dt,
+            end: request.fit_to,
         })
     }
 
@@ -147,7 +152,7 @@ impl StepSettings {
                 let newmark = Newmark::new(beta, gamma, self.dt)?.with_adaptive(self.adaptive);
                 Box::new(newmark.with_event_solve(self.event_solve))
             }
-            Scheme::Static => Box::new(StaticSteps::new(self.dt)),
+            Scheme::Static => Box::new(StaticSteps::new(self.dt).ending_at(self.end)),
         })
     }
 

@@ -113,7 +113,8 @@ pub trait Stepper: Send {
         None
     }
 
-    /// Retakes, sub-steps and event steps of an adaptive stepper; zero for the others.
+    /// Retakes, sub-steps and event steps of an adaptive stepper, the solves of an implicit or
+    /// static one; zero for the others.
     fn counts(&self) -> StepCounts {
         StepCounts::default()
     }

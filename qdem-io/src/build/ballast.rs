@@ -105,11 +105,7 @@ pub(crate) fn place_ballast(
         |d: &Draw| shapes[d.shape].extents * d.scale + Vec3::repeat(2.0 * ballast.contact_radius);
     let cell = draws.iter().map(size).fold(Vec3::zeros(), |a, b| a.sup(&b)) * 1.05;
     let cells = lattice(scene, ballast, cell)?;
-    let mut mesh = TetMesh {
-        nodes: Vec::new(),
-        tets: Vec::new(),
-        groups: Vec::new(),
-    };
+    let mut mesh = TetMesh::default();
     let mut info = BallastInfo {
         name: ballast.name.clone(),
         stones: Vec::with_capacity(draws.len()),

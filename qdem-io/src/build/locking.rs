@@ -6,7 +6,9 @@
 //! tetrahedra under a 500 N tip load, static, against Timoshenko beam theory (the issue's
 //! table), and the averaged-pressure formulation that does not lock
 //! ([`qdem_core::averaged_pressure_tet`]). The explicit step is set by the bulk
-//! (dilatational) wave whatever the formulation, which the warning states as well.
+//! (dilatational) wave whatever the formulation, which the warning of an explicit run states
+//! as well; an implicit or static run has no such step, so an averaged-pressure body is not
+//! warned of there at all.
 
 use crate::scene::{Formulation, Material, Scene};
 
@@ -18,10 +20,11 @@ pub const LOCKING_POISSON: f64 = 0.45;
 const MEASURED: [(f64, f64); 4] = [(0.45, 0.83), (0.49, 0.70), (0.499, 0.38), (0.4999, 0.10)];
 
 /// One warning per deformable `[[body]]` whose material has ν ≥ [`LOCKING_POISSON`]: for the
-/// standard formulation, the expected locking and the option that avoids it; for either, the
-/// bulk wave that sets the explicit step.
+/// standard formulation, the expected locking and the option that avoids it; in an explicit
+/// run, for either, the bulk wave that sets the step.
 pub fn warnings(scene: &Scene) -> Vec<String> {
     let materials = &scene.refs().body_materials;
+    let explicit = !super::scheme(scene).is_implicit();
     scene
         .bodies
         .iter()
@@ -29,13 +32,16 @@ pub fn warnings(scene: &Scene) -> Vec<String> {
         .filter(|(body, _)| !body.rigid)
         .filter_map(|(body, &m)| {
             let material = &scene.materials[m];
-            (material.poisson >= LOCKING_POISSON).then(|| warning(&body.name, material))
+            (material.poisson >= LOCKING_POISSON)
+                .then(|| warning(&body.name, material, explicit))
+                .flatten()
         })
         .collect()
 }
 
-/// The warning for body `body` of `material`.
-fn warning(body: &str, material: &Material) -> String {
+/// The warning for body `body` of `material` in an `explicit` run or not; none for an
+/// averaged-pressure body outside an explicit run.
+fn warning(body: &str, material: &Material, explicit: bool) -> Option<String> {
     let nu = material.poisson;
     let wave = bulk_wave_ratio(nu);
     let step = format!(
@@ -44,12 +50,18 @@ fn warning(body: &str, material: &Material) -> String {
          the shear (bending) response needs",
         bulk_wave_speed(material)
     );
+    let step = match explicit {
+        true => format!("; {step}"),
+        false => String::new(),
+    };
     match material.formulation {
-        Formulation::AveragedPressure => format!(
-            "body `{body}`: material `{}` has poisson = {nu} and formulation = \
-             \"averaged-pressure\" (locking-free); {step}",
-            material.name
-        ),
+        Formulation::AveragedPressure => explicit.then(|| {
+            format!(
+                "body `{body}`: material `{}` has poisson = {nu} and formulation = \
+                 \"averaged-pressure\" (locking-free){step}",
+                material.name
+            )
+        }),
         Formulation::Standard => {
             let (at, ratio) = MEASURED
                 .iter()
@@ -57,7 +69,7 @@ fn warning(body: &str, material: &Material) -> String {
                 .find(|(at, _)| *at <= nu)
                 .copied()
                 .unwrap_or(MEASURED[0]);
-            format!(
+            Some(format!(
                 "body `{body}`: material `{}` has poisson = {nu} >= {LOCKING_POISSON}: linear \
                  tetrahedra LOCK for nearly incompressible materials and the body will come out \
                  far too stiff in bending (a clamped bar of 4,376 tets at poisson = {at} \
@@ -65,9 +77,9 @@ fn warning(body: &str, material: &Material) -> String {
                  mesh); add formulation = \"averaged-pressure\" to [[material]] `{}` (average \
                  nodal pressure tetrahedra, which bend as a compressible material does: 0.85x \
                  beam theory at poisson = 0.4999 against 0.82x for the standard at 0.33 on a \
-                 3,600-tet bar); {step}",
+                 3,600-tet bar){step}",
                 material.name, material.name
-            )
+            ))
         }
     }
 }
@@ -102,14 +114,27 @@ mod tests {
 
     #[test]
     fn a_nearly_incompressible_standard_material_is_told_its_locking_and_the_fix() {
-        let w = warning("pad", &material(0.4999, Formulation::Standard));
+        let w = warning("pad", &material(0.4999, Formulation::Standard), true).unwrap();
         assert!(w.contains("LOCK"), "{w}");
         assert!(w.contains("0.10x beam theory"), "{w}");
         assert!(w.contains("formulation = \"averaged-pressure\""), "{w}");
         // c_d/c_s = √(2 · 0.5001 / 0.0002) = 70.7.
         assert!(w.contains("70.7x the shear wave speed"), "{w}");
-        let w = warning("pad", &material(0.46, Formulation::Standard));
+        let w = warning("pad", &material(0.46, Formulation::Standard), true).unwrap();
         assert!(w.contains("poisson = 0.45 deflected 0.83x"), "{w}");
+    }
+
+    /// An implicit or static run has no explicit step: the standard body is told its locking
+    /// without the step, and an averaged-pressure body is not warned of at all.
+    #[test]
+    fn a_run_that_is_not_explicit_hears_nothing_of_the_explicit_step() {
+        let w = warning("pad", &material(0.4999, Formulation::Standard), false).unwrap();
+        assert!(w.contains("LOCK"), "{w}");
+        assert!(!w.contains("explicit") && !w.contains("wave"), "{w}");
+        assert!(w.ends_with("3,600-tet bar)"), "{w}");
+        let averaged = material(0.4999, Formulation::AveragedPressure);
+        assert_eq!(warning("pad", &averaged, false), None);
+        assert!(warning("pad", &averaged, true).is_some());
     }
 
     #[test]

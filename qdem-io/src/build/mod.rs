@@ -63,7 +63,7 @@ use qdem_core::{
     CoreError, Dofs, EventSolve, Gravity, Material, Model, NodalLoad, Scheme, State, StepRequest,
     StepSettings, TetBody, TimeFunction, Vec3, World,
 };
-use qdem_mesh::{read_msh, MeshError, MeshStats, TetMesh};
+use qdem_mesh::{read_msh, FileIds, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -114,6 +114,10 @@ pub struct BodyInfo {
     pub stats: MeshStats,
     /// Mesh file.
     pub mesh: PathBuf,
+    /// The mesh file's numbering of its particles (in `particles` order) and tetrahedra (in
+    /// [`Simulation::body_tets`] order), and their physical volumes; empty for the
+    /// `[ballast]` stones, which are drawn from many files.
+    pub file_ids: FileIds,
 }
 
 /// A probe resolved to a particle.
@@ -519,6 +523,7 @@ fn build_bodies(
             kind,
             stats: placed.mesh.stats(),
             mesh: placed.path.clone(),
+            file_ids: placed.mesh.file_ids.clone(),
         });
     }
     let ballast = scene.ballast.as_ref().zip(scene.refs().ballast_material);
@@ -566,6 +571,7 @@ fn ballast_body(
         },
         stats: placed.mesh.stats(),
         mesh: placed.path.clone(),
+        file_ids: placed.mesh.file_ids.clone(),
     })
 }
 
@@ -591,6 +597,7 @@ fn rigid_ballast_body(
         },
         stats: placed.mesh.stats(),
         mesh: placed.path.clone(),
+        file_ids: placed.mesh.file_ids.clone(),
     })
 }
 

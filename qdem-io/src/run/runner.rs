@@ -365,7 +365,7 @@ impl Run {
                 .collect();
             fresh_start::remove_earlier_outputs(out_dir, &inputs);
         }
-        if sim.scene.output.writes_vtu() {
+        if record::snapshots::writes_vtu(&sim.scene) {
             create_dir(&out_dir.join("vtu"))?;
         }
         crate::output::remove_stale_temporaries(out_dir);

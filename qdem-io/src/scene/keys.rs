@@ -62,7 +62,7 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "[run]",
         "integrator",
         "\"verlet\", \"newmark\" or \"static\", optional",
-        "Time integrator; default `\"verlet\"`; `\"static\"`: a linear static solve at every `dt` of the load factor.",
+        "Time integrator; default `\"verlet\"`; `\"static\"`: a linear static solve at every `dt` of the load factor (default `probe_every`, else t_end / 100), once per distinct load level, writing the final state's VTU.",
     ),
     key(
         "[run]",
@@ -938,7 +938,7 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "[output]",
         "vtu_every",
         "number, optional",
-        "Simulated time between VTU snapshots, s; 0 (the default) writes none.",
+        "Simulated time between VTU snapshots, s; 0 (the default) writes none, except a static run's final state.",
     ),
     key(
         "[output]",

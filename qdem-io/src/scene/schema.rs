@@ -147,8 +147,9 @@ pub enum Integrator {
     /// (needs a numeric `dt`), explicit central difference for β = 0.
     #[serde(rename = "newmark")]
     Newmark,
-    /// Linear static solve K·u = f at every `dt` (default: every `probe_every`) of the load
-    /// ramp up to `t_end`; velocities and accelerations are zero.
+    /// Linear static solve K·u = f at every `dt` (default: `probe_every`, else t_end/100) of
+    /// the load ramp up to `t_end`, solving once per distinct load level; velocities and
+    /// accelerations are zero. The final state's VTU is written without `vtu_every`.
     #[serde(rename = "static")]
     Static,
 }

@@ -11,7 +11,7 @@
 //! | [`settlement::Settlement`] | `settlement.csv`, `settlement.svg` (a `cyclic` load and probes) | at each cycle's minimum and maximum |
 //! | [`walls::Walls`] | `walls.csv` (`[[wall]]`s: force, displacement) | every `probe_every` |
 //! | [`measures::Measures`] | `measure_NAME.csv`, `measure_NAME.svg`, `measure_NAME_energy.svg` (`[[measure]]`s) | every `every` |
-//! | [`snapshots::Snapshots`] | `vtu/state_NNNNN.vtu`, `results.pvd`; `vtu/spheres_NNNNN.vtu`, `vtu/contacts_NNNNN.vtu`, `vtu/walls.vtu` (contacts), `vtu/bonds_NNNNN.vtu` (`[bonded]`) | every `vtu_every` (never if 0) |
+//! | [`snapshots::Snapshots`] | `vtu/state_NNNNN.vtu`, `results.pvd`; `vtu/spheres_NNNNN.vtu`, `vtu/contacts_NNNNN.vtu`, `vtu/walls.vtu` (contacts), `vtu/bonds_NNNNN.vtu` (`[bonded]`) | every `vtu_every` (never if 0), and a static run's final state |
 //! | [`crack::Crack`] | `crack.svg`, the bonded timings | every step; the picture at the end |
 //! | [`grading::Grading`] | `grading.csv`, `grading.svg` (`[granular]`: sieve curve by mass) | at the start |
 //! | [`stones::Stones`] | `stones.csv` (`[granular]`) | at the end |
@@ -28,6 +28,7 @@ pub(crate) mod contacts_vtu;
 pub(crate) mod crack;
 pub(crate) mod grading;
 pub(crate) mod measures;
+pub(crate) mod nodal_stress;
 pub(crate) mod poses;
 pub(crate) mod probes;
 pub(crate) mod reactions;

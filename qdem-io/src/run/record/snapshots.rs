@@ -1,7 +1,10 @@
-//! [`Snapshots`]: every `vtu_every`, `vtu/state_NNNNN.vtu` of all bodies (reference points
-//! with displacement and velocity per particle, von Mises stress, volumetric strain, the
-//! stress tensor and the principal stresses per tetrahedron; rigid bodies' tetrahedra at
-//! zero), each file carrying its time as `TimeValue` field data and, beside it as further parts of the same
+//! [`Snapshots`]: every `vtu_every`, and a static run's final state, `vtu/state_NNNNN.vtu` of
+//! all bodies (reference points with displacement, velocity, the nodal stress
+//! ([`nodal_stress`](super::nodal_stress)) and the mesh file's node id per particle; von
+//! Mises stress, volumetric strain, the stress tensor, the principal stresses, the mesh
+//! file's element id and physical volume per tetrahedron; rigid bodies' tetrahedra at zero
+//! stress; −1 for an id no mesh file gives), each file carrying its time as `TimeValue` field
+//! data and, beside it as further parts of the same
 //! time in `results.pvd`, what else the scene has: the contact spheres
 //! ([`spheres_vtu`](super::spheres_vtu)) and their touching contacts
 //! ([`contacts_vtu`](super::contacts_vtu)), the walls ([`walls_vtu`](super::walls_vtu): one
@@ -14,6 +17,7 @@
 
 use super::bonds_vtu::write_bonds;
 use super::contacts_vtu::write_contacts;
+use super::nodal_stress::nodal_stress;
 use super::schedule::Schedule;
 use super::spheres_vtu::write_spheres;
 use super::tet_stress::StressFields;
@@ -21,7 +25,7 @@ use super::walls_vtu::{walls_move, write_walls};
 use super::{Recorder, RunFigures, StateRead, StepInfo};
 use crate::build::Simulation;
 use crate::output::{write_vtu_mesh_at, OutputError, PvdIndex, VtuCells, VtuField, VtuMesh};
-use crate::scene::Integrator;
+use crate::scene::{Integrator, Scene};
 use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -73,6 +77,8 @@ impl Part {
 /// The VTU series.
 pub(crate) struct Snapshots {
     schedule: Schedule,
+    /// A static run's end: its final state is written whatever the schedule.
+    end: Option<f64>,
     out_dir: PathBuf,
     /// `(time, body file)` of every time written, what a checkpoint keeps.
     times: Vec<(f64, String)>,
@@ -99,6 +105,7 @@ impl Snapshots {
         }
         Snapshots {
             schedule: Schedule::new(sim.scene.output.vtu_every),
+            end: (sim.scene.run.integrator == Integrator::Static).then_some(sim.scene.run.t_end),
             out_dir: out_dir.to_path_buf(),
             times: Vec::new(),
             parts,
@@ -116,6 +123,21 @@ impl Snapshots {
         }
         self.times.push((time, file));
     }
+
+    /// Whether a file is due at `time` (step `dt`): on the schedule, or a static run's final
+    /// state (its last level, the first within 10⁻⁹ dt of the end or past it, as
+    /// [`qdem_core::StepSettings::steps_to`] counts) that the schedule did not write.
+    fn is_due(&self, time: f64, dt: f64) -> bool {
+        let last = self.times.last().map(|t| t.0);
+        let at_end = |end: f64| time >= end - 1e-9 * dt;
+        let fin = self.end.is_some_and(at_end) && last != Some(time);
+        self.schedule.is_due(time, dt) || fin
+    }
+}
+
+/// Whether `scene`'s run writes `vtu/state_NNNNN.vtu`: with `vtu_every`, or static.
+pub(crate) fn writes_vtu(scene: &Scene) -> bool {
+    scene.output.writes_vtu() || scene.run.integrator == Integrator::Static
 }
 
 impl Recorder for Snapshots {
@@ -124,12 +146,14 @@ impl Recorder for Snapshots {
     }
 
     fn reads(&self, time: f64, dt: f64) -> StateRead {
-        StateRead::whole_if(self.schedule.is_due(time, dt))
+        StateRead::whole_if(self.is_due(time, dt))
     }
 
     fn record(&mut self, sim: &Simulation, step: &StepInfo<'_>) -> Result<(), OutputError> {
         let time = sim.world.state.time;
-        if !self.schedule.due(time, step.dt) {
+        let due = self.is_due(time, step.dt);
+        self.schedule.due(time, step.dt);
+        if !due {
             return Ok(());
         }
         let k = self.times.len();
@@ -174,13 +198,15 @@ impl Recorder for Snapshots {
     }
 }
 
-/// One VTU of all bodies at the state's time (its `TimeValue`): the particles' displacement
-/// and velocity, the tetrahedra's stress tensor, principal stresses, von Mises stress and
-/// volumetric strain ([`tet_stress`](super::tet_stress)). A static run's stress is the
-/// small-strain one of its linear solve ([`qdem_core::TetBody::small_strain_stresses`]).
+/// One VTU of all bodies at the state's time (its `TimeValue`): the particles' displacement,
+/// velocity, nodal stress and mesh node id, the tetrahedra's stress tensor, principal
+/// stresses, von Mises stress, volumetric strain ([`tet_stress`](super::tet_stress)), mesh
+/// element id and physical volume. A static run's stress is the small-strain one of its
+/// linear solve ([`qdem_core::TetBody::small_strain_stresses`]).
 fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
     let s = &sim.world.state;
     let displacement: Vec<Vec3> = (0..s.len()).map(|i| s.displacement(i)).collect();
+    let ids = MeshIds::of(sim);
     let mut tets = Vec::new();
     let mut stress = StressFields::default();
     let mut volumetric = Vec::new();
@@ -203,12 +229,15 @@ fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
         }
     }
     let [p1, p2, p3] = &stress.principal;
+    let nodal = nodal_stress(&s.reference, &tets, &stress.stress);
     let mesh = VtuMesh {
         points: &s.reference,
         cells: VtuCells::Tets(&tets),
         point_data: vec![
             ("displacement", VtuField::Vectors(&displacement)),
             ("velocity", VtuField::Vectors(&s.velocity)),
+            ("nodal_stress", VtuField::SymTensors(&nodal)),
+            ("gmsh_node_id", VtuField::Integers(&ids.nodes)),
         ],
         cell_data: vec![
             ("von_mises", VtuField::Scalars(&stress.von_mises)),
@@ -217,7 +246,52 @@ fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
             ("principal_stress_1", VtuField::Scalars(p1)),
             ("principal_stress_2", VtuField::Scalars(p2)),
             ("principal_stress_3", VtuField::Scalars(p3)),
+            ("gmsh_element_id", VtuField::Integers(&ids.tets)),
+            ("physical_group", VtuField::Integers(&ids.volumes)),
         ],
     };
     write_vtu_mesh_at(path, &mesh, Some(s.time))
+}
+
+/// The mesh files' numbering of every particle and tetrahedron of the state, in the VTU's
+/// order, −1 where no file numbers it (a generated body, the `[ballast]` stones, a rigid
+/// body's centre, a sphere; an id beyond 2⁶³ − 1, which only a binary file can hold).
+struct MeshIds {
+    /// `gmsh_node_id` per particle.
+    nodes: Vec<i64>,
+    /// `gmsh_element_id` per tetrahedron.
+    tets: Vec<i64>,
+    /// `physical_group` per tetrahedron (−1 also for an element in no physical volume).
+    volumes: Vec<i64>,
+}
+
+impl MeshIds {
+    /// The ids of `sim`'s bodies, their tetrahedra in body order.
+    fn of(sim: &Simulation) -> MeshIds {
+        let id = |n: &u64| i64::try_from(*n).unwrap_or(-1);
+        let mut nodes = vec![-1; sim.world.state.len()];
+        let (mut tets, mut volumes) = (Vec::new(), Vec::new());
+        for body in &sim.bodies {
+            let file = &body.file_ids;
+            for (slot, n) in nodes[body.particles.clone()].iter_mut().zip(&file.nodes) {
+                *slot = id(n);
+            }
+            let count = sim.body_tets(body).len();
+            match file.tets.len() == count {
+                true => {
+                    tets.extend(file.tets.iter().map(id));
+                    volumes.extend(file.volumes.iter().map(|&v| i64::from(v)));
+                }
+                false => {
+                    tets.extend(std::iter::repeat_n(-1, count));
+                    volumes.extend(std::iter::repeat_n(-1, count));
+                }
+            }
+        }
+        MeshIds {
+            nodes,
+            tets,
+            volumes,
+        }
+    }
 }

@@ -1,11 +1,13 @@
 //! `summary.json` of a finished run: the run's figures (steps, step, stable bound, wall time,
-//! rates, the stage counters of [`qdem_core::World`]), the bodies and probes, the contact
-//! set and the periodic cell, then each recorder's part ([`super::Recorder::summarize`]).
+//! rates, the stage counters of [`qdem_core::World`], a static run's linear solves), the
+//! bodies and probes, the contact set and the periodic cell, then each recorder's part
+//! ([`super::Recorder::summarize`]).
 
 use super::{Recorder, RunFigures};
 use crate::build::Simulation;
 use crate::output::{write_summary, OutputError};
 use crate::runner::RunReport;
+use qdem_core::Scheme;
 use serde_json::json;
 use std::path::Path;
 
@@ -22,6 +24,9 @@ pub(crate) fn write(
     let mut summary = base(sim, report);
     if let Some(step) = resumed_at {
         summary["resumed_at_step"] = json!(step);
+    }
+    if sim.world.settings().scheme == Scheme::Static {
+        summary["solves"] = json!(sim.world.stepper().counts().solves);
     }
     if let Some(contacts) = sim.contacts() {
         summary["contact"] = json!({
