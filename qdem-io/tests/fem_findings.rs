@@ -179,3 +179,99 @@ fn a_point_group_holds_and_loads_its_particle() {
     let load = sim.world.model::<qdem_core::NodalLoad>().unwrap().total();
     assert!((load.z - 5.0).abs() < 1e-12, "{load}");
 }
+
+/// Item 6: per-node reactions on request. `node_reactions.csv` of the two fixes sharing the
+/// clamp's nodes: each fix's rows sum to its `reactions.csv` force (to the nine printed
+/// digits), and each row's `gmsh_node_id` is the .msh file's node at the row's reference
+/// position (the nodes are reordered in the state, so the id is what maps a row back).
+#[test]
+fn node_reactions_sum_to_the_fix_and_name_the_gmsh_nodes() {
+    let dir = test_dir("fem-findings-node-reactions");
+    let scene_text = |dir: &Path| {
+        let scene = block(
+            dir,
+            "young = 45e9\npoisson = 0.2",
+            "[[fix]]\nbody = \"block\"\ngroup = \"left\"\n\n\
+             [[fix]]\nbody = \"block\"\ngroup = \"left\"\ndofs = \"z\"",
+            "group = \"right\"\ntraction = [-2.5e5, 0.0, 1.0e5]",
+        );
+        let path = scene.path.clone();
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(
+            &path,
+            text.replace("[output]\n", "[output]\nnode_reactions = true\n"),
+        )
+        .unwrap();
+        Scene::load(&path).unwrap()
+    };
+    let mut sim = Simulation::build(scene_text(&dir)).unwrap();
+    let out = dir.join("out");
+    run(&mut sim, &out, &mut |_| {}).unwrap();
+    let totals = common::columns(&out.join("reactions.csv"));
+    let text = std::fs::read_to_string(out.join("node_reactions.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "time,fix,gmsh_node_id,particle,x,y,z,fx,fy,fz"
+    );
+    let msh = msh_nodes(&fixture("msh/box_gmsh22_ascii.msh"));
+    let mut sums = [[0.0f64; 3]; 2];
+    let mut rows = 0;
+    let last_time = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .to_string();
+    for line in lines {
+        let v: Vec<&str> = line.split(',').collect();
+        if v[0] != last_time {
+            continue;
+        }
+        let fix: usize = v[1].parse().unwrap();
+        let id: i64 = v[2].parse().unwrap();
+        let x: Vec<f64> = v[4..7].iter().map(|s| s.parse().unwrap()).collect();
+        let at = msh[&id];
+        assert!(
+            (0..3).all(|k| (at[k] - x[k]).abs() < 1e-9),
+            "node {id} at {at:?}, row at {x:?}"
+        );
+        for k in 0..3 {
+            sums[fix - 1][k] += v[7 + k].parse::<f64>().unwrap();
+        }
+        rows += 1;
+    }
+    let left = sim.fix_particles[0].len();
+    assert_eq!(
+        rows,
+        2 * left,
+        "one row per fix and particle at the last time"
+    );
+    for (fix, sum) in sums.iter().enumerate() {
+        for (k, c) in ["fx", "fy", "fz"].iter().enumerate() {
+            let want = *totals[&format!("fix{}_{c}", fix + 1)].last().unwrap();
+            assert!(
+                (sum[k] - want).abs() <= 1e-7 * 2.5e5 * AREA,
+                "fix {} {c}: {} vs {want}",
+                fix + 1,
+                sum[k]
+            );
+        }
+    }
+}
+
+/// The nodes of an ASCII MSH 2.2 file by their tag.
+fn msh_nodes(path: &Path) -> std::collections::HashMap<i64, [f64; 3]> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let block = &text[text.find("$Nodes").unwrap()..text.find("$EndNodes").unwrap()];
+    block
+        .lines()
+        .skip(2)
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|s| s.parse().unwrap()).collect();
+            (v[0] as i64, [v[1], v[2], v[3]])
+        })
+        .collect()
+}

@@ -276,6 +276,20 @@ impl Simulation {
         })
     }
 
+    /// The mesh files' tag of every particle of the state (`gmsh_node_id`), −1 where no file
+    /// numbers it: a generated body, the `[ballast]` stones, a rigid body's centre, a
+    /// sphere, an id beyond 2⁶³ − 1 (which only a binary file can hold).
+    pub fn gmsh_node_ids(&self) -> Vec<i64> {
+        let mut nodes = vec![-1; self.world.state.len()];
+        for body in &self.bodies {
+            let file = &body.file_ids.nodes;
+            for (slot, n) in nodes[body.particles.clone()].iter_mut().zip(file) {
+                *slot = i64::try_from(*n).unwrap_or(-1);
+            }
+        }
+        nodes
+    }
+
     /// Number of steps to reach `t_end` (the last one may end slightly past it for a fixed dt).
     pub fn steps(&self) -> u64 {
         self.world.settings().steps_to(self.scene.run.t_end)

@@ -3,7 +3,7 @@
 //! unlisted (the VTUs of an earlier, longer run past this run's last one; the `boundary.csv`
 //! or `stones.csv` of another scene). Only files with the names a run writes are touched:
 //! `results.pvd`, `probes.csv`, `probes.svg`, `boundary.csv`, `sections.csv`,
-//! `reactions.csv`, `crack.svg`, `stones.csv`, `poses.csv`, `summary.json`, `walls.csv`,
+//! `reactions.csv`, `node_reactions.csv`, `crack.svg`, `stones.csv`, `poses.csv`, `summary.json`, `walls.csv`,
 //! `settlement.csv`, `settlement.svg`, `grading.csv`, `grading.svg`, every `measure_*.csv`
 //! and `measure_*.svg`, and in `vtu/` the numbered `state_`,
 //! `spheres_`, `contacts_`, `bonds_` and `walls_` VTUs and `walls.vtu`. A file the scene reads (a
@@ -15,13 +15,14 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 /// The files a run writes at the top of its output folder.
-const TOP_FILES: [&str; 15] = [
+const TOP_FILES: [&str; 16] = [
     "results.pvd",
     "probes.csv",
     "probes.svg",
     "boundary.csv",
     "sections.csv",
     "reactions.csv",
+    "node_reactions.csv",
     "crack.svg",
     "stones.csv",
     "poses.csv",

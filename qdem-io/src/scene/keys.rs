@@ -946,6 +946,12 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "number, optional",
         "Simulated time between checkpoints (`checkpoint.qdc` in the output directory, which `qdem run --resume` continues from), s; 0 (the default) writes one only when the run is interrupted (Ctrl-C, SIGTERM) or becomes unstable.",
     ),
+    key(
+        "[output]",
+        "node_reactions",
+        "bool, optional",
+        "Whether to write `node_reactions.csv`: every `probe_every`, the force each `[[fix]]` of a deformable body carries at each of its particles, with the particle's gmsh node id and reference position; default false.",
+    ),
 ];
 
 /// The registry as a Markdown table: `| table | key | type | meaning |`, one row per key.

@@ -631,6 +631,11 @@ pub struct Output {
     /// is interrupted (Ctrl-C, SIGTERM) or becomes unstable.
     #[serde(default)]
     pub checkpoint_every: f64,
+    /// Whether to write `node_reactions.csv`: every `probe_every`, the force each `[[fix]]` of
+    /// a deformable body carries at each of its particles, with the particle's gmsh node id and
+    /// reference position; default false.
+    #[serde(default)]
+    pub node_reactions: bool,
 }
 
 impl Output {
@@ -646,6 +651,7 @@ impl Default for Output {
             dir: default_out_dir(),
             vtu_every: 0.0,
             checkpoint_every: 0.0,
+            node_reactions: false,
         }
     }
 }

@@ -12,11 +12,17 @@
 //! body (which its centre holds) are left out. In a run over MPI ranks the forces are
 //! gathered from the particles' owners with the state ([`qdem_core::World::gather`]), so the
 //! file is the same for any rank count. A wall's force is `walls.csv`'s.
+//!
+//! With `[output] node_reactions = true`, `node_reactions.csv` gives the same forces per
+//! particle, as CalculiX's `*NODE PRINT … RF` does per node: a row per time, fix and particle,
+//! `time, fix, gmsh_node_id, particle, x, y, z, fx, fy, fz` (the fix's number, the node's tag
+//! in its .msh file or −1, the particle's index in the state and the VTU, its reference
+//! position, m, and the force, N); a fix's rows sum to its `reactions.csv` force.
 
 use super::schedule::{probe_interval, Schedule};
 use super::{write_rows, Recorder, StateRead, StepInfo};
 use crate::build::{BodyKind, Simulation};
-use crate::output::OutputError;
+use crate::output::{write_atomic, OutputError};
 use qdem_core::{CheckpointError, Decoder, Dofs, Encoder, State, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -40,6 +46,16 @@ pub(crate) struct Reactions {
     groups: Vec<FixGroup>,
     /// The rows, flat: the time, then six numbers per group.
     rows: Vec<f64>,
+    /// With `[output] node_reactions`: `node_reactions.csv` and its forces, flat: per time the
+    /// time, then three per particle of each group in turn.
+    nodes: Option<NodeRows>,
+}
+
+/// `node_reactions.csv`'s file, the gmsh node id of every particle, and the forces recorded.
+struct NodeRows {
+    path: PathBuf,
+    ids: Vec<i64>,
+    forces: Vec<f64>,
 }
 
 impl Reactions {
@@ -75,8 +91,71 @@ impl Reactions {
             path: out_dir.join("reactions.csv"),
             groups,
             rows: Vec::new(),
+            nodes: scene.output.node_reactions.then(|| NodeRows {
+                path: out_dir.join("node_reactions.csv"),
+                ids: sim.gmsh_node_ids(),
+                forces: Vec::new(),
+            }),
         })
     }
+
+    /// Adds the particles' forces of every group at `time` to `node_reactions.csv`'s rows.
+    fn record_nodes(&mut self, time: f64, state: &State, force: &[Vec3]) {
+        let Some(nodes) = &mut self.nodes else {
+            return;
+        };
+        nodes.forces.push(time);
+        for group in &self.groups {
+            for (&i, share) in group.particles.iter().zip(&group.shares) {
+                let r = match force.len() == state.len() {
+                    true => particle_reaction(force[i], share),
+                    false => Vec3::zeros(),
+                };
+                nodes.forces.extend(r.iter());
+            }
+        }
+    }
+
+    /// Writes `node_reactions.csv` (atomically) from the recorded rows.
+    fn write_nodes(&self, state: &State) -> Result<(), OutputError> {
+        let Some(nodes) = &self.nodes else {
+            return Ok(());
+        };
+        let per_time = 1 + 3 * self.groups.iter().map(|g| g.particles.len()).sum::<usize>();
+        if nodes.forces.is_empty() {
+            return Ok(());
+        }
+        write_atomic(&nodes.path, |w| {
+            writeln!(w, "time,fix,gmsh_node_id,particle,x,y,z,fx,fy,fz")?;
+            for row in nodes.forces.chunks_exact(per_time) {
+                let mut forces = row[1..].chunks_exact(3);
+                for group in &self.groups {
+                    for &i in &group.particles {
+                        let f = forces.next().expect("three per particle");
+                        let x = state.reference[i];
+                        writeln!(
+                            w,
+                            "{:.9e},{},{},{i},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
+                            row[0], group.number, nodes.ids[i], x.x, x.y, x.z, f[0], f[1], f[2]
+                        )?;
+                    }
+                }
+            }
+            Ok(())
+        })
+    }
+}
+
+/// The force a fix carries at one particle of total force `force`: −f in the directions it
+/// holds, times its `share` of each.
+fn particle_reaction(force: Vec3, share: &Vec3) -> Vec3 {
+    Vec3::from_fn(|k, _| {
+        if share[k] > 0.0 {
+            -force[k] * share[k]
+        } else {
+            0.0
+        }
+    })
 }
 
 /// Per particle of a state of `particles`, how many of the fixes `held` (number, particles,
@@ -141,26 +220,34 @@ impl Recorder for Reactions {
             };
             self.rows.extend(f.iter().chain(m.iter()));
         }
+        self.record_nodes(state.time, state, force);
         Ok(())
     }
 
-    fn finish(&mut self, _sim: &Simulation) -> Result<(), OutputError> {
+    fn finish(&mut self, sim: &Simulation) -> Result<(), OutputError> {
         let mut header = vec!["time".to_string()];
         for g in &self.groups {
             let k = g.number;
             header.extend(["fx", "fy", "fz", "mx", "my", "mz"].map(|c| format!("fix{k}_{c}")));
         }
-        write_rows(&self.path, &header, &self.rows)
+        write_rows(&self.path, &header, &self.rows)?;
+        self.write_nodes(&sim.world.state)
     }
 
     fn save(&self, out: &mut Encoder) {
         out.f64(self.schedule.next);
         out.f64s(&self.rows);
+        if let Some(nodes) = &self.nodes {
+            out.f64s(&nodes.forces);
+        }
     }
 
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
         self.schedule.next = input.f64("the reactions schedule")?;
         self.rows = input.f64s("the reaction rows")?;
+        if let Some(nodes) = &mut self.nodes {
+            nodes.forces = input.f64s("the node reaction rows")?;
+        }
         Ok(())
     }
 }

@@ -269,13 +269,10 @@ impl MeshIds {
     /// The ids of `sim`'s bodies, their tetrahedra in body order.
     fn of(sim: &Simulation) -> MeshIds {
         let id = |n: &u64| i64::try_from(*n).unwrap_or(-1);
-        let mut nodes = vec![-1; sim.world.state.len()];
+        let nodes = sim.gmsh_node_ids();
         let (mut tets, mut volumes) = (Vec::new(), Vec::new());
         for body in &sim.bodies {
             let file = &body.file_ids;
-            for (slot, n) in nodes[body.particles.clone()].iter_mut().zip(&file.nodes) {
-                *slot = id(n);
-            }
             let count = sim.body_tets(body).len();
             match file.tets.len() == count {
                 true => {
