@@ -125,7 +125,7 @@ fn integrator_line(sim: &Simulation) -> String {
     let name = sim.scene.run.integrator.name();
     match settings.scheme {
         Scheme::Static => format!(
-            "integrator static: load levels every {dt:.6e} s, {steps} levels to t_end = {t_end} \
+            "integrator static: load levels every {dt:.6e} s, {steps} steps to t_end = {t_end} \
              s, one solve per distinct load level"
         ),
         scheme if scheme.is_implicit() => format!(

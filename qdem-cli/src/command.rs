@@ -567,7 +567,7 @@ fn stepping_words(sim: &Simulation) -> String {
     let (dt, steps) = (sim.world.dt(), sim.steps());
     let name = sim.scene.run.integrator.name();
     match sim.world.settings().scheme {
-        Scheme::Static => format!("static with load levels every {dt:.4e} s, {steps} levels"),
+        Scheme::Static => format!("static with load levels every {dt:.4e} s, {steps} steps"),
         scheme if scheme.is_implicit() => format!("{name} with dt = {dt:.4e} s, {steps} steps"),
         _ => format!(
             "{name} with dt = {dt:.4e} s ({:.3}x the explicit stable bound), {steps} steps",
