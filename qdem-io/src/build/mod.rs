@@ -544,7 +544,7 @@ fn build_bodies(
     if let (Some((b, material)), Some(placed), Some(info)) =
         (ballast, meshes.get(scene.bodies.len()), ballast_info)
     {
-        let material = core_material(&scene.materials[material]);
+        let material = &scene.materials[material];
         bodies.push(if b.rigid {
             rigid_ballast_body(b, material.density, placed, info, state)?
         } else {
@@ -561,17 +561,18 @@ fn build_bodies(
     Ok(bodies)
 }
 
-/// The `[ballast]` stones as one [`TetBody`] of `material`, their lumped mass added to the
-/// state, with their initial velocity.
+/// The `[ballast]` stones as one [`TetBody`] of `material` in its formulation, their lumped
+/// mass added to the state, with their initial velocity.
 fn ballast_body(
     b: &crate::scene::Ballast,
-    material: Material,
+    material: &crate::scene::Material,
     placed: &PlacedMesh,
     state: &mut State,
     models: &mut Vec<Box<dyn Model>>,
 ) -> Result<BodyInfo, CoreError> {
     let tets = offset_tets(&placed.mesh, placed.particles.start);
-    let stones = TetBody::new(&b.name, &state.reference, tets, material)?;
+    let stones = TetBody::new(&b.name, &state.reference, tets, core_material(material))?
+        .with_formulation(material.formulation.core());
     stones.lump_mass(&mut state.mass);
     models.push(Box::new(stones));
     for i in placed.particles.clone() {
