@@ -2,7 +2,7 @@
 //! they are parsed, so that a bad argument is refused before any work, naming its flag. Errors
 //! from the libraries are rendered once, by `main`, through [`CliError`]'s `Display`.
 
-use crate::{check, progress};
+use crate::{check, progress, run_length};
 use clap::{Args, Parser, Subcommand};
 use qdem_bench::throughput::BenchPlan;
 use qdem_bench::{implicit, throughput, verify};
@@ -61,6 +61,9 @@ pub enum CliError {
         /// The command.
         command: &'static str,
     },
+    /// A run modelled to take more than a day, started without `--yes`.
+    #[error(transparent)]
+    TooLong(#[from] Box<run_length::TooLong>),
     /// A `qdem bench` block too large for this process's memory.
     #[error(transparent)]
     Block(#[from] throughput::BlockTooLarge),
@@ -181,6 +184,10 @@ pub struct RunArgs {
     /// slot's last step)
     #[arg(long, value_name = "N")]
     pub stop_after: Option<u64>,
+    /// Start the run even if it is modelled to take more than a day of wall time (without it,
+    /// such a run is refused, with the estimate and how to shorten it)
+    #[arg(long)]
+    pub yes: bool,
 }
 
 /// `qdem check`.
@@ -433,7 +440,7 @@ fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliErro
         Some(dir) => dir.to_path_buf(),
         None => scene.base_dir().join(&scene.output.dir).join("modes"),
     };
-    let mut sim = Simulation::build(scene)?;
+    let mut sim = progress::while_busy("building the scene", || Simulation::build(scene))?;
     for w in &sim.warnings {
         eprintln!("warning: {w}");
     }
@@ -520,7 +527,7 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
             .unwrap_or(Path::new("."))
             .join(&scene.output.dir),
     };
-    let mut sim = Simulation::build(scene)?;
+    let mut sim = progress::while_busy("building the scene", || Simulation::build(scene))?;
     let leader = ranks.as_ref().is_none_or(|r| r.rank() == 0);
     if let Some(ranks) = &ranks {
         sim.refuse_decomposition()?;
@@ -534,6 +541,10 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
         if leader {
             eprintln!("{}", decomposition_line(&figures));
         }
+    }
+    if resume.is_none() && !args.yes {
+        let ranks = ranks.as_ref().map_or(1, |r| r.size());
+        run_length::refuse_long(&sim, rayon::current_num_threads(), cores(), ranks)?;
     }
     if !leader {
         let options = RunOptions {

@@ -629,3 +629,55 @@ fn stop_after_a_step_a_resumed_checkpoint_has_passed_is_refused() {
     assert_eq!(resumed.status.code(), Some(130), "{stderr}");
     assert!(stderr.contains("(step 150)"), "{stderr}");
 }
+
+#[test]
+fn a_run_modelled_to_take_days_is_refused_without_yes() {
+    let tmp = TempDir::new("days");
+    // A contact stiffness of 10^30 N/m bounds the step at about 10^-16 s: 6.8e14 steps,
+    // which `qdem check` measures as 3.1e6 hours and `qdem run` once started.
+    let scene = variant(
+        "contact/collision.toml",
+        &[("normal_stiffness = 2e5", "normal_stiffness = 1e30")],
+        &tmp,
+    );
+    let out = tmp.path().join("out");
+    // --stop-after: a run that starts stops at once (exit 130) rather than run for years.
+    let stop_after = |yes: bool| {
+        let mut args = vec![OsStr::new("run"), scene.as_os_str(), OsStr::new("--out")];
+        args.extend([out.as_os_str(), OsStr::new("--stop-after"), OsStr::new("2")]);
+        args.extend(yes.then_some(OsStr::new("--yes")));
+        qdem(&args)
+    };
+    let message = refused(
+        &stop_after(false),
+        &[
+            "days of wall time on",
+            "more than the day a run starts without asking",
+            "fix: shorten it (a shorter t_end; a larger step",
+            "or give --yes to start it anyway",
+        ],
+    );
+    assert!(!out.exists(), "the refused run made its folder");
+    // At least 10^-7 s a step (the model's floor): at least 7.8e2 days.
+    let days: f64 = message
+        .split("at least ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|word| word.parse().ok())
+        .unwrap_or_else(|| panic!("no days in:\n{message}"));
+    let steps: f64 = message
+        .split("the run is ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|word| word.parse().ok())
+        .unwrap_or_else(|| panic!("no steps in:\n{message}"));
+    assert!(
+        days >= steps * 1e-7 / 86_400.0 * 0.999,
+        "{days} days for {steps} steps"
+    );
+    // With --yes it starts: stopped after its second step, checkpointed (exit 130).
+    let started = stop_after(true);
+    let said = String::from_utf8_lossy(&started.stderr);
+    assert_eq!(started.status.code(), Some(130), "{said}");
+    assert!(out.join("checkpoint.qdc").exists(), "{said}");
+}
