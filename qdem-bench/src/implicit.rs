@@ -32,6 +32,9 @@ pub struct ImplicitResult {
     pub step_seconds: f64,
 }
 
+/// The block sizes `qdem bench --implicit` measures by default, in tetrahedra.
+pub const DEFAULT_TETS: [usize; 3] = [16_000, 180_000, 550_000];
+
 /// Measures the implicit path on a block of about `tets` tetrahedra on `threads` threads: the
 /// stepper's first factorisation (at `initialize`, its assembly, symbolic and numeric times
 /// in [`qdem_core::FactorStats`]), then a few steps on it (the last one's triangular solve).
@@ -76,7 +79,7 @@ pub fn run_and_print(
     threads: usize,
     as_json: bool,
 ) -> Result<(), CoreError> {
-    let sizes = tets.unwrap_or_else(|| vec![16_000, 180_000, 550_000]);
+    let sizes = tets.unwrap_or_else(|| DEFAULT_TETS.to_vec());
     if !as_json {
         println!("machine: {}, {threads} threads", cpu_model());
         println!(

@@ -53,7 +53,8 @@ pub fn irregular_ring(radial: usize, around: usize, layers: usize, jitter: f64) 
         [A, 0.0, 0.0],
         [B, FRAC_PI_2, 0.01],
         [radial, around, layers],
-    );
+    )
+    .expect("a valid box");
     let (dr, dt) = ((B - A) / radial as f64, FRAC_PI_2 / around as f64);
     let mut seed: u64 = 0x2545_F491_4F6C_DD1D;
     let mut next = || {
@@ -153,7 +154,7 @@ pub const LOAD: f64 = 500.0;
 /// The mean tip deflection of the clamped bar (m, downward positive) and Timoshenko's.
 pub fn bar_tip(poisson: f64, formulation: Formulation, cells: [usize; 3]) -> (f64, f64) {
     let (length, width, height) = (1.0, 0.06, 0.10);
-    let mesh = structured_box([0.0; 3], [length, width, height], cells);
+    let mesh = structured_box([0.0; 3], [length, width, height], cells).expect("a valid box");
     let (mut state, body) = body(&mesh, poisson, formulation);
     for &n in &mesh.group("xmin").unwrap().nodes {
         state.fix(n as usize, Dofs::ALL);

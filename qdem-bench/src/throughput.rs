@@ -9,7 +9,8 @@
 use crate::vector_peak::vector_peak_flops;
 use qdem_core::continuum::tet_lanes::{LaneSet, FLOPS_ELASTIC, FLOPS_VISCOELASTIC};
 use qdem_core::{Material, Model, State, Stepper, TetBody, Vec3, Verlet};
-use qdem_mesh::{structured_box, TetMesh};
+use qdem_io::build::memory;
+use qdem_mesh::{structured_box, GridError, TetMesh};
 use serde_json::json;
 use std::time::Instant;
 
@@ -104,10 +105,73 @@ pub enum Ordering {
     Reordered,
 }
 
+/// The cells along each edge of the block of about `tets` tetrahedra (6 per cell).
+fn block_cells(tets: usize) -> usize {
+    ((tets as f64 / 6.0).cbrt().round() as usize).max(1)
+}
+
+/// Nonzeros of the Cholesky factor of the implicit block at 95,232 unknowns, and the power of
+/// the unknowns by which they grow (docs/BENCHMARKS.md: nested dissection of a 3D mesh).
+const FACTOR_NONZEROS: (f64, f64, f64) = (154_157_454.0, 95_232.0, 1.5);
+
+/// A block size `qdem bench` cannot build: too large for the memory this process may use
+/// (or for a mesh's 32-bit node ids), refused before anything is allocated.
+#[derive(Debug, thiserror::Error)]
+#[error("{message}")]
+pub struct BlockTooLarge {
+    /// The refusal: the size asked for, the memory it needs, the limit and the fix.
+    pub message: String,
+}
+
+/// Refuses a block of about `tets` tetrahedra that needs more memory than this process may
+/// use ([`qdem_io::build::memory`]: the estimate `qdem check` prints for its particles and
+/// tetrahedra, and with `implicit` 8 bytes per value of its Cholesky factor, from the growth
+/// measured in docs/BENCHMARKS.md), or more nodes than a mesh can number.
+///
+/// # Errors
+/// [`BlockTooLarge`] naming the size, the memory and the fix.
+pub fn check_block(tets: usize, implicit: bool) -> Result<(), BlockTooLarge> {
+    let n = block_cells(tets) as f64;
+    let (nodes, block_tets) = ((n + 1.0).powi(3), 6.0 * n.powi(3));
+    let what =
+        format!("--tets {tets}: a block of {block_tets:.3e} tetrahedra and {nodes:.3e} nodes");
+    let mut bytes = memory::estimate(nodes, block_tets);
+    let what = match implicit {
+        true => {
+            let (nonzeros, unknowns, power) = FACTOR_NONZEROS;
+            let factor = 8.0 * nonzeros * (3.0 * nodes / unknowns).powf(power);
+            bytes += factor;
+            format!(
+                "{what} with its Cholesky factor ({})",
+                memory::human(factor)
+            )
+        }
+        false => what,
+    };
+    let refusal = memory::refusal(&what, bytes, "give a smaller --tets");
+    if let Some(message) = refusal {
+        return Err(BlockTooLarge { message });
+    }
+    if nodes > f64::from(u32::MAX) {
+        let too_many = GridError::TooManyNodes {
+            cells: [n as usize; 3],
+            nodes: nodes as u128,
+        };
+        return Err(BlockTooLarge {
+            message: format!("--tets {tets}: {too_many}"),
+        });
+    }
+    Ok(())
+}
+
 /// A structured unit cube of about `tets` tetrahedra (6 per cell) in the given ordering.
+///
+/// # Panics
+/// For a size [`check_block`] refuses, as the allocation would.
 pub fn block_mesh(tets: usize, ordering: Ordering) -> TetMesh {
-    let n = ((tets as f64 / 6.0).cbrt().round() as usize).max(1);
-    let mut mesh = structured_box([0.0; 3], [1.0, 1.0, 1.0], [n, n, n]);
+    let n = block_cells(tets);
+    let mut mesh =
+        structured_box([0.0; 3], [1.0, 1.0, 1.0], [n, n, n]).expect("a size check_block takes");
     if ordering != Ordering::Structured {
         let mut seed = 12345u64;
         let nodes = shuffled(mesh.nodes.len(), &mut seed);

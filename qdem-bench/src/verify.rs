@@ -167,7 +167,7 @@ fn block_body(
     size: [f64; 3],
     material: Material,
 ) -> (TetBody, State, qdem_mesh::TetMesh) {
-    let mesh = structured_box([0.0; 3], size, cells);
+    let mesh = structured_box([0.0; 3], size, cells).expect("a valid box");
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let body = TetBody::new("block", &reference, mesh.tets.clone(), material).expect("valid block");
     let mut state = State::at_rest(reference);

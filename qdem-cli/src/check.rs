@@ -20,7 +20,7 @@ use std::time::Instant;
 /// ranks' figures.
 pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<(), CliError> {
     let scene = Scene::load(path)?;
-    let mut sim = Simulation::build(scene)?;
+    let mut sim = progress::while_busy("building the scene", || Simulation::build(scene))?;
     if let Some(r) = &ranks {
         sim.refuse_decomposition()?;
         sim.world

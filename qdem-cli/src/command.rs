@@ -2,7 +2,7 @@
 //! they are parsed, so that a bad argument is refused before any work, naming its flag. Errors
 //! from the libraries are rendered once, by `main`, through [`CliError`]'s `Display`.
 
-use crate::{check, progress};
+use crate::{check, progress, run_length};
 use clap::{Args, Parser, Subcommand};
 use qdem_bench::throughput::BenchPlan;
 use qdem_bench::{implicit, throughput, verify};
@@ -61,6 +61,12 @@ pub enum CliError {
         /// The command.
         command: &'static str,
     },
+    /// A run modelled to take more than a day, started without `--yes`.
+    #[error(transparent)]
+    TooLong(#[from] Box<run_length::TooLong>),
+    /// A `qdem bench` block too large for this process's memory.
+    #[error(transparent)]
+    Block(#[from] throughput::BlockTooLarge),
     /// The thread pool could not be set up.
     #[error("cannot start {threads} threads: {message}")]
     Threads {
@@ -178,6 +184,10 @@ pub struct RunArgs {
     /// slot's last step)
     #[arg(long, value_name = "N")]
     pub stop_after: Option<u64>,
+    /// Start the run even if it is modelled to take more than a day of wall time (without it,
+    /// such a run is refused, with the estimate and how to shorten it)
+    #[arg(long)]
+    pub yes: bool,
 }
 
 /// `qdem check`.
@@ -216,7 +226,7 @@ pub struct BenchArgs {
     #[arg(long, value_name = "N,..", value_delimiter = ',', value_parser = positive_whole)]
     pub tets: Option<Vec<usize>>,
     /// Thread counts, comma-separated [default: 1,2; with --implicit the last one, default 2]
-    #[arg(long, value_name = "N,..", value_delimiter = ',', value_parser = positive_whole)]
+    #[arg(long, value_name = "N,..", value_delimiter = ',', value_parser = threads_within_cores)]
     pub threads: Option<Vec<usize>>,
     /// Steps per measurement [default: about one second's worth, at least 3]
     #[arg(long, value_name = "N", value_parser = positive_whole)]
@@ -267,15 +277,52 @@ fn positive_whole(value: &str) -> Result<usize, String> {
         .ok_or_else(|| "give a positive whole number (1 or more)".to_string())
 }
 
-/// The one thread count of `run` and `check`.
+/// How many threads a core may be given: more only slow a run down (a pool of 100,000
+/// threads took over a minute to start, saying nothing), while a few more than the cores are
+/// asked for on purpose (a run on more threads than cores checks that its results do not
+/// depend on the count).
+const THREADS_PER_CORE: usize = 8;
+
+/// The cores this process may run on (1 where that cannot be told).
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// A thread count (of `run`, `check`, `modes` or `bench`): a positive whole number, at most
+/// [`THREADS_PER_CORE`] per core.
+fn threads_within_cores(value: &str) -> Result<usize, String> {
+    let threads = positive_whole(value)?;
+    let (cores, most) = (cores(), THREADS_PER_CORE * cores());
+    match threads <= most {
+        true => Ok(threads),
+        false => Err(format!(
+            "{threads} threads is more than {THREADS_PER_CORE} per core of the {cores} cores \
+             this process may use: they would only share them, slower; give at most {most} \
+             (leave --threads out for one per core)"
+        )),
+    }
+}
+
+/// The one thread count of `run`, `check` and `modes`.
 fn thread_count(value: &str) -> Result<usize, String> {
-    positive_whole(value).map_err(|e| {
+    threads_within_cores(value).map_err(|e| {
         if value.contains(',') {
             "give one positive whole number here (lists N,.. are for `qdem bench`)".to_string()
         } else {
             e
         }
     })
+}
+
+/// Says that `threads` share fewer cores (a run is then slower; its results are the same).
+fn note_shared_cores(threads: Option<usize>) {
+    let cores = cores();
+    if let Some(threads) = threads.filter(|&t| t > cores) {
+        eprintln!(
+            "note: {threads} threads on the {cores} cores this process may use: they share \
+             them (the results are the same, the run is slower)"
+        );
+    }
 }
 
 /// A finite non-negative number of seconds or hertz.
@@ -294,6 +341,7 @@ fn non_negative(value: &str) -> Result<f64, String> {
 /// per loop, which cost an explicit bonded-beam step (ten loops of a few microseconds each)
 /// about a fifth of its time.
 fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, CliError> {
+    note_shared_cores(threads);
     let count = threads.unwrap_or(0);
     rayon::ThreadPoolBuilder::new()
         .num_threads(count)
@@ -341,9 +389,17 @@ pub fn dispatch(cli: Cli, ranks: Option<Arc<dyn Communicator>>) -> Result<(), Cl
                     .as_deref()
                     .and_then(|t| t.last().copied())
                     .unwrap_or(2);
-                return Ok(implicit::run_and_print(a.tets, threads, a.json)?);
+                let sizes = a.tets.clone().unwrap_or(implicit::DEFAULT_TETS.to_vec());
+                for &tets in &sizes {
+                    throughput::check_block(tets, true)?;
+                }
+                return Ok(implicit::run_and_print(Some(sizes), threads, a.json)?);
             }
-            throughput::run_and_print(&BenchPlan::new(a.tets, a.threads, a.steps), a.json);
+            let plan = BenchPlan::new(a.tets, a.threads, a.steps);
+            for &tets in &plan.tets {
+                throughput::check_block(tets, false)?;
+            }
+            throughput::run_and_print(&plan, a.json);
             Ok(())
         }
     }
@@ -384,7 +440,7 @@ fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliErro
         Some(dir) => dir.to_path_buf(),
         None => scene.base_dir().join(&scene.output.dir).join("modes"),
     };
-    let mut sim = Simulation::build(scene)?;
+    let mut sim = progress::while_busy("building the scene", || Simulation::build(scene))?;
     for w in &sim.warnings {
         eprintln!("warning: {w}");
     }
@@ -471,7 +527,7 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
             .unwrap_or(Path::new("."))
             .join(&scene.output.dir),
     };
-    let mut sim = Simulation::build(scene)?;
+    let mut sim = progress::while_busy("building the scene", || Simulation::build(scene))?;
     let leader = ranks.as_ref().is_none_or(|r| r.rank() == 0);
     if let Some(ranks) = &ranks {
         sim.refuse_decomposition()?;
@@ -485,6 +541,10 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
         if leader {
             eprintln!("{}", decomposition_line(&figures));
         }
+    }
+    if resume.is_none() && !args.yes {
+        let ranks = ranks.as_ref().map_or(1, |r| r.size());
+        run_length::refuse_long(&sim, rayon::current_num_threads(), cores(), ranks)?;
     }
     if !leader {
         let options = RunOptions {

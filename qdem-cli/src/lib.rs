@@ -14,3 +14,4 @@ pub mod command;
 #[cfg(feature = "mpi")]
 pub mod mpi_ranks;
 pub mod progress;
+pub mod run_length;

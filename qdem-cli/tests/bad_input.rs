@@ -674,3 +674,90 @@ fn newmark_with_gamma_below_one_half_is_refused_naming_gamma() {
         ],
     );
 }
+
+#[test]
+fn bench_sizes_beyond_the_memory_are_refused_with_their_memory_before_any_work() {
+    // 10^12 tetrahedra once panicked in the mesh generator ("too many nodes", exit 101).
+    let out = qdem(&["bench", "--tets", "1000,1000000000000"]);
+    let message = assert_clean_error(
+        "qdem bench --tets 1000,1000000000000",
+        &out,
+        &[
+            "--tets 1000000000000: a block of ",
+            "nodes would need about",
+            "TiB of memory, more than",
+            "fix: give a smaller --tets",
+        ],
+    );
+    assert!(out.stdout.is_empty(), "measured before refusing: {message}");
+    let out = qdem(&["bench", "--implicit", "--tets", "50000000"]);
+    assert_clean_error(
+        "qdem bench --implicit --tets 50000000",
+        &out,
+        &["with its Cholesky factor (", "of memory, more than"],
+    );
+    // 2 x 10^8 tetrahedra under a 4 GiB address space once aborted allocating 14.4 GB
+    // (exit 134): refused against the limit (or a lower one), whatever the machine's memory.
+    let limited = Command::new("sh")
+        .args([
+            "-c",
+            "ulimit -v 4194304 && exec \"$0\" bench --tets 200000000",
+            QDEM,
+        ])
+        .env("CI", "1")
+        .output()
+        .expect("start sh");
+    assert_clean_error(
+        "qdem bench --tets 200000000 under ulimit -v 4194304",
+        &limited,
+        &["--tets 200000000: a block of ", "GiB of memory, more than"],
+    );
+}
+
+#[test]
+fn a_thread_count_far_beyond_the_cores_is_refused_at_once() {
+    let scene = good_scene();
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let most = (8 * cores).to_string();
+    // 100000 threads once spent a minute starting in silence.
+    let cases: [(&str, Vec<&OsStr>); 3] = [
+        (
+            "run",
+            vec![
+                OsStr::new("run"),
+                scene.as_os_str(),
+                OsStr::new("--threads"),
+                OsStr::new("100000"),
+            ],
+        ),
+        (
+            "check",
+            vec![
+                OsStr::new("check"),
+                scene.as_os_str(),
+                OsStr::new("--threads"),
+                OsStr::new("100000"),
+            ],
+        ),
+        (
+            "bench",
+            vec![
+                OsStr::new("bench"),
+                OsStr::new("--threads"),
+                OsStr::new("1,100000"),
+            ],
+        ),
+    ];
+    for (what, args) in cases {
+        let out = qdem(&args);
+        assert_clean_error(
+            &format!("qdem {what} --threads 100000"),
+            &out,
+            &[
+                "invalid value '100000' for '--threads",
+                "threads is more than 8 per core of the",
+                &format!("give at most {most}"),
+            ],
+        );
+    }
+}

@@ -60,23 +60,22 @@ fn last_probe(out: &Path, column: &str) -> f64 {
 }
 
 #[test]
-fn a_second_run_into_a_held_folder_is_refused_and_a_dead_holder_is_taken_over() {
+fn a_second_run_into_a_held_folder_is_refused_and_a_lock_nobody_holds_is_taken_over() {
     let tmp = TempDir::new("lock");
     let out = tmp.path().join("out");
     std::fs::create_dir_all(&out).unwrap();
     let scene = workspace().join("fixtures/contact/collision.toml");
-    // A live holder: a process that runs while the second run starts.
-    let mut holder = Command::new("sleep")
-        .arg("60")
-        .spawn()
-        .expect("start sleep");
+    // A live holder: this process, which locks the file as a run does and names itself.
     let lock = out.join(".qdem-run.lock");
-    std::fs::write(&lock, format!("{}\n", holder.id())).unwrap();
+    let held = std::fs::File::create(&lock).unwrap();
+    held.try_lock().expect("lock the file");
+    std::fs::write(&lock, format!("{}\n", std::process::id())).unwrap();
     let message = refused(
         &run(&scene, &out),
         &[
-            &format!("in use by another qdem run (pid {},", holder.id()),
-            "fix: wait for that run to end, give this one another --out",
+            &format!("in use by another qdem run (pid {},", std::process::id()),
+            "fix: wait for that run to end (or stop it: Ctrl-C or SIGTERM checkpoints it), or \
+             give this one another --out",
         ],
     );
     assert!(message.contains(&lock.display().to_string()), "{message}");
@@ -84,16 +83,110 @@ fn a_second_run_into_a_held_folder_is_refused_and_a_dead_holder_is_taken_over() 
         !out.join("probes.csv").exists(),
         "the refused run wrote into the held folder"
     );
-    // The holder is gone (killed, as by SIGKILL, and reaped): its lock is taken over.
-    holder.kill().unwrap();
-    holder.wait().unwrap();
-    let done = run(&scene, &out);
     assert!(
-        done.status.success(),
-        "{}",
-        String::from_utf8_lossy(&done.stderr)
+        lock.exists(),
+        "the refused run removed the holder's lock file"
     );
-    assert!(!lock.exists(), "the lock outlived the run");
+    // The holder ends (as one killed by SIGKILL: the kernel frees its lock) and leaves the file
+    // behind, naming a process that runs (the sleep), or nothing: the lock is taken over.
+    drop(held);
+    let mut sleep = Command::new("sleep")
+        .arg("60")
+        .spawn()
+        .expect("start sleep");
+    for stale in [format!("{}\n", sleep.id()), String::new()] {
+        std::fs::write(&lock, stale).unwrap();
+        let done = run(&scene, &out);
+        assert!(
+            done.status.success(),
+            "{}",
+            String::from_utf8_lossy(&done.stderr)
+        );
+        assert!(!lock.exists(), "the lock outlived the run");
+    }
+    sleep.kill().unwrap();
+    sleep.wait().unwrap();
+}
+
+/// Trials of two runs started at once into one folder whose lock file a run left behind:
+/// empty, holding garbage, or the pid of a process that has ended (cycled).
+const RACE_TRIALS: usize = 12;
+
+#[test]
+fn of_two_runs_started_at_once_over_any_stale_lock_one_runs_and_one_is_refused() {
+    let tmp = TempDir::new("lock-trials");
+    // Two scenes that tell their outputs apart: 11 and 21 state VTUs.
+    let longer = [
+        ("t_end = 0.05", "t_end = 0.5"),
+        ("vtu_every = 0.005", "vtu_every = 0.05"),
+    ];
+    let a = variant("contact/collision.toml", &longer, &tmp);
+    let b_dir = tmp.path().join("b");
+    std::fs::create_dir_all(&b_dir).unwrap();
+    let b_scene = std::fs::read_to_string(&a)
+        .unwrap()
+        .replace("vtu_every = 0.05", "vtu_every = 0.025");
+    let b = b_dir.join("collision.toml");
+    std::fs::write(&b, b_scene).unwrap();
+    let mut ended = Command::new("true").spawn().expect("start true");
+    let dead = ended.id();
+    ended.wait().unwrap();
+    for trial in 0..RACE_TRIALS {
+        let out = tmp.path().join(format!("out{trial}"));
+        std::fs::create_dir_all(&out).unwrap();
+        let stale = ["", "garbage\n", &format!("{dead}\n")][trial % 3].to_string();
+        std::fs::write(out.join(".qdem-run.lock"), &stale).unwrap();
+        let start = |scene: &Path| {
+            Command::new(env!("CARGO_BIN_EXE_qdem"))
+                .args([OsStr::new("run"), scene.as_os_str(), OsStr::new("--out")])
+                .arg(&out)
+                .env("CI", "1")
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .expect("start a run")
+        };
+        let (first, second) = (start(&a), start(&b));
+        let runs = [
+            first.wait_with_output().unwrap(),
+            second.wait_with_output().unwrap(),
+        ];
+        let said = |r: &Output| String::from_utf8_lossy(&r.stderr).into_owned();
+        let won: Vec<usize> = (0..2).filter(|&k| runs[k].status.success()).collect();
+        assert_eq!(
+            won.len(),
+            1,
+            "trial {trial} over {stale:?}: not exactly one run ran:\n{}\n{}",
+            said(&runs[0]),
+            said(&runs[1])
+        );
+        let loser = &runs[1 - won[0]];
+        let message = refused(loser, &["is in use by another qdem run (pid "]);
+        assert!(!message.contains("cannot"), "trial {trial}: {message}");
+        // The winner's outputs are whole and its own: every VTU it lists is there, the count
+        // its scene writes (11 for `a`, 21 for `b`), and nothing else.
+        let listed = std::fs::read_to_string(out.join("results.pvd")).unwrap();
+        let states: Vec<String> = std::fs::read_dir(out.join("vtu"))
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|name| name.starts_with("state_"))
+            .collect();
+        assert_eq!(states.len(), [11, 21][won[0]], "trial {trial}: {states:?}");
+        assert!(
+            states.iter().all(|s| listed.contains(s.as_str())),
+            "trial {trial}"
+        );
+        assert_eq!(
+            listed.matches("state_").count(),
+            states.len(),
+            "trial {trial}"
+        );
+        assert!(
+            !out.join(".qdem-run.lock").exists(),
+            "trial {trial}: the lock stayed"
+        );
+    }
 }
 
 #[test]
@@ -125,6 +218,95 @@ fn a_real_second_run_started_during_the_first_is_refused() {
         &second,
         &[&format!("in use by another qdem run (pid {},", first.id())],
     );
+}
+
+/// Three single-sphere stones above a floor, read from `SAMPLE`, written into `OUT`.
+const GRAINS: &str = r#"
+[run]
+t_end = 0.01
+gravity = [0.0, 0.0, -9.81]
+probe_every = 0.001
+
+[[material]]
+name = "granite"
+density = 2600.0
+young = 1e9
+poisson = 0.25
+
+[contact]
+law = "hertz-mindlin"
+friction = 0.6
+
+[granular]
+name = "ballast"
+material = "granite"
+sample = "SAMPLE"
+
+[[wall]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+
+[output]
+dir = "OUT"
+"#;
+
+#[test]
+fn a_run_that_would_write_over_a_file_it_reads_is_refused_naming_both() {
+    let tmp = TempDir::new("own-input");
+    let stones = "stone,x,y,z,radius\n1,0.0,0.0,0.06,0.05\n2,0.2,0.0,0.06,0.05\n";
+    let out = tmp.path().join("out");
+    std::fs::create_dir_all(out.join("vtu")).unwrap();
+    // The sample as the stones.csv a run writes, as a VTU the fresh start removes, and as
+    // the checkpoint a run writes, in the output folder given by the scene or by --out.
+    for (sample, given) in [
+        ("out/stones.csv", None),
+        ("out/vtu/state_00003.vtu", None),
+        ("elsewhere/../out/checkpoint.qdc", Some(&out)),
+    ] {
+        std::fs::create_dir_all(tmp.path().join("elsewhere")).unwrap();
+        let file = tmp.path().join(sample);
+        std::fs::write(&file, stones).unwrap();
+        let scene = tmp.path().join("grains.toml");
+        let text = GRAINS.replace("SAMPLE", sample).replace("OUT", "out");
+        std::fs::write(&scene, text).unwrap();
+        let mut args = vec![OsStr::new("run"), scene.as_os_str()];
+        if let Some(dir) = given {
+            args.extend([OsStr::new("--out"), dir.as_os_str()]);
+        }
+        let message = refused(
+            &qdem(&args),
+            &[
+                &format!("the scene reads (\"{sample}\")"),
+                "a run must not change its own input; fix: give the run another --out",
+            ],
+        );
+        let output = file.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(
+            message.contains(&format!("remove) {}", out.display())),
+            "{message}"
+        );
+        assert!(message.contains(&output), "{message}");
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), stones, "{sample}");
+        assert!(!out.join("probes.csv").exists(), "the refused run wrote");
+        std::fs::remove_file(&file).unwrap();
+    }
+    // The same sample beside the output folder: the run runs and leaves it as it was.
+    let file = tmp.path().join("stones.csv");
+    std::fs::write(&file, stones).unwrap();
+    let scene = tmp.path().join("grains.toml");
+    std::fs::write(
+        &scene,
+        GRAINS.replace("SAMPLE", "stones.csv").replace("OUT", "out"),
+    )
+    .unwrap();
+    let done = qdem(&[OsStr::new("run"), scene.as_os_str()]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), stones);
+    assert!(out.join("stones.csv").exists());
 }
 
 #[test]
@@ -446,4 +628,56 @@ fn stop_after_a_step_a_resumed_checkpoint_has_passed_is_refused() {
     let stderr = String::from_utf8_lossy(&resumed.stderr);
     assert_eq!(resumed.status.code(), Some(130), "{stderr}");
     assert!(stderr.contains("(step 150)"), "{stderr}");
+}
+
+#[test]
+fn a_run_modelled_to_take_days_is_refused_without_yes() {
+    let tmp = TempDir::new("days");
+    // A contact stiffness of 10^30 N/m bounds the step at about 10^-16 s: 6.8e14 steps,
+    // which `qdem check` measures as 3.1e6 hours and `qdem run` once started.
+    let scene = variant(
+        "contact/collision.toml",
+        &[("normal_stiffness = 2e5", "normal_stiffness = 1e30")],
+        &tmp,
+    );
+    let out = tmp.path().join("out");
+    // --stop-after: a run that starts stops at once (exit 130) rather than run for years.
+    let stop_after = |yes: bool| {
+        let mut args = vec![OsStr::new("run"), scene.as_os_str(), OsStr::new("--out")];
+        args.extend([out.as_os_str(), OsStr::new("--stop-after"), OsStr::new("2")]);
+        args.extend(yes.then_some(OsStr::new("--yes")));
+        qdem(&args)
+    };
+    let message = refused(
+        &stop_after(false),
+        &[
+            "days of wall time on",
+            "more than the day a run starts without asking",
+            "fix: shorten it (a shorter t_end; a larger step",
+            "or give --yes to start it anyway",
+        ],
+    );
+    assert!(!out.exists(), "the refused run made its folder");
+    // At least 10^-7 s a step (the model's floor): at least 7.8e2 days.
+    let days: f64 = message
+        .split("at least ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|word| word.parse().ok())
+        .unwrap_or_else(|| panic!("no days in:\n{message}"));
+    let steps: f64 = message
+        .split("the run is ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|word| word.parse().ok())
+        .unwrap_or_else(|| panic!("no steps in:\n{message}"));
+    assert!(
+        days >= steps * 1e-7 / 86_400.0 * 0.999,
+        "{days} days for {steps} steps"
+    );
+    // With --yes it starts: stopped after its second step, checkpointed (exit 130).
+    let started = stop_after(true);
+    let said = String::from_utf8_lossy(&started.stderr);
+    assert_eq!(started.status.code(), Some(130), "{said}");
+    assert!(out.join("checkpoint.qdc").exists(), "{said}");
 }

@@ -39,7 +39,7 @@ fn centre_velocity(state: &State, range: std::ops::Range<usize>) -> Vec3 {
 fn main() -> ExitCode {
     // Two copies of one 3 × 3 × 3-cell cube, the second shifted along x so that their
     // spheres are 0.1 mm apart, and sideways so that the impact is off-centre.
-    let mesh = structured_box([0.0; 3], [EDGE; 3], [3, 3, 3]);
+    let mesh = structured_box([0.0; 3], [EDGE; 3], [3, 3, 3]).unwrap();
     let n = mesh.nodes.len();
     let offset = Vec3::new(EDGE + 2.0 * RADIUS + 1e-4, 0.3 * EDGE, 0.1 * EDGE);
     let reference: Vec<Vec3> = mesh

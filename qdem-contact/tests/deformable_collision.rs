@@ -16,7 +16,7 @@ const RADIUS: f64 = 0.008;
 /// Runs the collision; returns (momentum drift / |p₀|, energy drift / E₀ maximum over the run,
 /// largest contact count seen).
 fn collide(friction: f64) -> (f64, f64, usize) {
-    let mesh = structured_box([0.0; 3], [EDGE; 3], [3, 3, 3]);
+    let mesh = structured_box([0.0; 3], [EDGE; 3], [3, 3, 3]).unwrap();
     let surface = mesh.surface_nodes();
     let n = mesh.nodes.len();
     let offset = Vec3::new(EDGE + 2.0 * RADIUS + 1e-4, 0.3 * EDGE, 0.1 * EDGE);

@@ -320,7 +320,7 @@ fn diverges(models: &mut [Box<dyn Model>], state: &mut State, dt: f64, steps: us
 /// nonlinear allowance, the shadow energy within the allowance, and its drift too.
 #[test]
 fn near_incompressible_nu_049_step_follows_c_p_and_energy_is_bounded() {
-    let cube = structured_box([0.0; 3], [1.0; 3], [1, 1, 1]);
+    let cube = structured_box([0.0; 3], [1.0; 3], [1, 1, 1]).unwrap();
     let reference: Vec<Vec3> = cube.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let refused = TetBody::new("b", &reference, cube.tets, Material::elastic(1.0, 1.0, 0.5));
     let message = refused.unwrap_err().to_string();
@@ -332,7 +332,7 @@ fn near_incompressible_nu_049_step_follows_c_p_and_energy_is_bounded() {
 
     let (edge, cells) = (0.1, 3);
     let a = edge / cells as f64;
-    let mesh = structured_box([0.0; 3], [edge; 3], [cells; 3]);
+    let mesh = structured_box([0.0; 3], [edge; 3], [cells; 3]).unwrap();
     let material = Material::elastic(1000.0, 1e7, 0.49);
     let lame = material.elastic_lame();
     let c_p = ((lame.lambda + 2.0 * lame.mu) / material.density).sqrt();
@@ -389,7 +389,7 @@ fn near_incompressible_nu_049_step_follows_c_p_and_energy_is_bounded() {
 #[test]
 fn sliver_tetrahedra_shrink_the_step_and_run_stably() {
     let edge = 0.1;
-    let good = structured_box([0.0; 3], [edge; 3], [2, 2, 2]);
+    let good = structured_box([0.0; 3], [edge; 3], [2, 2, 2]).unwrap();
     let centre = 13;
     assert_eq!(good.nodes[centre], [0.5 * edge; 3]);
     let tet = good.tets[7];
@@ -505,7 +505,7 @@ impl CloneBoxed for Vec<Box<dyn Model>> {
 fn high_spin_rigid_motion_has_round_off_forces_and_conserves_angular_momentum() {
     let edge = 0.01;
     let a = 0.5 * edge;
-    let mesh = structured_box([-0.5 * edge; 3], [0.5 * edge; 3], [2, 2, 2]);
+    let mesh = structured_box([-0.5 * edge; 3], [0.5 * edge; 3], [2, 2, 2]).unwrap();
     let mut material = Material::elastic(1000.0, 1e7, 0.3);
     material.shear_viscosity = 10.0;
     material.bulk_viscosity = 20.0;
@@ -597,7 +597,7 @@ fn high_spin_rigid_motion_has_round_off_forces_and_conserves_angular_momentum() 
 fn very_high_viscosity_shrinks_the_step_and_the_energy_decays_monotonically() {
     let (edge, cells) = (0.1, 2);
     let a = edge / cells as f64;
-    let mesh = structured_box([0.0; 3], [edge; 3], [cells; 3]);
+    let mesh = structured_box([0.0; 3], [edge; 3], [cells; 3]).unwrap();
     let elastic = Material::elastic(1000.0, 1e7, 0.3);
     let lame = elastic.elastic_lame();
     let omega_squared = kuhn_rate(a, elastic.density, lame);
@@ -732,7 +732,8 @@ fn very_stiff_contact_on_a_soft_body_sets_the_step_and_keeps_the_energy() {
         [-0.5 * edge, -0.5 * edge, bottom],
         [0.5 * edge, 0.5 * edge, bottom + edge],
         [cells; 3],
-    );
+    )
+    .unwrap();
     let material = Material::elastic(1000.0, 1e6, 0.3);
     let lame = material.elastic_lame();
     let (mut models, mut state) = body(&mesh, material.clone());
@@ -859,7 +860,7 @@ fn very_stiff_contact_on_a_soft_body_sets_the_step_and_keeps_the_energy() {
 #[test]
 fn million_undamped_steps_keep_the_energy_bounded() {
     let edge = 0.01;
-    let mesh = structured_box([0.0; 3], [edge; 3], [1, 1, 1]);
+    let mesh = structured_box([0.0; 3], [edge; 3], [1, 1, 1]).unwrap();
     let material = Material::elastic(1000.0, 1e7, 0.3);
     let lame = material.elastic_lame();
     let (mut models, mut state) = body(&mesh, material);

@@ -29,7 +29,7 @@ fn main() {
         .num_threads(threads)
         .build_global()
         .unwrap();
-    let mesh = structured_box([0.0; 3], [1.0, 0.06, 0.1], [cells, 6, 10]);
+    let mesh = structured_box([0.0; 3], [1.0, 0.06, 0.1], [cells, 6, 10]).unwrap();
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let tets = mesh.tets.len();
     for viscous in [false, true] {

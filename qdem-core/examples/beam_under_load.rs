@@ -24,7 +24,7 @@ const LOAD: f64 = 200.0;
 /// The clamped concrete beam with its tip load scaled by `ramp`: the state (masses lumped,
 /// the x = 0 face fixed), the models and the tip particles.
 fn beam(ramp: TimeFunction) -> (State, Vec<Box<dyn Model>>, Vec<u32>) {
-    let mesh = structured_box([0.0; 3], [LENGTH, WIDTH, HEIGHT], [12, 3, 2]);
+    let mesh = structured_box([0.0; 3], [LENGTH, WIDTH, HEIGHT], [12, 3, 2]).unwrap();
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let material = Material::elastic(2350.0, 45e9, 0.167);
     let body = TetBody::new("beam", &reference, mesh.tets.clone(), material).expect("valid mesh");

@@ -25,7 +25,7 @@ fn body(mesh: &TetMesh, poisson: f64, formulation: Formulation) -> (State, TetBo
 /// and a homogeneous deformation gives the standard kernel's forces.
 #[test]
 fn forces_match_the_tangent_and_the_standard_kernel_under_homogeneous_strain() {
-    let mesh = structured_box([0.0; 3], [1.0, 0.7, 0.5], [3, 3, 2]);
+    let mesh = structured_box([0.0; 3], [1.0, 0.7, 0.5], [3, 3, 2]).unwrap();
     let (mut state, averaged) = body(&mesh, 0.49, Formulation::AveragedPressure);
     let (_, standard) = body(&mesh, 0.49, Formulation::Standard);
     let forces = |model: &mut TetBody, state: &State| {
@@ -85,7 +85,7 @@ fn explicit_steps_are_bit_identical_for_any_thread_count() {
             .build()
             .unwrap();
         pool.install(|| {
-            let mesh = structured_box([0.0; 3], [1.0, 0.06, 0.1], [60, 4, 6]);
+            let mesh = structured_box([0.0; 3], [1.0, 0.06, 0.1], [60, 4, 6]).unwrap();
             let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
             let material = Material {
                 shear_viscosity: 50.0,
@@ -136,7 +136,7 @@ fn a_decomposed_run_refuses_the_averaged_pressure_body_by_name() {
     use qdem_core::thread_ranks::on_thread_ranks;
     use qdem_core::{Scheme, StepRequest, StepSettings, World};
     let errors = on_thread_ranks(2, |comm| {
-        let mesh = structured_box([0.0; 3], [1.0, 0.06, 0.1], [20, 2, 3]);
+        let mesh = structured_box([0.0; 3], [1.0, 0.06, 0.1], [20, 2, 3]).unwrap();
         let (state, body) = body(&mesh, 0.4999, Formulation::AveragedPressure);
         let models: Vec<Box<dyn Model>> = vec![Box::new(body)];
         let request = StepRequest {
@@ -171,7 +171,7 @@ fn a_decomposed_run_refuses_the_averaged_pressure_body_by_name() {
 /// own volumetric strains differ from their corners' averages.
 #[test]
 fn reported_stress_gives_the_bodys_own_forces() {
-    let mesh = structured_box([0.0; 3], [1.0, 0.7, 0.5], [4, 3, 3]);
+    let mesh = structured_box([0.0; 3], [1.0, 0.7, 0.5], [4, 3, 3]).unwrap();
     let (mut state, body) = body(&mesh, 0.499, Formulation::AveragedPressure);
     let u: Vec<Vec3> = (0..state.len())
         .map(|i| {

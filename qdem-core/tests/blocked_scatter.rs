@@ -8,7 +8,7 @@ use qdem_core::{Material, Model, State, TetBody, Vec3};
 use qdem_mesh::structured_box;
 
 fn check(viscous: bool) {
-    let mesh = structured_box([0.0; 3], [1.0, 0.6, 0.4], [20, 12, 8]);
+    let mesh = structured_box([0.0; 3], [1.0, 0.6, 0.4], [20, 12, 8]).unwrap();
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let mut material = Material::elastic(2350.0, 45e9, 0.167);
     if viscous {

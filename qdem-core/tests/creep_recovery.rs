@@ -80,7 +80,7 @@ const PRESSURE: f64 = 50.0;
 /// The bar: state (masses lumped, x and y fixed everywhere, z fixed at the bottom), the body and
 /// the consistent top loads scaled by `factor`, and the top particles.
 fn bar(factor: TimeFunction) -> (State, Vec<Box<dyn Model>>, Vec<u32>) {
-    let mesh = structured_box([0.0; 3], [SIDE, SIDE, LENGTH], [3, 3, 6]);
+    let mesh = structured_box([0.0; 3], [SIDE, SIDE, LENGTH], [3, 3, 6]).unwrap();
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let material = Material {
         density: DENSITY,

@@ -7,7 +7,7 @@ use qdem_core::{Dofs, Material, Model, State, TetBody, Vec3};
 use qdem_mesh::structured_box;
 
 fn setup() -> (Vec<Vec3>, Vec<[u32; 4]>, Material) {
-    let mesh = structured_box([0.0; 3], [1.2, 0.2, 0.15], [12, 3, 2]);
+    let mesh = structured_box([0.0; 3], [1.2, 0.2, 0.15], [12, 3, 2]).unwrap();
     let reference = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     (reference, mesh.tets, Material::elastic(2350.0, 45e9, 0.167))
 }

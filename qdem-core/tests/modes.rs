@@ -13,7 +13,7 @@ const RHO: f64 = 2350.0;
 
 /// A prism [0, l] × [0, b] × [0, h] of `cells`, clamped at x = 0 if `clamped`.
 fn prism(l: f64, b: f64, h: f64, cells: [usize; 3], clamped: bool) -> (State, Vec<Box<dyn Model>>) {
-    let mesh = structured_box([0.0; 3], [l, b, h], cells);
+    let mesh = structured_box([0.0; 3], [l, b, h], cells).unwrap();
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let body = TetBody::new(
         "prism",

@@ -15,7 +15,7 @@ const LOAD: f64 = 200.0;
 /// A clamped 2.4 × 0.25 × 0.22 m concrete beam (24×3×3 cells) with its tip load ramped by
 /// `ramp`, as a state, the models and the tip particles.
 fn beam(ramp: TimeFunction) -> (State, Vec<Box<dyn Model>>, Vec<u32>) {
-    let mesh = structured_box([0.0; 3], [LENGTH, 0.25, 0.22], [24, 3, 3]);
+    let mesh = structured_box([0.0; 3], [LENGTH, 0.25, 0.22], [24, 3, 3]).unwrap();
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let material = Material::elastic(2350.0, 45e9, 0.167);
     let body = TetBody::new("beam", &reference, mesh.tets, material).unwrap();
@@ -87,7 +87,9 @@ fn static_solve_equals_the_linear_tet_oracle() {
     let (deflection, solver) = static_deflection();
     let (state, _, tip) = beam(TimeFunction::constant(1.0));
     let material = Material::elastic(2350.0, 45e9, 0.167);
-    let tets = structured_box([0.0; 3], [LENGTH, 0.25, 0.22], [24, 3, 3]).tets;
+    let tets = structured_box([0.0; 3], [LENGTH, 0.25, 0.22], [24, 3, 3])
+        .unwrap()
+        .tets;
     let oracle = LinearTets::new(&state.reference, &tets, material.elastic_lame());
     let mut f = vec![Vec3::zeros(); state.len()];
     for &i in &tip {

@@ -26,7 +26,7 @@ fn material(r: f64) -> Material {
 /// in y: the tetrahedra of a structured mesh couple vertical and lateral bending, whose
 /// frequencies are close for this section, and the beating would hide the decay of one mode.
 fn beam(r: f64) -> (State, TetBody, Vec<u32>) {
-    let mesh = structured_box([0.0; 3], [LENGTH, 0.25, 0.22], CELLS);
+    let mesh = structured_box([0.0; 3], [LENGTH, 0.25, 0.22], CELLS).unwrap();
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let body = TetBody::new("beam", &reference, mesh.tets, material(r)).unwrap();
     let mut state = State::at_rest(reference);

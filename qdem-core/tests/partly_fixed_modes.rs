@@ -11,7 +11,7 @@ use std::f64::consts::PI;
 
 /// The plate of `cells` in steel, its bottom edges held in z.
 fn plate(cells: [usize; 3]) -> (State, TetBody) {
-    let mesh = structured_box([0.0; 3], [10.0, 10.0, 1.0], cells);
+    let mesh = structured_box([0.0; 3], [10.0, 10.0, 1.0], cells).unwrap();
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let body = TetBody::new(
         "plate",

@@ -8,7 +8,7 @@ use qdem_mesh::structured_box;
 const YOUNG: f64 = 45e9;
 
 fn block() -> (Vec<Vec3>, Vec<[u32; 4]>) {
-    let mesh = structured_box([0.0; 3], [1.0, 0.6, 0.4], [4, 3, 2]);
+    let mesh = structured_box([0.0; 3], [1.0, 0.6, 0.4], [4, 3, 2]).unwrap();
     (
         mesh.nodes.iter().map(|p| Vec3::from(*p)).collect(),
         mesh.tets,
@@ -112,7 +112,7 @@ fn uniform_strain_reproduces_hooke_and_balances_interior_particles() {
     // Under a uniform stress the forces on interior faces cancel, so every particle receives
     // −T·a/3 from each boundary triangle a it belongs to (outward, current area vector: the
     // internal force that balances an external traction T·n), and interior particles nothing.
-    let mesh = structured_box([0.0; 3], [1.0, 0.6, 0.4], [4, 3, 2]);
+    let mesh = structured_box([0.0; 3], [1.0, 0.6, 0.4], [4, 3, 2]).unwrap();
     let mut body = TetBody::new("block", &reference, tets, material).unwrap();
     let mut state = State::at_rest(reference.clone());
     state.position = x.clone();

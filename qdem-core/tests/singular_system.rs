@@ -13,7 +13,7 @@ const FORCE: [f64; 3] = [0.0, 0.0, -500.0];
 
 /// A free 1 × 0.4 × 0.3 m block named "block" with a constant total load on its x = 1 face.
 fn block() -> (State, Vec<Box<dyn Model>>) {
-    let mesh = structured_box([0.0; 3], [1.0, 0.4, 0.3], [5, 2, 2]);
+    let mesh = structured_box([0.0; 3], [1.0, 0.4, 0.3], [5, 2, 2]).unwrap();
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let body = TetBody::new(
         "block",

@@ -7,7 +7,7 @@ use qdem_core::{choose_step, CoreError, Material, Model, State, Stepper, TetBody
 use qdem_mesh::structured_box;
 
 fn body_and_state(material: Material) -> (Vec<Box<dyn Model>>, State) {
-    let mesh = structured_box([0.0; 3], [0.4, 0.3, 0.2], [4, 3, 2]);
+    let mesh = structured_box([0.0; 3], [0.4, 0.3, 0.2], [4, 3, 2]).unwrap();
     let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
     let body = TetBody::new("block", &reference, mesh.tets, material).unwrap();
     let mut state = State::at_rest(reference);

@@ -13,7 +13,7 @@ use qdem_mesh::structured_box;
 
 /// A viscoelastic cantilever under gravity and a ramped tip load.
 fn cantilever() -> (State, Vec<Box<dyn Model>>) {
-    let mesh = structured_box([0.0; 3], [1.2, 0.2, 0.2], [12, 2, 2]);
+    let mesh = structured_box([0.0; 3], [1.2, 0.2, 0.2], [12, 2, 2]).unwrap();
     let material = Material {
         density: 2350.0,
         young: 30e9,

@@ -136,7 +136,7 @@ mod tests {
 
     #[test]
     fn a_mesh_without_duplicates_has_no_coincident_nodes() {
-        let mesh = structured_box([0.0; 3], [1.0, 0.5, 0.5], [4, 2, 2]);
+        let mesh = structured_box([0.0; 3], [1.0, 0.5, 0.5], [4, 2, 2]).unwrap();
         assert_eq!(mesh.coincident_nodes(), None);
         let mut merged = mesh.clone();
         assert_eq!(merged.merge_coincident_nodes(), 0);
@@ -145,7 +145,7 @@ mod tests {
 
     #[test]
     fn two_boxes_side_by_side_share_their_face_once_merged() {
-        let left = structured_box([0.0; 3], [1.0, 1.0, 1.0], [1, 1, 1]);
+        let left = structured_box([0.0; 3], [1.0, 1.0, 1.0], [1, 1, 1]).unwrap();
         let mut mesh = left.clone();
         let offset = mesh.nodes.len() as u32;
         mesh.nodes

@@ -14,6 +14,37 @@ const KUHN: [([usize; 3], bool); 6] = [
     ([1, 0, 2], false),
 ];
 
+/// Why [`structured_box`] cannot build a box.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum GridError {
+    /// A cell count is zero.
+    #[error("a structured box needs at least one cell along every axis, got {cells:?}")]
+    NoCells {
+        /// The cell counts asked for.
+        cells: [usize; 3],
+    },
+    /// `min[d] >= max[d]` (or a bound that is not a number) on some axis.
+    #[error("a structured box needs min < max along every axis, got min {min:?}, max {max:?}")]
+    Empty {
+        /// The lower corner.
+        min: [f64; 3],
+        /// The upper corner.
+        max: [f64; 3],
+    },
+    /// More nodes than a mesh's `u32` node ids can number.
+    #[error(
+        "a structured box of {cells:?} cells has {nodes} nodes, more than the {} a mesh can \
+         number (32-bit node ids); fix: fewer cells",
+        u32::MAX
+    )]
+    TooManyNodes {
+        /// The cell counts asked for.
+        cells: [usize; 3],
+        /// Its node count `(nx + 1)(ny + 1)(nz + 1)` (at most `u128::MAX`).
+        nodes: u128,
+    },
+}
+
 /// A box `[min, max]` of `cells[0] × cells[1] × cells[2]` hexahedral cells, each split into 6
 /// tetrahedra (Kuhn/Freudenthal, the same split in every cell, so the mesh is conforming).
 ///
@@ -22,30 +53,35 @@ const KUHN: [([usize; 3], bool); 6] = [
 /// `"zmax"` (tags 1 to 6). Coordinates on the faces are exactly `min` and `max`. Every
 /// tetrahedron is positively oriented. No file numbers it: its [`FileIds`] are empty.
 ///
-/// # Panics
-/// If a cell count is zero, or `min[d] >= max[d]` on some axis, or the node count does not
-/// fit in `u32`.
+/// # Errors
+/// [`GridError`] if a cell count is zero, or `min[d] >= max[d]` on some axis, or the node
+/// count does not fit in `u32` (checked before anything is allocated).
 ///
 /// ```
-/// let m = qdem_mesh::structured_box([0.0; 3], [1.0, 2.0, 3.0], [2, 2, 2]);
+/// let m = qdem_mesh::structured_box([0.0; 3], [1.0, 2.0, 3.0], [2, 2, 2])?;
 /// assert_eq!(m.tets.len(), 6 * 8);
 /// assert!((m.volume() - 6.0).abs() < 1e-12);
+/// # Ok::<(), qdem_mesh::GridError>(())
 /// ```
-pub fn structured_box(min: [f64; 3], max: [f64; 3], cells: [usize; 3]) -> TetMesh {
-    assert!(
-        cells.iter().all(|&c| c > 0),
-        "structured_box: every cell count must be positive"
-    );
-    assert!(
-        (0..3).all(|d| min[d] < max[d]),
-        "structured_box: need min < max on every axis"
-    );
+pub fn structured_box(
+    min: [f64; 3],
+    max: [f64; 3],
+    cells: [usize; 3],
+) -> Result<TetMesh, GridError> {
+    if cells.contains(&0) {
+        return Err(GridError::NoCells { cells });
+    }
+    if !(0..3).all(|d| min[d] < max[d]) {
+        return Err(GridError::Empty { min, max });
+    }
+    let nodes = cells
+        .iter()
+        .fold(1u128, |n, &c| n.saturating_mul(c as u128 + 1));
+    if nodes > u32::MAX as u128 {
+        return Err(GridError::TooManyNodes { cells, nodes });
+    }
     let [nx, ny, nz] = cells;
-    let total = (nx + 1) * (ny + 1) * (nz + 1);
-    assert!(
-        u32::try_from(total).is_ok(),
-        "structured_box: too many nodes"
-    );
+    let total = nodes as usize;
     let coord = |d: usize, i: usize| {
         if i == cells[d] {
             max[d]
@@ -106,10 +142,10 @@ pub fn structured_box(min: [f64; 3], max: [f64; 3], cells: [usize; 3]) -> TetMes
             }
         })
         .collect();
-    TetMesh {
+    Ok(TetMesh {
         nodes,
         tets,
         groups,
         file_ids: FileIds::default(),
-    }
+    })
 }

@@ -64,7 +64,7 @@ use std::path::Path;
 pub use coincident::{CoincidentNodes, COINCIDENT_TOL};
 pub use element_types::element_info;
 pub use error::{Location, MeshError, MeshWarning};
-pub use generate::structured_box;
+pub use generate::{structured_box, GridError};
 pub use msh::{parse_msh, read_msh};
 pub use quality::{max_edge, radius_ratio, signed_volume6, MeshStats, TET_EDGES};
 pub use reorder::NodeGraph;

@@ -1,6 +1,6 @@
 //! `structured_box`, surface extraction, reordering and statistics.
 
-use qdem_mesh::{structured_box, TetMesh};
+use qdem_mesh::{structured_box, GridError, TetMesh};
 
 fn tri_area_vector(m: &TetMesh, t: &[u32; 3]) -> [f64; 3] {
     let [a, b, c] = t.map(|k| m.nodes[k as usize]);
@@ -17,7 +17,7 @@ fn tri_area_vector(m: &TetMesh, t: &[u32; 3]) -> [f64; 3] {
 fn box_counts_volume_orientation_and_surface() {
     let (min, max) = ([0.1, -0.2, 0.3], [0.4, 0.3, 0.5]);
     for cells in [[1, 1, 1], [3, 2, 4], [5, 1, 2]] {
-        let m = structured_box(min, max, cells);
+        let m = structured_box(min, max, cells).unwrap();
         let [nx, ny, nz] = cells;
         let (lx, ly, lz) = (max[0] - min[0], max[1] - min[1], max[2] - min[2]);
         assert_eq!(m.tets.len(), 6 * nx * ny * nz);
@@ -71,7 +71,7 @@ fn box_counts_volume_orientation_and_surface() {
 #[test]
 fn kuhn_split_is_conforming() {
     // Every interior face is shared by exactly two tetrahedra: the surface is only the box's.
-    let m = structured_box([0.0; 3], [1.0; 3], [3, 3, 3]);
+    let m = structured_box([0.0; 3], [1.0; 3], [3, 3, 3]).unwrap();
     assert_eq!(m.surface_triangles().len(), 2 * 2 * 27);
 }
 
@@ -92,7 +92,7 @@ fn shuffle(m: &mut TetMesh, seed: u64) {
 
 #[test]
 fn reorder_keeps_geometry_and_reduces_bandwidth() {
-    let mut m = structured_box([0.0; 3], [2.0, 1.0, 0.5], [12, 6, 3]);
+    let mut m = structured_box([0.0; 3], [2.0, 1.0, 0.5], [12, 6, 3]).unwrap();
     shuffle(&mut m, 7);
     let before = m.clone();
     let bw0 = m.bandwidth();
@@ -142,7 +142,7 @@ fn reorder_keeps_geometry_and_reduces_bandwidth() {
 
 #[test]
 fn stats_on_a_regular_mesh() {
-    let m = structured_box([0.0; 3], [1.0; 3], [4, 4, 4]);
+    let m = structured_box([0.0; 3], [1.0; 3], [4, 4, 4]).unwrap();
     let s = m.stats();
     assert_eq!(s.nodes, 125);
     assert_eq!(s.tets, 384);
@@ -160,4 +160,36 @@ fn stats_on_a_regular_mesh() {
         (empty.tets, empty.min_edge, empty.worst_quality),
         (0, 0.0, 0.0)
     );
+}
+
+#[test]
+fn a_box_that_cannot_be_built_is_a_typed_error_not_a_panic() {
+    // 10^12 tetrahedra (`qdem bench --tets 1000000000000`) once panicked "too many nodes".
+    let n = 5503;
+    assert_eq!(
+        structured_box([0.0; 3], [1.0; 3], [n; 3]).unwrap_err(),
+        GridError::TooManyNodes {
+            cells: [n; 3],
+            nodes: (n as u128 + 1).pow(3)
+        }
+    );
+    // Counts whose node count overflows 64 bits are counted exactly, not wrapped.
+    let huge = [usize::MAX; 3];
+    assert!(matches!(
+        structured_box([0.0; 3], [1.0; 3], huge),
+        Err(GridError::TooManyNodes { .. })
+    ));
+    // Just over: 1626^3 = 4,298,942,376 nodes against 2^32 - 1 ids.
+    assert!(matches!(
+        structured_box([0.0; 3], [1.0; 3], [1625; 3]),
+        Err(GridError::TooManyNodes { .. })
+    ));
+    assert_eq!(
+        structured_box([0.0; 3], [1.0; 3], [2, 0, 2]).unwrap_err(),
+        GridError::NoCells { cells: [2, 0, 2] }
+    );
+    let flat = structured_box([0.0; 3], [1.0, 0.0, 1.0], [1; 3]).unwrap_err();
+    assert!(flat.to_string().contains("min < max"), "{flat}");
+    let nan = structured_box([0.0; 3], [1.0, f64::NAN, 1.0], [1; 3]);
+    assert!(matches!(nan, Err(GridError::Empty { .. })));
 }

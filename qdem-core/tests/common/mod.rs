@@ -34,7 +34,7 @@ pub fn clamped_beam(
 /// tetrahedra, large enough that rayon splits the tetrahedron and particle loops and that its
 /// 16 blocks fall on several ranks), clamped, under a tip load of (0, 100, −200) kN.
 pub fn viscoelastic_beam() -> (State, Vec<Box<dyn Model>>) {
-    let mesh = structured_box([0.0; 3], [2.4, 0.25, 0.22], [60, 6, 6]);
+    let mesh = structured_box([0.0; 3], [2.4, 0.25, 0.22], [60, 6, 6]).unwrap();
     let material = Material {
         density: 2350.0,
         young: 45e9,

@@ -9,8 +9,10 @@
 //! about 110 bytes each), rounded up to [`BYTES_PER_PARTICLE`]; and per tetrahedron its
 //! nodes, reference shape and stress scratch ([`BYTES_PER_TET`]). It is an order of
 //! magnitude, which is what the refusal needs: the counts it stops are thousands of times
-//! over the limit. The limit is the machine's memory (`MemTotal` of `/proc/meminfo`); where
-//! that cannot be read only a count whose bytes do not fit in the address space is refused.
+//! over the limit. The limit is the memory this process may use ([`memory_limit`]): the
+//! machine's (`MemTotal` of `/proc/meminfo`), or less where its control group
+//! (`memory.max`) or its address-space limit (`ulimit -v`) allows less; where none of them
+//! can be read only a count whose bytes do not fit in the address space is refused.
 
 use super::BuildError;
 use std::path::Path;
@@ -54,29 +56,85 @@ pub fn human(bytes: f64) -> String {
     }
 }
 
+/// The memory this process may use, in bytes, and what sets it (see the module docs): the
+/// least of the machine's memory, its control group's `memory.max` and its address-space
+/// limit; the address space where none can be read.
+#[must_use]
+pub fn memory_limit() -> (f64, String) {
+    let mut limits: Vec<(f64, String)> = Vec::new();
+    if let Some(bytes) = machine_memory() {
+        limits.push((bytes, format!("this machine's {}", human(bytes))));
+    }
+    if let Some(bytes) = cgroup_limit() {
+        limits.push((
+            bytes,
+            format!("the {} its control group allows", human(bytes)),
+        ));
+    }
+    if let Some(bytes) = address_space_limit() {
+        limits.push((
+            bytes,
+            format!("the {} address space allowed (ulimit -v)", human(bytes)),
+        ));
+    }
+    limits
+        .into_iter()
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .unwrap_or_else(|| (isize::MAX as f64, "the address space".to_string()))
+}
+
+/// The memory limit of this process's control group (cgroup v2 `memory.max`), `None` where
+/// there is none or it cannot be read.
+fn cgroup_limit() -> Option<f64> {
+    let groups = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    let path = groups.lines().find_map(|l| l.strip_prefix("0::"))?;
+    let file = Path::new("/sys/fs/cgroup")
+        .join(path.trim_start_matches('/'))
+        .join("memory.max");
+    std::fs::read_to_string(file).ok()?.trim().parse().ok()
+}
+
+/// The address-space limit of this process (`Max address space` of `/proc/self/limits`,
+/// `ulimit -v`), `None` where it is unlimited or cannot be read.
+fn address_space_limit() -> Option<f64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = limits
+        .lines()
+        .find(|l| l.starts_with("Max address space"))?;
+    line.split_whitespace().nth(3)?.parse().ok()
+}
+
+/// Why `what`, which needs `bytes`, cannot be held, when that is more than the memory this
+/// process may use ([`memory_limit`]) or than the address space; `fix`: what to change.
+#[must_use]
+pub fn refusal(what: &str, bytes: f64, fix: &str) -> Option<String> {
+    let (limit, which) = memory_limit();
+    if bytes.is_finite() && bytes <= limit {
+        return None;
+    }
+    Some(format!(
+        "{what} would need about {} of memory, more than {which}; fix: {fix}",
+        human(bytes)
+    ))
+}
+
 /// Refuses `what` (e.g. "`[granular]` count = 1000000000000 stones of up to 4 spheres")
-/// when its `particles` and `tets` need more memory than the machine has, or more than the
-/// address space can hold; `fix` says what to change.
+/// when its `particles` and `tets` need more memory than this process may use ([`refusal`]);
+/// `fix` says what to change.
 pub(crate) fn check(
     scene: &Path,
     what: String,
     (particles, tets): (f64, f64),
     fix: &'static str,
 ) -> Result<(), BuildError> {
-    let bytes = estimate(particles, tets);
-    let limit = machine_memory().unwrap_or(isize::MAX as f64);
-    if bytes.is_finite() && bytes <= limit {
-        return Ok(());
+    let what = format!("{what}: {particles:.3e} particles");
+    match refusal(&what, estimate(particles, tets), fix) {
+        None => Ok(()),
+        Some(message) => Err(BuildError::Memory {
+            scene: scene.to_path_buf(),
+            message,
+        }),
     }
-    Err(BuildError::Memory {
-        scene: scene.to_path_buf(),
-        message: format!(
-            "{what}: {particles:.3e} particles would need about {} of memory, more than this \
-             machine's {}; fix: {fix}",
-            human(bytes),
-            human(limit)
-        ),
-    })
 }
 
 #[cfg(test)]

@@ -48,6 +48,25 @@ pub enum RunError {
     /// The output folder is in use by another run, or its lock cannot be taken.
     #[error(transparent)]
     Lock(#[from] LockError),
+    /// The run would write over (or, starting fresh, remove) a file its scene reads: refused
+    /// before it removes or writes anything.
+    #[error(
+        "{scene}: the run would write over (or, starting fresh, remove) {output}, which the \
+         scene reads (\"{input}\"): a run must not change its own input; fix: give the run \
+         another --out (or [output] dir), or copy the file out of the output folder and name \
+         the copy in the scene",
+        scene = scene.display(),
+        output = output.display(),
+        input = input.display()
+    )]
+    OverwritesInput {
+        /// The scene file.
+        scene: PathBuf,
+        /// The file read, as the scene names it.
+        input: PathBuf,
+        /// The output it is, in the output folder.
+        output: PathBuf,
+    },
     /// Two bodies pass through each other: the interpenetration watch stopped the run.
     #[error("{scene}: {source}")]
     Interpenetration {
@@ -347,8 +366,8 @@ struct Run {
 
 impl Run {
     /// Prepares `out_dir` (its folders and lock, no temporary files of killed runs, and for a
-    /// fresh run no outputs of an earlier one: `fresh_start`), refuses a run that
-    /// must checkpoint but cannot, registers the recorders and, resuming, restores the world
+    /// fresh run no outputs of an earlier one: `fresh_start`), refuses a run that would write
+    /// over a file its scene reads and one that must checkpoint but cannot, registers the recorders and, resuming, restores the world
     /// and the recorders from the checkpoint; then opens the recorders' files.
     fn open(
         sim: &mut Simulation,
@@ -358,12 +377,22 @@ impl Run {
         create_dir(out_dir)?;
         let lock = FolderLock::acquire(out_dir)?;
         let fingerprint = scene_fingerprint(&sim.scene);
+        let inputs: Vec<(PathBuf, PathBuf)> = crate::inputs::input_files(&sim.scene)
+            .into_iter()
+            .map(|named| {
+                let resolved = fingerprint.resolve(&named);
+                (named, resolved)
+            })
+            .collect();
+        if let Some((input, output)) = fresh_start::overwritten_input(out_dir, &inputs) {
+            return Err(RunError::OverwritesInput {
+                scene: sim.scene.path.clone(),
+                input,
+                output,
+            });
+        }
         if options.resume.is_none() {
-            let inputs: Vec<PathBuf> = crate::inputs::input_files(&sim.scene)
-                .iter()
-                .map(|f| fingerprint.resolve(f))
-                .collect();
-            fresh_start::remove_earlier_outputs(out_dir, &inputs);
+            fresh_start::remove_earlier_outputs(out_dir);
         }
         if record::snapshots::writes_vtu(&sim.scene) {
             create_dir(&out_dir.join("vtu"))?;
