@@ -25,7 +25,7 @@
 //! the models learn how they are stepped from [`Model::prepare`].
 
 use crate::checkpoint::{model_tag, whole_block, CheckpointError, Decoder, Encoder};
-use crate::error::CoreError;
+use crate::error::{unstable_advice, CoreError};
 use crate::parallel::{Communicator, Decomposition, Exchange, Reads};
 use crate::state::State;
 use crate::step::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
@@ -371,6 +371,7 @@ impl World {
             dt: self.settings.dt,
             bound,
             limiter,
+            advice: unstable_advice(self.settings.dt, bound),
         })
     }
 

@@ -12,6 +12,7 @@ use crate::output::{FolderLock, LockError, OutputError};
 use crate::run::contact_watch::{ContactWatch, Interpenetration};
 use crate::run::fresh_start;
 use crate::run::inputs::SceneFingerprint;
+use crate::run::load_cause::load_cause;
 use crate::run::record::schedule::{probe_interval, Schedule};
 use crate::run::record::{self, Recorder, RunFigures, StateRead, StepInfo};
 use crate::run::run_record::{decode_run, decode_world, encode_run, RunRecord};
@@ -570,8 +571,14 @@ fn encode(
 }
 
 /// A core error of `sim`'s run (an instability found by the world's failure check among
-/// them: [`CoreError::Unstable`]), naming the scene.
-fn core_error(sim: &Simulation, source: CoreError) -> RunError {
+/// them: [`CoreError::Unstable`], whose advice names the load when a load no step resolves
+/// caused it: [`load_cause`]), naming the scene.
+fn core_error(sim: &Simulation, mut source: CoreError) -> RunError {
+    if let CoreError::Unstable { advice, .. } = &mut source {
+        if let Some(cause) = load_cause(sim) {
+            *advice = cause;
+        }
+    }
     RunError::Core {
         scene: sim.scene.path.clone(),
         source,
