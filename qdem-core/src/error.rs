@@ -195,7 +195,8 @@ pub enum CoreError {
     #[error(
         "the run became unstable at step {step} (t = {time:.6e} s): {detail}. The step was dt \
          = {dt:.4e} s; the stable bound at this state is {bound:.4e} s (set by {limiter}): \
-         {advice}"
+         {}",
+        cause.as_deref().map_or_else(|| unstable_advice(*dt, *bound), String::clone)
     )]
     Unstable {
         /// The step that failed (1 for the first).
@@ -208,11 +209,12 @@ pub enum CoreError {
         dt: f64,
         /// The stable bound at this state.
         bound: f64,
-        /// The model that sets it.
-        limiter: String,
-        /// What to do about it: [`unstable_advice`] of the step and the bound, or what the
-        /// caller, who knows the scene, finds (a load that no step can resolve).
-        advice: String,
+        /// The model that sets it (a boxed `str`, as `cause` is boxed, to keep the error small).
+        limiter: Box<str>,
+        /// The cause and its fix where the caller, who knows the scene, finds one (a load
+        /// that no step can resolve); `None` gives [`unstable_advice`] of the step and the
+        /// bound. Boxed (a thin pointer) to keep the error as small as it was without it.
+        cause: Option<Box<String>>,
     },
     /// The sparse linear algebra failed for a reason other than definiteness.
     #[error("sparse factorisation failed: {0}")]

@@ -25,7 +25,7 @@
 //! the models learn how they are stepped from [`Model::prepare`].
 
 use crate::checkpoint::{model_tag, whole_block, CheckpointError, Decoder, Encoder};
-use crate::error::{unstable_advice, CoreError};
+use crate::error::CoreError;
 use crate::parallel::{Communicator, Decomposition, Exchange, Reads};
 use crate::state::State;
 use crate::step::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
@@ -370,8 +370,8 @@ impl World {
             detail,
             dt: self.settings.dt,
             bound,
-            limiter,
-            advice: unstable_advice(self.settings.dt, bound),
+            limiter: limiter.into_boxed_str(),
+            cause: None,
         })
     }
 

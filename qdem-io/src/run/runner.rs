@@ -571,13 +571,11 @@ fn encode(
 }
 
 /// A core error of `sim`'s run (an instability found by the world's failure check among
-/// them: [`CoreError::Unstable`], whose advice names the load when a load no step resolves
+/// them: [`CoreError::Unstable`], whose cause is the load when a load no step resolves
 /// caused it: [`load_cause`]), naming the scene.
 fn core_error(sim: &Simulation, mut source: CoreError) -> RunError {
-    if let CoreError::Unstable { advice, .. } = &mut source {
-        if let Some(cause) = load_cause(sim) {
-            *advice = cause;
-        }
+    if let CoreError::Unstable { cause, .. } = &mut source {
+        *cause = load_cause(sim).map(Box::new);
     }
     RunError::Core {
         scene: sim.scene.path.clone(),
