@@ -155,13 +155,14 @@ pub struct ModesArgs {
     #[arg(value_name = "SCENE")]
     pub scene: PathBuf,
     /// Number of modes, rigid-body modes included
-    #[arg(long, value_name = "N", value_parser = positive_whole, default_value_t = 10)]
+    #[arg(long, value_name = "N", value_parser = positive_whole, allow_negative_numbers = true,
+          default_value_t = 10)]
     pub count: usize,
     /// Output directory [default: the scene's [output] dir, then modes/]
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Worker threads [default: one per core]
-    #[arg(long, value_name = "N", value_parser = thread_count)]
+    #[arg(long, value_name = "N", value_parser = thread_count, allow_negative_numbers = true)]
     pub threads: Option<usize>,
 }
 
@@ -175,14 +176,14 @@ pub struct RunArgs {
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Worker threads [default: one per core]
-    #[arg(long, value_name = "N", value_parser = thread_count)]
+    #[arg(long, value_name = "N", value_parser = thread_count, allow_negative_numbers = true)]
     pub threads: Option<usize>,
     /// Continue the run from this checkpoint (DIR/checkpoint.qdc of a stopped run)
     #[arg(long, value_name = "CHECKPOINT")]
     pub resume: Option<PathBuf>,
     /// Stop after step N as Ctrl-C does: with DIR/checkpoint.qdc, exit status 130 (a batch
     /// slot's last step)
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = step_number, allow_negative_numbers = true)]
     pub stop_after: Option<u64>,
     /// Start the run even if it is modelled to take more than a day of wall time (without it,
     /// such a run is refused, with the estimate and how to shorten it)
@@ -197,7 +198,7 @@ pub struct CheckArgs {
     #[arg(value_name = "SCENE")]
     pub scene: PathBuf,
     /// Worker threads for the cost measurement [default: one per core]
-    #[arg(long, value_name = "N", value_parser = thread_count)]
+    #[arg(long, value_name = "N", value_parser = thread_count, allow_negative_numbers = true)]
     pub threads: Option<usize>,
 }
 
@@ -223,13 +224,15 @@ pub struct BenchArgs {
     pub json: bool,
     /// Approximate tetrahedron counts, comma-separated [default: 10000,100000,1000000; with
     /// --implicit 16000,180000,550000]
-    #[arg(long, value_name = "N,..", value_delimiter = ',', value_parser = positive_whole)]
+    #[arg(long, value_name = "N,..", value_delimiter = ',', value_parser = positive_whole,
+          allow_negative_numbers = true)]
     pub tets: Option<Vec<usize>>,
     /// Thread counts, comma-separated [default: 1,2; with --implicit the last one, default 2]
-    #[arg(long, value_name = "N,..", value_delimiter = ',', value_parser = threads_within_cores)]
+    #[arg(long, value_name = "N,..", value_delimiter = ',', value_parser = threads_within_cores,
+          allow_negative_numbers = true)]
     pub threads: Option<Vec<usize>>,
     /// Steps per measurement [default: about one second's worth, at least 3]
-    #[arg(long, value_name = "N", value_parser = positive_whole)]
+    #[arg(long, value_name = "N", value_parser = positive_whole, allow_negative_numbers = true)]
     pub steps: Option<usize>,
     /// Measure the implicit path (sparse Cholesky) against the number of unknowns instead
     #[arg(long)]
@@ -301,6 +304,17 @@ fn threads_within_cores(value: &str) -> Result<usize, String> {
              (leave --threads out for one per core)"
         )),
     }
+}
+
+/// The step of `--stop-after`: a whole number of at least 1 (the first step is step 1, so a 0
+/// would never stop the run).
+fn step_number(value: &str) -> Result<u64, String> {
+    value
+        .trim()
+        .parse::<u64>()
+        .ok()
+        .filter(|&n| n > 0)
+        .ok_or_else(|| "give a positive whole number of steps (1 or more)".to_string())
 }
 
 /// The one thread count of `run`, `check` and `modes`.

@@ -761,3 +761,222 @@ fn a_thread_count_far_beyond_the_cores_is_refused_at_once() {
         );
     }
 }
+// ---------------------------------------------------------------------------------------------
+// Messages that name the real cause (issue 56)
+// ---------------------------------------------------------------------------------------------
+
+/// A negative count was taken by clap for an unknown flag, with the tip to write `-- -1`,
+/// which would make it the scene's name; it must be refused as a count, naming the flag.
+#[test]
+fn a_negative_count_is_refused_as_a_count_not_a_flag() {
+    let scene = good_scene();
+    let scene = scene.to_str().expect("a UTF-8 path");
+    let cases: [&[&str]; 6] = [
+        &["run", scene, "--threads", "-1"],
+        &["run", scene, "--stop-after", "-5"],
+        &["run", scene, "--stop-after", "0"],
+        &["check", scene, "--threads", "-2"],
+        &["modes", scene, "--count", "-1"],
+        &["bench", "--tets", "-3"],
+    ];
+    for args in cases {
+        let (flag, value) = (args[args.len() - 2], args[args.len() - 1]);
+        let what = format!("qdem {}", args.join(" "));
+        let message = assert_clean_error(
+            &what,
+            &qdem(args),
+            &[
+                &format!("invalid value '{value}' for '{flag} <N"),
+                "give a positive whole number",
+            ],
+        );
+        assert!(!message.contains("tip"), "{what}:\n{message}");
+    }
+    let message = assert_clean_error(
+        "qdem bench --threads 2,-1",
+        &qdem(&["bench", "--threads", "2,-1"]),
+        &[
+            "invalid value '-1' for '--threads <N,..>'",
+            "positive whole",
+        ],
+    );
+    assert!(!message.contains("tip"), "{message}");
+}
+
+/// A file that starts like a checkpoint but holds random bytes after the magic was reported
+/// as "format version 2142358983632637349"; a file that does not start with it is named too.
+#[test]
+fn a_start_checkpoint_that_is_not_one_is_named_as_such() {
+    let tmp = TempDir::new("garbage-start");
+    let garbage = tmp.path().join("garbage.qdc");
+    // Bytes from a fixed linear congruential sequence (the probe's were random).
+    let mut x: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut bytes = b"QDEMCKPT".to_vec();
+    bytes.extend((0..400).map(|_| {
+        x = x.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+        (x >> 33) as u8
+    }));
+    std::fs::write(&garbage, &bytes).expect("write the garbage file");
+    let text = tmp.path().join("text.qdc");
+    std::fs::write(&text, "t,tip.ux\n0,0\n").expect("write the text file");
+    for (file, needles) in [
+        (
+            &garbage,
+            &[
+                "is not a qdem checkpoint: it starts with the bytes QDEMCKPT",
+                "which no qdem writes",
+                "fix: give a checkpoint.qdc that a qdem run wrote",
+            ][..],
+        ),
+        (
+            &text,
+            &[
+                "is not a qdem checkpoint (it does not start with the bytes QDEMCKPT",
+                "fix: give the checkpoint.qdc that a qdem run wrote",
+            ][..],
+        ),
+    ] {
+        let start = format!("probe_every = 1e-3\nstart_from = \"{}\"", file.display());
+        let scene = variant(
+            "contact/incline.toml",
+            &[("probe_every = 1e-3", &start)],
+            &tmp,
+        );
+        let message = check_and_run(&scene, needles);
+        assert!(!message.contains("has format version"), "{message}");
+    }
+}
+
+/// A scene that nothing bounds the step of (a rigid block falling, no contact) with
+/// `dt = "auto"` was told "dt = inf s is above the stable bound inf s ...; use dt = \"auto\"".
+#[test]
+fn an_automatic_step_that_nothing_bounds_is_explained() {
+    let tmp = TempDir::new("no-bound");
+    let scene = variant(
+        "contact/incline.toml",
+        &[
+            ("contact_radius = 0.01\n", ""),
+            (
+                "[contact]\nlaw = \"linear\"\nnormal_stiffness = 1e7\ntangential_stiffness = 1e7\n\
+                 friction = 0.3\ndamping_ratio = 0.05\n\n[[wall]]\npoint = [0.0, 0.0, 0.0]\n\
+                 normal = [-0.422618262, 0.0, 0.906307787]\n",
+                "",
+            ),
+        ],
+        &tmp,
+    );
+    let message = check_and_run(
+        &scene,
+        &[
+            "dt = \"auto\" cannot choose a step: no model of the scene bounds it",
+            "fix: give [run] dt in seconds",
+        ],
+    );
+    assert!(!message.contains("inf s"), "{message}");
+    // With a dt the same scene runs.
+    let given = variant(
+        "contact/incline.toml",
+        &[
+            ("contact_radius = 0.01\n", ""),
+            ("t_end = 0.4", "t_end = 0.01\ndt = 1e-3"),
+            (
+                "[contact]\nlaw = \"linear\"\nnormal_stiffness = 1e7\ntangential_stiffness = 1e7\n\
+                 friction = 0.3\ndamping_ratio = 0.05\n\n[[wall]]\npoint = [0.0, 0.0, 0.0]\n\
+                 normal = [-0.422618262, 0.0, 0.906307787]\n",
+                "",
+            ),
+        ],
+        &tmp,
+    );
+    let out = tmp.path().join("out");
+    let done = qdem(&[
+        OsStr::new("run"),
+        given.as_os_str(),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+}
+
+/// `[bonded] critical_fraction` sets the step of a bonded scene: a fraction whose step is
+/// above the rigorous bound is refused naming it, not with advice to use `dt = "auto"`.
+#[test]
+fn a_critical_fraction_above_the_bound_is_refused_naming_it() {
+    let tmp = TempDir::new("critical");
+    let scene = variant(
+        "bbm/small_beam.toml",
+        &[("critical_fraction = 0.2", "critical_fraction = 5.0")],
+        &tmp,
+    );
+    let message = check_and_run(
+        &scene,
+        &[
+            "[bonded]: critical_fraction = 5 gives dt = 5 x the bonds' critical step",
+            "above the rigorous stable bound",
+            "fix: give critical_fraction <= ",
+        ],
+    );
+    assert!(!message.contains("\"auto\""), "{message}");
+    // The fraction named gives a step within the bound: the scene passes `qdem check`.
+    let named: f64 = message
+        .split("critical_fraction <= ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|word| word.parse().ok())
+        .unwrap_or_else(|| panic!("no fraction in:\n{message}"));
+    let fitted = variant(
+        "bbm/small_beam.toml",
+        &[(
+            "critical_fraction = 0.2",
+            &format!("critical_fraction = {named}"),
+        )],
+        &tmp,
+    );
+    let check = qdem(&[OsStr::new("check"), fitted.as_os_str()]);
+    assert!(
+        check.status.success(),
+        "critical_fraction = {named}:\n{}",
+        String::from_utf8_lossy(&check.stderr)
+    );
+}
+
+/// The blocks of `collision.toml` thrown at ±400 m/s, twice the rubber's wave speed
+/// (√(5e7 / 1100) = 213 m/s): the report once asked for a smaller step; the speed is the cause.
+#[test]
+fn bodies_thrown_faster_than_their_wave_speed_are_reported_for_the_speed_not_the_step() {
+    let tmp = TempDir::new("fast-tunnel");
+    let scene = variant(
+        "contact/collision.toml",
+        &[
+            ("velocity = [4.0, 0.0, 0.0]", "velocity = [400.0, 0.0, 0.0]"),
+            (
+                "velocity = [-1.0, 0.0, 0.0]",
+                "velocity = [-400.0, 0.0, 0.0]",
+            ),
+        ],
+        &tmp,
+    );
+    let out = tmp.path().join("out");
+    let run = qdem(&[
+        OsStr::new("run"),
+        scene.as_os_str(),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    for part in [
+        "pass through each other",
+        "the load, not the step, is the cause",
+        "velocity (4.000e2 m/s) gives body",
+        "a strain of 1.876e0",
+        "fix: check the body's velocity",
+    ] {
+        assert!(stderr.contains(part), "{part:?} in:\n{stderr}");
+    }
+    assert!(!stderr.contains("fix: a smaller step"), "{stderr}");
+}

@@ -62,6 +62,22 @@ pub enum CoreError {
         /// The model that limits the step.
         limiter: String,
     },
+    /// An automatic step (`dt = "auto"`) where the models give no finite bound to take it
+    /// from: none bounds the step (no stiffness: rigid bodies, loads and gravity only), or the
+    /// bound is NaN.
+    #[error("{}", no_bound_message(*bound, limiter))]
+    NoStableBound {
+        /// The smallest bound of the models: infinite when none gives one, or NaN.
+        bound: f64,
+        /// The model that gives it (empty when none does).
+        limiter: String,
+    },
+    /// An implicit or static scheme given no step and no default for it.
+    #[error(
+        "an implicit or static step has no stable bound to take dt from, and none was given; \
+         fix: give [run] dt in seconds"
+    )]
+    ImplicitNeedsStep,
     /// A particle with zero mass that is not fixed in every direction.
     #[error(
         "particle {particle} has no mass and is not fully fixed: every particle must belong to a \
@@ -179,8 +195,8 @@ pub enum CoreError {
     #[error(
         "the run became unstable at step {step} (t = {time:.6e} s): {detail}. The step was dt \
          = {dt:.4e} s; the stable bound at this state is {bound:.4e} s (set by {limiter}): \
-         {advice}",
-        advice = unstable_advice(*dt, *bound)
+         {}",
+        cause.as_deref().map_or_else(|| unstable_advice(*dt, *bound), String::clone)
     )]
     Unstable {
         /// The step that failed (1 for the first).
@@ -193,8 +209,12 @@ pub enum CoreError {
         dt: f64,
         /// The stable bound at this state.
         bound: f64,
-        /// The model that sets it.
-        limiter: String,
+        /// The model that sets it (a boxed `str`, as `cause` is boxed, to keep the error small).
+        limiter: Box<str>,
+        /// The cause and its fix where the caller, who knows the scene, finds one (a load
+        /// that no step can resolve); `None` gives [`unstable_advice`] of the step and the
+        /// bound. Boxed (a thin pointer) to keep the error as small as it was without it.
+        cause: Option<Box<String>>,
     },
     /// The sparse linear algebra failed for a reason other than definiteness.
     #[error("sparse factorisation failed: {0}")]
@@ -206,6 +226,27 @@ pub enum CoreError {
     /// shared by two bodies).
     #[error("cannot decompose the run over processes: {0}")]
     Decomposition(String),
+}
+
+/// Why `dt = "auto"` has no step to choose: no model bounds it (`bound` infinite), or the
+/// bound `limiter` gives is NaN.
+fn no_bound_message(bound: f64, limiter: &str) -> String {
+    if bound.is_nan() {
+        format!(
+            "dt = \"auto\" cannot choose a step: the stable bound of `{limiter}` is NaN, so \
+             some mass or stiffness of it is zero or not a finite number (a zero density, a \
+             zero or infinite stiffness, a particle with no volume around it); fix: check \
+             the density, young and contact stiffness of `{limiter}`, or give [run] dt in \
+             seconds"
+        )
+    } else {
+        "dt = \"auto\" cannot choose a step: no model of the scene bounds it (nothing has a \
+         stiffness that limits an explicit step: no deformable body, no contact, no bond; \
+         rigid bodies, gravity and loads alone do not), so the bound is infinite; fix: give \
+         [run] dt in seconds, small enough to resolve the motion (e.g. a hundredth of the \
+         time its fastest change takes)"
+            .to_string()
+    }
 }
 
 /// What to do about an instability, given the step and its bound.

@@ -94,3 +94,51 @@ fn a_crushing_load_is_caught_as_an_inverted_tetrahedron() {
     assert!(message.contains("the cause is physical"), "{message}");
     assert!(checkpoint.exists());
 }
+
+/// Gravity of 1e8 m/s² or a spin of 1e5 rad/s crushes the cantilever at any step: the run
+/// names the key and the strain it asks of the body (ρ g L / E = 2350 · 1e8 · 2.4 / 45e9 =
+/// 12.53; ρ ω² L² / (8 E) = 2350 · 1e10 · 5.76 / 3.6e11 = 376), not the step (the message
+/// once said "a load or a contact stiffness too large", or blamed the step).
+#[test]
+fn a_load_that_no_step_resolves_is_named_as_the_cause() {
+    let cases = [
+        (
+            "gravity = [0.0, 0.0, 0.0]",
+            "gravity = [0.0, 0.0, -1e8]",
+            "[run] gravity (1.000e8 m/s^2) gives body `beam` a strain of 1.253e1",
+            "fix: check [run] gravity",
+        ),
+        (
+            "material = \"concrete\"\n\n[[fix]]",
+            "material = \"concrete\"\nangular_velocity = [0.0, 0.0, 1e5]\n\n[[fix]]",
+            "[[body]] \"beam\" angular_velocity (1.000e5 rad/s) gives body `beam` a strain of \
+             3.760e2",
+            "fix: check the body's angular_velocity",
+        ),
+    ];
+    for (from, to, cause, fix) in cases {
+        let dir = test_dir("load-cause");
+        let scene = short_cantilever(&dir, &[(from, to)]);
+        assert!(std::fs::read_to_string(&scene).unwrap().contains(to));
+        let mut sim = Simulation::build(Scene::load(&scene).unwrap()).unwrap();
+        let error = run(&mut sim, &dir.join("out"), &mut |_| {}).expect_err("a crushed body");
+        let (_, _, detail, dt, bound) = unstable(&error);
+        let message = error.to_string();
+        assert!(
+            detail.contains("turned inside out") && dt <= bound,
+            "{message}"
+        );
+        for part in ["the load, not the step, is the cause", cause, "any dt", fix] {
+            assert!(message.contains(part), "{part:?} in:\n{message}");
+        }
+        assert!(!message.contains("the cause is physical"), "{message}");
+    }
+    // Earth's gravity on the same beam asks a strain of 1.2e-6: the check stays silent.
+    let dir = test_dir("load-cause-earth");
+    let scene = short_cantilever(
+        &dir,
+        &[("gravity = [0.0, 0.0, 0.0]", "gravity = [0.0, 0.0, -9.81]")],
+    );
+    let mut sim = Simulation::build(Scene::load(&scene).unwrap()).unwrap();
+    run(&mut sim, &dir.join("out"), &mut |_| {}).unwrap();
+}

@@ -1048,3 +1048,146 @@ fn initial_motion_keys_and_grain_probes_are_checked_by_name() {
         ],
     );
 }
+
+// ---- messages that name the real cause (issue 56) ----------------------------------------
+
+#[test]
+fn a_subnormal_dt_is_refused_as_such_naming_run_dt() {
+    // 1e-320 s is positive, so the positivity check passed it, and the run then blamed the
+    // materials' density and young for a step they did not set.
+    let (_, msg) = error(&with("dt = \"auto\"", "dt = 1e-320"));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:3:6:",
+            "[run]: dt = 1e-320 s is subnormal",
+            "fix: give dt = \"auto\"",
+        ],
+    );
+    assert!(!msg.contains("density"), "{msg}");
+    // The smallest normal step is a step (a run of it is refused later for its step count).
+    let smallest = format!("dt = {:e}", f64::MIN_POSITIVE);
+    Scene::parse(&with("dt = \"auto\"", &smallest), Path::new(PATH)).unwrap();
+}
+
+#[test]
+fn each_non_finite_run_key_is_named_as_itself() {
+    // A Newmark scene, so that beta and gamma are read; each key in turn set to NaN and to
+    // infinity must be named itself, on its own line (gamma was named `beta`).
+    let newmark = with(
+        "integrator = \"verlet\"",
+        "integrator = \"newmark\"\nbeta = 0.25\ngamma = 0.5",
+    )
+    .replace("dt = \"auto\"", "dt = 1e-4");
+    let keys = [
+        ("t_end", "t_end = 2.0"),
+        ("dt", "dt = 1e-4"),
+        ("beta", "beta = 0.25"),
+        ("gamma", "gamma = 0.5"),
+        ("probe_every", "probe_every = 1e-4"),
+        ("dt_safety", "dt_safety = 0.9"),
+    ];
+    for (key, line) in keys {
+        let row = newmark
+            .lines()
+            .position(|l| l == line)
+            .expect("the key's line")
+            + 1;
+        for bad in ["nan", "inf", "-inf"] {
+            let text = newmark.replacen(line, &format!("{key} = {bad}"), 1);
+            let (_, msg) = error(&text);
+            let shown = if bad == "nan" { "NaN" } else { bad };
+            assert_has(
+                &msg,
+                &[
+                    &format!("scenes/scene.toml:{row}:"),
+                    &format!("[run]: `{key}` must be a finite number, not {shown}"),
+                ],
+            );
+            for (other, _) in keys.iter().filter(|(k, _)| *k != key) {
+                assert!(
+                    !msg.contains(&format!("`{other}`")),
+                    "{key} = {bad}:\n{msg}"
+                );
+            }
+        }
+    }
+    // A cyclic load's factors: each named by its own key.
+    for key in ["min", "max", "phase_deg", "start"] {
+        let mut cyclic = [
+            ("min", "0.1"),
+            ("max", "1.0"),
+            ("phase_deg", "0.0"),
+            ("start", "0.0"),
+        ]
+        .map(|(k, v)| (k, v.to_string()));
+        cyclic.iter_mut().find(|(k, _)| *k == key).unwrap().1 = "nan".into();
+        let fields: Vec<String> = cyclic.iter().map(|(k, v)| format!("{k} = {v}")).collect();
+        let text = with(
+            "ramp = [[0.0, 0.0], [1.0, 1.0]]",
+            &format!("cyclic = {{ {}, frequency = 10.0 }}", fields.join(", ")),
+        );
+        let (_, msg) = error(&text);
+        assert_has(
+            &msg,
+            &[&format!(
+                "[[load]] #1: `cyclic.{key}` must be a finite number, not NaN"
+            )],
+        );
+    }
+}
+
+#[test]
+fn newmark_parameters_with_another_integrator_are_refused() {
+    // BASE steps with Verlet: a beta or gamma there does nothing.
+    let (_, msg) = error(&with(
+        "integrator = \"verlet\"",
+        "integrator = \"verlet\"\nbeta = 0.25\ngamma = 0.6",
+    ));
+    assert_has(
+        &msg,
+        &[
+            "scenes/scene.toml:5:8: [run]: beta is a parameter of integrator = \"newmark\" only",
+            "scenes/scene.toml:6:9: [run]: gamma is a parameter of integrator = \"newmark\" only",
+            "with integrator = \"verlet\" (the default) it does nothing",
+            "fix: add integrator = \"newmark\" to [run]",
+        ],
+    );
+    let (_, msg) = error(&with(
+        "integrator = \"verlet\"",
+        "integrator = \"static\"\ngamma = 0.5",
+    ));
+    assert_has(
+        &msg,
+        &[
+            "[run]: gamma is a parameter",
+            "integrator = \"static\" it does",
+        ],
+    );
+    assert!(!msg.contains("beta"), "{msg}");
+    // Given with Newmark they are read.
+    let newmark = with(
+        "integrator = \"verlet\"",
+        "integrator = \"newmark\"\nbeta = 0.0\ngamma = 0.5",
+    );
+    Scene::parse(&newmark, Path::new(PATH)).unwrap();
+}
+
+#[test]
+fn a_granular_generation_of_zero_stones_is_refused() {
+    let granular = format!(
+        "{BASE}\n[contact]\nnormal_stiffness = 1e6\ntangential_stiffness = 1e6\n\n[granular]\n\
+         name = \"grains\"\nmaterial = \"concrete\"\nregion = [[0, 0, 0], [0.3, 0.7, 1.0]]\n\
+         count = 0\ngrading = [[0.05, 0.0], [0.1, 1.0]]\n"
+    );
+    let (_, msg) = error(&granular);
+    assert_has(
+        &msg,
+        &[
+            "[granular] \"grains\": count = 0 generates no stone",
+            "fix: give count >= 1",
+        ],
+    );
+    let one = granular.replace("count = 0", "count = 1");
+    Scene::parse(&one, Path::new(PATH)).unwrap();
+}

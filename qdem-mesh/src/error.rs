@@ -33,12 +33,26 @@ fn at(file: &Path, location: &Location) -> String {
     }
 }
 
+/// The corners of a tetrahedron, each coordinate in at most 24 characters (see
+/// [`fmt_coordinate`]).
 fn fmt_points(coords: &[[f64; 3]; 4]) -> String {
     let parts: Vec<String> = coords
         .iter()
-        .map(|p| format!("({}, {}, {})", p[0], p[1], p[2]))
+        .map(|p| p.map(fmt_coordinate).join(", "))
+        .map(|p| format!("({p})"))
         .collect();
     parts.join(", ")
+}
+
+/// A coordinate as written in meshes (`0.5`) when it is of an everyday size, else in
+/// exponent form (`3.5e300`): `Display` writes every digit of a large number, 300 of them
+/// for 1e300.
+fn fmt_coordinate(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 fn fmt_names(names: &[String]) -> String {
@@ -232,6 +246,30 @@ pub enum MeshError {
         coords: Box<[[f64; 3]; 4]>,
         /// Six times its signed volume.
         volume6: f64,
+    },
+
+    /// A tetrahedron so large that its volume is not a finite number: coordinates far beyond
+    /// any physical size, in the wrong unit or scaled wrongly.
+    #[error(
+        "{}: tetrahedron {element_id} (nodes {nodes:?}) is {span:.3e} m across, its corners are {}: \
+         its volume overflows the largest number a double holds (1.8e308), so the mesh's \
+         coordinates are not those of any physical object; fix: check the mesh's unit and \
+         scale (qdem reads metres: export the mesh in metres, or check gmsh's \
+         Mesh.ScalingFactor)",
+        .file.display(),
+        fmt_points(.coords)
+    )]
+    OverflowingTet {
+        /// The file.
+        file: PathBuf,
+        /// The element's id.
+        element_id: u64,
+        /// Its node ids as in the file.
+        nodes: [u64; 4],
+        /// Its corner coordinates (boxed to keep the error small).
+        coords: Box<[[f64; 3]; 4]>,
+        /// The widest side of the box around its corners (m).
+        span: f64,
     },
 
     /// The physical groups would hold more node entries than

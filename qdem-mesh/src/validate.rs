@@ -197,8 +197,17 @@ pub(crate) fn build(raw: RawMesh, file: &Path) -> Result<(TetMesh, Vec<MeshWarni
         let v6 = signed_volume6(&p);
         let h = max_edge(&p);
         let scale = DEGENERATE_TOL * h * h * h;
-        if !v6.is_finite() || !scale.is_finite() || v6.abs() <= scale {
-            let nodes_ids = r.map(|k| raw.node_ids[k as usize]);
+        let nodes_ids = r.map(|k| raw.node_ids[k as usize]);
+        if !v6.is_finite() || !scale.is_finite() {
+            return Err(MeshError::OverflowingTet {
+                file: file.to_path_buf(),
+                element_id: id,
+                nodes: nodes_ids,
+                coords: Box::new(p),
+                span: box_width(&p),
+            });
+        }
+        if v6.abs() <= scale {
             return Err(MeshError::DegenerateTet {
                 file: file.to_path_buf(),
                 element_id: id,
@@ -353,4 +362,19 @@ fn groups(
         });
     }
     Ok(out)
+}
+
+/// The widest side of the box around a tetrahedron's corners: finite for any finite corners
+/// (its longest edge, a square root of squares, overflows from about 1e154 m on).
+fn box_width(p: &[[f64; 3]; 4]) -> f64 {
+    (0..3)
+        .map(|axis| {
+            let (lo, hi) = p
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
+                    (lo.min(c[axis]), hi.max(c[axis]))
+                });
+            hi - lo
+        })
+        .fold(0.0, f64::max)
 }

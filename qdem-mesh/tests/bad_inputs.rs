@@ -332,3 +332,51 @@ fn binary_errors_report_byte_offsets() {
         "{e:?}"
     );
 }
+
+/// A unit tetrahedron scaled by 3.5e300 (coordinates in a wrong unit): its volume overflows.
+/// The message names the overflow and the unit, not duplicate nodes, and prints each
+/// coordinate in a few characters (the full digits of 3.5e300 are 301 characters each).
+#[test]
+fn a_tetrahedron_whose_volume_overflows_is_named_as_such_in_a_short_message() {
+    let s = 3.5e300;
+    let text = format!(
+        "{HEAD22}$Nodes\n4\n1 0 0 0\n2 {s} 0 0\n3 0 {s} 0\n4 0 0 {s}\n$EndNodes\n\
+         $Elements\n1\n1 4 2 1 1 1 2 3 4\n$EndElements\n"
+    );
+    let (err, msg) = parse_err(&text);
+    assert!(
+        matches!(
+            err,
+            MeshError::OverflowingTet {
+                element_id: 1,
+                nodes: [1, 2, 3, 4],
+                ..
+            }
+        ),
+        "{err:?}"
+    );
+    assert!(
+        msg.contains("overflows")
+            && msg.contains("(3.5e300, 0, 0)")
+            && msg.contains("is 3.500e300 m across")
+            && msg.contains("fix: check the mesh's unit and scale"),
+        "{msg}"
+    );
+    assert!(!msg.contains("duplicate"), "{msg}");
+    assert!(msg.len() < 600, "{} characters:\n{msg}", msg.len());
+}
+
+/// A degenerate tetrahedron far from the origin prints its corners in exponent form.
+#[test]
+fn a_degenerate_tetrahedron_far_away_prints_short_coordinates() {
+    let text = format!(
+        "{HEAD22}$Nodes\n4\n1 1e30 0 0\n2 1e30 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n\
+         $Elements\n1\n1 4 2 1 1 1 2 3 4\n$EndElements\n"
+    );
+    let (_, msg) = parse_err(&text);
+    assert!(
+        msg.contains("(1e30, 0, 0)") && msg.contains("degenerate"),
+        "{msg}"
+    );
+    assert!(msg.len() < 600, "{} characters:\n{msg}", msg.len());
+}

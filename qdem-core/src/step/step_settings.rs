@@ -112,13 +112,7 @@ impl StepSettings {
             (true, requested, _) => choose_step(state, models, requested, request.safety)?,
             (false, Some(dt), _) => dt,
             (false, None, Some(dt)) => dt,
-            (false, None, None) => {
-                return Err(CoreError::StepTooLarge {
-                    dt: f64::INFINITY,
-                    bound: stable_dt.0,
-                    limiter: "an implicit scheme needs a step; give dt".to_string(),
-                })
-            }
+            (false, None, None) => return Err(CoreError::ImplicitNeedsStep),
         };
         let dt = match (request.dt, request.fit_to) {
             (None, Some(end)) => end / (end / dt).ceil(),

@@ -376,10 +376,6 @@ pub fn choose_step(
         Some(dt) if dt > bound => Err(CoreError::StepTooLarge { dt, bound, limiter }),
         Some(dt) => Ok(dt),
         None if bound.is_finite() => Ok(safety * bound),
-        None => Err(CoreError::StepTooLarge {
-            dt: f64::INFINITY,
-            bound,
-            limiter: "no model bounds the step; give dt".to_string(),
-        }),
+        None => Err(CoreError::NoStableBound { bound, limiter }),
     }
 }

@@ -370,7 +370,8 @@ impl World {
             detail,
             dt: self.settings.dt,
             bound,
-            limiter,
+            limiter: limiter.into_boxed_str(),
+            cause: None,
         })
     }
 

@@ -10,7 +10,8 @@
 //!
 //! The step: `critical_fraction` × ∆t_crit of Eq. 28 when given, else `[run] dt` as for any
 //! scene; an explicit step is always checked against the rigorous bound
-//! ([`qdem_core::Model::stable_dt`]). The world watches the body for collapse
+//! ([`qdem_core::Model::stable_dt`]), and a `critical_fraction` whose step is above it is
+//! refused naming that key (not `[run] dt`, which it replaces). The world watches the body for collapse
 //! ([`CollapseWatch`]).
 
 use crate::build::{nearest_particle_in, step_request, BuildError, Simulation};
@@ -20,7 +21,7 @@ use qdem_contact::{
     PackingKind, UnbondedLaw,
 };
 use qdem_core::{
-    Dofs, Model, NodalLoad, State, StepRequest, StepSettings, TimeFunction, Vec3, World,
+    CoreError, Dofs, Model, NodalLoad, State, StepRequest, StepSettings, TimeFunction, Vec3, World,
 };
 
 /// A bonded run ends early once a particle has moved this many particle spacings: its linear
@@ -76,7 +77,21 @@ pub(crate) fn build_bonded(
         source,
     };
     let request = bonded_step(&scene, bonded, critical);
-    let settings = StepSettings::resolve(&request, &state, &models).map_err(core)?;
+    let settings = StepSettings::resolve(&request, &state, &models).map_err(|source| {
+        match (bonded.critical_fraction, source) {
+            (Some(fraction), CoreError::StepTooLarge { dt, bound, limiter }) => {
+                BuildError::CriticalFraction {
+                    scene: scene.path.clone(),
+                    fraction,
+                    critical,
+                    dt,
+                    bound,
+                    limiter,
+                }
+            }
+            (_, source) => core(source),
+        }
+    })?;
     let probes = scene
         .probes
         .iter()

@@ -213,6 +213,30 @@ pub enum BuildError {
         /// The key and count, the particles, the memory they need, the machine's, the fix.
         message: String,
     },
+    /// A `[bonded] critical_fraction` whose explicit step is above the rigorous stable bound.
+    #[error(
+        "{scene}: [bonded]: critical_fraction = {fraction} gives dt = {fraction} x the bonds' \
+         critical step of paper 001 Eq. 28 ({critical:.4e} s) = {dt:.4e} s, above the \
+         rigorous stable bound {bound:.4e} s (set by `{limiter}`); fix: give \
+         critical_fraction <= {:.4} (the bound over the critical step), or remove it to take \
+         the step from [run] dt",
+        // Rounded down, so that the fraction named gives a step within the bound.
+        (bound / critical * 1e4).floor() / 1e4
+    )]
+    CriticalFraction {
+        /// The scene file.
+        scene: PathBuf,
+        /// `critical_fraction`.
+        fraction: f64,
+        /// Eq. 28's critical step (s).
+        critical: f64,
+        /// The step it gives (s).
+        dt: f64,
+        /// The rigorous bound (s).
+        bound: f64,
+        /// The model that sets the bound.
+        limiter: String,
+    },
     /// A time step that cannot advance the run: zero, subnormal, not finite, or so small
     /// against `t_end` that the time stops advancing or the step count does not fit.
     #[error("{scene}: [run]: {message}")]

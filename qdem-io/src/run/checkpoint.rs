@@ -41,6 +41,11 @@ pub const FORMAT_VERSION: u64 = 8;
 const MAGIC: &[u8; 8] = b"QDEMCKPT";
 const HEADER: usize = 8 + 8 + 8;
 
+/// The largest format version a checkpoint is taken to have: versions go up by one with each
+/// change of the layout, so a larger number after the magic bytes (a file of random bytes that
+/// happens to start with them, or a damaged header) was written by no qdem.
+const LAST_VERSION_READ_AS_ONE: u64 = u16::MAX as u64;
+
 /// Why a checkpoint cannot be resumed from.
 #[derive(Debug, Error)]
 pub enum CheckpointFileError {
@@ -53,10 +58,31 @@ pub enum CheckpointFileError {
         source: std::io::Error,
     },
     /// Not a checkpoint at all.
-    #[error("`{path}` is not a qdem checkpoint (it does not start with QDEMCKPT)")]
+    #[error(
+        "`{path}` is not a qdem checkpoint (it does not start with the bytes QDEMCKPT that \
+         every checkpoint starts with); fix: give the checkpoint.qdc that a qdem run wrote in \
+         its output folder"
+    )]
     NotCheckpoint {
         /// The file.
         path: PathBuf,
+    },
+    /// A file that starts with the magic bytes but whose version is no version any qdem
+    /// writes: random bytes after them, or a damaged header.
+    #[error(
+        "`{path}` is not a qdem checkpoint: it starts with the bytes QDEMCKPT, but the format \
+         version after them reads {found:#018x}, which no qdem writes (versions are small \
+         numbers; this qdem writes {expected}), so the file is damaged or was not written by \
+         qdem; fix: give a checkpoint.qdc that a qdem run wrote (an earlier one), or run the \
+         scene from the start"
+    )]
+    DamagedHeader {
+        /// The file.
+        path: PathBuf,
+        /// The eight bytes where the version belongs, as a little-endian number.
+        found: u64,
+        /// The version this build reads.
+        expected: u64,
     },
     /// A checkpoint cut short before the end of its header (a copy or a disk that ran out).
     #[error(
@@ -198,6 +224,13 @@ pub fn read_checkpoint(
     }
     let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().expect("8 bytes"));
     let version = word(8);
+    if version == 0 || version > LAST_VERSION_READ_AS_ONE {
+        return Err(CheckpointFileError::DamagedHeader {
+            path,
+            found: version,
+            expected: FORMAT_VERSION,
+        });
+    }
     if version != FORMAT_VERSION {
         return Err(CheckpointFileError::Version {
             path,
@@ -317,6 +350,27 @@ mod tests {
                 expected: FORMAT_VERSION,
                 ..
             })
+        ));
+        // A version no qdem writes (0, or the random bytes of a file that starts with the
+        // magic): named a damaged header, not a version to resume with another qdem.
+        for garbage in [0, u64::from(u16::MAX) + 1, 0x1dbb_3025_18ca_4da5] {
+            bytes[8..16].copy_from_slice(&garbage.to_le_bytes());
+            std::fs::write(&path, &bytes).unwrap();
+            let error = read_checkpoint(&path, None).unwrap_err();
+            assert!(
+                matches!(error, CheckpointFileError::DamagedHeader { found, .. } if found == garbage),
+                "{error}"
+            );
+            assert!(
+                error.to_string().contains("is not a qdem checkpoint"),
+                "{error}"
+            );
+        }
+        bytes[8..16].copy_from_slice(&u64::from(u16::MAX).to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        assert!(matches!(
+            read_checkpoint(&path, None),
+            Err(CheckpointFileError::Version { .. })
         ));
         std::fs::write(&path, b"t,tip.ux\n0,0\n").unwrap();
         assert!(matches!(

@@ -9,7 +9,9 @@
 //! contact is too soft, or its spheres too small, for the speed; the step is not the cause.
 //! The run stops with [`Interpenetration`], naming the bodies, the overlap, their approach
 //! speed and the fix; a smaller dt is the fix only when the approach per step is a sizeable
-//! part of the radius (above [`STEP_FRACTION`]).
+//! part of the radius (above [`STEP_FRACTION`]) and no load is beyond what the bodies carry
+//! (`load_cause`: at ±400 m/s the rubber blocks meet at twice their wave speed, and the
+//! velocity, not the step, is named).
 //!
 //! What it does not see: a sphere that slips between two spheres of the other body (the
 //! spheres sit at the surface vertices only, and leave gaps where the vertices are more than
@@ -25,6 +27,7 @@
 //! watch (each rank sees only its own contacts).
 
 use crate::build::{BodyInfo, Simulation};
+use crate::run::load_cause::load_cause;
 use qdem_core::Vec3;
 use thiserror::Error;
 
@@ -137,7 +140,9 @@ impl ContactWatch {
         let radius = self.radius[a].min(self.radius[b]);
         let dt = sim.world.dt();
         let fraction = speed * dt / radius;
-        let fix = if fraction > STEP_FRACTION {
+        let fix = if let Some(cause) = load_cause(sim) {
+            cause
+        } else if fraction > STEP_FRACTION {
             format!(
                 "fix: a smaller step, dt <= {:.3e} s (a tenth of the radius per step at this \
                  speed), or a lower speed",

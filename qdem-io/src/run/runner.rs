@@ -12,6 +12,7 @@ use crate::output::{FolderLock, LockError, OutputError};
 use crate::run::contact_watch::{ContactWatch, Interpenetration};
 use crate::run::fresh_start;
 use crate::run::inputs::SceneFingerprint;
+use crate::run::load_cause::load_cause;
 use crate::run::record::schedule::{probe_interval, Schedule};
 use crate::run::record::{self, Recorder, RunFigures, StateRead, StepInfo};
 use crate::run::run_record::{decode_run, decode_world, encode_run, RunRecord};
@@ -599,8 +600,12 @@ fn encode(
 }
 
 /// A core error of `sim`'s run (an instability found by the world's failure check among
-/// them: [`CoreError::Unstable`]), naming the scene.
-fn core_error(sim: &Simulation, source: CoreError) -> RunError {
+/// them: [`CoreError::Unstable`], whose cause is the load when a load no step resolves
+/// caused it: [`load_cause`]), naming the scene.
+fn core_error(sim: &Simulation, mut source: CoreError) -> RunError {
+    if let CoreError::Unstable { cause, .. } = &mut source {
+        *cause = load_cause(sim).map(Box::new);
+    }
     RunError::Core {
         scene: sim.scene.path.clone(),
         source,

@@ -56,7 +56,7 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "[run]",
         "dt",
         "number or \"auto\", optional",
-        "Time step: `\"auto\"` (default) or a fixed number of seconds.",
+        "Time step: `\"auto\"` (default) or a fixed number of seconds (a normal number: a subnormal one such as 1e-320 is refused).",
     ),
     key(
         "[run]",
@@ -86,13 +86,13 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "[run]",
         "beta",
         "number, optional",
-        "Newmark β (paper 001 Eq. 13), for `integrator = \"newmark\"`; default ¼ (average acceleration, implicit). β = 0 with γ = ½ is explicit central difference.",
+        "Newmark β (paper 001 Eq. 13), for `integrator = \"newmark\"` only (refused with another integrator, where it would do nothing); default ¼ (average acceleration, implicit). β = 0 with γ = ½ is explicit central difference.",
     ),
     key(
         "[run]",
         "gamma",
         "number, optional",
-        "Newmark γ (paper 001 Eq. 14), for `integrator = \"newmark\"`; default ½.",
+        "Newmark γ (paper 001 Eq. 14), for `integrator = \"newmark\"` only (refused with another integrator); default ½.",
     ),
     key(
         "[run]",
@@ -662,7 +662,7 @@ pub const SCENE_KEYS: &[SceneKey] = &[
         "[granular]",
         "count",
         "integer, optional",
-        "Generation: number of stones.",
+        "Generation: number of stones, at least 1.",
     ),
     key(
         "[granular]",

@@ -37,11 +37,13 @@ pub struct Run {
     /// [`Run::DEFAULT_DT_SAFETY`].
     #[serde(default = "default_dt_safety")]
     pub dt_safety: f64,
-    /// Newmark β (paper 001 Eq. 13), for `integrator = "newmark"`; default ¼ (average
-    /// acceleration, implicit). β = 0 with γ = ½ is explicit central difference.
+    /// Newmark β (paper 001 Eq. 13), for `integrator = "newmark"` only (refused with another
+    /// integrator); default ¼ (average acceleration, implicit). β = 0 with γ = ½ is explicit
+    /// central difference.
     #[serde(default = "default_beta")]
     pub beta: f64,
-    /// Newmark γ (paper 001 Eq. 14), for `integrator = "newmark"`; default ½.
+    /// Newmark γ (paper 001 Eq. 14), for `integrator = "newmark"` only (refused with another
+    /// integrator); default ½.
     #[serde(default = "default_gamma")]
     pub gamma: f64,
     /// Start from the state in this checkpoint (written by another scene with the same bodies,
@@ -900,7 +902,7 @@ pub struct Granular {
     /// Generation: the box filled with stones on a loose lattice (m).
     #[serde(default)]
     pub region: Option<[[f64; 3]; 2]>,
-    /// Generation: number of stones.
+    /// Generation: number of stones, at least 1.
     #[serde(default)]
     pub count: Option<usize>,
     /// Generation: the grading curve, (sieve size m, fraction passing) points.

@@ -102,6 +102,12 @@ impl SpanIndex {
         }
     }
 
+    /// Whether the document writes the key at exactly `path`.
+    pub fn has(&self, path: &[&str]) -> bool {
+        let owned: Vec<String> = path.iter().map(|s| s.to_string()).collect();
+        self.get(&owned).is_some()
+    }
+
     /// Whether `path` is a table (including an element of an array of tables).
     pub fn is_table(&self, path: &[String]) -> bool {
         self.get(path).is_some_and(|e| e.is_table)

@@ -55,6 +55,12 @@ impl<'a> Checker<'a> {
             .map(|_| self.line_starts.partition_point(|&start| start <= offset))
     }
 
+    /// Whether the scene text writes the key at `at` (false for a scene built in code, which
+    /// has no text: its keys hold their defaults or what the code set).
+    pub(super) fn given(&self, at: &[&str]) -> bool {
+        self.spans.is_some_and(|s| s.has(at))
+    }
+
     pub(super) fn error(&mut self, at: &[&str], message: String) {
         let offset = self.offset(at);
         self.found.push((offset, message));

@@ -348,7 +348,14 @@ fn cyclic_load(c: &mut Checker<'_>, idx: &str, l: &str, cyclic: &CyclicLoad, has
         phase_deg,
         start,
     } = *cyclic;
-    c.finite(&at, l, "cyclic", &[min, max, phase_deg, start]);
+    for (key, value) in [
+        ("min", min),
+        ("max", max),
+        ("phase_deg", phase_deg),
+        ("start", start),
+    ] {
+        c.finite(&at, l, &format!("cyclic.{key}"), &[value]);
+    }
     if min > max {
         c.error(
             &at,

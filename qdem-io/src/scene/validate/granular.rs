@@ -1,6 +1,6 @@
 //! `[granular]`: a defined material, a `[contact]` table and no `[bonded]` body (what it shares
 //! with `[ballast]`, [`stone_table`]); a `sample` file or a generation (`region`, `count` and
-//! `grading`, `spheres_per_stone` in order), boxes with the upper corner above the lower one,
+//! `grading`, `count` at least 1, `spheres_per_stone` in order), boxes with the upper corner above the lower one,
 //! at least one translation in `copies` (more only with a sample), finite initial velocities
 //! (the `region_` ones only with a generation).
 
@@ -38,6 +38,16 @@ pub(super) fn granular_table(
             c.error(
                 &["granular"],
                 format!("{l}: generating stones needs all of `region`, `count` and `grading`"),
+            );
+        }
+        if g.count == Some(0) {
+            c.error(
+                &["granular", "count"],
+                format!(
+                    "{l}: count = 0 generates no stone, so `region`, `count` and `grading` do \
+                     nothing; fix: give count >= 1 (or, with a `sample`, remove all three to use \
+                     the sample alone)"
+                ),
             );
         }
         let [lo, hi] = g.spheres_per_stone;
