@@ -128,9 +128,7 @@ impl DemContacts {
                 WallShape::Plane(p) => Some(-p.distance(&x, time)).filter(|d| *d > 0.0),
                 WallShape::Mesh(m) => m.depth_inside(&x, time).or_else(|| {
                     let from = x - self.moved_since_build(s);
-                    since
-                        .filter(|&t0| m.crossed((&from, t0), (&x, time)))
-                        .map(|_| 0.0)
+                    m.crossed((&from, since?), (&x, time)).then_some(0.0)
                 }),
             };
             depth.map(|depth| Passage::Wall {
@@ -141,8 +139,12 @@ impl DemContacts {
         })
     }
 
-    /// Sphere `s`'s displacement since the last build (the minimum image when periodic).
+    /// Sphere `s`'s displacement since the last build (the minimum image when periodic);
+    /// zero before the lists were built.
     fn moved_since_build(&self, s: usize) -> Vec3 {
+        if !self.lists_built() {
+            return Vec3::zeros();
+        }
         let d = self.center[s] - self.built_at[s];
         match &self.periodic {
             Some(p) => d + p.image_shift(&d),
