@@ -467,3 +467,67 @@ fn an_implicit_run_and_the_other_commands_are_refused_on_two_ranks() {
     assert!(!ok);
     assert!(err.contains("`qdem modes` runs as one process"), "{err}");
 }
+
+/// The first line of the error of `qdem run` of `scene` into `out` on `ranks` processes
+/// (one without mpirun for 0), which must fail.
+fn failed_run(scene: &Path, out: &Path, ranks: usize) -> String {
+    let scene = scene.to_str().unwrap();
+    let out = out.to_str().unwrap();
+    let args = ["run", scene, "--out", out, "--threads", "1"];
+    let output = match ranks {
+        0 => Command::new(QDEM).args(args).output(),
+        n => Command::new("mpirun")
+            .args([
+                "--oversubscribe",
+                "--bind-to",
+                "none",
+                "-np",
+                &n.to_string(),
+            ])
+            .arg(QDEM)
+            .args(args)
+            .envs(MPI_ENV)
+            .output(),
+    }
+    .expect("start qdem (is mpirun installed?)");
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert!(!output.status.success(), "{ranks} ranks: it ran to the end");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    stderr
+        .lines()
+        .find(|l| l.starts_with("error:"))
+        .unwrap_or_else(|| panic!("{ranks} ranks: no error in:\n{stderr}"))
+        .to_string()
+}
+
+/// The deformable cubes' collision with `left` dropped at 40 m/s onto the ramp: every rank
+/// checks the spheres it owns at each rebuild of the lists, and all of them stop at the step
+/// one process stops at (on main the block went through the slab on any number of ranks).
+#[test]
+fn a_block_through_a_mesh_wall_is_stopped_on_any_number_of_ranks() {
+    let fixture = "contact/collision.toml";
+    let edits = [
+        ("t_end = ", "t_end = 0.01"),
+        ("rigid = ", "rigid = false"),
+        ("velocity = [4.0", "velocity = [0.0, 0.0, -40.0]"),
+    ];
+    let scene = ShortScene::edited(fixture, "through-wall", &edits);
+    let tmp = TempDir::new("mpi-through-wall");
+    let at_step = |line: &str| {
+        let from = line.find("passes through at step").expect("the report");
+        line[from..].split(':').next().unwrap().to_string()
+    };
+    let one = failed_run(&scene.0, &tmp.path().join("one"), 0);
+    for ranks in [2, 3] {
+        let many = failed_run(&scene.0, &tmp.path().join(format!("r{ranks}")), ranks);
+        assert!(
+            many.contains("body `left`") && many.contains("wall #1"),
+            "{many}"
+        );
+        assert_eq!(
+            at_step(&many),
+            at_step(&one),
+            "{ranks} ranks:\n{many}\n{one}"
+        );
+    }
+}

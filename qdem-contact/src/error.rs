@@ -82,6 +82,25 @@ pub enum ContactError {
         /// Centre of the sphere.
         at: [f64; 3],
     },
+    /// A body starts inside another body or a mesh wall.
+    #[error(
+        "body `{body}` starts inside {inside}: the centre of its contact sphere at {at:?} is \
+         {depth:.3e} m inside it (the sphere radius is {radius:.3e} m), where no contact \
+         holds the two apart; fix: place it outside {inside} (a [[body]]'s `translate`, a \
+         stone's rows in the sample)"
+    )]
+    InitialInside {
+        /// The body.
+        body: String,
+        /// What it is inside: "body `name`" or "wall #k".
+        inside: String,
+        /// How far inside (m).
+        depth: f64,
+        /// The sphere radius (m).
+        radius: f64,
+        /// Centre of the sphere.
+        at: [f64; 3],
+    },
     /// A triangulated wall parry3d could not build.
     #[error("wall `{wall}`: its triangle mesh is unusable: {reason}")]
     MeshWall {

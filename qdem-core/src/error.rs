@@ -216,6 +216,20 @@ pub enum CoreError {
         /// bound. Boxed (a thin pointer) to keep the error as small as it was without it.
         cause: Option<Box<String>>,
     },
+    /// A contact sphere went through a wall or into another body, found by the contact
+    /// model's pass-through check ([`crate::Model::failure`]): the step may be stable and
+    /// the result still wrong.
+    #[error("a body passes through at step {step} (t = {time:.6e} s, dt = {dt:.4e} s): {detail}")]
+    PassThrough {
+        /// The step that found it (1 for the first).
+        step: u64,
+        /// Simulated time after it.
+        time: f64,
+        /// The step size.
+        dt: f64,
+        /// The sphere, the wall or body, its speed and the fixes.
+        detail: String,
+    },
     /// The sparse linear algebra failed for a reason other than definiteness.
     #[error("sparse factorisation failed: {0}")]
     Sparse(String),

@@ -133,6 +133,9 @@ impl DemContacts {
             split: None,
             rebuilt: false,
             servos: Vec::new(),
+            surfaces: Vec::new(),
+            pass_through: None,
+            step: 0.0,
         }
     }
 

@@ -38,7 +38,8 @@
 //! `scatter.rs` its fused pass; `views.rs` what the outputs read; `persistence.rs` what a checkpoint
 //! keeps; `modal_springs.rs` the touching contacts as springs for a modal analysis;
 //! `split.rs` one rank's part in a decomposed run, whose stages the world's exchange runs
-//! ([`qdem_core::parallel`]).
+//! ([`qdem_core::parallel`]); `tunnelling.rs` the check, at each rebuild of the lists, for a
+//! sphere gone through a wall or into another body.
 
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
@@ -60,6 +61,7 @@ use scatter::{add_sum, add_to, pair_share, wall_share, ScatterPlan};
 use split::ContactPart;
 
 pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
+pub use tunnelling::BodySurface;
 
 mod build;
 mod displacement;
@@ -69,6 +71,7 @@ mod pipeline;
 mod scatter;
 mod servo;
 mod split;
+mod tunnelling;
 mod views;
 
 /// Marks a sphere that is no part of a rigid body, or whose moments go nowhere.
@@ -260,6 +263,12 @@ pub struct DemContacts {
     rebuilt: bool,
     /// The stress-controlled walls' servos, by wall (`servo.rs`); empty when none.
     servos: Vec<Option<servo::ServoWall>>,
+    /// The closed surfaces of the bodies built from meshes (`tunnelling.rs`).
+    surfaces: Vec<BodySurface>,
+    /// The report of the first sphere found through a wall or inside another body.
+    pass_through: Option<String>,
+    /// The run's step (s), for that report's fix; 0 until [`Model::prepare`].
+    step: f64,
 }
 
 /// A time-delayed periodic boundary along one periodic axis, and its latest state.
@@ -308,6 +317,7 @@ impl Model for DemContacts {
             if !read_every {
                 self.read_every_center(state);
             }
+            self.check_passage(state.time, None);
             self.rebuild_all(state.time);
             self.anchor(state, 0.0);
             if !read_every {
@@ -397,6 +407,16 @@ impl Model for DemContacts {
 
     fn persistence(&self) -> Persistence<'_> {
         Persistence::Saved(self)
+    }
+
+    fn prepare(&mut self, stepping: &qdem_core::Stepping) {
+        self.step = stepping.dt;
+    }
+
+    /// A sphere found through a wall or inside another body at the last rebuild of the
+    /// lists (`tunnelling.rs`).
+    fn failure(&self, state: &State) -> Option<qdem_core::CoreError> {
+        self.passage_failure(state.time)
     }
 
     fn persistent_mut(&mut self) -> Option<&mut dyn Persistent> {

@@ -262,6 +262,7 @@ impl SplitModel for DemContacts {
 
     fn rebuild(&mut self, time: f64) {
         self.with_part(|this, part| {
+            this.check_passage(time, Some(&part.own));
             this.rebuild_near(part, time);
             part.lists_changed = true;
         });

@@ -8,8 +8,10 @@
 //! 2. the **failure check**: a non-finite acceleration, a model's
 //!    [`Model::failure`] (an inverted tetrahedron) or a kinetic energy growing like an
 //!    unstable step's ([`crate::step::instability::EnergyGrowth`]) stops the run with
-//!    [`CoreError::Unstable`], which names the stable bound at that state;
-//!    in a run decomposed over processes ([`World::decompose`]) the ranks agree on it;
+//!    [`CoreError::Unstable`], which names the stable bound at that state, and a contact
+//!    sphere through a wall or into a body (the contacts' failure) with
+//!    [`CoreError::PassThrough`]; in a run decomposed over processes
+//!    ([`World::decompose`]) the ranks agree on it;
 //! 3. the **post-step hooks** ([`PostStep`]) in the order they were added: periodic wrapping
 //!    of bodies, a bonded body's collapse watch; a hook may [`Halt`] the run.
 //!
@@ -34,6 +36,10 @@ use crate::step::stages::{Stage, StageShare, StageTimes};
 use crate::step::step_settings::StepSettings;
 use crate::step::stepper::{stable_step, Stepper};
 use std::sync::Arc;
+
+/// Marks a model's [`CoreError::PassThrough`] in the text the ranks agree on, so that the
+/// failure check reports it as itself rather than as an unstable step.
+const PASS_THROUGH: &str = "\u{1}pass through\u{1}";
 
 /// Something a world does after every step, once the step has passed the failure check:
 /// periodic wrapping of bodies, a watch that ends the run when a body has failed.
@@ -344,7 +350,10 @@ impl World {
                 .models
                 .iter()
                 .find_map(|m| m.failure(&self.state))
-                .map(|e| e.to_string()),
+                .map(|e| match e {
+                    CoreError::PassThrough { detail, .. } => format!("{PASS_THROUGH}{detail}"),
+                    e => e.to_string(),
+                }),
         };
         let failure = self.exchange.agree(local);
         let kinetic = self.exchange.kinetic_energy(&self.state);
@@ -362,6 +371,14 @@ impl World {
             return Ok(());
         };
         self.gather();
+        if let Some(detail) = detail.strip_prefix(PASS_THROUGH) {
+            return Err(CoreError::PassThrough {
+                step: self.steps_done,
+                time: self.state.time,
+                dt: self.settings.dt,
+                detail: detail.to_string(),
+            });
+        }
         let (bound, limiter) = stable_step(&self.state, &self.models)
             .unwrap_or((f64::INFINITY, "nothing".to_string()));
         Err(CoreError::Unstable {

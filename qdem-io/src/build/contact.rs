@@ -8,6 +8,7 @@ use super::ballast::BallastInfo;
 use crate::build::{BuildError, PlacedMesh};
 use crate::scene::{Contact, ContactLawName, Scene};
 use qdem_contact::broad_phase::bounds;
+use qdem_contact::dem_contacts::BodySurface;
 use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, LinearSpring, MeshWall,
     PeriodicBox, PlaneWall, Wall, WallShape,
@@ -49,7 +50,7 @@ pub(crate) fn build_contacts(
     let Some(contact) = &scene.contact else {
         return Ok(None);
     };
-    let mut spheres = contact_spheres(scene, meshes)?;
+    let (mut spheres, surfaces) = contact_spheres(scene, meshes)?;
     spheres.extend(extra.spheres);
     let single_body = spheres.windows(2).all(|w| w[0].body == w[1].body);
     if spheres.is_empty() || (single_body && scene.walls.is_empty()) {
@@ -76,7 +77,8 @@ pub(crate) fn build_contacts(
         .map(|b| b.name.clone())
         .chain(extra.names)
         .collect();
-    let mut model = DemContacts::new(state, &spheres, names, &materials, settings, walls);
+    let mut model = DemContacts::new(state, &spheres, names, &materials, settings, walls)
+        .with_body_surfaces(surfaces);
     if let (Some(cell), Some(periodic)) = (extra.periodic, &scene.periodic) {
         model = super::periodic::periodic_contacts(scene, periodic, &cell, model)?;
     }
@@ -92,6 +94,7 @@ pub(crate) fn build_contacts(
     model
         .check_initial_overlaps(state, contact.overlap_tolerance)
         .map_err(contact_error)?;
+    model.check_initial_passage(state).map_err(contact_error)?;
     Ok(Some(model))
 }
 
@@ -108,10 +111,14 @@ fn law(contact: &Contact) -> ContactLaw {
     }
 }
 
-/// A sphere at every surface vertex of every body with a contact radius; refuses a radius
-/// larger than half the body's smallest extent.
-fn contact_spheres(scene: &Scene, meshes: &[PlacedMesh]) -> Result<Vec<ContactSphere>, BuildError> {
-    let mut spheres = Vec::new();
+/// A sphere at every surface vertex of every body with a contact radius, and each such
+/// body's surface as triangles of its spheres; refuses a radius larger than half the body's
+/// smallest extent.
+fn contact_spheres(
+    scene: &Scene,
+    meshes: &[PlacedMesh],
+) -> Result<(Vec<ContactSphere>, Vec<BodySurface>), BuildError> {
+    let (mut spheres, mut surfaces) = (Vec::new(), Vec::new());
     let materials = &scene.refs().body_materials;
     for (b, (body, &material)) in scene.bodies.iter().zip(materials).enumerate() {
         let Some(radius) = body.contact_radius else {
@@ -128,20 +135,32 @@ fn contact_spheres(scene: &Scene, meshes: &[PlacedMesh]) -> Result<Vec<ContactSp
                 limit: 0.5 * extent,
             });
         }
-        spheres.extend(
-            placed
-                .mesh
-                .surface_nodes()
-                .into_iter()
-                .map(|n| ContactSphere {
-                    particle: placed.particles.start + n as usize,
-                    radius,
-                    body: b,
-                    material,
-                }),
-        );
+        let nodes = placed.mesh.surface_nodes();
+        surfaces.push(surface(
+            b,
+            spheres.len(),
+            &nodes,
+            &placed.mesh.surface_triangles(),
+        ));
+        spheres.extend(nodes.into_iter().map(|n| ContactSphere {
+            particle: placed.particles.start + n as usize,
+            radius,
+            body: b,
+            material,
+        }));
     }
-    Ok(spheres)
+    Ok((spheres, surfaces))
+}
+
+/// Body `body`'s surface `triangles` (of mesh nodes) as triangles of its spheres, the first
+/// of which is sphere `first`, one per node of `nodes` (sorted).
+fn surface(body: usize, first: usize, nodes: &[u32], triangles: &[[u32; 3]]) -> BodySurface {
+    let local = |n: u32| nodes.binary_search(&n).expect("a surface node") as u32;
+    BodySurface {
+        body,
+        spheres: (first..first + nodes.len()).map(|s| s as u32).collect(),
+        triangles: triangles.iter().map(|t| t.map(local)).collect(),
+    }
 }
 
 fn smallest_extent(nodes: &[[f64; 3]]) -> f64 {

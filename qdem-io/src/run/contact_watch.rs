@@ -15,9 +15,10 @@
 //!
 //! What it does not see: a sphere that slips between two spheres of the other body (the
 //! spheres sit at the surface vertices only, and leave gaps where the vertices are more than
-//! two radii apart) without ever overlapping one by a radius; a search of every sphere
-//! against the other body's tetrahedra would, at a cost per step. No normal run comes near
-//! the test: the deepest overlap of the fixture scenes is a fraction of a radius
+//! two radii apart) without ever overlapping one by a radius: the contacts' pass-through
+//! check (`qdem-contact/src/dem_contacts/tunnelling.rs`, at each rebuild of the lists) stops
+//! that once the sphere is deeper than its radius in the other body. No normal run comes
+//! near the test: the deepest overlap of the fixture scenes is a fraction of a radius
 //! (docs/reliability.md). Reading the contacts changes nothing in the state, so outputs stay
 //! the same. It watches the scenes of two or more `[[body]]`s with contact spheres and no
 //! `[granular]` or `[ballast]` stones: reading every touching contact after every step
