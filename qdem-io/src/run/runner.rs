@@ -601,15 +601,29 @@ fn encode(
 
 /// A core error of `sim`'s run (an instability found by the world's failure check among
 /// them: [`CoreError::Unstable`], whose cause is the load when a load no step resolves
-/// caused it: [`load_cause`]), naming the scene.
+/// caused it: [`load_cause`]; a [`CoreError::PassThrough`] then names that cause in place of
+/// its fixes), naming the scene.
 fn core_error(sim: &Simulation, mut source: CoreError) -> RunError {
-    if let CoreError::Unstable { cause, .. } = &mut source {
-        *cause = load_cause(sim).map(Box::new);
+    match &mut source {
+        CoreError::Unstable { cause, .. } => *cause = load_cause(sim).map(Box::new),
+        CoreError::PassThrough { detail, .. } => {
+            if let Some(cause) = load_cause(sim) {
+                *detail = with_cause(detail, &cause);
+            }
+        }
+        _ => {}
     }
     RunError::Core {
         scene: sim.scene.path.clone(),
         source,
     }
+}
+
+/// A pass-through report whose fixes (from `Fix:` on) are replaced by the load `cause` that
+/// no step resolves: a smaller dt, which the report would advise, cannot help there.
+fn with_cause(detail: &str, cause: &str) -> String {
+    let what = detail.split_once(" Fix: ").map_or(detail, |(what, _)| what);
+    format!("{what} {cause}")
 }
 
 fn progress_at(step: u64, steps: u64, time: f64, start: Instant) -> Progress {
