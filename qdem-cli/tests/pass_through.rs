@@ -192,23 +192,6 @@ dir = "out"
     path
 }
 
-/// The last value of column `column` of a run's `probes.csv`.
-fn last_probe(out: &Path, column: &str) -> f64 {
-    let text = std::fs::read_to_string(out.join("probes.csv")).expect("probes.csv");
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
-    let at = header
-        .iter()
-        .position(|h| *h == column)
-        .expect("the column");
-    let row = lines.last().expect("a row");
-    row.split(',')
-        .nth(at)
-        .expect("the value")
-        .parse()
-        .expect("a number")
-}
-
 /// A 5 × 5 grid of stone centres 20 mm apart over the block's top face, at height `z`.
 fn grid(z: f64) -> Vec<[f64; 3]> {
     let at = [-0.04, -0.02, 0.0, 0.02, 0.04];
@@ -252,7 +235,7 @@ fn stones_falling_between_a_blocks_spheres_are_stopped() {
         "{}",
         String::from_utf8_lossy(&done.stderr)
     );
-    let height = 0.14 + last_probe(&out, "stone.uz");
+    let height = 0.14 + common::last_probe(&out, "stone.uz");
     assert!(height > 0.1085, "the stone ended at z = {height} m");
 }
 

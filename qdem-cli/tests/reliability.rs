@@ -42,23 +42,6 @@ fn refused(out: &Output, needles: &[&str]) -> String {
     stderr
 }
 
-/// The last value of column `column` of a run's `probes.csv`.
-fn last_probe(out: &Path, column: &str) -> f64 {
-    let text = std::fs::read_to_string(out.join("probes.csv")).expect("probes.csv");
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
-    let at = header
-        .iter()
-        .position(|h| *h == column)
-        .expect("the column");
-    let last = lines.last().expect("a row");
-    last.split(',')
-        .nth(at)
-        .expect("the value")
-        .parse()
-        .expect("a number")
-}
-
 #[test]
 fn a_second_run_into_a_held_folder_is_refused_and_a_lock_nobody_holds_is_taken_over() {
     let tmp = TempDir::new("lock");
@@ -484,7 +467,7 @@ fn duplicate_nodes_are_reported_and_merged_on_request() {
     let out = tmp.path().join("out-detached");
     let done = run(&detached, &out);
     assert!(String::from_utf8_lossy(&done.stderr).contains("4 nodes coincide"));
-    let loose = last_probe(&out, "tip.uz");
+    let loose = common::last_probe(&out, "tip.uz");
 
     let merged = tmp.path().join("merged.toml");
     std::fs::write(&merged, bar_scene(true)).unwrap();
@@ -493,7 +476,7 @@ fn duplicate_nodes_are_reported_and_merged_on_request() {
     let out = tmp.path().join("out-merged");
     let done = run(&merged, &out);
     assert!(done.status.success());
-    let held = last_probe(&out, "tip.uz");
+    let held = common::last_probe(&out, "tip.uz");
 
     // Detached, the outer half is a free body under the tip load: small rigid motion from
     // rest, with the lumped masses the run uses (a quarter of each tetrahedron's mass at each

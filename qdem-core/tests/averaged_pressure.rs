@@ -45,30 +45,9 @@ fn forces_match_the_tangent_and_the_standard_kernel_under_homogeneous_strain() {
         assert!((x - y).norm() < 1e-9 * scale, "{x} vs {y}");
     }
     // A small irregular displacement against −K u.
-    let u: Vec<Vec3> = (0..state.len())
-        .map(|i| {
-            let t = i as f64;
-            Vec3::new((1.3 * t).sin(), (0.7 * t).cos(), (2.1 * t).sin()) * 1e-7
-        })
-        .collect();
-    for ((x, r), d) in state.position.iter_mut().zip(&state.reference).zip(&u) {
-        *x = r + d;
-    }
+    let u = displace_irregularly(&mut state);
     let f = forces(&mut a, &state);
-    let mut tangent = qdem_core::Tangent::new();
-    qdem_core::Linearized::add_tangent(
-        &averaged,
-        &State::at_rest(state.reference.clone()),
-        &mut tangent,
-    );
-    let mut ku = vec![Vec3::zeros(); state.len()];
-    for e in tangent.stiffness_entries() {
-        let (r, c) = (e.row, e.col);
-        ku[r / 3][r % 3] += e.val * u[c / 3][c % 3];
-        if r != c {
-            ku[c / 3][c % 3] += e.val * u[r / 3][r % 3];
-        }
-    }
+    let ku = tangent_times(&averaged, &state.reference, &u);
     let scale = ku.iter().map(|f| f.norm()).fold(0.0, f64::max);
     for (f, k) in f.iter().zip(&ku) {
         // Second order in u: the Green strain's quadratic term, ~|∇u| ≈ 1e-6 relative.
@@ -173,15 +152,7 @@ fn a_decomposed_run_refuses_the_averaged_pressure_body_by_name() {
 fn reported_stress_gives_the_bodys_own_forces() {
     let mesh = structured_box([0.0; 3], [1.0, 0.7, 0.5], [4, 3, 3]).unwrap();
     let (mut state, body) = body(&mesh, 0.499, Formulation::AveragedPressure);
-    let u: Vec<Vec3> = (0..state.len())
-        .map(|i| {
-            let t = i as f64;
-            Vec3::new((1.3 * t).sin(), (0.7 * t).cos(), (2.1 * t).sin()) * 1e-7
-        })
-        .collect();
-    for ((x, r), d) in state.position.iter_mut().zip(&state.reference).zip(&u) {
-        *x = r + d;
-    }
+    let u = displace_irregularly(&mut state);
     let mut model = body.clone();
     let mut forces = vec![Vec3::zeros(); state.len()];
     model.add_forces(&state, &mut forces, &mut []);
@@ -193,13 +164,36 @@ fn reported_stress_gives_the_bodys_own_forces() {
         assert!((f + g).norm() < 1e-9 * scale, "{f} vs {}", -g);
     }
 
+    let ku = tangent_times(&body, &state.reference, &u);
+    let small = body.small_strain_stresses(&state);
+    let from_small = assemble(&mesh.tets, &state.reference, &small);
+    let scale = ku.iter().map(|f| f.norm()).fold(0.0, f64::max);
+    for (k, g) in ku.iter().zip(&from_small) {
+        assert!((k - g).norm() < 1e-9 * scale, "K u {k} vs Σ V σ ∇N {g}");
+    }
+}
+
+/// Moves every particle of `state` by a small irregular displacement (about 1e-7 m) from its
+/// reference position; returns the displacements.
+fn displace_irregularly(state: &mut State) -> Vec<Vec3> {
+    let u: Vec<Vec3> = (0..state.len())
+        .map(|i| {
+            let t = i as f64;
+            Vec3::new((1.3 * t).sin(), (0.7 * t).cos(), (2.1 * t).sin()) * 1e-7
+        })
+        .collect();
+    for ((x, r), d) in state.position.iter_mut().zip(&state.reference).zip(&u) {
+        *x = r + d;
+    }
+    u
+}
+
+/// K u of `body`'s small-strain tangent at its reference positions `reference` (the
+/// tangent's lower triangle, each off-diagonal entry acting both ways).
+fn tangent_times(body: &TetBody, reference: &[Vec3], u: &[Vec3]) -> Vec<Vec3> {
     let mut tangent = qdem_core::Tangent::new();
-    qdem_core::Linearized::add_tangent(
-        &body,
-        &State::at_rest(state.reference.clone()),
-        &mut tangent,
-    );
-    let mut ku = vec![Vec3::zeros(); state.len()];
+    qdem_core::Linearized::add_tangent(body, &State::at_rest(reference.to_vec()), &mut tangent);
+    let mut ku = vec![Vec3::zeros(); u.len()];
     for e in tangent.stiffness_entries() {
         let (r, c) = (e.row, e.col);
         ku[r / 3][r % 3] += e.val * u[c / 3][c % 3];
@@ -207,12 +201,7 @@ fn reported_stress_gives_the_bodys_own_forces() {
             ku[c / 3][c % 3] += e.val * u[r / 3][r % 3];
         }
     }
-    let small = body.small_strain_stresses(&state);
-    let from_small = assemble(&mesh.tets, &state.reference, &small);
-    let scale = ku.iter().map(|f| f.norm()).fold(0.0, f64::max);
-    for (k, g) in ku.iter().zip(&from_small) {
-        assert!((k - g).norm() < 1e-9 * scale, "K u {k} vs Σ V σ ∇N {g}");
-    }
+    ku
 }
 
 /// Σ_e V_e σ_e ∇N_a per particle a, the shape functions' gradients and volumes at `x`: the

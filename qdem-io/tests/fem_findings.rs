@@ -214,7 +214,8 @@ fn node_reactions_sum_to_the_fix_and_name_the_gmsh_nodes() {
         lines.next().unwrap(),
         "time,fix,gmsh_node_id,particle,x,y,z,fx,fy,fz"
     );
-    let msh = msh_nodes(&fixture("msh/box_gmsh22_ascii.msh"));
+    let msh_text = std::fs::read_to_string(fixture("msh/box_gmsh22_ascii.msh")).unwrap();
+    let (msh, _) = common::parse_msh22(&msh_text);
     let mut sums = [[0.0f64; 3]; 2];
     let mut rows = 0;
     let last_time = text
@@ -260,18 +261,4 @@ fn node_reactions_sum_to_the_fix_and_name_the_gmsh_nodes() {
             );
         }
     }
-}
-
-/// The nodes of an ASCII MSH 2.2 file by their tag.
-fn msh_nodes(path: &Path) -> std::collections::HashMap<i64, [f64; 3]> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let block = &text[text.find("$Nodes").unwrap()..text.find("$EndNodes").unwrap()];
-    block
-        .lines()
-        .skip(2)
-        .map(|l| {
-            let v: Vec<f64> = l.split_whitespace().map(|s| s.parse().unwrap()).collect();
-            (v[0] as i64, [v[1], v[2], v[3]])
-        })
-        .collect()
 }

@@ -16,7 +16,6 @@ use common::{fixture, test_dir};
 use qdem_io::build::Simulation;
 use qdem_io::runner::run;
 use qdem_io::scene::Scene;
-use std::collections::HashMap;
 use std::path::Path;
 
 const P: f64 = 1.0e6;
@@ -51,51 +50,6 @@ fn run_block(scene: Scene, dir: &Path) -> (Simulation, std::path::PathBuf, serde
     (sim, out, serde_json::from_str(&summary).unwrap())
 }
 
-/// The 8-byte values of the binary `<DataArray>` called `name` of a VTU written by qdem
-/// (base64 of a u64 byte count, then the little-endian values).
-fn array(vtu: &str, name: &str) -> Vec<[u8; 8]> {
-    let start = vtu
-        .find(&format!("Name=\"{name}\""))
-        .unwrap_or_else(|| panic!("no array {name}"));
-    let text = &vtu[start..];
-    let body = &text[text.find('>').unwrap() + 1..text.find("</DataArray>").unwrap()];
-    let bytes = base64(body.trim());
-    bytes[8..]
-        .chunks_exact(8)
-        .map(|c| c.try_into().unwrap())
-        .collect()
-}
-
-fn floats(vtu: &str, name: &str) -> Vec<f64> {
-    array(vtu, name)
-        .into_iter()
-        .map(f64::from_le_bytes)
-        .collect()
-}
-
-fn integers(vtu: &str, name: &str) -> Vec<i64> {
-    array(vtu, name)
-        .into_iter()
-        .map(i64::from_le_bytes)
-        .collect()
-}
-
-/// Standard base64 (RFC 4648, `=` padding) decoded.
-fn base64(text: &str) -> Vec<u8> {
-    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let value = |c: u8| ALPHABET.iter().position(|&a| a == c).unwrap() as u32;
-    let mut out = Vec::new();
-    for group in text.as_bytes().chunks(4) {
-        let digits: Vec<u8> = group.iter().copied().filter(|&c| c != b'=').collect();
-        let n = digits
-            .iter()
-            .enumerate()
-            .fold(0u32, |n, (k, &c)| n | value(c) << (18 - 6 * k));
-        out.extend(n.to_be_bytes()[1..digits.len()].iter());
-    }
-    out
-}
-
 /// The largest difference of six-component tensors from −p eₓ⊗eₓ.
 fn worst_from_uniaxial(tensors: &[f64]) -> f64 {
     let want = [-P, 0.0, 0.0, 0.0, 0.0, 0.0];
@@ -119,7 +73,7 @@ fn a_static_run_writes_its_final_state_without_vtu_every() {
         vtu.contains("Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">1.0<"),
         "no TimeValue 1.0 in the VTU"
     );
-    let worst = worst_from_uniaxial(&floats(&vtu, "stress"));
+    let worst = worst_from_uniaxial(&common::vtu_array(&vtu, "stress"));
     assert!(worst <= 1e-9 * P, "largest stress error {worst:e} Pa");
     let pvd = std::fs::read_to_string(out.join("results.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet ").count(), 1, "{pvd}");
@@ -140,47 +94,12 @@ fn a_static_run_solves_once_per_distinct_load_level_at_times_as_given() {
         assert_eq!(summary["solves"], solves, "{ramp}");
         assert_eq!(summary["final_time"].as_f64(), Some(1.0), "{ramp}");
         let vtu = std::fs::read_to_string(out.join("vtu/state_00000.vtu")).unwrap();
-        let worst = worst_from_uniaxial(&floats(&vtu, "stress"));
+        let worst = worst_from_uniaxial(&common::vtu_array(&vtu, "stress"));
         assert!(
             worst <= 1e-9 * P,
             "{ramp}: largest stress error {worst:e} Pa"
         );
     }
-}
-
-/// The box's nodes (id to coordinates) and tetrahedra (id to node ids), from the MSH 2.2
-/// ASCII file itself.
-fn parse_msh22(text: &str) -> (HashMap<i64, [f64; 3]>, HashMap<i64, [i64; 4]>) {
-    let section = |name: &str| {
-        let start = text.find(&format!("${name}\n")).unwrap() + name.len() + 2;
-        let end = text.find(&format!("$End{name}")).unwrap();
-        text[start..end].lines().skip(1).collect::<Vec<_>>()
-    };
-    let numbers = |line: &str| -> Vec<f64> {
-        line.split_whitespace()
-            .map(|w| w.parse().unwrap())
-            .collect()
-    };
-    let nodes = section("Nodes")
-        .into_iter()
-        .map(|l| {
-            let v = numbers(l);
-            (v[0] as i64, [v[1], v[2], v[3]])
-        })
-        .collect();
-    let tets = section("Elements")
-        .into_iter()
-        .map(numbers)
-        .filter(|v| v[1] == 4.0)
-        .map(|v| {
-            let n = v.len();
-            (
-                v[0] as i64,
-                [v[n - 4], v[n - 3], v[n - 2], v[n - 1]].map(|x| x as i64),
-            )
-        })
-        .collect();
-    (nodes, tets)
 }
 
 /// The VTU's `gmsh_node_id` of every point is the file's node at the same coordinates, its
@@ -192,10 +111,10 @@ fn gmsh_ids_in_the_vtu_are_the_msh_files_after_reordering() {
     let dir = test_dir("static-gmsh-ids");
     let (sim, out, _) = run_block(pressed_block(&dir, "", ""), &dir);
     let (file_nodes, file_tets) =
-        parse_msh22(&std::fs::read_to_string(fixture("msh/box_gmsh22_ascii.msh")).unwrap());
+        common::parse_msh22(&std::fs::read_to_string(fixture("msh/box_gmsh22_ascii.msh")).unwrap());
     let vtu = std::fs::read_to_string(out.join("vtu/state_00000.vtu")).unwrap();
-    let points = floats(&vtu, "Points");
-    let node_ids = integers(&vtu, "gmsh_node_id");
+    let points = common::vtu_array(&vtu, "Points");
+    let node_ids = common::vtu_integers(&vtu, "gmsh_node_id");
     assert_eq!(node_ids.len(), sim.world.state.len());
     assert_eq!(node_ids.len(), file_nodes.len());
     let in_file_order: Vec<i64> = (1..=node_ids.len() as i64).collect();
@@ -203,8 +122,8 @@ fn gmsh_ids_in_the_vtu_are_the_msh_files_after_reordering() {
     for (p, id) in points.chunks(3).zip(&node_ids) {
         assert_eq!(p, file_nodes[id], "node {id}");
     }
-    let connectivity = integers(&vtu, "connectivity");
-    let element_ids = integers(&vtu, "gmsh_element_id");
+    let connectivity = common::vtu_integers(&vtu, "connectivity");
+    let element_ids = common::vtu_integers(&vtu, "gmsh_element_id");
     assert_eq!(element_ids.len(), file_tets.len());
     for (cell, id) in connectivity.chunks(4).zip(&element_ids) {
         let mut got: Vec<i64> = cell.iter().map(|&k| node_ids[k as usize]).collect();
@@ -213,7 +132,10 @@ fn gmsh_ids_in_the_vtu_are_the_msh_files_after_reordering() {
         want.sort_unstable();
         assert_eq!(got, want, "element {id}");
     }
-    assert_eq!(integers(&vtu, "physical_group"), vec![1; element_ids.len()]);
+    assert_eq!(
+        common::vtu_integers(&vtu, "physical_group"),
+        vec![1; element_ids.len()]
+    );
 }
 
 /// Under the uniform stress every node's volume-weighted average of the stresses around it
@@ -224,8 +146,8 @@ fn nodal_stress_of_a_uniform_stress_is_the_element_stress() {
     let dir = test_dir("static-nodal-stress");
     let (sim, out, _) = run_block(pressed_block(&dir, "", ""), &dir);
     let vtu = std::fs::read_to_string(out.join("vtu/state_00000.vtu")).unwrap();
-    let nodal = floats(&vtu, "nodal_stress");
-    let element = floats(&vtu, "stress");
+    let nodal = common::vtu_array(&vtu, "nodal_stress");
+    let element = common::vtu_array(&vtu, "stress");
     assert_eq!(nodal.len(), 6 * sim.world.state.len());
     let worst = worst_from_uniaxial(&nodal);
     eprintln!("nodal stress: largest error {:.2e} p", worst / P);

@@ -98,3 +98,20 @@ pub fn variant(fixture: &str, edits: &[(&str, &str)], tmp: &TempDir) -> PathBuf 
     std::fs::write(&out, pieces.join("\"")).expect("write the variant");
     out
 }
+
+/// The last value of column `column` of a run's `probes.csv`.
+pub fn last_probe(out: &Path, column: &str) -> f64 {
+    let text = std::fs::read_to_string(out.join("probes.csv")).expect("probes.csv");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let at = header
+        .iter()
+        .position(|h| *h == column)
+        .expect("the column");
+    let last = lines.last().expect("a row");
+    last.split(',')
+        .nth(at)
+        .expect("the value")
+        .parse()
+        .expect("a number")
+}

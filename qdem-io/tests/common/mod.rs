@@ -133,9 +133,9 @@ normal = [0.0, 0.0, 1.0]
     )
 }
 
-/// The values of the binary `<DataArray>` called `name` of a VTU written by qdem (base64 of
-/// a u64 byte count, then little-endian f64s).
-pub fn vtu_array(vtu: &str, name: &str) -> Vec<f64> {
+/// The 8-byte values of the binary `<DataArray>` called `name` of a VTU written by qdem
+/// (base64 of a u64 byte count, then the little-endian values).
+pub fn vtu_values(vtu: &str, name: &str) -> Vec<[u8; 8]> {
     let start = vtu
         .find(&format!("Name=\"{name}\""))
         .unwrap_or_else(|| panic!("no array {name}"));
@@ -144,8 +144,64 @@ pub fn vtu_array(vtu: &str, name: &str) -> Vec<f64> {
     let bytes = base64(body.trim());
     bytes[8..]
         .chunks_exact(8)
-        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .map(|c| c.try_into().unwrap())
         .collect()
+}
+
+/// The f64 values of the VTU array `name` ([`vtu_values`]).
+pub fn vtu_array(vtu: &str, name: &str) -> Vec<f64> {
+    vtu_values(vtu, name)
+        .into_iter()
+        .map(f64::from_le_bytes)
+        .collect()
+}
+
+/// The i64 values of the VTU array `name` ([`vtu_values`]).
+pub fn vtu_integers(vtu: &str, name: &str) -> Vec<i64> {
+    vtu_values(vtu, name)
+        .into_iter()
+        .map(i64::from_le_bytes)
+        .collect()
+}
+
+/// The nodes (id to coordinates) and linear tetrahedra (id to node ids) of an ASCII MSH 2.2
+/// file's text, read by hand.
+pub fn parse_msh22(
+    text: &str,
+) -> (
+    std::collections::HashMap<i64, [f64; 3]>,
+    std::collections::HashMap<i64, [i64; 4]>,
+) {
+    let section = |name: &str| {
+        let start = text.find(&format!("${name}\n")).unwrap() + name.len() + 2;
+        let end = text.find(&format!("$End{name}")).unwrap();
+        text[start..end].lines().skip(1).collect::<Vec<_>>()
+    };
+    let numbers = |line: &str| -> Vec<f64> {
+        line.split_whitespace()
+            .map(|w| w.parse().unwrap())
+            .collect()
+    };
+    let nodes = section("Nodes")
+        .into_iter()
+        .map(|l| {
+            let v = numbers(l);
+            (v[0] as i64, [v[1], v[2], v[3]])
+        })
+        .collect();
+    let tets = section("Elements")
+        .into_iter()
+        .map(numbers)
+        .filter(|v| v[1] == 4.0)
+        .map(|v| {
+            let n = v.len();
+            (
+                v[0] as i64,
+                [v[n - 4], v[n - 3], v[n - 2], v[n - 1]].map(|x| x as i64),
+            )
+        })
+        .collect();
+    (nodes, tets)
 }
 
 /// Standard base64 (RFC 4648, `=` padding) decoded.
