@@ -141,16 +141,8 @@ fn grid_mass_properties(stone: &Stone, density: f64, h: f64) -> MassProperties {
     // Centres relative to the anchor: the grid points are (n + 1/2)·h, n integer.
     let spheres = anchored(stone);
     let mut moments = GridMoments::default();
-    let mut earlier = Vec::new();
     for (i, &(center, r)) in spheres.iter().enumerate() {
-        // Only the earlier spheres that reach into this one can hold its points: a clump of
-        // many spheres costs their overlaps, not the square of their count.
-        earlier.clear();
-        earlier.extend(
-            spheres[..i]
-                .iter()
-                .filter(|&&(c, q)| (c - center).norm() <= r + q + h),
-        );
+        let earlier = &spheres[..i];
         sum_sphere(center, r, h, |p| {
             if !earlier
                 .iter()
