@@ -219,7 +219,9 @@ pub enum CoreError {
     /// A contact sphere went through a wall or into another body, found by the contact
     /// model's pass-through check ([`crate::Model::failure`]): the step may be stable and
     /// the result still wrong.
-    #[error("a body passes through at step {step} (t = {time:.6e} s, dt = {dt:.4e} s): {detail}")]
+    #[error(
+        "a body passes through at step {step} (t = {time:.6e} s, dt = {dt:.4e} s): {detail} {fix}"
+    )]
     PassThrough {
         /// The step that found it (1 for the first).
         step: u64,
@@ -227,8 +229,11 @@ pub enum CoreError {
         time: f64,
         /// The step size.
         dt: f64,
-        /// The sphere, the wall or body, its speed and the fixes.
+        /// The sphere, the wall or body, and its speed.
         detail: String,
+        /// What to change (a caller that knows a deeper cause, a load no step resolves, puts
+        /// that here instead).
+        fix: String,
     },
     /// The sparse linear algebra failed for a reason other than definiteness.
     #[error("sparse factorisation failed: {0}")]

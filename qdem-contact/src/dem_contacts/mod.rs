@@ -265,8 +265,9 @@ pub struct DemContacts {
     servos: Vec<Option<servo::ServoWall>>,
     /// The closed surfaces of the bodies built from meshes (`tunnelling.rs`).
     surfaces: Vec<BodySurface>,
-    /// The report of the first sphere found through a wall or inside another body.
-    pass_through: Option<String>,
+    /// The report of the first sphere found through a wall or inside another body: what
+    /// happened, and the fix.
+    pass_through: Option<(String, String)>,
     /// The run's step (s), for that report's fix; 0 until [`Model::prepare`].
     step: f64,
 }

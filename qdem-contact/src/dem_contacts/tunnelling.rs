@@ -185,9 +185,9 @@ impl DemContacts {
         })
     }
 
-    /// The report of `passage` at `time`: the sphere, where it went, its speed since the
-    /// last build and the fix.
-    fn describe(&self, passage: Passage, time: f64) -> String {
+    /// The report of `passage` at `time`: the sphere, where it went and its speed since the
+    /// last build; and the fix.
+    fn describe(&self, passage: Passage, time: f64) -> (String, String) {
         let (s, into) = match passage {
             Passage::Wall {
                 sphere,
@@ -228,16 +228,12 @@ impl DemContacts {
             false => 0.0,
         };
         let (radius, x) = (self.radius[s], self.center[s]);
-        format!(
+        let what = format!(
             "the contact sphere of body `{}` at ({:.4}, {:.4}, {:.4}) m (radius {radius:.3e} \
-             m) {into}, moving at about {speed:.3e} m/s; the contact no longer holds it back. \
-             {}",
-            self.body_names[self.body[s] as usize],
-            x.x,
-            x.y,
-            x.z,
-            self.fix(passage, speed, radius),
-        )
+             m) {into}, moving at about {speed:.3e} m/s; the contact no longer holds it back.",
+            self.body_names[self.body[s] as usize], x.x, x.y, x.z,
+        );
+        (what, self.fix(passage, speed, radius))
     }
 
     /// What to change: a smaller step when the sphere moves more than [`STEP_FRACTION`] of
@@ -300,11 +296,12 @@ impl DemContacts {
     pub(super) fn passage_failure(&self, time: f64) -> Option<qdem_core::CoreError> {
         self.pass_through
             .clone()
-            .map(|detail| qdem_core::CoreError::PassThrough {
+            .map(|(detail, fix)| qdem_core::CoreError::PassThrough {
                 step: 0,
                 time,
                 dt: 0.0,
                 detail,
+                fix,
             })
     }
 }

@@ -38,7 +38,8 @@ use crate::step::stepper::{stable_step, Stepper};
 use std::sync::Arc;
 
 /// Marks a model's [`CoreError::PassThrough`] in the text the ranks agree on, so that the
-/// failure check reports it as itself rather than as an unstable step.
+/// failure check reports it as itself rather than as an unstable step; it also separates
+/// the report's detail from its fix.
 const PASS_THROUGH: &str = "\u{1}pass through\u{1}";
 
 /// Something a world does after every step, once the step has passed the failure check:
@@ -351,7 +352,9 @@ impl World {
                 .iter()
                 .find_map(|m| m.failure(&self.state))
                 .map(|e| match e {
-                    CoreError::PassThrough { detail, .. } => format!("{PASS_THROUGH}{detail}"),
+                    CoreError::PassThrough { detail, fix, .. } => {
+                        format!("{PASS_THROUGH}{detail}{PASS_THROUGH}{fix}")
+                    }
                     e => e.to_string(),
                 }),
         };
@@ -371,12 +374,14 @@ impl World {
             return Ok(());
         };
         self.gather();
-        if let Some(detail) = detail.strip_prefix(PASS_THROUGH) {
+        if let Some(report) = detail.strip_prefix(PASS_THROUGH) {
+            let (what, fix) = report.split_once(PASS_THROUGH).unwrap_or((report, ""));
             return Err(CoreError::PassThrough {
                 step: self.steps_done,
                 time: self.state.time,
                 dt: self.settings.dt,
-                detail: detail.to_string(),
+                detail: what.to_string(),
+                fix: fix.to_string(),
             });
         }
         let (bound, limiter) = stable_step(&self.state, &self.models)

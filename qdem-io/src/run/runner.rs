@@ -606,9 +606,9 @@ fn encode(
 fn core_error(sim: &Simulation, mut source: CoreError) -> RunError {
     match &mut source {
         CoreError::Unstable { cause, .. } => *cause = load_cause(sim).map(Box::new),
-        CoreError::PassThrough { detail, .. } => {
+        CoreError::PassThrough { fix, .. } => {
             if let Some(cause) = load_cause(sim) {
-                *detail = with_cause(detail, &cause);
+                *fix = cause;
             }
         }
         _ => {}
@@ -617,13 +617,6 @@ fn core_error(sim: &Simulation, mut source: CoreError) -> RunError {
         scene: sim.scene.path.clone(),
         source,
     }
-}
-
-/// A pass-through report whose fixes (from `Fix:` on) are replaced by the load `cause` that
-/// no step resolves: a smaller dt, which the report would advise, cannot help there.
-fn with_cause(detail: &str, cause: &str) -> String {
-    let what = detail.split_once(" Fix: ").map_or(detail, |(what, _)| what);
-    format!("{what} {cause}")
 }
 
 fn progress_at(step: u64, steps: u64, time: f64, start: Instant) -> Progress {
