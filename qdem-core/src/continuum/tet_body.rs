@@ -248,14 +248,18 @@ impl TetBody {
     /// in [`Formulation::AveragedPressure`], with the averaged pressure its forces use), and
     /// its volumetric strain det F − 1.
     pub fn tet_fields(&self, state: &State) -> (Vec<Mat3>, Vec<f64>) {
-        let (stress, volumetric) = self.standard_fields(state);
-        match &self.averaged {
-            Some(averaged) => (averaged.stresses(state, false), volumetric),
-            None => (stress, volumetric),
-        }
+        let Some(averaged) = &self.averaged else {
+            return self.standard_fields(state);
+        };
+        let volumetric = (0..self.tets.len())
+            .into_par_iter()
+            .with_min_len(TET_CHUNK)
+            .map(|e| self.volumetric_strain(e, &self.tets[e].map(|n| state.position[n as usize])))
+            .collect();
+        (averaged.stresses(state, false), volumetric)
     }
 
-    /// [`TetBody::tet_fields`] of the standard tetrahedron.
+    /// [`TetBody::tet_fields`] of the standard tetrahedron, in one pass.
     fn standard_fields(&self, state: &State) -> (Vec<Mat3>, Vec<f64>) {
         let viscous = !self.material.is_elastic();
         (0..self.tets.len())
@@ -264,17 +268,16 @@ impl TetBody {
             .map(|e| {
                 let x = self.tets[e].map(|n| state.position[n as usize]);
                 let v = viscous.then(|| self.tets[e].map(|n| state.velocity[n as usize]));
-                let (t, _) = tet_stress(
-                    &x,
-                    v.as_ref(),
-                    self.blocks.dm_inv(e),
-                    self.pair(),
-                    self.vpair(),
-                );
-                let j = deformation_gradient(&x, self.blocks.dm_inv(e)).determinant();
-                (t, j - 1.0)
+                let dm_inv = self.blocks.dm_inv(e);
+                let (t, _) = tet_stress(&x, v.as_ref(), dm_inv, self.pair(), self.vpair());
+                (t, self.volumetric_strain(e, &x))
             })
             .unzip()
+    }
+
+    /// The volumetric strain det F − 1 of tetrahedron `e` at its corners' positions `x`.
+    fn volumetric_strain(&self, e: usize, x: &[Vec3; 4]) -> f64 {
+        deformation_gradient(x, self.blocks.dm_inv(e)).determinant() - 1.0
     }
 
     /// The small-strain stress σ = λ tr(ε) I + 2μ ε of every tetrahedron, ε = sym(∇u) with

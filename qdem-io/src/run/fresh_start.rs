@@ -3,8 +3,9 @@
 //! unlisted (the VTUs of an earlier, longer run past this run's last one; the `boundary.csv`
 //! or `stones.csv` of another scene). Only files with the names a run writes are touched:
 //! `results.pvd`, `probes.csv`, `probes.svg`, `boundary.csv`, `sections.csv`,
-//! `reactions.csv`, `node_reactions.csv`, `crack.svg`, `stones.csv`, `poses.csv`, `summary.json`, `walls.csv`,
-//! `settlement.csv`, `settlement.svg`, `grading.csv`, `grading.svg`, every `measure_*.csv`
+//! `reactions.csv`, `node_reactions.csv`, `crack.svg`, `stones.csv`, `poses.csv`,
+//! `summary.json`, `walls.csv`, `settlement.csv`, `settlement.svg`, `grading.csv`,
+//! `grading.svg`, every `measure_*.csv`
 //! and `measure_*.svg`, and in `vtu/` the numbered `state_`,
 //! `spheres_`, `contacts_`, `bonds_` and `walls_` VTUs and `walls.vtu`. `checkpoint.qdc` is
 //! kept: a resume checks that it belongs to the scene and its files, and the run's first

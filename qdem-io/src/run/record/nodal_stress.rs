@@ -6,6 +6,7 @@
 //! depend on the thread count.
 
 use qdem_core::Vec3;
+use qdem_mesh::signed_volume6;
 
 /// Per particle of `reference`, the volume-weighted mean of the `stress` (six components,
 /// xx, yy, zz, xy, yz, xz, one per tetrahedron of `tets`) of the tetrahedra around it.
@@ -36,8 +37,7 @@ pub(crate) fn nodal_stress(
 
 /// The volume of tetrahedron `tet` in the reference configuration (m³).
 fn tet_volume(reference: &[Vec3], tet: &[u32; 4]) -> f64 {
-    let x = tet.map(|n| reference[n as usize]);
-    ((x[1] - x[0]).cross(&(x[2] - x[0])).dot(&(x[3] - x[0])) / 6.0).abs()
+    (signed_volume6(&tet.map(|n| reference[n as usize].into())) / 6.0).abs()
 }
 
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! [`Reactions`]: `reactions.csv`: every `probe_every`, the force and moment each `[[fix]]` of
 //! a deformable body carries: R = −Σ f_i over its particles, counting on each particle the
-//! directions that fix holds only (its `dofs`, not those another fix holds there), f_i the total (internal and external) force on particle i at the state
+//! directions that fix holds only (its `dofs`, not those another fix holds there), f_i the
+//! total (internal and external) force on particle i at the state
 //! (the stepper's last evaluation, [`qdem_core::stepper::Stepper::forces`]; a static solve's
 //! f − K u), and the moment M = Σ (X_i − c) × R_i about the centroid c of the fix's particles
 //! in the reference configuration (X_i their reference positions). Columns
@@ -99,23 +100,6 @@ impl Reactions {
         })
     }
 
-    /// Adds the particles' forces of every group at `time` to `node_reactions.csv`'s rows.
-    fn record_nodes(&mut self, time: f64, state: &State, force: &[Vec3]) {
-        let Some(nodes) = &mut self.nodes else {
-            return;
-        };
-        nodes.forces.push(time);
-        for group in &self.groups {
-            for (&i, share) in group.particles.iter().zip(&group.shares) {
-                let r = match force.len() == state.len() {
-                    true => particle_reaction(force[i], share),
-                    false => Vec3::zeros(),
-                };
-                nodes.forces.extend(r.iter());
-            }
-        }
-    }
-
     /// Writes `node_reactions.csv` (atomically) from the recorded rows.
     fn write_nodes(&self, state: &State) -> Result<(), OutputError> {
         let Some(nodes) = &self.nodes else {
@@ -180,19 +164,27 @@ fn share(dofs: Dofs, k: usize, holders: u32) -> f64 {
     }
 }
 
-/// The force and moment `group` carries, from the particles' total forces `force`.
-fn reaction(state: &State, force: &[Vec3], group: &FixGroup) -> (Vec3, Vec3) {
+/// The force and moment `group` carries, from the particles' total forces `force` (zero
+/// before any evaluation, when `force` is empty); each particle's force also to `per_node`
+/// when `node_reactions.csv` is written.
+fn reaction(
+    state: &State,
+    force: &[Vec3],
+    group: &FixGroup,
+    mut per_node: Option<&mut Vec<f64>>,
+) -> (Vec3, Vec3) {
+    let evaluated = force.len() == state.len();
     let mut total = (Vec3::zeros(), Vec3::zeros());
     for (&i, share) in group.particles.iter().zip(&group.shares) {
-        let r = Vec3::from_fn(|k, _| {
-            if share[k] > 0.0 {
-                -force[i][k] * share[k]
-            } else {
-                0.0
-            }
-        });
+        let r = match evaluated {
+            true => particle_reaction(force[i], share),
+            false => Vec3::zeros(),
+        };
         total.0 += r;
         total.1 += (state.reference[i] - group.centroid).cross(&r);
+        if let Some(rows) = per_node.as_deref_mut() {
+            rows.extend(r.iter());
+        }
     }
     total
 }
@@ -213,14 +205,14 @@ impl Recorder for Reactions {
         }
         let force = sim.world.stepper().forces();
         self.rows.push(state.time);
+        let mut per_node = self.nodes.as_mut().map(|nodes| &mut nodes.forces);
+        if let Some(rows) = per_node.as_deref_mut() {
+            rows.push(state.time);
+        }
         for group in &self.groups {
-            let (f, m) = match force.len() == state.len() {
-                true => reaction(state, force, group),
-                false => (Vec3::zeros(), Vec3::zeros()),
-            };
+            let (f, m) = reaction(state, force, group, per_node.as_deref_mut());
             self.rows.extend(f.iter().chain(m.iter()));
         }
-        self.record_nodes(state.time, state, force);
         Ok(())
     }
 
