@@ -1,14 +1,20 @@
-//! The registry of every scene key: its table, type and default, and meaning, in one place,
-//! rendered as README.md's key reference ([`markdown_table`], between [`README_BEGIN`] and
-//! [`README_END`]).
+//! The reference of every scene key: its table, type, default and meaning, rendered as
+//! README.md's key reference ([`markdown_table`], between [`README_BEGIN`] and [`README_END`]).
 //!
-//! The registry cannot fall behind the schema: a test asks serde itself which keys each table
-//! accepts (the "expected one of" list of an unknown key, so the list is the parser's own)
-//! and fails naming every key the parser accepts that the registry lacks, and every
-//! registered key the parser refuses; another fails when README.md's table differs from
-//! [`markdown_table`]. After adding a key to the schema: add its entry to [`SCENE_KEYS`]
-//! (in the table's order), then regenerate README.md's table with
+//! Each key is written once, beside its field: the `scene_table!` declarations of
+//! [`super::schema`] give every table's struct and its `KEYS` together, and [`SCENE_KEYS`]
+//! lists the tables. The tests hold the reference to what serde does: every key the parser
+//! accepts is listed and every listed key accepted; a required key left out is refused as
+//! missing and a scene of only required keys parses; a value of each stated type is accepted
+//! (each listed string) and a value of another type refused; an optional key written with its
+//! stated default parses to what its absence gives; and README.md's table is
+//! [`markdown_table`]. After adding a key to the schema, regenerate README.md's table with
 //! `QDEM_WRITE_KEYS=1 cargo test -p qdem-io --lib scene::keys`.
+
+use super::schema::{
+    Ballast, Body, Bonded, Contact, CyclicLoad, Granular, Material, Measure, Output, Periodic,
+    Probe, RawFix, RawLoad, Run, Section, Series, TimeDelay, Wall, WallServo,
+};
 
 /// One scene key.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -20,939 +26,72 @@ pub struct SceneKey {
     pub key: &'static str,
     /// Its type, then `required` or `optional`.
     pub kind: &'static str,
+    /// What serde fills in when an optional key is absent, as a TOML value (`"0.9"`,
+    /// `"[0.0, 0.0, 0.0]"`, `"\"auto\""`); `None` for a required key and for an optional one
+    /// that is then absent (an `Option` left `None`).
+    pub default: Option<&'static str>,
     /// What it means, with its unit and default.
     pub meaning: &'static str,
 }
 
-const fn key(
-    table: &'static str,
-    key: &'static str,
-    kind: &'static str,
-    meaning: &'static str,
-) -> SceneKey {
-    SceneKey {
-        table,
-        key,
-        kind,
-        meaning,
-    }
-}
-
 /// The line before README.md's key table.
 pub const README_BEGIN: &str =
-    "<!-- scene keys: generated from qdem-io/src/scene/keys.rs; QDEM_WRITE_KEYS=1 cargo test -p qdem-io --lib scene::keys -->";
+    "<!-- scene keys: generated from qdem-io/src/scene/schema/; QDEM_WRITE_KEYS=1 cargo test -p qdem-io --lib scene::keys -->";
 /// The line after README.md's key table.
 pub const README_END: &str = "<!-- end of scene keys -->";
 
-/// Every key a scene file may hold, table by table.
-pub const SCENE_KEYS: &[SceneKey] = &[
-    key(
-        "[run]",
-        "t_end",
-        "number, required",
-        "Simulated end time, s. Required, > 0.",
-    ),
-    key(
-        "[run]",
-        "dt",
-        "number or \"auto\", optional",
-        "Time step: `\"auto\"` (default) or a fixed number of seconds (a normal number: a subnormal one such as 1e-320 is refused).",
-    ),
-    key(
-        "[run]",
-        "integrator",
-        "\"verlet\", \"newmark\" or \"static\", optional",
-        "Time integrator; default `\"verlet\"`; `\"static\"`: a linear static solve at every `dt` of the load factor (default `probe_every`, else t_end / 100), once per distinct load level, writing the final state's VTU.",
-    ),
-    key(
-        "[run]",
-        "gravity",
-        "[x, y, z], optional",
-        "Gravitational acceleration, m/s²; default zero.",
-    ),
-    key(
-        "[run]",
-        "probe_every",
-        "number, optional",
-        "Simulated time between two rows of `probes.csv` (and the other CSV records), s (> 0); default t_end / 1000.",
-    ),
-    key(
-        "[run]",
-        "dt_safety",
-        "number, optional",
-        "Fraction of the stable time-step bound used when `dt = \"auto\"`, in (0, 1]; default 0.9.",
-    ),
-    key(
-        "[run]",
-        "beta",
-        "number, optional",
-        "Newmark β (paper 001 Eq. 13), for `integrator = \"newmark\"` only (refused with another integrator, where it would do nothing); default ¼ (average acceleration, implicit). β = 0 with γ = ½ is explicit central difference.",
-    ),
-    key(
-        "[run]",
-        "gamma",
-        "number, optional",
-        "Newmark γ (paper 001 Eq. 14), for `integrator = \"newmark\"` only (refused with another integrator); default ½.",
-    ),
-    key(
-        "[run]",
-        "start_from",
-        "path, optional",
-        "Start from the state in this checkpoint (written by another scene with the same bodies, e.g. a deposition run), relative to the scene file: positions, velocities and reference positions are taken from it, time restarts at 0, and the tangential contact springs are carried between the same spheres and walls (a spring whose sphere or wall this scene lacks is dropped and counted).",
-    ),
-    key(
-        "[[material]]",
-        "name",
-        "string, required",
-        "Unique name that `[[body]] material` refers to.",
-    ),
-    key(
-        "[[material]]",
-        "density",
-        "number, required",
-        "Mass density, kg/m³ (> 0).",
-    ),
-    key(
-        "[[material]]",
-        "young",
-        "number, required",
-        "Young's modulus, Pa (> 0).",
-    ),
-    key(
-        "[[material]]",
-        "poisson",
-        "number, required",
-        "Poisson's ratio ν, in (−1, 0.5).",
-    ),
-    key(
-        "[[material]]",
-        "shear_viscosity",
-        "number, optional",
-        "Shear viscosity μ_D, Pa·s (≥ 0); default 0.",
-    ),
-    key(
-        "[[material]]",
-        "bulk_viscosity",
-        "number, optional",
-        "Bulk viscosity λ_D + 2/3 μ_D, Pa·s (≥ 0); default 0.",
-    ),
-    key(
-        "[[material]]",
-        "formulation",
-        "string, optional",
-        "`\"standard\"` (default) or `\"averaged-pressure\"`: the average nodal pressure tetrahedron (Bonet & Burton 1998) that does not lock as ν → 0.5; refused under MPI.",
-    ),
-    key(
-        "[[body]]",
-        "name",
-        "string, required",
-        "Unique name that fixes, loads and probes refer to.",
-    ),
-    key(
-        "[[body]]",
-        "mesh",
-        "path, required",
-        "The gmsh mesh file (MSH 2.2 or 4.1, linear tetrahedra), relative to the scene file.",
-    ),
-    key(
-        "[[body]]",
-        "material",
-        "string, required",
-        "Name of a `[[material]]`.",
-    ),
-    key(
-        "[[body]]",
-        "reorder",
-        "bool, optional",
-        "Reorder nodes for memory locality after import; default `true`.",
-    ),
-    key(
-        "[[body]]",
-        "merge_nodes",
-        "bool, optional",
-        "Merge the mesh's coincident nodes (nodes at one place, within 1e-9 of the mesh's size, that its tetrahedra do not share, as separately meshed volumes leave them) so that the tetrahedra on either side connect; default `false`: they are reported in a warning and the body stays in pieces there.",
-    ),
-    key(
-        "[[body]]",
-        "contact_radius",
-        "number, optional",
-        "Radius (m) of the contact spheres put at the body's surface vertices (paper 000 §4); `None` (the default): the body touches nothing.",
-    ),
-    key(
-        "[[body]]",
-        "rigid",
-        "bool, optional",
-        "Integrate the body as a rigid body (6 degrees of freedom, mass and inertia from its tetrahedra) instead of a deformable one; default `false`.",
-    ),
-    key(
-        "[[body]]",
-        "translate",
-        "[x, y, z], optional",
-        "Translation applied to the mesh after the rotation (m); default zero.",
-    ),
-    key(
-        "[[body]]",
-        "rotate_deg",
-        "[x, y, z], optional",
-        "Rotation of the mesh about its nodes' centroid, in degrees about x, then y, then z (fixed axes); default zero.",
-    ),
-    key(
-        "[[body]]",
-        "velocity",
-        "[x, y, z], optional",
-        "Initial velocity of every particle of the body (m/s); default zero.",
-    ),
-    key(
-        "[[body]]",
-        "angular_velocity",
-        "[x, y, z], optional",
-        "Initial angular velocity of the body about its centre of mass (rad/s, world axes): a rigid body's ω; a deformable body's particles get v + ω × (x − x_c) in addition to `velocity`. Default zero.",
-    ),
-    key(
-        "[[body]]",
-        "rest_on",
-        "string, optional",
-        "Name of the `[granular]` sample to lay the body on: after `translate` it is lowered along −z until its contact spheres touch the stones beneath (`rest_on.rs`); default none (the body stays where `translate` puts it).",
-    ),
-    key(
-        "[[body]]",
-        "pose_from",
-        "path, optional",
-        "A `poses.csv` written by an earlier run (relative to the scene file): a rigid body is placed where that run left its body of the same name (`pose_from.rs`); default none.",
-    ),
-    key(
-        "[[body]]",
-        "pose_body",
-        "string, optional",
-        "With `pose_from`: take the pose of this body of the poses file instead of the body of the same name (the sleepers of a three-sleeper box placed from the one sleeper of a periodic cell); default the body's own name.",
-    ),
-    key(
-        "[[body]]",
-        "pose_shift",
-        "[x, y, z], optional",
-        "With `pose_from`: added to the pose's centre of mass (m), e.g. one period along a periodic axis; default zero.",
-    ),
-    key(
-        "[[fix]]",
-        "body",
-        "string, required",
-        "Name of the `[[body]]` (or `[ballast]`) whose particles are held.",
-    ),
-    key(
-        "[[fix]]",
-        "group",
-        "string, optional",
-        "A gmsh physical group of the mesh: its nodes are held (or `box`).",
-    ),
-    key(
-        "[[fix]]",
-        "box",
-        "[[x, y, z], [x, y, z]], optional",
-        "Instead of `group`: the particles inside the closed box (lower and upper corner, m).",
-    ),
-    key(
-        "[[fix]]",
-        "dofs",
-        "string, optional",
-        "The held directions, a subset of \"xyz\"; default \"xyz\". `reactions.csv` gives the force the fix carries.",
-    ),
-    key(
-        "[[fix]]",
-        "rotation",
-        "bool, optional",
-        "Also hold a rigid body's rotation; default false.",
-    ),
-    key(
-        "[[load]]",
-        "body",
-        "string, required",
-        "Name of the `[[body]]` loaded.",
-    ),
-    key(
-        "[[load]]",
-        "group",
-        "string, optional",
-        "A gmsh physical group: its nodes (for `total_force`) or the boundary triangles whose three nodes it holds (for `pressure`, `traction`).",
-    ),
-    key(
-        "[[load]]",
-        "box",
-        "[[x, y, z], [x, y, z]], optional",
-        "Instead of `group`: the particles inside the closed box, or the boundary triangles inside it.",
-    ),
-    key(
-        "[[load]]",
-        "total_force",
-        "[x, y, z], optional",
-        "Total force, N, shared equally by the selected particles; one of `total_force`, `pressure`, `traction`.",
-    ),
-    key(
-        "[[load]]",
-        "pressure",
-        "number, optional",
-        "Pressure, Pa, on the selected boundary faces along their inward normal (positive pushes in), lumped to the nodes by area (a third of each triangle's to each of its nodes).",
-    ),
-    key(
-        "[[load]]",
-        "traction",
-        "[x, y, z], optional",
-        "Force per unit area, Pa, on the selected boundary faces in a fixed direction, lumped like `pressure`.",
-    ),
-    key(
-        "[[load]]",
-        "ramp",
-        "[[t, factor], …], optional",
-        "Time factor: `[t, factor]` points, linear between, held outside; default a constant 1.",
-    ),
-    key(
-        "[[load]]",
-        "cyclic",
-        "inline table, optional",
-        "Time factor instead of `ramp`: `{ min, max, frequency, phase_deg, start }`, a sinusoid between min and max.",
-    ),
-    key(
-        "[[load]]",
-        "series",
-        "inline table, optional",
-        "Time factor instead of `ramp`: `{ file, column }`, a column of a CSV file (first column the time).",
-    ),
-    key(
-        "[[load]] cyclic",
-        "min",
-        "number, required",
-        "Factor at the minimum.",
-    ),
-    key(
-        "[[load]] cyclic",
-        "max",
-        "number, required",
-        "Factor at the maximum.",
-    ),
-    key(
-        "[[load]] cyclic",
-        "frequency",
-        "number, required",
-        "Hz (> 0).",
-    ),
-    key(
-        "[[load]] cyclic",
-        "phase_deg",
-        "number, optional",
-        "Phase lead in degrees; default 0.",
-    ),
-    key(
-        "[[load]] cyclic",
-        "start",
-        "number, optional",
-        "Time the first cycle begins, s; default 0 (before it the factor is `min`).",
-    ),
-    key(
-        "[[load]] series",
-        "file",
-        "path, required",
-        "The CSV file, relative to the scene file; a header row names the columns.",
-    ),
-    key(
-        "[[load]] series",
-        "column",
-        "string, required",
-        "The column to read.",
-    ),
-    key(
-        "[[probe]]",
-        "name",
-        "string, required",
-        "Unique name (the CSV column prefix).",
-    ),
-    key(
-        "[[probe]]",
-        "body",
-        "string, required",
-        "Name of the `[[body]]`, `[ballast]`, `[bonded]` body or `[granular]` sample.",
-    ),
-    key(
-        "[[probe]]",
-        "point",
-        "[x, y, z], optional",
-        "The particle of the body nearest to this point (in the reference configuration), or the stone whose centre of mass is nearest to it, is sampled.",
-    ),
-    key(
-        "[[probe]]",
-        "stone",
-        "integer, optional",
-        "`[granular]` only: the stone sampled, counted from 1 in the sample's order (the `stone` of `stones.csv`, `NAME stone K` in messages).",
-    ),
-    key(
-        "[[probe]]",
-        "box",
-        "[[x, y, z], [x, y, z]], optional",
-        "`[granular]` only: a box (lower and upper corner, m): the stones whose centre of mass lies inside are averaged (columns `vx, vy, vz, ke, count`).",
-    ),
-    key(
-        "[[section]]",
-        "name",
-        "string, required",
-        "Unique name (the CSV column).",
-    ),
-    key(
-        "[[section]]",
-        "axis",
-        "string, required",
-        "The axis the plane is normal to: \"x\", \"y\" or \"z\".",
-    ),
-    key(
-        "[[section]]",
-        "at",
-        "number, required",
-        "The plane's coordinate along `axis` (m).",
-    ),
-    key(
-        "[[section]]",
-        "area",
-        "number, optional",
-        "The section's area, m²: `sections.csv` also gives `NAME.stress`, the normal stress through the plane (Pa, tension positive).",
-    ),
-    key(
-        "[[measure]]",
-        "name",
-        "string, required",
-        "Unique name: the files `measure_NAME.csv`, `measure_NAME.svg`, `measure_NAME_energy.svg`.",
-    ),
-    key(
-        "[[measure]]",
-        "box",
-        "[[x, y, z], [x, y, z]], optional",
-        "The region as a box (lower and upper corner, m); or `center` and `radius`. Needs `[granular]` and `[contact]`.",
-    ),
-    key(
-        "[[measure]]",
-        "center",
-        "[x, y, z], optional",
-        "Instead of `box`: the centre of a spherical region (m), with `radius`.",
-    ),
-    key(
-        "[[measure]]",
-        "radius",
-        "number, optional",
-        "With `center`: the spherical region's radius (m).",
-    ),
-    key(
-        "[[measure]]",
-        "every",
-        "number, optional",
-        "Simulated time between two rows of `measure_NAME.csv`, s; default `probe_every`.",
-    ),
-    key(
-        "[contact]",
-        "law",
-        "\"linear\" or \"hertz-mindlin\", optional",
-        "The law; default linear.",
-    ),
-    key(
-        "[contact]",
-        "normal_stiffness",
-        "number, optional",
-        "Normal spring constant k_n (N/m), required by the linear law.",
-    ),
-    key(
-        "[contact]",
-        "tangential_stiffness",
-        "number, optional",
-        "Tangential spring constant k_t (N/m), required by the linear law.",
-    ),
-    key(
-        "[contact]",
-        "friction",
-        "number, optional",
-        "Coulomb friction coefficient between bodies (and walls that give none); default 0.",
-    ),
-    key(
-        "[contact]",
-        "damping_ratio",
-        "number, optional",
-        "Damping ratio ζ of the contact dashpots, in [0, 1); default 0 (paper 000: the viscosity is in the bulk).",
-    ),
-    key(
-        "[contact]",
-        "restitution",
-        "number, optional",
-        "Coefficient of restitution e of a head-on impact, in (0, 1], instead of `damping_ratio` (refused beside a non-zero one): ζ = −ln e / √(ln² e + π²).",
-    ),
-    key(
-        "[contact]",
-        "local_damping",
-        "number, optional",
-        "PFC's local non-viscous damping fraction, in [0, 1) (paper 003: 0.7 for quasi-static packing); default 0.",
-    ),
-    key(
-        "[contact]",
-        "skin",
-        "number, optional",
-        "Skin distance of the neighbour lists (m); default a quarter of the smallest contact radius.",
-    ),
-    key(
-        "[contact]",
-        "overlap_tolerance",
-        "number, optional",
-        "Largest overlap allowed at the start, as a fraction of the reduced radius; default 0.05.",
-    ),
-    key(
-        "[[wall]]",
-        "point",
-        "[x, y, z], optional",
-        "A point of the plane (m).",
-    ),
-    key(
-        "[[wall]]",
-        "normal",
-        "[x, y, z], optional",
-        "The plane's normal, pointing to the side where bodies are (any length).",
-    ),
-    key(
-        "[[wall]]",
-        "mesh",
-        "path, optional",
-        "A tetrahedral gmsh mesh whose boundary surface is the wall, relative to the scene file.",
-    ),
-    key(
-        "[[wall]]",
-        "friction",
-        "number, optional",
-        "Friction coefficient against bodies; default `[contact] friction`.",
-    ),
-    key(
-        "[[wall]]",
-        "velocity",
-        "[x, y, z], optional",
-        "Constant velocity of the wall (m/s); default zero.",
-    ),
-    key(
-        "[[wall]]",
-        "servo",
-        "inline table, optional",
-        "Stress control of a plane wall: `{ stress, area, gain, max_velocity }`; after each force evaluation its speed towards the bodies is clamp(G (σ_target − σ), ±v_max), σ the spheres' normal force on it over `area`. Not with `velocity`, a mesh, or MPI ranks.",
-    ),
-    key(
-        "[[wall]] servo",
-        "stress",
-        "number, required",
-        "Target compressive normal stress σ_target (Pa).",
-    ),
-    key(
-        "[[wall]] servo",
-        "area",
-        "number, required",
-        "The area A the wall's normal force is divided by (m², > 0).",
-    ),
-    key(
-        "[[wall]] servo",
-        "gain",
-        "number, optional",
-        "Gain G (m/(s·Pa), > 0); default 0.5 A / Σ (k_n Δt + c_n) over the wall's touching contacts, renewed each step (PFC's servo with the normal dashpots c_n).",
-    ),
-    key(
-        "[[wall]] servo",
-        "max_velocity",
-        "number, required",
-        "Largest speed v_max (m/s, > 0): the servo's clamp and the wall's speed bound for the neighbour lists.",
-    ),
-    key(
-        "[periodic]",
-        "axes",
-        "string, required",
-        "The periodic axes, e.g. `\"y\"` or `\"xy\"`.",
-    ),
-    key(
-        "[periodic]",
-        "length",
-        "[number, …], optional",
-        "One period per listed axis (m), in the order of `axes`.",
-    ),
-    key(
-        "[periodic]",
-        "origin",
-        "[x, y, z], optional",
-        "The lower corner of the cell (m); default the origin.",
-    ),
-    key(
-        "[periodic]",
-        "box",
-        "[[x, y, z], [x, y, z]], optional",
-        "The cell as a box (lower and upper corner, m): origin and periods at once.",
-    ),
-    key(
-        "[periodic]",
-        "time_delay",
-        "table, optional",
-        "A time-delayed boundary.",
-    ),
-    key(
-        "[periodic.time_delay]",
-        "body",
-        "string, required",
-        "The body (a sleeper) whose `cyclic` [[load]] sets the phase Φ.",
-    ),
-    key(
-        "[periodic.time_delay]",
-        "axis",
-        "string, optional",
-        "The delayed axis; default the only periodic axis.",
-    ),
-    key(
-        "[periodic.time_delay]",
-        "lag_deg",
-        "number, optional",
-        "Phase lag δ of the neighbour cells (degrees); default 90 (paper 003 Eqs. 4–5).",
-    ),
-    key(
-        "[periodic.time_delay]",
-        "sleeper_spacing",
-        "number, optional",
-        "With `speed`: the lag δ = 360° f s / v of sleepers `sleeper_spacing` apart (m).",
-    ),
-    key(
-        "[periodic.time_delay]",
-        "speed",
-        "number, optional",
-        "With `sleeper_spacing`: the speed of the travelling load (m/s).",
-    ),
-    key(
-        "[periodic.time_delay]",
-        "shared_faces",
-        "bool, optional",
-        "Shared faces (qdem's variant, not paper 003's Eqs. 6–7): both spheres of a pair through the boundary scaled alike, by the mean of the two faces' predicted forces, so the pair's action equals its reaction; default false.",
-    ),
-    key(
-        "[granular]",
-        "name",
-        "string, required",
-        "Name (stones are called `NAME stone K` in messages).",
-    ),
-    key(
-        "[granular]",
-        "material",
-        "string, required",
-        "A `[[material]]` (density and contact elasticity).",
-    ),
-    key(
-        "[granular]",
-        "sample",
-        "path, optional",
-        "A stones file (CSV `stone,x,y,z,radius`), relative to the scene file.",
-    ),
-    key(
-        "[granular]",
-        "copies",
-        "[[x, y, z], …], optional",
-        "The sample's stones placed once per translation (m), before `crop`: a sample deposited in a periodic cell, repeated by whole periods, fills a box several cells long with the cell's packing; default one copy where the file puts it.",
-    ),
-    key(
-        "[granular]",
-        "crop",
-        "[[x, y, z], [x, y, z]], optional",
-        "Keep only the sample's stones whose spheres all lie inside this box (m), up to `CROP_TOLERANCE` of a radius (a stone resting on a wall of the box stays).",
-    ),
-    key(
-        "[granular]",
-        "region",
-        "[[x, y, z], [x, y, z]], optional",
-        "Generation: the box filled with stones on a loose lattice (m).",
-    ),
-    key(
-        "[granular]",
-        "count",
-        "integer, optional",
-        "Generation: number of stones, at least 1.",
-    ),
-    key(
-        "[granular]",
-        "grading",
-        "[[size, passing], …], optional",
-        "Generation: the grading curve, (sieve size m, fraction passing) points.",
-    ),
-    key(
-        "[granular]",
-        "grading_basis",
-        "\"number\" or \"mass\", optional",
-        "Generation: what `grading`'s fractions passing count: `\"number\"` (default) the fraction of stones finer than a size (the sample is coarser by mass than the curve), `\"mass\"` the fraction of mass, as sieve analyses and ballast standards give it (within a segment the mass is spread uniformly in size, a stone weighing ∝ d³).",
-    ),
-    key(
-        "[granular]",
-        "spheres_per_stone",
-        "[integer, integer], optional",
-        "Generation: smallest and largest number of spheres per stone; default [3, 5].",
-    ),
-    key(
-        "[granular]",
-        "shape",
-        "\"elongated\" or \"angular\", optional",
-        "Generation: the stones' shape: `\"elongated\"` (default) a row of spheres along a long axis, a flaky stone; `\"angular\"` a core sphere with the other spheres as corners out towards an ellipsoid, like crushed ballast. Both stay within 0.65 of the sieve size of the stone's origin; one sphere is a plain sphere of radius d/2.",
-    ),
-    key(
-        "[granular]",
-        "seed",
-        "integer, optional",
-        "Generation: seed; default 1.",
-    ),
-    key(
-        "[granular]",
-        "velocity",
-        "[x, y, z], optional",
-        "Initial velocity of every stone (m/s); default zero.",
-    ),
-    key(
-        "[granular]",
-        "angular_velocity",
-        "[x, y, z], optional",
-        "Initial angular velocity of every stone about its centre of mass (rad/s, world axes); default zero.",
-    ),
-    key(
-        "[granular]",
-        "region_velocity",
-        "[x, y, z], optional",
-        "Initial velocity of the generated (`region`) stones instead of `velocity` (m/s): grains poured onto a sample at rest; default `velocity`.",
-    ),
-    key(
-        "[granular]",
-        "region_angular_velocity",
-        "[x, y, z], optional",
-        "Initial angular velocity of the generated stones instead of `angular_velocity` (rad/s); default `angular_velocity`.",
-    ),
-    key(
-        "[ballast]",
-        "name",
-        "string, required",
-        "Name of the ballast body (stones are `NAME stone K` in messages).",
-    ),
-    key(
-        "[ballast]",
-        "material",
-        "string, required",
-        "A `[[material]]`.",
-    ),
-    key(
-        "[ballast]",
-        "meshes",
-        "[path, …], required",
-        "Stone shapes: tetrahedral gmsh meshes, relative to the scene file.",
-    ),
-    key(
-        "[ballast]",
-        "contact_radius",
-        "number, required",
-        "Radius of the contact spheres at the stones' surface vertices, m (after scaling).",
-    ),
-    key(
-        "[ballast]",
-        "count",
-        "integer, required",
-        "Number of stones.",
-    ),
-    key(
-        "[ballast]",
-        "region",
-        "[[x, y, z], [x, y, z]], required",
-        "The box filled with stones, bottom layer first (m).",
-    ),
-    key(
-        "[ballast]",
-        "exclude",
-        "[[x, y, z], [x, y, z]], optional",
-        "A box no stone may reach into (m).",
-    ),
-    key(
-        "[ballast]",
-        "grading",
-        "[[size, passing], …], optional",
-        "Grading curve, (sieve size m, fraction passing) points; a stone's sieve size is the middle extent of its bounding box. Without one the meshes keep their size.",
-    ),
-    key(
-        "[ballast]",
-        "seed",
-        "integer, optional",
-        "Seed of the shapes, sizes, turns and lattice jitter; default 1.",
-    ),
-    key(
-        "[ballast]",
-        "velocity",
-        "[x, y, z], optional",
-        "Initial velocity of every stone (m/s), e.g. downward to shorten the fall; default 0.",
-    ),
-    key(
-        "[ballast]",
-        "angular_velocity",
-        "[x, y, z], optional",
-        "Initial angular velocity of every stone about its own centre of mass (rad/s, world axes): its particles get v + ω × (x − x_c); default 0.",
-    ),
-    key(
-        "[ballast]",
-        "rigid",
-        "bool, optional",
-        "Each stone a rigid body of its contact spheres (mass, centre and inertia from its tetrahedra) instead of a deformable one; default `false`. A scene that `start_from`s a checkpoint may change it: stones become deformable at their pose, unstressed, or rigid at their centre of mass and best-fit rotation.",
-    ),
-    key(
-        "[bonded]",
-        "name",
-        "string, required",
-        "Body name (for probes and messages).",
-    ),
-    key(
-        "[bonded]",
-        "material",
-        "string, required",
-        "A `[[material]]`: density, young, poisson of the continuum represented.",
-    ),
-    key(
-        "[bonded]",
-        "origin",
-        "[a, b], optional",
-        "Lower-left corner (m); default the origin.",
-    ),
-    key(
-        "[bonded]",
-        "size",
-        "[a, b], required",
-        "Width and height (m).",
-    ),
-    key(
-        "[bonded]",
-        "thickness",
-        "number, optional",
-        "Out-of-plane thickness (m); default 1.",
-    ),
-    key(
-        "[bonded]",
-        "element_size",
-        "number, required",
-        "Particle spacing (m).",
-    ),
-    key(
-        "[bonded]",
-        "packing",
-        "\"regular\" or \"random\", optional",
-        "`\"regular\"` (default) or `\"random\"`.",
-    ),
-    key(
-        "[bonded]",
-        "jitter",
-        "number, optional",
-        "Largest random offset in spacings for `packing = \"random\"`, in [0, 0.25); default 0.1.",
-    ),
-    key(
-        "[bonded]",
-        "packing_seed",
-        "integer, optional",
-        "Seed of the random packing.",
-    ),
-    key(
-        "[bonded]",
-        "strength_mean",
-        "number, required",
-        "Mean bond strength (Pa).",
-    ),
-    key(
-        "[bonded]",
-        "strength_std",
-        "number, optional",
-        "Standard deviation of the bond strength (Pa); default 0.",
-    ),
-    key(
-        "[bonded]",
-        "strength_seed",
-        "integer, optional",
-        "Seed of the strengths.",
-    ),
-    key(
-        "[bonded]",
-        "damping_ratio",
-        "number, optional",
-        "Bond damping ratio ξ_b (Eq. 8), in [0, 1); default 0.",
-    ),
-    key(
-        "[bonded]",
-        "critical_fraction",
-        "number, optional",
-        "Step as a multiple of the paper's ∆t_crit (Eq. 28): 0.2 for the paper's explicit runs, η for implicit ones. Optional; replaces `[run] dt`.",
-    ),
-    key(
-        "[bonded]",
-        "adaptive",
-        "bool, optional",
-        "Retake steps that overshoot a bond's strength or a contact's opening (Eqs. 29–30); default true.",
-    ),
-    key(
-        "[bonded]",
-        "event_solve",
-        "\"refactorize\" or \"preconditioned\", optional",
-        "Implicit runs: how a step is solved after bonds broke or contacts changed (issue 26); default `\"refactorize\"`.",
-    ),
-    key(
-        "[bonded]",
-        "tolerance",
-        "number, optional",
-        "Relative overshoot ε tolerated before a retake; default 0.05.",
-    ),
-    key(
-        "[bonded]",
-        "contact_shear_ratio",
-        "number, optional",
-        "Unbonded contacts: tangential over normal stiffness; default 0.2.",
-    ),
-    key(
-        "[bonded]",
-        "friction",
-        "number, optional",
-        "Unbonded contacts: Coulomb friction; default 0.5.",
-    ),
-    key(
-        "[bonded]",
-        "contact_damping_ratio",
-        "number, optional",
-        "Unbonded contacts: damping ratio ξ_u (Eq. 6), in [0, 1); default 0.",
-    ),
-    key(
-        "[bonded]",
-        "supports",
-        "\"simple\", \"pinned\" or \"none\", optional",
-        "`\"simple\"` (default), `\"pinned\"` or `\"none\"`.",
-    ),
-    key(
-        "[bonded]",
-        "top_load",
-        "number, optional",
-        "Uniform downward line load on the top row (N/m); default 0.",
-    ),
-    key(
-        "[bonded]",
-        "load_ramp",
-        "number, optional",
-        "Time over which `top_load` rises linearly from zero (s); default 0: applied at once.",
-    ),
-    key(
-        "[output]",
-        "dir",
-        "path, optional",
-        "Output directory as written (default `\"out\"`); the command line's `--out` overrides it.",
-    ),
-    key(
-        "[output]",
-        "vtu_every",
-        "number, optional",
-        "Simulated time between VTU snapshots, s; 0 (the default) writes none, except a static run's final state.",
-    ),
-    key(
-        "[output]",
-        "checkpoint_every",
-        "number, optional",
-        "Simulated time between checkpoints (`checkpoint.qdc` in the output directory, which `qdem run --resume` continues from), s; 0 (the default) writes one only when the run is interrupted (Ctrl-C, SIGTERM) or becomes unstable.",
-    ),
-    key(
-        "[output]",
-        "node_reactions",
-        "bool, optional",
-        "Whether to write `node_reactions.csv`: every `probe_every`, the force each `[[fix]]` of a deformable body carries at each of its particles, with the particle's gmsh node id and reference position; default false.",
-    ),
+/// Every key a scene file may hold, table by table: each table's keys as its struct in
+/// [`super::schema`] declares them (a table missing here fails the tests).
+pub const SCENE_KEYS: &[SceneKey] = &flatten::<{ count(TABLES) }>(TABLES);
+
+/// The tables, in README.md's order.
+const TABLES: &[&[SceneKey]] = &[
+    Run::KEYS,
+    Material::KEYS,
+    Body::KEYS,
+    RawFix::KEYS,
+    RawLoad::KEYS,
+    CyclicLoad::KEYS,
+    Series::KEYS,
+    Probe::KEYS,
+    Section::KEYS,
+    Measure::KEYS,
+    Contact::KEYS,
+    Wall::KEYS,
+    WallServo::KEYS,
+    Periodic::KEYS,
+    TimeDelay::KEYS,
+    Granular::KEYS,
+    Ballast::KEYS,
+    Bonded::KEYS,
+    Output::KEYS,
 ];
+
+/// The number of keys of `tables`.
+const fn count(tables: &[&[SceneKey]]) -> usize {
+    let (mut n, mut t) = (0, 0);
+    while t < tables.len() {
+        n += tables[t].len();
+        t += 1;
+    }
+    n
+}
+
+/// The keys of `tables` one after another (`N` of them).
+const fn flatten<const N: usize>(tables: &[&[SceneKey]]) -> [SceneKey; N] {
+    let mut out = [tables[0][0]; N];
+    let (mut n, mut t) = (0, 0);
+    while t < tables.len() {
+        let mut k = 0;
+        while k < tables[t].len() {
+            out[n] = tables[t][k];
+            n += 1;
+            k += 1;
+        }
+        t += 1;
+    }
+    out
+}
 
 /// The registry as a Markdown table: `| table | key | type | meaning |`, one row per key.
 ///
@@ -1008,9 +147,219 @@ mod tests {
             .collect()
     }
 
-    const HOW: &str = "add the key to SCENE_KEYS in qdem-io/src/scene/keys.rs (or remove it), \
-                       then regenerate README.md's table: QDEM_WRITE_KEYS=1 cargo test -p \
-                       qdem-io --lib scene::keys";
+    const HOW: &str = "declare the key in its table's scene_table! in qdem-io/src/scene/schema/ \
+                       (or remove it), and list a new table in TABLES of keys.rs; then \
+                       regenerate README.md's table: QDEM_WRITE_KEYS=1 cargo test -p qdem-io \
+                       --lib scene::keys";
+
+    /// The scene as serde reads it, or serde's message.
+    fn parse(text: &str) -> Result<RawScene, String> {
+        toml::from_str::<RawScene>(text).map_err(|e| e.to_string())
+    }
+
+    /// The keys of `table`.
+    fn keys_of(table: &str) -> impl Iterator<Item = &'static SceneKey> + '_ {
+        SCENE_KEYS.iter().filter(move |k| k.table == table)
+    }
+
+    /// The tables of the reference, in its order.
+    fn tables() -> Vec<&'static str> {
+        let mut tables: Vec<&str> = SCENE_KEYS.iter().map(|k| k.table).collect();
+        tables.dedup();
+        tables
+    }
+
+    /// Where `table` lives inside another table: the outer table and the key that holds it
+    /// (`[[load]] cyclic` in `[[load]]`, `[periodic.time_delay]` in `[periodic]`).
+    fn parent(table: &str) -> Option<(String, &str)> {
+        if let Some((outer, key)) = table.split_once(' ') {
+            return Some((outer.to_string(), key));
+        }
+        let (outer, key) = table.trim_matches(['[', ']']).split_once('.')?;
+        Some((format!("[{outer}]"), key))
+    }
+
+    /// The type of a key without its `, required` or `, optional`.
+    fn type_of(key: &SceneKey) -> &'static str {
+        key.kind.rsplit_once(", ").map_or(key.kind, |(ty, _)| ty)
+    }
+
+    fn is_required(key: &SceneKey) -> bool {
+        key.kind.ends_with(", required")
+    }
+
+    /// The table `key` holds, when its value is a table.
+    fn nested(key: &SceneKey) -> String {
+        tables()
+            .into_iter()
+            .find(|t| parent(t).is_some_and(|(outer, k)| outer == key.table && k == key.key))
+            .unwrap_or_else(|| panic!("{} {}: no table of its keys", key.table, key.key))
+            .to_string()
+    }
+
+    /// Values of the stated type of `key`, as TOML: every listed string for a type that lists
+    /// them.
+    fn samples(key: &SceneKey) -> Vec<String> {
+        let ty = type_of(key);
+        let one = |v: &str| vec![v.to_string()];
+        match ty {
+            "number" => one("2.5"),
+            "integer" => one("3"),
+            "string" => one("\"s\""),
+            "bool" => one("true"),
+            "path" => one("\"p.msh\""),
+            "[x, y, z]" => one("[1.0, 2.0, 3.0]"),
+            "[a, b]" => one("[1.0, 2.0]"),
+            "[number, …]" => one("[1.0, 2.0]"),
+            "[integer, integer]" => one("[3, 5]"),
+            "[path, …]" => one("[\"p.msh\", \"q.msh\"]"),
+            "[[x, y, z], [x, y, z]]" => one("[[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]"),
+            "[[x, y, z], …]" => one("[[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]"),
+            "[[t, factor], …]" | "[[size, passing], …]" => one("[[0.0, 0.0], [1.0, 1.0]]"),
+            "number or \"auto\"" => vec!["2.5".into(), "\"auto\"".into()],
+            "table" | "inline table" => {
+                one(&format!("{{ {} }}", fields(&nested(key), None).join(", ")))
+            }
+            _ => {
+                let listed = listed(ty);
+                assert!(
+                    !listed.is_empty(),
+                    "{} {}: no sample of the type {ty:?}",
+                    key.table,
+                    key.key
+                );
+                listed
+            }
+        }
+    }
+
+    /// The strings a type such as `"simple", "pinned" or "none"` lists, quoted.
+    fn listed(ty: &str) -> Vec<String> {
+        ty.split('"')
+            .skip(1)
+            .step_by(2)
+            .map(|s| format!("\"{s}\""))
+            .collect()
+    }
+
+    /// The lines of `table`: its required keys, each a sample of its type, and `set` (a key
+    /// and its value, or none to leave that key out).
+    fn fields(table: &str, set: Option<(&str, Option<&str>)>) -> Vec<String> {
+        let mut lines: Vec<String> = keys_of(table)
+            .filter(|k| is_required(k) && set.is_none_or(|(key, _)| key != k.key))
+            .map(|k| format!("{} = {}", k.key, samples(k)[0]))
+            .collect();
+        if let Some((key, Some(value))) = set {
+            lines.push(format!("{key} = {value}"));
+        }
+        lines
+    }
+
+    /// A scene that holds `table` with its required keys, inside its parents, and `set`.
+    fn scene(table: &str, set: Option<(&str, Option<&str>)>) -> String {
+        let run = match table {
+            "[run]" => String::new(),
+            _ => format!("[run]\n{}\n", fields("[run]", None).join("\n")),
+        };
+        let own = fields(table, set);
+        match parent(table) {
+            Some((outer, key)) if table.contains(' ') => format!(
+                "{run}{outer}\n{}\n{key} = {{ {} }}\n",
+                fields(&outer, None).join("\n"),
+                own.join(", ")
+            ),
+            Some((outer, _)) => format!(
+                "{run}{outer}\n{}\n{table}\n{}\n",
+                fields(&outer, None).join("\n"),
+                own.join("\n")
+            ),
+            None => format!("{run}{table}\n{}\n", own.join("\n")),
+        }
+    }
+
+    /// A scene of each table's required keys parses, and each required key left out is
+    /// refused as missing.
+    #[test]
+    fn required_keys_are_the_parsers() {
+        let mut wrong = Vec::new();
+        for table in tables() {
+            if let Err(e) = parse(&scene(table, None)) {
+                wrong.push(format!(
+                    "{table} with its required keys only is refused: {e}"
+                ));
+            }
+            for key in keys_of(table).filter(|k| is_required(k)) {
+                let missing = format!("missing field `{}`", key.key);
+                match parse(&scene(table, Some((key.key, None)))) {
+                    Err(e) if e.contains(&missing) => {}
+                    other => wrong.push(format!(
+                        "{table} {}: stated required, but without it: {other:?}",
+                        key.key
+                    )),
+                }
+            }
+        }
+        assert!(
+            wrong.is_empty(),
+            "{wrong:#?}\nfix the key's required/optional or its serde default"
+        );
+    }
+
+    /// Each key accepts a value of its stated type (every string a type lists) and refuses a
+    /// value of another type (and a string a type that lists strings does not list).
+    #[test]
+    fn stated_types_are_the_parsers() {
+        let mut wrong = Vec::new();
+        for key in SCENE_KEYS {
+            let with = |value: &str| parse(&scene(key.table, Some((key.key, Some(value)))));
+            for value in samples(key) {
+                if let Err(e) = with(&value) {
+                    wrong.push(format!(
+                        "{} {} = {value} (a {}) refused: {e}",
+                        key.table, key.key, key.kind
+                    ));
+                }
+            }
+            let mut foreign = vec![if type_of(key) == "bool" {
+                "\"s\""
+            } else {
+                "true"
+            }];
+            if !listed(type_of(key)).is_empty() {
+                foreign.push("\"zz_unlisted\"");
+            }
+            for value in foreign {
+                if with(value).is_ok() {
+                    wrong.push(format!(
+                        "{} {} = {value} accepted, not a {}",
+                        key.table, key.key, key.kind
+                    ));
+                }
+            }
+        }
+        assert!(wrong.is_empty(), "{wrong:#?}\nfix the key's stated type");
+    }
+
+    /// An optional key written with its stated default parses to what leaving it out gives:
+    /// the default is serde's.
+    #[test]
+    fn stated_defaults_are_the_parsers() {
+        let mut wrong = Vec::new();
+        for key in SCENE_KEYS {
+            let Some(default) = key.default else { continue };
+            let absent = parse(&scene(key.table, Some((key.key, None))));
+            let given = parse(&scene(key.table, Some((key.key, Some(default)))));
+            let (absent, given) = (format!("{absent:?}"), format!("{given:?}"));
+            if absent != given {
+                wrong.push(format!(
+                    "{} {}: stated default {default}, but left out it parses to\n{absent}\nand \
+                     written as {default} to\n{given}",
+                    key.table, key.key
+                ));
+            }
+        }
+        assert!(wrong.is_empty(), "{wrong:#?}\nfix the key's stated default");
+    }
 
     /// Every key the parser accepts is registered, and every registered key is accepted;
     /// every top-level table the parser accepts has registered keys.
@@ -1043,6 +392,55 @@ mod tests {
             "the scene key registry is out of date:\n  accepted by the parser but not \
              registered: {missing:?}\n  registered but refused by the parser: {stale:?}\n\
              fix: {HOW}"
+        );
+    }
+
+    /// The ways a meaning may write the TOML value `default`: the value itself, a number
+    /// without a zero fraction, `zero` or `the origin` for zeros, ¼ and ½, a string unquoted.
+    fn written(default: &str) -> Vec<String> {
+        let mut forms = vec![default.to_string(), default.trim_matches('"').to_string()];
+        let zeros = default
+            .trim_matches(['[', ']'])
+            .split(", ")
+            .all(|x| x == "0.0" || x == "0");
+        if zeros {
+            forms.extend(["0", "zero", "the origin"].map(String::from));
+        }
+        if let Ok(x) = default.parse::<f64>() {
+            forms.push(x.to_string());
+            forms.extend(match x {
+                0.25 => Some("¼".to_string()),
+                0.5 => Some("½".to_string()),
+                _ => None,
+            });
+        }
+        forms
+    }
+
+    /// The meaning of an optional key with a default names it: the clause (between `;`s) that
+    /// says `default` (up to `; ` or `. `) holds one of the ways of writing it.
+    #[test]
+    fn meanings_state_the_defaults() {
+        let mut wrong = Vec::new();
+        for key in SCENE_KEYS {
+            let Some(default) = key.default else { continue };
+            let forms = written(default);
+            let agrees = key
+                .meaning
+                .split("; ")
+                .flat_map(|clause| clause.split(". "))
+                .filter(|clause| clause.to_lowercase().contains("default"))
+                .any(|clause| forms.iter().any(|form| clause.contains(form.as_str())));
+            if !agrees {
+                wrong.push(format!(
+                    "{} {}: default {default}, meaning {:?}",
+                    key.table, key.key, key.meaning
+                ));
+            }
+        }
+        assert!(
+            wrong.is_empty(),
+            "{wrong:#?}\nfix the meaning's default or the stated one"
         );
     }
 

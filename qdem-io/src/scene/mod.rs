@@ -38,7 +38,6 @@ use std::path::{Path, PathBuf};
 
 mod error;
 pub mod keys;
-mod measure;
 mod refs;
 pub mod schema;
 mod spans;
@@ -46,13 +45,12 @@ pub mod suggest;
 mod validate;
 
 pub use error::{Diagnostic, SceneError};
-pub use measure::{Measure, MeasureRegion};
 pub use refs::{ProbeTarget, Refs};
 pub use schema::{
     AreaLoad, Ballast, Body, Bonded, ClumpShapeName, Contact, ContactLawName, CyclicLoad,
     EventSolveName, Fix, Formulation, GradingBasisName, Granular, Integrator, Load, Material,
-    Output, PackingName, Periodic, Probe, Ramp, Run, Section, Selection, Series, Supports,
-    TimeDelay, TimeStep, Wall, WallServo,
+    Measure, MeasureRegion, Output, PackingName, Periodic, Probe, Ramp, Run, Section, Selection,
+    Series, Supports, TimeDelay, TimeStep, Wall, WallServo,
 };
 
 use schema::RawScene;
