@@ -184,6 +184,7 @@ mod tests {
         key.kind.rsplit_once(", ").map_or(key.kind, |(ty, _)| ty)
     }
 
+    /// Whether the reference states `key` required.
     fn is_required(key: &SceneKey) -> bool {
         key.kind.ends_with(", required")
     }
