@@ -36,6 +36,7 @@ pub mod parallel;
 pub mod solvers;
 pub mod state;
 pub mod step;
+pub mod world;
 
 // The modules other crates and embedders reach by path.
 pub use continuum::tet_subdomain;
@@ -74,4 +75,4 @@ pub use step::model::{find_model, Linearized, Model, Persistence, Persistent, St
 pub use step::stages::{Stage, StageShare, StageTimes};
 pub use step::step_settings::{Scheme, StepRequest, StepSettings, Stepping};
 pub use step::stepper::{choose_step, stable_step, Stepper};
-pub use step::world::{Halt, PostStep, World};
+pub use world::{Halt, PostStep, World};

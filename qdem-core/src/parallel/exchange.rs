@@ -18,7 +18,7 @@ use crate::parallel::state_share::StateShare;
 use crate::state::State;
 use crate::step::model::Model;
 use crate::step::stages::{Stage, StageTimes};
-use crate::step::world::{Halt, PostStep};
+use crate::world::{Halt, PostStep};
 use crate::Vec3;
 use std::sync::Arc;
 

@@ -1,11 +1,9 @@
 //! The step API: [`model::Model`] (a source of forces) and its facets, [`stepper::Stepper`]
-//! (advances a state under the models), [`world::World`] (a state, its models, stepper and
-//! hooks, stepped as named, timed [`stages`]) and the step settings resolved once
-//! ([`step_settings`]).
+//! (advances a state under the models), the named, timed [`stages`] of a step and the step
+//! settings resolved once ([`step_settings`]).
 
 pub(crate) mod instability;
 pub mod model;
 pub mod stages;
 pub mod step_settings;
 pub mod stepper;
-pub mod world;
