@@ -34,20 +34,18 @@ pub mod loads;
 pub mod modal;
 pub mod parallel;
 pub mod solvers;
-pub mod state;
 pub mod step;
 pub mod world;
 
 // The modules other crates and embedders reach by path.
 pub use continuum::tet_subdomain;
 pub use continuum::{
-    averaged_pressure_tet, linear_tet, material, rigid_body, stable_step, tet_blocks, tet_kernel,
+    averaged_pressure_tet, linear_tet, material, stable_step, tet_blocks, tet_kernel,
 };
 pub use modal::lanczos;
 #[cfg(feature = "thread-ranks")]
 pub use parallel::thread_ranks;
-pub use solvers::tangent;
-pub use step::{stages, stepper};
+pub use step::{rigid_body, stages, state, stepper, tangent};
 
 /// A 3-vector of f64.
 pub type Vec3 = nalgebra::Vector3<f64>;
@@ -57,7 +55,7 @@ pub type Mat3 = nalgebra::Matrix3<f64>;
 pub use checkpoint::{CheckpointError, Decoder, Encoder, SavedState};
 pub use continuum::averaged_pressure_tet::Formulation;
 pub use continuum::material::Material;
-pub use continuum::rigid_body::RigidBodies;
+pub use step::rigid_body::RigidBodies;
 pub use continuum::tet_blocks::BlockLayout;
 pub use continuum::tet_body::TetBody;
 pub use error::CoreError;
@@ -68,9 +66,9 @@ pub use parallel::{Communicator, Decomposition, Exchange, Part, PartialSums, Rea
 pub use solvers::newmark::{EventSolve, Newmark, StepCounts, TangentUpdate};
 pub use solvers::sparse::FactorStats;
 pub use solvers::static_solve::{StaticSolver, StaticSteps};
-pub use solvers::tangent::Tangent;
+pub use step::tangent::Tangent;
 pub use solvers::verlet::Verlet;
-pub use state::{Dofs, ParticleSpin, State};
+pub use step::state::{Dofs, ParticleSpin, State};
 pub use step::model::{find_model, Linearized, Model, Persistence, Persistent, StepEvents};
 pub use step::stages::{Stage, StageShare, StageTimes};
 pub use step::step_settings::{Scheme, StepRequest, StepSettings, Stepping};

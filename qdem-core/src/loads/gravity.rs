@@ -1,8 +1,8 @@
 //! Uniform gravity: the force m g on every particle.
 
 use crate::parallel::split::Reads;
-use crate::solvers::tangent::Tangent;
-use crate::state::State;
+use crate::step::tangent::Tangent;
+use crate::step::state::State;
 use crate::step::model::{Linearized, Model, Persistence};
 use crate::Vec3;
 

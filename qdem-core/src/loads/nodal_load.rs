@@ -4,8 +4,8 @@
 
 use crate::loads::time_function::TimeFunction;
 use crate::parallel::split::Reads;
-use crate::solvers::tangent::Tangent;
-use crate::state::State;
+use crate::step::tangent::Tangent;
+use crate::step::state::State;
 use crate::step::model::{Linearized, Model, Persistence};
 use crate::Vec3;
 

@@ -52,7 +52,7 @@ use crate::modal::rigid_reduction::RigidReduction;
 use crate::solvers::sparse::{
     unconstrained_bodies, Assembler, FreeDofs, Scales, SparseCholesky, Tangent,
 };
-use crate::state::{Dofs, State};
+use crate::step::state::{Dofs, State};
 use crate::step::model::Model;
 use crate::Vec3;
 use nalgebra::{DMatrix, SymmetricEigen, Vector6};

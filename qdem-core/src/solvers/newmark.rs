@@ -53,14 +53,14 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::parallel::local_particles::ParticleRuns;
+use crate::step::local_particles::ParticleRuns;
 use crate::parallel::Exchange;
 use crate::solvers::conjugate_gradient::{self, Scratch};
 use crate::solvers::sparse::{
     copy_matrix, explain_failure, restore_matrix, save_matrix, Assembler, DampingRows, FactorStats,
     FreeDofs, Scales, SparseCholesky, Tangent,
 };
-use crate::state::State;
+use crate::step::state::State;
 use crate::step::model::Model;
 use crate::step::stages::{Stage, StageTimes};
 use crate::step::stepper::{

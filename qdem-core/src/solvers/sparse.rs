@@ -2,7 +2,7 @@
 //! and the linear static solve.
 //!
 //! - The models' tangent stiffness K and damping C arrive as a [`Tangent`] (lower-triangle
-//!   3×3 blocks per particle pair, [`crate::solvers::tangent`]).
+//!   3×3 blocks per particle pair, [`crate::step::tangent`]).
 //! - [`FreeDofs`] eliminates the constraints of Eqs. 23 and 27 (B∆u = 0, Bü = 0 with B selecting
 //!   the fixed directions): fixed DOFs are removed from the system, the others numbered
 //!   compactly in ascending order (so the lower triangle stays lower).
@@ -18,7 +18,7 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::state::{Dofs, State};
+use crate::step::state::{Dofs, State};
 use crate::step::model::Model;
 use crate::step::stepper::PARTICLE_CHUNK;
 use crate::{Mat3, Vec3};
@@ -34,8 +34,8 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::time::Instant;
 
-pub(crate) use crate::solvers::tangent::Tangent;
-use crate::solvers::tangent::{Entry, KeptEntries};
+pub(crate) use crate::step::tangent::Tangent;
+use crate::step::tangent::{Entry, KeptEntries};
 
 /// The damping C of a [`Tangent`] as whole rows (each stored lower-triangle entry on both
 /// sides, duplicates kept, in the tangent's order), so that C x runs row by row in parallel and

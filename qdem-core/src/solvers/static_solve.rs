@@ -43,7 +43,7 @@ use crate::solvers::sparse::{
     explain_failure, unconstrained_bodies, Assembler, FactorStats, FreeDofs, Scales,
     SparseCholesky, Tangent, FIX_HINT,
 };
-use crate::state::State;
+use crate::step::state::State;
 use crate::step::model::Model;
 use crate::step::stages::{Stage, StageTimes};
 use crate::step::stepper::{refuse_rigid, Stepper};

@@ -7,7 +7,7 @@
 //!
 //! Particle rotations ([`crate::ParticleSpin`]: a one-sphere grain, a bonded particle) are
 //! integrated the same way, ω_{n+½} = ω_n + ½∆t M_n/J, θ_{n+1} = θ_n + ∆t ω_{n+½},
-//! ω_{n+1} = ω_{n+½} + ½∆t M_{n+1}/J. Rigid bodies ([`crate::continuum::rigid_body`]) ride along: their
+//! ω_{n+1} = ω_{n+½} + ½∆t M_{n+1}/J. Rigid bodies ([`crate::step::rigid_body`]) ride along: their
 //! angular momentum gets the same two half kicks from the torque and their orientation the
 //! drift, and their members are placed after each. An optional local damping
 //! ([`crate::solvers::local_damping`]) acts on the summed forces before they become accelerations.
@@ -17,19 +17,19 @@
 //! the force sums, and, after the forces, a deferred uniform field (gravity), local damping,
 //! the accelerations, the second half kick and the finiteness check. In a run decomposed with
 //! a halo exchange ([`crate::Exchange::stepped`]) the sweeps cover only the rank's own
-//! particles and its halo ([`crate::parallel::local_particles`]), and the force sums are
+//! particles and its halo ([`crate::step::local_particles`]), and the force sums are
 //! zeroed whole by [`Exchange::sum_forces`].
 
 use crate::checkpoint::{same_count, CheckpointError, Decoder, Encoder};
-use crate::continuum::rigid_body::RigidBodies;
-use crate::continuum::rigid_body::{
+use crate::step::rigid_body::RigidBodies;
+use crate::step::rigid_body::{
     place_member_velocities, place_members, place_members_keeping_arms,
 };
 use crate::error::CoreError;
 use crate::parallel::Exchange;
 use crate::solvers::local_damping;
 use crate::solvers::verlet_sweeps::{self, DofArrays, KickSettings, Particles};
-use crate::state::State;
+use crate::step::state::State;
 use crate::step::model::Model;
 use crate::step::stages::{Stage, StageTimes};
 use crate::step::stepper::{check_finite_torque, check_masses, Stepper};
@@ -325,7 +325,7 @@ fn particles<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::Dofs;
+    use crate::step::state::Dofs;
     use crate::Gravity;
 
     /// A constant moment on particle 0 about z, and a constant force on it along x.

@@ -17,10 +17,10 @@
 //! task per thread, each of at least [`SWEEP_TASK`] particles: at 10⁴ particles two threads
 //! each take half.
 
-use crate::continuum::rigid_body::RigidBodies;
-use crate::parallel::local_particles::ParticleRuns;
+use crate::step::rigid_body::RigidBodies;
+use crate::step::local_particles::ParticleRuns;
 use crate::solvers::local_damping::damp;
-use crate::state::Dofs;
+use crate::step::state::Dofs;
 use crate::Vec3;
 use rayon::prelude::*;
 use std::ops::Range;

@@ -3,7 +3,11 @@
 //! settings resolved once ([`step_settings`]).
 
 pub(crate) mod instability;
+pub mod local_particles;
 pub mod model;
+pub mod rigid_body;
 pub mod stages;
+pub mod state;
 pub mod step_settings;
 pub mod stepper;
+pub mod tangent;

@@ -20,8 +20,8 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::parallel::split::Reads;
-use crate::solvers::tangent::Tangent;
-use crate::state::State;
+use crate::step::tangent::Tangent;
+use crate::step::state::State;
 use crate::step::step_settings::Stepping;
 use crate::Vec3;
 

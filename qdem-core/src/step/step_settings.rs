@@ -9,7 +9,7 @@
 //! reaches the request's `fit_to` time.
 
 use crate::error::CoreError;
-use crate::state::State;
+use crate::step::state::State;
 use crate::step::model::Model;
 use crate::step::stepper::{choose_step, stable_step, Stepper};
 use crate::{EventSolve, Newmark, StaticSteps, Verlet};

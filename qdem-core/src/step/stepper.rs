@@ -3,11 +3,11 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::parallel::local_particles::ParticleRuns;
+use crate::step::local_particles::ParticleRuns;
 use crate::parallel::Exchange;
 use crate::solvers::newmark::StepCounts;
 use crate::solvers::sparse::FactorStats;
-use crate::state::{Dofs, State};
+use crate::step::state::{Dofs, State};
 use crate::step::model::Model;
 use crate::step::stages::{Stage, StageTimes};
 use crate::Vec3;
