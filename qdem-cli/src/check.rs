@@ -314,7 +314,7 @@ fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<(f64, f64), CliEr
     };
     let world = &mut sim.world;
     world.initialize().map_err(run_error)?;
-    if let Some(s) = world.stepper().factor_stats() {
+    if let Some(s) = world.stepper().report().factor {
         println!(
             "implicit system: {} unknowns, {} non-zeros (lower triangle), factor {} non-zeros (fill {:.1}x); symbolic {:.3e} s, numeric {:.3e} s",
             s.dofs,

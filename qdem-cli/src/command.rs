@@ -622,7 +622,7 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
     };
     let steps = match sim.world.settings().scheme {
         Scheme::Static => {
-            let solves = sim.world.stepper().counts().solves;
+            let solves = sim.world.stepper().report().counts.solves;
             format!("{} steps (linear solves: {solves})", report.steps)
         }
         _ => format!("{} steps", report.steps),

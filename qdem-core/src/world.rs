@@ -29,10 +29,10 @@
 use crate::checkpoint::{model_tag, whole_block, CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::parallel::{Communicator, Decomposition, Exchange, Reads};
-use crate::step::state::State;
 use crate::step::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
 use crate::step::model::{find_model, Model, Persistence};
 use crate::step::stages::{Stage, StageShare, StageTimes};
+use crate::step::state::State;
 use crate::step::step_settings::StepSettings;
 use crate::step::stepper::{stable_step, Stepper};
 use std::sync::Arc;

@@ -52,8 +52,8 @@ use crate::modal::rigid_reduction::RigidReduction;
 use crate::solvers::sparse::{
     unconstrained_bodies, Assembler, FreeDofs, Scales, SparseCholesky, Tangent,
 };
-use crate::step::state::{Dofs, State};
 use crate::step::model::Model;
+use crate::step::state::{Dofs, State};
 use crate::Vec3;
 use nalgebra::{DMatrix, SymmetricEigen, Vector6};
 use std::f64::consts::PI;

@@ -7,17 +7,17 @@
 //! ([`crate::SplitModel`]) and the exchange runs the collectives between its stages, in the
 //! same order on every rank.
 
-use crate::step::rigid_body::reduce_member_forces;
 use crate::error::CoreError;
 use crate::parallel::communicator::{max_over_ranks, Communicator};
 use crate::parallel::decomposition::{decompose, Decomposition, Partition};
 use crate::parallel::ghosts::GhostTable;
-use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::parallel::split::{Part, Reads, SplitModel};
 use crate::parallel::state_share::StateShare;
-use crate::step::state::State;
+use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
+use crate::step::rigid_body::reduce_member_forces;
 use crate::step::stages::{Stage, StageTimes};
+use crate::step::state::State;
 use crate::world::{Halt, PostStep};
 use crate::Vec3;
 use std::sync::Arc;

@@ -16,6 +16,7 @@
 pub mod communicator;
 pub mod decomposition;
 mod exchange;
+mod exchange_seam;
 mod ghosts;
 pub mod split;
 mod state_share;

@@ -17,9 +17,9 @@
 //! task per thread, each of at least [`SWEEP_TASK`] particles: at 10⁴ particles two threads
 //! each take half.
 
-use crate::step::rigid_body::RigidBodies;
-use crate::step::local_particles::ParticleRuns;
 use crate::solvers::local_damping::damp;
+use crate::step::local_particles::ParticleRuns;
+use crate::step::rigid_body::RigidBodies;
 use crate::step::state::Dofs;
 use crate::Vec3;
 use rayon::prelude::*;
@@ -115,7 +115,7 @@ impl<'a> Particles<'a> {
 }
 
 /// The particles a sweep covers: every one, or a decomposed run's share
-/// ([`crate::Exchange::stepped`], [`crate::Exchange::computed`]).
+/// ([`crate::step::seam::Seam::stepped`], [`crate::step::seam::Seam::computed`]).
 pub(crate) fn cover(count: usize, only: Option<&ParticleRuns>) -> Vec<Range<usize>> {
     match only {
         None => std::iter::once(0..count).collect(),

@@ -6,6 +6,8 @@ pub(crate) mod instability;
 pub mod local_particles;
 pub mod model;
 pub mod rigid_body;
+pub mod seam;
+pub mod solve_report;
 pub mod stages;
 pub mod state;
 pub mod step_settings;

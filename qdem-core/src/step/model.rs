@@ -20,9 +20,9 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::parallel::split::Reads;
-use crate::step::tangent::Tangent;
 use crate::step::state::State;
 use crate::step::step_settings::Stepping;
+use crate::step::tangent::Tangent;
 use crate::Vec3;
 
 /// A source of particle forces. Models are `Any` so that the output can reach a body's

@@ -9,8 +9,8 @@
 //! reaches the request's `fit_to` time.
 
 use crate::error::CoreError;
-use crate::step::state::State;
 use crate::step::model::Model;
+use crate::step::state::State;
 use crate::step::stepper::{choose_step, stable_step, Stepper};
 use crate::{EventSolve, Newmark, StaticSteps, Verlet};
 

@@ -26,7 +26,7 @@ pub(crate) fn write(
         summary["resumed_at_step"] = json!(step);
     }
     if sim.world.settings().scheme == Scheme::Static {
-        summary["solves"] = json!(sim.world.stepper().counts().solves);
+        summary["solves"] = json!(sim.world.stepper().report().counts.solves);
     }
     if let Some(contacts) = sim.contacts() {
         summary["contact"] = json!({
