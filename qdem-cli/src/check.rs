@@ -106,7 +106,7 @@ fn print_scene(path: &Path, sim: &Simulation) {
         );
     }
     println!("{}", integrator_line(sim));
-    if !sim.world.settings().scheme.is_implicit() {
+    if !sim.world.settings().is_implicit() {
         print_step_limits(sim);
     }
     print_memory(sim);
@@ -123,7 +123,7 @@ fn integrator_line(sim: &Simulation) -> String {
     let settings = sim.world.settings();
     let (dt, steps, t_end) = (sim.world.dt(), sim.steps(), sim.scene.run.t_end);
     let name = sim.scene.run.integrator.name();
-    match settings.scheme {
+    match settings.request.scheme {
         Scheme::Static => format!(
             "integrator static: load levels every {dt:.6e} s, {steps} steps to t_end = {t_end} \
              s, one solve per distinct load level"

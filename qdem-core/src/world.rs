@@ -29,6 +29,7 @@
 use crate::checkpoint::{model_tag, whole_block, CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::parallel::{Communicator, Decomposition, Exchange, Reads};
+use crate::solvers::stepper_for::stepper_for;
 use crate::step::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
 use crate::step::model::{find_model, Model, Persistence};
 use crate::step::stages::{Stage, StageShare, StageTimes};
@@ -130,7 +131,7 @@ impl World {
         mut models: Vec<Box<dyn Model>>,
         settings: StepSettings,
     ) -> Result<World, CoreError> {
-        let stepper = settings.stepper()?;
+        let stepper = stepper_for(&settings)?;
         prepare(&mut models, &settings);
         let stages = StageTimes::new(models.len(), 0);
         Ok(World {
@@ -150,7 +151,7 @@ impl World {
     /// the next step), the models told again. No bound is checked: a step chosen here is the
     /// caller's responsibility (the failure check still catches an unstable one).
     pub fn set_settings(&mut self, settings: StepSettings) -> Result<(), CoreError> {
-        self.stepper = settings.stepper()?;
+        self.stepper = stepper_for(&settings)?;
         prepare(&mut self.models, &settings);
         self.settings = settings;
         let steps_in_part = self.stepper.steps_in_part();
@@ -225,7 +226,7 @@ impl World {
     /// [`World::initialize`] or [`World::restore`]. Only explicit runs (Verlet, explicit
     /// Newmark) can be decomposed.
     pub fn decompose(&mut self, comm: Arc<dyn Communicator>) -> Result<Decomposition, CoreError> {
-        if self.settings.scheme.is_implicit() {
+        if self.settings.is_implicit() {
             return Err(CoreError::Decomposition(format!(
                 "only explicit runs (Verlet, explicit Newmark) can be decomposed, and this one is \
                  stepped by {}; run it as one process (without mpirun)",
@@ -449,9 +450,8 @@ impl World {
 
 /// Tells every model how it is stepped.
 fn prepare(models: &mut [Box<dyn Model>], settings: &StepSettings) {
-    let stepping = settings.stepping();
     for model in models.iter_mut() {
-        model.prepare(&stepping);
+        model.prepare(settings);
     }
 }
 

@@ -64,6 +64,7 @@ use crate::step::seam::Seam;
 use crate::step::solve_report::{SolveReport, StepCounts};
 use crate::step::stages::{Stage, StageTimes};
 use crate::step::state::State;
+use crate::step::step_settings::EventSolve;
 use crate::step::stepper::{
     check_finite, check_masses, compute_accelerations_timed, refuse_rigid, Stepper, PARTICLE_CHUNK,
 };
@@ -80,19 +81,6 @@ pub enum TangentUpdate {
     Fixed,
     /// Every step, with K and C at the step's start (large displacements or rotations).
     EveryStep,
-}
-
-/// How the implicit stepper solves a step whose matrix changed since its factorisation
-/// (a model's events changed the tangent).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum EventSolve {
-    /// Refactorises the matrix at every change: the faster on the benchmark beam
-    /// (docs/bbm.md), and the default.
-    #[default]
-    Refactorize,
-    /// Conjugate gradients preconditioned by the kept factor of the same step length;
-    /// refactorises when they take more than [`MAX_ITERATIONS`].
-    Preconditioned,
 }
 
 /// The most conjugate-gradient iterations on a kept factor before refactorising. On the

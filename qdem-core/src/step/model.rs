@@ -21,7 +21,7 @@
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::parallel::split::Reads;
 use crate::step::state::State;
-use crate::step::step_settings::Stepping;
+use crate::step::step_settings::StepSettings;
 use crate::step::tangent::Tangent;
 use crate::Vec3;
 
@@ -76,8 +76,8 @@ pub trait Model: std::any::Any + Send + Sync {
     /// [`crate::World`] is made; a model whose forces depend on it (a bonded body whose
     /// contacts push only when active in an implicit run) keeps what it needs. The default
     /// ignores it.
-    fn prepare(&mut self, stepping: &Stepping) {
-        let _ = stepping;
+    fn prepare(&mut self, settings: &StepSettings) {
+        let _ = settings;
     }
 
     /// After a step: a physical impossibility the model met at its last force evaluation at
