@@ -7,7 +7,7 @@
 
 use crate::command::CliError;
 use crate::progress;
-use qdem_core::{Communicator, Decomposition, Model as _, Scheme, Stage, TetBody};
+use qdem_core::{Communicator, Decomposition, Model as _, Scheme, Stage};
 use qdem_io::build::{memory, BodyKind, Simulation};
 use qdem_io::runner::RunError;
 use qdem_io::scene::Scene;
@@ -214,7 +214,7 @@ fn rank_table(sim: &Simulation, d: &Decomposition, per_step: f64, exchange: f64)
         .models
         .iter()
         .enumerate()
-        .filter(|(_, m)| TetBody::of(m.as_ref()).is_some())
+        .filter(|(_, m)| m.deformable().is_some())
         .map(|(i, _)| world.stages().seconds(Stage::Forces(i)))
         .sum();
     let kernel = (bodies - exchange).max(0.0);
@@ -296,8 +296,8 @@ fn exchange_seconds(sim: &Simulation) -> f64 {
     let models = &sim.world.models;
     models
         .iter()
-        .filter_map(|m| TetBody::of(m.as_ref()))
-        .map(TetBody::exchange_seconds)
+        .filter_map(|m| m.deformable())
+        .map(|body| body.exchange_seconds())
         .sum()
 }
 

@@ -65,7 +65,9 @@ pub use parallel::{Communicator, Decomposition, Exchange, Part, PartialSums, Rea
 pub use solvers::newmark::{Newmark, TangentUpdate};
 pub use solvers::static_solve::{StaticSolver, StaticSteps};
 pub use solvers::verlet::Verlet;
-pub use step::model::{find_model, Linearized, Model, Persistence, Persistent, StepEvents};
+pub use step::model::{
+    find_model, Deformable, Linearized, Model, Persistence, Persistent, StepEvents,
+};
 pub use step::rigid_body::RigidBodies;
 pub use step::solve_report::{FactorStats, SolveReport, StepCounts};
 pub use step::stages::{Stage, StageShare, StageTimes};

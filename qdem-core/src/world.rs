@@ -460,8 +460,8 @@ fn prepare(models: &mut [Box<dyn Model>], settings: &StepSettings) {
 fn refuse_averaged_pressure(models: &[Box<dyn Model>]) -> Result<(), CoreError> {
     let averaged = models
         .iter()
-        .filter_map(|m| crate::TetBody::of(m.as_ref()))
-        .find(|b| b.formulation() == crate::Formulation::AveragedPressure);
+        .filter_map(|m| m.deformable())
+        .find(|b| b.averages_pressure());
     match averaged {
         Some(body) => Err(CoreError::Decomposition(format!(
             "body `{}` uses formulation = \"averaged-pressure\", which a run decomposed over \
