@@ -28,10 +28,11 @@
 
 use crate::checkpoint::{model_tag, whole_block, CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::parallel::{Communicator, Decomposition, Exchange, Reads};
+use crate::parallel::{Communicator, Decomposition, Exchange};
 use crate::solvers::stepper_for::stepper_for;
 use crate::step::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
 use crate::step::model::{find_model, Model, Persistence};
+use crate::step::post_step::{Halt, PostStep};
 use crate::step::stages::{Stage, StageShare, StageTimes};
 use crate::step::state::State;
 use crate::step::step_settings::StepSettings;
@@ -42,36 +43,6 @@ use std::sync::Arc;
 /// failure check reports it as itself rather than as an unstable step; it also separates
 /// the report's detail from its fix.
 const PASS_THROUGH: &str = "\u{1}pass through\u{1}";
-
-/// Something a world does after every step, once the step has passed the failure check:
-/// periodic wrapping of bodies, a watch that ends the run when a body has failed.
-pub trait PostStep: std::any::Any + Send + Sync {
-    /// A short name for the stage counters.
-    fn name(&self) -> &str;
-
-    /// Acts on the state after a step; returns a [`Halt`] to end the run after this step.
-    fn after_step(&mut self, state: &mut State, models: &[Box<dyn Model>]) -> Option<Halt>;
-
-    /// How the hook takes part in a decomposed run ([`Model::reads`]); the default,
-    /// [`Reads::All`], is always right. A split hook decides for its own particles and acts
-    /// on every rank's decisions ([`crate::SplitModel::decide`], [`crate::SplitModel::act`]).
-    fn reads(&mut self) -> Reads<'_> {
-        Reads::All
-    }
-}
-
-/// Why a post-step hook ended a run early (not a failure: the outputs are complete).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Halt {
-    /// The hook's name.
-    pub hook: String,
-    /// Simulated time (s).
-    pub time: f64,
-    /// The particle that triggered it.
-    pub particle: usize,
-    /// The quantity that passed its limit (a displacement in m for the collapse watch).
-    pub value: f64,
-}
 
 /// A simulation that steps itself: state, models, stepper, hooks and stage counters.
 ///
@@ -218,9 +189,10 @@ impl World {
     /// process computes its share of the deformable bodies and every step ends with the
     /// exchange of the particles each rank owns (after each sub-step of an adaptive explicit
     /// Newmark step too). When every model and hook reads only what a rank steps itself
-    /// ([`Reads::Own`] or [`Reads::Split`]) and the stepper can step in part (Verlet), a rank
-    /// steps only its own particles and its halo, and receives only its halo, and a split
-    /// model ([`crate::SplitModel`], DEM contacts) computes only what touches its particles:
+    /// ([`crate::parallel::Reads::Own`] or [`crate::parallel::Reads::Split`]) and the
+    /// stepper can step in part (Verlet), a rank steps only its own particles and its halo,
+    /// and receives only its halo, and a split model ([`crate::SplitModel`], DEM contacts)
+    /// computes only what touches its particles:
     /// call [`World::gather`] before reading the whole state. Otherwise every rank holds the
     /// state one process would after every step. Call it on every rank, before
     /// [`World::initialize`] or [`World::restore`]. Only explicit runs (Verlet, explicit

@@ -15,10 +15,10 @@ use crate::parallel::split::{Part, Reads, SplitModel};
 use crate::parallel::state_share::StateShare;
 use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
+use crate::step::post_step::{Halt, PostStep};
 use crate::step::rigid_body::reduce_member_forces;
 use crate::step::stages::{Stage, StageTimes};
 use crate::step::state::State;
-use crate::world::{Halt, PostStep};
 use crate::Vec3;
 use std::sync::Arc;
 

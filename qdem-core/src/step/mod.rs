@@ -5,6 +5,7 @@
 pub(crate) mod instability;
 pub mod local_particles;
 pub mod model;
+pub mod post_step;
 pub mod rigid_body;
 pub mod seam;
 pub mod solve_report;

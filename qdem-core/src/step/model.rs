@@ -21,6 +21,7 @@
 //!   evaluation and what it exchanges, which the world's [`crate::Exchange`] runs.
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
+use crate::error::CoreError;
 use crate::parallel::split::Reads;
 use crate::step::state::State;
 use crate::step::step_settings::StepSettings;
@@ -85,7 +86,7 @@ pub trait Model: std::any::Any + Send + Sync {
     /// After a step: a physical impossibility the model met at its last force evaluation at
     /// `state` (a tetrahedron turned inside out), which stops the run; `None` when all is
     /// well.
-    fn failure(&self, state: &State) -> Option<crate::CoreError> {
+    fn failure(&self, state: &State) -> Option<CoreError> {
         let _ = state;
         None
     }
