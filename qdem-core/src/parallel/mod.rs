@@ -10,7 +10,9 @@
 //! - [`Exchange`]: what a step exchanges (the models' forces through their split facets,
 //!   the state after each integration, the gathers, the failure agreement, the hooks'
 //!   decisions, the re-partitions), with the state share (`state_share.rs`), the particles a
-//!   rank steps ([`crate::step::local_particles::ParticleRuns`]) and the contacts' ghost records (`ghosts.rs`);
+//!   rank steps ([`crate::step::local_particles::ParticleRuns`]) and the contacts' ghost
+//!   records (`ghosts.rs`); it is the steppers' [`crate::step::seam::Seam`] of a decomposed
+//!   run (`exchange_seam.rs`);
 //! - [`Reads`] and [`SplitModel`] ([`split`]): what a model declares of a decomposed run.
 
 pub mod communicator;
