@@ -62,7 +62,7 @@ fn newmark_step(c: &mut Criterion) {
 
 fn implicit_refactorisation(c: &mut Criterion) {
     let mut sim = beam("implicit");
-    let Scheme::Newmark { beta, gamma } = sim.world.settings().scheme else {
+    let Scheme::Newmark { beta, gamma } = sim.world.settings().request.scheme else {
         panic!("the implicit beam steps by Newmark")
     };
     let mut stepper = Newmark::new(beta, gamma, sim.world.dt()).expect("implicit Newmark");

@@ -57,7 +57,7 @@ pub fn measure_implicit(tets: usize, threads: usize) -> Result<ImplicitResult, C
             stepper.step(&mut state, &mut models)?;
         }
         let step_seconds = start.elapsed().as_secs_f64() / steps as f64;
-        let stats = stepper.factor_stats().expect("factorised at initialize");
+        let stats = stepper.report().factor.expect("factorised at initialize");
         Ok(ImplicitResult {
             tets,
             dofs: stats.dofs,

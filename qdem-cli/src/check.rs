@@ -7,7 +7,7 @@
 
 use crate::command::CliError;
 use crate::progress;
-use qdem_core::{Communicator, Decomposition, Model as _, Scheme, Stage, TetBody};
+use qdem_core::{Communicator, Decomposition, Model as _, Scheme, Stage};
 use qdem_io::build::{memory, BodyKind, Simulation};
 use qdem_io::runner::RunError;
 use qdem_io::scene::Scene;
@@ -106,7 +106,7 @@ fn print_scene(path: &Path, sim: &Simulation) {
         );
     }
     println!("{}", integrator_line(sim));
-    if !sim.world.settings().scheme.is_implicit() {
+    if !sim.world.settings().is_implicit() {
         print_step_limits(sim);
     }
     print_memory(sim);
@@ -123,7 +123,7 @@ fn integrator_line(sim: &Simulation) -> String {
     let settings = sim.world.settings();
     let (dt, steps, t_end) = (sim.world.dt(), sim.steps(), sim.scene.run.t_end);
     let name = sim.scene.run.integrator.name();
-    match settings.scheme {
+    match settings.request.scheme {
         Scheme::Static => format!(
             "integrator static: load levels every {dt:.6e} s, {steps} steps to t_end = {t_end} \
              s, one solve per distinct load level"
@@ -214,7 +214,7 @@ fn rank_table(sim: &Simulation, d: &Decomposition, per_step: f64, exchange: f64)
         .models
         .iter()
         .enumerate()
-        .filter(|(_, m)| TetBody::of(m.as_ref()).is_some())
+        .filter(|(_, m)| m.deformable().is_some())
         .map(|(i, _)| world.stages().seconds(Stage::Forces(i)))
         .sum();
     let kernel = (bodies - exchange).max(0.0);
@@ -296,8 +296,8 @@ fn exchange_seconds(sim: &Simulation) -> f64 {
     let models = &sim.world.models;
     models
         .iter()
-        .filter_map(|m| TetBody::of(m.as_ref()))
-        .map(TetBody::exchange_seconds)
+        .filter_map(|m| m.deformable())
+        .map(|body| body.exchange_seconds())
         .sum()
 }
 
@@ -314,7 +314,7 @@ fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<(f64, f64), CliEr
     };
     let world = &mut sim.world;
     world.initialize().map_err(run_error)?;
-    if let Some(s) = world.stepper().factor_stats() {
+    if let Some(s) = world.stepper().report().factor {
         println!(
             "implicit system: {} unknowns, {} non-zeros (lower triangle), factor {} non-zeros (fill {:.1}x); symbolic {:.3e} s, numeric {:.3e} s",
             s.dofs,

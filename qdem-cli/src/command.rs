@@ -620,9 +620,9 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
     } else {
         format!("{:.3e} tet-steps/s", report.tet_steps_per_second)
     };
-    let steps = match sim.world.settings().scheme {
+    let steps = match sim.world.settings().request.scheme {
         Scheme::Static => {
-            let solves = sim.world.stepper().counts().solves;
+            let solves = sim.world.stepper().report().counts.solves;
             format!("{} steps (linear solves: {solves})", report.steps)
         }
         _ => format!("{} steps", report.steps),
@@ -640,7 +640,7 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
 fn stepping_words(sim: &Simulation) -> String {
     let (dt, steps) = (sim.world.dt(), sim.steps());
     let name = sim.scene.run.integrator.name();
-    match sim.world.settings().scheme {
+    match sim.world.settings().request.scheme {
         Scheme::Static => format!("static with load levels every {dt:.4e} s, {steps} steps"),
         scheme if scheme.is_implicit() => format!("{name} with dt = {dt:.4e} s, {steps} steps"),
         _ => format!(

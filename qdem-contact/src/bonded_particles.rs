@@ -46,7 +46,7 @@ use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
 use qdem_core::{
     CheckpointError, Decoder, Encoder, Linearized, Model, Persistence, Persistent, State,
-    StepEvents, Stepping, Tangent, Vec3,
+    StepEvents, StepSettings, Tangent, Vec3,
 };
 use rayon::prelude::*;
 use std::collections::HashSet;
@@ -605,8 +605,8 @@ impl Model for BondedParticles {
         &self.name
     }
 
-    fn prepare(&mut self, stepping: &Stepping) {
-        self.implicit = stepping.implicit;
+    fn prepare(&mut self, settings: &StepSettings) {
+        self.implicit = settings.is_implicit();
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {

@@ -120,10 +120,18 @@ fn lattice_has_the_continuum_modulus_and_poisson_ratio() {
         bbm::settings(),
     )
     .unwrap();
-    model.prepare(&qdem_core::Stepping {
-        implicit: true,
-        dt: 0.0,
-    });
+    // Solved statically: the bonds' contacts push only when active, as in an implicit run.
+    let request = qdem_core::StepRequest {
+        scheme: qdem_core::Scheme::Static,
+        dt: Some(1.0),
+        safety: 0.5,
+        local_damping: 0.0,
+        adaptive: false,
+        event_solve: Default::default(),
+        implicit_default: None,
+        fit_to: None,
+    };
+    model.prepare(&qdem_core::StepSettings::resolve(&request, &state, &[]).unwrap());
     let h = packing.spacing;
     let c = &packing.centers;
     let left: Vec<usize> = (0..c.len()).filter(|&p| c[p][0] < 0.51 * h).collect();

@@ -8,8 +8,8 @@
 //! their own history through [`crate::Persistent::save`] and [`crate::Stepper::save`]. The file
 //! around it (header, version, scene fingerprint) belongs to the caller.
 
-use crate::continuum::rigid_body::RigidBodies;
-use crate::state::{ParticleSpin, State};
+use crate::step::rigid_body::RigidBodies;
+use crate::step::state::{ParticleSpin, State};
 use crate::Vec3;
 use nalgebra::{Quaternion, UnitQuaternion};
 use thiserror::Error;

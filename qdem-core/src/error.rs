@@ -1,7 +1,6 @@
 //! Errors of the core: bad bodies, bad time functions, bad steps and unstable runs.
 
 use crate::checkpoint::CheckpointError;
-use crate::continuum::material::MaterialError;
 use thiserror::Error;
 
 /// Everything the core refuses, each message naming the offending item and the fix.
@@ -278,4 +277,29 @@ pub fn unstable_advice(dt: f64, bound: f64) -> String {
          pushing a vertex through its body (finer contact spheres)"
             .to_string()
     }
+}
+
+/// A material constant outside its physical range.
+#[derive(Debug, Error, PartialEq)]
+pub enum MaterialError {
+    /// ρ ≤ 0 or not finite.
+    #[error("density must be a positive number of kg/m^3, got {0}")]
+    Density(f64),
+    /// E ≤ 0 or not finite.
+    #[error("young must be a positive number of Pa, got {0}")]
+    Young(f64),
+    /// ν outside (−1, 0.5).
+    #[error(
+        "poisson must lie in (-1, 0.5), got {0}; incompressible materials are not supported by \
+         an explicit step: use 0.49 at most"
+    )]
+    Poisson(f64),
+    /// A negative or non-finite viscosity.
+    #[error("{name} must be a non-negative number of Pa s, got {value}")]
+    Viscosity {
+        /// Which viscosity.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+    },
 }

@@ -14,12 +14,22 @@
 //!   explicit (β = 0) or implicit (β > 0, a sparse Cholesky solve per step);
 //!   [`StaticSolver`] the linear static solve K u = f.
 //!
-//! The crate is laid out by area: [`step`] (the model, stepper and world API and the stage
-//! counters), [`continuum`] (the QDEM tetrahedron, its bodies, materials and step bounds,
-//! rigid bodies), [`loads`] (gravity, nodal loads, time functions), [`solvers`] (Verlet,
-//! Newmark-β, the static solve and their sparse algebra), [`modal`] (Lanczos modes),
-//! [`parallel`] (the decomposition over ranks, behind one seam: the [`Exchange`]) and
-//! [`checkpoint`].
+//! The crate is laid out by area, in layers that import only downwards (checked by
+//! `tests/layers.rs`):
+//!
+//! 1. [`step`]: the state and the rigid bodies in it, the model and its facets, the post-step
+//!    hooks, the stepper and the seam it evaluates forces through, the tangent, the stages,
+//!    the step settings and the solve report (with [`error`] and [`checkpoint`]);
+//! 2. the physics, [`continuum`] (the QDEM tetrahedron, its bodies, materials and step
+//!    bounds) and [`loads`] (gravity, nodal loads, time functions), and the [`solvers`]
+//!    (Verlet, Newmark-β, the static solve and their sparse algebra), each on its own;
+//! 3. [`modal`] (Lanczos modes of the tangents);
+//! 4. [`parallel`] (the decomposition over ranks, distributing what the models declare,
+//!    behind one seam: the [`Exchange`]);
+//! 5. [`world`]: the [`World`], which holds the parallel runtime.
+//!
+//! The flat re-exports below are for other crates and embedders; the crate itself names
+//! everything by its area path.
 //!
 //! The QDEM tetrahedron (Nishiura, Sakaguchi & Aikawa 2017, Eqs. 1–11) is in [`tet_kernel`],
 //! with the literal 12-triangle subdomain construction kept as its oracle in
@@ -34,19 +44,18 @@ pub mod loads;
 pub mod modal;
 pub mod parallel;
 pub mod solvers;
-pub mod state;
 pub mod step;
+pub mod world;
 
 // The modules other crates and embedders reach by path.
 pub use continuum::tet_subdomain;
 pub use continuum::{
-    averaged_pressure_tet, linear_tet, material, rigid_body, stable_step, tet_blocks, tet_kernel,
+    averaged_pressure_tet, linear_tet, material, stable_step, tet_blocks, tet_kernel,
 };
 pub use modal::lanczos;
 #[cfg(feature = "thread-ranks")]
 pub use parallel::thread_ranks;
-pub use solvers::tangent;
-pub use step::{stages, stepper};
+pub use step::{rigid_body, stages, state, stepper, tangent};
 
 /// A 3-vector of f64.
 pub type Vec3 = nalgebra::Vector3<f64>;
@@ -56,7 +65,6 @@ pub type Mat3 = nalgebra::Matrix3<f64>;
 pub use checkpoint::{CheckpointError, Decoder, Encoder, SavedState};
 pub use continuum::averaged_pressure_tet::Formulation;
 pub use continuum::material::Material;
-pub use continuum::rigid_body::RigidBodies;
 pub use continuum::tet_blocks::BlockLayout;
 pub use continuum::tet_body::TetBody;
 pub use error::CoreError;
@@ -64,14 +72,18 @@ pub use loads::gravity::Gravity;
 pub use loads::nodal_load::NodalLoad;
 pub use loads::time_function::{Cyclic, TimeFunction};
 pub use parallel::{Communicator, Decomposition, Exchange, Part, PartialSums, Reads, SplitModel};
-pub use solvers::newmark::{EventSolve, Newmark, StepCounts, TangentUpdate};
-pub use solvers::sparse::FactorStats;
+pub use solvers::newmark::{Newmark, TangentUpdate};
 pub use solvers::static_solve::{StaticSolver, StaticSteps};
-pub use solvers::tangent::Tangent;
 pub use solvers::verlet::Verlet;
-pub use state::{Dofs, ParticleSpin, State};
-pub use step::model::{find_model, Linearized, Model, Persistence, Persistent, StepEvents};
+pub use step::model::{
+    find_model, Deformable, Linearized, Model, Persistence, Persistent, StepEvents,
+};
+pub use step::post_step::{Halt, PostStep};
+pub use step::rigid_body::RigidBodies;
+pub use step::solve_report::{FactorStats, SolveReport, StepCounts};
 pub use step::stages::{Stage, StageShare, StageTimes};
-pub use step::step_settings::{Scheme, StepRequest, StepSettings, Stepping};
+pub use step::state::{Dofs, ParticleSpin, State};
+pub use step::step_settings::{EventSolve, Scheme, StepRequest, StepSettings};
 pub use step::stepper::{choose_step, stable_step, Stepper};
-pub use step::world::{Halt, PostStep, World};
+pub use step::tangent::Tangent;
+pub use world::World;

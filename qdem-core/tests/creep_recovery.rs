@@ -220,7 +220,7 @@ fn implicit_newmark_follows_kelvin_voigt_creep_and_recovery() {
     let (rms, max, at) = errors(tau);
     let (rms_mu, max_mu, _) = errors(SHEAR_VISCOSITY / YOUNG);
     let peak = history.iter().map(|h| h.1).fold(0.0, f64::max);
-    let stats = stepper.factor_stats().unwrap();
+    let stats = stepper.report().factor.unwrap();
 
     eprintln!(
         "creep–recovery: E = {YOUNG:.1e} Pa, ρ = {DENSITY} kg/m³, μ_D = {SHEAR_VISCOSITY:.4e} Pa s, \

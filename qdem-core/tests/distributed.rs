@@ -98,7 +98,7 @@ fn one_process_for(newmark: bool, steps: usize) -> (State, u64) {
     for _ in 0..steps {
         world.step().unwrap();
     }
-    let retakes = world.stepper().counts().retakes;
+    let retakes = world.stepper().report().counts.retakes;
     (world.state, retakes)
 }
 

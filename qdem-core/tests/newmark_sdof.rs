@@ -83,7 +83,7 @@ fn average_acceleration_conserves_amplitude_and_lengthens_the_period() {
         assert!(drift < 1e-10, "amplitude drift {drift:e}");
         assert!(error < 1e-6, "period elongation error {error:e}");
         assert_eq!(
-            stepper.factor_stats().unwrap().factorizations,
+            stepper.report().factor.unwrap().factorizations,
             1,
             "a fixed tangent is factorised once"
         );

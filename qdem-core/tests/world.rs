@@ -165,5 +165,5 @@ fn the_step_rule_refuses_an_explicit_step_above_the_bound_and_fits_an_automatic_
     };
     let big = StepSettings::resolve(&implicit, &state, &models).unwrap();
     assert_eq!(big.dt, 100.0 * bound);
-    assert!(big.stepping().implicit);
+    assert!(big.is_implicit());
 }

@@ -6,7 +6,7 @@
 mod common;
 
 use common::{fixture, test_dir};
-use qdem_core::{Model, Vec3};
+use qdem_core::Vec3;
 use qdem_io::build::{BodyKind, BuildError, Simulation};
 use qdem_io::runner::{run_with, RunOptions};
 use qdem_io::scene::Scene;

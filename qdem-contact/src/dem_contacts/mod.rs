@@ -410,8 +410,8 @@ impl Model for DemContacts {
         Persistence::Saved(self)
     }
 
-    fn prepare(&mut self, stepping: &qdem_core::Stepping) {
-        self.step = stepping.dt;
+    fn prepare(&mut self, settings: &qdem_core::StepSettings) {
+        self.step = settings.dt;
     }
 
     /// A sphere found through a wall or inside another body at the last rebuild of the

@@ -36,8 +36,8 @@
 use crate::continuum::material::Material;
 use crate::continuum::tet_body::{current_gradients, lame_block};
 use crate::continuum::tet_kernel::{cofactor, edge_matrix, velocity_gradient, vertex_forces};
-use crate::solvers::tangent::Tangent;
-use crate::state::State;
+use crate::step::state::State;
+use crate::step::tangent::Tangent;
 use crate::{Mat3, Vec3};
 use rayon::prelude::*;
 

@@ -9,7 +9,7 @@
 
 use crate::continuum::material::Lame;
 use crate::continuum::tet_kernel::edge_matrix;
-use crate::state::Dofs;
+use crate::step::state::Dofs;
 use crate::{Mat3, Vec3};
 
 /// A linear-tetrahedron stiffness operator on a mesh.

@@ -5,7 +5,7 @@
 //! κ_D = λ_D + ⅔ μ_D, the two scalars a user can measure. A material with zero viscosities is
 //! elastic and the tetrahedron kernel skips its viscous path.
 
-use thiserror::Error;
+use crate::error::MaterialError;
 
 /// Material constants of a Kelvin–Voigt solid.
 #[derive(Clone, Debug, PartialEq)]
@@ -20,31 +20,6 @@ pub struct Material {
     pub shear_viscosity: f64,
     /// Bulk viscosity κ_D = λ_D + ⅔ μ_D (Pa s).
     pub bulk_viscosity: f64,
-}
-
-/// A material constant outside its physical range.
-#[derive(Debug, Error, PartialEq)]
-pub enum MaterialError {
-    /// ρ ≤ 0 or not finite.
-    #[error("density must be a positive number of kg/m^3, got {0}")]
-    Density(f64),
-    /// E ≤ 0 or not finite.
-    #[error("young must be a positive number of Pa, got {0}")]
-    Young(f64),
-    /// ν outside (−1, 0.5).
-    #[error(
-        "poisson must lie in (-1, 0.5), got {0}; incompressible materials are not supported by \
-         an explicit step: use 0.49 at most"
-    )]
-    Poisson(f64),
-    /// A negative or non-finite viscosity.
-    #[error("{name} must be a non-negative number of Pa s, got {value}")]
-    Viscosity {
-        /// Which viscosity.
-        name: &'static str,
-        /// The value given.
-        value: f64,
-    },
 }
 
 /// Lamé-type pair (λ, μ) of either the elastic (Pa) or the viscous (Pa s) part.

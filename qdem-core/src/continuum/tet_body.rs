@@ -27,9 +27,9 @@ use crate::continuum::tet_lanes::{block_forces, BlockInput, LaneSet};
 use crate::error::CoreError;
 use crate::parallel::decomposition::{BodyLayout, BodySplit};
 use crate::parallel::split::{Part, PartialSums, Reads, SplitModel};
-use crate::solvers::tangent::Tangent;
-use crate::state::State;
-use crate::step::model::{Linearized, Model, Persistence};
+use crate::step::model::{Deformable, Linearized, Model, Persistence};
+use crate::step::state::State;
+use crate::step::tangent::Tangent;
 use crate::{Mat3, Vec3};
 use rayon::prelude::*;
 use std::sync::Mutex;
@@ -184,8 +184,9 @@ impl TetBody {
         }
     }
 
-    /// The model as a deformable body, if it is one (models are `Any`).
-    pub fn of(model: &dyn Model) -> Option<&TetBody> {
+    /// The model as a deformable body, if it is one (models are `Any`). Crate-private: other
+    /// code reads a body through its [`Deformable`] facet ([`Model::deformable`]).
+    pub(crate) fn of(model: &dyn Model) -> Option<&TetBody> {
         let any: &dyn std::any::Any = model;
         any.downcast_ref::<TetBody>()
     }
@@ -529,6 +530,28 @@ fn rate_bound(dm_inv: &[Mat3], material: &Material, lame: Lame) -> f64 {
         .reduce(|| 0.0, f64::max)
 }
 
+impl Deformable for TetBody {
+    fn tets(&self) -> &[[u32; 4]] {
+        TetBody::tets(self)
+    }
+
+    fn tet_fields(&self, state: &State) -> (Vec<Mat3>, Vec<f64>) {
+        TetBody::tet_fields(self, state)
+    }
+
+    fn small_strain_stresses(&self, state: &State) -> Vec<Mat3> {
+        TetBody::small_strain_stresses(self, state)
+    }
+
+    fn averages_pressure(&self) -> bool {
+        self.averaged.is_some()
+    }
+
+    fn exchange_seconds(&self) -> f64 {
+        TetBody::exchange_seconds(self)
+    }
+}
+
 impl Model for TetBody {
     fn failure(&self, state: &State) -> Option<CoreError> {
         let tet = self.inverted?;
@@ -553,6 +576,10 @@ impl Model for TetBody {
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
         self.compute(state);
         self.gather(force);
+    }
+
+    fn deformable(&self) -> Option<&dyn Deformable> {
+        Some(self)
     }
 
     fn stable_dt(&self, _state: &State) -> Option<f64> {

@@ -1,9 +1,9 @@
 //! Uniform gravity: the force m g on every particle.
 
 use crate::parallel::split::Reads;
-use crate::solvers::tangent::Tangent;
-use crate::state::State;
 use crate::step::model::{Linearized, Model, Persistence};
+use crate::step::state::State;
+use crate::step::tangent::Tangent;
 use crate::Vec3;
 
 /// Uniform gravitational acceleration acting on every particle.

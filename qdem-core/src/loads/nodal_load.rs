@@ -4,9 +4,9 @@
 
 use crate::loads::time_function::TimeFunction;
 use crate::parallel::split::Reads;
-use crate::solvers::tangent::Tangent;
-use crate::state::State;
 use crate::step::model::{Linearized, Model, Persistence};
+use crate::step::state::State;
+use crate::step::tangent::Tangent;
 use crate::Vec3;
 
 /// Forces F_i·φ(t) on a set of particles: a total force divided equally among them

@@ -44,7 +44,6 @@
 //!   modes the fractions of each direction sum to 1 (the modes are an M-orthonormal basis of
 //!   the free DOFs). The direction with the largest fraction is the mode's dominant direction.
 
-use crate::continuum::tet_body::TetBody;
 use crate::error::CoreError;
 use crate::modal::mechanisms::{tet_piece_rows, unresisted_motions, SystemDofs};
 use crate::modal::partly_fixed;
@@ -52,8 +51,8 @@ use crate::modal::rigid_reduction::RigidReduction;
 use crate::solvers::sparse::{
     unconstrained_bodies, Assembler, FreeDofs, Scales, SparseCholesky, Tangent,
 };
-use crate::state::{Dofs, State};
 use crate::step::model::Model;
+use crate::step::state::{Dofs, State};
 use crate::Vec3;
 use nalgebra::{DMatrix, SymmetricEigen, Vector6};
 use std::f64::consts::PI;
@@ -726,7 +725,7 @@ fn tet_pieces(particles: usize, models: &[Box<dyn Model>]) -> (Vec<Option<u32>>,
     }
     let mut in_body = vec![false; particles];
     for model in models {
-        let Some(body) = TetBody::of(model.as_ref()) else {
+        let Some(body) = model.deformable() else {
             continue;
         };
         for tet in body.tets() {

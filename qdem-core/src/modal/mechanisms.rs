@@ -17,7 +17,7 @@
 //! own 6 × 6 block), which misses the mechanisms of several pieces.
 
 use crate::solvers::sparse::rigid_motion;
-use crate::solvers::tangent::Entry;
+use crate::step::tangent::Entry;
 use crate::Vec3;
 use nalgebra::{DMatrix, DVector, Matrix6, SymmetricEigen, Vector6};
 use std::ops::Range;
@@ -187,7 +187,7 @@ fn held_pieces(piece: &[Option<u32>], pieces: usize, dofs: &SystemDofs<'_>) -> V
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solvers::tangent::Entry as Triplet;
+    use crate::step::tangent::Entry as Triplet;
 
     /// The four corners of a tetrahedron, one piece, each held to the ground along z by a
     /// spring: the z translation and the rotations about x and y stretch them, the x and y

@@ -22,8 +22,8 @@
 //!   second moment of mass about its centre, s_k = ½ ΣI − I_k, so that the three shares sum to
 //!   m |u_c|² + θᵀ J θ.
 
-use crate::solvers::tangent::{Entry, Tangent};
-use crate::state::{Dofs, State};
+use crate::step::state::{Dofs, State};
+use crate::step::tangent::{Entry, Tangent};
 use crate::{Mat3, Vec3};
 use faer::sparse::Triplet;
 

@@ -44,11 +44,11 @@
 use crate::continuum::tet_body::TetBody;
 use crate::error::CoreError;
 use crate::parallel::communicator::Communicator;
-use crate::parallel::local_particles::{LocalParticles, ParticleRuns};
 use crate::parallel::split::Reads;
 use crate::parallel::state_share::{Halo, StateShare};
-use crate::state::State;
+use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
+use crate::step::state::State;
 use crate::Vec3;
 use std::ops::Range;
 use std::sync::Arc;

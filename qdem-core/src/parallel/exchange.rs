@@ -7,18 +7,18 @@
 //! ([`crate::SplitModel`]) and the exchange runs the collectives between its stages, in the
 //! same order on every rank.
 
-use crate::continuum::rigid_body::reduce_member_forces;
 use crate::error::CoreError;
 use crate::parallel::communicator::{max_over_ranks, Communicator};
 use crate::parallel::decomposition::{decompose, Decomposition, Partition};
 use crate::parallel::ghosts::GhostTable;
-use crate::parallel::local_particles::{LocalParticles, ParticleRuns};
 use crate::parallel::split::{Part, Reads, SplitModel};
 use crate::parallel::state_share::StateShare;
-use crate::state::State;
+use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
+use crate::step::post_step::{Halt, PostStep};
+use crate::step::rigid_body::reduce_member_forces;
 use crate::step::stages::{Stage, StageTimes};
-use crate::step::world::{Halt, PostStep};
+use crate::step::state::State;
 use crate::Vec3;
 use std::sync::Arc;
 

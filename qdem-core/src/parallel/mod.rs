@@ -10,14 +10,16 @@
 //! - [`Exchange`]: what a step exchanges (the models' forces through their split facets,
 //!   the state after each integration, the gathers, the failure agreement, the hooks'
 //!   decisions, the re-partitions), with the state share (`state_share.rs`), the particles a
-//!   rank steps ([`ParticleRuns`]) and the contacts' ghost records (`ghosts.rs`);
+//!   rank steps ([`crate::step::local_particles::ParticleRuns`]) and the contacts' ghost
+//!   records (`ghosts.rs`); it is the steppers' [`crate::step::seam::Seam`] of a decomposed
+//!   run (`exchange_seam.rs`);
 //! - [`Reads`] and [`SplitModel`] ([`split`]): what a model declares of a decomposed run.
 
 pub mod communicator;
 pub mod decomposition;
 mod exchange;
+mod exchange_seam;
 mod ghosts;
-pub mod local_particles;
 pub mod split;
 mod state_share;
 #[cfg(feature = "thread-ranks")]
@@ -26,5 +28,4 @@ pub mod thread_ranks;
 pub use communicator::Communicator;
 pub use decomposition::Decomposition;
 pub use exchange::Exchange;
-pub use local_particles::ParticleRuns;
 pub use split::{Part, PartialSums, Reads, SplitModel};

@@ -25,7 +25,7 @@
 //! 7. [`SplitModel::apply`]: the rank adds its own particles' forces.
 
 use crate::parallel::decomposition::{BodySplit, SumExchange};
-use crate::state::State;
+use crate::step::state::State;
 use crate::Vec3;
 use std::sync::Arc;
 

@@ -25,8 +25,8 @@
 
 use crate::parallel::communicator::Communicator;
 use crate::parallel::decomposition::Decomposition;
-use crate::parallel::local_particles::ParticleRuns;
-use crate::state::State;
+use crate::step::local_particles::ParticleRuns;
+use crate::step::state::State;
 use crate::Vec3;
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::ops::Range;

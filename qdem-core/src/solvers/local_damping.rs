@@ -5,7 +5,7 @@
 //! velocity and the moment on a rotating particle against its rate. It dissipates energy without a viscosity scale, for quasi-static packing; it is
 //! not physical damping and is off unless a scene asks for it.
 
-use crate::state::State;
+use crate::step::state::State;
 use crate::Vec3;
 
 /// Applies local damping with fraction `alpha` (0 ≤ α < 1) to the forces and torques of one

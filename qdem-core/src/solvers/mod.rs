@@ -1,13 +1,13 @@
 //! The steppers and their algebra: explicit [`verlet::Verlet`] (paper 000 §2.4), the
 //! Newmark-β family ([`newmark::Newmark`], paper 001 §3), the linear static solve
-//! ([`static_solve`]), local damping, the tangent ([`tangent::Tangent`]) and the sparse
-//! factorisations behind them.
+//! ([`static_solve`]), local damping and the sparse factorisations behind them; the stepper a
+//! run's settings describe ([`stepper_for::stepper_for`]).
 
 pub(crate) mod conjugate_gradient;
 pub mod local_damping;
 pub mod newmark;
 pub(crate) mod sparse;
 pub mod static_solve;
-pub mod tangent;
+pub mod stepper_for;
 pub mod verlet;
 pub(crate) mod verlet_sweeps;

@@ -53,16 +53,18 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::parallel::local_particles::ParticleRuns;
-use crate::parallel::Exchange;
 use crate::solvers::conjugate_gradient::{self, Scratch};
 use crate::solvers::sparse::{
-    copy_matrix, explain_failure, restore_matrix, save_matrix, Assembler, DampingRows, FactorStats,
-    FreeDofs, Scales, SparseCholesky, Tangent,
+    copy_matrix, explain_failure, restore_matrix, save_matrix, Assembler, DampingRows, FreeDofs,
+    Scales, SparseCholesky, Tangent,
 };
-use crate::state::State;
+use crate::step::local_particles::ParticleRuns;
 use crate::step::model::Model;
+use crate::step::seam::Seam;
+use crate::step::solve_report::{SolveReport, StepCounts};
 use crate::step::stages::{Stage, StageTimes};
+use crate::step::state::State;
+use crate::step::step_settings::EventSolve;
 use crate::step::stepper::{
     check_finite, check_masses, compute_accelerations_timed, refuse_rigid, Stepper, PARTICLE_CHUNK,
 };
@@ -79,19 +81,6 @@ pub enum TangentUpdate {
     Fixed,
     /// Every step, with K and C at the step's start (large displacements or rotations).
     EveryStep,
-}
-
-/// How the implicit stepper solves a step whose matrix changed since its factorisation
-/// (a model's events changed the tangent).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum EventSolve {
-    /// Refactorises the matrix at every change: the faster on the benchmark beam
-    /// (docs/bbm.md), and the default.
-    #[default]
-    Refactorize,
-    /// Conjugate gradients preconditioned by the kept factor of the same step length;
-    /// refactorises when they take more than [`MAX_ITERATIONS`].
-    Preconditioned,
 }
 
 /// The most conjugate-gradient iterations on a kept factor before refactorising. On the
@@ -114,69 +103,6 @@ const MAX_REDOS: usize = 8;
 /// The shortest sub-step of the adaptive control, as a fraction of ∆t: a crack that runs
 /// bond after bond would otherwise be resolved one bond per (refactorised) sub-step.
 const MIN_FRACTION: f64 = 1.0 / 16.0;
-
-/// What the adaptive control and the events did (for summaries and the paper's Tables 1–2).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct StepCounts {
-    /// Steps rejected and retaken with ∆t·√α (Eqs. 29–30).
-    pub retakes: u64,
-    /// Accepted steps (sub-steps included: a retaken step is finished by further sub-steps so
-    /// that every step still ends at t + ∆t).
-    pub substeps: u64,
-    /// Accepted steps at whose end a model's tangent changed (bonds broke, contacts changed).
-    pub event_steps: u64,
-    /// Numeric factorisations of the effective matrix (nominal and sub-step), implicit only.
-    pub factorizations: u64,
-    /// Trial steps redone with the contacts the trial met in the matrix (implicit only).
-    pub redos: u64,
-    /// Linear solves of the implicit step (one per trial step).
-    pub solves: u64,
-    /// Of the solves, those by conjugate gradients on a kept factor ([`EventSolve`]).
-    pub iterative_solves: u64,
-    /// Conjugate-gradient iterations of those solves, together.
-    pub iterations: u64,
-}
-
-impl StepCounts {
-    /// The number of counts.
-    pub const LEN: usize = 8;
-
-    /// The counts in field order (for checkpoints).
-    ///
-    /// ```
-    /// use qdem_core::StepCounts;
-    /// let counts = StepCounts { retakes: 2, iterations: 7, ..StepCounts::default() };
-    /// assert_eq!(StepCounts::from_array(counts.to_array()), counts);
-    /// ```
-    pub fn to_array(&self) -> [u64; StepCounts::LEN] {
-        [
-            self.retakes,
-            self.substeps,
-            self.event_steps,
-            self.factorizations,
-            self.redos,
-            self.solves,
-            self.iterative_solves,
-            self.iterations,
-        ]
-    }
-
-    /// The counts [`Self::to_array`] listed.
-    pub fn from_array(n: [u64; StepCounts::LEN]) -> StepCounts {
-        let [retakes, substeps, event_steps, factorizations, redos, solves, iterative_solves, iterations] =
-            n;
-        StepCounts {
-            retakes,
-            substeps,
-            event_steps,
-            factorizations,
-            redos,
-            solves,
-            iterative_solves,
-            iterations,
-        }
-    }
-}
 
 /// The Newmark-β family: explicit for β = 0, implicit for β > 0, optionally adaptive.
 ///
@@ -529,7 +455,7 @@ impl Newmark {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         h: f64,
-        (stages, exchange): (&mut StageTimes, &mut Exchange),
+        (stages, seam): (&mut StageTimes, &mut dyn Seam),
     ) -> Result<(), CoreError> {
         self.prepare_solve(state, models, h)?;
         stages.mark(Stage::Solve);
@@ -539,7 +465,7 @@ impl Newmark {
         change.1.resize(state.spin.len(), Vec3::zeros());
         hold(state, h, beta, gamma, (&mut change.0, &mut change.1));
         stages.mark(Stage::Predict);
-        exchange.sum_forces(state, models, &mut self.force, &mut self.torque, stages);
+        seam.sum_forces(state, models, &mut self.force, &mut self.torque, stages);
         let rigid = state.rigid.len();
         let moments = &mut self.torque[rigid..];
         subtract_inertia(state, &mut self.force, moments);
@@ -572,16 +498,16 @@ impl Newmark {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         h: f64,
-        (stages, exchange): (&mut StageTimes, &mut Exchange),
+        (stages, seam): (&mut StageTimes, &mut dyn Seam),
     ) -> Result<(), CoreError> {
         if self.is_implicit() {
-            return self.implicit_step(state, models, h, (stages, exchange));
+            return self.implicit_step(state, models, h, (stages, seam));
         }
         let (beta, gamma) = (self.beta, self.gamma);
         predict(state, h, beta, gamma);
         stages.mark(Stage::Predict);
         let (force, torque) = (&mut self.force, &mut self.torque);
-        compute_accelerations_timed(state, models, force, torque, stages, exchange)?;
+        compute_accelerations_timed(state, models, force, torque, stages, seam)?;
         correct(state, h, beta, gamma);
         stages.mark(Stage::Integrate);
         Ok(())
@@ -597,7 +523,7 @@ impl Newmark {
         models: &mut [Box<dyn Model>],
         span: f64,
         stages: &mut StageTimes,
-        exchange: &mut Exchange,
+        seam: &mut dyn Seam,
     ) -> Result<f64, CoreError> {
         let mut h = span;
         if self.adaptive || self.is_implicit() {
@@ -610,8 +536,8 @@ impl Newmark {
         let (mut retakes, mut redos) = (0, 0);
         stages.mark(Stage::Events);
         loop {
-            let advanced = self.advance(state, models, h, (&mut *stages, &mut *exchange));
-            exchange.complete(state, stages, advanced, true)?;
+            let advanced = self.advance(state, models, h, (&mut *stages, &mut *seam));
+            seam.complete(state, stages, advanced, true)?;
             let alpha = models
                 .iter_mut()
                 .filter_map(|m| m.events()?.check_step(state, forces_here))
@@ -844,13 +770,12 @@ impl Stepper for Newmark {
         self.dt
     }
 
-    fn factor_stats(&self) -> Option<&FactorStats> {
+    fn report(&self) -> SolveReport {
         let cholesky = &self.system.factors.nominal.cholesky;
-        cholesky.is_factored().then(|| cholesky.stats())
-    }
-
-    fn counts(&self) -> StepCounts {
-        self.counts
+        SolveReport {
+            counts: self.counts,
+            factor: cholesky.is_factored().then(|| cholesky.stats().clone()),
+        }
     }
 
     fn forces(&self) -> &[Vec3] {
@@ -928,13 +853,13 @@ impl Stepper for Newmark {
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
-        exchange: &mut Exchange,
+        seam: &mut dyn Seam,
     ) -> Result<(), CoreError> {
         refuse_rigid(state, "newmark")?;
         check_masses(state)?;
         let (force, torque) = (&mut self.force, &mut self.torque);
         let stages = &mut StageTimes::off();
-        compute_accelerations_timed(state, models, force, torque, stages, exchange)?;
+        compute_accelerations_timed(state, models, force, torque, stages, seam)?;
         if self.is_implicit() {
             self.refactor(state, models, self.dt)?;
         }
@@ -949,12 +874,12 @@ impl Stepper for Newmark {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
-        exchange: &mut Exchange,
+        seam: &mut dyn Seam,
     ) -> Result<(), CoreError> {
         let end = state.time + self.dt;
         let mut remaining = self.dt;
         while remaining > 1e-9 * self.dt {
-            remaining -= self.advance_adaptively(state, models, remaining, stages, exchange)?;
+            remaining -= self.advance_adaptively(state, models, remaining, stages, seam)?;
         }
         state.time = end;
         Ok(())

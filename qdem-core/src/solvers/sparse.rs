@@ -2,7 +2,7 @@
 //! and the linear static solve.
 //!
 //! - The models' tangent stiffness K and damping C arrive as a [`Tangent`] (lower-triangle
-//!   3×3 blocks per particle pair, [`crate::solvers::tangent`]).
+//!   3×3 blocks per particle pair, [`crate::step::tangent`]).
 //! - [`FreeDofs`] eliminates the constraints of Eqs. 23 and 27 (B∆u = 0, Bü = 0 with B selecting
 //!   the fixed directions): fixed DOFs are removed from the system, the others numbered
 //!   compactly in ascending order (so the lower triangle stays lower).
@@ -18,8 +18,9 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::state::{Dofs, State};
 use crate::step::model::Model;
+use crate::step::solve_report::FactorStats;
+use crate::step::state::{Dofs, State};
 use crate::step::stepper::PARTICLE_CHUNK;
 use crate::{Mat3, Vec3};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -34,8 +35,8 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::time::Instant;
 
-pub(crate) use crate::solvers::tangent::Tangent;
-use crate::solvers::tangent::{Entry, KeptEntries};
+pub(crate) use crate::step::tangent::Tangent;
+use crate::step::tangent::{Entry, KeptEntries};
 
 /// The damping C of a [`Tangent`] as whole rows (each stored lower-triangle entry on both
 /// sides, duplicates kept, in the tangent's order), so that C x runs row by row in parallel and
@@ -678,29 +679,6 @@ impl Terms<'_> {
             .for_each(|(value, (sk, sc))| *value = k * sk + c * sc);
         self.fill(matrix, slots, [kept.stiffness, kept.damping])
     }
-}
-
-/// Size, sparsity and cost of the last factorisation (for `qdem check`).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct FactorStats {
-    /// Order of the matrix (free DOFs).
-    pub dofs: usize,
-    /// Stored non-zeros of the matrix (lower triangle).
-    pub nonzeros: usize,
-    /// Stored values of the Cholesky factor L (its fill; supernodes are stored dense).
-    pub factor_nonzeros: usize,
-    /// Time of the last symbolic analysis (s).
-    pub symbolic_seconds: f64,
-    /// Time of the last numeric factorisation (s).
-    pub numeric_seconds: f64,
-    /// Time of the assembly of the matrix last factorised (s).
-    pub assembly_seconds: f64,
-    /// Time of the last solve, a forward and a backward triangular solve (s).
-    pub solve_seconds: f64,
-    /// Number of symbolic analyses so far (one per sparsity pattern met).
-    pub analyses: usize,
-    /// Number of numeric factorisations so far.
-    pub factorizations: usize,
 }
 
 /// The symbolic analysis of one sparsity pattern, with the scratch space its numeric

@@ -37,15 +37,16 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::parallel::Exchange;
-use crate::solvers::newmark::{collect_tangent, StepCounts};
+use crate::solvers::newmark::collect_tangent;
 use crate::solvers::sparse::{
-    explain_failure, unconstrained_bodies, Assembler, FactorStats, FreeDofs, Scales,
-    SparseCholesky, Tangent, FIX_HINT,
+    explain_failure, unconstrained_bodies, Assembler, FreeDofs, Scales, SparseCholesky, Tangent,
+    FIX_HINT,
 };
-use crate::state::State;
 use crate::step::model::Model;
+use crate::step::seam::{OneProcess, Seam};
+use crate::step::solve_report::{FactorStats, SolveReport, StepCounts};
 use crate::step::stages::{Stage, StageTimes};
+use crate::step::state::State;
 use crate::step::stepper::{refuse_rigid, Stepper};
 use crate::Vec3;
 
@@ -128,7 +129,7 @@ impl StaticSolver {
         if !self.cholesky.is_factored() {
             self.factorize(state, models)?;
         }
-        Exchange::default().sum_forces(
+        OneProcess.sum_forces(
             state,
             models,
             &mut self.force,
@@ -274,7 +275,7 @@ impl Stepper for StaticSteps {
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
-        _exchange: &mut Exchange,
+        _seam: &mut dyn Seam,
     ) -> Result<(), CoreError> {
         let time = state.time;
         self.solver.solve(state, models, time)
@@ -286,7 +287,7 @@ impl Stepper for StaticSteps {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
-        _exchange: &mut Exchange,
+        _seam: &mut dyn Seam,
     ) -> Result<(), CoreError> {
         let time = self.next_level(state.time);
         let solved = self.solver.solve(state, models, time);
@@ -294,18 +295,16 @@ impl Stepper for StaticSteps {
         solved
     }
 
-    fn factor_stats(&self) -> Option<&FactorStats> {
-        self.solver.factor_stats()
-    }
-
-    /// The linear solves made by this process ([`StaticSolver::solves`]) and the one
-    /// factorisation once made.
-    fn counts(&self) -> StepCounts {
-        StepCounts {
+    /// The linear solves made by this process ([`StaticSolver::solves`]), the one
+    /// factorisation once made and its size and cost.
+    fn report(&self) -> SolveReport {
+        let counts = StepCounts {
             solves: self.solver.solves(),
             factorizations: u64::from(self.solver.cholesky.is_factored()),
             ..StepCounts::default()
-        }
+        };
+        let factor = self.solver.factor_stats().cloned();
+        SolveReport { counts, factor }
     }
 
     fn forces(&self) -> &[Vec3] {

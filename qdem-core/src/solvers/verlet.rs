@@ -7,7 +7,7 @@
 //!
 //! Particle rotations ([`crate::ParticleSpin`]: a one-sphere grain, a bonded particle) are
 //! integrated the same way, ω_{n+½} = ω_n + ½∆t M_n/J, θ_{n+1} = θ_n + ∆t ω_{n+½},
-//! ω_{n+1} = ω_{n+½} + ½∆t M_{n+1}/J. Rigid bodies ([`crate::continuum::rigid_body`]) ride along: their
+//! ω_{n+1} = ω_{n+½} + ½∆t M_{n+1}/J. Rigid bodies ([`crate::step::rigid_body`]) ride along: their
 //! angular momentum gets the same two half kicks from the torque and their orientation the
 //! drift, and their members are placed after each. An optional local damping
 //! ([`crate::solvers::local_damping`]) acts on the summed forces before they become accelerations.
@@ -16,22 +16,20 @@
 //! (`qdem-core/src/solvers/verlet_sweeps.rs`): the first half kick with the drift and the zeroing of
 //! the force sums, and, after the forces, a deferred uniform field (gravity), local damping,
 //! the accelerations, the second half kick and the finiteness check. In a run decomposed with
-//! a halo exchange ([`crate::Exchange::stepped`]) the sweeps cover only the rank's own
-//! particles and its halo ([`crate::parallel::local_particles`]), and the force sums are
-//! zeroed whole by [`Exchange::sum_forces`].
+//! a halo exchange ([`Seam::stepped`]) the sweeps cover only the rank's own
+//! particles and its halo ([`crate::step::local_particles`]), and the force sums are
+//! zeroed whole by [`Seam::sum_forces`].
 
 use crate::checkpoint::{same_count, CheckpointError, Decoder, Encoder};
-use crate::continuum::rigid_body::RigidBodies;
-use crate::continuum::rigid_body::{
-    place_member_velocities, place_members, place_members_keeping_arms,
-};
 use crate::error::CoreError;
-use crate::parallel::Exchange;
 use crate::solvers::local_damping;
 use crate::solvers::verlet_sweeps::{self, DofArrays, KickSettings, Particles};
-use crate::state::State;
 use crate::step::model::Model;
+use crate::step::rigid_body::RigidBodies;
+use crate::step::rigid_body::{place_member_velocities, place_members, place_members_keeping_arms};
+use crate::step::seam::Seam;
 use crate::step::stages::{Stage, StageTimes};
+use crate::step::state::State;
 use crate::step::stepper::{check_finite_torque, check_masses, Stepper};
 use crate::Vec3;
 
@@ -95,7 +93,7 @@ impl Verlet {
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
-        (stages, exchange): (&mut StageTimes, &mut Exchange),
+        (stages, seam): (&mut StageTimes, &mut dyn Seam),
         kick: Option<f64>,
         zeroed: bool,
     ) -> Result<(), CoreError> {
@@ -106,8 +104,8 @@ impl Verlet {
         };
         let (force, torque) = (&mut self.force, &mut self.torque);
         match zeroed {
-            true => exchange.add_forces(state, &mut models[..summed], force, torque, stages),
-            false => exchange.sum_forces(state, &mut models[..summed], force, torque, stages),
+            true => seam.add_forces(state, &mut models[..summed], force, torque, stages),
+            false => seam.sum_forces(state, &mut models[..summed], force, torque, stages),
         }
         self.rigid_bodies = state.rigid.len();
         let (rigid, moment) = self.torque.split_at_mut(self.rigid_bodies);
@@ -121,7 +119,7 @@ impl Verlet {
             field,
             damping: self.local_damping,
         };
-        let ranges = verlet_sweeps::cover(state.len(), exchange.computed());
+        let ranges = verlet_sweeps::cover(state.len(), seam.computed());
         let (particles, rigid_bodies) = particles(state, &mut self.force, moment);
         let (bad, bad_spin) = verlet_sweeps::kick(particles, &ranges, rigid_bodies, settings);
         let time = state.time;
@@ -142,10 +140,10 @@ impl Verlet {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
-        exchange: &mut Exchange,
+        seam: &mut dyn Seam,
     ) -> Result<(), CoreError> {
         let dt = self.dt;
-        let stepped = exchange.stepped();
+        let stepped = seam.stepped();
         // After a resume the force sums are not there yet.
         self.force.resize(state.len(), Vec3::zeros());
         self.torque
@@ -165,7 +163,7 @@ impl Verlet {
             place_members_keeping_arms(state, &mut self.arms);
         }
         stages.mark(Stage::Predict);
-        self.evaluate(state, models, (stages, exchange), Some(0.5 * dt), zero)?;
+        self.evaluate(state, models, (stages, seam), Some(0.5 * dt), zero)?;
         self.kick_rigid(state);
         stages.mark(Stage::Integrate);
         Ok(())
@@ -199,19 +197,13 @@ impl Stepper for Verlet {
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
-        exchange: &mut Exchange,
+        seam: &mut dyn Seam,
     ) -> Result<(), CoreError> {
         check_masses(state)?;
         if !state.rigid.is_empty() {
             place_members(state);
         }
-        self.evaluate(
-            state,
-            models,
-            (&mut StageTimes::off(), exchange),
-            None,
-            false,
-        )
+        self.evaluate(state, models, (&mut StageTimes::off(), seam), None, false)
     }
 
     /// The torques of the last evaluation: the rigid bodies', which the next step's first
@@ -274,10 +266,10 @@ impl Stepper for Verlet {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
-        exchange: &mut Exchange,
+        seam: &mut dyn Seam,
     ) -> Result<(), CoreError> {
-        let advanced = self.advance(state, models, stages, exchange);
-        exchange.complete(state, stages, advanced, false)
+        let advanced = self.advance(state, models, stages, seam);
+        seam.complete(state, stages, advanced, false)
     }
 }
 
@@ -325,7 +317,7 @@ fn particles<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::Dofs;
+    use crate::step::state::Dofs;
     use crate::Gravity;
 
     /// A constant moment on particle 0 about z, and a constant force on it along x.

@@ -17,10 +17,10 @@
 //! task per thread, each of at least [`SWEEP_TASK`] particles: at 10⁴ particles two threads
 //! each take half.
 
-use crate::continuum::rigid_body::RigidBodies;
-use crate::parallel::local_particles::ParticleRuns;
 use crate::solvers::local_damping::damp;
-use crate::state::Dofs;
+use crate::step::local_particles::ParticleRuns;
+use crate::step::rigid_body::RigidBodies;
+use crate::step::state::Dofs;
 use crate::Vec3;
 use rayon::prelude::*;
 use std::ops::Range;
@@ -115,7 +115,7 @@ impl<'a> Particles<'a> {
 }
 
 /// The particles a sweep covers: every one, or a decomposed run's share
-/// ([`crate::Exchange::stepped`], [`crate::Exchange::computed`]).
+/// ([`crate::step::seam::Seam::stepped`], [`crate::step::seam::Seam::computed`]).
 pub(crate) fn cover(count: usize, only: Option<&ParticleRuns>) -> Vec<Range<usize>> {
     match only {
         None => std::iter::once(0..count).collect(),

@@ -1,11 +1,20 @@
-//! The step API: [`model::Model`] (a source of forces) and its facets, [`stepper::Stepper`]
-//! (advances a state under the models), [`world::World`] (a state, its models, stepper and
-//! hooks, stepped as named, timed [`stages`]) and the step settings resolved once
-//! ([`step_settings`]).
+//! The bottom layer of the crate, what every other area builds on: the [`state::State`] (with
+//! its [`rigid_body`]s and the [`local_particles`] a rank steps), [`model::Model`] (a source
+//! of forces) and its facets, the [`post_step`] hooks, [`stepper::Stepper`] (advances a state
+//! under the models) with the [`seam`] it evaluates forces through and the [`solve_report`]
+//! it gives, the [`tangent`] of implicit solves, the named, timed [`stages`] of a step and
+//! the step settings resolved once ([`step_settings`]). It names no other area but the
+//! split facets' `Reads` of [`crate::parallel`], until those facets move here.
 
 pub(crate) mod instability;
+pub mod local_particles;
 pub mod model;
+pub mod post_step;
+pub mod rigid_body;
+pub mod seam;
+pub mod solve_report;
 pub mod stages;
+pub mod state;
 pub mod step_settings;
 pub mod stepper;
-pub mod world;
+pub mod tangent;

@@ -13,17 +13,20 @@
 //!   their commitment;
 //! - [`Persistent`] ([`Model::persistence`]): the history a checkpoint must keep for a resumed
 //!   run to continue bit for bit;
+//! - [`Deformable`] ([`Model::deformable`]): a deformable body of tetrahedra, what the outputs,
+//!   the modal analysis, the checks and a decomposed run read of it without its type;
 //! - [`Reads`] ([`Model::reads`]): what the model reads of the particles' motion in a run
 //!   decomposed over ranks, and for a model that one rank computes in part (deformable
 //!   bodies, DEM contacts) its [`crate::SplitModel`] facet: the stages of its force
 //!   evaluation and what it exchanges, which the world's [`crate::Exchange`] runs.
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
+use crate::error::CoreError;
 use crate::parallel::split::Reads;
-use crate::solvers::tangent::Tangent;
-use crate::state::State;
-use crate::step::step_settings::Stepping;
-use crate::Vec3;
+use crate::step::state::State;
+use crate::step::step_settings::StepSettings;
+use crate::step::tangent::Tangent;
+use crate::{Mat3, Vec3};
 
 /// A source of particle forces. Models are `Any` so that the output can reach a body's
 /// element fields by downcasting.
@@ -76,14 +79,14 @@ pub trait Model: std::any::Any + Send + Sync {
     /// [`crate::World`] is made; a model whose forces depend on it (a bonded body whose
     /// contacts push only when active in an implicit run) keeps what it needs. The default
     /// ignores it.
-    fn prepare(&mut self, stepping: &Stepping) {
-        let _ = stepping;
+    fn prepare(&mut self, settings: &StepSettings) {
+        let _ = settings;
     }
 
     /// After a step: a physical impossibility the model met at its last force evaluation at
     /// `state` (a tetrahedron turned inside out), which stops the run; `None` when all is
     /// well.
-    fn failure(&self, state: &State) -> Option<crate::CoreError> {
+    fn failure(&self, state: &State) -> Option<CoreError> {
         let _ = state;
         None
     }
@@ -101,6 +104,12 @@ pub trait Model: std::any::Any + Send + Sync {
     /// closing.
     fn modal_stiffness(&self) -> Option<&dyn Linearized> {
         self.linearized()
+    }
+
+    /// The model as a deformable body of tetrahedra; `None` (the default) for every other
+    /// model (loads, contacts, bonds).
+    fn deformable(&self) -> Option<&dyn Deformable> {
+        None
     }
 
     /// The model's step events; `None` (the default): it has none.
@@ -144,6 +153,32 @@ pub trait Linearized {
     fn particles(&self) -> Vec<usize> {
         Vec::new()
     }
+}
+
+/// The facet of a deformable body of tetrahedra (a [`Model`] whose
+/// [`Model::deformable`] is itself): its mesh and its element fields, what the outputs, the
+/// modal analysis and the checks read of it.
+pub trait Deformable: Model {
+    /// The body's tetrahedra (indices into the state's particles).
+    fn tets(&self) -> &[[u32; 4]];
+
+    /// The stress (Pa) of every tetrahedron at `state`, the tensor its forces follow from,
+    /// and its volumetric strain det F − 1.
+    fn tet_fields(&self, state: &State) -> (Vec<Mat3>, Vec<f64>);
+
+    /// The small-strain stress of every tetrahedron at `state`'s displacements (the stress
+    /// that belongs to a static solve's answer).
+    fn small_strain_stresses(&self, state: &State) -> Vec<Mat3>;
+
+    /// Whether the tetrahedra average their pressure over the nodes (the locking-free
+    /// formulation for nearly incompressible materials), which needs the nodal averages of
+    /// the whole body at every force evaluation.
+    fn averages_pressure(&self) -> bool;
+
+    /// In a run decomposed over processes, the wall seconds this process has spent
+    /// exchanging the body's sums with the other ranks (waiting for them included); 0
+    /// otherwise.
+    fn exchange_seconds(&self) -> f64;
 }
 
 /// The events facet of a model: what happens within a step that the stepper must resolve.

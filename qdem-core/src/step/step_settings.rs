@@ -1,6 +1,13 @@
-//! How a run steps, decided once when it is built: the scheme (Verlet, Newmark-β, static), the
-//! step, the safety factor on the stable bound, local damping and adaptivity
-//! ([`StepSettings`]); and what the models learn of it ([`Stepping`]).
+//! How a run steps, in two types for the two moments of one decision: what the scene asks for
+//! ([`StepRequest`]: the [`Scheme`], a step or none, the safety factor on the stable bound,
+//! local damping, adaptivity, the event solve) and what the run does, resolved once against
+//! the models' stable bounds ([`StepSettings`]: the request kept whole, with the step it
+//! resolved to and the bound it was chosen under). They stay apart because a request may
+//! leave the step open and says how to fill it (an automatic explicit step, an implicit
+//! fallback, the end to fit), while everything after the resolution (the stepper, the models
+//! at [`Model::prepare`](crate::step::model::Model::prepare), the outputs) reads a decided
+//! step; the settings hold the request rather than copies of its fields. [`Scheme`] is the
+//! integration method, a part of both, and [`EventSolve`] a part of the scheme's request.
 //!
 //! The step rule: an explicit scheme (Verlet, Newmark with β = 0) takes `safety` times the
 //! rigorous stable bound of [`crate::step::stepper::stable_step`] when no step is requested, and refuses a
@@ -9,10 +16,9 @@
 //! reaches the request's `fit_to` time.
 
 use crate::error::CoreError;
-use crate::state::State;
 use crate::step::model::Model;
-use crate::step::stepper::{choose_step, stable_step, Stepper};
-use crate::{EventSolve, Newmark, StaticSteps, Verlet};
+use crate::step::state::State;
+use crate::step::stepper::{choose_step, stable_step};
 
 /// The time-integration scheme.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,13 +47,18 @@ impl Scheme {
     }
 }
 
-/// What the models learn of the run's stepping ([`Model::prepare`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Stepping {
-    /// The scheme solves a linear system with the models' tangents.
-    pub implicit: bool,
-    /// The step (s).
-    pub dt: f64,
+/// How the implicit stepper solves a step whose matrix changed since its factorisation
+/// (a model's events changed the tangent).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EventSolve {
+    /// Refactorises the matrix at every change: the faster on the benchmark beam
+    /// (docs/bbm.md), and the default.
+    #[default]
+    Refactorize,
+    /// Conjugate gradients preconditioned by the kept factor of the same step length;
+    /// refactorises when they take more than a few iterations (the Newmark stepper's
+    /// `MAX_ITERATIONS`).
+    Preconditioned,
 }
 
 /// A run's stepping as the scene asks for it, before the step is resolved.
@@ -74,27 +85,19 @@ pub struct StepRequest {
     pub fit_to: Option<f64>,
 }
 
-/// A run's stepping, resolved: the scheme, the step and the stable bound it was chosen under.
+/// A run's stepping, resolved: the request, the step it resolved to and the stable bound it
+/// was chosen under. What the stepper is built from and what the models learn
+/// ([`Model::prepare`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct StepSettings {
-    /// The scheme.
-    pub scheme: Scheme,
+    /// What the scene asked for: the scheme and its options, and the end of the run
+    /// ([`StepRequest::fit_to`]) where a static run's last load level lands exactly.
+    pub request: StepRequest,
     /// The step (s).
     pub dt: f64,
-    /// The safety factor the step was chosen with.
-    pub safety: f64,
-    /// Local non-viscous damping fraction (Verlet).
-    pub local_damping: f64,
-    /// Adaptive Newmark steps.
-    pub adaptive: bool,
-    /// How an implicit Newmark step solves after events changed the tangent.
-    pub event_solve: EventSolve,
     /// The rigorous explicit stable bound at the start (s; infinite when no model bounds it)
     /// and the model that sets it.
     pub stable_dt: (f64, String),
-    /// The end of the run the request named ([`StepRequest::fit_to`]), where a static run's
-    /// last load level lands exactly.
-    pub end: Option<f64>,
 }
 
 impl StepSettings {
@@ -119,35 +122,16 @@ impl StepSettings {
             _ => dt,
         };
         Ok(StepSettings {
-            scheme: request.scheme,
+            request: *request,
             dt,
-            safety: request.safety,
-            local_damping: request.local_damping,
-            adaptive: request.adaptive,
-            event_solve: request.event_solve,
             stable_dt,
-            end: request.fit_to,
         })
     }
 
-    /// What the models learn of the stepping.
-    pub fn stepping(&self) -> Stepping {
-        Stepping {
-            implicit: self.scheme.is_implicit(),
-            dt: self.dt,
-        }
-    }
-
-    /// The stepper these settings describe.
-    pub fn stepper(&self) -> Result<Box<dyn Stepper>, CoreError> {
-        Ok(match self.scheme {
-            Scheme::Verlet => Box::new(Verlet::new(self.dt).with_local_damping(self.local_damping)),
-            Scheme::Newmark { beta, gamma } => {
-                let newmark = Newmark::new(beta, gamma, self.dt)?.with_adaptive(self.adaptive);
-                Box::new(newmark.with_event_solve(self.event_solve))
-            }
-            Scheme::Static => Box::new(StaticSteps::new(self.dt).ending_at(self.end)),
-        })
+    /// Whether a step solves a linear system with the models' tangents (implicit Newmark,
+    /// static).
+    pub fn is_implicit(&self) -> bool {
+        self.request.scheme.is_implicit()
     }
 
     /// Number of steps to reach `t_end` (the last one may end slightly past it for a fixed

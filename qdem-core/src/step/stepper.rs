@@ -3,13 +3,12 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::parallel::local_particles::ParticleRuns;
-use crate::parallel::Exchange;
-use crate::solvers::newmark::StepCounts;
-use crate::solvers::sparse::FactorStats;
-use crate::state::{Dofs, State};
+use crate::step::local_particles::ParticleRuns;
 use crate::step::model::Model;
+use crate::step::seam::{OneProcess, Seam};
+use crate::step::solve_report::SolveReport;
 use crate::step::stages::{Stage, StageTimes};
+use crate::step::state::{Dofs, State};
 use crate::Vec3;
 use rayon::prelude::*;
 
@@ -34,44 +33,38 @@ pub trait Stepper: Send {
         state: &mut State,
         models: &mut [Box<dyn Model>],
     ) -> Result<(), CoreError> {
-        self.initialize_in(state, models, &mut Exchange::default())
+        self.initialize_in(state, models, &mut OneProcess)
     }
 
-    /// [`Stepper::initialize`], evaluating the forces through `exchange` (a
+    /// [`Stepper::initialize`], evaluating the forces through `seam` (a
     /// [`crate::World`]'s, decomposed or not).
     fn initialize_in(
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
-        exchange: &mut Exchange,
+        seam: &mut dyn Seam,
     ) -> Result<(), CoreError>;
 
     /// Advances `state` by one step.
     fn step(&mut self, state: &mut State, models: &mut [Box<dyn Model>]) -> Result<(), CoreError> {
-        self.step_timed(
-            state,
-            models,
-            &mut StageTimes::off(),
-            &mut Exchange::default(),
-        )
+        self.step_timed(state, models, &mut StageTimes::off(), &mut OneProcess)
     }
 
     /// [`Stepper::step`], marking the end of each of its stages on `stages` (predict, each
     /// model's forces, integrate, solve, events: [`crate::stages`]), evaluating the forces
-    /// through `exchange` ([`Exchange::sum_forces`]) and ending each integration with
-    /// [`Exchange::complete`] (in a decomposed run, the share of the ranks' new motion), on
-    /// `exchange`'s particles only when it says so ([`Exchange::stepped`],
-    /// [`Exchange::computed`]).
+    /// through `seam` ([`Seam::sum_forces`]) and ending each integration with
+    /// [`Seam::complete`] (in a decomposed run, the share of the ranks' new motion), on
+    /// `seam`'s particles only when it says so ([`Seam::stepped`], [`Seam::computed`]).
     fn step_timed(
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
-        exchange: &mut Exchange,
+        seam: &mut dyn Seam,
     ) -> Result<(), CoreError>;
 
-    /// Whether the stepper steps only the particles [`Exchange::stepped`] and
-    /// [`Exchange::computed`] name, so that a decomposed run may share only its halo; the
+    /// Whether the stepper steps only the particles [`Seam::stepped`] and
+    /// [`Seam::computed`] name, so that a decomposed run may share only its halo; the
     /// default cannot, and a decomposed run then shares the whole state after every step.
     fn steps_in_part(&self) -> bool {
         false
@@ -107,16 +100,11 @@ pub trait Stepper: Send {
         &[]
     }
 
-    /// Size and cost of the sparse factorisation, for steppers that solve a linear system;
-    /// `None` for explicit steppers and before the first factorisation.
-    fn factor_stats(&self) -> Option<&FactorStats> {
-        None
-    }
-
-    /// Retakes, sub-steps and event steps of an adaptive stepper, the solves of an implicit or
-    /// static one; zero for the others.
-    fn counts(&self) -> StepCounts {
-        StepCounts::default()
+    /// What the stepper did so far: its retakes, sub-steps, event steps and solves, and its
+    /// last sparse factorisation if it solves a linear system. The default, an explicit
+    /// stepper's: all zero, no factorisation.
+    fn report(&self) -> SolveReport {
+        SolveReport::default()
     }
 
     /// Writes what the next step depends on beyond the state and the models (a force buffer
@@ -192,11 +180,11 @@ pub fn compute_accelerations(
     force: &mut Vec<Vec3>,
     torque: &mut Vec<Vec3>,
 ) -> Result<(), CoreError> {
-    let (mut stages, mut exchange) = (StageTimes::off(), Exchange::default());
-    compute_accelerations_timed(state, models, force, torque, &mut stages, &mut exchange)
+    let mut stages = StageTimes::off();
+    compute_accelerations_timed(state, models, force, torque, &mut stages, &mut OneProcess)
 }
 
-/// [`compute_accelerations`] through `exchange`, marking each model's forces and then the
+/// [`compute_accelerations`] through `seam`, marking each model's forces and then the
 /// integrate stage.
 pub(crate) fn compute_accelerations_timed(
     state: &mut State,
@@ -204,9 +192,9 @@ pub(crate) fn compute_accelerations_timed(
     force: &mut Vec<Vec3>,
     torque: &mut Vec<Vec3>,
     stages: &mut StageTimes,
-    exchange: &mut Exchange,
+    seam: &mut dyn Seam,
 ) -> Result<(), CoreError> {
-    exchange.sum_forces(state, models, force, torque, stages);
+    seam.sum_forces(state, models, force, torque, stages);
     set_accelerations(state, force)?;
     let spun = set_spin_accelerations(state, &torque[state.rigid.len()..]);
     stages.mark(Stage::Integrate);

@@ -38,7 +38,7 @@ fn tiny_step(sim: &Simulation) -> Option<String> {
     };
     let settings = sim.world.settings();
     let (bound, limiter) = &settings.stable_dt;
-    let explicit = !settings.scheme.is_implicit();
+    let explicit = !settings.is_implicit();
     if !(explicit && bound.is_finite() && dt < TINY_STEP_FRACTION * bound) {
         return None;
     }

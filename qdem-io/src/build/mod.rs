@@ -59,6 +59,7 @@ use nalgebra::{Rotation3, UnitQuaternion};
 use qdem_contact::BondedParticles;
 use qdem_contact::{DemContacts, PeriodicBox, PeriodicWrap};
 use qdem_core::rigid_body::tet_mass_properties;
+use qdem_core::step::model::Deformable;
 use qdem_core::{
     CoreError, Dofs, EventSolve, Gravity, Material, Model, NodalLoad, Scheme, State, StepRequest,
     StepSettings, TetBody, TimeFunction, Vec3, World,
@@ -300,12 +301,13 @@ impl Simulation {
         self.bodies.iter().map(|b| b.stats.tets).sum()
     }
 
-    /// The [`TetBody`] of a deformable body; `None` for a rigid one.
-    pub fn tet_body(&self, body: &BodyInfo) -> Option<&TetBody> {
+    /// The deformable body's model as a [`Deformable`] (its [`TetBody`]); `None` for a rigid
+    /// one.
+    pub fn tet_body(&self, body: &BodyInfo) -> Option<&dyn Deformable> {
         let BodyKind::Deformable { model } = body.kind else {
             return None;
         };
-        TetBody::of(self.world.models[model].as_ref())
+        self.world.models[model].deformable()
     }
 
     /// The tetrahedra of a body, deformable or rigid, as state particle indices.

@@ -205,7 +205,7 @@ fn evaluate_once(sim: &mut Simulation) -> Vec<Vec3> {
     let mut internal = vec![Vec3::zeros(); state.len()];
     let mut torque = vec![Vec3::zeros(); state.rigid.len() + state.spin.len()];
     for model in world.models.iter_mut() {
-        let body = qdem_core::TetBody::of(model.as_ref()).is_some();
+        let body = model.deformable().is_some();
         let force = if body { &mut internal } else { &mut push };
         model.add_forces(state, force, &mut torque);
     }

@@ -60,7 +60,7 @@ impl Recorder for Crack {
         }
         self.cracked = sim.bonded().is_some_and(|b| b.broken() > 0);
         if !self.cracked {
-            self.at_crack = sim.world.stepper().counts();
+            self.at_crack = sim.world.stepper().report().counts;
         }
         Ok(())
     }
@@ -73,9 +73,8 @@ impl Recorder for Crack {
     fn summarize(&self, sim: &Simulation, run: &RunFigures, summary: &mut serde_json::Value) {
         let model = sim.bonded().expect("registered for a bonded scene");
         let per = |s: f64, n: u64| if n > 0 { s / n as f64 } else { 0.0 };
-        let stepper = sim.world.stepper();
-        let counts = stepper.counts();
-        let factor = stepper.factor_stats();
+        let report = sim.world.stepper().report();
+        let (counts, factor) = (report.counts, report.factor.as_ref());
         summary["bonded"] = json!({
             "bonds": model.bonds().len(),
             "broken_bonds": model.broken(),

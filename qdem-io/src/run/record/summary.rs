@@ -25,8 +25,8 @@ pub(crate) fn write(
     if let Some(step) = resumed_at {
         summary["resumed_at_step"] = json!(step);
     }
-    if sim.world.settings().scheme == Scheme::Static {
-        summary["solves"] = json!(sim.world.stepper().counts().solves);
+    if sim.world.settings().request.scheme == Scheme::Static {
+        summary["solves"] = json!(sim.world.stepper().report().counts.solves);
     }
     if let Some(contacts) = sim.contacts() {
         summary["contact"] = json!({

@@ -16,7 +16,7 @@
 //! principal moments spins at a constant rate.
 
 use crate::error::CoreError;
-use crate::state::State;
+use crate::step::state::State;
 use crate::{Mat3, Vec3};
 use nalgebra::{Rotation3, SymmetricEigen, UnitQuaternion};
 use rayon::prelude::*;

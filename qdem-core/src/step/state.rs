@@ -5,7 +5,7 @@
 //! shares it, §2.4) and a per-direction fixity mask. Models read the state and write forces;
 //! steppers advance it. All numerical code works on the slices directly.
 
-use crate::continuum::rigid_body::RigidBodies;
+use crate::step::rigid_body::RigidBodies;
 use crate::Vec3;
 
 /// A subset of the three translational directions, stored as a bit mask (x = 1, y = 2, z = 4).

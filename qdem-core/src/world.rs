@@ -28,11 +28,13 @@
 
 use crate::checkpoint::{model_tag, whole_block, CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::parallel::{Communicator, Decomposition, Exchange, Reads};
-use crate::state::State;
+use crate::parallel::{Communicator, Decomposition, Exchange};
+use crate::solvers::stepper_for::stepper_for;
 use crate::step::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
 use crate::step::model::{find_model, Model, Persistence};
+use crate::step::post_step::{Halt, PostStep};
 use crate::step::stages::{Stage, StageShare, StageTimes};
+use crate::step::state::State;
 use crate::step::step_settings::StepSettings;
 use crate::step::stepper::{stable_step, Stepper};
 use std::sync::Arc;
@@ -41,36 +43,6 @@ use std::sync::Arc;
 /// failure check reports it as itself rather than as an unstable step; it also separates
 /// the report's detail from its fix.
 const PASS_THROUGH: &str = "\u{1}pass through\u{1}";
-
-/// Something a world does after every step, once the step has passed the failure check:
-/// periodic wrapping of bodies, a watch that ends the run when a body has failed.
-pub trait PostStep: std::any::Any + Send + Sync {
-    /// A short name for the stage counters.
-    fn name(&self) -> &str;
-
-    /// Acts on the state after a step; returns a [`Halt`] to end the run after this step.
-    fn after_step(&mut self, state: &mut State, models: &[Box<dyn Model>]) -> Option<Halt>;
-
-    /// How the hook takes part in a decomposed run ([`Model::reads`]); the default,
-    /// [`Reads::All`], is always right. A split hook decides for its own particles and acts
-    /// on every rank's decisions ([`crate::SplitModel::decide`], [`crate::SplitModel::act`]).
-    fn reads(&mut self) -> Reads<'_> {
-        Reads::All
-    }
-}
-
-/// Why a post-step hook ended a run early (not a failure: the outputs are complete).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Halt {
-    /// The hook's name.
-    pub hook: String,
-    /// Simulated time (s).
-    pub time: f64,
-    /// The particle that triggered it.
-    pub particle: usize,
-    /// The quantity that passed its limit (a displacement in m for the collapse watch).
-    pub value: f64,
-}
 
 /// A simulation that steps itself: state, models, stepper, hooks and stage counters.
 ///
@@ -130,7 +102,7 @@ impl World {
         mut models: Vec<Box<dyn Model>>,
         settings: StepSettings,
     ) -> Result<World, CoreError> {
-        let stepper = settings.stepper()?;
+        let stepper = stepper_for(&settings)?;
         prepare(&mut models, &settings);
         let stages = StageTimes::new(models.len(), 0);
         Ok(World {
@@ -150,7 +122,7 @@ impl World {
     /// the next step), the models told again. No bound is checked: a step chosen here is the
     /// caller's responsibility (the failure check still catches an unstable one).
     pub fn set_settings(&mut self, settings: StepSettings) -> Result<(), CoreError> {
-        self.stepper = settings.stepper()?;
+        self.stepper = stepper_for(&settings)?;
         prepare(&mut self.models, &settings);
         self.settings = settings;
         let steps_in_part = self.stepper.steps_in_part();
@@ -217,15 +189,16 @@ impl World {
     /// process computes its share of the deformable bodies and every step ends with the
     /// exchange of the particles each rank owns (after each sub-step of an adaptive explicit
     /// Newmark step too). When every model and hook reads only what a rank steps itself
-    /// ([`Reads::Own`] or [`Reads::Split`]) and the stepper can step in part (Verlet), a rank
-    /// steps only its own particles and its halo, and receives only its halo, and a split
-    /// model ([`crate::SplitModel`], DEM contacts) computes only what touches its particles:
+    /// ([`crate::parallel::Reads::Own`] or [`crate::parallel::Reads::Split`]) and the
+    /// stepper can step in part (Verlet), a rank steps only its own particles and its halo,
+    /// and receives only its halo, and a split model ([`crate::SplitModel`], DEM contacts)
+    /// computes only what touches its particles:
     /// call [`World::gather`] before reading the whole state. Otherwise every rank holds the
     /// state one process would after every step. Call it on every rank, before
     /// [`World::initialize`] or [`World::restore`]. Only explicit runs (Verlet, explicit
     /// Newmark) can be decomposed.
     pub fn decompose(&mut self, comm: Arc<dyn Communicator>) -> Result<Decomposition, CoreError> {
-        if self.settings.scheme.is_implicit() {
+        if self.settings.is_implicit() {
             return Err(CoreError::Decomposition(format!(
                 "only explicit runs (Verlet, explicit Newmark) can be decomposed, and this one is \
                  stepped by {}; run it as one process (without mpirun)",
@@ -449,9 +422,8 @@ impl World {
 
 /// Tells every model how it is stepped.
 fn prepare(models: &mut [Box<dyn Model>], settings: &StepSettings) {
-    let stepping = settings.stepping();
     for model in models.iter_mut() {
-        model.prepare(&stepping);
+        model.prepare(settings);
     }
 }
 
@@ -460,8 +432,8 @@ fn prepare(models: &mut [Box<dyn Model>], settings: &StepSettings) {
 fn refuse_averaged_pressure(models: &[Box<dyn Model>]) -> Result<(), CoreError> {
     let averaged = models
         .iter()
-        .filter_map(|m| crate::TetBody::of(m.as_ref()))
-        .find(|b| b.formulation() == crate::Formulation::AveragedPressure);
+        .filter_map(|m| m.deformable())
+        .find(|b| b.averages_pressure());
     match averaged {
         Some(body) => Err(CoreError::Decomposition(format!(
             "body `{}` uses formulation = \"averaged-pressure\", which a run decomposed over \

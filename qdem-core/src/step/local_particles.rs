@@ -18,7 +18,7 @@ use std::ops::Range;
 /// mesh numbered across its cut come in runs of a few dozen).
 ///
 /// ```
-/// use qdem_core::parallel::ParticleRuns;
+/// use qdem_core::step::local_particles::ParticleRuns;
 ///
 /// let runs = ParticleRuns::from_mask(&[true, true, false, true]);
 /// assert_eq!(runs.len(), 3);
@@ -114,7 +114,7 @@ impl ParticleRuns {
 /// What one rank of a decomposed run steps itself ([`crate::parallel::Exchange::stepped`]).
 ///
 /// ```
-/// use qdem_core::parallel::local_particles::{LocalParticles, ParticleRuns};
+/// use qdem_core::step::local_particles::{LocalParticles, ParticleRuns};
 ///
 /// // Particles 0 and 1 are this rank's, particle 2 is its halo, particle 3 another rank's.
 /// let local = LocalParticles {
