@@ -22,7 +22,6 @@ pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<
     let scene = Scene::load(path)?;
     let mut sim = progress::while_busy("building the scene", || Simulation::build(scene))?;
     if let Some(r) = &ranks {
-        sim.refuse_decomposition()?;
         sim.world
             .decompose(r.clone())
             .map_err(|source| CliError::Decompose {

@@ -544,7 +544,6 @@ fn run_scene(args: &RunArgs, ranks: Option<Arc<dyn Communicator>>) -> Result<(),
     let mut sim = progress::while_busy("building the scene", || Simulation::build(scene))?;
     let leader = ranks.as_ref().is_none_or(|r| r.rank() == 0);
     if let Some(ranks) = &ranks {
-        sim.refuse_decomposition()?;
         let figures = sim
             .world
             .decompose(ranks.clone())

@@ -241,6 +241,42 @@ fn a_measure_over_a_packing_of_clumps_is_byte_identical_on_any_number_of_ranks()
     }
 }
 
+/// A lid held at 1 kPa by its servo over the poured grains: its force is the sum over every
+/// rank's contacts on it, in one process's order, so `walls.csv` (the lid's force and where
+/// its servo moved it) is byte-identical too; by 0.1 s the lid has come down onto the grains
+/// (a force and a displacement in the file, so the comparison is not of zeros).
+#[test]
+fn a_servo_wall_over_poured_grains_is_byte_identical_on_any_number_of_ranks() {
+    let fixture = "contact/grains.toml";
+    let lid = "[[wall]]\npoint = [0.0, 0.0, 0.12]\nnormal = [0.0, 0.0, -1.0]\n\
+               servo = { stress = 1e3, area = 0.04, max_velocity = 1.0 }\n\n[[section]]";
+    let edits = [("t_end = ", "t_end = 0.1"), ("[[section]]", lid)];
+    let scene = ShortScene::edited(fixture, "servo", &edits);
+    let tmp = TempDir::new("servo");
+    let single = tmp.path().join("single");
+    run(&scene.0, &single, 0, 1, &[]);
+    let text = std::fs::read_to_string(single.join("walls.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let last: Vec<f64> = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let column = |name: &str| last[header.iter().position(|h| *h == name).unwrap()];
+    assert!(
+        column("wall6.fz") > 0.0 && column("wall6.uz") < 0.0,
+        "{text}"
+    );
+    for (ranks, threads) in [(2, 1), (3, 1), (2, 2)] {
+        let out = tmp.path().join(format!("r{ranks}t{threads}"));
+        run(&scene.0, &out, ranks, threads, &[]);
+        let what = format!("{fixture} with a servo lid on {ranks} ranks x {threads} threads");
+        assert_same_outputs(&single, &out, &what);
+    }
+}
+
 /// The grains' contacts are split: each rank evaluates those of the grains it owns.
 #[test]
 fn poured_grains_are_byte_identical_on_any_number_of_ranks() {

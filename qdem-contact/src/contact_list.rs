@@ -1,15 +1,15 @@
 //! The candidate list of a contact set: one record per candidate contact (a pair of spheres, or
 //! a sphere and a wall) holding everything a step reads and writes of it, so that the pair
-//! loop streams through one array and the gather touches one record per contact.
+//! loop streams through one array.
 //!
 //! A record keeps what a step reads and writes of a contact, in 64 bytes: its partners, its
 //! tangential spring ξ and this evaluation's results, the force f on the first partner and
 //! δ/2. The moment of the contact force about a partner's centre follows from them and the
 //! normal: the contact point lies at x_a + (r_a − δ/2) n, at a distance r − δ/2 from either
 //! centre along ∓n, so the moment on a is (r_a − δ/2) n × f and the moment on b, which feels
-//! −f, is (r_b − δ/2) n × f. The fused pass adds the moments as it evaluates; the record path
-//! (split ranks, a time-delayed boundary) keeps n × f in a column beside the records for its
-//! gather. The image translation of the second partner, only through a periodic boundary, is
+//! −f, is (r_b − δ/2) n × f. The pair kernel adds the moments as it evaluates; when its sums
+//! run apart from its law (a time-delayed boundary, a servo wall) or a rank's records are
+//! merged, it keeps n × f in a column beside the records. The image translation of the second partner, only through a periodic boundary, is
 //! a column too.
 
 use qdem_core::checkpoint::same_count;
@@ -67,8 +67,8 @@ pub(crate) struct ContactList {
     /// Image translation of each contact's second partner (m): one per record with periodic
     /// axes, else none (all zero).
     pub(crate) shift: Vec<Vec3>,
-    /// n × f of each contact at the last evaluation by the record path, for its gather (N);
-    /// none after the fused pass.
+    /// n × f of each contact at the last evaluation (N), when the kernel keeps it (a sum
+    /// pass apart from the law, a rank's records); else none.
     pub(crate) turn: Vec<Vec3>,
 }
 

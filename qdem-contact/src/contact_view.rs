@@ -1,6 +1,7 @@
-//! What an output reads of a [`DemContacts`](crate::DemContacts) between steps: each contact
-//! sphere where it is ([`SphereRecord`]), and each touching contact as a segment with its
-//! force split into normal and tangential parts ([`TouchingContact`]).
+//! The record types an output reads of a [`DemContacts`](crate::DemContacts) between steps
+//! (the queries that make them are `dem_contacts/output_queries.rs`): each contact sphere
+//! where it is ([`SphereRecord`]), and each touching contact as a segment with its force
+//! split into normal and tangential parts ([`TouchingContact`]).
 //!
 //! Both are produced serially, in sphere and contact-list order, from what the last force
 //! evaluation left in the model, so reading them neither changes nor slows a step, and they

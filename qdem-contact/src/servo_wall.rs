@@ -1,4 +1,5 @@
-//! Stress-controlled (servo) plane walls, as PFC's wall servo and LIGGGHTS's
+//! The servo law of stress-controlled plane walls (the loads it reads and the walls it
+//! drives are `dem_contacts/servo_loads.rs`'s), as PFC's wall servo and LIGGGHTS's
 //! `fix mesh/surface/stress/servo`: after each force evaluation the wall's speed along its
 //! normal (towards the bodies) is set to
 //!

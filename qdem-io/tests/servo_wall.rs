@@ -190,10 +190,4 @@ fn what_a_servo_cannot_have_is_refused_by_name() {
         mesh.contains("[[wall]] #3") && mesh.contains("mesh wall"),
         "{mesh}"
     );
-    // A decomposed run: refused before decomposing, naming the wall.
-    let dir = test_dir("servo-ranks");
-    let sim = build(&bed_scene(&dir, 0.1, ""));
-    let message = sim.refuse_decomposition().unwrap_err().to_string();
-    assert!(message.contains("[[wall]] #2 has a servo"), "{message}");
-    let _ = std::fs::remove_dir_all(&dir);
 }

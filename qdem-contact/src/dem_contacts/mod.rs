@@ -1,23 +1,24 @@
 //! The contact model: contact spheres on bodies, walls, and the step pipeline
-//! broad phase → narrow phase → contact forces → gather.
+//! broad phase → narrow phase → contact forces → per-sphere sums.
 //!
 //! Paper 000 §4 puts a sphere at each surface vertex of a QDEM body, used only for contact;
 //! a rigid body's spheres sit on its members or at its centre ([`qdem_core::rigid_body`]); a
 //! one-sphere grain is a particle that rotates ([`qdem_core::ParticleSpin`]).
-//! Spheres of one body never interact. Each evaluation
+//! Spheres of one body never interact. Each evaluation runs the stages of `stages.rs`, the
+//! same on one process and on a rank of a decomposed run:
 //! 1. reads the sphere centres from their particles,
 //! 2. rebuilds the pair and wall candidate lists if some sphere (or wall) moved more than the
 //!    skin allows ([`crate::broad_phase`]), carrying the tangential springs of surviving
 //!    pairs over (on rigid bodies, a bound per body spares reading every sphere:
 //!    `displacement.rs`),
-//! 3. evaluates the law of every candidate pair and wall contact and adds each force, and its
-//!    moment about the sphere's centre, straight into per-sphere sums, in parallel over fixed
-//!    runs of spheres (`scatter.rs`; no atomics, so results do not depend on the thread
-//!    count),
-//! 4. adds each partner's sum to its particle force and the moment to the sphere's rigid body
-//!    or rotating particle. A split rank, and a time-delayed boundary (whose ghost scales
-//!    follow from this very evaluation's forces), evaluate into per-contact records first and
-//!    gather them per sphere over a fixed incidence list, in the same order.
+//! 3. runs the pair kernel (`pair_kernel.rs`): the law of every candidate pair and wall
+//!    contact, each force and its moment about the sphere's centre added straight into
+//!    per-sphere sums, in parallel over fixed runs of spheres (no atomics, so results do not
+//!    depend on the thread or rank count), each sum then added to its particle force and the
+//!    moment to the sphere's rigid body or rotating particle. With a time-delayed boundary
+//!    (whose ghost scales follow from this very evaluation's forces) or a servo wall (whose
+//!    load sets its velocity) a reduction over the ranks reads the forces between the law
+//!    and the sums.
 //!
 //! The contact point is at x_a + (r_a − δ/2) n; its velocity includes the rigid body's (or
 //! the rotating particle's) spin, v + ω × (x_cp − x). Tangential springs grow by the relative
@@ -33,23 +34,26 @@
 //! evaluation, before the scaling, and drives [`TimeDelayedBoundary`].
 //!
 //! The files: this one holds the model (its records, the narrow phase, the [`Model`] facet
-//! and the stable step); `build.rs` its construction; `pipeline.rs` the single-process
-//! pipeline above; `displacement.rs` its displacement check's bound for rigid bodies;
-//! `scatter.rs` its fused pass; `views.rs` what the outputs read; `persistence.rs` what a checkpoint
-//! keeps; `modal_springs.rs` the touching contacts as springs for a modal analysis;
-//! `split.rs` one rank's part in a decomposed run, whose stages the world's exchange runs
-//! ([`qdem_core::parallel`]); `tunnelling.rs` the check, at each rebuild of the lists, for a
-//! sphere gone through a wall or into another body.
+//! and the stable step); `build.rs` its construction; `stages.rs` the stages of one
+//! evaluation; `pair_kernel.rs` the pair kernel; `pipeline.rs` the reading of the spheres
+//! and the building of the candidate lists; `displacement.rs` its displacement check's bound
+//! for rigid bodies; `servo_loads.rs` the stress-controlled walls' servo; `output_queries.rs` what the
+//! outputs read; `persistence.rs` what a checkpoint keeps; `linearized.rs` the touching
+//! contacts as springs for a modal analysis; `split.rs` one rank's part in a decomposed run,
+//! whose stages the world's exchange runs ([`qdem_core::parallel`]); `tunnelling.rs` the
+//! check, at each rebuild of the lists, for a sphere gone through a wall or into another
+//! body.
 
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
 use crate::contact_list::{Contact, ContactList};
-use crate::contact_springs::{add_spring, spring, Attachment};
 use crate::contact_view::{Partner, SphereRecord, TouchingContact};
 use crate::error::ContactError;
 use crate::periodic_boundary::PeriodicBox;
+use crate::spring_blocks::{add_spring, spring, Attachment};
 use crate::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
 use crate::wall::Wall;
+use pair_kernel::KernelPlan;
 use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
 use qdem_core::{
@@ -57,27 +61,28 @@ use qdem_core::{
     State, Tangent, Vec3,
 };
 use rayon::prelude::*;
-use scatter::{add_sum, add_to, pair_share, wall_share, ScatterPlan};
 use split::ContactPart;
+use stages::Evaluated;
 
 pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
 pub use tunnelling::BodySurface;
 
 mod build;
 mod displacement;
-mod modal_springs;
+mod linearized;
+mod output_queries;
+mod pair_kernel;
 mod persistence;
 mod pipeline;
-mod scatter;
-mod servo;
+mod servo_loads;
 mod split;
+mod stages;
 mod tunnelling;
-mod views;
 
 /// Marks a sphere that is no part of a rigid body, or whose moments go nowhere.
 const NOT_RIGID: u32 = u32::MAX;
 
-/// Contacts per parallel task of the narrow phase and law, and spheres per task of the gather
+/// Spheres per parallel task of the wall candidates' search and of the passage check
 /// (about 30 µs of work each: a task much shorter than waking a worker, tens of µs on the
 /// 2-core benchmark machine, makes a parallel loop slower than a serial one).
 const CONTACT_CHUNK: usize = 2048;
@@ -223,7 +228,7 @@ pub struct DemContacts {
     body: Vec<u32>,
     rigid: Vec<u32>,
     turn: Vec<u32>,
-    /// Per sphere, whether its particle and rotation are its alone (`scatter.rs`).
+    /// Per sphere, whether its particle and rotation are its alone (`pair_kernel.rs`).
     exclusive: Vec<bool>,
     lever: Vec<f64>,
     bound_mass: Vec<f64>,
@@ -234,6 +239,12 @@ pub struct DemContacts {
     settings: ContactSettings,
     walls: Vec<Wall>,
     last_time: Option<f64>,
+    /// The time since the previous evaluation (s), from stage 1 of this one (`stages.rs`).
+    dt: f64,
+    /// Whether stage 1 of this evaluation read every sphere (else the partners only).
+    read_every: bool,
+    /// How far the pair kernel has run in this evaluation (`stages.rs`).
+    evaluated: Evaluated,
     /// Every sphere's centre at the last evaluation.
     center: Vec<Vec3>,
     /// What the narrow phase reads of each sphere, current for the partners of candidates.
@@ -246,14 +257,11 @@ pub struct DemContacts {
     built: bool,
     pairs: ContactList,
     wall_contacts: ContactList,
-    incidence_start: Vec<u32>,
-    incidence: Vec<u32>,
-    wall_start: Vec<u32>,
     /// The spheres that are partners of some candidate (pair or wall contact), ascending.
     partners: Vec<u32>,
     sphere_force: Vec<(Vec3, Vec3)>,
-    /// The fused pass's plan for the current lists (`scatter.rs`).
-    scatter: ScatterPlan,
+    /// The pair kernel's plan for the current lists (`pair_kernel.rs`).
+    kernel_plan: KernelPlan,
     rebuilds: u64,
     periodic: Option<PeriodicBox>,
     time_delay: Option<TimeDelay>,
@@ -261,8 +269,8 @@ pub struct DemContacts {
     split: Option<ContactPart>,
     /// Whether the lists were rebuilt since [`SplitModel::rebuilt`] last asked.
     rebuilt: bool,
-    /// The stress-controlled walls' servos, by wall (`servo.rs`); empty when none.
-    servos: Vec<Option<servo::ServoWall>>,
+    /// The stress-controlled walls' servos, by wall (`servo_loads.rs`); empty when none.
+    servos: Vec<Option<servo_loads::ServoWall>>,
     /// The closed surfaces of the bodies built from meshes (`tunnelling.rs`).
     surfaces: Vec<BodySurface>,
     /// The report of the first sphere found through a wall or inside another body: what
@@ -307,35 +315,10 @@ impl Model for DemContacts {
         &self.name
     }
 
-    /// The pipeline of one process (`pipeline.rs`); a rank of a decomposed run is evaluated
-    /// through its split facet instead (`split.rs`).
+    /// The stages of a rank's evaluation on one process (`stages.rs`); a rank of a
+    /// decomposed run runs the same stages through its split facet (`split.rs`).
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], torque: &mut [Vec3]) {
-        let dt = self.last_time.map_or(0.0, |t| state.time - t);
-        self.last_time = Some(state.time);
-        let read_every = self.reads_every_sphere();
-        let moved = self.read_centers(state);
-        if self.outgrew_skin(moved, state.time) {
-            if !read_every {
-                self.read_every_center(state);
-            }
-            self.check_passage(state.time, None);
-            self.rebuild_all(state.time);
-            self.anchor(state, 0.0);
-            if !read_every {
-                self.read_all_partners(state);
-            }
-        }
-        if self.fuses() {
-            self.evaluate_and_add(state.time, dt, force, torque);
-        } else {
-            self.evaluate(state.time, dt);
-            self.update_time_delay(state.time);
-            self.gather();
-            for (s, (f, t)) in self.sphere_force.iter().enumerate() {
-                self.add_sphere(s, f, t, force, torque);
-            }
-        }
-        self.drive_servos(state.time, dt);
+        self.evaluate_one_rank(state, force, torque);
     }
 
     /// Split in a decomposed run ([`qdem_core::SplitModel`], `split.rs`): a rank reads its own spheres
@@ -425,7 +408,7 @@ impl Model for DemContacts {
     }
 
     /// The contacts touching at the last evaluation, as sticking springs
-    /// (`contact_springs.rs`), attached through the arm to the contact point to the
+    /// (`spring_blocks.rs`), attached through the arm to the contact point to the
     /// rotation of a sphere that turns (a rigid body's, a rotating particle's). The contacts
     /// give no [`Model::linearized`] facet: an implicit step would need the events of contacts
     /// opening and closing.

@@ -129,7 +129,7 @@ impl DemContacts {
         self.pairs = ContactList::with_springs(pairs);
         self.wall_contacts = ContactList::with_springs(wall_contacts);
         self.built = false;
-        self.build_incidence();
+        self.index_partners();
         CarriedSprings {
             carried,
             dropped: saved.len() - carried,
@@ -202,7 +202,7 @@ impl Persistent for DemContacts {
             delay.boundary.restore(input)?;
         }
         self.restore_servos(input)?;
-        self.build_incidence();
+        self.index_partners();
         if let Some(split) = &mut self.split {
             split.whole = true;
         }

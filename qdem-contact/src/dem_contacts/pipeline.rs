@@ -1,6 +1,7 @@
-//! The single-process pipeline of a [`DemContacts`] evaluation (paper 000 §4): read the
-//! centres, rebuild the candidate lists when a sphere moved more than the skin allows,
-//! narrow phase and law per candidate, and the per-sphere gather in a fixed order.
+//! What the stages of a [`DemContacts`] evaluation (`stages.rs`) read and build (paper 000
+//! §4): the sphere centres and motions from the state, the displacement check, the candidate
+//! lists of the broad phase and their partners, and each candidate's geometry for the narrow
+//! phase.
 
 use super::*;
 
@@ -47,9 +48,6 @@ impl DemContacts {
         } else {
             self.displacement(state)
         };
-        if !every {
-            self.read_all_partners(state);
-        }
         moved
     }
 
@@ -139,10 +137,10 @@ impl DemContacts {
             .collect()
     }
 
-    /// After new candidate lists: the incidence, and where and when they were built.
+    /// After new candidate lists: their partners, and where and when they were built.
     pub(super) fn finish_build(&mut self, time: f64) {
         self.anchor = None;
-        self.build_incidence();
+        self.index_partners();
         self.built_at = self.center.clone();
         self.built_time = time;
         self.built = true;
@@ -150,44 +148,21 @@ impl DemContacts {
         self.rebuilt = true;
     }
 
-    /// For each sphere, its pairs (2k for the first partner of pair k, 2k + 1 for the second)
-    /// in ascending pair order, and the start of its run of wall contacts.
-    pub(super) fn build_incidence(&mut self) {
-        let n = self.particle.len();
-        let mut start = vec![0u32; n + 1];
+    /// After new or changed lists: the partners of their candidates, and the pair
+    /// kernel's plan for them.
+    pub(super) fn index_partners(&mut self) {
+        let mut touches = vec![false; self.particle.len()];
         for c in &self.pairs.items {
-            start[c.first as usize + 1] += 1;
-            start[c.second as usize + 1] += 1;
+            touches[c.first as usize] = true;
+            touches[c.second as usize] = true;
         }
-        for i in 0..n {
-            start[i + 1] += start[i];
-        }
-        let mut fill = start.clone();
-        let mut incidence = vec![0u32; 2 * self.pairs.len()];
-        for (k, c) in self.pairs.items.iter().enumerate() {
-            let (a, b) = (c.first, c.second);
-            incidence[fill[a as usize] as usize] = 2 * k as u32;
-            fill[a as usize] += 1;
-            incidence[fill[b as usize] as usize] = 2 * k as u32 + 1;
-            fill[b as usize] += 1;
-        }
-        let mut wall_start = vec![0u32; n + 1];
         for c in &self.wall_contacts.items {
-            wall_start[c.first as usize + 1] += 1;
+            touches[c.first as usize] = true;
         }
-        for i in 0..n {
-            wall_start[i + 1] += wall_start[i];
-        }
-        self.partners = (0..n as u32)
-            .filter(|&s| {
-                let s = s as usize;
-                start[s + 1] > start[s] || wall_start[s + 1] > wall_start[s]
-            })
+        self.partners = (0..touches.len() as u32)
+            .filter(|&s| touches[s as usize])
             .collect();
-        self.incidence_start = start;
-        self.incidence = incidence;
-        self.wall_start = wall_start;
-        self.plan_scatter();
+        self.plan_runs();
     }
 
     /// The geometry and elasticity of the pair of spheres of `contact`, with the image
@@ -237,146 +212,12 @@ impl DemContacts {
         Some((geometry, self.wall_elasticity[sphere.material as usize]))
     }
 
-    /// Narrow phase and law over the pairs and the wall contacts, one parallel region: the
-    /// wall contacts are a task beside the pairs' (one record per contact).
-    pub(super) fn evaluate(&mut self, time: f64, dt: f64) {
-        let (mut pairs, mut walls) = (
-            std::mem::take(&mut self.pairs),
-            std::mem::take(&mut self.wall_contacts),
-        );
-        let this = &*self;
-        rayon::join(
-            || this.evaluate_list(&mut pairs, time, dt, false),
-            || this.evaluate_list(&mut walls, time, dt, true),
-        );
-        (self.pairs, self.wall_contacts) = (pairs, walls);
-    }
-
-    /// Narrow phase and law over one list, in parallel, one record and its n × f per
-    /// contact.
-    pub(super) fn evaluate_list(&self, list: &mut ContactList, time: f64, dt: f64, walls: bool) {
-        let law = &self.settings.law;
-        let evaluate = |contact: &mut Contact, shift: &mut Vec3, turn: &mut Vec3| {
-            let touching = if walls {
-                self.wall_contact(time, contact.first as usize, contact.second as usize)
-            } else {
-                self.pair_contact(contact, shift)
-            };
-            *turn = match touching {
-                Some((g, e)) => {
-                    let force = law.force(&g, &e, &mut contact.history, dt);
-                    contact.touch(force, &g.normal, g.overlap)
-                }
-                None => {
-                    contact.part();
-                    Vec3::zeros()
-                }
-            };
-        };
-        list.turn.resize(list.items.len(), Vec3::zeros());
-        let with_shifts = list.shift.len() == list.items.len();
-        let (items, turn) = (list.items.par_iter_mut(), list.turn.par_iter_mut());
-        if with_shifts {
-            items
-                .zip(turn)
-                .zip(list.shift.par_iter_mut())
-                .with_min_len(CONTACT_CHUNK)
-                .for_each(|((contact, turn), shift)| evaluate(contact, shift, turn));
-        } else {
-            items
-                .zip(turn)
-                .with_min_len(CONTACT_CHUNK)
-                .for_each(|(contact, turn)| evaluate(contact, &mut Vec3::zeros(), turn));
-        }
-    }
-
-    /// The average magnitude of the touching pairs' forces through the boundaries of `axis`.
-    pub(super) fn boundary_force(&self, axis: usize) -> f64 {
-        self.mean_pair_force(|_, shift| shift[axis] != 0.0)
-    }
-
-    /// Measures the boundary force over this process's pairs and updates the ghost scales of
-    /// a time-delayed boundary.
-    pub(super) fn update_time_delay(&mut self, time: f64) {
-        if let Some(axis) = self.time_delay.as_ref().map(|t| t.axis) {
-            let measured = self.boundary_force(axis);
-            self.set_boundary_force(time, measured);
-        }
-    }
-
     /// The measured force through the time-delayed boundary, and the ghost scales that
     /// follow (paper 003 Eqs. 6–7).
     pub(super) fn set_boundary_force(&mut self, time: f64, measured: f64) {
         let delay = self.time_delay.as_mut().expect("a time-delayed boundary");
         delay.boundary_force = measured;
         delay.scales = delay.boundary.update(time, measured);
-    }
-
-    /// Per-sphere sums of contact forces, and their moments about the sphere's centre for
-    /// spheres that turn (of rigid bodies, rotating particles), in a fixed order; forces from
-    /// delayed ghosts scaled.
-    pub(super) fn gather(&mut self) {
-        let mut sphere_force = std::mem::take(&mut self.sphere_force);
-        sphere_force
-            .par_iter_mut()
-            .with_min_len(CONTACT_CHUNK)
-            .enumerate()
-            .for_each(|(s, out)| *out = self.sphere_sum(s));
-        self.sphere_force = sphere_force;
-    }
-
-    /// Sphere `s`'s sum of contact forces, and their moment about its centre, in the order of
-    /// the fused pass (`scatter.rs`): the pairs of each run of first spheres before its own
-    /// summed apart, in ascending pair order, these partial sums added in run order, its own
-    /// run's partial (its pairs there, then its wall contacts) last; forces from delayed
-    /// ghosts scaled.
-    #[inline]
-    pub(super) fn sphere_sum(&self, s: usize) -> (Vec3, Vec3) {
-        let (pairs, walls) = (&self.pairs, &self.wall_contacts);
-        let (start, incidence, wall_start) =
-            (&self.incidence_start, &self.incidence, &self.wall_start);
-        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
-        let radius = self.radius[s];
-        let own = self.run_of(s as u32);
-        let (mut total, mut partial, mut run) = (None, (Vec3::zeros(), Vec3::zeros()), own);
-        for &e in &incidence[start[s] as usize..start[s + 1] as usize] {
-            let k = (e / 2) as usize;
-            let c = &pairs.items[k];
-            let first = e % 2 == 0;
-            let r = self.run_of(c.first);
-            if r != run {
-                if run != own {
-                    total = Some(add_sum(total, partial));
-                }
-                (partial, run) = ((Vec3::zeros(), Vec3::zeros()), r);
-            }
-            let scale = match &delay {
-                Some((axis, scales)) => {
-                    let (a, b) = pair_scales(pairs.shift(k)[*axis], scales);
-                    if first {
-                        a
-                    } else {
-                        b
-                    }
-                }
-                None => 1.0,
-            };
-            add_to(
-                &mut partial,
-                pair_share(c, &pairs.turn[k], first, radius, scale),
-            );
-        }
-        if run != own {
-            total = Some(add_sum(total, partial));
-            partial = (Vec3::zeros(), Vec3::zeros());
-        }
-        for k in wall_start[s] as usize..wall_start[s + 1] as usize {
-            add_to(
-                &mut partial,
-                wall_share(&walls.items[k], &walls.turn[k], radius),
-            );
-        }
-        add_sum(total, partial)
     }
 
     /// Adds sphere `s`'s contact force `f` to its particle and its moment `t` to the rigid

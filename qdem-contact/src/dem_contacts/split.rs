@@ -8,7 +8,7 @@
 //! two ranks' spheres is evaluated on both, from the same values, so both hold the same
 //! record. The candidate lists are sorted by partners, so a rank's list is a sub-sequence of
 //! the one a single process holds and each of its spheres sums its contacts in that
-//! process's order (paper 000 §4's gather, in the fixed order of `pipeline.rs`).
+//! process's order (the pair kernel's sums, `pair_kernel.rs`).
 //!
 //! What a rank reads of the other ranks' spheres, the **ghosts** (the partners of its
 //! candidates that it does not own), their owners send at each evaluation: the centre,
@@ -41,16 +41,12 @@ pub(super) struct ContactPart {
     /// cut down to this rank's before the next evaluation.
     pub(super) whole: bool,
     /// Whether the lists changed since the ghosts were last declared.
-    lists_changed: bool,
+    pub(super) lists_changed: bool,
     /// The own spheres that are partners of this rank's candidates, ascending: those whose
     /// motion the lists read and whose contacts are summed.
     partners: Vec<u32>,
     /// The spheres of other ranks this rank reads at each evaluation.
     pub(super) ghosts: usize,
-    /// The time since the previous evaluation.
-    dt: f64,
-    /// Scratch: the partners' sums.
-    sums: Vec<(Vec3, Vec3)>,
 }
 
 impl ContactPart {
@@ -68,8 +64,6 @@ impl ContactPart {
             lists_changed: false,
             partners: Vec::new(),
             ghosts: 0,
-            dt: 0.0,
-            sums: Vec::new(),
         }
     }
 
@@ -77,6 +71,16 @@ impl ContactPart {
     #[inline]
     fn owns(&self, s: u32) -> bool {
         self.owner[s as usize] == self.me
+    }
+
+    /// This rank's spheres, ascending.
+    pub(super) fn own(&self) -> &[u32] {
+        &self.own
+    }
+
+    /// The own spheres that are partners of this rank's candidates, ascending.
+    pub(super) fn partners(&self) -> &[u32] {
+        &self.partners
     }
 
     /// Whether a contact belongs to this rank's list: a pair touching an own sphere, a wall
@@ -87,8 +91,17 @@ impl ContactPart {
 }
 
 impl DemContacts {
+    /// Whether this process or rank adds sphere `s`'s sum to its particle: it owns it.
+    #[inline]
+    pub(super) fn adds_to(&self, s: u32) -> bool {
+        self.split.as_ref().is_none_or(|p| p.owns(s))
+    }
+
     /// Runs `stage` on this rank's part, which it holds for the while.
-    fn with_part<T>(&mut self, stage: impl FnOnce(&mut Self, &mut ContactPart) -> T) -> T {
+    pub(super) fn with_part<T>(
+        &mut self,
+        stage: impl FnOnce(&mut Self, &mut ContactPart) -> T,
+    ) -> T {
         let mut part = self.split.take().expect("a split contact set");
         let out = stage(self, &mut part);
         self.split = Some(part);
@@ -97,7 +110,7 @@ impl DemContacts {
 
     /// Reads the centres of the spheres `own` from `state`; returns the largest distance one
     /// has moved since the last build (infinite before it).
-    fn read_own_centers(&mut self, state: &State, own: &[u32]) -> f64 {
+    pub(super) fn read_own_centers(&mut self, state: &State, own: &[u32]) -> f64 {
         let built = self.lists_built();
         let mut moved: f64 = if built { 0.0 } else { f64::INFINITY };
         for &s in own {
@@ -129,7 +142,7 @@ impl DemContacts {
     /// a sphere it owns, found among the spheres within reach of the box around its own
     /// (along a periodic axis, those with an image there), and its own spheres' wall
     /// candidates; the springs of the pairs that stay are kept.
-    fn rebuild_near(&mut self, part: &ContactPart, time: f64) {
+    pub(super) fn rebuild_near(&mut self, part: &ContactPart, time: f64) {
         let reach = 2.0 * self.radius.iter().cloned().fold(0.0, f64::max) + self.settings.skin;
         let (mut low, mut high) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
         for &s in &part.own {
@@ -178,6 +191,18 @@ impl DemContacts {
         self.finish_build(time);
     }
 
+    /// When the lists changed since the last call: the own partners of the new lists, and
+    /// the spheres of other ranks they read (ascending).
+    pub(super) fn declare_ghosts(&mut self, part: &mut ContactPart) -> Option<Vec<u32>> {
+        if !std::mem::take(&mut part.lists_changed) {
+            return None;
+        }
+        self.learn_partners(part);
+        let ghosts = self.ghosts_of(part);
+        part.ghosts = ghosts.len();
+        Some(ghosts)
+    }
+
     /// The partners of this rank's pairs that other ranks own, ascending.
     fn ghosts_of(&self, part: &ContactPart) -> Vec<u32> {
         let mut ghosts: Vec<u32> = self
@@ -194,36 +219,28 @@ impl DemContacts {
 
     /// Cuts lists that hold every rank's contacts (after a merge, a restore) down to this
     /// rank's.
-    fn cut_to_rank(&mut self, part: &mut ContactPart) {
+    pub(super) fn cut_to_rank(&mut self, part: &mut ContactPart) {
         self.pairs.retain(|c| part.keeps(c, false));
         self.wall_contacts.retain(|c| part.keeps(c, true));
-        self.build_incidence();
+        self.index_partners();
         part.whole = false;
         part.lists_changed = true;
     }
 }
 
-impl SplitModel for DemContacts {
-    /// The particles of every sphere (those of deformable bodies already have owners).
-    fn free_particles(&self) -> Vec<usize> {
-        self.items()
-    }
-
-    fn split(&mut self, part: Option<Part>) {
-        self.split = part.map(|p| ContactPart::new(&self.particle, &p.owner, p.rank));
-    }
-
-    /// The contact spheres.
-    fn items(&self) -> Vec<usize> {
+impl DemContacts {
+    /// The particle of every contact sphere, the items whose records the ranks exchange.
+    pub(super) fn sphere_particles(&self) -> Vec<usize> {
         self.particle.iter().map(|&p| p as usize).collect()
     }
 
-    /// Centre, velocity and spin.
-    fn record_values(&self) -> usize {
-        SPHERE_VALUES
+    /// From now on, this rank's part of the contacts (`None`: whole again).
+    pub(super) fn set_part(&mut self, part: Option<Part>) {
+        self.split = part.map(|p| ContactPart::new(&self.particle, &p.owner, p.rank));
     }
 
-    fn pack(&self, items: &[u32], out: &mut Vec<f64>) {
+    /// Appends the records of the spheres `items`: centre, velocity and spin.
+    pub(super) fn pack_spheres(&self, items: &[u32], out: &mut Vec<f64>) {
         for &s in items {
             let n = &self.now[s as usize];
             for v in [self.center[s as usize], n.velocity, n.spin] {
@@ -232,7 +249,8 @@ impl SplitModel for DemContacts {
         }
     }
 
-    fn unpack(&mut self, items: &[u32], values: &[f64]) {
+    /// Sets the records of the spheres `items` from what [`DemContacts::pack_spheres`] wrote.
+    pub(super) fn unpack_spheres(&mut self, items: &[u32], values: &[f64]) {
         for (&s, v) in items.iter().zip(values.chunks_exact(SPHERE_VALUES)) {
             let n = &mut self.now[s as usize];
             n.center = Vec3::new(v[0], v[1], v[2]);
@@ -242,107 +260,9 @@ impl SplitModel for DemContacts {
         }
     }
 
-    /// Cuts whole lists to this rank's, then reads the own spheres' centres.
-    fn read_own(&mut self, state: &State) -> Option<f64> {
-        let dt = self.last_time.map_or(0.0, |t| state.time - t);
-        self.last_time = Some(state.time);
-        let moved = self.with_part(|this, part| {
-            part.dt = dt;
-            if part.whole {
-                this.cut_to_rank(part);
-            }
-            this.read_own_centers(state, &part.own)
-        });
-        Some(moved)
-    }
-
-    fn needs_rebuild(&self, moved: f64, time: f64) -> bool {
-        self.outgrew_skin(moved, time)
-    }
-
-    fn rebuild(&mut self, time: f64) {
-        self.with_part(|this, part| {
-            this.check_passage(time, Some(&part.own));
-            this.rebuild_near(part, time);
-            part.lists_changed = true;
-        });
-    }
-
-    fn new_ghosts(&mut self) -> Option<Vec<u32>> {
-        self.with_part(|this, part| {
-            if !std::mem::take(&mut part.lists_changed) {
-                return None;
-            }
-            this.learn_partners(part);
-            let ghosts = this.ghosts_of(part);
-            part.ghosts = ghosts.len();
-            Some(ghosts)
-        })
-    }
-
-    fn read_partners(&mut self, state: &State) {
-        self.with_part(|this, part| this.read_motions(state, &part.partners));
-    }
-
-    fn compute(&mut self, state: &State) {
-        let dt = self.split.as_ref().map_or(0.0, |p| p.dt);
-        self.evaluate(state.time, dt);
-    }
-
-    /// The touching pairs through a time-delayed boundary: partners and force magnitude.
-    fn reduction(&mut self, out: &mut Vec<f64>) -> bool {
-        let Some(axis) = self.time_delay.as_ref().map(|t| t.axis) else {
-            return false;
-        };
-        for (c, shift) in self.pairs.with_shifts() {
-            if c.force != Vec3::zeros() && shift[axis] != 0.0 {
-                out.extend([c.first as f64, c.second as f64, c.force.norm()]);
-            }
-        }
-        true
-    }
-
-    /// The average magnitude of the forces through the boundary as one process measures it
-    /// over its list: the ranks' pairs merged by partners (a pair two ranks hold taken once)
-    /// and summed in that order; the ghost scales follow (paper 003 Eqs. 6–7).
-    fn reduced(&mut self, time: f64, all: &[f64]) {
-        let mut forces: Vec<(u32, u32, f64)> = all
-            .chunks_exact(3)
-            .map(|v| (v[0] as u32, v[1] as u32, v[2]))
-            .collect();
-        forces.sort_by_key(|&(a, b, _)| (a, b));
-        forces.dedup_by_key(|&mut (a, b, _)| (a, b));
-        let mut sum = 0.0;
-        for &(_, _, f) in &forces {
-            sum += f;
-        }
-        let measured = match forces.len() {
-            0 => 0.0,
-            n => sum / n as f64,
-        };
-        self.set_boundary_force(time, measured);
-    }
-
-    /// Each own partner's sum, in the single process's order, added to its particle.
-    fn apply(&mut self, force: &mut [Vec3], torque: &mut [Vec3]) {
-        let mut part = self.split.take().expect("a split contact set");
-        let this = &*self;
-        let mut sums = std::mem::take(&mut part.sums);
-        sums.resize(part.partners.len(), (Vec3::zeros(), Vec3::zeros()));
-        sums.par_iter_mut()
-            .zip(&part.partners)
-            .with_min_len(CONTACT_CHUNK)
-            .for_each(|(sum, &s)| *sum = this.sphere_sum(s as usize));
-        for (&s, (f, t)) in part.partners.iter().zip(&sums) {
-            self.add_sphere(s as usize, f, t, force, torque);
-            self.sphere_force[s as usize] = (*f, *t);
-        }
-        part.sums = sums;
-        self.split = Some(part);
-    }
-
-    /// This rank's pairs, then its wall contacts; nothing once whole.
-    fn records(&self, out: &mut Vec<f64>) -> bool {
+    /// Appends this rank's pairs, then its wall contacts, and returns true; false once
+    /// whole.
+    pub(super) fn rank_records(&self, out: &mut Vec<f64>) -> bool {
         if self.split.as_ref().is_none_or(|p| p.whole) {
             return false;
         }
@@ -361,8 +281,8 @@ impl SplitModel for DemContacts {
 
     /// Every rank's lists merged into the ones a single process holds (sorted by partners,
     /// a pair that two ranks hold taken once: their records are equal), and every sphere's
-    /// contacts summed as one process does.
-    fn merge(&mut self, all: &[f64]) {
+    /// contacts summed as one process does (the pair kernel's sums over the records).
+    pub(super) fn merge_records(&mut self, all: &[f64]) {
         let at = |v: &[f64], k: usize| Vec3::new(v[k], v[k + 1], v[k + 2]);
         let (mut pairs, mut walls) = (Vec::new(), Vec::new());
         for v in all.chunks_exact(CONTACT_VALUES) {
@@ -389,25 +309,27 @@ impl SplitModel for DemContacts {
                 shift: items.iter().map(|e| e.2).collect(),
             };
         }
-        self.build_incidence();
-        self.gather();
+        self.index_partners();
+        self.run_kernel::<false, true>(0.0, 0.0, None);
         if let Some(part) = &mut self.split {
             part.whole = true;
         }
     }
 
-    fn rebuilt(&mut self) -> bool {
+    /// Whether the lists were rebuilt since the last call.
+    pub(super) fn take_rebuilt(&mut self) -> bool {
         std::mem::take(&mut self.rebuilt)
     }
 
-    /// `CANDIDATE_WORK` (three) per candidate contact this rank evaluates.
-    fn work(&self) -> f64 {
+    /// This rank's work at its last evaluation: `CANDIDATE_WORK` (three) per candidate
+    /// contact.
+    pub(super) fn candidate_work(&self) -> f64 {
         CANDIDATE_WORK * self.candidates() as f64
     }
 
-    /// Half of `CANDIDATE_WORK` per candidate pair to each partner's particle, all of it
-    /// per wall candidate.
-    fn add_costs(&self, cost: &mut [f64]) {
+    /// Adds half of `CANDIDATE_WORK` per candidate pair to each partner's particle, all of
+    /// it per wall candidate.
+    pub(super) fn add_candidate_costs(&self, cost: &mut [f64]) {
         let half = 0.5 * CANDIDATE_WORK;
         for c in &self.pairs.items {
             cost[self.particle[c.first as usize] as usize] += half;
@@ -416,6 +338,94 @@ impl SplitModel for DemContacts {
         for c in &self.wall_contacts.items {
             cost[self.particle[c.first as usize] as usize] += CANDIDATE_WORK;
         }
+    }
+}
+
+impl SplitModel for DemContacts {
+    /// The particles of every sphere (those of deformable bodies already have owners).
+    fn free_particles(&self) -> Vec<usize> {
+        self.sphere_particles()
+    }
+
+    fn split(&mut self, part: Option<Part>) {
+        self.set_part(part);
+    }
+
+    /// The contact spheres.
+    fn items(&self) -> Vec<usize> {
+        self.sphere_particles()
+    }
+
+    /// Centre, velocity and spin.
+    fn record_values(&self) -> usize {
+        SPHERE_VALUES
+    }
+
+    fn pack(&self, items: &[u32], out: &mut Vec<f64>) {
+        self.pack_spheres(items, out);
+    }
+
+    fn unpack(&mut self, items: &[u32], values: &[f64]) {
+        self.unpack_spheres(items, values);
+    }
+
+    /// Stage 1 (`stages.rs`).
+    fn read_own(&mut self, state: &State) -> Option<f64> {
+        Some(self.read_own_stage(state))
+    }
+
+    fn needs_rebuild(&self, moved: f64, time: f64) -> bool {
+        self.needs_rebuild_stage(moved, time)
+    }
+
+    fn rebuild(&mut self, time: f64) {
+        self.rebuild_stage(time);
+    }
+
+    fn new_ghosts(&mut self) -> Option<Vec<u32>> {
+        self.new_ghosts_stage()
+    }
+
+    fn read_partners(&mut self, state: &State) {
+        self.read_partners_stage(state);
+    }
+
+    fn compute(&mut self, state: &State) {
+        self.compute_stage(state.time);
+    }
+
+    /// A time-delayed boundary's pairs and the servo walls' contacts (`stages.rs`).
+    fn reduction(&mut self, out: &mut Vec<f64>) -> bool {
+        self.reduction_stage(out)
+    }
+
+    fn reduced(&mut self, time: f64, all: &[f64]) {
+        self.reduced_stage(time, all);
+    }
+
+    /// Each own partner's sum, in the single process's order, added to its particle.
+    fn apply(&mut self, force: &mut [Vec3], torque: &mut [Vec3]) {
+        self.apply_stage(force, torque);
+    }
+
+    fn records(&self, out: &mut Vec<f64>) -> bool {
+        self.rank_records(out)
+    }
+
+    fn merge(&mut self, all: &[f64]) {
+        self.merge_records(all);
+    }
+
+    fn rebuilt(&mut self) -> bool {
+        self.take_rebuilt()
+    }
+
+    fn work(&self) -> f64 {
+        self.candidate_work()
+    }
+
+    fn add_costs(&self, cost: &mut [f64]) {
+        self.add_candidate_costs(cost);
     }
 }
 

@@ -37,18 +37,6 @@ pub enum BuildError {
         /// `; did you mean `…`?` if a name is close, then `(available: …)`.
         candidates: String,
     },
-    /// A servo wall in a run decomposed over processes.
-    #[error(
-        "{scene}: [[wall]] #{wall} has a servo, whose wall force would need a sum over the \
-         processes of a decomposed run, which is not supported; fix: run it as one process \
-         (without mpirun: threads give the same result bit for bit), or drop its `servo`"
-    )]
-    ServoDecomposed {
-        /// The scene file.
-        scene: PathBuf,
-        /// The wall, from 1 in scene order.
-        wall: usize,
-    },
     /// The contact set-up is refused (initial overlap, a bad wall, a sphere too large).
     #[error("{scene}: {source}")]
     Contact {

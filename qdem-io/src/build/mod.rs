@@ -182,19 +182,6 @@ impl Simulation {
         Ok(sim)
     }
 
-    /// Refuses what a run decomposed over processes cannot do, before
-    /// [`qdem_core::World::decompose`]: a servo wall (its force would be a sum over ranks, and a
-    /// model calls no collective).
-    pub fn refuse_decomposition(&self) -> Result<(), BuildError> {
-        match self.scene.walls.iter().position(|w| w.servo.is_some()) {
-            Some(w) => Err(BuildError::ServoDecomposed {
-                scene: self.scene.path.clone(),
-                wall: w + 1,
-            }),
-            None => Ok(()),
-        }
-    }
-
     /// [`Simulation::build`] before its step is checked.
     fn build_models(scene: Scene) -> Result<Simulation, BuildError> {
         if let Some((bonded, material)) = scene.bonded.clone().zip(scene.refs().bonded_material) {

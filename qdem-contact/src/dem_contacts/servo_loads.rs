@@ -1,11 +1,25 @@
 //! The servo of stress-controlled plane walls (`servo_wall.rs`) inside the contact model:
-//! after each evaluation, each servo wall's stress from its touching contacts, summed in list
-//! order (by sphere), sets its velocity; its plane is re-based so that its position stays
-//! continuous. Its place and velocity are saved with the contact lists.
+//! after each evaluation's law, each servo wall's stress from its touching contacts, summed
+//! in the order of one process's list (by sphere) over every rank through the evaluation's
+//! reduction (`stages.rs`), sets its velocity; its plane is re-based so that its position
+//! stays continuous. Its place and velocity are saved with the contact lists.
 
 use super::*;
 use crate::servo_wall::Servo;
 use crate::wall::WallShape;
+
+/// A touching contact on a servo wall, what its load and response take of it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ServoContact {
+    /// The sphere.
+    pub(super) sphere: u32,
+    /// The wall.
+    pub(super) wall: u32,
+    /// f · n (N), n the wall's inward normal.
+    pub(super) load: f64,
+    /// k_n dt (N·s/m) and c_n = 2ζ√(k_n m) (N·s/m).
+    pub(super) response: (f64, f64),
+}
 
 /// A servo wall's settings and its plane's point at t = 0.
 #[derive(Clone, Copy, Debug)]
@@ -59,17 +73,49 @@ impl DemContacts {
         self.servos.get(wall).and_then(Option::as_ref)
     }
 
-    /// Sets each servo wall's velocity from this evaluation's contact forces (`dt` since the
-    /// last evaluation), keeping its plane where it is at `time`.
-    pub(super) fn drive_servos(&mut self, time: f64, dt: f64) {
+    /// The touching contacts on servo walls in list order (by sphere, then wall): sphere,
+    /// wall, the compressive normal force (N) the sphere puts on the wall of inward normal n,
+    /// f · n, and the two terms of the contact's response k_n `dt` + c_n (N·s/m), k_n `dt`
+    /// and c_n = 2ζ√(k_n m).
+    pub(super) fn servo_contacts(&self, dt: f64) -> impl Iterator<Item = ServoContact> + '_ {
+        let law = &self.settings.law;
+        let zeta = law.damping_ratio();
+        self.wall_contacts.items.iter().filter_map(move |c| {
+            let w = c.second as usize;
+            let (Some(_), WallShape::Plane(plane)) = (self.servo_of(w), &self.walls[w].shape)
+            else {
+                return None;
+            };
+            if c.force == Vec3::zeros() {
+                return None;
+            }
+            let s = c.first as usize;
+            let sphere = &self.now[s];
+            let e = &self.wall_elasticity[sphere.material as usize];
+            let (kn, _) = law.stiffness(2.0 * c.half_overlap, self.radius[s], e);
+            let damper = 2.0 * zeta * (kn * sphere.mass).sqrt();
+            Some(ServoContact {
+                sphere: c.first,
+                wall: c.second,
+                load: c.force.dot(&plane.normal),
+                response: (kn * dt, damper),
+            })
+        })
+    }
+
+    /// Sets each servo wall's velocity from its load, the sums over `contacts` (every
+    /// touching contact on a servo wall, as [`DemContacts::servo_contacts`] gives them, in
+    /// the order of one process's list) of the normal forces and of the responses, keeping
+    /// its plane where it is at `time`.
+    pub(super) fn drive_servos(&mut self, time: f64, contacts: &[ServoContact]) {
         for w in 0..self.servos.len() {
             let Some(servo) = self.servos[w].map(|s| s.servo) else {
                 continue;
             };
-            let WallShape::Plane(plane) = &self.walls[w].shape else {
-                continue;
-            };
-            let (force, response) = self.wall_load(w, &plane.normal, dt);
+            let (mut force, mut response) = (0.0, 0.0);
+            for c in contacts.iter().filter(|c| c.wall as usize == w) {
+                (force, response) = (force + c.load, response + c.response.0 + c.response.1);
+            }
             let speed = servo.speed(force / servo.area, response);
             let WallShape::Plane(plane) = &mut self.walls[w].shape else {
                 continue;
@@ -78,27 +124,6 @@ impl DemContacts {
             plane.point += (plane.velocity - velocity) * time;
             plane.velocity = velocity;
         }
-    }
-
-    /// The compressive normal force (N) the spheres put on wall `wall` of inward normal
-    /// `normal`, and the response Σ (k_n `dt` + c_n) (N·s/m) of its touching contacts, c_n =
-    /// 2ζ√(k_n m), in list order.
-    fn wall_load(&self, wall: usize, normal: &Vec3, dt: f64) -> (f64, f64) {
-        let law = &self.settings.law;
-        let zeta = law.damping_ratio();
-        let mut load = (0.0, 0.0);
-        for c in &self.wall_contacts.items {
-            if c.second as usize != wall || c.force == Vec3::zeros() {
-                continue;
-            }
-            let s = c.first as usize;
-            let sphere = &self.now[s];
-            let e = &self.wall_elasticity[sphere.material as usize];
-            let (kn, _) = law.stiffness(2.0 * c.half_overlap, self.radius[s], e);
-            let damper = 2.0 * zeta * (kn * sphere.mass).sqrt();
-            load = (load.0 + c.force.dot(normal), load.1 + kn * dt + damper);
-        }
-        load
     }
 
     /// Saves each servo wall's plane (point and velocity), in wall order.

@@ -1,63 +1,68 @@
-//! The fused pass of a single-process evaluation: narrow phase, law and the per-sphere sums in
-//! one parallel region, with no gather.
+//! The pair kernel, the one loop of narrow phase → contact law → per-sphere sums that every
+//! evaluation runs: one process, a rank of a decomposed run, and the evaluation with a
+//! time-delayed boundary (paper 000 §4; the law of each pair is `contact_law.rs`'s, its
+//! forces on delayed ghosts scaled by paper 003 Eqs. 6–7).
 //!
 //! The spheres are cut into fixed runs ([`run_length`]: by sphere index, whatever the number
-//! of threads; an even number of runs of at most [`SCATTER_CHUNK`], so that two threads share
-//! them equally). A run owns the candidate pairs whose first sphere it holds (the lists
-//! are sorted by partners, so these are one slice of the list) and the wall contacts of its
-//! spheres. It evaluates them in list order and adds each contact's force and moment
-//! straight into the sums of its own spheres (pairs, then walls) and, for a second sphere
-//! beyond the run, into a small accumulator of that run's own ("foreign" sums, one slot per
-//! distinct such sphere, planned at each build). A serial pass then adds, for every partner
-//! of a candidate, its foreign sums in ascending run order and its own run's sum last, and
-//! the total to its particle: each sphere's sum is the same sequence of additions for any
-//! thread count, without atomics. A sphere that receives no foreign sums and whose particle
-//! and rotation no other sphere shares (a one-sphere grain, a vertex of a deformable body) is
-//! complete when its run ends: the run adds it to its particle itself, so the serial pass
-//! runs over the spheres near a run's start alone. The gather of the record path (`pipeline.rs`, the split
-//! ranks and the time-delayed boundary) sums in exactly this order, so both paths agree bit
-//! for bit.
+//! of threads or ranks; an even number of runs of at most [`RUN_CHUNK`], so that two
+//! threads share them equally). A run owns the candidate pairs whose first sphere it holds
+//! (the lists are sorted by partners, so these are one slice of the list) and the wall
+//! contacts of its spheres. It evaluates them in list order and adds each contact's force and
+//! moment straight into the sums of its own spheres (pairs, then walls) and, for a second
+//! sphere beyond the run, into a small accumulator of that run's own ("foreign" sums, one
+//! slot per distinct such sphere, planned at each build). A serial pass then adds, for every
+//! partner of a candidate, its foreign sums in ascending run order and its own run's sum
+//! last, and the total to its particle: each sphere's sum is the same sequence of additions
+//! for any thread count, without atomics. A sphere that receives no foreign sums and whose
+//! particle and rotation no other sphere shares (a one-sphere grain, a vertex of a deformable
+//! body) is complete when its run ends: the run adds it to its particle itself, so the serial
+//! pass runs over the spheres near a run's start alone.
 //!
-//! Per step a candidate pair costs its record (read and written once, as before) and two
-//! additions into sums that are in cache; the gather's two reads of every record, its
-//! incidence list and its pass over every sphere are gone, and the serial add runs over the
-//! partners of candidates only.
+//! A rank's lists are the sub-sequence of one process's that touches its own spheres, so
+//! each own sphere's sum is the same sequence of additions as on one process; a rank adds
+//! only its own spheres' sums. When a reduction must read this evaluation's forces first (a
+//! time-delayed boundary's ghost scales, a servo wall's load: `stages.rs`), the kernel runs
+//! in two passes over the same runs, the law (keeping each contact's n × f beside its
+//! record) and then the sums, which add the same shares in the same order as the fused pass.
+//!
+//! Per step a candidate pair costs its record (read and written once) and two additions into
+//! sums that are in cache, and the serial add runs over the partners of candidates only.
 
 use super::*;
 use std::ops::Range;
 
 /// The most spheres in a run of the fused pass.
-pub(crate) const SCATTER_CHUNK: usize = 2048;
+pub(crate) const RUN_CHUNK: usize = 2048;
 
 /// A force and a moment.
 type Sum = (Vec3, Vec3);
 
-/// Spheres per run of `n` spheres: one run of up to [`SCATTER_CHUNK`], else an even number
-/// of runs of at most [`SCATTER_CHUNK`], as equal as can be. It depends on `n` alone, so the
+/// Spheres per run of `n` spheres: one run of up to [`RUN_CHUNK`], else an even number
+/// of runs of at most [`RUN_CHUNK`], as equal as can be. It depends on `n` alone, so the
 /// order of every sum does not depend on the number of threads or ranks.
 pub(super) fn run_length(n: usize) -> usize {
-    match n <= SCATTER_CHUNK {
-        true => SCATTER_CHUNK,
-        false => n.div_ceil(2 * n.div_ceil(2 * SCATTER_CHUNK)),
+    match n <= RUN_CHUNK {
+        true => RUN_CHUNK,
+        false => n.div_ceil(2 * n.div_ceil(2 * RUN_CHUNK)),
     }
 }
 
+#[cfg(test)]
 impl DemContacts {
     /// The run of sphere `s`.
-    #[inline]
-    pub(super) fn run_of(&self, s: u32) -> usize {
+    fn run_of(&self, s: u32) -> usize {
         s as usize / run_length(self.particle.len())
     }
 }
 
 /// What the fused pass knows of the lists, made at each build.
 #[derive(Default)]
-pub(super) struct ScatterPlan {
+pub(super) struct KernelPlan {
     /// Per run: its pairs (a slice of the pair list), wall contacts and partners (a slice of
     /// [`DemContacts::partners`]).
     runs: Vec<RunPlan>,
     /// Per pair: where its second sphere's share goes in its run: `s − lo` for a sphere of the
-    /// run, `SCATTER_CHUNK + k` for the run's k-th foreign sphere.
+    /// run, `RUN_CHUNK + k` for the run's k-th foreign sphere.
     slot: Vec<u32>,
     /// The foreign sums: (sphere, run, slot in that run's accumulator), sorted.
     receive: Vec<(u32, u32, u32)>,
@@ -78,20 +83,13 @@ struct RunPlan {
 }
 
 impl DemContacts {
-    /// Whether this evaluation may use the fused pass: one process (the split ranks gather),
-    /// and no time-delayed boundary (its ghost scales follow from the forces of this very
-    /// evaluation, so they are known only after the law has run over every pair).
-    pub(super) fn fuses(&self) -> bool {
-        self.split.is_none() && self.time_delay.is_none()
-    }
-
     /// The plan of the fused pass for the current lists.
-    pub(super) fn plan_scatter(&mut self) {
+    pub(super) fn plan_runs(&mut self) {
         let n = self.particle.len();
         let length = run_length(n);
         let runs = n.div_ceil(length);
         let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
-        let mut plan = std::mem::take(&mut self.scatter);
+        let mut plan = std::mem::take(&mut self.kernel_plan);
         plan.runs.clear();
         plan.slot.clear();
         plan.slot.resize(pairs.len(), 0);
@@ -126,9 +124,7 @@ impl DemContacts {
                 let b = pairs[k].second;
                 plan.slot[k] = match b < hi {
                     true => b - lo,
-                    false => {
-                        SCATTER_CHUNK as u32 + foreign.binary_search(&b).expect("planned") as u32
-                    }
+                    false => RUN_CHUNK as u32 + foreign.binary_search(&b).expect("planned") as u32,
                 };
             }
             let r32 = r as u32;
@@ -150,40 +146,60 @@ impl DemContacts {
                 plan.late.push(s);
             }
         }
-        self.scatter = plan;
+        self.kernel_plan = plan;
         // Spheres that touch nothing keep a zero sum until the next build.
         self.sphere_force.fill((Vec3::zeros(), Vec3::zeros()));
     }
 
-    /// Narrow phase, law and per-sphere sums over every run in parallel, then the serial
-    /// add of the partners' sums to their particles (`force`) and rotations (`torque`).
-    pub(super) fn evaluate_and_add(
+    /// The pair kernel over every run in parallel: with `LAW`, the narrow phase and the law
+    /// of every candidate (its record, and its n × f column when a later pass or a merge
+    /// reads it); with `SUM`, each contact's shares added into the per-sphere sums, then the
+    /// serial pass that completes the sums of the spheres a run could not. With `out` (the
+    /// particle forces and the rotations' torques), each complete sum of a sphere this
+    /// process or rank owns is added there too: by its run for an early sphere, in the serial
+    /// pass for the others.
+    pub(super) fn run_kernel<const LAW: bool, const SUM: bool>(
         &mut self,
         time: f64,
         dt: f64,
-        force: &mut [Vec3],
-        torque: &mut [Vec3],
+        mut out: Option<(&mut [Vec3], &mut [Vec3])>,
     ) {
-        let mut plan = std::mem::take(&mut self.scatter);
-        let mut pairs = std::mem::take(&mut self.pairs.items);
-        let mut shifts = std::mem::take(&mut self.pairs.shift);
-        let mut walls = std::mem::take(&mut self.wall_contacts.items);
-        self.pairs.turn.clear();
-        self.wall_contacts.turn.clear();
+        let keep_turn = LAW && (!SUM || self.split.is_some());
+        let mut plan = std::mem::take(&mut self.kernel_plan);
+        let mut pairs = std::mem::take(&mut self.pairs);
+        let mut walls = std::mem::take(&mut self.wall_contacts);
+        if LAW {
+            for list in [&mut pairs, &mut walls] {
+                list.turn.clear();
+                if keep_turn {
+                    list.turn.resize(list.items.len(), Vec3::zeros());
+                }
+            }
+        }
         let mut sums = std::mem::take(&mut self.sphere_force);
         {
-            let carriers = (Carriers::new(force), Carriers::new(torque));
-            let pair_runs = cut(&mut pairs, plan.runs.iter().map(|r| r.pairs.len()));
-            let periodic = self.periodic.is_some();
-            let shift_runs = cut(
-                &mut shifts,
-                plan.runs
-                    .iter()
-                    .map(|r| if periodic { r.pairs.len() } else { 0 }),
-            );
-            let wall_runs = cut(&mut walls, plan.runs.iter().map(|r| r.walls.len()));
+            let carriers = out
+                .as_mut()
+                .map(|(force, torque)| (Carriers::new(force), Carriers::new(torque)));
+            let runs = &plan.runs;
+            let pair_lengths = || runs.iter().map(|r| r.pairs.len());
+            let wall_lengths = || runs.iter().map(|r| r.walls.len());
+            let lists: Vec<RunLists<'_>> = cut(&mut pairs.items, pair_lengths())
+                .into_iter()
+                .zip(cut_column(&mut pairs.shift, pair_lengths()))
+                .zip(cut_column(&mut pairs.turn, pair_lengths()))
+                .zip(cut(&mut walls.items, wall_lengths()))
+                .zip(cut_column(&mut walls.turn, wall_lengths()))
+                .map(|((((pairs, shifts), turns), walls), wall_turns)| RunLists {
+                    pairs,
+                    shifts,
+                    turns,
+                    walls,
+                    wall_turns,
+                })
+                .collect();
             let this = &*self;
-            let (runs, slot, early) = (&plan.runs, &plan.slot, &plan.early);
+            let (slot, early) = (&plan.slot, &plan.early);
             let length = run_length(sums.len());
             // Each run a task of its own on several threads: the runs' costs differ (a
             // packing's floor layers carry its wall contacts), and rayon's halving split put
@@ -194,98 +210,166 @@ impl DemContacts {
             };
             sums.par_chunks_mut(length)
                 .zip(plan.foreign.par_iter_mut())
-                .zip(pair_runs.into_par_iter().zip(shift_runs).zip(wall_runs))
+                .zip(lists)
                 .enumerate()
                 .with_max_len(per_task)
-                .for_each(|(r, ((own, foreign), ((pairs, shifts), walls)))| {
+                .for_each(|(r, ((own, foreign), lists))| {
                     let run = &runs[r];
                     let lo = (r * length) as u32;
                     let slots = &slot[run.pairs.clone()];
                     let partners = &this.partners[run.partners.clone()];
-                    let lists = (pairs, shifts, slots, walls, partners);
-                    this.evaluate_run(time, dt, lo, lists, own, foreign);
+                    let sums = RunSums { own, foreign, lo };
+                    this.evaluate_run::<LAW, SUM>(time, dt, lists, slots, partners, sums);
+                    let (true, Some(carriers)) = (SUM, &carriers) else {
+                        return;
+                    };
                     let early = &early[run.partners.clone()];
                     for (&s, _) in partners.iter().zip(early).filter(|(_, &e)| e) {
+                        if !this.adds_to(s) {
+                            continue;
+                        }
                         let (f, t) = &own[(s - lo) as usize];
                         // SAFETY: an early sphere's particle and rotation are its own
                         // (`exclusive_carriers`), and each sphere is in one run.
-                        unsafe { this.add_exclusive(s as usize, f, t, &carriers) };
+                        unsafe { this.add_exclusive(s as usize, f, t, carriers) };
                     }
                 });
         }
-        (self.pairs.items, self.pairs.shift) = (pairs, shifts);
-        self.wall_contacts.items = walls;
-        let mut receive = plan.receive.iter().peekable();
-        for &s in &plan.late {
-            let mut total: Option<Sum> = None;
-            while let Some(&(_, r, k)) = receive.next_if(|e| e.0 == s) {
-                total = Some(add_sum(total, plan.foreign[r as usize][k as usize]));
+        (self.pairs, self.wall_contacts) = (pairs, walls);
+        if SUM {
+            let mut receive = plan.receive.iter().peekable();
+            for &s in &plan.late {
+                let mut total: Option<Sum> = None;
+                while let Some(&(_, r, k)) = receive.next_if(|e| e.0 == s) {
+                    total = Some(add_sum(total, plan.foreign[r as usize][k as usize]));
+                }
+                let total = add_sum(total, sums[s as usize]);
+                sums[s as usize] = total;
+                if let Some((force, torque)) = &mut out {
+                    if self.adds_to(s) {
+                        self.add_sphere(s as usize, &total.0, &total.1, force, torque);
+                    }
+                }
             }
-            let total = add_sum(total, sums[s as usize]);
-            sums[s as usize] = total;
-            self.add_sphere(s as usize, &total.0, &total.1, force, torque);
         }
         self.sphere_force = sums;
-        self.scatter = plan;
+        self.kernel_plan = plan;
+    }
+
+    /// Adds the complete sum of every partner this process or rank owns to its particle
+    /// (`force`) and rotation (`torque`), in ascending sphere order: after a kernel pass that
+    /// summed without them.
+    pub(super) fn add_partner_sums(&self, force: &mut [Vec3], torque: &mut [Vec3]) {
+        for &s in self.partners.iter().filter(|&&s| self.adds_to(s)) {
+            let (f, t) = &self.sphere_force[s as usize];
+            self.add_sphere(s as usize, f, t, force, torque);
+        }
     }
 
     /// One run: its partners' sums set to zero, then each pair in list order (its shares to
     /// its first sphere and to its second, in the run or foreign), then each wall contact.
-    /// `shifts` are the pairs' image translations with periodic axes, else empty.
-    fn evaluate_run(
+    /// With `LAW`, a contact's force comes from the narrow phase and the law, and a contact
+    /// found apart adds nothing; without, from its record and n × f column, scaled for a
+    /// ghost beyond a time-delayed boundary (paper 003 Eqs. 6–7).
+    #[inline(always)]
+    fn evaluate_run<const LAW: bool, const SUM: bool>(
         &self,
         time: f64,
         dt: f64,
-        lo: u32,
-        (pairs, shifts, slots, walls, partners): RunLists<'_>,
-        own: &mut [Sum],
-        foreign: &mut [Sum],
+        lists: RunLists<'_>,
+        slots: &[u32],
+        partners: &[u32],
+        sums: RunSums<'_>,
     ) {
         let law = &self.settings.law;
-        for &s in partners {
-            own[(s - lo) as usize] = (Vec3::zeros(), Vec3::zeros());
-        }
-        foreign.fill((Vec3::zeros(), Vec3::zeros()));
-        for (k, (contact, &slot)) in pairs.iter_mut().zip(slots).enumerate() {
-            let mut shift = Vec3::zeros();
-            let touching = self.pair_contact(contact, &mut shift);
-            if let Some(at) = shifts.get_mut(k) {
-                *at = shift;
+        let RunSums { own, foreign, lo } = sums;
+        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
+        if SUM {
+            for &s in partners {
+                own[(s - lo) as usize] = (Vec3::zeros(), Vec3::zeros());
             }
-            let Some((g, e)) = touching else {
-                contact.part();
-                continue;
+            foreign.fill((Vec3::zeros(), Vec3::zeros()));
+        }
+        let RunLists {
+            pairs,
+            shifts,
+            turns,
+            walls,
+            wall_turns,
+        } = lists;
+        for (k, (contact, &slot)) in pairs.iter_mut().zip(slots).enumerate() {
+            let turn = match LAW {
+                true => {
+                    let mut shift = Vec3::zeros();
+                    let touching = self.pair_contact(contact, &mut shift);
+                    if let Some(at) = shifts.get_mut(k) {
+                        *at = shift;
+                    }
+                    let Some((g, e)) = touching else {
+                        contact.part();
+                        if let Some(at) = turns.get_mut(k) {
+                            *at = Vec3::zeros();
+                        }
+                        continue;
+                    };
+                    let f = law.force(&g, &e, &mut contact.history, dt);
+                    let turn = contact.touch(f, &g.normal, g.overlap);
+                    if let Some(at) = turns.get_mut(k) {
+                        *at = turn;
+                    }
+                    turn
+                }
+                false => turns[k],
             };
-            let f = law.force(&g, &e, &mut contact.history, dt);
-            let turn = contact.touch(f, &g.normal, g.overlap);
+            if !SUM {
+                continue;
+            }
             let (a, b) = (contact.first as usize, contact.second as usize);
+            let (scale_a, scale_b) = match &delay {
+                Some((axis, scales)) => pair_scales(shifts[k][*axis], scales),
+                None => (1.0, 1.0),
+            };
             let (first, second) = (
-                pair_share(contact, &turn, true, self.now[a].radius, 1.0),
-                pair_share(contact, &turn, false, self.now[b].radius, 1.0),
+                pair_share(contact, &turn, true, self.now[a].radius, scale_a),
+                pair_share(contact, &turn, false, self.now[b].radius, scale_b),
             );
             add_to(&mut own[a - lo as usize], first);
-            match (slot as usize).checked_sub(SCATTER_CHUNK) {
+            match (slot as usize).checked_sub(RUN_CHUNK) {
                 None => add_to(&mut own[slot as usize], second),
                 Some(k) => add_to(&mut foreign[k], second),
             }
         }
-        for contact in walls.iter_mut() {
+        for (k, contact) in walls.iter_mut().enumerate() {
             let s = contact.first as usize;
-            let Some((g, e)) = self.wall_contact(time, s, contact.second as usize) else {
-                contact.part();
-                continue;
+            let turn = match LAW {
+                true => {
+                    let Some((g, e)) = self.wall_contact(time, s, contact.second as usize) else {
+                        contact.part();
+                        if let Some(at) = wall_turns.get_mut(k) {
+                            *at = Vec3::zeros();
+                        }
+                        continue;
+                    };
+                    let f = law.force(&g, &e, &mut contact.history, dt);
+                    let turn = contact.touch(f, &g.normal, g.overlap);
+                    if let Some(at) = wall_turns.get_mut(k) {
+                        *at = turn;
+                    }
+                    turn
+                }
+                false => wall_turns[k],
             };
-            let f = law.force(&g, &e, &mut contact.history, dt);
-            let turn = contact.touch(f, &g.normal, g.overlap);
-            add_to(
-                &mut own[s - lo as usize],
-                wall_share(contact, &turn, self.now[s].radius),
-            );
+            if SUM {
+                add_to(
+                    &mut own[s - lo as usize],
+                    wall_share(contact, &turn, self.now[s].radius),
+                );
+            }
         }
     }
 }
 
-/// Force or torque sums that the runs of the fused pass add to in parallel, each element
+/// Force or torque sums that the runs of the pair kernel add to in parallel, each element
 /// from one sphere only.
 struct Carriers {
     at: *mut Vec3,
@@ -353,30 +437,37 @@ impl DemContacts {
 /// The share of pair `c` (with n × f `turn`) of sphere `first` (else the second), of radius
 /// `radius`, with its ghost scale `scale`: ±`scale` f and the moment (r − δ/2) `scale` n × f.
 #[inline]
-pub(super) fn pair_share(c: &Contact, turn: &Vec3, first: bool, radius: f64, scale: f64) -> Sum {
+fn pair_share(c: &Contact, turn: &Vec3, first: bool, radius: f64, scale: f64) -> Sum {
     let f = if first { scale } else { -scale } * c.force;
     (f, c.moment(turn, radius, scale))
 }
 
 /// The share of wall contact `c` (with n × f `turn`) of its sphere, of radius `radius`.
 #[inline]
-pub(super) fn wall_share(c: &Contact, turn: &Vec3, radius: f64) -> Sum {
+fn wall_share(c: &Contact, turn: &Vec3, radius: f64) -> Sum {
     (c.force, c.moment(turn, radius, 1.0))
 }
 
-/// What a run of the fused pass evaluates: its pairs, their image translations (or none),
-/// their slots in its sums, its wall contacts and its partners.
-type RunLists<'a> = (
-    &'a mut [Contact],
-    &'a mut [Vec3],
-    &'a [u32],
-    &'a mut [Contact],
-    &'a [u32],
-);
+/// A run's slices of the candidate lists: its pairs, their image translations and n × f
+/// (each empty when the lists hold no such column), its wall contacts and their n × f.
+struct RunLists<'a> {
+    pairs: &'a mut [Contact],
+    shifts: &'a mut [Vec3],
+    turns: &'a mut [Vec3],
+    walls: &'a mut [Contact],
+    wall_turns: &'a mut [Vec3],
+}
+
+/// A run's sums: those of its own spheres (from sphere `lo` on) and its foreign sums.
+struct RunSums<'a> {
+    own: &'a mut [Sum],
+    foreign: &'a mut [Sum],
+    lo: u32,
+}
 
 /// `sum += share`.
 #[inline]
-pub(super) fn add_to(sum: &mut Sum, share: Sum) {
+fn add_to(sum: &mut Sum, share: Sum) {
     sum.0 += share.0;
     sum.1 += share.1;
 }
@@ -384,11 +475,18 @@ pub(super) fn add_to(sum: &mut Sum, share: Sum) {
 /// The running total of a sphere's partial sums, in run order: the first partial itself,
 /// then each further one added.
 #[inline]
-pub(super) fn add_sum(total: Option<Sum>, partial: Sum) -> Sum {
+fn add_sum(total: Option<Sum>, partial: Sum) -> Sum {
     match total {
         None => partial,
         Some((f, t)) => (f + partial.0, t + partial.1),
     }
+}
+
+/// A column of the lists (`column`, empty when the lists hold none) cut into the runs'
+/// slices of `lengths`: empty slices when empty.
+fn cut_column<T>(column: &mut [T], lengths: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
+    let empty = column.is_empty();
+    cut(column, lengths.map(|n| if empty { 0 } else { n }))
 }
 
 /// `items` cut into consecutive slices of `lengths`.
@@ -465,8 +563,9 @@ mod tests {
         (state, contacts)
     }
 
-    /// Three evaluations 10 µs apart (the springs grow), by the fused pass or by the record
-    /// path's law and gather: the particle forces and torques of the last.
+    /// Three evaluations 10 µs apart (the springs grow), by the fused pass or by a law pass
+    /// then a sum pass (as with a time-delayed boundary): the particle forces and torques of
+    /// the last.
     fn forces(fused: bool, threads: usize) -> (Vec<Vec3>, Vec<Vec3>, usize) {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -483,17 +582,15 @@ mod tests {
                 if fused {
                     contacts.add_forces(&state, &mut force, &mut torque);
                 } else {
-                    let dt = contacts.last_time.map_or(0.0, |t| state.time - t);
-                    contacts.last_time = Some(state.time);
-                    contacts.read_centers(&state);
-                    if !contacts.lists_built() {
-                        contacts.rebuild_all(state.time);
+                    let moved = contacts.read_own_stage(&state);
+                    if contacts.needs_rebuild_stage(moved, state.time) {
+                        contacts.rebuild_stage(state.time);
                     }
-                    contacts.evaluate(state.time, dt);
-                    contacts.gather();
-                    for (s, (f, t)) in contacts.sphere_force.iter().enumerate() {
-                        contacts.add_sphere(s, f, t, &mut force, &mut torque);
-                    }
+                    contacts.read_partners_stage(&state);
+                    let (time, dt) = (state.time, contacts.dt);
+                    contacts.run_kernel::<true, false>(time, dt, None);
+                    let out = Some((&mut force[..], &mut torque[..]));
+                    contacts.run_kernel::<false, true>(time, dt, out);
                 }
             }
             (force, torque, contacts.contacts())
@@ -501,22 +598,22 @@ mod tests {
     }
 
     #[test]
-    fn the_fused_pass_sums_as_the_gather_does_bit_for_bit_on_any_thread_count() {
+    fn the_law_and_the_sums_in_two_passes_sum_as_the_fused_pass_bit_for_bit_on_any_thread_count() {
         let (_, contacts) = packing();
-        assert!(contacts.spheres() > 2 * SCATTER_CHUNK);
-        let gathered = forces(false, 1);
+        assert!(contacts.spheres() > 2 * RUN_CHUNK);
+        let apart = forces(false, 1);
         // Most spheres touch: the comparison is not one of zeros.
-        assert!(gathered.2 > 10_000, "{} touching contacts", gathered.2);
+        assert!(apart.2 > 10_000, "{} touching contacts", apart.2);
         for threads in [1, 2, 3] {
             let fused = forces(true, threads);
-            assert_eq!(fused.2, gathered.2);
+            assert_eq!(fused.2, apart.2);
             for p in 0..fused.0.len() {
                 assert_eq!(
-                    fused.0[p], gathered.0[p],
+                    fused.0[p], apart.0[p],
                     "force on particle {p}, {threads} threads"
                 );
                 assert_eq!(
-                    fused.1[p], gathered.1[p],
+                    fused.1[p], apart.1[p],
                     "torque on particle {p}, {threads} threads"
                 );
             }
@@ -524,11 +621,11 @@ mod tests {
     }
 
     #[test]
-    fn the_runs_are_an_even_number_of_at_most_scatter_chunk_spheres_beyond_one_run() {
-        assert_eq!(run_length(SCATTER_CHUNK), SCATTER_CHUNK);
+    fn the_runs_are_an_even_number_of_at_most_run_chunk_spheres_beyond_one_run() {
+        assert_eq!(run_length(RUN_CHUNK), RUN_CHUNK);
         for n in [2049, 4096, 4097, 10_000, 100_000, 279_074] {
             let length = run_length(n);
-            assert!(length <= SCATTER_CHUNK, "{n} spheres: runs of {length}");
+            assert!(length <= RUN_CHUNK, "{n} spheres: runs of {length}");
             assert_eq!(n.div_ceil(length) % 2, 0, "{n} spheres: runs of {length}");
         }
         assert_eq!(run_length(10_000), 1667);
@@ -537,9 +634,9 @@ mod tests {
     #[test]
     fn the_plan_routes_second_spheres_beyond_a_run_through_its_foreign_sums() {
         let (state, mut contacts) = packing();
-        contacts.read_centers(&state);
-        contacts.rebuild_all(0.0);
-        let plan = &contacts.scatter;
+        contacts.read_own_stage(&state);
+        contacts.rebuild_stage(0.0);
+        let plan = &contacts.kernel_plan;
         let mut crossing = 0;
         for (k, c) in contacts.pairs.items.iter().enumerate() {
             let slot = plan.slot[k] as usize;
@@ -548,10 +645,7 @@ mod tests {
                 assert_eq!(slot, c.second as usize % length);
             } else {
                 crossing += 1;
-                let (r, f) = (
-                    contacts.run_of(c.first) as u32,
-                    (slot - SCATTER_CHUNK) as u32,
-                );
+                let (r, f) = (contacts.run_of(c.first) as u32, (slot - RUN_CHUNK) as u32);
                 assert!(plan.receive.binary_search(&(c.second, r, f)).is_ok());
             }
         }

@@ -1,4 +1,6 @@
-//! The contacts as linear springs about a state, for a modal analysis ([`qdem_core::lanczos`]):
+//! One contact as a linear spring about a state and its blocks in the stiffness matrix (the
+//! facet that assembles every touching contact is `dem_contacts/linearized.rs`), for a modal
+//! analysis ([`qdem_core::lanczos`]):
 //! the sleeper's modes on its settled bed, paper 000 §4.2.
 //!
 //! A touching contact with unit normal n (from the first sphere towards the second, or from

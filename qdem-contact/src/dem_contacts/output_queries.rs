@@ -1,6 +1,7 @@
-//! What the outputs read of a [`DemContacts`]: counts, the spheres with their contact
-//! forces, the touching contacts split into normal and tangential parts, the force through
-//! a section or a time-delayed boundary.
+//! The queries the outputs make of a [`DemContacts`]: counts, the spheres with their
+//! contact forces, the touching contacts split into normal and tangential parts, the force
+//! through a section or a time-delayed boundary (the record types they return are
+//! `contact_view.rs`'s).
 
 use super::*;
 
