@@ -18,7 +18,7 @@
 //! counters), [`continuum`] (the QDEM tetrahedron, its bodies, materials and step bounds,
 //! rigid bodies), [`loads`] (gravity, nodal loads, time functions), [`solvers`] (Verlet,
 //! Newmark-β, the static solve and their sparse algebra), [`modal`] (Lanczos modes),
-//! [`parallel`] (the decomposition over ranks, behind one seam: the [`Exchange`]) and
+//! [`parallel`] (the decomposition over ranks, behind one seam: the [`ParallelRuntime`]) and
 //! [`checkpoint`].
 //!
 //! The QDEM tetrahedron (Nishiura, Sakaguchi & Aikawa 2017, Eqs. 1–11) is in [`tet_kernel`],
@@ -63,7 +63,7 @@ pub use error::CoreError;
 pub use loads::gravity::Gravity;
 pub use loads::nodal_load::NodalLoad;
 pub use loads::time_function::{Cyclic, TimeFunction};
-pub use parallel::{Communicator, Decomposition, Exchange, Part, PartialSums, Reads, SplitModel};
+pub use parallel::{Communicator, ParallelRuntime, Part, PartialSums, RankFigures, Reads};
 pub use solvers::newmark::{EventSolve, Newmark, StepCounts, TangentUpdate};
 pub use solvers::sparse::FactorStats;
 pub use solvers::static_solve::{StaticSolver, StaticSteps};
@@ -74,4 +74,4 @@ pub use step::model::{find_model, Linearized, Model, Persistence, Persistent, St
 pub use step::stages::{Stage, StageShare, StageTimes};
 pub use step::step_settings::{Scheme, StepRequest, StepSettings, Stepping};
 pub use step::stepper::{choose_step, stable_step, Stepper};
-pub use step::world::{Halt, PostStep, World};
+pub use step::world::{Gather, Halt, PostStep, World};

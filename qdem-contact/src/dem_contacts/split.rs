@@ -1,6 +1,6 @@
 //! One rank's part of a [`DemContacts`] in a run decomposed with a halo exchange
-//! ([`qdem_core::parallel`]), bit-identical to one process: its [`SplitModel`] facet, whose
-//! stages the world's [`qdem_core::Exchange`] runs with the collectives in between.
+//! ([`qdem_core::parallel`]), bit-identical to one process: its facets ([`Facets`]), whose
+//! stages the world's [`qdem_core::ParallelRuntime`] runs with the collectives in between.
 //!
 //! A sphere belongs to the rank that owns its particle (the mesh's decomposition for a
 //! deformable body's vertices, runs of particle order for one-sphere grains, a rigid body
@@ -12,15 +12,17 @@
 //!
 //! What a rank reads of the other ranks' spheres, the **ghosts** (the partners of its
 //! candidates that it does not own), their owners send at each evaluation: the centre,
-//! velocity and spin ([`SplitModel::pack`]). At a rebuild of the lists, which the ranks
+//! velocity and spin ([`Halo::pack`]). At a rebuild of the lists, which the ranks
 //! decide on the largest displacement among all spheres, every rank receives every sphere's
 //! record, finds the pairs near its own spheres, and declares its new ghosts. Owners do not
 //! change between re-partitions, so the tangential springs of a rank's pairs are always on
 //! that rank. Before an output or a checkpoint reads the contacts, the ranks' lists are
-//! merged into the one list a single process holds ([`SplitModel::merge`]).
+//! merged into the one list a single process holds ([`Merge::merge`]).
 
 use super::*;
-use qdem_core::{Part, SplitModel};
+use qdem_core::parallel::{
+    Balance, Evaluation, Facets, Halo, Lists, Merge, Ownership, Part, Reduction,
+};
 
 /// Values per sphere record: centre, velocity, spin.
 const SPHERE_VALUES: usize = 9;
@@ -203,7 +205,7 @@ impl DemContacts {
     }
 }
 
-impl SplitModel for DemContacts {
+impl Ownership for DemContacts {
     /// The particles of every sphere (those of deformable bodies already have owners).
     fn free_particles(&self) -> Vec<usize> {
         self.items()
@@ -212,7 +214,35 @@ impl SplitModel for DemContacts {
     fn split(&mut self, part: Option<Part>) {
         self.split = part.map(|p| ContactPart::new(&self.particle, &p.owner, p.rank));
     }
+}
 
+impl Facets for DemContacts {
+    fn evaluation(&mut self) -> Option<&mut dyn Evaluation> {
+        Some(self)
+    }
+
+    fn lists(&mut self) -> Option<&mut dyn Lists> {
+        Some(self)
+    }
+
+    fn halo(&mut self) -> Option<&mut dyn Halo> {
+        Some(self)
+    }
+
+    fn reduction(&mut self) -> Option<&mut dyn Reduction> {
+        Some(self)
+    }
+
+    fn merge(&mut self) -> Option<&mut dyn Merge> {
+        Some(self)
+    }
+
+    fn balance(&mut self) -> Option<&mut dyn Balance> {
+        Some(self)
+    }
+}
+
+impl Halo for DemContacts {
     /// The contact spheres.
     fn items(&self) -> Vec<usize> {
         self.particle.iter().map(|&p| p as usize).collect()
@@ -242,32 +272,6 @@ impl SplitModel for DemContacts {
         }
     }
 
-    /// Cuts whole lists to this rank's, then reads the own spheres' centres.
-    fn read_own(&mut self, state: &State) -> Option<f64> {
-        let dt = self.last_time.map_or(0.0, |t| state.time - t);
-        self.last_time = Some(state.time);
-        let moved = self.with_part(|this, part| {
-            part.dt = dt;
-            if part.whole {
-                this.cut_to_rank(part);
-            }
-            this.read_own_centers(state, &part.own)
-        });
-        Some(moved)
-    }
-
-    fn needs_rebuild(&self, moved: f64, time: f64) -> bool {
-        self.outgrew_skin(moved, time)
-    }
-
-    fn rebuild(&mut self, time: f64) {
-        self.with_part(|this, part| {
-            this.check_passage(time, Some(&part.own));
-            this.rebuild_near(part, time);
-            part.lists_changed = true;
-        });
-    }
-
     fn new_ghosts(&mut self) -> Option<Vec<u32>> {
         self.with_part(|this, part| {
             if !std::mem::take(&mut part.lists_changed) {
@@ -283,14 +287,64 @@ impl SplitModel for DemContacts {
     fn read_partners(&mut self, state: &State) {
         self.with_part(|this, part| this.read_motions(state, &part.partners));
     }
+}
 
+impl Lists for DemContacts {
+    /// Cuts whole lists to this rank's, then reads the own spheres' centres.
+    fn moved(&mut self, state: &State) -> f64 {
+        let dt = self.last_time.map_or(0.0, |t| state.time - t);
+        self.last_time = Some(state.time);
+        let moved = self.with_part(|this, part| {
+            part.dt = dt;
+            if part.whole {
+                this.cut_to_rank(part);
+            }
+            this.read_own_centers(state, &part.own)
+        });
+        moved
+    }
+
+    fn needs_rebuild(&self, moved: f64, time: f64) -> bool {
+        self.outgrew_skin(moved, time)
+    }
+
+    fn rebuild(&mut self, time: f64) {
+        self.with_part(|this, part| {
+            this.check_passage(time, Some(&part.own));
+            this.rebuild_near(part, time);
+            part.lists_changed = true;
+        });
+    }
+}
+
+impl Evaluation for DemContacts {
     fn compute(&mut self, state: &State) {
         let dt = self.split.as_ref().map_or(0.0, |p| p.dt);
         self.evaluate(state.time, dt);
     }
 
+    /// Each own partner's sum, in the single process's order, added to its particle.
+    fn apply(&mut self, force: &mut [Vec3], torque: &mut [Vec3]) {
+        let mut part = self.split.take().expect("a split contact set");
+        let this = &*self;
+        let mut sums = std::mem::take(&mut part.sums);
+        sums.resize(part.partners.len(), (Vec3::zeros(), Vec3::zeros()));
+        sums.par_iter_mut()
+            .zip(&part.partners)
+            .with_min_len(CONTACT_CHUNK)
+            .for_each(|(sum, &s)| *sum = this.sphere_sum(s as usize));
+        for (&s, (f, t)) in part.partners.iter().zip(&sums) {
+            self.add_sphere(s as usize, f, t, force, torque);
+            self.sphere_force[s as usize] = (*f, *t);
+        }
+        part.sums = sums;
+        self.split = Some(part);
+    }
+}
+
+impl Reduction for DemContacts {
     /// The touching pairs through a time-delayed boundary: partners and force magnitude.
-    fn reduction(&mut self, out: &mut Vec<f64>) -> bool {
+    fn mine(&mut self, out: &mut Vec<f64>) -> bool {
         let Some(axis) = self.time_delay.as_ref().map(|t| t.axis) else {
             return false;
         };
@@ -322,25 +376,9 @@ impl SplitModel for DemContacts {
         };
         self.set_boundary_force(time, measured);
     }
+}
 
-    /// Each own partner's sum, in the single process's order, added to its particle.
-    fn apply(&mut self, force: &mut [Vec3], torque: &mut [Vec3]) {
-        let mut part = self.split.take().expect("a split contact set");
-        let this = &*self;
-        let mut sums = std::mem::take(&mut part.sums);
-        sums.resize(part.partners.len(), (Vec3::zeros(), Vec3::zeros()));
-        sums.par_iter_mut()
-            .zip(&part.partners)
-            .with_min_len(CONTACT_CHUNK)
-            .for_each(|(sum, &s)| *sum = this.sphere_sum(s as usize));
-        for (&s, (f, t)) in part.partners.iter().zip(&sums) {
-            self.add_sphere(s as usize, f, t, force, torque);
-            self.sphere_force[s as usize] = (*f, *t);
-        }
-        part.sums = sums;
-        self.split = Some(part);
-    }
-
+impl Merge for DemContacts {
     /// This rank's pairs, then its wall contacts; nothing once whole.
     fn records(&self, out: &mut Vec<f64>) -> bool {
         if self.split.as_ref().is_none_or(|p| p.whole) {
@@ -395,7 +433,9 @@ impl SplitModel for DemContacts {
             part.whole = true;
         }
     }
+}
 
+impl Balance for DemContacts {
     fn rebuilt(&mut self) -> bool {
         std::mem::take(&mut self.rebuilt)
     }

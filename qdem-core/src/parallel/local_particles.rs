@@ -111,7 +111,7 @@ impl ParticleRuns {
     }
 }
 
-/// What one rank of a decomposed run steps itself ([`crate::parallel::Exchange::stepped`]).
+/// What one rank of a decomposed run steps itself ([`crate::parallel::ParallelRuntime::stepped`]).
 ///
 /// ```
 /// use qdem_core::parallel::local_particles::{LocalParticles, ParticleRuns};

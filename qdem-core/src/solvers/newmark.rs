@@ -54,7 +54,7 @@
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::parallel::local_particles::ParticleRuns;
-use crate::parallel::Exchange;
+use crate::parallel::ParallelRuntime;
 use crate::solvers::conjugate_gradient::{self, Scratch};
 use crate::solvers::sparse::{
     copy_matrix, explain_failure, restore_matrix, save_matrix, Assembler, DampingRows, FactorStats,
@@ -529,7 +529,7 @@ impl Newmark {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         h: f64,
-        (stages, exchange): (&mut StageTimes, &mut Exchange),
+        (stages, exchange): (&mut StageTimes, &mut ParallelRuntime),
     ) -> Result<(), CoreError> {
         self.prepare_solve(state, models, h)?;
         stages.mark(Stage::Solve);
@@ -572,7 +572,7 @@ impl Newmark {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         h: f64,
-        (stages, exchange): (&mut StageTimes, &mut Exchange),
+        (stages, exchange): (&mut StageTimes, &mut ParallelRuntime),
     ) -> Result<(), CoreError> {
         if self.is_implicit() {
             return self.implicit_step(state, models, h, (stages, exchange));
@@ -597,7 +597,7 @@ impl Newmark {
         models: &mut [Box<dyn Model>],
         span: f64,
         stages: &mut StageTimes,
-        exchange: &mut Exchange,
+        exchange: &mut ParallelRuntime,
     ) -> Result<f64, CoreError> {
         let mut h = span;
         if self.adaptive || self.is_implicit() {
@@ -928,7 +928,7 @@ impl Stepper for Newmark {
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
-        exchange: &mut Exchange,
+        exchange: &mut ParallelRuntime,
     ) -> Result<(), CoreError> {
         refuse_rigid(state, "newmark")?;
         check_masses(state)?;
@@ -949,7 +949,7 @@ impl Stepper for Newmark {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
-        exchange: &mut Exchange,
+        exchange: &mut ParallelRuntime,
     ) -> Result<(), CoreError> {
         let end = state.time + self.dt;
         let mut remaining = self.dt;

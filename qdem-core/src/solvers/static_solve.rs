@@ -37,7 +37,7 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::parallel::Exchange;
+use crate::parallel::ParallelRuntime;
 use crate::solvers::newmark::{collect_tangent, StepCounts};
 use crate::solvers::sparse::{
     explain_failure, unconstrained_bodies, Assembler, FactorStats, FreeDofs, Scales,
@@ -128,7 +128,7 @@ impl StaticSolver {
         if !self.cholesky.is_factored() {
             self.factorize(state, models)?;
         }
-        Exchange::default().sum_forces(
+        ParallelRuntime::default().sum_forces(
             state,
             models,
             &mut self.force,
@@ -274,7 +274,7 @@ impl Stepper for StaticSteps {
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
-        _exchange: &mut Exchange,
+        _exchange: &mut ParallelRuntime,
     ) -> Result<(), CoreError> {
         let time = state.time;
         self.solver.solve(state, models, time)
@@ -286,7 +286,7 @@ impl Stepper for StaticSteps {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
-        _exchange: &mut Exchange,
+        _exchange: &mut ParallelRuntime,
     ) -> Result<(), CoreError> {
         let time = self.next_level(state.time);
         let solved = self.solver.solve(state, models, time);

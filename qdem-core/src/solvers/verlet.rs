@@ -16,9 +16,9 @@
 //! (`qdem-core/src/solvers/verlet_sweeps.rs`): the first half kick with the drift and the zeroing of
 //! the force sums, and, after the forces, a deferred uniform field (gravity), local damping,
 //! the accelerations, the second half kick and the finiteness check. In a run decomposed with
-//! a halo exchange ([`crate::Exchange::stepped`]) the sweeps cover only the rank's own
+//! a halo exchange ([`crate::ParallelRuntime::stepped`]) the sweeps cover only the rank's own
 //! particles and its halo ([`crate::parallel::local_particles`]), and the force sums are
-//! zeroed whole by [`Exchange::sum_forces`].
+//! zeroed whole by [`ParallelRuntime::sum_forces`].
 
 use crate::checkpoint::{same_count, CheckpointError, Decoder, Encoder};
 use crate::continuum::rigid_body::RigidBodies;
@@ -26,7 +26,7 @@ use crate::continuum::rigid_body::{
     place_member_velocities, place_members, place_members_keeping_arms,
 };
 use crate::error::CoreError;
-use crate::parallel::Exchange;
+use crate::parallel::ParallelRuntime;
 use crate::solvers::local_damping;
 use crate::solvers::verlet_sweeps::{self, DofArrays, KickSettings, Particles};
 use crate::state::State;
@@ -95,7 +95,7 @@ impl Verlet {
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
-        (stages, exchange): (&mut StageTimes, &mut Exchange),
+        (stages, exchange): (&mut StageTimes, &mut ParallelRuntime),
         kick: Option<f64>,
         zeroed: bool,
     ) -> Result<(), CoreError> {
@@ -142,7 +142,7 @@ impl Verlet {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
-        exchange: &mut Exchange,
+        exchange: &mut ParallelRuntime,
     ) -> Result<(), CoreError> {
         let dt = self.dt;
         let stepped = exchange.stepped();
@@ -199,7 +199,7 @@ impl Stepper for Verlet {
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
-        exchange: &mut Exchange,
+        exchange: &mut ParallelRuntime,
     ) -> Result<(), CoreError> {
         check_masses(state)?;
         if !state.rigid.is_empty() {
@@ -274,7 +274,7 @@ impl Stepper for Verlet {
         state: &mut State,
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
-        exchange: &mut Exchange,
+        exchange: &mut ParallelRuntime,
     ) -> Result<(), CoreError> {
         let advanced = self.advance(state, models, stages, exchange);
         exchange.complete(state, stages, advanced, false)

@@ -115,7 +115,7 @@ impl<'a> Particles<'a> {
 }
 
 /// The particles a sweep covers: every one, or a decomposed run's share
-/// ([`crate::Exchange::stepped`], [`crate::Exchange::computed`]).
+/// ([`crate::ParallelRuntime::stepped`], [`crate::ParallelRuntime::computed`]).
 pub(crate) fn cover(count: usize, only: Option<&ParticleRuns>) -> Vec<Range<usize>> {
     match only {
         None => std::iter::once(0..count).collect(),

@@ -4,7 +4,7 @@
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::parallel::local_particles::ParticleRuns;
-use crate::parallel::Exchange;
+use crate::parallel::ParallelRuntime;
 use crate::solvers::newmark::StepCounts;
 use crate::solvers::sparse::FactorStats;
 use crate::state::{Dofs, State};
@@ -34,7 +34,7 @@ pub trait Stepper: Send {
         state: &mut State,
         models: &mut [Box<dyn Model>],
     ) -> Result<(), CoreError> {
-        self.initialize_in(state, models, &mut Exchange::default())
+        self.initialize_in(state, models, &mut ParallelRuntime::default())
     }
 
     /// [`Stepper::initialize`], evaluating the forces through `exchange` (a
@@ -43,7 +43,7 @@ pub trait Stepper: Send {
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
-        exchange: &mut Exchange,
+        exchange: &mut ParallelRuntime,
     ) -> Result<(), CoreError>;
 
     /// Advances `state` by one step.
@@ -52,26 +52,26 @@ pub trait Stepper: Send {
             state,
             models,
             &mut StageTimes::off(),
-            &mut Exchange::default(),
+            &mut ParallelRuntime::default(),
         )
     }
 
     /// [`Stepper::step`], marking the end of each of its stages on `stages` (predict, each
     /// model's forces, integrate, solve, events: [`crate::stages`]), evaluating the forces
-    /// through `exchange` ([`Exchange::sum_forces`]) and ending each integration with
-    /// [`Exchange::complete`] (in a decomposed run, the share of the ranks' new motion), on
-    /// `exchange`'s particles only when it says so ([`Exchange::stepped`],
-    /// [`Exchange::computed`]).
+    /// through `exchange` ([`ParallelRuntime::sum_forces`]) and ending each integration with
+    /// [`ParallelRuntime::complete`] (in a decomposed run, the share of the ranks' new motion), on
+    /// `exchange`'s particles only when it says so ([`ParallelRuntime::stepped`],
+    /// [`ParallelRuntime::computed`]).
     fn step_timed(
         &mut self,
         state: &mut State,
         models: &mut [Box<dyn Model>],
         stages: &mut StageTimes,
-        exchange: &mut Exchange,
+        exchange: &mut ParallelRuntime,
     ) -> Result<(), CoreError>;
 
-    /// Whether the stepper steps only the particles [`Exchange::stepped`] and
-    /// [`Exchange::computed`] name, so that a decomposed run may share only its halo; the
+    /// Whether the stepper steps only the particles [`ParallelRuntime::stepped`] and
+    /// [`ParallelRuntime::computed`] name, so that a decomposed run may share only its halo; the
     /// default cannot, and a decomposed run then shares the whole state after every step.
     fn steps_in_part(&self) -> bool {
         false
@@ -192,7 +192,7 @@ pub fn compute_accelerations(
     force: &mut Vec<Vec3>,
     torque: &mut Vec<Vec3>,
 ) -> Result<(), CoreError> {
-    let (mut stages, mut exchange) = (StageTimes::off(), Exchange::default());
+    let (mut stages, mut exchange) = (StageTimes::off(), ParallelRuntime::default());
     compute_accelerations_timed(state, models, force, torque, &mut stages, &mut exchange)
 }
 
@@ -204,7 +204,7 @@ pub(crate) fn compute_accelerations_timed(
     force: &mut Vec<Vec3>,
     torque: &mut Vec<Vec3>,
     stages: &mut StageTimes,
-    exchange: &mut Exchange,
+    exchange: &mut ParallelRuntime,
 ) -> Result<(), CoreError> {
     exchange.sum_forces(state, models, force, torque, stages);
     set_accelerations(state, force)?;
