@@ -338,8 +338,8 @@ impl Model for DemContacts {
         self.drive_servos(state.time, dt);
     }
 
-    /// Split in a decomposed run ([`qdem_core::parallel::Facets`], `split.rs`): a rank reads its own spheres
-    /// and receives the ghosts it declares.
+    /// Split in a decomposed run ([`qdem_core::parallel::Facets`], `split.rs`): a rank reads
+    /// its own spheres and receives the ghosts it declares.
     fn reads(&mut self) -> Reads<'_> {
         Reads::Split(self)
     }

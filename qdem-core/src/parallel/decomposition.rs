@@ -401,9 +401,9 @@ impl Partition {
     }
 }
 
-/// Gives owners to the particles that split models ([`crate::parallel::Ownership::free_particles`]) move and no
-/// deformable body holds (`owner` `u32::MAX`): runs of particle order of about equal `cost`
-/// (one per particle without it), a rigid body (its centre and members) whole to one rank.
+/// Gives owners to the particles that split models move and no deformable body holds
+/// ([`crate::parallel::Ownership::free_particles`], `owner` `u32::MAX`): runs of particle
+/// order of about equal `cost` (one per particle without it), a rigid body (its centre and members) whole to one rank.
 /// The builders place grains layer by layer, so a run is a slab of the packing (its ghosts
 /// are one layer at each cut) and a rank streams contiguous memory when it steps its
 /// grains; counts them in `owned`.

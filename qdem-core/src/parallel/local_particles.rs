@@ -111,7 +111,8 @@ impl ParticleRuns {
     }
 }
 
-/// What one rank of a decomposed run steps itself ([`crate::parallel::ParallelRuntime::stepped`]).
+/// What one rank of a decomposed run steps itself
+/// ([`crate::parallel::ParallelRuntime::stepped`]).
 ///
 /// ```
 /// use qdem_core::parallel::local_particles::{LocalParticles, ParticleRuns};

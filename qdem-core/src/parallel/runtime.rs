@@ -1,9 +1,9 @@
-//! [`ParallelRuntime`]: the one place where a step meets the ranks. A [`crate::World`] owns one:
-//! single-process by default, where every call is a plain loop or does nothing, and
+//! [`ParallelRuntime`]: the one place where a step meets the ranks. A [`crate::World`] owns
+//! one: single-process by default, where every call is a plain loop or does nothing, and
 //! decomposed after [`crate::World::decompose`]. The steppers evaluate forces through it
-//! ([`ParallelRuntime::sum_forces`]) and end each integration with it ([`ParallelRuntime::complete`]); the
-//! world runs its gathers, its failure agreement, the post-step hooks and the re-partitions
-//! through it. Models never call a collective: a split model declares what it exchanges
+//! ([`ParallelRuntime::sum_forces`]) and end each integration with it
+//! ([`ParallelRuntime::complete`]); the world runs its gathers, its failure agreement, the
+//! post-step hooks and the re-partitions through it. Models never call a collective: a split model declares what it exchanges
 //! ([`crate::parallel::Facets`]) and the runtime runs the collectives between its stages, in
 //! the same order on every rank.
 
@@ -32,8 +32,8 @@ const REPARTITION_IMBALANCE: f64 = 1.1;
 const REPARTITION_REBUILDS: usize = 8;
 
 /// What a step exchanges between the ranks of a decomposed run; nothing in a run of one
-/// process ([`ParallelRuntime::default`]), where [`ParallelRuntime::sum_forces`] sums the models' forces
-/// and the rest does nothing.
+/// process ([`ParallelRuntime::default`]), where [`ParallelRuntime::sum_forces`] sums the
+/// models' forces and the rest does nothing.
 ///
 /// ```
 /// use qdem_core::{ParallelRuntime, Gravity, Model, State, StageTimes, Vec3};
@@ -100,8 +100,8 @@ impl ParallelRuntime {
         self.add_forces(state, models, force, torque, stages);
     }
 
-    /// [`ParallelRuntime::sum_forces`] into `force` and `torque` that the caller has sized and zeroed
-    /// (Verlet zeroes them in its drift sweep).
+    /// [`ParallelRuntime::sum_forces`] into `force` and `torque` that the caller has sized and
+    /// zeroed (Verlet zeroes them in its drift sweep).
     pub(crate) fn add_forces(
         &mut self,
         state: &State,
