@@ -7,13 +7,19 @@ cd "$(dirname "$0")/.."
 if ! python3 -c "import meshio" 2>/dev/null; then
     python3 -m pip install --quiet --disable-pip-version-check meshio
 fi
-# Only the seam names the Communicator (docs/architecture.md, "The ranks, behind one seam"):
-# the decomposition lives in qdem-core/src/parallel/, World::decompose takes one, and the CLI's
-# MPI set-up makes it and hands it over. A model that named it would be calling collectives.
+# Only the seam calls a collective (docs/architecture.md, "The ranks, behind one seam"): the
+# decomposition lives in qdem-core/src/parallel/, the World offers its collectives as named
+# methods (World::gather, World::agree_on_stop, World::rank_rows, ...), World::decompose takes
+# the Communicator, and the CLI's MPI set-up makes it and hands it over. Outside the seam no
+# file names the Communicator, one of its collectives (its `min`, `rank` and `size` are
+# reached only through a value of it, so only by naming it) or the parallel runtime's raw
+# ones: a model or a driver that did would be calling collectives itself.
 seam='^(qdem-core/src/parallel/|qdem-core/src/lib\.rs|qdem-core/src/step/world\.rs|qdem-cli/src/(main|mpi_ranks|command|check)\.rs)'
-outside=$(grep -rl --include='*.rs' -w Communicator qdem-* | grep -Ev "$seam" || true)
+collectives='Communicator|all_to_all|all_gather|all_gather_one|all_gather_varying|broadcast|agree_min|gather_values|max_over_ranks'
+outside=$(grep -rnwE --include='*.rs' "$collectives" qdem-* | grep -Ev "$seam" || true)
 if [ -n "$outside" ]; then
-    echo "these files name Communicator outside the seam (qdem-core/src/parallel/):" >&2
+    echo "these lines name a collective outside the seam (qdem-core/src/parallel/ and the World);" >&2
+    echo "call a named World method instead (World::gather, World::agree_on_stop, ...):" >&2
     echo "$outside" >&2
     exit 1
 fi

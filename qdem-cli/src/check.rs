@@ -7,7 +7,7 @@
 
 use crate::command::CliError;
 use crate::progress;
-use qdem_core::{Communicator, Decomposition, Model as _, Scheme, Stage};
+use qdem_core::{Communicator, Model as _, RankFigures, Scheme, Stage};
 use qdem_io::build::{memory, BodyKind, Simulation};
 use qdem_io::runner::RunError;
 use qdem_io::scene::Scene;
@@ -29,7 +29,7 @@ pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<
                 source,
             })?;
     }
-    let leader = sim.world.exchange().rank() == 0;
+    let leader = sim.world.rank() == 0;
     if leader {
         print_scene(path, &sim);
     }
@@ -204,7 +204,7 @@ fn print_cost(sim: &Simulation, per_step: f64) {
 /// whose motion it receives per step, the candidate contacts it evaluates and the contact
 /// spheres of other ranks it receives (ghosts) after the measured steps, its step and kernel
 /// seconds, and the imbalance of the kernel (the slowest rank's kernel time over the mean).
-fn rank_table(sim: &Simulation, d: &Decomposition, per_step: f64, exchange: f64) -> String {
+fn rank_table(sim: &Simulation, d: &RankFigures, per_step: f64, exchange: f64) -> String {
     let world = &sim.world;
     let steps = world.stages().steps().max(1) as f64;
     // The bodies' force time without their exchange of block sums (which waits for the
@@ -229,7 +229,7 @@ fn rank_table(sim: &Simulation, d: &Decomposition, per_step: f64, exchange: f64)
         contacts as f64,
         ghosts as f64,
     ];
-    let all = world.exchange().gather_values(&mine);
+    let all = world.rank_rows(&mine);
     let mut table = format!(
         "decomposed over {} ranks ({} bodies cut between ranks):\n  rank  tets      owned     halo      received  contacts  ghosts    step (s)   kernel (s) share (s)\n",
         d.ranks, d.cut_bodies

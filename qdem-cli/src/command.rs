@@ -490,7 +490,7 @@ fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliErro
 
 /// The line `qdem run` prints of a decomposed run: per rank, the tetrahedra it computes, the
 /// particles it owns and the block sums it receives per step.
-fn decomposition_line(d: &qdem_core::Decomposition) -> String {
+fn decomposition_line(d: &qdem_core::RankFigures) -> String {
     let list = |v: &[usize]| {
         v.iter()
             .map(|n| n.to_string())

@@ -5,12 +5,13 @@
 //! In a run decomposed with a halo exchange ([`qdem_core::parallel`]) a rank holds only
 //! its own particles' and its halo's positions, so the rank that owns a group's anchor
 //! decides whether the group wraps, from the position one process would read
-//! ([`SplitModel::decide`]); the world's exchange shares the decisions after every step and
-//! each rank moves every particle of a wrapping group (position and reference) by the same
-//! period ([`SplitModel::act`]), so all ranks agree with one process.
+//! ([`Decisions::decide`]); the world's parallel runtime shares the decisions after every
+//! step and each rank moves every particle of a wrapping group (position and reference) by
+//! the same period ([`Decisions::act`]), so all ranks agree with one process.
 
 use crate::periodic_boundary::{PeriodicBox, WrapGroup};
-use qdem_core::{Halt, Model, Part, PostStep, Reads, SplitModel, State, Vec3};
+use qdem_core::parallel::{Decisions, Facets, Ownership, Part, Reads};
+use qdem_core::{Halt, Model, PostStep, State, Vec3};
 
 /// Wraps groups of particles (whole bodies) back into a periodic cell after every step.
 ///
@@ -74,11 +75,20 @@ impl PostStep for PeriodicWrap {
     }
 }
 
-impl SplitModel for PeriodicWrap {
+impl Ownership for PeriodicWrap {
     fn split(&mut self, part: Option<Part>) {
         self.split = part;
     }
+}
 
+/// A hook: it decides, and computes no forces.
+impl Facets for PeriodicWrap {
+    fn decisions(&mut self) -> Option<&mut dyn Decisions> {
+        Some(self)
+    }
+}
+
+impl Decisions for PeriodicWrap {
     /// The groups whose anchor this rank owns (rank 0 for an anchor every rank computes)
     /// and that wrap: group index, then the shift.
     fn decide(&self, state: &State, out: &mut Vec<f64>) {
@@ -110,10 +120,4 @@ impl SplitModel for PeriodicWrap {
             }
         }
     }
-
-    /// Nothing to compute in a force evaluation: a hook.
-    fn compute(&mut self, _state: &State) {}
-
-    /// Nothing to add: a hook.
-    fn apply(&mut self, _force: &mut [Vec3], _torque: &mut [Vec3]) {}
 }

@@ -25,7 +25,7 @@
 //!    (Verlet, Newmark-β, the static solve and their sparse algebra), each on its own;
 //! 3. [`modal`] (Lanczos modes of the tangents);
 //! 4. [`parallel`] (the decomposition over ranks, distributing what the models declare,
-//!    behind one seam: the [`Exchange`]);
+//!    behind one seam: the [`ParallelRuntime`]);
 //! 5. [`world`]: the [`World`], which holds the parallel runtime.
 //!
 //! The flat re-exports below are for other crates and embedders; the crate itself names
@@ -71,7 +71,7 @@ pub use error::CoreError;
 pub use loads::gravity::Gravity;
 pub use loads::nodal_load::NodalLoad;
 pub use loads::time_function::{Cyclic, TimeFunction};
-pub use parallel::{Communicator, Decomposition, Exchange, Part, PartialSums, Reads, SplitModel};
+pub use parallel::{Communicator, ParallelRuntime, Part, PartialSums, RankFigures, Reads};
 pub use solvers::newmark::{Newmark, TangentUpdate};
 pub use solvers::static_solve::{StaticSolver, StaticSteps};
 pub use solvers::verlet::Verlet;
@@ -86,4 +86,4 @@ pub use step::state::{Dofs, ParticleSpin, State};
 pub use step::step_settings::{EventSolve, Scheme, StepRequest, StepSettings};
 pub use step::stepper::{choose_step, stable_step, Stepper};
 pub use step::tangent::Tangent;
-pub use world::World;
+pub use world::{Gather, World};

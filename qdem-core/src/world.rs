@@ -16,7 +16,7 @@
 //!    of bodies, a bonded body's collapse watch; a hook may [`Halt`] the run.
 //!
 //! In a run decomposed over processes, every collective runs in the world's
-//! [`Exchange`] ([`crate::parallel`]): the steppers evaluate the forces through it and end
+//! [`ParallelRuntime`] ([`crate::parallel`]): the steppers evaluate the forces through it and end
 //! each integration with it (the **share** of each rank's new motion), the hooks that decide
 //! for their own particles share their decisions through it, and a step ends with its
 //! re-partition check; in a run of one process each of these is a plain loop or nothing, so
@@ -28,7 +28,7 @@
 
 use crate::checkpoint::{model_tag, whole_block, CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::parallel::{Communicator, Decomposition, Exchange};
+use crate::parallel::{Communicator, ParallelRuntime, RankFigures};
 use crate::solvers::stepper_for::stepper_for;
 use crate::step::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
 use crate::step::model::{find_model, Model, Persistence};
@@ -43,6 +43,18 @@ use std::sync::Arc;
 /// failure check reports it as itself rather than as an unstable step; it also separates
 /// the report's detail from its fix.
 const PASS_THROUGH: &str = "\u{1}pass through\u{1}";
+
+/// What a driver reads of the state after a step ([`World::agree_on_stop`]), which a
+/// decomposed run makes whole first; each reads more than the ones before it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Gather {
+    /// Nothing.
+    Nothing,
+    /// Some particles (the probes').
+    Particles,
+    /// The whole state.
+    Whole,
+}
 
 /// A simulation that steps itself: state, models, stepper, hooks and stage counters.
 ///
@@ -89,8 +101,9 @@ pub struct World {
     stages: StageTimes,
     energy: EnergyGrowth,
     steps_done: u64,
-    /// What a step exchanges between ranks: nothing in a run of one process.
-    exchange: Exchange,
+    /// The parallel runtime: what a step exchanges between ranks, nothing in a run of one
+    /// process.
+    parallel: ParallelRuntime,
 }
 
 impl World {
@@ -114,7 +127,7 @@ impl World {
             stages,
             energy: EnergyGrowth::new(),
             steps_done: 0,
-            exchange: Exchange::default(),
+            parallel: ParallelRuntime::default(),
         })
     }
 
@@ -128,7 +141,7 @@ impl World {
         let steps_in_part = self.stepper.steps_in_part();
         let torques = self.stepper.rigid_torques_mut();
         let (state, models, hooks) = (&mut self.state, &mut self.models, &mut self.hooks);
-        self.exchange
+        self.parallel
             .restepped(steps_in_part, state, models, hooks, torques);
         Ok(())
     }
@@ -189,15 +202,14 @@ impl World {
     /// process computes its share of the deformable bodies and every step ends with the
     /// exchange of the particles each rank owns (after each sub-step of an adaptive explicit
     /// Newmark step too). When every model and hook reads only what a rank steps itself
-    /// ([`crate::parallel::Reads::Own`] or [`crate::parallel::Reads::Split`]) and the
-    /// stepper can step in part (Verlet), a rank steps only its own particles and its halo,
-    /// and receives only its halo, and a split model ([`crate::SplitModel`], DEM contacts)
-    /// computes only what touches its particles:
+    /// ([`Reads::Own`] or [`Reads::Split`]) and the stepper can step in part (Verlet), a rank
+    /// steps only its own particles and its halo, and receives only its halo, and a split
+    /// model ([`crate::parallel::Facets`], DEM contacts) computes only what touches its particles:
     /// call [`World::gather`] before reading the whole state. Otherwise every rank holds the
     /// state one process would after every step. Call it on every rank, before
     /// [`World::initialize`] or [`World::restore`]. Only explicit runs (Verlet, explicit
     /// Newmark) can be decomposed.
-    pub fn decompose(&mut self, comm: Arc<dyn Communicator>) -> Result<Decomposition, CoreError> {
+    pub fn decompose(&mut self, comm: Arc<dyn Communicator>) -> Result<RankFigures, CoreError> {
         if self.settings.is_implicit() {
             return Err(CoreError::Decomposition(format!(
                 "only explicit runs (Verlet, explicit Newmark) can be decomposed, and this one is \
@@ -208,14 +220,14 @@ impl World {
         refuse_averaged_pressure(&self.models)?;
         let steps_in_part = self.stepper.steps_in_part();
         let (state, models, hooks) = (&mut self.state, &mut self.models, &mut self.hooks);
-        self.exchange
+        self.parallel
             .decompose(state, models, hooks, comm, steps_in_part)?;
         Ok(self.decomposition().expect("decomposed").clone())
     }
 
     /// Gives the particles no deformable body holds (grains, rigid bodies) new owners, in
     /// runs of particle order of about equal measured work (each particle's step, and its
-    /// share of the split models' work, [`crate::SplitModel::add_costs`]): a collective,
+    /// share of the split models' work, [`crate::parallel::Balance::add_costs`]): a collective,
     /// which every rank calls after the same step, in a run decomposed with a halo exchange
     /// (a no-op otherwise). The state and the split models are gathered first and split
     /// again by the new owners, so the run goes on bit for bit as before. A step calls it at
@@ -224,12 +236,12 @@ impl World {
     pub fn repartition(&mut self) {
         let torques = self.stepper.rigid_torques_mut();
         let (state, models, hooks) = (&mut self.state, &mut self.models, &mut self.hooks);
-        self.exchange.repartition(state, models, hooks, torques);
+        self.parallel.repartition(state, models, hooks, torques);
     }
 
     /// How many times [`World::repartition`] has run.
     pub fn repartitions(&self) -> usize {
-        self.exchange.repartitions()
+        self.parallel.repartitions()
     }
 
     /// Makes the state whole on every rank of a decomposed run, as one process holds it (and
@@ -240,7 +252,7 @@ impl World {
     pub fn gather(&mut self) {
         let torques = self.stepper.rigid_torques_mut();
         let (state, models) = (&mut self.state, &mut self.models);
-        self.exchange.gather(state, models, torques);
+        self.parallel.gather(state, models, torques);
         self.gather_forces();
     }
 
@@ -248,27 +260,59 @@ impl World {
     /// decomposed run, each particle's from its owner (a reaction sums fixed particles'
     /// forces, which only their owners hold whole); every rank calls it after the same step.
     pub fn gather_forces(&mut self) {
-        self.exchange.gather_forces(self.stepper.forces_mut());
+        self.parallel.gather_forces(self.stepper.forces_mut());
     }
 
     /// [`World::gather`] of `particles` only (the probes' particles): every rank calls it
     /// after the same step with the same list, and then holds their position, velocity and
     /// acceleration as one process would.
     pub fn gather_particles(&mut self, particles: &[usize]) {
-        self.exchange.gather_particles(&mut self.state, particles);
+        self.parallel.gather_particles(&mut self.state, particles);
     }
 
     /// How the run is decomposed over processes; `None` for a run of one process.
-    pub fn decomposition(&self) -> Option<&Decomposition> {
-        self.exchange.decomposition()
+    pub fn decomposition(&self) -> Option<&RankFigures> {
+        self.parallel.decomposition()
     }
 
-    /// The world's exchange with the other ranks: its rank, and the agreements a driver of
-    /// a decomposed run needs besides the steps ([`Exchange::agree_min`],
-    /// [`Exchange::gather_values`]); a run of one process's, where they return the value
-    /// given.
-    pub fn exchange(&self) -> &Exchange {
-        &self.exchange
+    /// This process's rank in a decomposed run (0 in a run of one process).
+    pub fn rank(&self) -> usize {
+        self.parallel.rank()
+    }
+
+    /// After a step of a driver of the run, on every rank after the same step: whether the
+    /// run stops (`stop`: this rank was asked to), having made whole what the ranks read
+    /// (`wanted`: what this rank reads; `particles`: those [`Gather::Particles`] makes whole,
+    /// the same on every rank). In a decomposed run the ranks agree in one collective: the
+    /// run stops when any rank was asked to, and every rank gathers the most that any rank
+    /// reads, the whole state at a stop (for its checkpoint). A run of one process stops
+    /// when asked to and has nothing to gather.
+    pub fn agree_on_stop(&mut self, stop: bool, wanted: Gather, particles: &[usize]) -> bool {
+        if self.decomposition().is_none() {
+            return stop;
+        }
+        // The smallest wins: 0 stop (and the whole state), 1 the whole state, 2 the
+        // particles, 3 nothing.
+        let mine = match (stop, wanted) {
+            (true, _) => 0,
+            (false, Gather::Whole) => 1,
+            (false, Gather::Particles) => 2,
+            (false, Gather::Nothing) => 3,
+        };
+        let agreed = self.parallel.agree_min(mine);
+        match agreed {
+            0 | 1 => self.gather(),
+            2 => self.gather_particles(particles),
+            _ => {}
+        }
+        agreed == 0
+    }
+
+    /// Every rank's `row` of figures (of one length on every rank), in rank order, on every
+    /// rank: a report's table of the ranks (`row` itself in a run of one process). A
+    /// collective, which every rank calls after the same step.
+    pub fn rank_rows(&self, row: &[f64]) -> Vec<f64> {
+        self.parallel.gather_values(row)
     }
 
     /// Makes the accelerations consistent with the forces at the start (and factorises, for
@@ -277,9 +321,9 @@ impl World {
         let (state, models) = (&mut self.state, &mut self.models);
         let done = self
             .stepper
-            .initialize_in(state, models, &mut self.exchange);
+            .initialize_in(state, models, &mut self.parallel);
         let torques = self.stepper.rigid_torques_mut();
-        self.exchange.initialized(&mut self.state, torques, done)
+        self.parallel.initialized(&mut self.state, torques, done)
     }
 
     /// Advances one step through every stage; `Ok(Some(halt))` when a hook ends the run.
@@ -288,7 +332,7 @@ impl World {
         let (state, models, stages) = (&mut self.state, &mut self.models, &mut self.stages);
         let stepped = self
             .stepper
-            .step_timed(state, models, stages, &mut self.exchange);
+            .step_timed(state, models, stages, &mut self.parallel);
         self.steps_done += 1;
         let checked = self.check(stepped);
         self.stages.mark(Stage::Check);
@@ -296,15 +340,15 @@ impl World {
         let mut halt = None;
         for (i, hook) in self.hooks.iter_mut().enumerate() {
             let (state, models) = (&mut self.state, &self.models[..]);
-            if let Some(h) = self.exchange.after_step(i, hook.as_mut(), state, models) {
+            if let Some(h) = self.parallel.after_step(i, hook.as_mut(), state, models) {
                 halt.get_or_insert(h);
             }
             self.stages.mark(Stage::Hook(i));
         }
-        if self.exchange.rebalances() {
+        if self.parallel.rebalances() {
             let torques = self.stepper.rigid_torques_mut();
             let (state, models, hooks) = (&mut self.state, &mut self.models, &mut self.hooks);
-            self.exchange.rebalance(state, models, hooks, torques);
+            self.parallel.rebalance(state, models, hooks, torques);
             self.stages.mark(Stage::Share);
         }
         Ok(halt)
@@ -331,8 +375,8 @@ impl World {
                     e => e.to_string(),
                 }),
         };
-        let failure = self.exchange.agree(local);
-        let kinetic = self.exchange.kinetic_energy(&self.state);
+        let failure = self.parallel.agree(local);
+        let kinetic = self.parallel.kinetic_energy(&self.state);
         let failure = failure.or_else(|| {
             self.energy.observe(kinetic).map(|growth| {
                 format!(

@@ -7,7 +7,7 @@ mod common;
 
 use qdem_core::thread_ranks::on_thread_ranks;
 use qdem_core::{
-    Decomposition, Model, Scheme, State, StepEvents, StepRequest, StepSettings, Vec3, World,
+    Gather, Model, RankFigures, Scheme, State, StepEvents, StepRequest, StepSettings, Vec3, World,
 };
 
 /// An event every time the tip's vertical velocity crosses a multiple of [`BAND`]: a
@@ -109,7 +109,7 @@ fn ranks(
     size: usize,
     newmark: bool,
     gather_every: Option<usize>,
-) -> (Vec<State>, Decomposition, Vec<bool>) {
+) -> (Vec<State>, RankFigures, Vec<bool>) {
     let runs = on_thread_ranks(size, move |comm| {
         let mut world = beam_world(newmark);
         let figures = world.decompose(comm).unwrap();
@@ -172,6 +172,57 @@ fn a_probe_gather_gives_every_rank_the_probed_particles_of_one_process() {
     assert!(
         !states.iter().all(whole),
         "only the probed particles were gathered"
+    );
+}
+
+/// After 150 steps over three ranks, each rank's answer to [`World::agree_on_stop`] when
+/// only rank 2 is asked to stop (`stop`) and only rank 1 reads the probes, with its state.
+fn agreements(stop: bool) -> Vec<(bool, State)> {
+    on_thread_ranks(3, move |comm| {
+        let mut world = beam_world(false);
+        world.decompose(comm).unwrap();
+        world.initialize().unwrap();
+        for _ in 0..150 {
+            world.step().unwrap();
+        }
+        let asked = stop && world.rank() == 2;
+        let wanted = match world.rank() {
+            1 => Gather::Particles,
+            _ => Gather::Nothing,
+        };
+        let stops = world.agree_on_stop(asked, wanted, &PROBED);
+        (stops, world.state)
+    })
+}
+
+/// A stop asked for on one rank stops every rank, each holding the whole state of one
+/// process (the checkpoint rank 0 writes at a stop reads it), whatever the others read.
+#[test]
+fn a_stop_asked_on_one_rank_stops_every_rank_with_the_whole_state() {
+    let (reference, _) = one_process_for(false, 150);
+    let runs = agreements(true);
+    assert!(runs.iter().all(|(stops, _)| *stops), "every rank stops");
+    let states: Vec<State> = runs.into_iter().map(|(_, s)| s).collect();
+    assert_all_equal(&states, &reference);
+}
+
+/// Without a stop the ranks gather the most any of them reads: the probes' particles that
+/// rank 1 reads, on every rank, and not the whole state.
+#[test]
+fn the_ranks_agree_to_gather_what_any_rank_reads() {
+    let (reference, _) = one_process_for(false, 150);
+    let runs = agreements(false);
+    assert!(runs.iter().all(|(stops, _)| !*stops), "no rank stops");
+    for (rank, (_, state)) in runs.iter().enumerate() {
+        for p in PROBED {
+            let bits = |s: &State| [s.position[p], s.velocity[p]].map(|v| v.map(f64::to_bits));
+            assert_eq!(bits(state), bits(&reference), "rank {rank}, particle {p}");
+        }
+    }
+    let whole = |s: &State| common::motion_bits(s) == common::motion_bits(&reference);
+    assert!(
+        !runs.iter().all(|(_, s)| whole(s)),
+        "only the probes were gathered"
     );
 }
 

@@ -1,6 +1,6 @@
 //! One rank's part of a [`DemContacts`] in a run decomposed with a halo exchange
-//! ([`qdem_core::parallel`]), bit-identical to one process: its [`SplitModel`] facet, whose
-//! stages the world's [`qdem_core::Exchange`] runs with the collectives in between.
+//! ([`qdem_core::parallel`]), bit-identical to one process: its facets ([`Facets`]), whose
+//! stages the world's [`qdem_core::ParallelRuntime`] runs with the collectives in between.
 //!
 //! A sphere belongs to the rank that owns its particle (the mesh's decomposition for a
 //! deformable body's vertices, runs of particle order for one-sphere grains, a rigid body
@@ -12,15 +12,17 @@
 //!
 //! What a rank reads of the other ranks' spheres, the **ghosts** (the partners of its
 //! candidates that it does not own), their owners send at each evaluation: the centre,
-//! velocity and spin ([`SplitModel::pack`]). At a rebuild of the lists, which the ranks
+//! velocity and spin ([`Halo::pack`]). At a rebuild of the lists, which the ranks
 //! decide on the largest displacement among all spheres, every rank receives every sphere's
 //! record, finds the pairs near its own spheres, and declares its new ghosts. Owners do not
 //! change between re-partitions, so the tangential springs of a rank's pairs are always on
 //! that rank. Before an output or a checkpoint reads the contacts, the ranks' lists are
-//! merged into the one list a single process holds ([`SplitModel::merge`]).
+//! merged into the one list a single process holds ([`Merge::merge`]).
 
 use super::*;
-use qdem_core::{Part, SplitModel};
+use qdem_core::parallel::{
+    Balance, Evaluation, Facets, Halo, Lists, Merge, Ownership, Part, Reduction,
+};
 
 /// Values per sphere record: centre, velocity, spin.
 const SPHERE_VALUES: usize = 9;
@@ -341,7 +343,7 @@ impl DemContacts {
     }
 }
 
-impl SplitModel for DemContacts {
+impl Ownership for DemContacts {
     /// The particles of every sphere (those of deformable bodies already have owners).
     fn free_particles(&self) -> Vec<usize> {
         self.sphere_particles()
@@ -350,7 +352,35 @@ impl SplitModel for DemContacts {
     fn split(&mut self, part: Option<Part>) {
         self.set_part(part);
     }
+}
 
+impl Facets for DemContacts {
+    fn evaluation(&mut self) -> Option<&mut dyn Evaluation> {
+        Some(self)
+    }
+
+    fn lists(&mut self) -> Option<&mut dyn Lists> {
+        Some(self)
+    }
+
+    fn halo(&mut self) -> Option<&mut dyn Halo> {
+        Some(self)
+    }
+
+    fn reduction(&mut self) -> Option<&mut dyn Reduction> {
+        Some(self)
+    }
+
+    fn merge(&mut self) -> Option<&mut dyn Merge> {
+        Some(self)
+    }
+
+    fn balance(&mut self) -> Option<&mut dyn Balance> {
+        Some(self)
+    }
+}
+
+impl Halo for DemContacts {
     /// The contact spheres.
     fn items(&self) -> Vec<usize> {
         self.sphere_particles()
@@ -369,9 +399,19 @@ impl SplitModel for DemContacts {
         self.unpack_spheres(items, values);
     }
 
+    fn new_ghosts(&mut self) -> Option<Vec<u32>> {
+        self.new_ghosts_stage()
+    }
+
+    fn read_partners(&mut self, state: &State) {
+        self.read_partners_stage(state);
+    }
+}
+
+impl Lists for DemContacts {
     /// Stage 1 (`stages.rs`).
-    fn read_own(&mut self, state: &State) -> Option<f64> {
-        Some(self.read_own_stage(state))
+    fn moved(&mut self, state: &State) -> f64 {
+        self.read_own_stage(state)
     }
 
     fn needs_rebuild(&self, moved: f64, time: f64) -> bool {
@@ -381,33 +421,31 @@ impl SplitModel for DemContacts {
     fn rebuild(&mut self, time: f64) {
         self.rebuild_stage(time);
     }
+}
 
-    fn new_ghosts(&mut self) -> Option<Vec<u32>> {
-        self.new_ghosts_stage()
-    }
-
-    fn read_partners(&mut self, state: &State) {
-        self.read_partners_stage(state);
-    }
-
+impl Evaluation for DemContacts {
     fn compute(&mut self, state: &State) {
         self.compute_stage(state.time);
-    }
-
-    /// A time-delayed boundary's pairs and the servo walls' contacts (`stages.rs`).
-    fn reduction(&mut self, out: &mut Vec<f64>) -> bool {
-        self.reduction_stage(out)
-    }
-
-    fn reduced(&mut self, time: f64, all: &[f64]) {
-        self.reduced_stage(time, all);
     }
 
     /// Each own partner's sum, in the single process's order, added to its particle.
     fn apply(&mut self, force: &mut [Vec3], torque: &mut [Vec3]) {
         self.apply_stage(force, torque);
     }
+}
 
+impl Reduction for DemContacts {
+    /// A time-delayed boundary's pairs and the servo walls' contacts (`stages.rs`).
+    fn mine(&mut self, out: &mut Vec<f64>) -> bool {
+        self.reduction_stage(out)
+    }
+
+    fn reduced(&mut self, time: f64, all: &[f64]) {
+        self.reduced_stage(time, all);
+    }
+}
+
+impl Merge for DemContacts {
     fn records(&self, out: &mut Vec<f64>) -> bool {
         self.rank_records(out)
     }
@@ -415,7 +453,9 @@ impl SplitModel for DemContacts {
     fn merge(&mut self, all: &[f64]) {
         self.merge_records(all);
     }
+}
 
+impl Balance for DemContacts {
     fn rebuilt(&mut self) -> bool {
         self.take_rebuilt()
     }

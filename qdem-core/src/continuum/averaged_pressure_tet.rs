@@ -273,7 +273,7 @@ impl AveragedPressure {
 
     /// Adds each particle's tetrahedron forces of the last [`AveragedPressure::compute`] to
     /// `force`, its tetrahedra in ascending order.
-    pub(crate) fn gather(&self, force: &mut [Vec3]) {
+    pub(crate) fn add_particle_sums(&self, force: &mut [Vec3]) {
         let count = self.corner_start.len() - 1;
         let (starts, corners, forces) = (&self.corner_start, &self.corners, &self.forces);
         force[self.first..self.first + count]

@@ -3,7 +3,7 @@
 //! Each step computes the Kelvin–Voigt stress and the four particle forces of every
 //! tetrahedron (paper 000 Eqs. 1–10, see [`crate::continuum::tet_kernel`]) block by block: the blocks of
 //! [`crate::continuum::tet_blocks`] run in parallel, each against a cached copy of its nodes' positions,
-//! summing its forces per node; a per-particle gather then adds each particle's block sums in
+//! summing its forces per node; a per-particle sum then adds each particle's block sums in
 //! ascending block order (Eq. 11). Blocks are fixed by the mesh, so every particle sums its
 //! contributions in the same order for any number of threads: results are bit-identical (no
 //! atomics, no reduction-order dependence).
@@ -26,7 +26,7 @@ use crate::continuum::tet_kernel::{
 use crate::continuum::tet_lanes::{block_forces, BlockInput, LaneSet};
 use crate::error::CoreError;
 use crate::parallel::decomposition::{BodyLayout, BodySplit};
-use crate::parallel::split::{Part, PartialSums, Reads, SplitModel};
+use crate::parallel::split::{Evaluation, Facets, Ownership, Part, PartialSums, Reads};
 use crate::step::model::{Deformable, Linearized, Model, Persistence};
 use crate::step::state::State;
 use crate::step::tangent::Tangent;
@@ -36,8 +36,13 @@ use std::sync::Mutex;
 
 /// Tetrahedra per parallel task in the per-element fields.
 const TET_CHUNK: usize = 512;
-/// Particles per parallel task in the gather.
+/// Particles per parallel task in the per-particle sums.
 const PARTICLE_CHUNK: usize = 1024;
+
+/// Cost of a viscous tetrahedron relative to an elastic one, for the decomposition's cut of
+/// the blocks: the viscous path costs about 1.6 times the elastic one (docs/BENCHMARKS.md,
+/// kernel section).
+const VISCOUS_COST: f64 = 1.6;
 
 /// A deformable body of linear QDEM tetrahedra.
 ///
@@ -71,7 +76,7 @@ pub struct TetBody {
     volume: Vec<f64>,
     blocks: TetBlocks,
     /// Per block node, the sum of its block's tetrahedron forces (laid out like the blocks'
-    /// node lists), written by the block pass and read by the gather.
+    /// node lists), written by the block pass and read by the per-particle sums.
     sums: Vec<Vec3>,
     scratch: ScratchPool,
     omega_squared: f64,
@@ -184,13 +189,6 @@ impl TetBody {
         }
     }
 
-    /// The model as a deformable body, if it is one (models are `Any`). Crate-private: other
-    /// code reads a body through its [`Deformable`] facet ([`Model::deformable`]).
-    pub(crate) fn of(model: &dyn Model) -> Option<&TetBody> {
-        let any: &dyn std::any::Any = model;
-        any.downcast_ref::<TetBody>()
-    }
-
     /// The body's tetrahedra (indices into the scene's particles).
     pub fn tets(&self) -> &[[u32; 4]] {
         &self.tets
@@ -201,23 +199,15 @@ impl TetBody {
         self.blocks.layout()
     }
 
-    /// Whether the material has no viscosity (the kernel's cheaper path).
-    pub(crate) fn is_elastic(&self) -> bool {
-        self.material.is_elastic()
-    }
-
-    /// The number of tetrahedra of each block, in block order.
-    pub(crate) fn block_tets(&self) -> impl Iterator<Item = usize> + '_ {
-        self.blocks
-            .tet_start
-            .windows(2)
-            .map(|w| (w[1] - w[0]) as usize)
-    }
-
     /// What a decomposition reads of the blocks.
-    pub(crate) fn body_layout(&self) -> BodyLayout<'_> {
+    fn body_layout(&self) -> BodyLayout<'_> {
         let b = &self.blocks;
         BodyLayout {
+            tet_cost: match self.material.is_elastic() {
+                true => 1.0,
+                false => VISCOUS_COST,
+            },
+            tet_start: &b.tet_start,
             node_start: &b.node_start,
             nodes: &b.nodes,
             first: b.first,
@@ -396,9 +386,9 @@ impl TetBody {
 
     /// Stage 2: per-particle sums of its block entries, in ascending block order (Eq. 11);
     /// in a decomposed run, of the particles this process owns only.
-    fn gather(&self, force: &mut [Vec3]) {
+    fn add_particle_sums(&self, force: &mut [Vec3]) {
         if let Some(averaged) = &self.averaged {
-            return averaged.gather(force);
+            return averaged.add_particle_sums(force);
         }
         let blocks = &self.blocks;
         let count = blocks.entry_start.len() - 1;
@@ -575,7 +565,7 @@ impl Model for TetBody {
 
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
         self.compute(state);
-        self.gather(force);
+        self.add_particle_sums(force);
     }
 
     fn deformable(&self) -> Option<&dyn Deformable> {
@@ -614,11 +604,31 @@ impl Model for TetBody {
 /// In a decomposed run a rank computes the blocks the decomposition gives it
 /// ([`crate::parallel::decomposition`]) and sums the particles it owns; the block sums of a
 /// node another rank owns go to the owner in the exchange's reverse stage.
-impl SplitModel for TetBody {
+impl Ownership for TetBody {
     fn split(&mut self, part: Option<Part>) {
         self.split = part.and_then(|p| p.body);
     }
+}
 
+impl Facets for TetBody {
+    fn body(&self) -> Option<BodyLayout<'_>> {
+        Some(self.body_layout())
+    }
+
+    fn evaluation(&mut self) -> Option<&mut dyn Evaluation> {
+        Some(self)
+    }
+
+    fn reverse_sums(&mut self) -> Option<PartialSums<'_>> {
+        let plan = self.split.as_mut().and_then(|s| s.exchange.as_mut())?;
+        Some(PartialSums {
+            sums: &mut self.sums,
+            plan,
+        })
+    }
+}
+
+impl Evaluation for TetBody {
     /// Stage 1 of Eqs. 9–11: the block sums of this rank's blocks.
     fn compute(&mut self, state: &State) {
         if let Some(averaged) = &mut self.averaged {
@@ -630,16 +640,8 @@ impl SplitModel for TetBody {
         }
     }
 
-    fn partial_sums(&mut self) -> Option<PartialSums<'_>> {
-        let plan = self.split.as_mut().and_then(|s| s.exchange.as_mut())?;
-        Some(PartialSums {
-            sums: &mut self.sums,
-            plan,
-        })
-    }
-
     fn apply(&mut self, force: &mut [Vec3], _torque: &mut [Vec3]) {
-        self.gather(force);
+        self.add_particle_sums(force);
     }
 }
 

@@ -1,5 +1,5 @@
 //! [`Communicator`]: the collectives of a run decomposed over ranks. Only the seam
-//! ([`crate::parallel`]) calls them: the [`crate::parallel::Exchange`] that a
+//! ([`crate::parallel`]) calls them: the [`crate::parallel::ParallelRuntime`] that a
 //! [`crate::World`] owns runs them around the models' force evaluations, in the same order
 //! on every rank; no model calls one.
 

@@ -5,7 +5,7 @@
 //! per rank of about equal cost; a body whose blocks all fall on one rank is computed there
 //! alone. A particle of a deformable body is **owned** by the rank of the block of its first
 //! entry; its **halo** ranks are the others whose blocks hold it. The particles that split
-//! models ([`crate::SplitModel`]: DEM contacts) move and no deformable body holds are given
+//! models ([`crate::parallel::Facets`]: DEM contacts) move and no deformable body holds are given
 //! out in runs of particle order, a rigid body whole to one rank, and given out again by
 //! their measured work at a re-partition ([`crate::World::repartition`]). Each step:
 //!
@@ -16,7 +16,7 @@
 //!    ranks), so that the owner adds **every** block sum of its particle in ascending block
 //!    order, exactly as one process does (Eq. 11);
 //! 3. a split model computes what touches the rank's particles, and the exchange
-//!    ([`crate::parallel::Exchange`]) brings it what it declares it reads of the others (the
+//!    ([`crate::parallel::ParallelRuntime`]) brings it what it declares it reads of the others (the
 //!    contacts' ghosts); the other models (loads, gravity) act on the
 //!    rank's particles from the time and the masses, or, when some model reads any particle,
 //!    every model is computed whole on every rank from the same state;
@@ -41,11 +41,10 @@
 //! of ranks and threads. (The one sum over ranks is the kinetic energy that the failure check
 //! watches in halo mode; see `state_share.rs`.)
 
-use crate::continuum::tet_body::TetBody;
 use crate::error::CoreError;
 use crate::parallel::communicator::Communicator;
 use crate::parallel::split::Reads;
-use crate::parallel::state_share::{Halo, StateShare};
+use crate::parallel::state_share::{StateHalo, StateShare};
 use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
 use crate::step::state::State;
@@ -53,10 +52,11 @@ use crate::Vec3;
 use std::ops::Range;
 use std::sync::Arc;
 
-/// How the deformable bodies' blocks fall on the ranks, the same on every rank: what
-/// [`crate::World::decompose`] returns (see the example of [`Communicator`]).
+/// The figures of a decomposition, per rank: how the deformable bodies' blocks and the
+/// particles fall on the ranks, the same on every rank; what [`crate::World::decompose`]
+/// returns (see the example of [`Communicator`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Decomposition {
+pub struct RankFigures {
     /// The number of ranks.
     pub ranks: usize,
     /// Per rank, the tetrahedra it computes.
@@ -77,15 +77,17 @@ pub struct Decomposition {
 /// and the partition, and per model its blocks for this rank if it is a deformable body.
 pub(crate) type Decomposed = (
     StateShare,
-    Decomposition,
+    RankFigures,
     Option<(LocalParticles, Partition)>,
     Vec<Option<BodySplit>>,
 );
 
 /// One deformable body's share of the decomposition, for one rank: which of its blocks the
-/// rank computes, which of its particles the rank owns, which block sums go where.
+/// rank computes, which of its particles the rank owns, which block sums go where. The
+/// decomposition makes it from the body's [`BodyLayout`] and hands it over in
+/// [`crate::Part::body`].
 #[derive(Clone, Debug)]
-pub(crate) struct BodySplit {
+pub struct BodySplit {
     /// The blocks this rank computes.
     pub mine: Range<usize>,
     /// This rank.
@@ -101,9 +103,10 @@ pub(crate) struct BodySplit {
 }
 
 /// The block sums a rank sends to and receives from the others each step (slots of the
-/// body's sums, grouped by rank, ascending within a rank: both sides list them alike).
+/// body's sums, grouped by rank, ascending within a rank: both sides list them alike). A
+/// body hands it back in its [`crate::PartialSums`]; the runtime runs it.
 #[derive(Clone)]
-pub(crate) struct SumExchange {
+pub struct SumExchange {
     send_slots: Vec<u32>,
     /// Values (three per sum) sent to each rank.
     send_counts: Vec<usize>,
@@ -128,8 +131,8 @@ impl std::fmt::Debug for SumExchange {
 impl SumExchange {
     /// Sends the sums this rank computed for other ranks' particles, and writes those the
     /// others computed for this rank's particles into `sums`: the reverse exchange of
-    /// [`crate::parallel::Exchange`].
-    pub fn run(&mut self, comm: &dyn Communicator, sums: &mut [Vec3]) {
+    /// [`crate::parallel::ParallelRuntime`].
+    pub(crate) fn run(&mut self, comm: &dyn Communicator, sums: &mut [Vec3]) {
         let start = std::time::Instant::now();
         self.send.clear();
         for &s in &self.send_slots {
@@ -209,9 +212,15 @@ pub(crate) fn split_body(
     }
 }
 
-/// What [`split_body`] reads of a body's blocks.
+/// What the decomposition reads of a deformable body's blocks, which the body declares
+/// ([`crate::parallel::Facets::body`]): block `b` holds the tetrahedra
+/// `tet_start[b]..tet_start[b + 1]` and the node slots `node_start[b]..node_start[b + 1]`.
 #[derive(Clone, Copy)]
-pub(crate) struct BodyLayout<'a> {
+pub struct BodyLayout<'a> {
+    /// What one tetrahedron of the body costs to compute, relative to an elastic one.
+    pub tet_cost: f64,
+    /// Block `b`'s tetrahedra are `tet_start[b]..tet_start[b + 1]`.
+    pub tet_start: &'a [u32],
     /// Block `b`'s slots are `node_start[b]..node_start[b + 1]`.
     pub node_start: &'a [u32],
     /// The particle of each slot.
@@ -233,28 +242,21 @@ fn slot_blocks(node_start: &[u32]) -> Vec<u32> {
     block
 }
 
-/// Cost of a block relative to an elastic tetrahedron: the viscous path costs about 1.6 times
-/// the elastic one (docs/BENCHMARKS.md, kernel section).
-const VISCOUS_COST: f64 = 1.6;
-
-/// Cuts the blocks of every deformable body of `models` (model order, then block order) into
-/// `ranks` contiguous ranges of about equal cost; per body, the rank of each block.
-fn assign_blocks(bodies: &[&TetBody], ranks: usize) -> Vec<Vec<u32>> {
-    let weight = |body: &TetBody| match body.is_elastic() {
-        true => 1.0,
-        false => VISCOUS_COST,
-    };
+/// Cuts the blocks of every deformable body (`bodies`: per body, the cost of one of its
+/// tetrahedra and the tetrahedra of each block; model order, then block order) into `ranks`
+/// contiguous ranges of about equal cost; per body, the rank of each block.
+fn assign_blocks(bodies: &[(f64, Vec<usize>)], ranks: usize) -> Vec<Vec<u32>> {
     let total: f64 = bodies
         .iter()
-        .map(|b| weight(b) * b.tets().len() as f64)
+        .map(|(w, blocks)| w * blocks.iter().sum::<usize>() as f64)
         .sum();
     let mut done = 0.0;
     bodies
         .iter()
-        .map(|body| {
-            let w = weight(body);
-            body.block_tets()
-                .map(|tets| {
+        .map(|(w, blocks)| {
+            blocks
+                .iter()
+                .map(|&tets| {
                     let cost = w * tets as f64;
                     let middle = done + 0.5 * cost;
                     done += cost;
@@ -262,6 +264,27 @@ fn assign_blocks(bodies: &[&TetBody], ranks: usize) -> Vec<Vec<u32>> {
                 })
                 .collect()
         })
+        .collect()
+}
+
+/// The blocks a deformable body declares ([`crate::parallel::Facets::body`]); `None` for
+/// the other models.
+fn body_of(model: &mut dyn Model) -> Option<BodyLayout<'_>> {
+    match model.reads() {
+        Reads::Split(facets) => {
+            let facets: &dyn crate::parallel::Facets = facets;
+            facets.body()
+        }
+        _ => None,
+    }
+}
+
+/// The tetrahedra of each of a body's blocks, in block order.
+fn block_tets(layout: &BodyLayout<'_>) -> Vec<usize> {
+    layout
+        .tet_start
+        .windows(2)
+        .map(|w| (w[1] - w[0]) as usize)
         .collect()
 }
 
@@ -277,13 +300,14 @@ pub(crate) fn decompose(
     halo_allowed: bool,
 ) -> Result<Decomposed, CoreError> {
     let ranks = comm.size();
-    let bodies: Vec<&TetBody> = models
-        .iter()
-        .filter_map(|m| TetBody::of(m.as_ref()))
+    let bodies: Vec<(f64, Vec<usize>)> = models
+        .iter_mut()
+        .filter_map(|m| body_of(m.as_mut()))
+        .map(|layout| (layout.tet_cost, block_tets(&layout)))
         .collect();
     let block_ranks = assign_blocks(&bodies, ranks);
     let halo = halo_allowed && models.iter_mut().all(|m| !matches!(m.reads(), Reads::All));
-    let mut figures = Decomposition {
+    let mut figures = RankFigures {
         ranks,
         tets: vec![0; ranks],
         owned: vec![0; ranks],
@@ -295,17 +319,17 @@ pub(crate) fn decompose(
     let mut needs = Vec::new();
     let mut block_ranks = block_ranks.into_iter();
     let mut splits = Vec::with_capacity(models.len());
-    for model in models.iter() {
-        let Some(body) = TetBody::of(model.as_ref()) else {
+    for model in models.iter_mut() {
+        let Some(layout) = body_of(model.as_mut()) else {
             splits.push(None);
             continue;
         };
         let block_rank = block_ranks.next().expect("one block assignment per body");
-        for (tets, &r) in body.block_tets().zip(&block_rank) {
+        for (tets, &r) in block_tets(&layout).into_iter().zip(&block_rank) {
             figures.tets[r as usize] += tets;
         }
         figures.cut_bodies += usize::from(block_rank.iter().any(|&r| r != block_rank[0]));
-        let split = split_body(body.body_layout(), &block_rank, &comm);
+        let split = split_body(layout, &block_rank, &comm);
         for (i, &r) in split.owner.iter().enumerate() {
             let p = split.first + i;
             if owner[p] != u32::MAX {
@@ -320,7 +344,7 @@ pub(crate) fn decompose(
             *total += n;
         }
         if halo {
-            needs.extend(halo_of(body.body_layout(), &block_rank, &split.owner));
+            needs.extend(halo_of(layout, &block_rank, &split.owner));
         }
         splits.push(Some(split));
     }
@@ -377,9 +401,9 @@ impl Partition {
     }
 }
 
-/// Gives owners to the particles that split models ([`crate::SplitModel`]) move and no
-/// deformable body holds (`owner` `u32::MAX`): runs of particle order of about equal `cost`
-/// (one per particle without it), a rigid body (its centre and members) whole to one rank.
+/// Gives owners to the particles that split models move and no deformable body holds
+/// ([`crate::parallel::Ownership::free_particles`], `owner` `u32::MAX`): runs of particle
+/// order of about equal `cost` (one per particle without it), a rigid body (its centre and members) whole to one rank.
 /// The builders place grains layer by layer, so a run is a slab of the packing (its ghosts
 /// are one layer at each cut) and a rank streams contiguous memory when it steps its
 /// grains; counts them in `owned`.
@@ -468,7 +492,7 @@ fn halo_exchange(
     needs: &[(u32, u32)],
     me: u32,
     ranks: usize,
-) -> (Halo, LocalParticles) {
+) -> (StateHalo, LocalParticles) {
     let (mut send, mut recv) = (vec![Vec::new(); ranks], vec![Vec::new(); ranks]);
     let mut stepped: Vec<bool> = owner.iter().map(|&r| r == me || r == u32::MAX).collect();
     let computed = ParticleRuns::from_mask(&stepped);
@@ -485,7 +509,7 @@ fn halo_exchange(
         .iter()
         .map(|&r| r == me || (me == 0 && r == u32::MAX))
         .collect();
-    let halo = Halo {
+    let halo = StateHalo {
         send_counts: send.iter().map(Vec::len).collect(),
         send: send.concat(),
         recv_counts: recv.iter().map(Vec::len).collect(),

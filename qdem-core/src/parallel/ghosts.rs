@@ -1,5 +1,5 @@
 //! [`GhostTable`]: who sends which item records to whom, for a split model that exchanges
-//! records ([`crate::SplitModel::items`]: contact spheres), and the three exchanges that use
+//! records ([`crate::parallel::Halo::items`]: contact spheres), and the three exchanges that use
 //! it: the **borders** (every item's record to every rank, at a rebuild of the lists and a
 //! whole gather), the **ghost requests** (after a rebuild: each rank asks the owners for the
 //! items its lists read) and the **forward** exchange (at each evaluation, the ghosts'
@@ -8,7 +8,7 @@
 //! A record is copied, never summed, so every rank reads the owner's bits.
 
 use crate::parallel::communicator::Communicator;
-use crate::parallel::split::SplitModel;
+use crate::parallel::split::Halo;
 
 /// One split model's exchange of item records.
 pub(crate) struct GhostTable {
@@ -52,28 +52,28 @@ impl GhostTable {
         }
     }
 
-    /// Every item's record, from its owner, unpacked into `part`.
-    pub fn borders(&mut self, comm: &dyn Communicator, part: &mut dyn SplitModel) {
-        let per = part.record_values();
+    /// Every item's record, from its owner, unpacked into `halo`.
+    pub fn borders(&mut self, comm: &dyn Communicator, halo: &mut dyn Halo) {
+        let per = halo.record_values();
         self.mine.clear();
         let own = self.own_start..self.own_start + self.by_rank_counts[comm.rank()];
-        part.pack(&self.by_rank[own], &mut self.mine);
+        halo.pack(&self.by_rank[own], &mut self.mine);
         let counts: Vec<usize> = self.by_rank_counts.iter().map(|n| per * n).collect();
         self.all.resize(per * self.by_rank.len(), 0.0);
         comm.all_gather(&self.mine, &mut self.all, &counts);
-        part.unpack(&self.by_rank, &self.all);
+        halo.unpack(&self.by_rank, &self.all);
     }
 
-    /// The ghosts' records, from their owners, unpacked into `part`.
-    pub fn forward(&mut self, comm: &dyn Communicator, part: &mut dyn SplitModel) {
-        let per = part.record_values();
+    /// The ghosts' records, from their owners, unpacked into `halo`.
+    pub fn forward(&mut self, comm: &dyn Communicator, halo: &mut dyn Halo) {
+        let per = halo.record_values();
         self.mine.clear();
-        part.pack(&self.send, &mut self.mine);
+        halo.pack(&self.send, &mut self.mine);
         let counts = |c: &[usize]| c.iter().map(|n| per * n).collect::<Vec<_>>();
         let (send_counts, recv_counts) = (counts(&self.send_counts), counts(&self.recv_counts));
         self.all.resize(per * self.recv.len(), 0.0);
         comm.all_to_all(&self.mine, &send_counts, &mut self.all, &recv_counts);
-        part.unpack(&self.recv, &self.all);
+        halo.unpack(&self.recv, &self.all);
     }
 
     /// Makes `ghosts` (ascending) the items this rank receives at each evaluation, and

@@ -1,31 +1,34 @@
 //! The decomposition of a run over ranks (MPI processes, or threads in tests), behind one
-//! seam: a [`crate::World`] owns an [`Exchange`] (single-process by default, decomposed after
-//! [`crate::World::decompose`]) and every collective of a step runs there, around the
-//! stepper's force evaluations and integrations, never inside a model.
+//! seam: a [`crate::World`] owns a [`ParallelRuntime`] (single-process by default,
+//! decomposed after [`crate::World::decompose`]) and every collective of a step runs there,
+//! around the stepper's force evaluations and integrations, never inside a model.
 //!
 //! - [`Communicator`]: the collectives a decomposed run needs (MPI in `qdem`, threads in
 //!   tests: `thread_ranks`, with the `thread-ranks` feature);
 //! - [`decomposition`]: who owns what (the deformable bodies' blocks, the free particles'
-//!   runs) and the figures of it ([`Decomposition`]);
-//! - [`Exchange`]: what a step exchanges (the models' forces through their split facets,
+//!   runs) and the figures of it per rank ([`RankFigures`]);
+//! - [`ParallelRuntime`]: what a step exchanges (the models' forces through their facets,
 //!   the state after each integration, the gathers, the failure agreement, the hooks'
 //!   decisions, the re-partitions), with the state share (`state_share.rs`), the particles a
-//!   rank steps ([`crate::step::local_particles::ParticleRuns`]) and the contacts' ghost
-//!   records (`ghosts.rs`); it is the steppers' [`crate::step::seam::Seam`] of a decomposed
-//!   run (`exchange_seam.rs`);
-//! - [`Reads`] and [`SplitModel`] ([`split`]): what a model declares of a decomposed run.
+//!   rank steps ([`ParticleRuns`]) and the contacts' ghost records (`ghosts.rs`); it is the
+//!   steppers' [`crate::step::seam::Seam`] of a decomposed run (`runtime_seam.rs`);
+//! - [`Reads`] and the [`Facets`] of a split model ([`split`]): what a model declares of a
+//!   decomposed run.
 
 pub mod communicator;
 pub mod decomposition;
-mod exchange;
-mod exchange_seam;
 mod ghosts;
+mod runtime;
+mod runtime_seam;
 pub mod split;
 mod state_share;
 #[cfg(feature = "thread-ranks")]
 pub mod thread_ranks;
 
 pub use communicator::Communicator;
-pub use decomposition::Decomposition;
-pub use exchange::Exchange;
-pub use split::{Part, PartialSums, Reads, SplitModel};
+pub use decomposition::{BodyLayout, BodySplit, RankFigures, SumExchange};
+pub use runtime::ParallelRuntime;
+pub use split::{
+    Balance, Decisions, Evaluation, Facets, Halo, Lists, Merge, Ownership, Part, PartialSums,
+    Reads, Reduction,
+};

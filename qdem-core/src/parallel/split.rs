@@ -1,30 +1,93 @@
 //! What a model declares of a decomposed run: [`Reads`] (what it reads of the particles'
-//! motion) and, for a model that one rank computes in part, its [`SplitModel`] facet: the
-//! stages of its force evaluation and what it packs for the others, which the
-//! [`crate::parallel::Exchange`] runs with its collectives in between. A model never calls
-//! a collective; the way LAMMPS's pair styles give `pack_forward_comm` and
+//! motion) and, for a model (or hook) that one rank computes in part, its [`Facets`]: small
+//! traits with one job each, which the [`crate::parallel::ParallelRuntime`] runs with its
+//! collectives in between. A model implements only the facets it uses and never calls a
+//! collective; the way LAMMPS's pair styles give `pack_forward_comm` and
 //! `unpack_forward_comm` to its `Comm`.
 //!
-//! One force evaluation of a split model, as the exchange runs it on every rank:
+//! - [`Ownership`]: the model's part ([`Part`]) and the particles it moves that no
+//!   deformable body holds;
+//! - [`Facets::body`]: a deformable body's blocks, which the decomposition cuts between
+//!   the ranks ([`BodyLayout`]);
+//! - [`Evaluation`]: its force evaluation in two stages, computing and adding;
+//! - [`Lists`]: neighbour lists and when they are rebuilt;
+//! - [`Halo`]: the item records it exchanges forward (contact spheres), and its ghosts;
+//! - [`Reduction`]: what the ranks reduce together within an evaluation;
+//! - [`Facets::reverse_sums`]: the sums it computed for other ranks' particles
+//!   ([`PartialSums`]);
+//! - [`Merge`]: its records, merged into the whole model a single process holds;
+//! - [`Balance`]: its work, by which the free particles are re-partitioned;
+//! - [`Decisions`]: a post-step hook's decisions for its own particles, and its acts on
+//!   every rank's.
 //!
-//! 1. [`SplitModel::read_own`]: the rank reads its own particles; a model that keeps
-//!    neighbour lists returns how far one has moved since they were built, and the exchange
-//!    takes the largest over the ranks (a max: exact);
-//! 2. [`SplitModel::needs_rebuild`] on that largest displacement: if so, every rank receives
-//!    every item's record (**borders**: [`SplitModel::pack`] and [`SplitModel::unpack`] of
-//!    each rank's own items) and [`SplitModel::rebuild`]s its lists;
-//! 3. [`SplitModel::new_ghosts`]: the items of other ranks that the rank's lists now read,
-//!    when they changed; the exchange learns who sends what to whom;
-//! 4. [`SplitModel::read_partners`], then the **forward** exchange: each rank packs the
-//!    items others read as ghosts, and unpacks its own ghosts;
-//! 5. [`SplitModel::compute`], then a **reduction** when the model asks for one
-//!    ([`SplitModel::reduction`], [`SplitModel::reduced`]: a time-delayed boundary's force,
+//! One force evaluation of a split model, as the runtime runs it on every rank:
+//!
+//! 1. [`Lists::moved`]: the rank reads its own particles and returns how far one has moved
+//!    since its lists were built, and the runtime takes the largest over the ranks (a max:
+//!    exact);
+//! 2. [`Lists::needs_rebuild`] on that largest displacement: if so, every rank receives
+//!    every item's record (**borders**: [`Halo::pack`] and [`Halo::unpack`] of each rank's
+//!    own items) and [`Lists::rebuild`]s its lists;
+//! 3. [`Halo::new_ghosts`]: the items of other ranks that the rank's lists now read, when
+//!    they changed; the runtime learns who sends what to whom;
+//! 4. [`Halo::read_partners`], then the **forward** exchange: each rank packs the items
+//!    others read as ghosts, and unpacks its own ghosts;
+//! 5. [`Evaluation::compute`], then a **reduction** when the model has one
+//!    ([`Reduction::mine`], [`Reduction::reduced`]: a time-delayed boundary's force,
 //!    measured over every rank's pairs);
-//! 6. the **reverse** exchange of [`SplitModel::partial_sums`] (a deformable body's block
-//!    sums for nodes another rank owns);
-//! 7. [`SplitModel::apply`]: the rank adds its own particles' forces.
+//! 6. the **reverse** exchange of [`Facets::reverse_sums`] (a deformable body's block sums
+//!    for nodes another rank owns);
+//! 7. [`Evaluation::apply`]: the rank adds its own particles' forces.
+//!
+//! A post-step hook that decides for its own particles ([`crate::PostStep::reads`]) has
+//! [`Ownership`] and [`Decisions`] only:
+//!
+//! ```
+//! use qdem_core::parallel::split::{Decisions, Facets, Ownership};
+//! use qdem_core::{Halt, Model, Part, PostStep, Reads, State};
+//!
+//! /// Pins particle 0 back to x = 0 after every step; the rank that owns it decides.
+//! struct Pin {
+//!     part: Option<Part>,
+//! }
+//!
+//! impl PostStep for Pin {
+//!     fn name(&self) -> &str { "pin" }
+//!     fn after_step(&mut self, state: &mut State, _: &[Box<dyn Model>]) -> Option<Halt> {
+//!         state.position[0].x = 0.0;
+//!         None
+//!     }
+//!     fn reads(&mut self) -> Reads<'_> { Reads::Split(self) }
+//! }
+//!
+//! impl Ownership for Pin {
+//!     fn split(&mut self, part: Option<Part>) { self.part = part; }
+//! }
+//!
+//! impl Facets for Pin {
+//!     fn decisions(&mut self) -> Option<&mut dyn Decisions> { Some(self) }
+//! }
+//!
+//! impl Decisions for Pin {
+//!     fn decide(&self, state: &State, out: &mut Vec<f64>) {
+//!         let owns = self.part.as_ref().is_some_and(|p| p.owner[0] == p.rank);
+//!         if owns && state.position[0].x != 0.0 {
+//!             out.push(0.0);
+//!         }
+//!     }
+//!     fn act(&mut self, state: &mut State, all: &[f64]) {
+//!         if !all.is_empty() {
+//!             state.position[0].x = 0.0;
+//!         }
+//!     }
+//! }
+//!
+//! let mut pin = Pin { part: None };
+//! let Reads::Split(facets) = pin.reads() else { unreachable!() };
+//! assert!(facets.decisions().is_some() && facets.evaluation().is_none());
+//! ```
 
-use crate::parallel::decomposition::{BodySplit, SumExchange};
+use crate::parallel::decomposition::{BodyLayout, BodySplit, SumExchange};
 use crate::step::state::State;
 use crate::Vec3;
 use std::sync::Arc;
@@ -47,168 +110,226 @@ pub enum Reads<'a> {
     /// Only what a rank steps itself: nothing of the motion for gravity and nodal loads
     /// (they read the time and the masses).
     Own,
-    /// Computed in part by each rank, through the model's split facet: it reads its own
+    /// Computed in part by each rank, through the model's facets: it reads its own
     /// particles and receives what it declares of the others (deformable bodies, contacts,
     /// the periodic wrap).
-    Split(&'a mut dyn SplitModel),
+    Split(&'a mut dyn Facets),
 }
 
-/// A model's part of a decomposed run, given to [`SplitModel::split`]: per particle, the
-/// rank that owns it (`u32::MAX`: computed by every rank), and this rank.
+/// A model's part of a decomposed run, given to [`Ownership::split`]: per particle, the
+/// rank that owns it (`u32::MAX`: computed by every rank), this rank, and for a deformable
+/// body ([`Facets::body`]) its share of the blocks.
+///
+/// ```
+/// use qdem_core::Part;
+/// use std::sync::Arc;
+///
+/// // Rank 1 of a run whose three particles are owned by ranks 0, 1 and every rank.
+/// let part = Part { owner: Arc::from([0, 1, u32::MAX]), rank: 1, body: None };
+/// let own: Vec<usize> = (0..3).filter(|&p| part.owner[p] == part.rank).collect();
+/// assert_eq!(own, [1]);
+/// ```
 #[derive(Clone)]
 pub struct Part {
-    /// Per particle, the rank that owns it (`u32::MAX`: computed by every rank).
+    /// Per particle, the rank that owns it (`u32::MAX`: computed by every rank); empty for
+    /// a deformable body, whose owners are its [`BodySplit::owner`].
     pub owner: Arc<[u32]>,
     /// This rank.
     pub rank: u32,
-    /// A deformable body's blocks for this rank (the decomposition's).
-    pub(crate) body: Option<BodySplit>,
+    /// A deformable body's blocks for this rank (the decomposition's of its
+    /// [`Facets::body`]); `None` for the other models.
+    pub body: Option<BodySplit>,
 }
 
 /// A deformable body's block sums for the nodes that other ranks own, which the reverse
-/// exchange sends to the owners ([`SplitModel::partial_sums`]).
+/// exchange sends to the owners ([`Facets::reverse_sums`]); a body builds it from its
+/// sums and the exchange of its [`BodySplit`].
+///
+/// ```
+/// use qdem_core::parallel::BodySplit;
+/// use qdem_core::{PartialSums, Vec3};
+///
+/// /// A body's sums per slot of its blocks, and its share of a decomposed run.
+/// struct Body {
+///     sums: Vec<Vec3>,
+///     split: Option<BodySplit>,
+/// }
+///
+/// impl Body {
+///     /// What the reverse exchange sends: only a body cut between ranks has an exchange.
+///     fn reverse_sums(&mut self) -> Option<PartialSums<'_>> {
+///         let plan = self.split.as_mut()?.exchange.as_mut()?;
+///         Some(PartialSums { sums: &mut self.sums, plan })
+///     }
+/// }
+///
+/// let mut whole = Body { sums: vec![Vec3::zeros(); 4], split: None };
+/// assert!(whole.reverse_sums().is_none());
+/// ```
 pub struct PartialSums<'a> {
-    /// The body's block sums (a slot per node of a block).
-    pub(crate) sums: &'a mut [Vec3],
+    /// The body's block sums (a slot per node of a block, laid out as its
+    /// [`BodyLayout::nodes`]).
+    pub sums: &'a mut [Vec3],
     /// Which slots go to and come from which rank.
-    pub(crate) plan: &'a mut SumExchange,
+    pub plan: &'a mut SumExchange,
 }
 
-/// The facet of a model that one rank of a decomposed run computes in part (see the module
-/// documentation for the order in which the exchange calls it). Every method but
-/// [`SplitModel::split`] has a default that does nothing, so a model declares only what it
-/// exchanges.
-pub trait SplitModel {
+/// Who owns what of a split model: the facet every split model (and split hook) has.
+pub trait Ownership {
+    /// From now on, computes the forces on the particles `part.owner[p] == part.rank` only
+    /// (a deformable body: on the particles its [`BodySplit`] gives this rank), each as one
+    /// process sums it; `None`: whole again, on a state every rank holds whole.
+    fn split(&mut self, part: Option<Part>);
+
     /// The particles the model moves that no deformable body holds (one-sphere grains, rigid
     /// bodies): the decomposition gives them owners in runs of particle order, a rigid body
-    /// whole to one rank.
+    /// whole to one rank. The default: none.
     fn free_particles(&self) -> Vec<usize> {
         Vec::new()
     }
+}
 
-    /// From now on, computes the forces on the particles `part.owner[p] == part.rank` only,
-    /// each as one process sums it; `None`: whole again, on a state every rank holds whole.
-    fn split(&mut self, part: Option<Part>);
-
-    /// The particle of each item whose record the ranks exchange (contact spheres); empty
-    /// (the default) for a model that exchanges none.
-    fn items(&self) -> Vec<usize> {
-        Vec::new()
-    }
-
-    /// Values per item record in [`SplitModel::pack`].
-    fn record_values(&self) -> usize {
-        0
-    }
-
-    /// Appends the records of `items` (this rank's own) to `out`.
-    fn pack(&self, items: &[u32], out: &mut Vec<f64>) {
-        let _ = (items, out);
-    }
-
-    /// Sets the records of `items` from what [`SplitModel::pack`] wrote on their owners.
-    fn unpack(&mut self, items: &[u32], values: &[f64]) {
-        let _ = (items, values);
-    }
-
-    /// Stage 1: reads this rank's own particles at `state`; returns, for a model that keeps
-    /// neighbour lists, the largest distance one of its own items has moved since they were
-    /// built (infinite before); `None` (the default) for a model without lists.
-    fn read_own(&mut self, state: &State) -> Option<f64> {
-        let _ = state;
+/// The facets of a model that one rank of a decomposed run computes in part: its
+/// [`Ownership`], and each facet it has (`None`, the default, for those it has not). See
+/// the module documentation for the order in which the runtime uses them.
+pub trait Facets: Ownership {
+    /// A deformable body's blocks, which the decomposition cuts between the ranks.
+    fn body(&self) -> Option<BodyLayout<'_>> {
         None
     }
 
-    /// Stage 2: whether the lists must be rebuilt, given the largest displacement over every
-    /// rank (the same answer on every rank).
-    fn needs_rebuild(&self, moved: f64, time: f64) -> bool {
-        let _ = (moved, time);
-        false
-    }
-
-    /// Stage 2: rebuilds the lists near this rank's items, once every item's record is known.
-    fn rebuild(&mut self, time: f64) {
-        let _ = time;
-    }
-
-    /// Stage 3: the items of other ranks that this rank's lists read (ascending), when they
-    /// changed since the last call; `None` when unchanged.
-    fn new_ghosts(&mut self) -> Option<Vec<u32>> {
+    /// The stages of a model's force evaluation (every split model has them; a hook not).
+    fn evaluation(&mut self) -> Option<&mut dyn Evaluation> {
         None
     }
 
-    /// Stage 4: reads the motion of the own items that the lists read, before the forward
-    /// exchange sends them.
-    fn read_partners(&mut self, state: &State) {
-        let _ = state;
+    /// Neighbour lists, rebuilt when the ranks agree they must be.
+    fn lists(&mut self) -> Option<&mut dyn Lists> {
+        None
     }
 
-    /// Stage 5: computes this rank's part from the state and the ghosts' records.
+    /// Item records exchanged forward: every rank's own at a rebuild, the ghosts' at each
+    /// evaluation.
+    fn halo(&mut self) -> Option<&mut dyn Halo> {
+        None
+    }
+
+    /// What the ranks reduce together within an evaluation.
+    fn reduction(&mut self) -> Option<&mut dyn Reduction> {
+        None
+    }
+
+    /// The sums this rank computed for particles other ranks own (a deformable body cut
+    /// between ranks).
+    fn reverse_sums(&mut self) -> Option<PartialSums<'_>> {
+        None
+    }
+
+    /// Records that a whole gather merges into the model one process holds.
+    fn merge(&mut self) -> Option<&mut dyn Merge> {
+        None
+    }
+
+    /// The work that a re-partition balances.
+    fn balance(&mut self) -> Option<&mut dyn Balance> {
+        None
+    }
+
+    /// A post-step hook's decisions for its own particles.
+    fn decisions(&mut self) -> Option<&mut dyn Decisions> {
+        None
+    }
+}
+
+/// A split model's force evaluation: stages 5 and 7 of the module documentation.
+pub trait Evaluation {
+    /// Computes this rank's part from the state and the ghosts' records.
     fn compute(&mut self, state: &State);
 
-    /// Stage 5: appends what the ranks must reduce together (a time-delayed boundary's
-    /// contact forces) to `out` and returns true; false (the default) for none.
-    fn reduction(&mut self, out: &mut Vec<f64>) -> bool {
-        let _ = out;
-        false
-    }
-
-    /// Stage 5: every rank's [`SplitModel::reduction`], in rank order.
-    fn reduced(&mut self, time: f64, all: &[f64]) {
-        let _ = (time, all);
-    }
-
-    /// Stage 6: the sums this rank computed for particles other ranks own; `None` (the
-    /// default) for a model without.
-    fn partial_sums(&mut self) -> Option<PartialSums<'_>> {
-        None
-    }
-
-    /// Stage 7: adds the forces (and moments) on this rank's own particles.
+    /// Adds the forces (and moments) on this rank's own particles.
     fn apply(&mut self, force: &mut [Vec3], torque: &mut [Vec3]);
+}
 
-    /// What a whole gather merges: appends this rank's records (contacts) to `out` and
-    /// returns true; false (the default) when the model is whole already (the same answer on
-    /// every rank).
-    fn records(&self, out: &mut Vec<f64>) -> bool {
-        let _ = out;
-        false
-    }
+/// A split model's neighbour lists: stages 1 and 2.
+pub trait Lists {
+    /// Reads this rank's own particles at `state`; returns the largest distance one of its
+    /// own items has moved since the lists were built (infinite before).
+    fn moved(&mut self, state: &State) -> f64;
+
+    /// Whether the lists must be rebuilt, given the largest displacement over every rank
+    /// (the same answer on every rank).
+    fn needs_rebuild(&self, moved: f64, time: f64) -> bool;
+
+    /// Rebuilds the lists near this rank's items, once every item's record is known.
+    fn rebuild(&mut self, time: f64);
+}
+
+/// A split model's item records, exchanged forward from their owners: stages 2 to 4.
+pub trait Halo {
+    /// The particle of each item whose record the ranks exchange (contact spheres).
+    fn items(&self) -> Vec<usize>;
+
+    /// Values per item record in [`Halo::pack`].
+    fn record_values(&self) -> usize;
+
+    /// Appends the records of `items` (this rank's own) to `out`.
+    fn pack(&self, items: &[u32], out: &mut Vec<f64>);
+
+    /// Sets the records of `items` from what [`Halo::pack`] wrote on their owners.
+    fn unpack(&mut self, items: &[u32], values: &[f64]);
+
+    /// The items of other ranks that this rank's lists read (ascending), when they changed
+    /// since the last call; `None` when unchanged.
+    fn new_ghosts(&mut self) -> Option<Vec<u32>>;
+
+    /// Reads the motion of the own items that the lists read, before the forward exchange
+    /// sends them.
+    fn read_partners(&mut self, state: &State);
+}
+
+/// What the ranks of a decomposed run reduce together within an evaluation (a time-delayed
+/// boundary's contact forces): stage 5.
+pub trait Reduction {
+    /// Appends this rank's share to `out` and returns true; false when there is nothing to
+    /// reduce (the same answer on every rank).
+    fn mine(&mut self, out: &mut Vec<f64>) -> bool;
+
+    /// Every rank's [`Reduction::mine`], in rank order.
+    fn reduced(&mut self, time: f64, all: &[f64]);
+}
+
+/// The records a whole gather ([`crate::World::gather`]) merges.
+pub trait Merge {
+    /// Appends this rank's records (contacts) to `out` and returns true; false when the
+    /// model is whole already (the same answer on every rank).
+    fn records(&self, out: &mut Vec<f64>) -> bool;
 
     /// Makes the model whole, as one process holds it after its last evaluation, from every
-    /// rank's [`SplitModel::records`] (`all`, in rank order) and every item's record.
-    fn merge(&mut self, all: &[f64]) {
-        let _ = all;
-    }
+    /// rank's [`Merge::records`] (`all`, in rank order) and every item's record.
+    fn merge(&mut self, all: &[f64]);
+}
 
-    /// After a step, for a post-step hook: appends what this rank decided (the groups whose
-    /// anchor it owns that wrap) to `out`.
-    fn decide(&self, state: &State, out: &mut Vec<f64>) {
-        let _ = (state, out);
-    }
-
-    /// After a step, for a post-step hook: acts on every rank's decisions (`all`, in rank
-    /// order).
-    fn act(&mut self, state: &mut State, all: &[f64]) {
-        let _ = (state, all);
-    }
-
+/// A split model's work, which a re-partition ([`crate::World::repartition`]) balances.
+pub trait Balance {
     /// Whether the model has rebuilt what decides its work (DEM contacts: their candidate
     /// lists) since the last call, the same on every rank: a decomposed world may then
-    /// re-partition ([`crate::World::repartition`]). The default: never.
-    fn rebuilt(&mut self) -> bool {
-        false
-    }
+    /// re-partition.
+    fn rebuilt(&mut self) -> bool;
 
     /// This rank's work in the model at its last evaluation, in units of one particle's
-    /// step (DEM contacts: three per candidate contact). The default: none.
-    fn work(&self) -> f64 {
-        0.0
-    }
+    /// step (DEM contacts: three per candidate contact).
+    fn work(&self) -> f64;
 
     /// Adds each particle's share of the model's work to `cost` (one entry per particle),
-    /// from the whole records after a gather. The default adds nothing.
-    fn add_costs(&self, cost: &mut [f64]) {
-        let _ = cost;
-    }
+    /// from the whole records after a gather.
+    fn add_costs(&self, cost: &mut [f64]);
+}
+
+/// A post-step hook's decisions, which every rank acts on after a step.
+pub trait Decisions {
+    /// Appends what this rank decided (the groups whose anchor it owns that wrap) to `out`.
+    fn decide(&self, state: &State, out: &mut Vec<f64>);
+
+    /// Acts on every rank's decisions (`all`, in rank order).
+    fn act(&mut self, state: &mut State, all: &[f64]);
 }

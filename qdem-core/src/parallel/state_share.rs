@@ -24,7 +24,7 @@
 //! rank order, equal to one process's sum up to its rounding.
 
 use crate::parallel::communicator::Communicator;
-use crate::parallel::decomposition::Decomposition;
+use crate::parallel::decomposition::RankFigures;
 use crate::step::local_particles::ParticleRuns;
 use crate::step::state::State;
 use crate::Vec3;
@@ -46,14 +46,14 @@ pub(crate) struct StateShare {
     /// Whether the particles have rotational DOFs.
     spin: bool,
     /// The halo exchange, when a step shares only the halo.
-    halo: Option<Halo>,
+    halo: Option<StateHalo>,
     mine: Vec<f64>,
     all: Vec<f64>,
 }
 
 /// The particles a rank sends to and receives from each other rank after each step: grouped
 /// by rank, ascending within a rank, so that both sides list them alike.
-pub(crate) struct Halo {
+pub(crate) struct StateHalo {
     pub send: Vec<u32>,
     /// Particles sent to each rank.
     pub send_counts: Vec<usize>,
@@ -71,7 +71,7 @@ impl StateShare {
     pub fn new(
         owner: &[u32],
         state: &State,
-        halo: Option<Halo>,
+        halo: Option<StateHalo>,
         comm: Arc<dyn Communicator>,
     ) -> StateShare {
         let ranks = comm.size();
@@ -102,7 +102,7 @@ impl StateShare {
 
     /// Shares the whole state after every step from now on (a stepper that cannot step a
     /// rank's particles alone); `figures` learn what each rank then receives.
-    pub fn share_whole_every_step(&mut self, figures: &mut Decomposition) {
+    pub fn share_whole_every_step(&mut self, figures: &mut RankFigures) {
         self.halo = None;
         let total: usize = self.owned.iter().sum();
         for (received, owned) in figures.received.iter_mut().zip(&self.owned) {

@@ -111,7 +111,8 @@ impl ParticleRuns {
     }
 }
 
-/// What one rank of a decomposed run steps itself ([`crate::parallel::Exchange::stepped`]).
+/// What one rank of a decomposed run steps itself
+/// ([`crate::parallel::ParallelRuntime::stepped`]).
 ///
 /// ```
 /// use qdem_core::step::local_particles::{LocalParticles, ParticleRuns};

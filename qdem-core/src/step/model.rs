@@ -17,8 +17,9 @@
 //!   the modal analysis, the checks and a decomposed run read of it without its type;
 //! - [`Reads`] ([`Model::reads`]): what the model reads of the particles' motion in a run
 //!   decomposed over ranks, and for a model that one rank computes in part (deformable
-//!   bodies, DEM contacts) its [`crate::SplitModel`] facet: the stages of its force
-//!   evaluation and what it exchanges, which the world's [`crate::Exchange`] runs.
+//!   bodies, DEM contacts) its [`crate::parallel::Facets`]: the stages of its
+//!   force evaluation and what it exchanges, which the world's [`crate::ParallelRuntime`]
+//!   runs.
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;

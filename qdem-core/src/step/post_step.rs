@@ -17,8 +17,7 @@ pub trait PostStep: std::any::Any + Send + Sync {
 
     /// How the hook takes part in a decomposed run ([`Model::reads`]); the default,
     /// [`Reads::All`], is always right. A split hook decides for its own particles and acts
-    /// on every rank's decisions ([`crate::parallel::split::SplitModel::decide`],
-    /// [`crate::parallel::split::SplitModel::act`]).
+    /// on every rank's decisions ([`crate::parallel::Decisions`]).
     fn reads(&mut self) -> Reads<'_> {
         Reads::All
     }

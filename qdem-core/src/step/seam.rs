@@ -1,7 +1,7 @@
 //! [`Seam`]: where a stepper's force evaluations and integrations meet the rest of the run,
 //! so that a stepper is written once for one process and for many ranks without knowing
 //! which. A run of one process passes [`OneProcess`]; a decomposed run passes the parallel
-//! exchange ([`crate::parallel::Exchange`]), which evaluates the models that one rank
+//! runtime ([`crate::parallel::ParallelRuntime`]), which evaluates the models that one rank
 //! computes in part stage by stage with the ranks' exchanges in between, steps only a rank's
 //! particles when it can ([`Seam::stepped`], [`Seam::computed`]) and shares each
 //! integration's outcome ([`Seam::complete`]).

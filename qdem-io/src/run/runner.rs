@@ -16,6 +16,7 @@ use crate::run::load_cause::load_cause;
 use crate::run::record::schedule::{probe_interval, Schedule};
 use crate::run::record::{self, Recorder, RunFigures, StateRead, StepInfo};
 use crate::run::run_record::{decode_run, decode_world, encode_run, RunRecord};
+use qdem_core::world::Gather;
 use qdem_core::{CoreError, Halt, World};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -184,56 +185,21 @@ impl std::fmt::Debug for RunOptions<'_> {
     }
 }
 
-/// What the ranks of a run agree on after each step.
-#[derive(Clone, Copy, Debug)]
-struct Sync {
-    /// The run stops after this step (a stop was asked for on some rank).
-    stop: bool,
-    /// What every rank gathers first ([`qdem_core::World::gather`]): what rank 0 records,
-    /// checkpoints or keeps; the whole state at a stop.
-    read: StateRead,
-}
-
-impl Sync {
-    /// Gathers what the ranks agreed on; `probes`: the probes' particles.
-    fn gather(&self, sim: &mut Simulation, probes: &[usize]) {
-        match self.read {
-            StateRead::Nothing => {}
-            StateRead::Probes => sim.world.gather_particles(probes),
-            StateRead::Whole => sim.world.gather(),
-        }
-    }
-}
-
 impl RunOptions<'_> {
-    /// After `step`: whether the run stops (asked to, on any rank of a decomposed run), and
-    /// what must be gathered first (`read`: what rank 0 reads; the whole state at a stop,
-    /// for its checkpoint). One agreement of `world`'s ranks per step in a decomposed run
-    /// (rank 0 writes every output, the others only step).
-    fn sync_after(&self, world: &World, step: u64, read: StateRead) -> Sync {
+    /// After `step`: whether the run stops (asked to, on any rank of a decomposed run),
+    /// having made whole what the ranks read first (`read`: what this rank reads, of the
+    /// `probes`' particles for [`StateRead::Probes`]; the whole state at a stop, for its
+    /// checkpoint): [`World::agree_on_stop`], one agreement of `world`'s ranks per step in a
+    /// decomposed run (rank 0 writes every output, the others only step).
+    fn stops_after(&self, world: &mut World, step: u64, read: StateRead, probes: &[usize]) -> bool {
         let asked =
             self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) || self.stop_after == Some(step);
-        if world.decomposition().is_none() {
-            return Sync { stop: asked, read };
-        }
-        // The smallest wins: 0 stop (and the whole state), 1 the whole state, 2 the probes,
-        // 3 nothing.
-        let mine = match (asked, read) {
-            (true, _) => 0,
-            (false, StateRead::Whole) => 1,
-            (false, StateRead::Probes) => 2,
-            (false, StateRead::Nothing) => 3,
+        let wanted = match read {
+            StateRead::Nothing => Gather::Nothing,
+            StateRead::Probes => Gather::Particles,
+            StateRead::Whole => Gather::Whole,
         };
-        let agreed = world.exchange().agree_min(mine);
-        let read = match agreed {
-            0 | 1 => StateRead::Whole,
-            2 => StateRead::Probes,
-            _ => StateRead::Nothing,
-        };
-        Sync {
-            stop: agreed == 0,
-            read,
-        }
+        world.agree_on_stop(asked, wanted, probes)
     }
 }
 
@@ -266,7 +232,7 @@ pub fn run_with(
     options: RunOptions<'_>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<RunReport, RunError> {
-    if sim.world.exchange().rank() != 0 {
+    if sim.world.rank() != 0 {
         return follow(sim, options);
     }
     let mut run = Run::open(sim, out_dir, options)?;
@@ -314,9 +280,8 @@ pub fn run_with(
                 true => StateRead::Whole,
                 false => run.reads_state(sim, dt),
             };
-            let sync = options.sync_after(&sim.world, step, read);
-            sync.gather(sim, &probes);
-            run.after_step(sim, step, &info, sync, keep_good)?;
+            let stop = options.stops_after(&mut sim.world, step, read, &probes);
+            run.after_step(sim, step, &info, stop, keep_good)?;
             if step % 64 == 0 && last_report.elapsed().as_secs_f64() > 0.5 {
                 last_report = Instant::now();
                 let time = sim.world.state.time;
@@ -452,15 +417,15 @@ impl Run {
     }
 
     /// After the sample at the start (step 0) and after every step, with the state whole
-    /// where `sync` says so: the recorders record, then a checkpoint when due or asked for
-    /// (a stop request ends the run with [`RunError::Interrupted`]), else, with `keep_good`,
+    /// where the ranks agreed: the recorders record, then a checkpoint when due or at a
+    /// `stop` (which ends the run with [`RunError::Interrupted`]), else, with `keep_good`,
     /// the last good state in memory.
     fn after_step(
         &mut self,
         sim: &Simulation,
         step: u64,
         info: &StepInfo<'_>,
-        sync: Sync,
+        stop: bool,
         keep_good: bool,
     ) -> Result<(), RunError> {
         for r in self.recorders.iter_mut() {
@@ -469,7 +434,6 @@ impl Run {
         let time = sim.world.state.time;
         self.good_schedule.due(time, info.dt);
         self.record.next_step = step + 1;
-        let stop = sync.stop;
         if self.record.checkpoints.due(time, info.dt) || stop {
             for r in self.recorders.iter_mut() {
                 r.publish()?;
@@ -536,9 +500,7 @@ fn follow(sim: &mut Simulation, options: RunOptions<'_>) -> Result<RunReport, Ru
         if step > 0 {
             halt = sim.world.step().map_err(|source| core_error(sim, source))?;
         }
-        let sync = options.sync_after(&sim.world, step, StateRead::Nothing);
-        sync.gather(sim, &probes);
-        stopped = sync.stop;
+        stopped = options.stops_after(&mut sim.world, step, StateRead::Nothing, &probes);
         if stopped || halt.is_some() {
             break;
         }

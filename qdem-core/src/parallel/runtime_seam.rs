@@ -1,9 +1,9 @@
-//! The parallel [`Exchange`] as a stepper's [`Seam`]: a decomposed run's force evaluations,
+//! The [`ParallelRuntime`] as a stepper's [`Seam`]: a decomposed run's force evaluations,
 //! the particles a rank steps and the share of each integration, through the exchange's own
 //! methods.
 
 use crate::error::CoreError;
-use crate::parallel::Exchange;
+use crate::parallel::ParallelRuntime;
 use crate::step::local_particles::ParticleRuns;
 use crate::step::model::Model;
 use crate::step::seam::Seam;
@@ -11,7 +11,7 @@ use crate::step::stages::StageTimes;
 use crate::step::state::State;
 use crate::Vec3;
 
-impl Seam for Exchange {
+impl Seam for ParallelRuntime {
     fn add_forces(
         &mut self,
         state: &State,
@@ -20,7 +20,7 @@ impl Seam for Exchange {
         torque: &mut [Vec3],
         stages: &mut StageTimes,
     ) {
-        Exchange::add_forces(self, state, models, force, torque, stages);
+        ParallelRuntime::add_forces(self, state, models, force, torque, stages);
     }
 
     fn sum_forces(
@@ -31,15 +31,15 @@ impl Seam for Exchange {
         torque: &mut Vec<Vec3>,
         stages: &mut StageTimes,
     ) {
-        Exchange::sum_forces(self, state, models, force, torque, stages);
+        ParallelRuntime::sum_forces(self, state, models, force, torque, stages);
     }
 
     fn stepped(&self) -> Option<&ParticleRuns> {
-        Exchange::stepped(self)
+        ParallelRuntime::stepped(self)
     }
 
     fn computed(&self) -> Option<&ParticleRuns> {
-        Exchange::computed(self)
+        ParallelRuntime::computed(self)
     }
 
     fn complete(
@@ -49,6 +49,6 @@ impl Seam for Exchange {
         outcome: Result<(), CoreError>,
         agree: bool,
     ) -> Result<(), CoreError> {
-        Exchange::complete(self, state, stages, outcome, agree)
+        ParallelRuntime::complete(self, state, stages, outcome, agree)
     }
 }

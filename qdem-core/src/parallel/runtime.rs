@@ -1,17 +1,17 @@
-//! [`Exchange`]: the one place where a step meets the ranks. A [`crate::World`] owns one:
-//! single-process by default, where every call is a plain loop or does nothing, and
+//! [`ParallelRuntime`]: the one place where a step meets the ranks. A [`crate::World`] owns
+//! one: single-process by default, where every call is a plain loop or does nothing, and
 //! decomposed after [`crate::World::decompose`]. The steppers evaluate forces through it
-//! ([`Exchange::sum_forces`]) and end each integration with it ([`Exchange::complete`]); the
-//! world runs its gathers, its failure agreement, the post-step hooks and the re-partitions
-//! through it. Models never call a collective: a split model declares what it exchanges
-//! ([`crate::SplitModel`]) and the exchange runs the collectives between its stages, in the
-//! same order on every rank.
+//! ([`ParallelRuntime::sum_forces`]) and end each integration with it
+//! ([`ParallelRuntime::complete`]); the world runs its gathers, its failure agreement, the
+//! post-step hooks and the re-partitions through it. Models never call a collective: a split model declares what it exchanges
+//! ([`crate::parallel::Facets`]) and the runtime runs the collectives between its stages, in
+//! the same order on every rank.
 
 use crate::error::CoreError;
 use crate::parallel::communicator::{max_over_ranks, Communicator};
-use crate::parallel::decomposition::{decompose, Decomposition, Partition};
+use crate::parallel::decomposition::{decompose, Partition, RankFigures};
 use crate::parallel::ghosts::GhostTable;
-use crate::parallel::split::{Part, Reads, SplitModel};
+use crate::parallel::split::{Balance, Facets, Part, Reads};
 use crate::parallel::state_share::StateShare;
 use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
@@ -32,23 +32,23 @@ const REPARTITION_IMBALANCE: f64 = 1.1;
 const REPARTITION_REBUILDS: usize = 8;
 
 /// What a step exchanges between the ranks of a decomposed run; nothing in a run of one
-/// process ([`Exchange::default`]), where [`Exchange::sum_forces`] sums the models' forces
-/// and the rest does nothing.
+/// process ([`ParallelRuntime::default`]), where [`ParallelRuntime::sum_forces`] sums the
+/// models' forces and the rest does nothing.
 ///
 /// ```
-/// use qdem_core::{Exchange, Gravity, Model, State, StageTimes, Vec3};
+/// use qdem_core::{ParallelRuntime, Gravity, Model, State, StageTimes, Vec3};
 ///
 /// let mut state = State::at_rest(vec![Vec3::zeros()]);
 /// state.mass[0] = 2.0;
 /// let mut models: Vec<Box<dyn Model>> = vec![Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81)))];
 /// let (mut force, mut torque) = (Vec::new(), Vec::new());
-/// let mut exchange = Exchange::default();
+/// let mut exchange = ParallelRuntime::default();
 /// exchange.sum_forces(&state, &mut models, &mut force, &mut torque, &mut StageTimes::off());
 /// assert_eq!(force[0].z, -19.62);
 /// assert!(exchange.decomposition().is_none());
 /// ```
 #[derive(Default)]
-pub struct Exchange {
+pub struct ParallelRuntime {
     ranks: Option<Ranks>,
 }
 
@@ -56,7 +56,7 @@ pub struct Exchange {
 struct Ranks {
     comm: Arc<dyn Communicator>,
     share: StateShare,
-    figures: Decomposition,
+    figures: RankFigures,
     /// The particles this rank steps, when a step shares only the halo.
     local: Option<LocalParticles>,
     /// What a re-partition keeps, when a step shares only the halo.
@@ -74,11 +74,11 @@ struct Ranks {
     all: Vec<f64>,
 }
 
-/// A split model's exchange of item records; none for a deformable body, which exchanges
-/// block sums only.
+/// A split model's exchange of item records; none for a model without a halo (a deformable
+/// body, which exchanges block sums only).
 type Ghosts = Option<GhostTable>;
 
-impl Exchange {
+impl ParallelRuntime {
     /// Sums the forces and torques of all `models` at `state` into `force` and `torque`
     /// (resized and zeroed here; rigid bodies' torques, then particles' moments), then moves
     /// the forces on members of rigid bodies onto their bodies. A model that this rank
@@ -100,8 +100,8 @@ impl Exchange {
         self.add_forces(state, models, force, torque, stages);
     }
 
-    /// [`Exchange::sum_forces`] into `force` and `torque` that the caller has sized and zeroed
-    /// (Verlet zeroes them in its drift sweep).
+    /// [`ParallelRuntime::sum_forces`] into `force` and `torque` that the caller has sized and
+    /// zeroed (Verlet zeroes them in its drift sweep).
     pub(crate) fn add_forces(
         &mut self,
         state: &State,
@@ -113,8 +113,8 @@ impl Exchange {
         for (i, model) in models.iter_mut().enumerate() {
             match self.ranks.as_mut() {
                 Some(ranks) if ranks.models[i].is_some() => {
-                    let part = split_facet(model.as_mut()).expect("a split model");
-                    ranks.evaluate(i, part, state, force, torque);
+                    let facets = split_facets(model.as_mut()).expect("a split model");
+                    ranks.evaluate(i, facets, state, force, torque);
                 }
                 _ => model.add_forces(state, force, torque),
             }
@@ -171,7 +171,7 @@ impl Exchange {
     }
 
     /// How the run is decomposed over processes; `None` for a run of one process.
-    pub fn decomposition(&self) -> Option<&Decomposition> {
+    pub fn decomposition(&self) -> Option<&RankFigures> {
         self.ranks.as_ref().map(|r| &r.figures)
     }
 
@@ -182,13 +182,13 @@ impl Exchange {
 
     /// The smallest of the ranks' `value`s, on every rank (`value` in a run of one process):
     /// a collective, which every rank calls at the same point of the run.
-    pub fn agree_min(&self, value: u64) -> u64 {
+    pub(crate) fn agree_min(&self, value: u64) -> u64 {
         self.ranks.as_ref().map_or(value, |r| r.comm.min(value))
     }
 
     /// Every rank's `mine` (of one length on every rank), in rank order (`mine` in a run of
     /// one process): a collective, which every rank calls at the same point of the run.
-    pub fn gather_values(&self, mine: &[f64]) -> Vec<f64> {
+    pub(crate) fn gather_values(&self, mine: &[f64]) -> Vec<f64> {
         let Some(ranks) = &self.ranks else {
             return mine.to_vec();
         };
@@ -236,8 +236,8 @@ impl Exchange {
         };
         for ((model, body), slot) in models.iter_mut().zip(bodies).zip(&mut ranks.models) {
             if let Some(body) = body {
-                let part = split_facet(model.as_mut()).expect("a deformable body splits");
-                part.split(Some(Part {
+                let facets = split_facets(model.as_mut()).expect("a deformable body splits");
+                facets.split(Some(Part {
                     owner: Arc::from([]),
                     rank: ranks.comm.rank() as u32,
                     body: Some(body),
@@ -349,17 +349,19 @@ impl Exchange {
         let Some(ranks) = self.ranks.as_mut().filter(|r| r.hooks[i]) else {
             return hook.after_step(state, models);
         };
-        let Reads::Split(part) = hook.reads() else {
-            unreachable!("a split hook has a split facet");
+        let decisions = match hook.reads() {
+            Reads::Split(facets) => facets.decisions(),
+            _ => None,
         };
+        let decisions = decisions.expect("a split hook decides");
         ranks.mine.clear();
-        part.decide(state, &mut ranks.mine);
+        decisions.decide(state, &mut ranks.mine);
         ranks.comm.all_gather_varying(&ranks.mine, &mut ranks.all);
-        part.act(state, &ranks.all);
+        decisions.act(state, &ranks.all);
         None
     }
 
-    /// Whether a step ends with [`Exchange::rebalance`] (a run decomposed with a halo
+    /// Whether a step ends with [`ParallelRuntime::rebalance`] (a run decomposed with a halo
     /// exchange).
     pub(crate) fn rebalances(&self) -> bool {
         self.ranks.as_ref().is_some_and(|r| r.partition.is_some())
@@ -384,9 +386,9 @@ impl Exchange {
         };
         let mut rebuilt = false;
         let mut work = ranks.local.as_ref().map_or(0, |l| l.computed.len()) as f64;
-        for part in split_parts(models, hooks, &ranks.models, &ranks.hooks) {
-            rebuilt |= part.rebuilt();
-            work += part.work();
+        for balance in balances(models, hooks, &ranks.models, &ranks.hooks) {
+            rebuilt |= balance.rebuilt();
+            work += balance.work();
         }
         if !rebuilt {
             return;
@@ -417,8 +419,8 @@ impl Exchange {
         };
         ranks.gather(state, models, torques);
         let mut cost = vec![1.0; state.len()];
-        for part in split_parts(models, hooks, &ranks.models, &ranks.hooks) {
-            part.add_costs(&mut cost);
+        for balance in balances(models, hooks, &ranks.models, &ranks.hooks) {
+            balance.add_costs(&mut cost);
         }
         let partition = ranks.partition.as_ref().expect("checked above");
         let (share, owned, local) = partition.assign(state, models, Some(&cost));
@@ -432,48 +434,56 @@ impl Exchange {
 }
 
 impl Ranks {
-    /// One force evaluation of split model `i` (`part`), its stages with the collectives in
-    /// between ([`crate::parallel::split`]).
+    /// One force evaluation of split model `i` (its `facets`), its stages with the
+    /// collectives in between ([`crate::parallel::split`]).
     fn evaluate(
         &mut self,
         i: usize,
-        part: &mut dyn SplitModel,
+        facets: &mut dyn Facets,
         state: &State,
         force: &mut [Vec3],
         torque: &mut [Vec3],
     ) {
         let comm = self.comm.as_ref();
         let ghosts = self.models[i].as_mut().expect("a split model");
-        if let Some(moved) = part.read_own(state) {
-            let moved = max_over_ranks(comm, moved);
-            if part.needs_rebuild(moved, state.time) {
-                let table = ghosts
-                    .as_mut()
-                    .expect("a split model with lists has a ghost table");
-                table.borders(comm, part);
-                part.rebuild(state.time);
-            }
-        }
-        if let Some(wanted) = part.new_ghosts() {
+        let rebuild = facets.lists().is_some_and(|lists| {
+            let moved = max_over_ranks(comm, lists.moved(state));
+            lists.needs_rebuild(moved, state.time)
+        });
+        if rebuild {
             let table = ghosts
                 .as_mut()
-                .expect("a split model with ghosts has a ghost table");
-            table.set_ghosts(comm, &wanted);
+                .expect("a split model with lists has a ghost table");
+            table.borders(
+                comm,
+                facets.halo().expect("a split model with lists has a halo"),
+            );
+            facets.lists().expect("checked above").rebuild(state.time);
         }
-        part.read_partners(state);
-        if let Some(table) = ghosts {
-            table.forward(comm, part);
+        if let Some(halo) = facets.halo() {
+            let table = ghosts
+                .as_mut()
+                .expect("a split model with a halo has a ghost table");
+            if let Some(wanted) = halo.new_ghosts() {
+                table.set_ghosts(comm, &wanted);
+            }
+            halo.read_partners(state);
+            table.forward(comm, halo);
         }
-        part.compute(state);
-        self.mine.clear();
-        if part.reduction(&mut self.mine) {
-            comm.all_gather_varying(&self.mine, &mut self.all);
-            part.reduced(state.time, &self.all);
+        let evaluation = facets.evaluation().expect("a split model evaluates");
+        evaluation.compute(state);
+        if let Some(reduction) = facets.reduction() {
+            self.mine.clear();
+            if reduction.mine(&mut self.mine) {
+                comm.all_gather_varying(&self.mine, &mut self.all);
+                reduction.reduced(state.time, &self.all);
+            }
         }
-        if let Some(sums) = part.partial_sums() {
+        if let Some(sums) = facets.reverse_sums() {
             sums.plan.run(comm, sums.sums);
         }
-        part.apply(force, torque);
+        let evaluation = facets.evaluation().expect("a split model evaluates");
+        evaluation.apply(force, torque);
     }
 
     /// Splits the models and hooks that a rank computes in part by the share's owners (the
@@ -492,18 +502,21 @@ impl Ranks {
             if self.bodies[i] {
                 continue;
             }
-            let Reads::Split(split) = model.reads() else {
+            let Reads::Split(facets) = model.reads() else {
                 continue;
             };
             // A table even without items: every rank runs the same exchanges whatever it
             // holds (an empty contact set still takes part in the max and the forward).
-            let item_owner = split.items().iter().map(|&p| owner[p]).collect();
-            split.split(part());
-            self.models[i] = Some(Some(GhostTable::new(item_owner, me, size)));
+            let table = facets.halo().map(|halo| {
+                let item_owner = halo.items().iter().map(|&p| owner[p]).collect();
+                GhostTable::new(item_owner, me, size)
+            });
+            facets.split(part());
+            self.models[i] = Some(table);
         }
         for (i, hook) in hooks.iter_mut().enumerate() {
-            if let Reads::Split(split) = hook.reads() {
-                split.split(part());
+            if let Reads::Split(facets) = hook.reads() {
+                facets.split(part());
                 self.hooks[i] = true;
             }
         }
@@ -514,16 +527,16 @@ impl Ranks {
     fn step_whole(&mut self, models: &mut [Box<dyn Model>], hooks: &mut [Box<dyn PostStep>]) {
         for (i, model) in models.iter_mut().enumerate() {
             if self.models[i].is_some() && !self.bodies[i] {
-                if let Reads::Split(part) = model.reads() {
-                    part.split(None);
+                if let Reads::Split(facets) = model.reads() {
+                    facets.split(None);
                 }
                 self.models[i] = None;
             }
         }
         for (i, hook) in hooks.iter_mut().enumerate() {
             if self.hooks[i] {
-                if let Reads::Split(part) = hook.reads() {
-                    part.split(None);
+                if let Reads::Split(facets) = hook.reads() {
+                    facets.split(None);
                 }
                 self.hooks[i] = false;
             }
@@ -544,46 +557,47 @@ impl Ranks {
             let Some(Some(table)) = self.models[i].as_mut() else {
                 continue;
             };
-            let Reads::Split(part) = model.reads() else {
+            let Reads::Split(facets) = model.reads() else {
                 continue;
             };
             self.mine.clear();
-            if part.records(&mut self.mine) {
+            let mine = &mut self.mine;
+            if facets.merge().is_some_and(|merge| merge.records(mine)) {
                 comm.all_gather_varying(&self.mine, &mut self.all);
-                table.borders(comm, part);
-                part.merge(&self.all);
+                table.borders(comm, facets.halo().expect("a merged model has a halo"));
+                facets.merge().expect("checked above").merge(&self.all);
             }
         }
     }
 }
 
-/// The split facet of a model.
-fn split_facet(model: &mut dyn Model) -> Option<&mut dyn SplitModel> {
+/// The facets of a split model.
+fn split_facets(model: &mut dyn Model) -> Option<&mut dyn Facets> {
     match model.reads() {
-        Reads::Split(part) => Some(part),
+        Reads::Split(facets) => Some(facets),
         _ => None,
     }
 }
 
-/// The split facets of the models and hooks that are split, models first.
-fn split_parts<'a>(
+/// The balance facets of the models and hooks that are split, models first.
+fn balances<'a>(
     models: &'a mut [Box<dyn Model>],
     hooks: &'a mut [Box<dyn PostStep>],
     split_models: &'a [Option<Ghosts>],
     split_hooks: &'a [bool],
-) -> impl Iterator<Item = &'a mut dyn SplitModel> {
+) -> impl Iterator<Item = &'a mut dyn Balance> {
     let models = models
         .iter_mut()
         .zip(split_models)
         .filter(|(_, s)| s.is_some())
-        .filter_map(|(m, _)| split_facet(m.as_mut()));
+        .filter_map(|(m, _)| split_facets(m.as_mut()));
     let hooks = hooks
         .iter_mut()
         .zip(split_hooks)
         .filter(|(_, &s)| s)
         .filter_map(|(h, _)| match h.reads() {
-            Reads::Split(part) => Some(part),
+            Reads::Split(facets) => Some(facets),
             _ => None,
         });
-    models.chain(hooks)
+    models.chain(hooks).filter_map(|facets| facets.balance())
 }
