@@ -294,14 +294,13 @@ impl Lists for DemContacts {
     fn moved(&mut self, state: &State) -> f64 {
         let dt = self.last_time.map_or(0.0, |t| state.time - t);
         self.last_time = Some(state.time);
-        let moved = self.with_part(|this, part| {
+        self.with_part(|this, part| {
             part.dt = dt;
             if part.whole {
                 this.cut_to_rank(part);
             }
             this.read_own_centers(state, &part.own)
-        });
-        moved
+        })
     }
 
     fn needs_rebuild(&self, moved: f64, time: f64) -> bool {
