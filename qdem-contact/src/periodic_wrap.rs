@@ -10,7 +10,7 @@
 //! the same period ([`Decisions::act`]), so all ranks agree with one process.
 
 use crate::periodic_boundary::{PeriodicBox, WrapGroup};
-use qdem_core::parallel::{Decisions, Facets, Ownership, Part, Reads};
+use qdem_core::step::split::{Decisions, Facets, Ownership, Part, Reads};
 use qdem_core::{Halt, Model, PostStep, State, Vec3};
 
 /// Wraps groups of particles (whole bodies) back into a periodic cell after every step.

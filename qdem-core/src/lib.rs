@@ -71,7 +71,7 @@ pub use error::CoreError;
 pub use loads::gravity::Gravity;
 pub use loads::nodal_load::NodalLoad;
 pub use loads::time_function::{Cyclic, TimeFunction};
-pub use parallel::{Communicator, ParallelRuntime, Part, PartialSums, RankFigures, Reads};
+pub use parallel::{Communicator, ParallelRuntime, RankFigures};
 pub use solvers::newmark::{Newmark, TangentUpdate};
 pub use solvers::static_solve::{StaticSolver, StaticSteps};
 pub use solvers::verlet::Verlet;
@@ -81,6 +81,7 @@ pub use step::model::{
 pub use step::post_step::{Halt, PostStep};
 pub use step::rigid_body::RigidBodies;
 pub use step::solve_report::{FactorStats, SolveReport, StepCounts};
+pub use step::split::{Part, PartialSums, Reads};
 pub use step::stages::{Stage, StageShare, StageTimes};
 pub use step::state::{Dofs, ParticleSpin, State};
 pub use step::step_settings::{EventSolve, Scheme, StepRequest, StepSettings};

@@ -204,7 +204,7 @@ impl World {
     /// Newmark step too). When every model and hook reads only what a rank steps itself
     /// ([`Reads::Own`] or [`Reads::Split`]) and the stepper can step in part (Verlet), a rank
     /// steps only its own particles and its halo, and receives only its halo, and a split
-    /// model ([`crate::parallel::Facets`], DEM contacts) computes only what touches its particles:
+    /// model ([`crate::step::split::Facets`], DEM contacts) computes only what touches its particles:
     /// call [`World::gather`] before reading the whole state. Otherwise every rank holds the
     /// state one process would after every step. Call it on every rank, before
     /// [`World::initialize`] or [`World::restore`]. Only explicit runs (Verlet, explicit
@@ -227,7 +227,7 @@ impl World {
 
     /// Gives the particles no deformable body holds (grains, rigid bodies) new owners, in
     /// runs of particle order of about equal measured work (each particle's step, and its
-    /// share of the split models' work, [`crate::parallel::Balance::add_costs`]): a collective,
+    /// share of the split models' work, [`crate::step::split::Balance::add_costs`]): a collective,
     /// which every rank calls after the same step, in a run decomposed with a halo exchange
     /// (a no-op otherwise). The state and the split models are gathered first and split
     /// again by the new owners, so the run goes on bit for bit as before. A step calls it at

@@ -1,7 +1,8 @@
 //! The areas of qdem-core import one another in one direction only, bottom to top:
 //!
-//! 0. `step` (the state, the model and its facets, the stepper, the tangent, the stages, the
-//!    step settings), with the crate's `error` and `checkpoint` modules;
+//! 0. `step` (the state, the model and its facets, what a model declares of a decomposed run,
+//!    the stepper, the tangent, the stages, the step settings), with the crate's `error` and
+//!    `checkpoint` modules;
 //! 1. the physics, `continuum` and `loads`, and the `solvers`, each on its own;
 //! 2. `modal` (its modes are a solve of the tangents);
 //! 3. `parallel`, which distributes what the models declare;
@@ -31,19 +32,6 @@ const LAYERS: &[&[(&str, &[&str])]] = &[
 
 /// What every area may name at the crate root besides the areas.
 const ROOT_TYPES: &[&str] = &["Vec3", "Mat3"];
-
-/// Imports that still go up, each with the part of issue 54 that removes it: a model
-/// declares what it reads of a decomposed run (`Reads`) and takes part through the split
-/// facets, which are being replaced by small facets that models implement (they move into
-/// `step/` with that work). (file under src/, the area it names). A listed exception that no
-/// longer occurs fails too, so that the list only shrinks.
-const PENDING: &[(&str, &str)] = &[
-    ("step/model.rs", "parallel"),
-    ("step/post_step.rs", "parallel"),
-    ("loads/gravity.rs", "parallel"),
-    ("loads/nodal_load.rs", "parallel"),
-    ("continuum/tet_body.rs", "parallel"),
-];
 
 /// The area and layer of a crate-root module name.
 fn area_of(module: &str) -> Option<(&'static str, usize)> {
@@ -177,32 +165,14 @@ fn violations(src: &Path) -> Vec<(String, String, String)> {
 #[test]
 fn areas_import_only_their_own_and_lower_layers() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let found = violations(&src);
-    let pending = |(file, name, _): &(String, String, String)| {
-        let named = area_of(name).map(|(a, _)| a);
-        PENDING.iter().any(|(f, a)| f == file && named == Some(*a))
-    };
-    let broken: Vec<String> = found
+    let broken: Vec<String> = violations(&src)
         .iter()
-        .filter(|v| !pending(v))
         .map(|(file, name, why)| format!("src/{file}: crate::{name}: {why}"))
         .collect();
     assert!(
         broken.is_empty(),
         "imports against the layers:\n{}",
         broken.join("\n")
-    );
-    let stale: Vec<&(&str, &str)> = PENDING
-        .iter()
-        .filter(|(f, a)| {
-            !found
-                .iter()
-                .any(|(file, name, _)| file == f && area_of(name).map(|(x, _)| x) == Some(*a))
-        })
-        .collect();
-    assert!(
-        stale.is_empty(),
-        "exceptions that no longer occur: {stale:?}"
     );
 }
 

@@ -267,7 +267,7 @@ pub struct DemContacts {
     time_delay: Option<TimeDelay>,
     /// This rank's part, in a run decomposed with a halo exchange.
     split: Option<ContactPart>,
-    /// Whether the lists were rebuilt since [`qdem_core::parallel::Balance::rebuilt`] last asked.
+    /// Whether the lists were rebuilt since [`qdem_core::step::split::Balance::rebuilt`] last asked.
     rebuilt: bool,
     /// The stress-controlled walls' servos, by wall (`servo_loads.rs`); empty when none.
     servos: Vec<Option<servo_loads::ServoWall>>,
@@ -321,7 +321,7 @@ impl Model for DemContacts {
         self.evaluate_one_rank(state, force, torque);
     }
 
-    /// Split in a decomposed run ([`qdem_core::parallel::Facets`], `split.rs`): a rank reads
+    /// Split in a decomposed run ([`qdem_core::step::split::Facets`], `split.rs`): a rank reads
     /// its own spheres and receives the ghosts it declares.
     fn reads(&mut self) -> Reads<'_> {
         Reads::Split(self)

@@ -145,7 +145,7 @@ impl DemContacts {
     }
 
     /// The spheres of other ranks whose motion this rank receives at each evaluation, in a
-    /// run decomposed with split contacts ([`qdem_core::parallel::Facets`]); 0 otherwise.
+    /// run decomposed with split contacts ([`qdem_core::step::split::Facets`]); 0 otherwise.
     pub fn ghosts(&self) -> usize {
         self.split.as_ref().map_or(0, |p| p.ghosts)
     }

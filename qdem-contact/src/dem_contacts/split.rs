@@ -20,7 +20,7 @@
 //! merged into the one list a single process holds ([`Merge::merge`]).
 
 use super::*;
-use qdem_core::parallel::{
+use qdem_core::step::split::{
     Balance, Evaluation, Facets, Halo, Lists, Merge, Ownership, Part, Reduction,
 };
 

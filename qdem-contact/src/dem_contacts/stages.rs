@@ -1,6 +1,6 @@
 //! The stages of one evaluation of a [`DemContacts`], the same for one process and for a
 //! rank of a decomposed run (as LAMMPS's one `Pair::compute()` serves both): the
-//! [`qdem_core::parallel::Facets`] (`split.rs`) calls each stage once, and the world's
+//! [`qdem_core::step::split::Facets`] (`split.rs`) calls each stage once, and the world's
 //! exchange runs the collectives in between; [`DemContacts::evaluate_one_rank`] runs the same
 //! stages in the same order on one process, where each collective is the identity (the
 //! largest displacement over one rank is its own, the spheres of the other ranks are none,

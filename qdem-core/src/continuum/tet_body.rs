@@ -25,9 +25,9 @@ use crate::continuum::tet_kernel::{
 };
 use crate::continuum::tet_lanes::{block_forces, BlockInput, LaneSet};
 use crate::error::CoreError;
-use crate::parallel::decomposition::{BodyLayout, BodySplit};
-use crate::parallel::split::{Evaluation, Facets, Ownership, Part, PartialSums, Reads};
 use crate::step::model::{Deformable, Linearized, Model, Persistence};
+use crate::step::split::{BodyLayout, BodySplit};
+use crate::step::split::{Evaluation, Facets, Ownership, Part, PartialSums, Reads};
 use crate::step::state::State;
 use crate::step::tangent::Tangent;
 use crate::{Mat3, Vec3};

@@ -1,7 +1,7 @@
 //! Uniform gravity: the force m g on every particle.
 
-use crate::parallel::split::Reads;
 use crate::step::model::{Linearized, Model, Persistence};
+use crate::step::split::Reads;
 use crate::step::state::State;
 use crate::step::tangent::Tangent;
 use crate::Vec3;

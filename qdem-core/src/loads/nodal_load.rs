@@ -3,8 +3,8 @@
 //! traction lumped to the nodes, [`crate::loads::surface_load`]).
 
 use crate::loads::time_function::TimeFunction;
-use crate::parallel::split::Reads;
 use crate::step::model::{Linearized, Model, Persistence};
+use crate::step::split::Reads;
 use crate::step::state::State;
 use crate::step::tangent::Tangent;
 use crate::Vec3;

@@ -5,7 +5,7 @@
 //! per rank of about equal cost; a body whose blocks all fall on one rank is computed there
 //! alone. A particle of a deformable body is **owned** by the rank of the block of its first
 //! entry; its **halo** ranks are the others whose blocks hold it. The particles that split
-//! models ([`crate::parallel::Facets`]: DEM contacts) move and no deformable body holds are given
+//! models ([`crate::step::split::Facets`]: DEM contacts) move and no deformable body holds are given
 //! out in runs of particle order, a rigid body whole to one rank, and given out again by
 //! their measured work at a re-partition ([`crate::World::repartition`]). Each step:
 //!
@@ -43,13 +43,12 @@
 
 use crate::error::CoreError;
 use crate::parallel::communicator::Communicator;
-use crate::parallel::split::Reads;
 use crate::parallel::state_share::{StateHalo, StateShare};
 use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
+use crate::step::split::{BodyLayout, BodySplit, Reads, SumExchange};
 use crate::step::state::State;
 use crate::Vec3;
-use std::ops::Range;
 use std::sync::Arc;
 
 /// The figures of a decomposition, per rank: how the deformable bodies' blocks and the
@@ -81,52 +80,6 @@ pub(crate) type Decomposed = (
     Option<(LocalParticles, Partition)>,
     Vec<Option<BodySplit>>,
 );
-
-/// One deformable body's share of the decomposition, for one rank: which of its blocks the
-/// rank computes, which of its particles the rank owns, which block sums go where. The
-/// decomposition makes it from the body's [`BodyLayout`] and hands it over in
-/// [`crate::Part::body`].
-#[derive(Clone, Debug)]
-pub struct BodySplit {
-    /// The blocks this rank computes.
-    pub mine: Range<usize>,
-    /// This rank.
-    pub me: u32,
-    /// The body's first particle.
-    pub first: usize,
-    /// Per particle of the body (from `first`), the rank that owns it and sums its force.
-    pub owner: Vec<u32>,
-    /// The exchange of block sums, for a body cut between ranks.
-    pub exchange: Option<SumExchange>,
-    /// Per rank, the body's block sums it receives per step.
-    pub halo: Vec<usize>,
-}
-
-/// The block sums a rank sends to and receives from the others each step (slots of the
-/// body's sums, grouped by rank, ascending within a rank: both sides list them alike). A
-/// body hands it back in its [`crate::PartialSums`]; the runtime runs it.
-#[derive(Clone)]
-pub struct SumExchange {
-    send_slots: Vec<u32>,
-    /// Values (three per sum) sent to each rank.
-    send_counts: Vec<usize>,
-    recv_slots: Vec<u32>,
-    /// Values received from each rank.
-    recv_counts: Vec<usize>,
-    send: Vec<f64>,
-    recv: Vec<f64>,
-    /// Wall seconds spent in the exchange so far (waiting for the other ranks included).
-    pub seconds: f64,
-}
-
-impl std::fmt::Debug for SumExchange {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("SumExchange")
-            .field("send", &self.send_slots.len())
-            .field("recv", &self.recv_slots.len())
-            .finish()
-    }
-}
 
 impl SumExchange {
     /// Sends the sums this rank computed for other ranks' particles, and writes those the
@@ -212,27 +165,6 @@ pub(crate) fn split_body(
     }
 }
 
-/// What the decomposition reads of a deformable body's blocks, which the body declares
-/// ([`crate::parallel::Facets::body`]): block `b` holds the tetrahedra
-/// `tet_start[b]..tet_start[b + 1]` and the node slots `node_start[b]..node_start[b + 1]`.
-#[derive(Clone, Copy)]
-pub struct BodyLayout<'a> {
-    /// What one tetrahedron of the body costs to compute, relative to an elastic one.
-    pub tet_cost: f64,
-    /// Block `b`'s tetrahedra are `tet_start[b]..tet_start[b + 1]`.
-    pub tet_start: &'a [u32],
-    /// Block `b`'s slots are `node_start[b]..node_start[b + 1]`.
-    pub node_start: &'a [u32],
-    /// The particle of each slot.
-    pub nodes: &'a [u32],
-    /// The body's first particle.
-    pub first: usize,
-    /// Particle `first + i`'s entries are `entries[entry_start[i]..entry_start[i + 1]]`.
-    pub entry_start: &'a [u32],
-    /// Slots, per particle in ascending block order.
-    pub entries: &'a [u32],
-}
-
 /// The block of every slot.
 fn slot_blocks(node_start: &[u32]) -> Vec<u32> {
     let mut block = Vec::with_capacity(*node_start.last().unwrap_or(&0) as usize);
@@ -267,12 +199,12 @@ fn assign_blocks(bodies: &[(f64, Vec<usize>)], ranks: usize) -> Vec<Vec<u32>> {
         .collect()
 }
 
-/// The blocks a deformable body declares ([`crate::parallel::Facets::body`]); `None` for
+/// The blocks a deformable body declares ([`crate::step::split::Facets::body`]); `None` for
 /// the other models.
 fn body_of(model: &mut dyn Model) -> Option<BodyLayout<'_>> {
     match model.reads() {
         Reads::Split(facets) => {
-            let facets: &dyn crate::parallel::Facets = facets;
+            let facets: &dyn crate::step::split::Facets = facets;
             facets.body()
         }
         _ => None,
@@ -402,7 +334,7 @@ impl Partition {
 }
 
 /// Gives owners to the particles that split models move and no deformable body holds
-/// ([`crate::parallel::Ownership::free_particles`], `owner` `u32::MAX`): runs of particle
+/// ([`crate::step::split::Ownership::free_particles`], `owner` `u32::MAX`): runs of particle
 /// order of about equal `cost` (one per particle without it), a rigid body (its centre and members) whole to one rank.
 /// The builders place grains layer by layer, so a run is a slab of the packing (its ghosts
 /// are one layer at each cut) and a rank streams contiguous memory when it steps its

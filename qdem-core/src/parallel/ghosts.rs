@@ -1,5 +1,5 @@
 //! [`GhostTable`]: who sends which item records to whom, for a split model that exchanges
-//! records ([`crate::parallel::Halo::items`]: contact spheres), and the three exchanges that use
+//! records ([`crate::step::split::Halo::items`]: contact spheres), and the three exchanges that use
 //! it: the **borders** (every item's record to every rank, at a rebuild of the lists and a
 //! whole gather), the **ghost requests** (after a rebuild: each rank asks the owners for the
 //! items its lists read) and the **forward** exchange (at each evaluation, the ghosts'
@@ -8,7 +8,7 @@
 //! A record is copied, never summed, so every rank reads the owner's bits.
 
 use crate::parallel::communicator::Communicator;
-use crate::parallel::split::Halo;
+use crate::step::split::Halo;
 
 /// One split model's exchange of item records.
 pub(crate) struct GhostTable {

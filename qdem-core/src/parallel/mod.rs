@@ -20,15 +20,10 @@ pub mod decomposition;
 mod ghosts;
 mod runtime;
 mod runtime_seam;
-pub mod split;
 mod state_share;
 #[cfg(feature = "thread-ranks")]
 pub mod thread_ranks;
 
 pub use communicator::Communicator;
-pub use decomposition::{BodyLayout, BodySplit, RankFigures, SumExchange};
+pub use decomposition::RankFigures;
 pub use runtime::ParallelRuntime;
-pub use split::{
-    Balance, Decisions, Evaluation, Facets, Halo, Lists, Merge, Ownership, Part, PartialSums,
-    Reads, Reduction,
-};

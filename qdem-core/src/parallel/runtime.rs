@@ -4,19 +4,19 @@
 //! ([`ParallelRuntime::sum_forces`]) and end each integration with it
 //! ([`ParallelRuntime::complete`]); the world runs its gathers, its failure agreement, the
 //! post-step hooks and the re-partitions through it. Models never call a collective: a split model declares what it exchanges
-//! ([`crate::parallel::Facets`]) and the runtime runs the collectives between its stages, in
+//! ([`crate::step::split::Facets`]) and the runtime runs the collectives between its stages, in
 //! the same order on every rank.
 
 use crate::error::CoreError;
 use crate::parallel::communicator::{max_over_ranks, Communicator};
 use crate::parallel::decomposition::{decompose, Partition, RankFigures};
 use crate::parallel::ghosts::GhostTable;
-use crate::parallel::split::{Balance, Facets, Part, Reads};
 use crate::parallel::state_share::StateShare;
 use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
 use crate::step::post_step::{Halt, PostStep};
 use crate::step::rigid_body::reduce_member_forces;
+use crate::step::split::{Balance, Facets, Part, Reads};
 use crate::step::stages::{Stage, StageTimes};
 use crate::step::state::State;
 use crate::Vec3;
@@ -83,7 +83,7 @@ impl ParallelRuntime {
     /// (resized and zeroed here; rigid bodies' torques, then particles' moments), then moves
     /// the forces on members of rigid bodies onto their bodies. A model that this rank
     /// computes in part is evaluated stage by stage with the ranks' exchanges in between
-    /// ([`crate::parallel::split`]). Each model's force evaluation is marked as its own
+    /// ([`crate::step::split`]). Each model's force evaluation is marked as its own
     /// stage on `stages` (the caller marks the stage before).
     pub fn sum_forces(
         &mut self,
@@ -435,7 +435,7 @@ impl ParallelRuntime {
 
 impl Ranks {
     /// One force evaluation of split model `i` (its `facets`), its stages with the
-    /// collectives in between ([`crate::parallel::split`]).
+    /// collectives in between ([`crate::step::split`]).
     fn evaluate(
         &mut self,
         i: usize,

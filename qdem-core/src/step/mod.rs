@@ -13,6 +13,7 @@ pub mod post_step;
 pub mod rigid_body;
 pub mod seam;
 pub mod solve_report;
+pub mod split;
 pub mod stages;
 pub mod state;
 pub mod step_settings;

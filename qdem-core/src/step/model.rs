@@ -17,13 +17,13 @@
 //!   the modal analysis, the checks and a decomposed run read of it without its type;
 //! - [`Reads`] ([`Model::reads`]): what the model reads of the particles' motion in a run
 //!   decomposed over ranks, and for a model that one rank computes in part (deformable
-//!   bodies, DEM contacts) its [`crate::parallel::Facets`]: the stages of its
+//!   bodies, DEM contacts) its [`crate::step::split::Facets`]: the stages of its
 //!   force evaluation and what it exchanges, which the world's [`crate::ParallelRuntime`]
 //!   runs.
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::parallel::split::Reads;
+use crate::step::split::Reads;
 use crate::step::state::State;
 use crate::step::step_settings::StepSettings;
 use crate::step::tangent::Tangent;

@@ -2,8 +2,8 @@
 //! run), and the [`Halt`] a hook ends a run with. Declared here, beside the models, so that
 //! the parallel runtime can run the hooks of a decomposed run as it runs the models.
 
-use crate::parallel::split::Reads;
 use crate::step::model::Model;
+use crate::step::split::Reads;
 use crate::step::state::State;
 
 /// Something a world does after every step, once the step has passed the failure check:
@@ -17,7 +17,7 @@ pub trait PostStep: std::any::Any + Send + Sync {
 
     /// How the hook takes part in a decomposed run ([`Model::reads`]); the default,
     /// [`Reads::All`], is always right. A split hook decides for its own particles and acts
-    /// on every rank's decisions ([`crate::parallel::Decisions`]).
+    /// on every rank's decisions ([`crate::step::split::Decisions`]).
     fn reads(&mut self) -> Reads<'_> {
         Reads::All
     }

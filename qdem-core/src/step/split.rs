@@ -43,7 +43,7 @@
 //! [`Ownership`] and [`Decisions`] only:
 //!
 //! ```
-//! use qdem_core::parallel::split::{Decisions, Facets, Ownership};
+//! use qdem_core::step::split::{Decisions, Facets, Ownership};
 //! use qdem_core::{Halt, Model, Part, PostStep, Reads, State};
 //!
 //! /// Pins particle 0 back to x = 0 after every step; the rank that owns it decides.
@@ -87,9 +87,9 @@
 //! assert!(facets.decisions().is_some() && facets.evaluation().is_none());
 //! ```
 
-use crate::parallel::decomposition::{BodyLayout, BodySplit, SumExchange};
 use crate::step::state::State;
 use crate::Vec3;
+use std::ops::Range;
 use std::sync::Arc;
 
 /// How a [`crate::Model`] (or a [`crate::PostStep`] hook) takes part in a run decomposed
@@ -146,7 +146,7 @@ pub struct Part {
 /// sums and the exchange of its [`BodySplit`].
 ///
 /// ```
-/// use qdem_core::parallel::BodySplit;
+/// use qdem_core::step::split::BodySplit;
 /// use qdem_core::{PartialSums, Vec3};
 ///
 /// /// A body's sums per slot of its blocks, and its share of a decomposed run.
@@ -332,4 +332,71 @@ pub trait Decisions {
 
     /// Acts on every rank's decisions (`all`, in rank order).
     fn act(&mut self, state: &mut State, all: &[f64]);
+}
+
+/// One deformable body's share of the decomposition, for one rank: which of its blocks the
+/// rank computes, which of its particles the rank owns, which block sums go where. The
+/// decomposition makes it from the body's [`BodyLayout`] and hands it over in
+/// [`crate::Part::body`].
+#[derive(Clone, Debug)]
+pub struct BodySplit {
+    /// The blocks this rank computes.
+    pub mine: Range<usize>,
+    /// This rank.
+    pub me: u32,
+    /// The body's first particle.
+    pub first: usize,
+    /// Per particle of the body (from `first`), the rank that owns it and sums its force.
+    pub owner: Vec<u32>,
+    /// The exchange of block sums, for a body cut between ranks.
+    pub exchange: Option<SumExchange>,
+    /// Per rank, the body's block sums it receives per step.
+    pub halo: Vec<usize>,
+}
+
+/// The block sums a rank sends to and receives from the others each step (slots of the
+/// body's sums, grouped by rank, ascending within a rank: both sides list them alike). A
+/// body hands it back in its [`crate::PartialSums`]; the runtime runs it.
+#[derive(Clone)]
+pub struct SumExchange {
+    pub(crate) send_slots: Vec<u32>,
+    /// Values (three per sum) sent to each rank.
+    pub(crate) send_counts: Vec<usize>,
+    pub(crate) recv_slots: Vec<u32>,
+    /// Values received from each rank.
+    pub(crate) recv_counts: Vec<usize>,
+    pub(crate) send: Vec<f64>,
+    pub(crate) recv: Vec<f64>,
+    /// Wall seconds spent in the exchange so far (waiting for the other ranks included).
+    pub seconds: f64,
+}
+
+impl std::fmt::Debug for SumExchange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SumExchange")
+            .field("send", &self.send_slots.len())
+            .field("recv", &self.recv_slots.len())
+            .finish()
+    }
+}
+
+/// What the decomposition reads of a deformable body's blocks, which the body declares
+/// ([`crate::step::split::Facets::body`]): block `b` holds the tetrahedra
+/// `tet_start[b]..tet_start[b + 1]` and the node slots `node_start[b]..node_start[b + 1]`.
+#[derive(Clone, Copy)]
+pub struct BodyLayout<'a> {
+    /// What one tetrahedron of the body costs to compute, relative to an elastic one.
+    pub tet_cost: f64,
+    /// Block `b`'s tetrahedra are `tet_start[b]..tet_start[b + 1]`.
+    pub tet_start: &'a [u32],
+    /// Block `b`'s slots are `node_start[b]..node_start[b + 1]`.
+    pub node_start: &'a [u32],
+    /// The particle of each slot.
+    pub nodes: &'a [u32],
+    /// The body's first particle.
+    pub first: usize,
+    /// Particle `first + i`'s entries are `entries[entry_start[i]..entry_start[i + 1]]`.
+    pub entry_start: &'a [u32],
+    /// Slots, per particle in ascending block order.
+    pub entries: &'a [u32],
 }
