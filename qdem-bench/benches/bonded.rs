@@ -15,7 +15,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use qdem_bench::throughput::on_threads;
-use qdem_core::{Newmark, Scheme, Stepper};
+use qdem_core::{solvers::Newmark, step::Scheme, step::Stepper};
 use qdem_io::build::Simulation;
 use qdem_io::scene::Scene;
 use std::path::Path;

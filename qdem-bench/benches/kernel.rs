@@ -5,7 +5,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use qdem_bench::throughput::block;
-use qdem_core::{Model, Stepper, Verlet};
+use qdem_core::{solvers::Verlet, step::Model, step::Stepper};
 
 fn verlet_step(c: &mut Criterion) {
     let mut group = c.benchmark_group("verlet_step");

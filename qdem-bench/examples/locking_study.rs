@@ -6,7 +6,7 @@
 //! `cargo run --release -p qdem-bench --example locking_study`
 
 use qdem_bench::locking_cases::{bar_tip, ring_bore};
-use qdem_core::Formulation;
+use qdem_core::continuum::Formulation;
 
 fn main() {
     for poisson in [0.3, 0.49, 0.4999] {

@@ -15,8 +15,10 @@ use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, PlaneWall, Wall,
     WallShape,
 };
-use qdem_core::rigid_body::point_inertia;
-use qdem_core::{Gravity, Mat3, Model, State, Stepper, Vec3, Verlet};
+use qdem_core::step::rigid_body::point_inertia;
+use qdem_core::{
+    loads::Gravity, solvers::Verlet, step::Model, step::State, step::Stepper, Mat3, Vec3,
+};
 use serde_json::{json, Value};
 use std::path::Path;
 use std::time::Instant;
@@ -53,7 +55,7 @@ pub enum GranularError {
     },
     /// The run failed.
     #[error("the granular run failed: {0}")]
-    Core(#[from] qdem_core::CoreError),
+    Core(#[from] qdem_core::error::CoreError),
 }
 
 /// A packing: sphere centres in a box with an open top.
@@ -82,7 +84,7 @@ pub fn rayleigh_time() -> f64 {
 /// The step of both codes: 20% of the Rayleigh time (LIGGGHTS's recommended limit) or 90% of
 /// qdem's stable bound for the packing's models, whichever is smaller.
 pub fn time_step(state: &State, models: &[Box<dyn Model>]) -> f64 {
-    let bound = qdem_core::stable_step(state, models).map_or(f64::INFINITY, |b| b.0);
+    let bound = qdem_core::step::stepper::stable_step(state, models).map_or(f64::INFINITY, |b| b.0);
     (0.2 * rayleigh_time()).min(0.9 * bound)
 }
 
@@ -417,7 +419,8 @@ pub fn clump_throughput(packing: &Packing, steps: usize) -> Result<Value, Granul
         let (state, models) = packing.build();
         time_step(&state, &models)
     };
-    let bound = qdem_core::stable_step(&state, &models).map_or(f64::INFINITY, |b| b.0);
+    let bound =
+        qdem_core::step::stepper::stable_step(&state, &models).map_or(f64::INFINITY, |b| b.0);
     let (stepper, seconds) = timed_steps(&mut state, &mut models, dt.min(0.9 * bound), steps)?;
     let contacts = first_contacts(&models);
     let clumps = packing.centers.len();
@@ -443,7 +446,8 @@ pub fn clump_throughput(packing: &Packing, steps: usize) -> Result<Value, Granul
 pub fn throughput(packing: &Packing, steps: usize) -> Result<Value, GranularError> {
     let (mut state, mut models) = packing.build();
     let dt = time_step(&state, &models);
-    let bound = qdem_core::stable_step(&state, &models).map_or(f64::INFINITY, |b| b.0);
+    let bound =
+        qdem_core::step::stepper::stable_step(&state, &models).map_or(f64::INFINITY, |b| b.0);
     let (_, seconds) = timed_steps(&mut state, &mut models, dt, steps)?;
     let contacts = first_contacts(&models);
     let n = packing.centers.len();

@@ -5,7 +5,7 @@
 //! [`run_and_print`] is `qdem bench --implicit`: those costs as a table or as one JSON document.
 
 use crate::throughput::{block_mesh, body_on, cpu_model, on_threads, Ordering};
-use qdem_core::{CoreError, Dofs, Model, Newmark, Stepper};
+use qdem_core::{error::CoreError, solvers::Newmark, step::Dofs, step::Model, step::Stepper};
 use serde_json::json;
 use std::time::Instant;
 
@@ -37,7 +37,7 @@ pub const DEFAULT_TETS: [usize; 3] = [16_000, 180_000, 550_000];
 
 /// Measures the implicit path on a block of about `tets` tetrahedra on `threads` threads: the
 /// stepper's first factorisation (at `initialize`, its assembly, symbolic and numeric times
-/// in [`qdem_core::FactorStats`]), then a few steps on it (the last one's triangular solve).
+/// in [`qdem_core::step::FactorStats`]), then a few steps on it (the last one's triangular solve).
 pub fn measure_implicit(tets: usize, threads: usize) -> Result<ImplicitResult, CoreError> {
     on_threads(threads, || {
         let mesh = block_mesh(tets, Ordering::Structured);

@@ -6,13 +6,14 @@
 //!
 //! ```
 //! use qdem_bench::locking_cases::ring_bore;
-//! use qdem_core::Formulation;
+//! use qdem_core::continuum::Formulation;
 //! let (computed, lame) = ring_bore(0.3, Formulation::AveragedPressure, (4, 8));
 //! assert!((computed / lame - 1.0).abs() < 0.05);
 //! ```
 
 use qdem_core::{
-    Dofs, Formulation, Material, Model, NodalLoad, State, StaticSolver, TetBody, TimeFunction, Vec3,
+    continuum::Formulation, continuum::Material, continuum::TetBody, loads::NodalLoad,
+    loads::TimeFunction, solvers::StaticSolver, step::Dofs, step::Model, step::State, Vec3,
 };
 use qdem_mesh::{structured_box, TetMesh};
 use std::f64::consts::FRAC_PI_2;

@@ -8,7 +8,10 @@
 
 use crate::vector_peak::vector_peak_flops;
 use qdem_core::continuum::tet_lanes::{LaneSet, FLOPS_ELASTIC, FLOPS_VISCOELASTIC};
-use qdem_core::{Material, Model, State, Stepper, TetBody, Vec3, Verlet};
+use qdem_core::{
+    continuum::Material, continuum::TetBody, solvers::Verlet, step::Model, step::State,
+    step::Stepper, Vec3,
+};
 use qdem_io::build::memory;
 use qdem_mesh::{structured_box, GridError, TetMesh};
 use serde_json::json;
@@ -47,7 +50,7 @@ pub struct BenchResult {
     pub tets: usize,
     /// Particles.
     pub particles: usize,
-    /// Entries of the block sums (`qdem_core::tet_blocks::BlockLayout::block_nodes`).
+    /// Entries of the block sums (`qdem_core::continuum::tet_blocks::BlockLayout::block_nodes`).
     pub block_nodes: usize,
     /// Whether the viscous path ran.
     pub viscous: bool,
@@ -66,7 +69,7 @@ impl BenchResult {
     }
 
     /// Compulsory memory traffic of one step divided by the tetrahedra (bytes), for the blocked
-    /// kernel of `qdem_core::tet_blocks`:
+    /// kernel of `qdem_core::continuum::tet_blocks`:
     /// - per tetrahedron its hot record, dX⁻¹ and four local corners (80 B);
     /// - per block node (a particle counted once per block that touches it): its index (4 B),
     ///   its position copied in (24 B, 48 B with velocities), its block sum written and read

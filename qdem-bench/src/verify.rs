@@ -13,12 +13,12 @@
 use crate::cantilever::{
     cantilever, cantilever_scene, newmark_variant, StudyError, CALCULIX_F1_HZ, CALCULIX_TIP_UZ_UM,
 };
-use qdem_core::linear_tet::LinearTets;
-use qdem_core::tet_kernel::{edge_matrix, tet_stress, vertex_forces};
-use qdem_core::tet_subdomain::subdomain_forces;
+use qdem_core::continuum::linear_tet::LinearTets;
+use qdem_core::continuum::tet_kernel::{edge_matrix, tet_stress, vertex_forces};
+use qdem_core::continuum::tet_subdomain::subdomain_forces;
 use qdem_core::{
-    Mat3, Material, Model, NodalLoad, State, StaticSolver, Stepper, TetBody, TimeFunction, Vec3,
-    Verlet,
+    continuum::Material, continuum::TetBody, loads::NodalLoad, loads::TimeFunction,
+    solvers::StaticSolver, solvers::Verlet, step::Model, step::State, step::Stepper, Mat3, Vec3,
 };
 use qdem_io::build::{BuildError, Simulation};
 use qdem_io::output::OutputError;
@@ -312,7 +312,7 @@ pub fn p_wave_speed() -> Row {
 }
 
 /// Tip deflection (µm) of a cantilever scene's mesh, loads (at t = 1.5 s) and fixity, from the
-/// independent small-strain linear-tet static solve of [`qdem_core::linear_tet`].
+/// independent small-strain linear-tet static solve of [`qdem_core::continuum::linear_tet`].
 pub fn cantilever_static(scene: &Path) -> Result<f64, VerifyError> {
     let mut sim = Simulation::build(Scene::load(scene)?)?;
     sim.world.state.time = 1.5;
@@ -323,7 +323,8 @@ pub fn cantilever_static(scene: &Path) -> Result<f64, VerifyError> {
     let body = &sim.bodies[0];
     let tet_body = sim.tet_body(body).ok_or(VerifyError::NotDeformable)?;
     let lame = sim.scene.materials[0].clone();
-    let lame = qdem_core::Material::elastic(lame.density, lame.young, lame.poisson).elastic_lame();
+    let lame = qdem_core::continuum::Material::elastic(lame.density, lame.young, lame.poisson)
+        .elastic_lame();
     let oracle = LinearTets::new(&sim.world.state.reference, tet_body.tets(), lame);
     let solution = oracle.solve(&load, &sim.world.state.fixed, 1e-13);
     let tip = sim.probes.first().ok_or(VerifyError::NoProbe)?;

@@ -8,7 +8,7 @@
 
 use crate::locking_cases::ring_bore;
 use crate::verify::Row;
-use qdem_core::Formulation;
+use qdem_core::continuum::Formulation;
 use std::time::Instant;
 
 /// The rows: per ν, the standard kernel (informational) and the averaged-pressure one (2%).

@@ -4,7 +4,7 @@
 //! [`qdem_bench::locking_cases`]).
 
 use qdem_bench::locking_cases::{bar_tip, irregular_ring, ring_bore, ring_bore_on};
-use qdem_core::Formulation;
+use qdem_core::continuum::Formulation;
 
 /// On the 8 × 16-cell quarter ring (768 tetrahedra) the standard kernel is 26% short of
 /// Lamé at ν = 0.4999 (0.742 measured; it stays 0.72–0.75 from 192 to 1,728 tetrahedra, see

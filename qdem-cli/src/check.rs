@@ -1,13 +1,15 @@
 //! `qdem check SCENE`: validates a scene and prints its meshes, mass, stable step (of an
 //! explicit run), an estimate of the memory the run keeps, checkpoint support, the measured
 //! cost of a step with the projected run time, and where a step's time goes, stage by stage of the world's step
-//! ([`qdem_core::stages`]). Under `mpirun` (N > 1) the run is decomposed as `qdem run`
+//! ([`qdem_core::step::stages`]). Under `mpirun` (N > 1) the run is decomposed as `qdem run`
 //! decomposes it, and rank 0 also prints each rank's tetrahedra, owned particles, halo and
 //! measured step cost, and the imbalance.
 
 use crate::command::CliError;
 use crate::progress;
-use qdem_core::{Communicator, Model as _, RankFigures, Scheme, Stage};
+use qdem_core::{
+    parallel::Communicator, parallel::RankFigures, step::Model as _, step::Scheme, step::Stage,
+};
 use qdem_io::build::{memory, BodyKind, Simulation};
 use qdem_io::runner::RunError;
 use qdem_io::scene::Scene;
@@ -267,7 +269,7 @@ fn imbalance(values: &[f64]) -> f64 {
     largest / mean.max(f64::MIN_POSITIVE)
 }
 
-/// Where the measured steps' time went, stage by stage ([`qdem_core::stages`]).
+/// Where the measured steps' time went, stage by stage ([`qdem_core::step::stages`]).
 fn print_stages(sim: &Simulation) {
     println!(
         "time per step by stage ({} steps):",

@@ -6,7 +6,7 @@ use crate::{check, progress, run_length};
 use clap::{Args, Parser, Subcommand};
 use qdem_bench::throughput::BenchPlan;
 use qdem_bench::{implicit, throughput, verify};
-use qdem_core::{Communicator, CoreError, Halt, Scheme};
+use qdem_core::{error::CoreError, parallel::Communicator, step::Halt, step::Scheme};
 use qdem_io::analyze::AnalyzeOptions;
 use qdem_io::build::{BuildError, Simulation};
 use qdem_io::runner::{run_with, RunError, RunOptions};
@@ -490,7 +490,7 @@ fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliErro
 
 /// The line `qdem run` prints of a decomposed run: per rank, the tetrahedra it computes, the
 /// particles it owns and the block sums it receives per step.
-fn decomposition_line(d: &qdem_core::RankFigures) -> String {
+fn decomposition_line(d: &qdem_core::parallel::RankFigures) -> String {
     let list = |v: &[usize]| {
         v.iter()
             .map(|n| n.to_string())

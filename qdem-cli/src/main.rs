@@ -6,7 +6,7 @@
 
 use clap::Parser;
 use qdem_cli::command::{dispatch, Cli, CliError};
-use qdem_core::Communicator;
+use qdem_core::parallel::Communicator;
 use qdem_io::runner::RunError;
 use std::process::ExitCode;
 use std::sync::Arc;

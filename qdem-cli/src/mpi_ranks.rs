@@ -1,5 +1,5 @@
 //! MPI (Open MPI through rsmpi) for `mpirun -np N qdem run SCENE`: the collectives a
-//! decomposed run needs ([`qdem_core::Communicator`]) over `MPI_COMM_WORLD`. Built only with
+//! decomposed run needs ([`qdem_core::parallel::Communicator`]) over `MPI_COMM_WORLD`. Built only with
 //! `--features mpi`.
 
 use mpi::collective::{CommunicatorCollectives, Root, SystemOperation};
@@ -7,12 +7,12 @@ use mpi::datatype::{Partition, PartitionMut};
 use mpi::environment::Universe;
 use mpi::topology::{Communicator as _, SimpleCommunicator};
 use mpi::Threading;
-use qdem_core::Communicator;
+use qdem_core::parallel::Communicator;
 
 /// The processes of an `mpirun`, as a [`Communicator`].
 ///
 /// ```no_run
-/// use qdem_core::Communicator;
+/// use qdem_core::parallel::Communicator;
 ///
 /// // Started by `mpirun -np 2`: two ranks; started alone: `None`.
 /// if let Some((_universe, ranks)) = qdem_cli::mpi_ranks::start() {

@@ -12,7 +12,9 @@ use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring, PlaneWall, Wall,
     WallShape,
 };
-use qdem_core::{Gravity, Mat3, Model, State, Stepper, Vec3, Verlet};
+use qdem_core::{
+    loads::Gravity, solvers::Verlet, step::Model, step::State, step::Stepper, Mat3, Vec3,
+};
 
 const RADIUS: f64 = 0.01;
 const DENSITY: f64 = 2700.0;

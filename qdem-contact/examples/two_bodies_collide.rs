@@ -11,7 +11,10 @@
 use std::process::ExitCode;
 
 use qdem_contact::{ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring};
-use qdem_core::{Material, Model, State, Stepper, TetBody, Vec3, Verlet};
+use qdem_core::{
+    continuum::Material, continuum::TetBody, solvers::Verlet, step::Model, step::State,
+    step::Stepper, Vec3,
+};
 use qdem_mesh::structured_box;
 
 /// Cube edge (m) and contact sphere radius (m).

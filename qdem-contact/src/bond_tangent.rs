@@ -13,8 +13,8 @@
 //! matrix (issue 44).
 
 use crate::beam_bond::{to_global_matrix, BeamBond};
-use qdem_core::tangent::{Entry, KeptEntries};
-use qdem_core::Tangent;
+use qdem_core::step::tangent::{Entry, KeptEntries};
+use qdem_core::step::Tangent;
 use std::ops::Range;
 
 /// Entries of one bond's 6×6 block on or below the diagonal (its six DOFs are distinct).

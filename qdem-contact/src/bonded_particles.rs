@@ -10,7 +10,7 @@
 //!   DOFs 3p, 3p+1, its θ is DOF 3(N + p) + 2, N the number of particles). A broken bond keeps
 //!   zero entries in the pattern so that breaking bonds never forces a new symbolic analysis.
 //!   Unbonded contacts enter with their frame at the step's start, where the implicit step
-//!   linearises (Eq. 26, see `qdem_core::Newmark`), not at Eq. 21's Taylor mid-point
+//!   linearises (Eq. 26, see `qdem_core::solvers::Newmark`), not at Eq. 21's Taylor mid-point
 //!   u + ∆t u̇/2 + ∆t² ü/4: in a long implicit step the accelerations carry the undamped
 //!   ringing of the stiff modes (a = ω²x with ω∆t ≫ 1), and ∆t² ü/4 moved discs of the
 //!   benchmark by 6 cm (10⁴ m/s² after the first break, ∆t = 5 ms; spacing 2.5 cm), ∆t u̇/2
@@ -43,10 +43,11 @@ use crate::error::ContactError;
 use crate::particle_packing::{lattice_section, Packing, SplitMix64};
 use crate::unbonded_contact::{overlap, PairKinematics, UnbondedLaw, UnbondedPair};
 use qdem_core::checkpoint::same_count;
-use qdem_core::stable_step::critical_step;
+use qdem_core::continuum::stable_step::critical_step;
 use qdem_core::{
-    CheckpointError, Decoder, Encoder, Linearized, Model, Persistence, Persistent, State,
-    StepEvents, StepSettings, Tangent, Vec3,
+    checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, step::Linearized,
+    step::Model, step::Persistence, step::Persistent, step::State, step::StepEvents,
+    step::StepSettings, step::Tangent, Vec3,
 };
 use rayon::prelude::*;
 use std::collections::HashSet;
@@ -205,10 +206,10 @@ impl BondedParticles {
         state.mass.fill(mass);
         state
             .fixed
-            .fill(qdem_core::Dofs::parse("z").expect("valid"));
+            .fill(qdem_core::step::Dofs::parse("z").expect("valid"));
         state.add_spin(
             vec![0.5 * mass * r * r; packing.len()],
-            qdem_core::Dofs::parse("xy").expect("valid"),
+            qdem_core::step::Dofs::parse("xy").expect("valid"),
         );
         let mut rng = SplitMix64(material.seed);
         let bonds = packing

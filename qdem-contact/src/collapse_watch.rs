@@ -5,7 +5,7 @@
 //! outputs.
 
 use crate::bonded_particles::BondedParticles;
-use qdem_core::{find_model, Halt, Model, PostStep, State};
+use qdem_core::{step::model::find_model, step::Halt, step::Model, step::PostStep, step::State};
 
 /// Halts a run when a particle of its [`BondedParticles`] has moved more than `limit`.
 #[derive(Clone, Debug)]

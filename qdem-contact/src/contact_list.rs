@@ -13,7 +13,7 @@
 //! a column too.
 
 use qdem_core::checkpoint::same_count;
-use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
+use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, Vec3};
 
 /// One candidate contact.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -4,7 +4,7 @@
 //! linear Voigt springs with a Coulomb slider or Hertz–Mindlin with a Mohr–Coulomb limit
 //! (paper 003 §3), plane and triangulated walls, found by a deterministic cell-grid broad phase.
 //!
-//! - [`DemContacts`]: the [`qdem_core::Model`] that owns the spheres, walls and contact lists
+//! - [`DemContacts`]: the [`qdem_core::step::Model`] that owns the spheres, walls and contact lists
 //!   and runs broad phase → narrow phase → forces → gather each evaluation.
 //! - [`broad_phase`]: the cell grid with a skin.
 //! - [`contact_view`]: what an output reads of the spheres and touching contacts.
@@ -20,10 +20,10 @@
 //! neighbour cells' load phase) and [`clump_sample`] (ballast-like stones as rigid clumps with
 //! a grading, shaped by [`clump_shape`]).
 //!
-//! Post-step hooks of a [`qdem_core::World`]: [`PeriodicWrap`] (bodies wrapped back into a
+//! Post-step hooks of a [`qdem_core::world::World`]: [`PeriodicWrap`] (bodies wrapped back into a
 //! periodic cell) and [`CollapseWatch`] (a bonded run ends once its body has failed).
 //!
-//! Rigid bodies are integrated by qdem-core ([`qdem_core::rigid_body`]); their spheres add the
+//! Rigid bodies are integrated by qdem-core ([`qdem_core::step::rigid_body`]); their spheres add the
 //! moment of each contact force about the sphere's centre to the body's torque.
 
 #![warn(missing_docs)]

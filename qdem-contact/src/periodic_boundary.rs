@@ -15,7 +15,7 @@
 //! straddling a boundary is never torn apart and its displacement field stays continuous.
 
 use crate::error::ContactError;
-use qdem_core::{State, Vec3};
+use qdem_core::{step::State, Vec3};
 
 /// The periodic axes of a scene.
 #[derive(Clone, Debug, PartialEq)]

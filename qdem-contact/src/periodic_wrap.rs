@@ -11,13 +11,13 @@
 
 use crate::periodic_boundary::{PeriodicBox, WrapGroup};
 use qdem_core::step::split::{Decisions, Facets, Ownership, Part, Reads};
-use qdem_core::{Halt, Model, PostStep, State, Vec3};
+use qdem_core::{step::Halt, step::Model, step::PostStep, step::State, Vec3};
 
 /// Wraps groups of particles (whole bodies) back into a periodic cell after every step.
 ///
 /// ```
 /// use qdem_contact::{PeriodicBox, PeriodicWrap, WrapGroup};
-/// use qdem_core::{PostStep, State, Vec3};
+/// use qdem_core::{step::PostStep, step::State, Vec3};
 ///
 /// // A cell periodic in x over [0, 1): a two-particle body whose anchor left it at x = 1.2.
 /// let cell = PeriodicBox::new(Vec3::zeros(), [Some(1.0), None, None]).unwrap();

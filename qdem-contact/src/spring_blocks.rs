@@ -1,6 +1,6 @@
 //! One contact as a linear spring about a state and its blocks in the stiffness matrix (the
 //! facet that assembles every touching contact is `dem_contacts/linearized.rs`), for a modal
-//! analysis ([`qdem_core::lanczos`]):
+//! analysis ([`qdem_core::modal::lanczos`]):
 //! the sleeper's modes on its settled bed, paper 000 §4.2.
 //!
 //! A touching contact with unit normal n (from the first sphere towards the second, or from
@@ -15,7 +15,7 @@
 //! taken as sticking (a sliding contact would give no tangential stiffness) and their damping
 //! is left out, as the modes are undamped.
 
-use qdem_core::{Mat3, Tangent, Vec3};
+use qdem_core::{step::Tangent, Mat3, Vec3};
 
 /// The spring of a contact with unit normal `normal` and stiffnesses `kn`, `kt`.
 pub(crate) fn spring(normal: &Vec3, kn: f64, kt: f64) -> Mat3 {

@@ -61,7 +61,7 @@
 //! spheres. For δ = π/2 the swing of the boundary force about its mean is halved; for δ = 0
 //! s is exactly 1.
 
-use qdem_core::{CheckpointError, Decoder, Encoder};
+use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
 /// Cycle counts this close below an integer count as that integer, so that a time computed as

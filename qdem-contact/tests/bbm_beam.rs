@@ -5,7 +5,7 @@
 mod bbm;
 
 use bbm::{beam, cracking_load, timoshenko_deflection};
-use qdem_core::{Model, StaticSolver, StepEvents};
+use qdem_core::{solvers::StaticSolver, step::Model, step::StepEvents};
 
 /// Static midspan deflection of the bonded beam at three element sizes against Timoshenko's
 /// (bending plus shear): the error shrinks with refinement and is within 2% at 0.01 m. The
@@ -110,7 +110,7 @@ fn clapeyron_holds_at_the_static_answer() {
 #[test]
 fn lattice_has_the_continuum_modulus_and_poisson_ratio() {
     use qdem_contact::{BondedParticles, Packing, PackingKind};
-    use qdem_core::{Dofs, NodalLoad, TimeFunction, Vec3};
+    use qdem_core::{loads::NodalLoad, loads::TimeFunction, step::Dofs, Vec3};
     let (w, hgt) = (2.0, 0.5);
     let packing = Packing::rectangle([0.0, 0.0], [w, hgt], 0.025, PackingKind::Regular).unwrap();
     let (mut state, mut model) = BondedParticles::from_packing(
@@ -121,8 +121,8 @@ fn lattice_has_the_continuum_modulus_and_poisson_ratio() {
     )
     .unwrap();
     // Solved statically: the bonds' contacts push only when active, as in an implicit run.
-    let request = qdem_core::StepRequest {
-        scheme: qdem_core::Scheme::Static,
+    let request = qdem_core::step::StepRequest {
+        scheme: qdem_core::step::Scheme::Static,
         dt: Some(1.0),
         safety: 0.5,
         local_damping: 0.0,
@@ -131,7 +131,7 @@ fn lattice_has_the_continuum_modulus_and_poisson_ratio() {
         implicit_default: None,
         fit_to: None,
     };
-    model.prepare(&qdem_core::StepSettings::resolve(&request, &state, &[]).unwrap());
+    model.prepare(&qdem_core::step::StepSettings::resolve(&request, &state, &[]).unwrap());
     let h = packing.spacing;
     let c = &packing.centers;
     let left: Vec<usize> = (0..c.len()).filter(|&p| c[p][0] < 0.51 * h).collect();
@@ -150,7 +150,7 @@ fn lattice_has_the_continuum_modulus_and_poisson_ratio() {
         Vec3::new(sigma * hgt, 0.0, 0.0),
         TimeFunction::constant(1.0),
     );
-    let mut models: Vec<Box<dyn qdem_core::Model>> = vec![Box::new(model), Box::new(load)];
+    let mut models: Vec<Box<dyn qdem_core::step::Model>> = vec![Box::new(model), Box::new(load)];
     StaticSolver::new()
         .solve(&mut state, &mut models, 0.0)
         .unwrap();

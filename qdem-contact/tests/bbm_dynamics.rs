@@ -5,7 +5,7 @@
 mod bbm;
 
 use bbm::beam;
-use qdem_core::{Newmark, Stepper};
+use qdem_core::{solvers::Newmark, step::Stepper};
 
 /// Total energy of the undamped beam under its constant load: kinetic + bond energy − load × u.
 fn energy(b: &bbm::Beam, q: f64) -> f64 {

@@ -6,7 +6,7 @@ mod bbm;
 
 use std::collections::BTreeMap;
 
-use qdem_core::{EventSolve, Newmark, StepCounts, Stepper, Vec3};
+use qdem_core::{solvers::Newmark, step::EventSolve, step::StepCounts, step::Stepper, Vec3};
 
 const LOAD: f64 = 300e3;
 

@@ -7,7 +7,9 @@ mod common;
 
 use common::{stepper, total_energy};
 use qdem_contact::{ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring};
-use qdem_core::{Material, Model, State, Stepper, TetBody, Vec3};
+use qdem_core::{
+    continuum::Material, continuum::TetBody, step::Model, step::State, step::Stepper, Vec3,
+};
 use qdem_mesh::structured_box;
 
 const EDGE: f64 = 0.1;

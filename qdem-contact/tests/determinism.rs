@@ -5,7 +5,7 @@ mod common;
 
 use common::{contacts, rigid_spheres, stepper};
 use qdem_contact::{ContactLaw, ContactSettings, HertzMindlin, PlaneWall, Wall, WallShape};
-use qdem_core::{Gravity, Model, State, Stepper, Vec3};
+use qdem_core::{loads::Gravity, step::Model, step::State, step::Stepper, Vec3};
 
 const R: f64 = 0.005;
 

@@ -1,5 +1,5 @@
 //! Hard cases (issue 8 part 3). Each runs with the step the runner would choose by itself
-//! (`dt = "auto"`: [`SAFETY`] times the models' stable bound, [`qdem_core::choose_step`]) and
+//! (`dt = "auto"`: [`SAFETY`] times the models' stable bound, [`qdem_core::step::stepper::choose_step`]) and
 //! checks that this step follows the hard case and that the run stays stable and accurate:
 //!
 //! 1. ν = 0.49 (ν ≥ 0.5 is refused up front with a message);
@@ -37,9 +37,10 @@ use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring, PlaneWall, Wall,
     WallShape,
 };
-use qdem_core::material::Lame;
+use qdem_core::continuum::material::Lame;
 use qdem_core::{
-    choose_step, stable_step, Mat3, Material, Model, State, Stepper, TetBody, Vec3, Verlet,
+    continuum::Material, continuum::TetBody, solvers::Verlet, step::stepper::choose_step,
+    step::stepper::stable_step, step::Model, step::State, step::Stepper, Mat3, Vec3,
 };
 use qdem_mesh::{max_edge, radius_ratio, structured_box, TetMesh};
 use std::f64::consts::PI;

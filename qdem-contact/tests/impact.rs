@@ -6,7 +6,7 @@ mod common;
 
 use common::{contacts, rigid_spheres, stepper};
 use qdem_contact::{ContactLaw, ContactSettings, HertzMindlin, LinearSpring};
-use qdem_core::{Model, Stepper, Vec3};
+use qdem_core::{step::Model, step::Stepper, Vec3};
 
 const RADIUS: f64 = 0.01;
 const DENSITY: f64 = 2700.0;
@@ -30,7 +30,8 @@ fn collide(law: ContactLaw, speed: f64, dt: f64) -> (f64, f64, f64) {
     let model = contacts(&state, &spheres, (7e10, 0.3), settings, vec![]);
     let mut models: Vec<Box<dyn Model>> = vec![Box::new(model)];
     let mut s = stepper(dt, &mut state, &mut models);
-    let overlap = |st: &qdem_core::State| 2.0 * RADIUS - (st.position[1] - st.position[0]).norm();
+    let overlap =
+        |st: &qdem_core::step::State| 2.0 * RADIUS - (st.position[1] - st.position[0]).norm();
     let (mut start, mut end, mut max) = (None, None, 0.0f64);
     for step in 1..2_000_000 {
         s.step(&mut state, &mut models).unwrap();

@@ -8,7 +8,7 @@ use common::{contacts, stepper};
 use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, LinearSpring, PlaneWall, Wall, WallShape,
 };
-use qdem_core::{Gravity, Mat3, Model, State, Stepper, Vec3};
+use qdem_core::{loads::Gravity, step::Model, step::State, step::Stepper, Mat3, Vec3};
 
 const G: f64 = 9.81;
 const MU: f64 = 0.3;

@@ -6,7 +6,7 @@ mod common;
 
 use common::{contacts, rigid_spheres, stepper};
 use qdem_contact::{ContactLaw, ContactSettings, LinearSpring, PlaneWall, Wall, WallShape};
-use qdem_core::{Gravity, Model, Stepper, Vec3};
+use qdem_core::{loads::Gravity, step::Model, step::Stepper, Vec3};
 
 #[test]
 fn a_rising_floor_carries_a_sphere_at_its_speed_and_the_static_overlap() {

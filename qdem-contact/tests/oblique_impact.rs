@@ -15,7 +15,7 @@ use common::{contacts, rigid_spheres, stepper};
 use qdem_contact::{
     ContactLaw, ContactSettings, HertzMindlin, LinearSpring, PlaneWall, Wall, WallShape,
 };
-use qdem_core::{Model, Stepper, Vec3};
+use qdem_core::{step::Model, step::Stepper, Vec3};
 
 const RADIUS: f64 = 0.01;
 const DENSITY: f64 = 2500.0;

@@ -16,7 +16,7 @@ use common::{contacts, rigid_spheres, stepper};
 use qdem_contact::{
     ContactLaw, ContactSettings, DemContacts, HertzMindlin, LoadCycle, TimeDelayedBoundary,
 };
-use qdem_core::{Model, State, Stepper, Vec3};
+use qdem_core::{step::Model, step::State, step::Stepper, Vec3};
 
 #[test]
 fn shifting_a_periodic_packing_changes_nothing_but_the_shift() {

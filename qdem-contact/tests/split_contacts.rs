@@ -2,7 +2,7 @@
 //! evaluates the contacts that touch the grains it owns and receives its ghosts) give the
 //! bits of one process: the state, every contact record, the per-sphere forces and the
 //! checkpoint, for 2 and 3 ranks (threads of this process,
-//! [`qdem_core::thread_ranks::on_thread_ranks`]), for grains that rotate as particles or as
+//! [`qdem_core::parallel::thread_ranks::on_thread_ranks`]), for grains that rotate as particles or as
 //! rigid bodies (owned whole by one rank), in a box and in a cell periodic across the ranks'
 //! cut (grains wrapping back into it), with and without a time delay on the periodic
 //! boundary; a checkpoint written at 2 ranks resumes at 1 and 3.
@@ -14,10 +14,10 @@ use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring, LoadCycle, PeriodicBox,
     PeriodicWrap, PlaneWall, TimeDelayedBoundary, Wall, WallShape, WrapGroup,
 };
-use qdem_core::thread_ranks::on_thread_ranks;
+use qdem_core::parallel::thread_ranks::on_thread_ranks;
 use qdem_core::{
-    Decoder, Dofs, Encoder, Gravity, Mat3, Model, Scheme, State, StepRequest, StepSettings, Vec3,
-    World,
+    checkpoint::Decoder, checkpoint::Encoder, loads::Gravity, step::Dofs, step::Model,
+    step::Scheme, step::State, step::StepRequest, step::StepSettings, world::World, Mat3, Vec3,
 };
 
 const R: f64 = 0.005;

@@ -4,7 +4,9 @@
 //!
 //! `cargo run --release -p qdem-core --example averaged_pressure_cost [-- CELLS_X [THREADS]]`
 
-use qdem_core::{Formulation, Material, Model, State, TetBody, Vec3};
+use qdem_core::{
+    continuum::Formulation, continuum::Material, continuum::TetBody, step::Model, step::State, Vec3,
+};
 use qdem_mesh::structured_box;
 use std::time::Instant;
 

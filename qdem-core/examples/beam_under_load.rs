@@ -9,8 +9,9 @@
 use std::process::ExitCode;
 
 use qdem_core::{
-    choose_step, Dofs, Material, Model, NodalLoad, State, StaticSolver, Stepper, TetBody,
-    TimeFunction, Vec3, Verlet,
+    continuum::Material, continuum::TetBody, loads::NodalLoad, loads::TimeFunction,
+    solvers::StaticSolver, solvers::Verlet, step::stepper::choose_step, step::Dofs, step::Model,
+    step::State, step::Stepper, Vec3,
 };
 use qdem_mesh::structured_box;
 

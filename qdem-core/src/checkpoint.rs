@@ -5,7 +5,7 @@
 //! length and then its elements; every part starts with a named tag, so a checkpoint read
 //! against a different scene fails at the first part that does not fit, naming it, rather
 //! than giving a silently wrong run. [`State`] is encoded here; models and steppers encode
-//! their own history through [`crate::Persistent::save`] and [`crate::Stepper::save`]. The file
+//! their own history through [`crate::step::Persistent::save`] and [`crate::step::Stepper::save`]. The file
 //! around it (header, version, scene fingerprint) belongs to the caller.
 
 use crate::step::rigid_body::RigidBodies;
@@ -324,7 +324,7 @@ pub fn same_count(
     }
 }
 
-/// The tag before a model's history in a checkpoint ([`crate::World::save`]).
+/// The tag before a model's history in a checkpoint ([`crate::world::World::save`]).
 pub(crate) fn model_tag(name: &str) -> String {
     format!("model {name}")
 }
@@ -341,7 +341,7 @@ pub(crate) fn whole_block(name: &str, block: &Decoder<'_>) -> Result<(), Checkpo
 }
 
 /// Each model's name and saved history (empty for a model without one), as
-/// [`crate::World::save`] wrote them after the [`State`], up to the stepper's part: what a
+/// [`crate::world::World::save`] wrote them after the [`State`], up to the stepper's part: what a
 /// scene that starts from another scene's checkpoint reads of its models (their contact
 /// springs) without the models that wrote them.
 pub fn model_histories<'a>(

@@ -216,7 +216,7 @@ pub enum CoreError {
         cause: Option<Box<String>>,
     },
     /// A contact sphere went through a wall or into another body, found by the contact
-    /// model's pass-through check ([`crate::Model::failure`]): the step may be stable and
+    /// model's pass-through check ([`crate::step::Model::failure`]): the step may be stable and
     /// the result still wrong.
     #[error(
         "a body passes through at step {step} (t = {time:.6e} s, dt = {dt:.4e} s): {detail} {fix}"

@@ -47,44 +47,7 @@ pub mod solvers;
 pub mod step;
 pub mod world;
 
-// The modules other crates and embedders reach by path.
-pub use continuum::tet_subdomain;
-pub use continuum::{
-    averaged_pressure_tet, linear_tet, material, stable_step, tet_blocks, tet_kernel,
-};
-pub use modal::lanczos;
-#[cfg(feature = "thread-ranks")]
-pub use parallel::thread_ranks;
-pub use step::{rigid_body, stages, state, stepper, tangent};
-
 /// A 3-vector of f64.
 pub type Vec3 = nalgebra::Vector3<f64>;
 /// A 3×3 matrix of f64.
 pub type Mat3 = nalgebra::Matrix3<f64>;
-
-pub use checkpoint::{CheckpointError, Decoder, Encoder, SavedState};
-pub use continuum::averaged_pressure_tet::Formulation;
-pub use continuum::material::Material;
-pub use continuum::tet_blocks::BlockLayout;
-pub use continuum::tet_body::TetBody;
-pub use error::CoreError;
-pub use loads::gravity::Gravity;
-pub use loads::nodal_load::NodalLoad;
-pub use loads::time_function::{Cyclic, TimeFunction};
-pub use parallel::{Communicator, ParallelRuntime, RankFigures};
-pub use solvers::newmark::{Newmark, TangentUpdate};
-pub use solvers::static_solve::{StaticSolver, StaticSteps};
-pub use solvers::verlet::Verlet;
-pub use step::model::{
-    find_model, Deformable, Linearized, Model, Persistence, Persistent, StepEvents,
-};
-pub use step::post_step::{Halt, PostStep};
-pub use step::rigid_body::RigidBodies;
-pub use step::solve_report::{FactorStats, SolveReport, StepCounts};
-pub use step::split::{Part, PartialSums, Reads};
-pub use step::stages::{Stage, StageShare, StageTimes};
-pub use step::state::{Dofs, ParticleSpin, State};
-pub use step::step_settings::{EventSolve, Scheme, StepRequest, StepSettings};
-pub use step::stepper::{choose_step, stable_step, Stepper};
-pub use step::tangent::Tangent;
-pub use world::{Gather, World};

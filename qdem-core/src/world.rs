@@ -3,8 +3,8 @@
 //!
 //! One [`World::step`] runs, in this order:
 //! 1. **predict**, **forces** of each model, **integrate** (and **solve**, **events** for
-//!    Newmark-β): the stepper ([`crate::Verlet`], [`crate::Newmark`],
-//!    [`crate::StaticSteps`]) marks each stage as it goes;
+//!    Newmark-β): the stepper ([`crate::solvers::Verlet`], [`crate::solvers::Newmark`],
+//!    [`crate::solvers::StaticSteps`]) marks each stage as it goes;
 //! 2. the **failure check**: a non-finite acceleration, a model's
 //!    [`Model::failure`] (an inverted tetrahedron) or a kinetic energy growing like an
 //!    unstable step's ([`crate::step::instability::EnergyGrowth`]) stops the run with
@@ -59,8 +59,7 @@ pub enum Gather {
 /// A simulation that steps itself: state, models, stepper, hooks and stage counters.
 ///
 /// ```
-/// use qdem_core::{Material, Model, NodalLoad, Scheme, State, StepRequest, StepSettings,
-///     TetBody, TimeFunction, Vec3, World};
+/// use qdem_core::{continuum::Material, step::Model, loads::NodalLoad, step::Scheme, step::State, step::StepRequest, step::StepSettings, ///     TetBody, loads::TimeFunction, Vec3, world::World};
 ///
 /// // One tetrahedron with three corners held, pulled at the fourth.
 /// let nodes = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];
@@ -71,7 +70,7 @@ pub enum Gather {
 ///     .unwrap();
 /// body.lump_mass(&mut state.mass);
 /// for p in 0..3 {
-///     state.fix(p, qdem_core::Dofs::ALL);
+///     state.fix(p, qdem_core::step::Dofs::ALL);
 /// }
 /// let pull = NodalLoad::new("pull", vec![3], Vec3::new(0.0, 0.0, 10.0),
 ///     TimeFunction::constant(1.0));

@@ -4,8 +4,9 @@
 //! cylinder, the clamped bar) is tested in qdem-bench (`tests/locking.rs`).
 
 use qdem_core::{
-    Dofs, Formulation, Material, Model, NodalLoad, State, Stepper, TetBody, TimeFunction, Vec3,
-    Verlet,
+    continuum::Formulation, continuum::Material, continuum::TetBody, loads::NodalLoad,
+    loads::TimeFunction, solvers::Verlet, step::Dofs, step::Model, step::State, step::Stepper,
+    Vec3,
 };
 use qdem_mesh::{structured_box, TetMesh};
 
@@ -112,8 +113,8 @@ fn explicit_steps_are_bit_identical_for_any_thread_count() {
 /// would need an exchange of their own), on every rank.
 #[test]
 fn a_decomposed_run_refuses_the_averaged_pressure_body_by_name() {
-    use qdem_core::thread_ranks::on_thread_ranks;
-    use qdem_core::{Scheme, StepRequest, StepSettings, World};
+    use qdem_core::parallel::thread_ranks::on_thread_ranks;
+    use qdem_core::{step::Scheme, step::StepRequest, step::StepSettings, world::World};
     let errors = on_thread_ranks(2, |comm| {
         let mesh = structured_box([0.0; 3], [1.0, 0.06, 0.1], [20, 2, 3]).unwrap();
         let (state, body) = body(&mesh, 0.4999, Formulation::AveragedPressure);
@@ -191,8 +192,12 @@ fn displace_irregularly(state: &mut State) -> Vec<Vec3> {
 /// K u of `body`'s small-strain tangent at its reference positions `reference` (the
 /// tangent's lower triangle, each off-diagonal entry acting both ways).
 fn tangent_times(body: &TetBody, reference: &[Vec3], u: &[Vec3]) -> Vec<Vec3> {
-    let mut tangent = qdem_core::Tangent::new();
-    qdem_core::Linearized::add_tangent(body, &State::at_rest(reference.to_vec()), &mut tangent);
+    let mut tangent = qdem_core::step::Tangent::new();
+    qdem_core::step::Linearized::add_tangent(
+        body,
+        &State::at_rest(reference.to_vec()),
+        &mut tangent,
+    );
     let mut ku = vec![Vec3::zeros(); u.len()];
     for e in tangent.stiffness_entries() {
         let (r, c) = (e.row, e.col);

@@ -1,10 +1,10 @@
-//! The blocked scatter of a body's tetrahedron forces (`qdem_core::tet_blocks`) gives every
+//! The blocked scatter of a body's tetrahedron forces (`qdem_core::continuum::tet_blocks`) gives every
 //! particle the sum of its tetrahedra's forces: against a plain serial sum over the
 //! tetrahedra in mesh order, on a deformed, moving block of many blocks, elastic and
 //! viscoelastic, equal to round-off (the two sum in different orders).
 
-use qdem_core::tet_kernel::{edge_matrix, tet_stress, vertex_forces};
-use qdem_core::{Material, Model, State, TetBody, Vec3};
+use qdem_core::continuum::tet_kernel::{edge_matrix, tet_stress, vertex_forces};
+use qdem_core::{continuum::Material, continuum::TetBody, step::Model, step::State, Vec3};
 use qdem_mesh::structured_box;
 
 fn check(viscous: bool) {

@@ -51,7 +51,8 @@
 //! ([`Model::stable_dt`], viscosity included) and the number of explicit steps to 1.0 s.
 
 use qdem_core::{
-    Dofs, Material, Model, Newmark, NodalLoad, State, StaticSolver, Stepper, TetBody, TimeFunction,
+    continuum::Material, continuum::TetBody, loads::NodalLoad, loads::TimeFunction,
+    solvers::Newmark, solvers::StaticSolver, step::Dofs, step::Model, step::State, step::Stepper,
     Vec3,
 };
 use qdem_mesh::structured_box;

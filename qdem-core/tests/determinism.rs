@@ -3,7 +3,7 @@
 
 mod common;
 
-use qdem_core::{State, Stepper, Verlet};
+use qdem_core::{solvers::Verlet, step::State, step::Stepper};
 
 fn run() -> State {
     let (mut state, mut models) = common::viscoelastic_beam();

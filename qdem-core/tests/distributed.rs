@@ -1,13 +1,14 @@
 //! A run decomposed over ranks gives the bit-identical state of one process, for 2 and 3
 //! ranks: here the ranks are threads of this process
-//! ([`qdem_core::thread_ranks::on_thread_ranks`]), so the decomposition itself is tested
+//! ([`qdem_core::parallel::thread_ranks::on_thread_ranks`]), so the decomposition itself is tested
 //! without MPI.
 
 mod common;
 
-use qdem_core::thread_ranks::on_thread_ranks;
+use qdem_core::parallel::thread_ranks::on_thread_ranks;
 use qdem_core::{
-    Gather, Model, RankFigures, Scheme, State, StepEvents, StepRequest, StepSettings, Vec3, World,
+    parallel::RankFigures, step::Model, step::Scheme, step::State, step::StepEvents,
+    step::StepRequest, step::StepSettings, world::Gather, world::World, Vec3,
 };
 
 /// An event every time the tip's vertical velocity crosses a multiple of [`BAND`]: a

@@ -3,9 +3,11 @@
 //! random tetrahedra, deformation gradients and velocity gradients.
 
 use proptest::prelude::*;
-use qdem_core::tet_kernel::{cofactor, edge_matrix, tet_forces, tet_stress, vertex_forces};
-use qdem_core::tet_subdomain::subdomain_forces;
-use qdem_core::{Mat3, Material, Model, State, TetBody, Vec3};
+use qdem_core::continuum::tet_kernel::{
+    cofactor, edge_matrix, tet_forces, tet_stress, vertex_forces,
+};
+use qdem_core::continuum::tet_subdomain::subdomain_forces;
+use qdem_core::{continuum::Material, continuum::TetBody, step::Model, step::State, Mat3, Vec3};
 
 fn vec3() -> impl Strategy<Value = Vec3> {
     prop::array::uniform3(-1.0f64..1.0).prop_map(Vec3::from)

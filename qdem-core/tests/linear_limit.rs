@@ -2,8 +2,10 @@
 //! f_QDEM(X + u) = −K u + O(|u|²), and a clamped block under a tip load solved statically by
 //! the linear-tet oracle is in equilibrium under the QDEM forces.
 
-use qdem_core::linear_tet::LinearTets;
-use qdem_core::{Dofs, Material, Model, State, TetBody, Vec3};
+use qdem_core::continuum::linear_tet::LinearTets;
+use qdem_core::{
+    continuum::Material, continuum::TetBody, step::Dofs, step::Model, step::State, Vec3,
+};
 use qdem_mesh::structured_box;
 
 fn setup() -> (Vec<Vec3>, Vec<[u32; 4]>, Material) {

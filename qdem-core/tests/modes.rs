@@ -1,9 +1,12 @@
-//! Natural modes by shift-invert Lanczos ([`qdem_core::lanczos`]) against an independent
+//! Natural modes by shift-invert Lanczos ([`qdem_core::modal::lanczos`]) against an independent
 //! dense eigen-solve of the same K and M, rigid-body modes, beam theory and bad input.
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
-use qdem_core::lanczos::{natural_modes, ModalError, Modes};
-use qdem_core::{Dofs, Linearized, Material, Model, State, Tangent, TetBody, Vec3};
+use qdem_core::modal::lanczos::{natural_modes, ModalError, Modes};
+use qdem_core::{
+    continuum::Material, continuum::TetBody, step::Dofs, step::Linearized, step::Model,
+    step::State, step::Tangent, Vec3,
+};
 use qdem_mesh::structured_box;
 use std::f64::consts::PI;
 
@@ -151,7 +154,7 @@ fn bending(n: usize, clamped: bool) -> (f64, f64) {
     let (state, models) = prism(1.0, 0.06, 0.05, [n, n / 10, n / 10], clamped);
     let modes = lanczos(&state, &models, if clamped { 2 } else { 8 });
     let elastic: Vec<_> = modes.modes.iter().filter(|m| !m.rigid).collect();
-    let lateral = |m: &qdem_core::lanczos::Mode, axis: usize| -> f64 {
+    let lateral = |m: &qdem_core::modal::lanczos::Mode, axis: usize| -> f64 {
         m.shape.iter().map(|u| u[axis] * u[axis]).sum()
     };
     // The lower mode bends in z (h < b): its z motion dominates (the Kuhn split, the same in

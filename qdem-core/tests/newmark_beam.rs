@@ -2,10 +2,11 @@
 //! an implicit Newmark run settles at the static answer, and explicit central-difference
 //! Newmark is the Verlet scheme (paper 001 Eqs. 13–16, 26; paper 000 §3.1).
 
-use qdem_core::linear_tet::LinearTets;
+use qdem_core::continuum::linear_tet::LinearTets;
 use qdem_core::{
-    choose_step, Dofs, Material, Model, Newmark, NodalLoad, State, StaticSolver, Stepper, TetBody,
-    TimeFunction, Vec3, Verlet,
+    continuum::Material, continuum::TetBody, loads::NodalLoad, loads::TimeFunction,
+    solvers::Newmark, solvers::StaticSolver, solvers::Verlet, step::stepper::choose_step,
+    step::Dofs, step::Model, step::State, step::Stepper, Vec3,
 };
 use qdem_mesh::structured_box;
 

@@ -4,8 +4,9 @@
 //! deflection, explicit and implicit (paper 001 Eqs. 13–16, 26), for ζ₁ ≈ 0.5%, 1%, 2%.
 
 use qdem_core::{
-    choose_step, Dofs, Material, Model, Newmark, NodalLoad, State, StaticSolver, Stepper, TetBody,
-    TimeFunction, Vec3,
+    continuum::Material, continuum::TetBody, loads::NodalLoad, loads::TimeFunction,
+    solvers::Newmark, solvers::StaticSolver, step::stepper::choose_step, step::Dofs, step::Model,
+    step::State, step::Stepper, Vec3,
 };
 use qdem_mesh::structured_box;
 

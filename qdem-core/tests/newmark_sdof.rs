@@ -3,7 +3,8 @@
 //! T̃/T = ω∆t / (2 atan(ω∆t/2)); central difference is stable for ω∆t ≤ 2 only.
 
 use qdem_core::{
-    CoreError, Linearized, Model, Newmark, State, StaticSolver, Stepper, Tangent, Vec3,
+    error::CoreError, solvers::Newmark, solvers::StaticSolver, step::Linearized, step::Model,
+    step::State, step::Stepper, step::Tangent, Vec3,
 };
 
 /// A linear spring of stiffness k from one particle to its reference position.

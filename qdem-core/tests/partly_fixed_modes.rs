@@ -4,8 +4,11 @@
 //! and its elastic modes, against a dense solve of the same K and M.
 
 use nalgebra::{DMatrix, SymmetricEigen};
-use qdem_core::lanczos::natural_modes;
-use qdem_core::{Dofs, Linearized, Material, Model, State, Tangent, TetBody, Vec3};
+use qdem_core::modal::lanczos::natural_modes;
+use qdem_core::{
+    continuum::Material, continuum::TetBody, step::Dofs, step::Linearized, step::Model,
+    step::State, step::Tangent, Vec3,
+};
 use qdem_mesh::structured_box;
 use std::f64::consts::PI;
 

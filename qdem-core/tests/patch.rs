@@ -1,8 +1,8 @@
 //! Patch tests of the QDEM kernel on a structured block of tetrahedra: rigid motions give zero
 //! stress to round-off, and a uniform strain reproduces Hooke's law exactly.
 
-use qdem_core::tet_kernel::{deformation_gradient, elastic_stress, tet_stress};
-use qdem_core::{Mat3, Material, Model, State, TetBody, Vec3};
+use qdem_core::continuum::tet_kernel::{deformation_gradient, elastic_stress, tet_stress};
+use qdem_core::{continuum::Material, continuum::TetBody, step::Model, step::State, Mat3, Vec3};
 use qdem_mesh::structured_box;
 
 const YOUNG: f64 = 45e9;
@@ -101,7 +101,7 @@ fn uniform_strain_reproduces_hooke_and_balances_interior_particles() {
     for tet in &tets {
         let xr = tet.map(|n| reference[n as usize]);
         let xc = tet.map(|n| x[n as usize]);
-        let dm_inv = qdem_core::tet_kernel::edge_matrix(&xr)
+        let dm_inv = qdem_core::continuum::tet_kernel::edge_matrix(&xr)
             .try_inverse()
             .unwrap();
         let got_f = deformation_gradient(&xc, &dm_inv);

@@ -2,7 +2,10 @@
 //! members follow the pose, and a torque-free tumbling body keeps its angular momentum exactly
 //! and its kinetic energy within the second-order error of the rotation update.
 
-use qdem_core::{Gravity, Mat3, Model, NodalLoad, State, Stepper, TimeFunction, Vec3, Verlet};
+use qdem_core::{
+    loads::Gravity, loads::NodalLoad, loads::TimeFunction, solvers::Verlet, step::Model,
+    step::State, step::Stepper, Mat3, Vec3,
+};
 
 /// A body: centre particle 0 (mass 3 kg) with members at ±x, ±y, ±z.
 fn body(inertia: Vec3) -> State {

@@ -4,8 +4,9 @@
 //! factorisation names the particle of the failing pivot and its model.
 
 use qdem_core::{
-    CoreError, Dofs, Linearized, Mat3, Material, Model, Newmark, NodalLoad, State, StaticSolver,
-    Stepper, Tangent, TetBody, TimeFunction, Vec3,
+    continuum::Material, continuum::TetBody, error::CoreError, loads::NodalLoad,
+    loads::TimeFunction, solvers::Newmark, solvers::StaticSolver, step::Dofs, step::Linearized,
+    step::Model, step::State, step::Stepper, step::Tangent, Mat3, Vec3,
 };
 use qdem_mesh::structured_box;
 

@@ -2,8 +2,11 @@
 //! the assembled lumped-mass system, and not a loose one; Verlet runs stably at the bound and
 //! diverges just above the true limit; a too-large user step is refused with the bound.
 
-use qdem_core::stepper::compute_accelerations;
-use qdem_core::{choose_step, CoreError, Material, Model, State, Stepper, TetBody, Vec3, Verlet};
+use qdem_core::step::stepper::compute_accelerations;
+use qdem_core::{
+    continuum::Material, continuum::TetBody, error::CoreError, solvers::Verlet,
+    step::stepper::choose_step, step::Model, step::State, step::Stepper, Vec3,
+};
 use qdem_mesh::structured_box;
 
 fn body_and_state(material: Material) -> (Vec<Box<dyn Model>>, State) {

@@ -6,8 +6,9 @@
 mod common;
 
 use qdem_core::{
-    CoreError, Halt, Material, Model, PostStep, Scheme, State, StepRequest, StepSettings, Stepper,
-    Vec3, Verlet, World,
+    continuum::Material, error::CoreError, solvers::Verlet, step::Halt, step::Model,
+    step::PostStep, step::Scheme, step::State, step::StepRequest, step::StepSettings,
+    step::Stepper, world::World, Vec3,
 };
 use qdem_mesh::structured_box;
 

@@ -6,7 +6,7 @@
 //!   messages that name the file, line and key; validation resolves the references between
 //!   tables into indices.
 //! - [`build`]: turns a validated scene into a [`build::Simulation`]: the
-//!   [`qdem_core::World`] (one [`qdem_core::State`] for all bodies, only the models the scene
+//!   [`qdem_core::world::World`] (one [`qdem_core::step::State`] for all bodies, only the models the scene
 //!   needs, the step settings, the post-step hooks) and what the outputs need to know of its
 //!   bodies and probes; one module per part of the scene (contacts, `[granular]` stones,
 //!   `[ballast]`, a `[bonded]` beam of paper 001, the `[periodic]` cell of paper 003,

@@ -379,14 +379,14 @@ fn a_resumed_static_run_equals_the_uninterrupted_one() {
 /// A model without a checkpoint of its history (none of the scene models is one any more).
 struct Forgetful;
 
-impl qdem_core::Model for Forgetful {
+impl qdem_core::step::Model for Forgetful {
     fn name(&self) -> &str {
         "forgetful"
     }
 
     fn add_forces(
         &mut self,
-        _state: &qdem_core::State,
+        _state: &qdem_core::step::State,
         _force: &mut [qdem_core::Vec3],
         _torque: &mut [qdem_core::Vec3],
     ) {

@@ -176,7 +176,11 @@ fn a_point_group_holds_and_loads_its_particle() {
     );
     let sim = Simulation::build(scene).unwrap();
     assert_eq!(sim.fix_particles[1].len(), 1);
-    let load = sim.world.model::<qdem_core::NodalLoad>().unwrap().total();
+    let load = sim
+        .world
+        .model::<qdem_core::loads::NodalLoad>()
+        .unwrap()
+        .total();
     assert!((load.z - 5.0).abs() < 1e-12, "{load}");
 }
 

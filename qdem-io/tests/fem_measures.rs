@@ -13,7 +13,7 @@
 mod common;
 
 use common::{fixture, test_dir};
-use qdem_core::NodalLoad;
+use qdem_core::loads::NodalLoad;
 use qdem_io::analyze::{analyze, AnalyzeOptions};
 use qdem_io::build::{load_resultant, Simulation};
 use qdem_io::runner::run;

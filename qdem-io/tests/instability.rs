@@ -6,7 +6,7 @@
 mod common;
 
 use common::{short_cantilever, test_dir};
-use qdem_core::CoreError;
+use qdem_core::error::CoreError;
 use qdem_io::build::Simulation;
 use qdem_io::checkpoint::{read_checkpoint, scene_fingerprint, CHECKPOINT_FILE};
 use qdem_io::runner::{run, RunError};

@@ -222,7 +222,7 @@ mod tests {
             state.rigid.rotate(dt);
             state.position[9].y += 3e-5 * (0.02 * k).cos();
             state.position[18].z = -1e-4 * (0.05 * k).sin();
-            qdem_core::rigid_body::place_members(&mut state);
+            qdem_core::step::rigid_body::place_members(&mut state);
             state.time += dt;
             let exact = positions(&state)
                 .iter()
@@ -259,7 +259,7 @@ mod tests {
         assert_eq!(contacts.rebuilds(), 1);
         assert!(contacts.displacement_bound(&state).is_some());
         state.position[0].y += 0.6;
-        qdem_core::rigid_body::place_members(&mut state);
+        qdem_core::step::rigid_body::place_members(&mut state);
         state.time += 1e-3;
         contacts.add_forces(&state, &mut force, &mut torque);
         assert_eq!(contacts.rebuilds(), 2);

@@ -1,5 +1,5 @@
 //! The touching contacts of a [`DemContacts`] as sticking springs for a modal analysis
-//! (`spring_blocks.rs`): the stiffness [`qdem_core::Model::modal_stiffness`] gives.
+//! (`spring_blocks.rs`): the stiffness [`qdem_core::step::Model::modal_stiffness`] gives.
 
 use super::*;
 

@@ -2,8 +2,8 @@
 //! broad phase → narrow phase → contact forces → per-sphere sums.
 //!
 //! Paper 000 §4 puts a sphere at each surface vertex of a QDEM body, used only for contact;
-//! a rigid body's spheres sit on its members or at its centre ([`qdem_core::rigid_body`]); a
-//! one-sphere grain is a particle that rotates ([`qdem_core::ParticleSpin`]).
+//! a rigid body's spheres sit on its members or at its centre ([`qdem_core::step::rigid_body`]); a
+//! one-sphere grain is a particle that rotates ([`qdem_core::step::ParticleSpin`]).
 //! Spheres of one body never interact. Each evaluation runs the stages of `stages.rs`, the
 //! same on one process and on a rank of a decomposed run:
 //! 1. reads the sphere centres from their particles,
@@ -55,10 +55,11 @@ use crate::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
 use crate::wall::Wall;
 use pair_kernel::KernelPlan;
 use qdem_core::checkpoint::same_count;
-use qdem_core::stable_step::critical_step;
+use qdem_core::continuum::stable_step::critical_step;
 use qdem_core::{
-    CheckpointError, Decoder, Dofs, Encoder, Linearized, Model, Persistence, Persistent, Reads,
-    State, Tangent, Vec3,
+    checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, step::Dofs,
+    step::Linearized, step::Model, step::Persistence, step::Persistent, step::Reads, step::State,
+    step::Tangent, Vec3,
 };
 use rayon::prelude::*;
 use split::ContactPart;
@@ -187,7 +188,7 @@ pub(crate) fn narrow_phase(
 ///     ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring, PlaneWall, Wall,
 ///     WallShape,
 /// };
-/// use qdem_core::{Model, State, Vec3};
+/// use qdem_core::{step::Model, step::State, Vec3};
 ///
 /// // Two spheres of radius 0.01 m on particles of bodies 0 and 1, overlapping by 1 mm, the
 /// // second also resting 0.5 mm into a floor z = 0.
@@ -328,7 +329,7 @@ impl Model for DemContacts {
     }
 
     /// The critical step 2/(√(ω² + γ²/4) + γ/2) of Gershgorin's bounds on M⁻¹K and M⁻¹C
-    /// ([`qdem_core::stable_step::critical_step`]) for the worst carrier of spheres: ω² =
+    /// ([`qdem_core::continuum::stable_step::critical_step`]) for the worst carrier of spheres: ω² =
     /// 2 Σ k (1/m + ℓ²/I), γ = 2 Σ c (1/m + ℓ²/I) with c = 2ζ√(k m), summed over the contacts
     /// a carrier can have at once: [`COORDINATION`] for a vertex sphere of a deformable body or
     /// a rigid single sphere, one per sphere for a rigid body with several (all of them may
@@ -393,13 +394,13 @@ impl Model for DemContacts {
         Persistence::Saved(self)
     }
 
-    fn prepare(&mut self, settings: &qdem_core::StepSettings) {
+    fn prepare(&mut self, settings: &qdem_core::step::StepSettings) {
         self.step = settings.dt;
     }
 
     /// A sphere found through a wall or inside another body at the last rebuild of the
     /// lists (`tunnelling.rs`).
-    fn failure(&self, state: &State) -> Option<qdem_core::CoreError> {
+    fn failure(&self, state: &State) -> Option<qdem_core::error::CoreError> {
         self.passage_failure(state.time)
     }
 

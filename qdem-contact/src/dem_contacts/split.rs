@@ -1,6 +1,6 @@
 //! One rank's part of a [`DemContacts`] in a run decomposed with a halo exchange
 //! ([`qdem_core::parallel`]), bit-identical to one process: its facets ([`Facets`]), whose
-//! stages the world's [`qdem_core::ParallelRuntime`] runs with the collectives in between.
+//! stages the world's [`qdem_core::parallel::ParallelRuntime`] runs with the collectives in between.
 //!
 //! A sphere belongs to the rank that owns its particle (the mesh's decomposition for a
 //! deformable body's vertices, runs of particle order for one-sphere grains, a rigid body

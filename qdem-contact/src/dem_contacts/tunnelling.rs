@@ -21,7 +21,7 @@
 //! (a clump, whose volume is its spheres) deep in another sphere (the run's interpenetration
 //! watch, `qdem-io/src/run/contact_watch.rs`, covers that for `[[body]]`s).
 //!
-//! The first finding is kept and reported by [`qdem_core::Model::failure`] after the step, so
+//! The first finding is kept and reported by [`qdem_core::step::Model::failure`] after the step, so
 //! the world stops the run (in a decomposed run every rank agrees on it).
 
 use super::*;
@@ -81,7 +81,7 @@ impl DemContacts {
 
     /// Before a rebuild at `time` (every centre current, the last build's at `built_at`):
     /// keeps the first sphere of `own` (all spheres when `None`) found through a wall or
-    /// inside another body, with the report [`qdem_core::Model::failure`] gives.
+    /// inside another body, with the report [`qdem_core::step::Model::failure`] gives.
     pub(super) fn check_passage(&mut self, time: f64, own: Option<&[u32]>) {
         if self.pass_through.is_some() {
             return;
@@ -293,10 +293,10 @@ impl DemContacts {
     }
 
     /// The pass-through found at the last rebuild, if any.
-    pub(super) fn passage_failure(&self, time: f64) -> Option<qdem_core::CoreError> {
+    pub(super) fn passage_failure(&self, time: f64) -> Option<qdem_core::error::CoreError> {
         self.pass_through
             .clone()
-            .map(|(detail, fix)| qdem_core::CoreError::PassThrough {
+            .map(|(detail, fix)| qdem_core::error::CoreError::PassThrough {
                 step: 0,
                 time,
                 dt: 0.0,

@@ -4,7 +4,9 @@
 use qdem_contact::{
     BondSettings, BondedMaterial, BondedParticles, Packing, PackingKind, UnbondedLaw,
 };
-use qdem_core::{Dofs, Model, NodalLoad, State, TimeFunction, Vec3};
+use qdem_core::{
+    loads::NodalLoad, loads::TimeFunction, step::Dofs, step::Model, step::State, Vec3,
+};
 
 pub const LENGTH: f64 = 3.0;
 pub const HEIGHT: f64 = 0.5;

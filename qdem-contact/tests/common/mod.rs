@@ -4,7 +4,7 @@
 pub mod packing;
 
 use qdem_contact::{ContactSettings, ContactSphere, DemContacts, Wall};
-use qdem_core::{Mat3, Model, State, Stepper, Vec3, Verlet};
+use qdem_core::{solvers::Verlet, step::Model, step::State, step::Stepper, Mat3, Vec3};
 
 /// A state of rigid spheres: one centre particle per sphere, each its own body.
 pub fn rigid_spheres(centers: &[Vec3], radius: f64, density: f64) -> (State, Vec<ContactSphere>) {

@@ -5,7 +5,7 @@ use super::{contacts, rigid_spheres, stepper};
 use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, PeriodicBox, Wall,
 };
-use qdem_core::{Model, State, Stepper, Vec3};
+use qdem_core::{step::Model, step::State, step::Stepper, Vec3};
 
 /// Sphere radius (m).
 pub const R: f64 = 0.005;

@@ -1,7 +1,7 @@
 //! The average nodal pressure tetrahedron (Bonet & Burton 1998, "A simple average nodal
 //! pressure tetrahedral element for incompressible and nearly incompressible dynamic explicit
 //! applications", Commun. Numer. Meth. Engng 14:437–449): the locking-free option of a
-//! [`crate::TetBody`] for nearly incompressible materials (ν → ½), chosen per material with
+//! [`crate::continuum::TetBody`] for nearly incompressible materials (ν → ½), chosen per material with
 //! [`Formulation::AveragedPressure`].
 //!
 //! The stress of the QDEM tetrahedron (paper 000 Eqs. 2, 7, 8) splits into a volumetric and a
@@ -25,13 +25,13 @@
 //! equals its element value and the stress is the standard kernel's.
 //!
 //! The explicit step: θ̄_a² ≤ Σ_{e∋a} (V_e/4) θ_e² / V̄_a (Jensen), so the averaged energy
-//! never exceeds the standard one, and the standard element bound ([`crate::stable_step`])
+//! never exceeds the standard one, and the standard element bound ([`crate::step::stepper::stable_step`])
 //! still bounds M⁻¹K: the bulk wave sets the step as before (the option removes the locking,
 //! not the short step).
 //!
 //! Every sum runs in a fixed order (a particle's tetrahedra ascending), in parallel over
 //! tetrahedra and over particles with no shared accumulator: results are bit-identical for
-//! any number of threads. A run decomposed over processes refuses it ([`crate::World::decompose`]).
+//! any number of threads. A run decomposed over processes refuses it ([`crate::world::World::decompose`]).
 
 use crate::continuum::material::Material;
 use crate::continuum::tet_body::{current_gradients, lame_block};

@@ -15,3 +15,8 @@ pub mod tet_body;
 pub mod tet_kernel;
 pub mod tet_lanes;
 pub mod tet_subdomain;
+
+pub use averaged_pressure_tet::Formulation;
+pub use material::Material;
+pub use tet_blocks::BlockLayout;
+pub use tet_body::TetBody;

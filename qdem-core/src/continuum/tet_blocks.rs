@@ -32,13 +32,13 @@ const MIN_BLOCK: usize = 256;
 /// How a body's tetrahedra are cut into blocks, for a model of the memory traffic of a step.
 ///
 /// ```
-/// use qdem_core::{Material, TetBody, Vec3};
+/// use qdem_core::{continuum::Material, continuum::TetBody, Vec3};
 ///
 /// let nodes = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];
 /// let body = TetBody::new("tet", &nodes, vec![[0, 1, 2, 3]], Material::elastic(1.0, 1.0, 0.25))?;
 /// let layout = body.block_layout();
 /// assert_eq!((layout.blocks, layout.block_nodes), (1, 4));
-/// # Ok::<(), qdem_core::CoreError>(())
+/// # Ok::<(), qdem_core::error::CoreError>(())
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BlockLayout {

@@ -9,7 +9,7 @@
 //! atomics, no reduction-order dependence).
 //! Elastic materials take a path without the viscous stress.
 //!
-//! For implicit and static solves the body adds its tangent (its [`crate::Linearized`] facet):
+//! For implicit and static solves the body adds its tangent (its [`crate::step::Linearized`] facet):
 //! the small-strain linear-tetrahedron stiffness K_e = V Gᵀ D G per element, with the volume V
 //! and shape-function gradients G of the current configuration, and the same operator with the
 //! viscous Lamé pair for the damping C_e. This is the exact linearisation of Eqs. 1–10 about an
@@ -47,7 +47,7 @@ const VISCOUS_COST: f64 = 1.6;
 /// A deformable body of linear QDEM tetrahedra.
 ///
 /// ```
-/// use qdem_core::{Material, Model, State, TetBody, Vec3};
+/// use qdem_core::{continuum::Material, step::Model, step::State, continuum::TetBody, Vec3};
 ///
 /// // One tetrahedron of volume 1/6 m³.
 /// let nodes = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];
@@ -64,7 +64,7 @@ const VISCOUS_COST: f64 = 1.6;
 /// assert!(force[1].x < 0.0);
 /// let total: Vec3 = force.iter().sum();
 /// assert!(total.norm() < 1e-9 * force[1].norm());
-/// # Ok::<(), qdem_core::CoreError>(())
+/// # Ok::<(), qdem_core::error::CoreError>(())
 /// ```
 #[derive(Clone, Debug)]
 pub struct TetBody {
@@ -273,7 +273,7 @@ impl TetBody {
 
     /// The small-strain stress σ = λ tr(ε) I + 2μ ε of every tetrahedron, ε = sym(∇u) with
     /// ∇u = du · dX⁻¹ from the particles' displacements (the linear-tetrahedron stress that
-    /// belongs to a static solve's answer, [`crate::StaticSolver`]: exact for any
+    /// belongs to a static solve's answer, [`crate::solvers::StaticSolver`]: exact for any
     /// displacement that is linear in space, without the O(ε) of [`TetBody::tet_fields`]'s
     /// finite-strain tensor). In [`Formulation::AveragedPressure`], the deviatoric part of
     /// each element's own ε with the pressure κ θ̄ of its corners' averaged tr ε, the stress

@@ -5,3 +5,8 @@ pub mod gravity;
 pub mod nodal_load;
 pub mod surface_load;
 pub mod time_function;
+
+pub use gravity::Gravity;
+pub use nodal_load::NodalLoad;
+pub use time_function::Cyclic;
+pub use time_function::TimeFunction;

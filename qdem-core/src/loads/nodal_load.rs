@@ -37,7 +37,7 @@ impl NodalLoad {
     /// to the nodes by [`crate::loads::surface_load::lump_traction`].
     ///
     /// ```
-    /// use qdem_core::{NodalLoad, TimeFunction, Vec3};
+    /// use qdem_core::{loads::NodalLoad, loads::TimeFunction, Vec3};
     /// let forces = vec![(0, Vec3::new(0.0, 0.0, -1.0)), (3, Vec3::new(0.0, 0.0, -2.0))];
     /// let load = NodalLoad::per_particle("top", forces, TimeFunction::constant(1.0));
     /// assert_eq!(load.total(), Vec3::new(0.0, 0.0, -3.0));

@@ -211,8 +211,8 @@ pub struct Modes {
 /// at `state`.
 ///
 /// ```
-/// use qdem_core::lanczos::natural_modes;
-/// use qdem_core::{Dofs, Material, Model, State, TetBody, Vec3};
+/// use qdem_core::modal::lanczos::natural_modes;
+/// use qdem_core::{step::Dofs, continuum::Material, step::Model, step::State, continuum::TetBody, Vec3};
 ///
 /// // One tetrahedron, three vertices fixed: 3 free DOFs, 3 modes.
 /// let nodes = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];
@@ -224,7 +224,7 @@ pub struct Modes {
 /// let modes = natural_modes(&state, &models, 3)?;
 /// assert_eq!(modes.modes.len(), 3);
 /// assert!(modes.modes.windows(2).all(|w| w[0].frequency_hz <= w[1].frequency_hz));
-/// # Ok::<(), qdem_core::lanczos::ModalError>(())
+/// # Ok::<(), qdem_core::modal::lanczos::ModalError>(())
 /// ```
 pub fn natural_modes(
     state: &State,

@@ -1,6 +1,6 @@
 //! [`Communicator`]: the collectives of a run decomposed over ranks. Only the seam
 //! ([`crate::parallel`]) calls them: the [`crate::parallel::ParallelRuntime`] that a
-//! [`crate::World`] owns runs them around the models' force evaluations, in the same order
+//! [`crate::world::World`] owns runs them around the models' force evaluations, in the same order
 //! on every rank; no model calls one.
 
 /// What a decomposed run needs of its message passing: the collectives every rank calls in
@@ -10,8 +10,7 @@
 /// Counts are per rank, in rank order; buffers hold the ranks' parts one after the other.
 ///
 /// ```
-/// use qdem_core::{Communicator, Material, Model, Scheme, State, StepRequest, StepSettings,
-///     TetBody, Vec3, World};
+/// use qdem_core::{parallel::Communicator, continuum::Material, step::Model, step::Scheme, step::State, step::StepRequest, step::StepSettings, ///     TetBody, Vec3, world::World};
 ///
 /// /// The communicator of a single process: every collective is a copy.
 /// struct Alone;

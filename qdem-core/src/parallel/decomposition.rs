@@ -7,7 +7,7 @@
 //! entry; its **halo** ranks are the others whose blocks hold it. The particles that split
 //! models ([`crate::step::split::Facets`]: DEM contacts) move and no deformable body holds are given
 //! out in runs of particle order, a rigid body whole to one rank, and given out again by
-//! their measured work at a re-partition ([`crate::World::repartition`]). Each step:
+//! their measured work at a re-partition ([`crate::world::World::repartition`]). Each step:
 //!
 //! 1. each rank predicts the particles it steps (the same arithmetic on the same values
 //!    everywhere, so the predicted positions and half-step velocities agree bit for bit);
@@ -26,11 +26,11 @@
 //!
 //! What a rank steps and what step 4 sends depend on what the models read:
 //! - **halo exchange**, when every model and hook reads only what a rank steps itself or
-//!   declares the rest it reads ([`crate::Reads::Own`]: gravity, nodal loads;
-//!   [`crate::Reads::Split`]: deformable bodies, contacts, the periodic wrap) and the stepper can be
+//!   declares the rest it reads ([`crate::step::Reads::Own`]: gravity, nodal loads;
+//!   [`crate::step::Reads::Split`]: deformable bodies, contacts, the periodic wrap) and the stepper can be
 //!   restricted (Verlet): a rank predicts its own particles and its halo, integrates its
 //!   own, and receives only its halo's motion. The other particles keep the value of the
-//!   last whole gather ([`crate::World::gather`]), which the outputs, checkpoints and
+//!   last whole gather ([`crate::world::World::gather`]), which the outputs, checkpoints and
 //!   failure reports ask for before they read the state;
 //! - **whole share** otherwise (bonded particles, explicit Newmark): every rank steps every
 //!   particle and receives every other rank's owned particles, so that it holds the one
@@ -52,7 +52,7 @@ use crate::Vec3;
 use std::sync::Arc;
 
 /// The figures of a decomposition, per rank: how the deformable bodies' blocks and the
-/// particles fall on the ranks, the same on every rank; what [`crate::World::decompose`]
+/// particles fall on the ranks, the same on every rank; what [`crate::world::World::decompose`]
 /// returns (see the example of [`Communicator`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RankFigures {
@@ -303,7 +303,7 @@ pub(crate) fn decompose(
 
 /// The part of a halo-exchanged decomposition that does not change as bodies move: the
 /// deformable bodies' owners and halo. The rest (the grains' and rigid bodies' owners) is
-/// assigned again at a re-partition ([`crate::World::repartition`]).
+/// assigned again at a re-partition ([`crate::world::World::repartition`]).
 pub(crate) struct Partition {
     pub comm: Arc<dyn Communicator>,
     /// Per particle, the rank of the deformable body's block that owns it (`u32::MAX` for

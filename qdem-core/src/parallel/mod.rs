@@ -1,6 +1,6 @@
 //! The decomposition of a run over ranks (MPI processes, or threads in tests), behind one
-//! seam: a [`crate::World`] owns a [`ParallelRuntime`] (single-process by default,
-//! decomposed after [`crate::World::decompose`]) and every collective of a step runs there,
+//! seam: a [`crate::world::World`] owns a [`ParallelRuntime`] (single-process by default,
+//! decomposed after [`crate::world::World::decompose`]) and every collective of a step runs there,
 //! around the stepper's force evaluations and integrations, never inside a model.
 //!
 //! - [`Communicator`]: the collectives a decomposed run needs (MPI in `qdem`, threads in

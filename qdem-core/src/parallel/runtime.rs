@@ -1,6 +1,6 @@
-//! [`ParallelRuntime`]: the one place where a step meets the ranks. A [`crate::World`] owns
+//! [`ParallelRuntime`]: the one place where a step meets the ranks. A [`crate::world::World`] owns
 //! one: single-process by default, where every call is a plain loop or does nothing, and
-//! decomposed after [`crate::World::decompose`]. The steppers evaluate forces through it
+//! decomposed after [`crate::world::World::decompose`]. The steppers evaluate forces through it
 //! ([`ParallelRuntime::sum_forces`]) and end each integration with it
 //! ([`ParallelRuntime::complete`]); the world runs its gathers, its failure agreement, the
 //! post-step hooks and the re-partitions through it. Models never call a collective: a split model declares what it exchanges
@@ -23,7 +23,7 @@ use crate::Vec3;
 use std::sync::Arc;
 
 /// The ratio of the busiest rank's work to the mean above which a rebuild of a split
-/// model's lists re-partitions the free particles ([`crate::World::repartition`]).
+/// model's lists re-partitions the free particles ([`crate::world::World::repartition`]).
 const REPARTITION_IMBALANCE: f64 = 1.1;
 
 /// Rebuilds between two re-partitions at least: a re-partition gathers the whole state, and
@@ -36,7 +36,7 @@ const REPARTITION_REBUILDS: usize = 8;
 /// models' forces and the rest does nothing.
 ///
 /// ```
-/// use qdem_core::{ParallelRuntime, Gravity, Model, State, StageTimes, Vec3};
+/// use qdem_core::{parallel::ParallelRuntime, loads::Gravity, step::Model, step::State, step::StageTimes, Vec3};
 ///
 /// let mut state = State::at_rest(vec![Vec3::zeros()]);
 /// state.mass[0] = 2.0;
@@ -205,7 +205,7 @@ impl ParallelRuntime {
         self.ranks.as_ref().map_or(0, |r| r.repartitions)
     }
 
-    /// Decomposes the run over `comm`'s ranks (see [`crate::World::decompose`]): a halo
+    /// Decomposes the run over `comm`'s ranks (see [`crate::world::World::decompose`]): a halo
     /// exchange when every model and hook reads only what a rank steps itself and
     /// `steps_in_part` (the stepper can step a rank's particles alone), else every rank
     /// steps every particle and receives the others' after every step.
@@ -274,7 +274,7 @@ impl ParallelRuntime {
     }
 
     /// Makes the state and the split models whole on every rank, as one process holds them
-    /// (see [`crate::World::gather`]); a no-op in a run of one process.
+    /// (see [`crate::world::World::gather`]); a no-op in a run of one process.
     pub(crate) fn gather(
         &mut self,
         state: &mut State,
@@ -287,14 +287,14 @@ impl ParallelRuntime {
     }
 
     /// Makes the stepper's per-particle `forces` whole on every rank (see
-    /// [`crate::World::gather_forces`]).
+    /// [`crate::world::World::gather_forces`]).
     pub(crate) fn gather_forces(&mut self, forces: &mut [Vec3]) {
         if let Some(ranks) = &mut self.ranks {
             ranks.share.gather_vectors(forces);
         }
     }
 
-    /// Makes `particles`' motion whole on every rank (see [`crate::World::gather_particles`]).
+    /// Makes `particles`' motion whole on every rank (see [`crate::world::World::gather_particles`]).
     pub(crate) fn gather_particles(&mut self, state: &mut State, particles: &[usize]) {
         if let Some(ranks) = &mut self.ranks {
             ranks.share.gather_some(state, particles);
@@ -373,7 +373,7 @@ impl ParallelRuntime {
     }
 
     /// After a step: re-partitions when a split model rebuilt its lists and the ranks' work
-    /// is out of balance ([`crate::World::repartition`]).
+    /// is out of balance ([`crate::world::World::repartition`]).
     pub(crate) fn rebalance(
         &mut self,
         state: &mut State,
@@ -406,7 +406,7 @@ impl ParallelRuntime {
     }
 
     /// Gives the free particles new owners by their measured work (see
-    /// [`crate::World::repartition`]); a no-op unless the run shares only the halo.
+    /// [`crate::world::World::repartition`]); a no-op unless the run shares only the halo.
     pub(crate) fn repartition(
         &mut self,
         state: &mut State,

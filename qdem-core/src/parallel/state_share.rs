@@ -6,7 +6,7 @@
 //! next prediction (paper 000 §2.4: x += ∆t (v + ½∆t a), v += ½∆t a) needs besides the
 //! position, and the position follows bit for bit from them. Two ways:
 //! - **whole**: every owned particle to every rank ([`Communicator::all_gather`]), when some
-//!   model or hook reads any particle ([`crate::Reads::All`]) or the stepper steps
+//!   model or hook reads any particle ([`crate::step::Reads::All`]) or the stepper steps
 //!   every particle; every rank then holds the state one process holds after every step;
 //! - **halo**: each owned particle only to the ranks whose tetrahedra touch it
 //!   ([`Communicator::all_to_all`]); a rank steps its own particles and its halo, and the

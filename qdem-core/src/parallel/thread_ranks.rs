@@ -26,8 +26,8 @@ pub struct ThreadRank {
 /// rank of one set.
 ///
 /// ```
-/// use qdem_core::thread_ranks::on_thread_ranks;
-/// use qdem_core::Communicator;
+/// use qdem_core::parallel::thread_ranks::on_thread_ranks;
+/// use qdem_core::parallel::Communicator;
 ///
 /// let ranks = on_thread_ranks(3, |comm| {
 ///     let mut all = vec![0.0; 3];

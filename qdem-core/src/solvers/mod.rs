@@ -11,3 +11,9 @@ pub mod static_solve;
 pub mod stepper_for;
 pub mod verlet;
 pub(crate) mod verlet_sweeps;
+
+pub use newmark::Newmark;
+pub use newmark::TangentUpdate;
+pub use static_solve::StaticSolver;
+pub use static_solve::StaticSteps;
+pub use verlet::Verlet;

@@ -11,7 +11,7 @@
 //!
 //! - **β = 0** (explicit; γ = ½ is central difference): x_{n+1} = x̃ needs no solve and
 //!   a_{n+1} = M⁻¹ f(t_{n+1}, x̃, ṽ), the viscous force seeing the predicted velocity ṽ. For
-//!   γ = ½, ṽ is the half-step velocity and the scheme is [`crate::Verlet`], operation for
+//!   γ = ½, ṽ is the half-step velocity and the scheme is [`crate::solvers::Verlet`], operation for
 //!   operation; it is stable for ∆t ≤ [`crate::continuum::stable_step()`].
 //! - **β > 0** (implicit): Eq. 26 linearises the force at the step's start,
 //!   f(x_{n+1}, v_{n+1}) ≈ f(x_n, v_n) − K (x_{n+1} − x_n) − C (v_{n+1} − v_n), and reads
@@ -43,7 +43,7 @@
 //! and refactorised, reusing the symbolic analysis. The fixity is read when factorising.
 //!
 //! When a model's events change the tangent (bonds break, contacts open or close,
-//! [`crate::StepEvents::commit_step`]), the matrix is reassembled and, by default
+//! [`crate::step::StepEvents::commit_step`]), the matrix is reassembled and, by default
 //! ([`EventSolve::Refactorize`]), refactorised. With [`EventSolve::Preconditioned`] (issue 26)
 //! it is solved instead by conjugate gradients preconditioned with the kept factor of the same
 //! step length (`conjugate_gradient`: k events change the matrix by a rank of at most 3k, so
@@ -76,7 +76,7 @@ use rayon::prelude::*;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TangentUpdate {
     /// With K and C at the initial state, and again only when a model's events change its
-    /// tangent ([`crate::StepEvents::commit_step`]: bonds broken, contacts made or lost).
+    /// tangent ([`crate::step::StepEvents::commit_step`]: bonds broken, contacts made or lost).
     #[default]
     Fixed,
     /// Every step, with K and C at the step's start (large displacements or rotations).
@@ -107,10 +107,7 @@ const MIN_FRACTION: f64 = 1.0 / 16.0;
 /// The Newmark-β family: explicit for β = 0, implicit for β > 0, optionally adaptive.
 ///
 /// ```
-/// use qdem_core::{
-///     stable_step, Dofs, Material, Model, Newmark, NodalLoad, State, StaticSolver, Stepper,
-///     TetBody, TimeFunction, Vec3,
-/// };
+/// use qdem_core::{///     stable_step, step::Dofs, continuum::Material, step::Model, solvers::Newmark, loads::NodalLoad, step::State, solvers::StaticSolver, step::Stepper, ///     TetBody, loads::TimeFunction, Vec3, ///};
 ///
 /// // One viscous tetrahedron with three vertices clamped and a load on the fourth.
 /// let build = || {
@@ -148,7 +145,7 @@ const MIN_FRACTION: f64 = 1.0 / 16.0;
 /// }
 /// let settled = state.displacement(3);
 /// assert!((settled - expected).norm() < 1e-2 * expected.norm());
-/// # Ok::<(), qdem_core::CoreError>(())
+/// # Ok::<(), qdem_core::error::CoreError>(())
 /// ```
 #[derive(Debug)]
 pub struct Newmark {
@@ -275,7 +272,7 @@ impl Newmark {
     }
 
     /// The same stepper with the adaptive control of paper 001 Eqs. 29–30: a step that a
-    /// model's [`crate::StepEvents::check_step`] rejects is retaken once from its start with ∆t·√α (but
+    /// model's [`crate::step::StepEvents::check_step`] rejects is retaken once from its start with ∆t·√α (but
     /// not shorter than ∆t/16), and the remainder of the nominal step follows as further
     /// sub-steps, each checked the same way (so outputs stay on the nominal grid). Off by
     /// default.

@@ -909,7 +909,7 @@ pub fn explain_failure(
     }
 }
 
-/// The models owning particles ([`crate::Linearized::particles`], i.e. deformable bodies) that the fixed
+/// The models owning particles ([`crate::step::Linearized::particles`], i.e. deformable bodies) that the fixed
 /// directions of `dofs` leave free to move rigidly with no stiffness against it, each with the
 /// number of its free rigid-body modes (of 3 translations and 3 rotations, at the current
 /// positions).
@@ -1057,7 +1057,7 @@ pub(crate) fn sparse_error(e: impl std::fmt::Debug) -> CoreError {
     CoreError::Sparse(format!("{e:?}"))
 }
 
-/// The particles a model's elements join ([`crate::Linearized::particles`]); none for a model
+/// The particles a model's elements join ([`crate::step::Linearized::particles`]); none for a model
 /// without a linearisation.
 fn particles_of(model: &dyn Model) -> Vec<usize> {
     model.linearized().map_or_else(Vec::new, |l| l.particles())

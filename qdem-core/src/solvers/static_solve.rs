@@ -3,7 +3,7 @@
 //!
 //! f is the total force the models give on the reference configuration at the requested time
 //! (loads and gravity; the internal force vanishes there), K the models' tangent stiffness at
-//! the reference configuration ([`crate::Linearized::add_tangent`]). For QDEM tetrahedra this is the
+//! the reference configuration ([`crate::step::Linearized::add_tangent`]). For QDEM tetrahedra this is the
 //! small-strain linear-tetrahedron stiffness, so the answer is the mesh's linear FEM solution.
 //! K is assembled and factorised by `sparse::SparseCholesky` on the first solve (with the fixity of
 //! that moment) and reused for every later load level: one further force evaluation per
@@ -244,7 +244,7 @@ impl StaticSteps {
     }
 
     /// The levels end at `end` (s): the level within rounding of it (10⁻⁹ dt, the tolerance
-    /// of [`crate::StepSettings::steps_to`]) is solved at `end` itself.
+    /// of [`crate::step::StepSettings::steps_to`]) is solved at `end` itself.
     pub fn ending_at(mut self, end: Option<f64>) -> StaticSteps {
         self.end = end;
         self
@@ -269,7 +269,7 @@ impl Stepper for StaticSteps {
         self.dt
     }
 
-    /// A static solve is never decomposed ([`crate::World::decompose`] refuses it): the
+    /// A static solve is never decomposed ([`crate::world::World::decompose`] refuses it): the
     /// exchange is a single process's.
     fn initialize_in(
         &mut self,

@@ -5,7 +5,7 @@
 //! Viscous forces see the half-step velocity, as in explicit FE codes, which is what the step
 //! bound of [`mod@crate::continuum::stable_step`] assumes. Fixed directions keep zero velocity.
 //!
-//! Particle rotations ([`crate::ParticleSpin`]: a one-sphere grain, a bonded particle) are
+//! Particle rotations ([`crate::step::ParticleSpin`]: a one-sphere grain, a bonded particle) are
 //! integrated the same way, ω_{n+½} = ω_n + ½∆t M_n/J, θ_{n+1} = θ_n + ∆t ω_{n+½},
 //! ω_{n+1} = ω_{n+½} + ½∆t M_{n+1}/J. Rigid bodies ([`crate::step::rigid_body`]) ride along: their
 //! angular momentum gets the same two half kicks from the torque and their orientation the
@@ -36,7 +36,7 @@ use crate::Vec3;
 /// Velocity Verlet with a fixed step.
 ///
 /// ```
-/// use qdem_core::{Gravity, Model, State, Stepper, Vec3, Verlet};
+/// use qdem_core::{loads::Gravity, step::Model, step::State, step::Stepper, Vec3, solvers::Verlet};
 ///
 /// // A particle dropped from rest: under a constant force velocity Verlet is exact.
 /// let mut state = State::at_rest(vec![Vec3::zeros()]);
@@ -52,7 +52,7 @@ use crate::Vec3;
 /// assert!((t - 0.5).abs() < 1e-12);
 /// assert!((state.position[0] - 0.5 * g * t * t).norm() < 1e-12);
 /// assert!((state.velocity[0] - g * t).norm() < 1e-12);
-/// # Ok::<(), qdem_core::CoreError>(())
+/// # Ok::<(), qdem_core::error::CoreError>(())
 /// ```
 #[derive(Clone, Debug)]
 pub struct Verlet {
@@ -317,8 +317,8 @@ fn particles<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::loads::Gravity;
     use crate::step::state::Dofs;
-    use crate::Gravity;
 
     /// A constant moment on particle 0 about z, and a constant force on it along x.
     struct Twist {

@@ -6,7 +6,7 @@
 //!   predictor with β = 0, γ = ½, bit for bit), ω and θ likewise, and the zeroing of the
 //!   force and moment sums the models then add into;
 //! - [`kick`]: after the forces, a uniform field's force m g deferred from the models
-//!   ([`crate::Model::uniform_acceleration`]), local damping
+//!   ([`crate::step::Model::uniform_acceleration`]), local damping
 //!   ([`crate::solvers::local_damping`]), a = f/m (zero in fixed directions and on members of
 //!   rigid bodies, which follow their body), the second half kick v += ½∆t a and the check
 //!   that every acceleration is finite; θ̈ = M/J and ω likewise.

@@ -1,6 +1,6 @@
 //! Detecting a run that has gone unstable, so that it stops with a diagnosis instead of
 //! writing garbage: non-finite accelerations (the steppers), inverted tetrahedra (the
-//! bodies, [`crate::Model::failure`]) and runaway kinetic energy ([`EnergyGrowth`]).
+//! bodies, [`crate::step::Model::failure`]) and runaway kinetic energy ([`EnergyGrowth`]).
 
 /// Kinetic energy growth at every step by at least this factor counts towards runaway.
 pub const GROWTH_PER_STEP: f64 = 1.2;

@@ -18,7 +18,7 @@
 //! - [`Reads`] ([`Model::reads`]): what the model reads of the particles' motion in a run
 //!   decomposed over ranks, and for a model that one rank computes in part (deformable
 //!   bodies, DEM contacts) its [`crate::step::split::Facets`]: the stages of its
-//!   force evaluation and what it exchanges, which the world's [`crate::ParallelRuntime`]
+//!   force evaluation and what it exchanges, which the world's [`crate::parallel::ParallelRuntime`]
 //!   runs.
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
@@ -77,7 +77,7 @@ pub trait Model: std::any::Any + Send + Sync {
     }
 
     /// Learns how the run is stepped (implicit or explicit, the step), once, when the
-    /// [`crate::World`] is made; a model whose forces depend on it (a bonded body whose
+    /// [`crate::world::World`] is made; a model whose forces depend on it (a bonded body whose
     /// contacts push only when active in an implicit run) keeps what it needs. The default
     /// ignores it.
     fn prepare(&mut self, settings: &StepSettings) {

@@ -79,7 +79,7 @@ pub trait Seam {
 /// ```
 /// use qdem_core::step::seam::{OneProcess, Seam};
 /// use qdem_core::step::{model::Model, stages::StageTimes, state::State};
-/// use qdem_core::{Gravity, Vec3};
+/// use qdem_core::{loads::Gravity, Vec3};
 ///
 /// let mut state = State::at_rest(vec![Vec3::zeros()]);
 /// state.mass[0] = 2.0;

@@ -46,7 +46,7 @@ impl StepCounts {
     /// The counts in field order (for checkpoints).
     ///
     /// ```
-    /// use qdem_core::StepCounts;
+    /// use qdem_core::step::StepCounts;
     /// let counts = StepCounts { retakes: 2, iterations: 7, ..StepCounts::default() };
     /// assert_eq!(StepCounts::from_array(counts.to_array()), counts);
     /// ```

@@ -39,12 +39,12 @@
 //!    for nodes another rank owns);
 //! 7. [`Evaluation::apply`]: the rank adds its own particles' forces.
 //!
-//! A post-step hook that decides for its own particles ([`crate::PostStep::reads`]) has
+//! A post-step hook that decides for its own particles ([`crate::step::PostStep::reads`]) has
 //! [`Ownership`] and [`Decisions`] only:
 //!
 //! ```
 //! use qdem_core::step::split::{Decisions, Facets, Ownership};
-//! use qdem_core::{Halt, Model, Part, PostStep, Reads, State};
+//! use qdem_core::{step::Halt, step::Model, step::Part, step::PostStep, step::Reads, step::State};
 //!
 //! /// Pins particle 0 back to x = 0 after every step; the rank that owns it decides.
 //! struct Pin {
@@ -92,12 +92,12 @@ use crate::Vec3;
 use std::ops::Range;
 use std::sync::Arc;
 
-/// How a [`crate::Model`] (or a [`crate::PostStep`] hook) takes part in a run decomposed
+/// How a [`crate::step::Model`] (or a [`crate::step::PostStep`] hook) takes part in a run decomposed
 /// over ranks: what it reads of the particles' motion at each step. The default,
 /// [`Reads::All`], is always right.
 ///
 /// ```
-/// use qdem_core::{Gravity, Model, Reads, Vec3};
+/// use qdem_core::{loads::Gravity, step::Model, step::Reads, Vec3};
 ///
 /// // Gravity reads the masses and nothing of the motion.
 /// let mut g = Gravity::new(Vec3::new(0.0, 0.0, -9.81));
@@ -121,7 +121,7 @@ pub enum Reads<'a> {
 /// body ([`Facets::body`]) its share of the blocks.
 ///
 /// ```
-/// use qdem_core::Part;
+/// use qdem_core::step::Part;
 /// use std::sync::Arc;
 ///
 /// // Rank 1 of a run whose three particles are owned by ranks 0, 1 and every rank.
@@ -147,7 +147,7 @@ pub struct Part {
 ///
 /// ```
 /// use qdem_core::step::split::BodySplit;
-/// use qdem_core::{PartialSums, Vec3};
+/// use qdem_core::{step::PartialSums, Vec3};
 ///
 /// /// A body's sums per slot of its blocks, and its share of a decomposed run.
 /// struct Body {
@@ -298,7 +298,7 @@ pub trait Reduction {
     fn reduced(&mut self, time: f64, all: &[f64]);
 }
 
-/// The records a whole gather ([`crate::World::gather`]) merges.
+/// The records a whole gather ([`crate::world::World::gather`]) merges.
 pub trait Merge {
     /// Appends this rank's records (contacts) to `out` and returns true; false when the
     /// model is whole already (the same answer on every rank).
@@ -309,7 +309,7 @@ pub trait Merge {
     fn merge(&mut self, all: &[f64]);
 }
 
-/// A split model's work, which a re-partition ([`crate::World::repartition`]) balances.
+/// A split model's work, which a re-partition ([`crate::world::World::repartition`]) balances.
 pub trait Balance {
     /// Whether the model has rebuilt what decides its work (DEM contacts: their candidate
     /// lists) since the last call, the same on every rank: a decomposed world may then
@@ -337,7 +337,7 @@ pub trait Decisions {
 /// One deformable body's share of the decomposition, for one rank: which of its blocks the
 /// rank computes, which of its particles the rank owns, which block sums go where. The
 /// decomposition makes it from the body's [`BodyLayout`] and hands it over in
-/// [`crate::Part::body`].
+/// [`crate::step::Part::body`].
 #[derive(Clone, Debug)]
 pub struct BodySplit {
     /// The blocks this rank computes.
@@ -356,7 +356,7 @@ pub struct BodySplit {
 
 /// The block sums a rank sends to and receives from the others each step (slots of the
 /// body's sums, grouped by rank, ascending within a rank: both sides list them alike). A
-/// body hands it back in its [`crate::PartialSums`]; the runtime runs it.
+/// body hands it back in its [`crate::step::PartialSums`]; the runtime runs it.
 #[derive(Clone)]
 pub struct SumExchange {
     pub(crate) send_slots: Vec<u32>,

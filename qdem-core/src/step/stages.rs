@@ -1,11 +1,11 @@
 //! Stage counters: the wall time a step spends in each of its named stages, in the spirit of
 //! rapier's `PhysicsPipeline` counters.
 //!
-//! A [`crate::World`] step runs as stages — predict, the forces of each model, integrate,
+//! A [`crate::world::World`] step runs as stages — predict, the forces of each model, integrate,
 //! solve (implicit steps: tangent, factorisation, back substitution), events (the models'
 //! step checks and commits), the post-step hooks, and the failure check — and the steppers
 //! mark the end of each stage on a [`StageTimes`] as they go. Marking a disabled clock
-//! ([`StageTimes::off`]) costs a branch, so the plain [`crate::Stepper::step`] pays nothing.
+//! ([`StageTimes::off`]) costs a branch, so the plain [`crate::step::Stepper::step`] pays nothing.
 
 use std::time::Instant;
 

@@ -64,7 +64,7 @@ impl Dofs {
 /// Degrees of freedom of all particles of a scene, one entry per particle in each array.
 ///
 /// ```
-/// use qdem_core::{Dofs, State, Vec3};
+/// use qdem_core::{step::Dofs, step::State, Vec3};
 ///
 /// // Two particles at rest where they were put; masses are the caller's (or a body's
 /// // `lump_mass`) to fill in.
@@ -112,7 +112,7 @@ pub struct State {
 /// array has one entry per particle.
 ///
 /// Rotations are integrated linearly, like translations (small rotations, the setting of the
-/// paper's beam matrices); a model that needs finite rotations uses [`crate::RigidBodies`].
+/// paper's beam matrices); a model that needs finite rotations uses [`crate::step::RigidBodies`].
 /// A sphere needs no orientation (its contacts read only ω), so a one-sphere grain rotates
 /// here, with θ̇ = ω exact and θ its accumulated rotation vector, which nothing reads.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -207,7 +207,7 @@ impl State {
     /// refuse rigid bodies and never see it.
     ///
     /// ```
-    /// use qdem_core::{State, Vec3};
+    /// use qdem_core::{step::State, Vec3};
     ///
     /// let state = State::at_rest(vec![Vec3::zeros(); 4]);
     /// assert_eq!(state.body_rotation_node(1), 5);
@@ -305,7 +305,7 @@ impl State {
     /// (the checkpoint of another scene), so that every fixed direction starts at rest.
     ///
     /// ```
-    /// use qdem_core::{Dofs, State, Vec3};
+    /// use qdem_core::{step::Dofs, step::State, Vec3};
     ///
     /// let mut state = State::at_rest(vec![Vec3::zeros()]);
     /// state.fix(0, Dofs::parse("z").unwrap());

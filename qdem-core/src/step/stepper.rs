@@ -37,7 +37,7 @@ pub trait Stepper: Send {
     }
 
     /// [`Stepper::initialize`], evaluating the forces through `seam` (a
-    /// [`crate::World`]'s, decomposed or not).
+    /// [`crate::world::World`]'s, decomposed or not).
     fn initialize_in(
         &mut self,
         state: &mut State,
@@ -51,7 +51,7 @@ pub trait Stepper: Send {
     }
 
     /// [`Stepper::step`], marking the end of each of its stages on `stages` (predict, each
-    /// model's forces, integrate, solve, events: [`crate::stages`]), evaluating the forces
+    /// model's forces, integrate, solve, events: [`crate::step::stages`]), evaluating the forces
     /// through `seam` ([`Seam::sum_forces`]) and ending each integration with
     /// [`Seam::complete`] (in a decomposed run, the share of the ranks' new motion), on
     /// `seam`'s particles only when it says so ([`Seam::stepped`], [`Seam::computed`]).
@@ -71,14 +71,14 @@ pub trait Stepper: Send {
     }
 
     /// The force buffer of [`Stepper::forces`], for a decomposed run's gather
-    /// ([`crate::World::gather_forces`]); empty (the default) for a stepper that keeps none.
+    /// ([`crate::world::World::gather_forces`]); empty (the default) for a stepper that keeps none.
     fn forces_mut(&mut self) -> &mut [Vec3] {
         &mut []
     }
 
     /// The torques on the rigid bodies that the next step reads (Verlet's first half kick),
     /// which a run decomposed with a halo exchange gathers from the bodies' owners with the
-    /// state ([`crate::World::gather`]); empty (the default) for a stepper that keeps none
+    /// state ([`crate::world::World::gather`]); empty (the default) for a stepper that keeps none
     /// from one step to the next or cannot step in part.
     fn rigid_torques_mut(&mut self) -> &mut [Vec3] {
         &mut []

@@ -1,5 +1,5 @@
 //! [`Tangent`]: the tangent stiffness K = −∂f/∂x and damping C = −∂f/∂v that the models'
-//! linearisations ([`crate::Linearized`]) add for implicit and static solves (paper 001
+//! linearisations ([`crate::step::Linearized`]) add for implicit and static solves (paper 001
 //! Eq. 26), as 3×3 blocks per particle pair in global numbering (DOF 3·particle + axis). Only
 //! the lower triangle (row ≥ column) is kept: both matrices are symmetric and the Cholesky
 //! factorisation reads the lower triangle only. The solvers assemble and factorise it

@@ -2,7 +2,10 @@
 
 #![allow(dead_code)] // each test binary uses a subset
 
-use qdem_core::{Dofs, Gravity, Material, Model, NodalLoad, State, TetBody, TimeFunction, Vec3};
+use qdem_core::{
+    continuum::Material, continuum::TetBody, loads::Gravity, loads::NodalLoad, loads::TimeFunction,
+    step::Dofs, step::Model, step::State, Vec3,
+};
 use qdem_mesh::{structured_box, TetMesh};
 
 /// A cantilever over `mesh` (clamped on its `xmin` group) of `material`, under gravity and a

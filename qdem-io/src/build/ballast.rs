@@ -13,10 +13,10 @@
 //! jittered inside its cell by what its own size leaves free. The stones are deposited by
 //! running the scene under gravity (`velocity` starts them falling).
 //!
-//! All stones together form one deformable body (one [`qdem_core::TetBody`], so the kernel
+//! All stones together form one deformable body (one [`qdem_core::continuum::TetBody`], so the kernel
 //! runs over all their tetrahedra in parallel); in contact each stone is its own body, so its
 //! spheres never touch each other, and a periodic cell wraps each stone whole. With
-//! `rigid = true` each stone is instead a rigid body ([`qdem_core::rigid_body`]): a centre
+//! `rigid = true` each stone is instead a rigid body ([`qdem_core::step::rigid_body`]): a centre
 //! particle at the centre of mass of its tetrahedra with their mass and inertia, its mesh nodes
 //! massless members that carry its contact spheres ([`rigid_stones`]).
 
@@ -27,8 +27,8 @@ use qdem_contact::broad_phase::bounds;
 use qdem_contact::clump_sample::Grading;
 use qdem_contact::particle_packing::SplitMix64;
 use qdem_contact::ContactSphere;
-use qdem_core::rigid_body::tet_mass_properties;
-use qdem_core::{CoreError, Mat3, State, Vec3};
+use qdem_core::step::rigid_body::tet_mass_properties;
+use qdem_core::{error::CoreError, step::State, Mat3, Vec3};
 use qdem_mesh::TetMesh;
 use std::ops::Range;
 use std::path::PathBuf;
@@ -171,7 +171,7 @@ pub(crate) fn rigid_stones(
         state.rigid.set_angular_velocity(b, w);
         info.centers.push(c);
     }
-    qdem_core::rigid_body::place_members(state);
+    qdem_core::step::rigid_body::place_members(state);
     Ok(first)
 }
 

@@ -10,7 +10,7 @@
 //!
 //! The step: `critical_fraction` × ∆t_crit of Eq. 28 when given, else `[run] dt` as for any
 //! scene; an explicit step is always checked against the rigorous bound
-//! ([`qdem_core::Model::stable_dt`]), and a `critical_fraction` whose step is above it is
+//! ([`qdem_core::step::Model::stable_dt`]), and a `critical_fraction` whose step is above it is
 //! refused naming that key (not `[run] dt`, which it replaces). The world watches the body for collapse
 //! ([`CollapseWatch`]).
 
@@ -21,7 +21,8 @@ use qdem_contact::{
     PackingKind, UnbondedLaw,
 };
 use qdem_core::{
-    CoreError, Dofs, Model, NodalLoad, State, StepRequest, StepSettings, TimeFunction, Vec3, World,
+    error::CoreError, loads::NodalLoad, loads::TimeFunction, step::Dofs, step::Model, step::State,
+    step::StepRequest, step::StepSettings, world::World, Vec3,
 };
 
 /// A bonded run ends early once a particle has moved this many particle spacings: its linear

@@ -13,7 +13,7 @@ use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, LinearSpring, MeshWall,
     PeriodicBox, PlaneWall, Wall, WallShape,
 };
-use qdem_core::{State, Vec3};
+use qdem_core::{step::State, Vec3};
 use qdem_mesh::read_msh;
 
 /// Spheres that do not come from mesh bodies (the stones of `[granular]`), their bodies'

@@ -1,7 +1,7 @@
 //! [`BuildError`]: why a scene could not be turned into a simulation, each variant naming the
 //! scene file (or the data file) and saying how to fix it.
 
-use qdem_core::CoreError;
+use qdem_core::error::CoreError;
 use qdem_mesh::MeshError;
 use std::path::PathBuf;
 use thiserror::Error;

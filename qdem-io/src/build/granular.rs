@@ -37,7 +37,7 @@ use qdem_contact::clump_sample::{
     SampleError, SampleSpec, Stone,
 };
 use qdem_contact::ContactSphere;
-use qdem_core::{State, Vec3};
+use qdem_core::{step::State, Vec3};
 use std::ops::Range;
 use std::path::Path;
 
@@ -210,7 +210,7 @@ pub(crate) fn add_stones(
         info.stones.push((center, members));
     }
     if spinning {
-        qdem_core::rigid_body::place_members(state);
+        qdem_core::step::rigid_body::place_members(state);
     }
     Ok((info, spheres))
 }

@@ -4,9 +4,9 @@
 //! `[ballast]` stone) gets v_i = v + ω × (x_i − x_c), x_c the mean of its particles weighted by
 //! their lumped masses; a rigid body (a `[[body]]` with `rigid = true`, a `[granular]` clump)
 //! gets v at its centre and ω as its angular velocity, its members following
-//! ([`qdem_core::rigid_body::place_members`]); a one-sphere stone gets v and the spin ω.
+//! ([`qdem_core::step::rigid_body::place_members`]); a one-sphere stone gets v and the spin ω.
 
-use qdem_core::{State, Vec3};
+use qdem_core::{step::State, Vec3};
 use std::ops::Range;
 
 /// The particles of `part` (a deformable body or stone) moving rigidly with `velocity` and the

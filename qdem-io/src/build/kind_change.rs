@@ -26,8 +26,8 @@ use crate::build::{BodyInfo, BodyKind, PlacedMesh};
 use crate::scene::Scene;
 use nalgebra::{Matrix3, UnitQuaternion};
 use qdem_core::checkpoint::SavedState;
-use qdem_core::rigid_body::{place_body_members, point_inertia, tet_mass_properties};
-use qdem_core::{Material, Model, State, TetBody, Vec3};
+use qdem_core::step::rigid_body::{place_body_members, point_inertia, tet_mass_properties};
+use qdem_core::{continuum::Material, continuum::TetBody, step::Model, step::State, Vec3};
 use std::ops::Range;
 
 /// A part of a body that is one rigid body when the body is rigid: a `[[body]]`, or a stone.

@@ -4,7 +4,7 @@
 //!
 //! The file has a header row naming its columns; the first column is time in seconds,
 //! non-decreasing; the named column gives the factor. The factor becomes a piecewise-linear
-//! [`qdem_core::TimeFunction`] (held before the first and after the last row).
+//! [`qdem_core::loads::TimeFunction`] (held before the first and after the last row).
 
 use crate::build::BuildError;
 use std::path::Path;

@@ -5,7 +5,7 @@
 //! other sign. The figures quoted are measured: a clamped 1.0 × 0.06 × 0.10 m bar of 4,376
 //! tetrahedra under a 500 N tip load, static, against Timoshenko beam theory (the issue's
 //! table), and the averaged-pressure formulation that does not lock
-//! ([`qdem_core::averaged_pressure_tet`]). The explicit step is set by the bulk
+//! ([`qdem_core::continuum::averaged_pressure_tet`]). The explicit step is set by the bulk
 //! (dilatational) wave whatever the formulation, which the warning of an explicit run states
 //! as well; an implicit or static run has no such step, so an averaged-pressure body is not
 //! warned of there at all.

@@ -2,7 +2,7 @@
 //! `translate`), particles of all bodies laid out one body after another in one [`State`]
 //! (then one centre particle per rigid body), and only the models the scene needs: a
 //! [`TetBody`] per deformable body (a rigid body gets none: its mass and inertia come from its
-//! tetrahedra, [`qdem_core::rigid_body`]), contacts only when bodies carry contact spheres
+//! tetrahedra, [`qdem_core::step::rigid_body`]), contacts only when bodies carry contact spheres
 //! (`contact`), [`Gravity`] only for a non-zero gravity, a [`NodalLoad`] per load.
 //!
 //! # The stage
@@ -58,11 +58,12 @@ use granular::GranularInfo;
 use nalgebra::{Rotation3, UnitQuaternion};
 use qdem_contact::BondedParticles;
 use qdem_contact::{DemContacts, PeriodicBox, PeriodicWrap};
-use qdem_core::rigid_body::tet_mass_properties;
 use qdem_core::step::model::Deformable;
+use qdem_core::step::rigid_body::tet_mass_properties;
 use qdem_core::{
-    CoreError, Dofs, EventSolve, Gravity, Material, Model, NodalLoad, Scheme, State, StepRequest,
-    StepSettings, TetBody, TimeFunction, Vec3, World,
+    continuum::Material, continuum::TetBody, error::CoreError, loads::Gravity, loads::NodalLoad,
+    loads::TimeFunction, step::Dofs, step::EventSolve, step::Model, step::Scheme, step::State,
+    step::StepRequest, step::StepSettings, world::World, Vec3,
 };
 use qdem_mesh::{read_msh, FileIds, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
@@ -71,7 +72,7 @@ use std::path::{Path, PathBuf};
 /// How a body is integrated.
 #[derive(Clone, Debug)]
 pub enum BodyKind {
-    /// A QDEM body: index of its [`TetBody`] in the world's models ([`qdem_core::World::models`]).
+    /// A QDEM body: index of its [`TetBody`] in the world's models ([`qdem_core::world::World::models`]).
     Deformable {
         /// The model index.
         model: usize,
@@ -545,7 +546,7 @@ fn build_bodies(
         .iter()
         .any(|b| b.rigid && b.angular_velocity != [0.0; 3])
     {
-        qdem_core::rigid_body::place_members(state);
+        qdem_core::step::rigid_body::place_members(state);
     }
     Ok(bodies)
 }

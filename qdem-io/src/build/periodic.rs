@@ -8,7 +8,7 @@ use crate::build::{BodyInfo, BodyKind, BuildError};
 use crate::scene::{Periodic, Scene};
 use qdem_contact::time_delayed_boundary::lag_from_spacing;
 use qdem_contact::{DemContacts, LoadCycle, PeriodicBox, TimeDelayedBoundary, WrapGroup};
-use qdem_core::{State, Vec3};
+use qdem_core::{step::State, Vec3};
 
 /// The axes named in `axes` ("y" → [1]).
 fn axes(text: &str) -> Vec<usize> {

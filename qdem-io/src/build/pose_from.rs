@@ -31,7 +31,7 @@ use crate::csv_rows::{finite, read_text, rows};
 use crate::output::{write_atomic, OutputError};
 use crate::scene::Scene;
 use nalgebra::{Quaternion, UnitQuaternion};
-use qdem_core::rigid_body::tet_mass_properties;
+use qdem_core::step::rigid_body::tet_mass_properties;
 use qdem_core::Vec3;
 use std::path::Path;
 

@@ -5,7 +5,7 @@
 
 use super::{BodyInfo, BodyKind, BuildError, GranularInfo, ProbePoint};
 use crate::scene::{ProbeTarget, Scene};
-use qdem_core::{State, Vec3};
+use qdem_core::{step::State, Vec3};
 use std::ops::Range;
 
 /// A `[[probe]] box` over the `[granular]` sample: the stones whose centre of mass lies inside

@@ -21,9 +21,9 @@ use crate::build::BuildError;
 use crate::checkpoint::read_checkpoint;
 use crate::scene::Scene;
 use qdem_contact::{DemContacts, PeriodicBox, SavedSprings, WrapGroup};
+use qdem_core::checkpoint::CheckpointError;
 use qdem_core::checkpoint::{model_histories, Decoder, SavedState};
-use qdem_core::CheckpointError;
-use qdem_core::{State, Vec3};
+use qdem_core::{step::State, Vec3};
 use std::path::Path;
 
 /// How far a reference position may differ from the checkpoint's (m): the same mesh placed the

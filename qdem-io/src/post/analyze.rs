@@ -334,7 +334,7 @@ fn input_load(scene: &Scene, time: &[f64]) -> Result<Option<Vec<f64>>, AnalyzeEr
     for (k, load) in scene.loads.iter().enumerate() {
         let Some(series) = &load.series else { continue };
         let rows = crate::load_series::read_series(&scene.resolve(&series.file), &series.column)?;
-        let f = qdem_core::TimeFunction::new(rows).map_err(|source| BuildError::Core {
+        let f = qdem_core::loads::TimeFunction::new(rows).map_err(|source| BuildError::Core {
             scene: scene.path.clone(),
             source,
         })?;

@@ -32,7 +32,7 @@
 
 use crate::scene::MeasureRegion;
 use qdem_contact::{DemContacts, Partner};
-use qdem_core::{Mat3, State};
+use qdem_core::{step::State, Mat3};
 use std::collections::BTreeSet;
 
 /// The stones a measure reads: per stone its centre particle and volume, and per particle

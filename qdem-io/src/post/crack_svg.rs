@@ -5,7 +5,7 @@
 
 use crate::output::{write_atomic, OutputError};
 use qdem_contact::BondedParticles;
-use qdem_core::State;
+use qdem_core::step::State;
 use std::io::Write;
 use std::path::Path;
 

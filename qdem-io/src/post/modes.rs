@@ -1,5 +1,5 @@
 //! `qdem modes`: the natural modes of a scene's deformable and rigid bodies
-//! ([`qdem_core::lanczos`]) and their files.
+//! ([`qdem_core::modal::lanczos`]) and their files.
 //!
 //! - `modes.csv`: one row per mode, `mode,frequency_hz,kind,direction,participation,mass_x,
 //!   mass_y,mass_z,mass_rx,mass_ry,mass_rz,motion_x,motion_y,motion_z`: `kind` is `rigid` (a rigid-body mode of a body
@@ -20,7 +20,7 @@
 
 use crate::build::{BodyKind, Simulation};
 use crate::output::{write_atomic, write_vtu, OutputError, PvdIndex, VtuGrid};
-use qdem_core::lanczos::{natural_modes, ModalError, Mode, Modes, DIRECTIONS};
+use qdem_core::modal::lanczos::{natural_modes, ModalError, Mode, Modes, DIRECTIONS};
 use qdem_core::Vec3;
 use std::io::Write;
 use std::path::{Path, PathBuf};

@@ -7,7 +7,7 @@
 //! checkpoint, as written in the scene: [`crate::inputs`]; a checkpoint is refused when any
 //! of them changed or is missing), the body and an FNV-1a checksum of everything after the
 //! scene's fingerprint. The body is the run loop's record (step, output
-//! schedules, probe rows written, the plot's history), then the [`qdem_core::State`], the
+//! schedules, probe rows written, the plot's history), then the [`qdem_core::step::State`], the
 //! stepper's and every model's history, each part tagged ([`qdem_core::checkpoint`]). The
 //! file is written atomically (temporary file, fsync, rename), so a kill at any moment leaves
 //! the previous checkpoint intact.
@@ -15,7 +15,7 @@
 use crate::inputs::{decode_inputs, fnv1a, InputChange};
 use crate::output::{write_atomic, OutputError};
 use crate::scene::Scene;
-use qdem_core::CheckpointError;
+use qdem_core::checkpoint::CheckpointError;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 

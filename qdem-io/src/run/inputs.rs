@@ -11,7 +11,7 @@
 //! run would fail later for no visible reason (a "tetrahedron turned inside out").
 
 use crate::scene::Scene;
-use qdem_core::{CheckpointError, Decoder, Encoder};
+use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder};
 use std::path::{Path, PathBuf};
 
 /// FNV-1a, 64 bit.

@@ -1,5 +1,5 @@
 //! The run stage: the run loop ([`runner`]) that steps a built [`crate::build::Simulation`]'s
-//! [`qdem_core::World`] and hands every step to one recorder per output (`record`), the
+//! [`qdem_core::world::World`] and hands every step to one recorder per output (`record`), the
 //! checkpoints of a run ([`checkpoint`], the run record's encoding in `run_record`) and the
 //! fingerprints of the files a checkpoint depends on ([`inputs`]); a fresh run's removal of
 //! an earlier run's outputs in its folder (`fresh_start`); the watch that stops two bodies

@@ -4,14 +4,16 @@
 //!
 //! A body is the run record as one block (the next step, the checkpoint schedule, then each
 //! recorder's history tagged with its name: [`crate::run::record`]), then the world
-//! ([`qdem_core::World::save`]: the state, every model, the stepper). The record is a block so
+//! ([`qdem_core::world::World::save`]: the state, every model, the stepper). The record is a block so
 //! that `[run] start_from`, which takes only the state, can skip it whatever outputs the scene
 //! that wrote it had.
 
 use crate::build::Simulation;
 use crate::run::record::schedule::Schedule;
 use crate::run::record::{restore_all, save_all, Recorder};
-use qdem_core::{CheckpointError, CoreError, Decoder, Encoder};
+use qdem_core::{
+    checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, error::CoreError,
+};
 
 /// The run loop's own state.
 pub(crate) struct RunRecord {

@@ -1,4 +1,4 @@
-//! The run loop: steps a [`Simulation`]'s [`qdem_core::World`] to `t_end`, hands the state
+//! The run loop: steps a [`Simulation`]'s [`qdem_core::world::World`] to `t_end`, hands the state
 //! after every step to the outputs' recorders (`record`: probes, VTU/PVD, sections,
 //! boundary, crack picture, stones, poses), checkpoints when due or asked to, and writes
 //! `summary.json` at the end. Every output file is written atomically; a run stopped by an
@@ -17,7 +17,7 @@ use crate::run::record::schedule::{probe_interval, Schedule};
 use crate::run::record::{self, Recorder, RunFigures, StateRead, StepInfo};
 use crate::run::run_record::{decode_run, decode_world, encode_run, RunRecord};
 use qdem_core::world::Gather;
-use qdem_core::{CoreError, Halt, World};
+use qdem_core::{error::CoreError, step::Halt, world::World};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;

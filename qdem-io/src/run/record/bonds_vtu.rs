@@ -7,7 +7,7 @@
 
 use crate::output::{write_vtu_mesh_at, OutputError, VtuCells, VtuField, VtuMesh};
 use qdem_contact::BondedParticles;
-use qdem_core::State;
+use qdem_core::step::State;
 use std::path::Path;
 
 /// Writes the discs and bonds of `bonded` at `state` to `path`.

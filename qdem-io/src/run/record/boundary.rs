@@ -6,7 +6,7 @@ use super::schedule::{probe_interval, Schedule};
 use super::{Recorder, StateRead, StepInfo};
 use crate::build::Simulation;
 use crate::output::{write_atomic, OutputError};
-use qdem_core::{CheckpointError, Decoder, Encoder};
+use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder};
 use std::path::{Path, PathBuf};
 
 /// The time-delayed boundary's record.

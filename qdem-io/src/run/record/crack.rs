@@ -6,7 +6,10 @@ use super::{Recorder, RunFigures, StepInfo};
 use crate::build::Simulation;
 use crate::crack_svg::write_crack_svg;
 use crate::output::OutputError;
-use qdem_core::{CheckpointError, Decoder, Encoder, Halt, StepCounts};
+use qdem_core::{
+    checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, step::Halt,
+    step::StepCounts,
+};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 

@@ -12,7 +12,7 @@ use crate::plot::{line_plot_svg, Labels, Series};
 use crate::post::contact_stress::{measure, Measurement, Stones};
 use crate::scene::MeasureRegion;
 use qdem_core::checkpoint::same_count;
-use qdem_core::{CheckpointError, Decoder, Encoder};
+use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder};
 use std::path::{Path, PathBuf};
 
 /// The columns of `measure_NAME.csv` after `time`.

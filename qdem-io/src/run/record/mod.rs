@@ -45,7 +45,9 @@ pub(crate) mod walls_vtu;
 
 use crate::build::Simulation;
 use crate::output::{write_atomic, OutputError};
-use qdem_core::{CheckpointError, Decoder, Encoder, Halt};
+use qdem_core::{
+    checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, step::Halt,
+};
 use std::path::Path;
 
 /// What a recorder learns of the step just taken.
@@ -111,7 +113,7 @@ pub(crate) trait Recorder {
     }
 
     /// What [`Recorder::record`] reads of the particles' motion at `time` (a sample is due),
-    /// so that a decomposed run gathers it first ([`qdem_core::World::gather`]). The default:
+    /// so that a decomposed run gathers it first ([`qdem_core::world::World::gather`]). The default:
     /// nothing.
     fn reads(&self, time: f64, dt: f64) -> StateRead {
         let _ = (time, dt);

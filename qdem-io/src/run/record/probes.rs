@@ -3,7 +3,7 @@
 //! streamed) and, at the end, `probes.svg` (the displacements against time).
 //!
 //! A probe on a rigid body's member (a surface vertex, a clump's sphere) reads the rigid
-//! motion's acceleration a_c + α × r + ω × (ω × r) ([`qdem_core::RigidBodies::point_acceleration`]):
+//! motion's acceleration a_c + α × r + ω × (ω × r) ([`qdem_core::step::RigidBodies::point_acceleration`]):
 //! a member carries no acceleration of its own. Reading it, or a box probe, needs the rigid
 //! bodies' motion and every stone, so a decomposed run gathers its whole state for such a
 //! sample instead of the probes' particles.
@@ -15,7 +15,7 @@ use crate::build::Simulation;
 use crate::output::{OutputError, ProbeCsv};
 use crate::plot::{line_plot_svg, Labels, Series};
 use qdem_core::checkpoint::same_count;
-use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
+use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, Vec3};
 use std::path::{Path, PathBuf};
 
 /// The probes' record.

@@ -2,7 +2,7 @@
 //! a deformable body carries: R = −Σ f_i over its particles, counting on each particle the
 //! directions that fix holds only (its `dofs`, not those another fix holds there), f_i the
 //! total (internal and external) force on particle i at the state
-//! (the stepper's last evaluation, [`qdem_core::stepper::Stepper::forces`]; a static solve's
+//! (the stepper's last evaluation, [`qdem_core::step::stepper::Stepper::forces`]; a static solve's
 //! f − K u), and the moment M = Σ (X_i − c) × R_i about the centroid c of the fix's particles
 //! in the reference configuration (X_i their reference positions). Columns
 //! `fixK_fx, fixK_fy, fixK_fz, fixK_mx, fixK_my, fixK_mz` (N, N·m) for the K-th `[[fix]]`
@@ -11,7 +11,7 @@
 //! their overlap (over-constrained in no physical sense: a held direction stays at rest
 //! whichever fix holds it, so no fix has a better claim to its force). Fixes on a rigid
 //! body (which its centre holds) are left out. In a run over MPI ranks the forces are
-//! gathered from the particles' owners with the state ([`qdem_core::World::gather`]), so the
+//! gathered from the particles' owners with the state ([`qdem_core::world::World::gather`]), so the
 //! file is the same for any rank count. A wall's force is `walls.csv`'s.
 //!
 //! With `[output] node_reactions = true`, `node_reactions.csv` gives the same forces per
@@ -24,7 +24,10 @@ use super::schedule::{probe_interval, Schedule};
 use super::{write_rows, Recorder, StateRead, StepInfo};
 use crate::build::{BodyKind, Simulation};
 use crate::output::{write_atomic, OutputError};
-use qdem_core::{CheckpointError, Decoder, Dofs, Encoder, State, Vec3};
+use qdem_core::{
+    checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, step::Dofs, step::State,
+    Vec3,
+};
 use std::path::{Path, PathBuf};
 
 /// One fix's particles, the share of each held direction's force it carries, and the point

@@ -11,7 +11,7 @@ use super::{write_rows, Recorder, StateRead, StepInfo};
 use crate::build::Simulation;
 use crate::output::OutputError;
 use qdem_contact::{DemContacts, Partner};
-use qdem_core::{CheckpointError, Decoder, Encoder};
+use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder};
 use std::path::{Path, PathBuf};
 
 /// The sections' record.

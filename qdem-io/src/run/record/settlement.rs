@@ -20,7 +20,9 @@ use super::{Recorder, StateRead, StepInfo};
 use crate::build::Simulation;
 use crate::output::{write_atomic, OutputError};
 use crate::plot::{line_plot_svg, Labels, Series};
-use qdem_core::{CheckpointError, Cyclic, Decoder, Encoder, Vec3};
+use qdem_core::{
+    checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, loads::Cyclic, Vec3,
+};
 use std::path::{Path, PathBuf};
 
 /// One cyclic load: its number, cycle, direction, and the time of its next extremum.

@@ -26,7 +26,7 @@ use super::{Recorder, RunFigures, StateRead, StepInfo};
 use crate::build::Simulation;
 use crate::output::{write_vtu_mesh_at, OutputError, PvdIndex, VtuCells, VtuField, VtuMesh};
 use crate::scene::{Integrator, Scene};
-use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
+use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, Vec3};
 use std::path::{Path, PathBuf};
 
 /// A part of every time of the series besides the bodies.
@@ -126,7 +126,7 @@ impl Snapshots {
 
     /// Whether a file is due at `time` (step `dt`): on the schedule, or a static run's final
     /// state (its last level, the first within 10⁻⁹ dt of the end or past it, as
-    /// [`qdem_core::StepSettings::steps_to`] counts) that the schedule did not write.
+    /// [`qdem_core::step::StepSettings::steps_to`] counts) that the schedule did not write.
     fn is_due(&self, time: f64, dt: f64) -> bool {
         let last = self.times.last().map(|t| t.0);
         let at_end = |end: f64| time >= end - 1e-9 * dt;
@@ -202,7 +202,7 @@ impl Recorder for Snapshots {
 /// velocity, nodal stress and mesh node id, the tetrahedra's stress tensor, principal
 /// stresses, von Mises stress, volumetric strain ([`tet_stress`](super::tet_stress)), mesh
 /// element id and physical volume. A static run's stress is the small-strain one of its
-/// linear solve ([`qdem_core::TetBody::small_strain_stresses`]).
+/// linear solve ([`qdem_core::continuum::TetBody::small_strain_stresses`]).
 fn write_snapshot(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
     let s = &sim.world.state;
     let displacement: Vec<Vec3> = (0..s.len()).map(|i| s.displacement(i)).collect();

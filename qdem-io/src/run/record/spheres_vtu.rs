@@ -6,7 +6,7 @@
 
 use crate::output::{write_vtu_mesh_at, OutputError, VtuCells, VtuField, VtuMesh};
 use qdem_contact::DemContacts;
-use qdem_core::{State, Vec3};
+use qdem_core::{step::State, Vec3};
 use std::path::Path;
 
 /// Writes the spheres of `contacts` at `state` to `path`.

@@ -1,5 +1,5 @@
 //! `summary.json` of a finished run: the run's figures (steps, step, stable bound, wall time,
-//! rates, the stage counters of [`qdem_core::World`], a static run's linear solves), the
+//! rates, the stage counters of [`qdem_core::world::World`], a static run's linear solves), the
 //! bodies and probes, the contact set and the periodic cell, then each recorder's part
 //! ([`super::Recorder::summarize`]).
 
@@ -7,7 +7,7 @@ use super::{Recorder, RunFigures};
 use crate::build::Simulation;
 use crate::output::{write_summary, OutputError};
 use crate::runner::RunReport;
-use qdem_core::Scheme;
+use qdem_core::step::Scheme;
 use serde_json::json;
 use std::path::Path;
 

@@ -1,10 +1,10 @@
 //! The stress fields of the tetrahedra in `vtu/state_NNNNN.vtu`: from each tetrahedron's
 //! stress tensor σ (the Cauchy stress of the QDEM kernel, paper 000 Eq. 2,
-//! [`qdem_core::TetBody::tet_fields`]) its six components in ParaView's symmetric-tensor
+//! [`qdem_core::continuum::TetBody::tet_fields`]) its six components in ParaView's symmetric-tensor
 //! order (xx, yy, zz, xy, yz, xz), its three principal stresses σ₁ ≥ σ₂ ≥ σ₃ (the eigenvalues
 //! of σ, tension positive) and its von Mises stress √(3/2 s:s).
 
-use qdem_core::tet_kernel::von_mises;
+use qdem_core::continuum::tet_kernel::von_mises;
 use qdem_core::Mat3;
 
 /// The cell fields of the tetrahedra, one entry per tetrahedron in each.

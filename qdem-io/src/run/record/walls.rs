@@ -9,7 +9,7 @@ use super::{write_rows, Recorder, StateRead, StepInfo};
 use crate::build::Simulation;
 use crate::output::OutputError;
 use qdem_contact::{DemContacts, Partner};
-use qdem_core::{CheckpointError, Decoder, Encoder, Vec3};
+use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, Vec3};
 use std::path::{Path, PathBuf};
 
 /// The walls' record.

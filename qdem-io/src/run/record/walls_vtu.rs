@@ -6,7 +6,7 @@
 
 use crate::output::{write_vtu_mesh_at, OutputError, VtuCells, VtuField, VtuMesh};
 use qdem_contact::{PlaneWall, Wall, WallShape};
-use qdem_core::{State, Vec3};
+use qdem_core::{step::State, Vec3};
 use std::path::Path;
 
 /// Whether some wall of `walls` has a velocity (and so needs a file per time; so does a servo

@@ -183,8 +183,8 @@ scene_table! {
 
 impl CyclicLoad {
     /// The core's cycle.
-    pub fn cycle(&self) -> qdem_core::Cyclic {
-        qdem_core::Cyclic {
+    pub fn cycle(&self) -> qdem_core::loads::Cyclic {
+        qdem_core::loads::Cyclic {
             min: self.min,
             max: self.max,
             frequency: self.frequency,
@@ -224,10 +224,12 @@ impl Ramp {
     /// assert_eq!(f.value(2.0), 0.0);
     /// assert_eq!(Ramp::constant().time_function().unwrap().value(3.0), 1.0);
     /// ```
-    pub fn time_function(&self) -> Result<qdem_core::TimeFunction, qdem_core::CoreError> {
+    pub fn time_function(
+        &self,
+    ) -> Result<qdem_core::loads::TimeFunction, qdem_core::error::CoreError> {
         if self.points.is_empty() {
-            return Ok(qdem_core::TimeFunction::constant(1.0));
+            return Ok(qdem_core::loads::TimeFunction::constant(1.0));
         }
-        qdem_core::TimeFunction::new(self.points.iter().map(|p| (p[0], p[1])).collect())
+        qdem_core::loads::TimeFunction::new(self.points.iter().map(|p| (p[0], p[1])).collect())
     }
 }

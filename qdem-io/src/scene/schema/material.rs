@@ -30,7 +30,7 @@ scene_table! {
 }
 
 /// `[[material]] formulation`: the standard QDEM tetrahedron, or the average nodal pressure
-/// one (Bonet & Burton 1998) that does not lock as ν → 0.5 ([`qdem_core::Formulation`]).
+/// one (Bonet & Burton 1998) that does not lock as ν → 0.5 ([`qdem_core::continuum::Formulation`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Formulation {
@@ -43,10 +43,10 @@ pub enum Formulation {
 
 impl Formulation {
     /// The core's formulation.
-    pub fn core(self) -> qdem_core::Formulation {
+    pub fn core(self) -> qdem_core::continuum::Formulation {
         match self {
-            Formulation::Standard => qdem_core::Formulation::Standard,
-            Formulation::AveragedPressure => qdem_core::Formulation::AveragedPressure,
+            Formulation::Standard => qdem_core::continuum::Formulation::Standard,
+            Formulation::AveragedPressure => qdem_core::continuum::Formulation::AveragedPressure,
         }
     }
 }
