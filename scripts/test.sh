@@ -14,7 +14,7 @@ fi
 # file names the Communicator, one of its collectives (its `min`, `rank` and `size` are
 # reached only through a value of it, so only by naming it) or the parallel runtime's raw
 # ones: a model or a driver that did would be calling collectives itself.
-seam='^(qdem-core/src/parallel/|qdem-core/src/lib\.rs|qdem-core/src/step/world\.rs|qdem-cli/src/(main|mpi_ranks|command|check)\.rs)'
+seam='^(qdem-core/src/parallel/|qdem-core/src/lib\.rs|qdem-core/src/world\.rs|qdem-cli/src/(main|mpi_ranks|command|check)\.rs)'
 collectives='Communicator|all_to_all|all_gather|all_gather_one|all_gather_varying|broadcast|agree_min|gather_values|max_over_ranks'
 outside=$(grep -rnwE --include='*.rs' "$collectives" qdem-* | grep -Ev "$seam" || true)
 if [ -n "$outside" ]; then
