@@ -11,7 +11,7 @@
 //!   the state after each integration, the gathers, the failure agreement, the hooks'
 //!   decisions, the re-partitions), with the state share (`state_share.rs`), the particles a
 //!   rank steps ([`ParticleRuns`]) and the contacts' ghost records (`ghosts.rs`); it is the
-//!   steppers' [`crate::step::seam::Seam`] of a decomposed run (`runtime_seam.rs`);
+//!   steppers' [`crate::step::seam::Seam`];
 //! - [`Reads`] and the [`Facets`] of a split model ([`split`]): what a model declares of a
 //!   decomposed run.
 
@@ -19,7 +19,6 @@ pub mod communicator;
 pub mod decomposition;
 mod ghosts;
 mod runtime;
-mod runtime_seam;
 mod state_share;
 #[cfg(feature = "thread-ranks")]
 pub mod thread_ranks;

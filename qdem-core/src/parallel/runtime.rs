@@ -16,6 +16,7 @@ use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
 use crate::step::post_step::{Halt, PostStep};
 use crate::step::rigid_body::reduce_member_forces;
+use crate::step::seam::{OneProcess, Seam};
 use crate::step::split::{Balance, Facets, Part, Reads};
 use crate::step::stages::{Stage, StageTimes};
 use crate::step::state::State;
@@ -79,95 +80,8 @@ struct Ranks {
 type Ghosts = Option<GhostTable>;
 
 impl ParallelRuntime {
-    /// Sums the forces and torques of all `models` at `state` into `force` and `torque`
-    /// (resized and zeroed here; rigid bodies' torques, then particles' moments), then moves
-    /// the forces on members of rigid bodies onto their bodies. A model that this rank
-    /// computes in part is evaluated stage by stage with the ranks' exchanges in between
-    /// ([`crate::step::split`]). Each model's force evaluation is marked as its own
-    /// stage on `stages` (the caller marks the stage before).
-    pub fn sum_forces(
-        &mut self,
-        state: &State,
-        models: &mut [Box<dyn Model>],
-        force: &mut Vec<Vec3>,
-        torque: &mut Vec<Vec3>,
-        stages: &mut StageTimes,
-    ) {
-        force.clear();
-        force.resize(state.len(), Vec3::zeros());
-        torque.clear();
-        torque.resize(state.rigid.len() + state.spin.len(), Vec3::zeros());
-        self.add_forces(state, models, force, torque, stages);
-    }
-
-    /// [`ParallelRuntime::sum_forces`] into `force` and `torque` that the caller has sized and
-    /// zeroed (Verlet zeroes them in its drift sweep).
-    pub(crate) fn add_forces(
-        &mut self,
-        state: &State,
-        models: &mut [Box<dyn Model>],
-        force: &mut [Vec3],
-        torque: &mut [Vec3],
-        stages: &mut StageTimes,
-    ) {
-        for (i, model) in models.iter_mut().enumerate() {
-            match self.ranks.as_mut() {
-                Some(ranks) if ranks.models[i].is_some() => {
-                    let facets = split_facets(model.as_mut()).expect("a split model");
-                    ranks.evaluate(i, facets, state, force, torque);
-                }
-                _ => model.add_forces(state, force, torque),
-            }
-            stages.mark(Stage::Forces(i));
-        }
-        if !state.rigid.is_empty() {
-            reduce_member_forces(state, force, torque);
-        }
-    }
-
-    /// In a run decomposed with a halo exchange, the particles a stepper predicts (its own and
-    /// its halo); `None`: every particle.
-    pub fn stepped(&self) -> Option<&ParticleRuns> {
-        self.local().map(|l| &l.stepped)
-    }
-
-    /// In a run decomposed with a halo exchange, the particles a stepper integrates (those
-    /// whose forces this rank sums); `None`: every particle.
-    pub fn computed(&self) -> Option<&ParticleRuns> {
-        self.local().map(|l| &l.computed)
-    }
-
     fn local(&self) -> Option<&LocalParticles> {
         self.ranks.as_ref().and_then(|r| r.local.as_ref())
-    }
-
-    /// Ends an integration whose outcome is `outcome`: in a decomposed run, copies each
-    /// rank's owned particles' new motion to the ranks that read it (marked as the share
-    /// stage), and with `agree` (a stepper that reads the outcome before the step ends: the
-    /// sub-steps of an adaptive step) makes every rank go on with the same outcome: its own
-    /// when no rank failed or it failed itself, the failure of the lowest failing rank
-    /// otherwise. A run of one process goes on with `outcome`.
-    pub fn complete(
-        &mut self,
-        state: &mut State,
-        stages: &mut StageTimes,
-        outcome: Result<(), CoreError>,
-        agree: bool,
-    ) -> Result<(), CoreError> {
-        let Some(ranks) = &mut self.ranks else {
-            return outcome;
-        };
-        ranks.share.share(state);
-        stages.mark(Stage::Share);
-        if !agree {
-            return outcome;
-        }
-        let local = outcome.as_ref().err().map(|e| e.to_string());
-        match (ranks.share.agree(local), outcome) {
-            (None, _) => Ok(()),
-            (Some(_), Err(own)) => Err(own),
-            (Some(failure), Ok(())) => Err(CoreError::Decomposition(failure)),
-        }
     }
 
     /// How the run is decomposed over processes; `None` for a run of one process.
@@ -430,6 +344,81 @@ impl ParallelRuntime {
         ranks.split_by_owners(models, hooks);
         ranks.repartitions += 1;
         ranks.rebuilds_since = 0;
+    }
+}
+
+/// The runtime is a stepper's seam: in a run of one process it evaluates as [`OneProcess`];
+/// on a rank of a decomposed run each split model stage by stage, with the ranks' exchanges in
+/// between.
+impl Seam for ParallelRuntime {
+    /// Every model's forces in model order, a split model's through its facets on a rank of
+    /// a decomposed run, each marked as its own stage; then the forces on members of rigid
+    /// bodies moved onto their bodies.
+    fn add_forces(
+        &mut self,
+        state: &State,
+        models: &mut [Box<dyn Model>],
+        force: &mut [Vec3],
+        torque: &mut [Vec3],
+        stages: &mut StageTimes,
+    ) {
+        let Some(ranks) = self.ranks.as_mut() else {
+            return OneProcess.add_forces(state, models, force, torque, stages);
+        };
+        for (i, model) in models.iter_mut().enumerate() {
+            match ranks.models[i].is_some() {
+                true => {
+                    let facets = split_facets(model.as_mut()).expect("a split model");
+                    ranks.evaluate(i, facets, state, force, torque);
+                }
+                false => model.add_forces(state, force, torque),
+            }
+            stages.mark(Stage::Forces(i));
+        }
+        if !state.rigid.is_empty() {
+            reduce_member_forces(state, force, torque);
+        }
+    }
+
+    /// In a run decomposed with a halo exchange, the particles a stepper predicts (its own and
+    /// its halo); `None`: every particle.
+    fn stepped(&self) -> Option<&ParticleRuns> {
+        self.local().map(|l| &l.stepped)
+    }
+
+    /// In a run decomposed with a halo exchange, the particles a stepper integrates (those
+    /// whose forces this rank sums); `None`: every particle.
+    fn computed(&self) -> Option<&ParticleRuns> {
+        self.local().map(|l| &l.computed)
+    }
+
+    /// Ends an integration whose outcome is `outcome`: in a decomposed run, copies each
+    /// rank's owned particles' new motion to the ranks that read it (marked as the share
+    /// stage), and with `agree` (a stepper that reads the outcome before the step ends: the
+    /// sub-steps of an adaptive step) makes every rank go on with the same outcome: its own
+    /// when no rank failed or it failed itself, the failure of the lowest failing rank
+    /// otherwise. A run of one process goes on with `outcome`.
+    fn complete(
+        &mut self,
+        state: &mut State,
+        stages: &mut StageTimes,
+        outcome: Result<(), CoreError>,
+        agree: bool,
+    ) -> Result<(), CoreError> {
+        let Some(ranks) = &mut self.ranks else {
+            return outcome;
+        };
+        ranks.share.share(state);
+        stages.mark(Stage::Share);
+        if !agree {
+            return outcome;
+        }
+        let local = outcome.as_ref().err().map(|e| e.to_string());
+        match (ranks.share.agree(local), outcome) {
+            (None, _) => Ok(()),
+            (Some(_), Err(own)) => Err(own),
+            (Some(failure), Ok(())) => Err(CoreError::Decomposition(failure)),
+        }
     }
 }
 
