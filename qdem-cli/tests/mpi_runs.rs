@@ -208,6 +208,44 @@ fn a_reduced_ballast_deposit_is_byte_identical_on_any_number_of_ranks() {
     same_for_any_ranks("ballast/reduced_deposit.toml", 0.004, "deposit");
 }
 
+/// The last row of the CSV file `name` of the run in `dir`, read by column name, with the
+/// file's text for a failure's message.
+fn last_row(dir: &Path, name: &str) -> (impl Fn(&str) -> f64, String) {
+    let text = std::fs::read_to_string(dir.join(name)).unwrap();
+    let header: Vec<String> = text
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .map(String::from)
+        .collect();
+    let last: Vec<f64> = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let column = move |name: &str| last[header.iter().position(|h| h == name).unwrap()];
+    (column, text)
+}
+
+/// Runs `scene` on one process, lets `check` read its outputs (so that the comparison is not
+/// of zeros), then runs it on 2 and 3 ranks of a thread and 2 ranks of two threads and
+/// compares their outputs with the single process's, byte for byte.
+fn same_as_one_process(scene: &ShortScene, tag: &str, what: &str, check: impl Fn(&Path)) {
+    let tmp = TempDir::new(tag);
+    let single = tmp.path().join("single");
+    run(&scene.0, &single, 0, 1, &[]);
+    check(&single);
+    for (ranks, threads) in [(2, 1), (3, 1), (2, 2)] {
+        let out = tmp.path().join(format!("r{ranks}t{threads}"));
+        run(&scene.0, &out, ranks, threads, &[]);
+        let what = format!("{what} on {ranks} ranks x {threads} threads");
+        assert_same_outputs(&single, &out, &what);
+    }
+}
+
 /// A `[[measure]]` over the packing's clumps (one and two spheres) gathers the whole state and
 /// the contacts before each sample, so `measure_bed.csv` (contact stress, solid fraction,
 /// coordination, kinetic energy) is byte-identical too; by 0.1 s the falling stones touch
@@ -219,26 +257,15 @@ fn a_measure_over_a_packing_of_clumps_is_byte_identical_on_any_number_of_ranks()
                    every = 0.01\n\n[output]";
     let edits = [("t_end = ", "t_end = 0.1"), ("[output]", measure)];
     let scene = ShortScene::edited(fixture, "measure", &edits);
-    let tmp = TempDir::new("measure");
-    let single = tmp.path().join("single");
-    run(&scene.0, &single, 0, 1, &[]);
-    let text = std::fs::read_to_string(single.join("measure_bed.csv")).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let last: Vec<f64> = text
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .map(|v| v.parse().unwrap())
-        .collect();
-    let column = |name: &str| last[header.iter().position(|h| *h == name).unwrap()];
-    assert!(column("contacts") > 0.0 && column("szz") < 0.0, "{text}");
-    for (ranks, threads) in [(2, 1), (3, 1), (2, 2)] {
-        let out = tmp.path().join(format!("r{ranks}t{threads}"));
-        run(&scene.0, &out, ranks, threads, &[]);
-        let what = format!("{fixture} with a measure on {ranks} ranks x {threads} threads");
-        assert_same_outputs(&single, &out, &what);
-    }
+    same_as_one_process(
+        &scene,
+        "measure",
+        &format!("{fixture} with a measure"),
+        |dir| {
+            let (column, text) = last_row(dir, "measure_bed.csv");
+            assert!(column("contacts") > 0.0 && column("szz") < 0.0, "{text}");
+        },
+    );
 }
 
 /// A lid held at 1 kPa by its servo over the poured grains: its force is the sum over every
@@ -252,29 +279,18 @@ fn a_servo_wall_over_poured_grains_is_byte_identical_on_any_number_of_ranks() {
                servo = { stress = 1e3, area = 0.04, max_velocity = 1.0 }\n\n[[section]]";
     let edits = [("t_end = ", "t_end = 0.1"), ("[[section]]", lid)];
     let scene = ShortScene::edited(fixture, "servo", &edits);
-    let tmp = TempDir::new("servo");
-    let single = tmp.path().join("single");
-    run(&scene.0, &single, 0, 1, &[]);
-    let text = std::fs::read_to_string(single.join("walls.csv")).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let last: Vec<f64> = text
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .map(|v| v.parse().unwrap())
-        .collect();
-    let column = |name: &str| last[header.iter().position(|h| *h == name).unwrap()];
-    assert!(
-        column("wall6.fz") > 0.0 && column("wall6.uz") < 0.0,
-        "{text}"
+    same_as_one_process(
+        &scene,
+        "servo",
+        &format!("{fixture} with a servo lid"),
+        |dir| {
+            let (column, text) = last_row(dir, "walls.csv");
+            assert!(
+                column("wall6.fz") > 0.0 && column("wall6.uz") < 0.0,
+                "{text}"
+            );
+        },
     );
-    for (ranks, threads) in [(2, 1), (3, 1), (2, 2)] {
-        let out = tmp.path().join(format!("r{ranks}t{threads}"));
-        run(&scene.0, &out, ranks, threads, &[]);
-        let what = format!("{fixture} with a servo lid on {ranks} ranks x {threads} threads");
-        assert_same_outputs(&single, &out, &what);
-    }
 }
 
 /// The grains' contacts are split: each rank evaluates those of the grains it owns.
