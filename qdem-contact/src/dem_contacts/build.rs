@@ -166,12 +166,7 @@ impl DemContacts {
                 axis: ['x', 'y', 'z'][axis.min(2)],
             });
         }
-        self.time_delay = Some(TimeDelay {
-            axis,
-            boundary,
-            scales: GhostScales::PERIODIC,
-            boundary_force: 0.0,
-        });
+        self.time_delay = Some(TimeDelay::new(axis, boundary));
         Ok(self)
     }
 

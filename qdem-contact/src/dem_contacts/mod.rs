@@ -39,7 +39,8 @@
 //! and the building of the candidate lists; `displacement.rs` its displacement check's bound
 //! for rigid bodies; `servo_loads.rs` the stress-controlled walls' servo; `output_queries.rs` what the
 //! outputs read; `persistence.rs` what a checkpoint keeps; `linearized.rs` the touching
-//! contacts as springs for a modal analysis; `split.rs` one rank's part in a decomposed run,
+//! contacts as springs for a modal analysis; `time_delay.rs` the time-delayed boundary's
+//! part (its reduction and ghost scales); `split.rs` one rank's part in a decomposed run,
 //! whose stages the world's exchange runs ([`qdem_core::parallel`]); `tunnelling.rs` the
 //! check, at each rebuild of the lists, for a sphere gone through a wall or into another
 //! body.
@@ -63,6 +64,7 @@ use qdem_core::{
 use rayon::prelude::*;
 use split::ContactPart;
 use stages::Evaluated;
+use time_delay::{pair_scales, TimeDelay};
 
 pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
 pub use tunnelling::BodySurface;
@@ -77,6 +79,7 @@ mod pipeline;
 mod servo_loads;
 mod split;
 mod stages;
+mod time_delay;
 mod tunnelling;
 
 /// Marks a sphere that is no part of a rigid body, or whose moments go nowhere.
@@ -278,30 +281,6 @@ pub struct DemContacts {
     pass_through: Option<(String, String)>,
     /// The run's step (s), for that report's fix; 0 until [`Model::prepare`].
     step: f64,
-}
-
-/// A time-delayed periodic boundary along one periodic axis, and its latest state.
-struct TimeDelay {
-    axis: usize,
-    boundary: TimeDelayedBoundary,
-    scales: GhostScales,
-    boundary_force: f64,
-}
-
-/// Scales of the forces on the first and second sphere of a pair whose second sphere's image
-/// was translated by `shift` along the delay axis: a negative shift means the second sphere
-/// sits near the right boundary and its image beyond the left one, so the first sphere feels
-/// a left ghost and the second (through the image of the first beyond the right boundary) a
-/// right ghost; a positive shift is the mirror case; zero is an ordinary pair.
-#[inline]
-fn pair_scales(shift: f64, scales: &GhostScales) -> (f64, f64) {
-    if shift < 0.0 {
-        (scales.left, scales.right)
-    } else if shift > 0.0 {
-        (scales.right, scales.left)
-    } else {
-        (1.0, 1.0)
-    }
 }
 
 /// r_a r_b / (r_a + r_b).

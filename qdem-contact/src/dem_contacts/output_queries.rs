@@ -9,9 +9,7 @@ impl DemContacts {
     /// The ghost scales (left, right) of the last evaluation and the average magnitude of the
     /// contact forces through the delayed boundary it measured; `None` without a time delay.
     pub fn time_delay_state(&self) -> Option<(GhostScales, f64)> {
-        self.time_delay
-            .as_ref()
-            .map(|t| (t.scales, t.boundary_force))
+        self.time_delay.as_ref().map(TimeDelay::state)
     }
 
     /// The average magnitude of the touching pairs' forces across the plane x\[axis\] = `at`
@@ -112,7 +110,7 @@ impl DemContacts {
     /// second times its scale), their forces are [`SphereRecord::force`].
     pub fn touching(&self) -> impl Iterator<Item = TouchingContact> + '_ {
         let time = self.last_time.unwrap_or(0.0);
-        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
+        let delay = self.time_delay.as_ref().map(TimeDelay::ghosts);
         let pairs = self.pairs.with_shifts();
         let pairs = pairs.filter(|(c, _)| c.force != Vec3::zeros());
         let pairs = pairs.map(move |(c, shift)| {

@@ -283,7 +283,7 @@ impl DemContacts {
     ) {
         let law = &self.settings.law;
         let RunSums { own, foreign, lo } = sums;
-        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
+        let delay = self.time_delay.as_ref().map(TimeDelay::ghosts);
         if SUM {
             for &s in partners {
                 own[(s - lo) as usize] = (Vec3::zeros(), Vec3::zeros());

@@ -154,10 +154,7 @@ impl Persistent for DemContacts {
         self.wall_contacts.save(out);
         out.bool(self.time_delay.is_some());
         if let Some(delay) = &self.time_delay {
-            out.f64(delay.scales.left);
-            out.f64(delay.scales.right);
-            out.f64(delay.boundary_force);
-            delay.boundary.save(out);
+            delay.save(out);
         }
         self.save_servos(out);
     }
@@ -194,12 +191,7 @@ impl Persistent for DemContacts {
             delayed as usize,
         )?;
         if let Some(delay) = &mut self.time_delay {
-            delay.scales = GhostScales {
-                left: input.f64("the left ghost scale")?,
-                right: input.f64("the right ghost scale")?,
-            };
-            delay.boundary_force = input.f64("the boundary force")?;
-            delay.boundary.restore(input)?;
+            delay.restore(input)?;
         }
         self.restore_servos(input)?;
         self.index_partners();

@@ -212,14 +212,6 @@ impl DemContacts {
         Some((geometry, self.wall_elasticity[sphere.material as usize]))
     }
 
-    /// The measured force through the time-delayed boundary, and the ghost scales that
-    /// follow (paper 003 Eqs. 6–7).
-    pub(super) fn set_boundary_force(&mut self, time: f64, measured: f64) {
-        let delay = self.time_delay.as_mut().expect("a time-delayed boundary");
-        delay.boundary_force = measured;
-        delay.scales = delay.boundary.update(time, measured);
-    }
-
     /// Adds sphere `s`'s contact force `f` to its particle and its moment `t` to the rigid
     /// body or rotating particle it turns with.
     #[inline]

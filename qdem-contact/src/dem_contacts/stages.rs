@@ -147,19 +147,8 @@ impl DemContacts {
     /// contacts on servo walls (sphere, wall, normal force and response: `servo_loads.rs`). False
     /// when the model has neither.
     pub(super) fn reduction_stage(&mut self, out: &mut Vec<f64>) -> bool {
-        if let Some(axis) = self.time_delay.as_ref().map(|t| t.axis) {
-            for (c, shift) in self.pairs.with_shifts() {
-                if c.force != Vec3::zeros() && shift[axis] != 0.0 {
-                    out.extend([
-                        0.0,
-                        c.first as f64,
-                        c.second as f64,
-                        c.force.norm(),
-                        0.0,
-                        0.0,
-                    ]);
-                }
-            }
+        if let Some(delay) = &self.time_delay {
+            delay.reduction(&self.pairs, out);
         }
         for c in self.servo_contacts(self.dt) {
             let (sphere, wall) = (c.sphere as f64, c.wall as f64);
@@ -186,18 +175,8 @@ impl DemContacts {
                 }),
             }
         }
-        if self.time_delay.is_some() {
-            pairs.sort_by_key(|&(a, b, _)| (a, b));
-            pairs.dedup_by_key(|&mut (a, b, _)| (a, b));
-            let mut sum = 0.0;
-            for &(_, _, f) in &pairs {
-                sum += f;
-            }
-            let measured = match pairs.len() {
-                0 => 0.0,
-                n => sum / n as f64,
-            };
-            self.set_boundary_force(time, measured);
+        if let Some(delay) = &mut self.time_delay {
+            delay.reduced(time, pairs);
         }
         if self.has_servo() {
             walls.sort_by_key(|c| (c.sphere, c.wall));
