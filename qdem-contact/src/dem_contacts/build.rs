@@ -2,6 +2,7 @@
 //! axes and a time-delayed boundary, and the check of the initial overlaps.
 
 use super::*;
+use crate::servo_wall::Servo;
 
 impl DemContacts {
     /// Contacts between `spheres` (of bodies `body_names`, with elastic constants (E, ν) per
@@ -65,10 +66,6 @@ impl DemContacts {
             .iter()
             .flat_map(|a| materials.iter().map(|b| PairElasticity::new(*a, Some(*b))))
             .collect();
-        let wall_elasticity = materials
-            .iter()
-            .map(|a| PairElasticity::new(*a, None))
-            .collect();
         // A carrier held in every direction (and, for a rigid body, in rotation) cannot
         // oscillate: it does not limit the step (infinite mass in the bound below).
         let held = |s: &ContactSphere, r: u32| {
@@ -109,9 +106,8 @@ impl DemContacts {
             body_names,
             materials: materials.len(),
             elasticity,
-            wall_elasticity,
             settings,
-            walls,
+            walls: Walls::new(walls, materials),
             last_time: None,
             dt: 0.0,
             read_every: true,
@@ -132,7 +128,6 @@ impl DemContacts {
             time_delay: None,
             split: None,
             rebuilt: false,
-            servos: Vec::new(),
             surfaces: Vec::new(),
             pass_through: None,
             step: 0.0,
@@ -147,6 +142,12 @@ impl DemContacts {
         self.periodic = Some(periodic);
         self.built = false;
         Ok(self)
+    }
+
+    /// Makes plane wall `wall` stress-controlled by `servo`, from now on; refused for a mesh
+    /// wall or a wall out of range.
+    pub fn set_servo(&mut self, wall: usize, servo: Servo) -> Result<(), ContactError> {
+        self.walls.set_servo(wall, servo)
     }
 
     /// Scales the forces from ghosts beyond the boundaries of periodic `axis` by `boundary`'s
@@ -197,7 +198,10 @@ impl DemContacts {
         }
         for c in &self.wall_contacts.items {
             let (s, w) = (c.first as usize, c.second as usize);
-            let (overlap, _) = self.walls[w].overlap(&self.center[s], self.radius[s], state.time);
+            let (overlap, _) =
+                self.walls
+                    .get(w)
+                    .overlap(&self.center[s], self.radius[s], state.time);
             if overlap > tolerance * self.radius[s] {
                 return Err(ContactError::InitialWallOverlap {
                     body: self.body_names[self.body[s] as usize].clone(),

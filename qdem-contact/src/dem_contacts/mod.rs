@@ -37,7 +37,7 @@
 //! and the stable step); `build.rs` its construction; `stages.rs` the stages of one
 //! evaluation; `pair_kernel.rs` the pair kernel; `pipeline.rs` the reading of the spheres
 //! and the building of the candidate lists; `displacement.rs` its displacement check's bound
-//! for rigid bodies; `servo_loads.rs` the stress-controlled walls' servo; `output_queries.rs` what the
+//! for rigid bodies; `walls.rs` the walls' part (walls, their elasticity, the narrow phase against a wall) and `servo_loads.rs` its stress-controlled walls' servos; `output_queries.rs` what the
 //! outputs read; `persistence.rs` what a checkpoint keeps; `linearized.rs` the touching
 //! contacts as springs for a modal analysis; `time_delay.rs` the time-delayed boundary's
 //! part (its reduction and ghost scales); `split.rs` one rank's part in a decomposed run,
@@ -65,6 +65,7 @@ use rayon::prelude::*;
 use split::ContactPart;
 use stages::Evaluated;
 use time_delay::{pair_scales, TimeDelay};
+use walls::Walls;
 
 pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
 pub use tunnelling::BodySurface;
@@ -81,6 +82,7 @@ mod split;
 mod stages;
 mod time_delay;
 mod tunnelling;
+mod walls;
 
 /// Marks a sphere that is no part of a rigid body, or whose moments go nowhere.
 const NOT_RIGID: u32 = u32::MAX;
@@ -238,9 +240,9 @@ pub struct DemContacts {
     body_names: Vec<String>,
     materials: usize,
     elasticity: Vec<PairElasticity>,
-    wall_elasticity: Vec<PairElasticity>,
     settings: ContactSettings,
-    walls: Vec<Wall>,
+    /// The walls, their elasticity and their servos (`walls.rs`).
+    walls: Walls,
     last_time: Option<f64>,
     /// The time since the previous evaluation (s), from stage 1 of this one (`stages.rs`).
     dt: f64,
@@ -272,8 +274,6 @@ pub struct DemContacts {
     split: Option<ContactPart>,
     /// Whether the lists were rebuilt since [`SplitModel::rebuilt`] last asked.
     rebuilt: bool,
-    /// The stress-controlled walls' servos, by wall (`servo_loads.rs`); empty when none.
-    servos: Vec<Option<servo_loads::ServoWall>>,
     /// The closed surfaces of the bodies built from meshes (`tunnelling.rs`).
     surfaces: Vec<BodySurface>,
     /// The report of the first sphere found through a wall or inside another body: what
@@ -330,7 +330,7 @@ impl Model for DemContacts {
         for s in 0..self.particle.len() {
             let r = self.radius[s];
             let sphere = &self.now[s];
-            let e = self.wall_elasticity[sphere.material as usize];
+            let e = self.walls.elasticity(sphere.material);
             let (kn, kt) = law.stiffness(REFERENCE_OVERLAP * r, r, &e);
             let k = kn.max(kt);
             let mass = self.bound_mass[s];

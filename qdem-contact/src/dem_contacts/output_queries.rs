@@ -69,9 +69,19 @@ impl DemContacts {
             .count()
     }
 
+    /// Whether some wall is stress-controlled.
+    pub fn has_servo(&self) -> bool {
+        self.walls.has_servo()
+    }
+
+    /// The displacement (m) of wall `wall` at `time` from its place at t = 0.
+    pub fn wall_displacement(&self, wall: usize, time: f64) -> Vec3 {
+        self.walls.displacement(wall, time)
+    }
+
     /// The walls.
     pub fn wall_list(&self) -> &[Wall] {
-        &self.walls
+        self.walls.list()
     }
 
     /// The names of the bodies the spheres belong to ([`SphereRecord::body`] indexes them).
@@ -135,7 +145,7 @@ impl DemContacts {
         let walls = walls.map(move |c| {
             let (s, w) = (c.first as usize, c.second as usize);
             let from = self.center[s];
-            let (overlap, normal) = self.walls[w].overlap(&from, self.radius[s], time);
+            let (overlap, normal) = self.walls.get(w).overlap(&from, self.radius[s], time);
             let to = from + (self.radius[s] - overlap) * normal;
             touching_contact(s, Partner::Wall(w), from, to, normal, c.force, (1.0, 1.0))
         });

@@ -156,7 +156,7 @@ impl Persistent for DemContacts {
         if let Some(delay) = &self.time_delay {
             delay.save(out);
         }
-        self.save_servos(out);
+        self.walls.save_servos(out);
     }
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
         input.tag("contact")?;
@@ -193,7 +193,7 @@ impl Persistent for DemContacts {
         if let Some(delay) = &mut self.time_delay {
             delay.restore(input)?;
         }
-        self.restore_servos(input)?;
+        self.walls.restore_servos(input)?;
         self.index_partners();
         if let Some(split) = &mut self.split {
             split.whole = true;

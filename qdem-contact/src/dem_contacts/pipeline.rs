@@ -95,9 +95,7 @@ impl DemContacts {
     /// Whether some pair outside the lists may have come within reach since the last build,
     /// given the largest distance a sphere has moved.
     pub(super) fn outgrew_skin(&self, moved: f64, time: f64) -> bool {
-        let wall_moved = (0..self.walls.len())
-            .map(|w| self.wall_speed_bound(w) * (time - self.built_time).abs())
-            .fold(0.0, f64::max);
+        let wall_moved = self.walls.moved_bound((time - self.built_time).abs());
         2.0 * moved >= self.settings.skin || moved + wall_moved >= self.settings.skin
     }
 
@@ -124,7 +122,7 @@ impl DemContacts {
         spheres: impl IndexedParallelIterator<Item = usize>,
         time: f64,
     ) -> Vec<(u32, u32)> {
-        let (walls, skin) = (&self.walls, self.settings.skin);
+        let (walls, skin) = (self.walls.list(), self.settings.skin);
         let (radius, center) = (&self.radius, &self.center);
         spheres
             .with_min_len(CONTACT_CHUNK)
@@ -194,22 +192,7 @@ impl DemContacts {
         s: usize,
         w: usize,
     ) -> Option<(PairGeometry, PairElasticity)> {
-        let wall = &self.walls[w];
-        let sphere = &self.now[s];
-        let (overlap, normal) = wall.overlap(&sphere.center, sphere.radius, time);
-        if overlap <= 0.0 || normal == Vec3::zeros() {
-            return None;
-        }
-        let lever = sphere.radius - 0.5 * overlap;
-        let geometry = PairGeometry {
-            overlap,
-            normal,
-            velocity: sphere.velocity + lever * sphere.spin.cross(&normal) - wall.velocity(),
-            radius: sphere.radius,
-            mass: sphere.mass,
-            friction: wall.friction,
-        };
-        Some((geometry, self.wall_elasticity[sphere.material as usize]))
+        self.walls.contact(time, &self.now[s], w)
     }
 
     /// Adds sphere `s`'s contact force `f` to its particle and its moment `t` to the rigid

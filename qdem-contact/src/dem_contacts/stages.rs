@@ -150,7 +150,11 @@ impl DemContacts {
         if let Some(delay) = &self.time_delay {
             delay.reduction(&self.pairs, out);
         }
-        for c in self.servo_contacts(self.dt) {
+        let spheres = (&self.now[..], &self.radius[..]);
+        let servo =
+            self.walls
+                .servo_contacts(&self.wall_contacts, spheres, &self.settings.law, self.dt);
+        for c in servo {
             let (sphere, wall) = (c.sphere as f64, c.wall as f64);
             out.extend([1.0, sphere, wall, c.load, c.response.0, c.response.1]);
         }
@@ -180,7 +184,7 @@ impl DemContacts {
         }
         if self.has_servo() {
             walls.sort_by_key(|c| (c.sphere, c.wall));
-            self.drive_servos(time, &walls);
+            self.walls.drive_servos(time, &walls);
         }
     }
 

@@ -123,7 +123,7 @@ impl DemContacts {
     /// The first wall sphere `s` went into or through.
     fn through_wall(&self, s: usize, time: f64, since: Option<f64>) -> Option<Passage> {
         let x = self.center[s];
-        self.walls.iter().enumerate().find_map(|(w, wall)| {
+        self.walls.list().iter().enumerate().find_map(|(w, wall)| {
             let depth = match &wall.shape {
                 WallShape::Plane(p) => Some(-p.distance(&x, time)).filter(|d| *d > 0.0),
                 WallShape::Mesh(m) => m.depth_inside(&x, time).or_else(|| {
