@@ -95,14 +95,17 @@ impl DemContacts {
         let particle: Vec<u32> = spheres.iter().map(|s| s.particle as u32).collect();
         DemContacts {
             name: "contact".to_string(),
-            exclusive: pair_kernel::exclusive_carriers(&particle, &turn),
-            particle,
-            radius: spheres.iter().map(|s| s.radius).collect(),
-            body: spheres.iter().map(|s| s.body as u32).collect(),
-            rigid,
-            turn,
-            lever,
-            bound_mass,
+            spheres: Spheres::new(SphereColumns {
+                exclusive: pair_kernel::exclusive_carriers(&particle, &turn),
+                particle,
+                radius: spheres.iter().map(|s| s.radius).collect(),
+                body: spheres.iter().map(|s| s.body as u32).collect(),
+                rigid,
+                turn,
+                lever,
+                bound_mass,
+                now,
+            }),
             body_names,
             materials: materials.len(),
             elasticity,
@@ -112,8 +115,6 @@ impl DemContacts {
             dt: 0.0,
             read_every: true,
             evaluated: Evaluated::Nothing,
-            center: vec![Vec3::zeros(); spheres.len()],
-            now,
             built_at: Vec::new(),
             anchor: None,
             built_time: 0.0,
@@ -137,7 +138,7 @@ impl DemContacts {
     /// Makes the contacts periodic along the axes of `periodic`; refused when a period is not
     /// longer than twice the reach of the largest spheres (two radii plus the skin).
     pub fn with_periodic(mut self, periodic: PeriodicBox) -> Result<DemContacts, ContactError> {
-        let r_max = self.radius.iter().cloned().fold(0.0, f64::max);
+        let r_max = self.spheres.radius().iter().cloned().fold(0.0, f64::max);
         periodic.check_reach(2.0 * r_max + self.settings.skin)?;
         self.periodic = Some(periodic);
         self.built = false;
@@ -182,34 +183,36 @@ impl DemContacts {
         self.rebuild_all(state.time);
         for c in &self.pairs.items {
             let (a, b) = (c.first as usize, c.second as usize);
-            let radius = reduced(self.radius[a], self.radius[b]);
-            let overlap = self.radius[a] + self.radius[b] - self.separation(a, b).0.norm();
+            let radius = reduced(self.spheres.radius()[a], self.spheres.radius()[b]);
+            let overlap = self.spheres.radius()[a] + self.spheres.radius()[b]
+                - self.separation(a, b).0.norm();
             if overlap > tolerance * radius {
                 return Err(ContactError::InitialOverlap {
-                    a: self.body_names[self.body[a] as usize].clone(),
-                    b: self.body_names[self.body[b] as usize].clone(),
+                    a: self.body_names[self.spheres.body()[a] as usize].clone(),
+                    b: self.body_names[self.spheres.body()[b] as usize].clone(),
                     overlap,
                     radius,
                     tolerance: 100.0 * tolerance,
-                    at_a: self.center[a].into(),
-                    at_b: self.center[b].into(),
+                    at_a: self.spheres.center()[a].into(),
+                    at_b: self.spheres.center()[b].into(),
                 });
             }
         }
         for c in &self.wall_contacts.items {
             let (s, w) = (c.first as usize, c.second as usize);
-            let (overlap, _) =
-                self.walls
-                    .get(w)
-                    .overlap(&self.center[s], self.radius[s], state.time);
-            if overlap > tolerance * self.radius[s] {
+            let (overlap, _) = self.walls.get(w).overlap(
+                &self.spheres.center()[s],
+                self.spheres.radius()[s],
+                state.time,
+            );
+            if overlap > tolerance * self.spheres.radius()[s] {
                 return Err(ContactError::InitialWallOverlap {
-                    body: self.body_names[self.body[s] as usize].clone(),
+                    body: self.body_names[self.spheres.body()[s] as usize].clone(),
                     wall: w + 1,
                     overlap,
-                    radius: self.radius[s],
+                    radius: self.spheres.radius()[s],
                     tolerance: 100.0 * tolerance,
-                    at: self.center[s].into(),
+                    at: self.spheres.center()[s].into(),
                 });
             }
         }

@@ -55,18 +55,18 @@ impl DemContacts {
     /// position (0 right after a build). Without rigid bodies there is nothing to bound.
     pub(super) fn anchor(&mut self, state: &State, moved: f64) {
         self.anchor = None;
-        if state.rigid.is_empty() || self.rigid.iter().all(|&r| r == NOT_RIGID) {
+        if state.rigid.is_empty() || self.spheres.rigid().iter().all(|&r| r == NOT_RIGID) {
             return;
         }
         let mut reach = vec![None; state.rigid.len()];
         let mut free = Vec::new();
-        for (s, &b) in self.rigid.iter().enumerate() {
+        for (s, &b) in self.spheres.rigid().iter().enumerate() {
             if b == NOT_RIGID {
                 free.push(s as u32);
                 continue;
             }
             let c = state.position[state.rigid.center[b as usize]];
-            let arm = (state.position[self.particle[s] as usize] - c).norm();
+            let arm = (state.position[self.spheres.particle()[s] as usize] - c).norm();
             let r: &mut Option<f64> = &mut reach[b as usize];
             *r = Some(r.map_or(arm, |r| r.max(arm)));
         }
@@ -101,7 +101,7 @@ impl DemContacts {
         }
         let free = anchor.free.iter().map(|&s| {
             let s = s as usize;
-            (state.position[self.particle[s] as usize] - self.built_at[s]).norm_squared()
+            (state.position[self.spheres.particle()[s] as usize] - self.built_at[s]).norm_squared()
         });
         Some(bound.max(free.fold(0.0, f64::max).sqrt()))
     }
@@ -109,7 +109,7 @@ impl DemContacts {
     /// The largest distance a sphere has moved since the last build, read from every sphere
     /// (infinite before a build).
     pub(super) fn exact_displacement(&self, state: &State) -> f64 {
-        let (particle, built_at) = (&self.particle, &self.built_at);
+        let (particle, built_at) = (&self.spheres.particle(), &self.built_at);
         if !self.lists_built() {
             return f64::INFINITY;
         }
@@ -205,7 +205,7 @@ mod tests {
         let (mut state, mut contacts) = bodies_and_a_grain();
         let n = state.len();
         let (mut force, mut torque) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n + 2]);
-        let sphere_particles = contacts.particle.clone();
+        let sphere_particles = contacts.spheres.particle().to_vec();
         let positions = |state: &State| -> Vec<Vec3> {
             sphere_particles
                 .iter()

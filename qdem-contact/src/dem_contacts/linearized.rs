@@ -8,13 +8,13 @@ impl DemContacts {
     /// centre.
     pub(super) fn attachment(&self, state: &State, s: usize, arm: Vec3) -> Attachment {
         let bodies = state.rigid.len();
-        let node = match self.turn[s] {
+        let node = match self.spheres.turn()[s] {
             NOT_RIGID => None,
             t if (t as usize) < bodies => Some(state.body_rotation_node(t as usize)),
             t => Some(state.len() + t as usize - bodies),
         };
         Attachment {
-            particle: self.particle[s] as usize,
+            particle: self.spheres.particle()[s] as usize,
             turn: node.map(|n| (n, arm)),
         }
     }
@@ -26,7 +26,7 @@ impl Linearized for DemContacts {
         let law = &self.settings.law;
         for c in &self.pairs.items {
             let (a, b) = (c.first as usize, c.second as usize);
-            let (sa, sb) = (&self.now[a], &self.now[b]);
+            let (sa, sb) = (self.spheres.now(a), self.spheres.now(b));
             let shift = self.separation(a, b).1;
             let Some(g) = narrow_phase(sa, sb, shift, self.settings.friction) else {
                 continue;
@@ -45,7 +45,7 @@ impl Linearized for DemContacts {
                 continue;
             };
             let (kn, kt) = law.stiffness(g.overlap, g.radius, &e);
-            let arm = (self.now[s].radius - 0.5 * g.overlap) * g.normal;
+            let arm = (self.spheres.now(s).radius - 0.5 * g.overlap) * g.normal;
             let side = self.attachment(state, s, arm);
             add_spring(tangent, side, None, &spring(&g.normal, kn, kt));
         }

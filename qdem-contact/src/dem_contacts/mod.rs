@@ -33,8 +33,8 @@
 //! magnitude of the contact forces through the boundary, F_Ave_current, is measured at every
 //! evaluation, before the scaling, and drives [`TimeDelayedBoundary`].
 //!
-//! The files: this one holds the model (its records, the narrow phase, the [`Model`] facet
-//! and the stable step); `build.rs` its construction; `stages.rs` the stages of one
+//! The files: this one holds the model (its parts, the narrow phase, the [`Model`] facet
+//! and the stable step); `spheres.rs` the sphere records; `build.rs` its construction; `stages.rs` the stages of one
 //! evaluation; `pair_kernel.rs` the pair kernel; `pipeline.rs` the reading of the spheres
 //! and the building of the candidate lists; `displacement.rs` its displacement check's bound
 //! for rigid bodies; `walls.rs` the walls' part (walls, their elasticity, the narrow phase against a wall) and `servo_loads.rs` its stress-controlled walls' servos; `output_queries.rs` what the
@@ -62,6 +62,7 @@ use qdem_core::{
     State, Tangent, Vec3,
 };
 use rayon::prelude::*;
+use spheres::{SphereColumns, Spheres};
 use split::ContactPart;
 use stages::Evaluated;
 use time_delay::{pair_scales, TimeDelay};
@@ -78,6 +79,7 @@ mod pair_kernel;
 mod persistence;
 mod pipeline;
 mod servo_loads;
+mod spheres;
 mod split;
 mod stages;
 mod time_delay;
@@ -228,15 +230,8 @@ pub(crate) fn narrow_phase(
 /// ```
 pub struct DemContacts {
     name: String,
-    particle: Vec<u32>,
-    radius: Vec<f64>,
-    body: Vec<u32>,
-    rigid: Vec<u32>,
-    turn: Vec<u32>,
-    /// Per sphere, whether its particle and rotation are its alone (`pair_kernel.rs`).
-    exclusive: Vec<bool>,
-    lever: Vec<f64>,
-    bound_mass: Vec<f64>,
+    /// The sphere records (`spheres.rs`).
+    spheres: Spheres,
     body_names: Vec<String>,
     materials: usize,
     elasticity: Vec<PairElasticity>,
@@ -250,10 +245,6 @@ pub struct DemContacts {
     read_every: bool,
     /// How far the pair kernel has run in this evaluation (`stages.rs`).
     evaluated: Evaluated,
-    /// Every sphere's centre at the last evaluation.
-    center: Vec<Vec3>,
-    /// What the narrow phase reads of each sphere, current for the partners of candidates.
-    now: Vec<SphereNow>,
     built_at: Vec<Vec3>,
     /// The rigid bodies' poses at the step the displacement check's bound starts from
     /// (`displacement.rs`).
@@ -319,7 +310,8 @@ impl Model for DemContacts {
         let law = &self.settings.law;
         let zeta = law.damping_ratio();
         let n_rigid = self
-            .rigid
+            .spheres
+            .rigid()
             .iter()
             .filter(|&&r| r != NOT_RIGID)
             .map(|&r| r as usize + 1)
@@ -327,19 +319,19 @@ impl Model for DemContacts {
             .unwrap_or(0);
         let mut per_body = vec![(0.0, 0.0, 0usize); n_rigid];
         let mut worst = (0.0f64, 0.0f64);
-        for s in 0..self.particle.len() {
-            let r = self.radius[s];
-            let sphere = &self.now[s];
+        for s in 0..self.spheres.len() {
+            let r = self.spheres.radius()[s];
+            let sphere = self.spheres.now(s);
             let e = self.walls.elasticity(sphere.material);
             let (kn, kt) = law.stiffness(REFERENCE_OVERLAP * r, r, &e);
             let k = kn.max(kt);
-            let mass = self.bound_mass[s];
+            let mass = self.spheres.bound_mass()[s];
             if mass.is_infinite() {
                 continue;
             }
-            let compliance = 1.0 / mass + self.lever[s];
+            let compliance = 1.0 / mass + self.spheres.lever()[s];
             let (w, g) = (k * compliance, 2.0 * zeta * (k * mass).sqrt() * compliance);
-            match self.rigid[s] {
+            match self.spheres.rigid()[s] {
                 NOT_RIGID => worst = (worst.0.max(COORDINATION * w), worst.1.max(COORDINATION * g)),
                 b => {
                     let entry = &mut per_body[b as usize];

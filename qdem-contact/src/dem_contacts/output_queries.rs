@@ -21,8 +21,8 @@ impl DemContacts {
     pub fn section_force(&self, axis: usize, at: f64) -> f64 {
         let period = self.periodic.as_ref().and_then(|p| p.length(axis));
         self.mean_pair_force(|c, shift| {
-            let a = self.center[c.first as usize][axis] - at;
-            let b = self.center[c.second as usize][axis] + shift[axis] - at;
+            let a = self.spheres.center()[c.first as usize][axis] - at;
+            let b = self.spheres.center()[c.second as usize][axis] + shift[axis] - at;
             crosses(a, b, period)
         })
     }
@@ -46,7 +46,7 @@ impl DemContacts {
 
     /// Number of contact spheres.
     pub fn spheres(&self) -> usize {
-        self.particle.len()
+        self.spheres.len()
     }
 
     /// Number of walls.
@@ -96,17 +96,17 @@ impl DemContacts {
         state: &'a State,
     ) -> impl Iterator<Item = SphereRecord> + 'a {
         let bodies = state.rigid.len();
-        (0..self.particle.len()).map(move |s| {
-            let particle = self.particle[s] as usize;
-            let spin = match self.turn[s] as usize {
+        (0..self.spheres.len()).map(move |s| {
+            let particle = self.spheres.particle()[s] as usize;
+            let spin = match self.spheres.turn()[s] as usize {
                 t if t == NOT_RIGID as usize => None,
                 b if b < bodies => Some(state.rigid.angular_velocity[b]),
                 t => Some(state.spin.velocity[t - bodies]),
             };
             SphereRecord {
                 particle,
-                radius: self.radius[s],
-                body: self.body[s] as usize,
+                radius: self.spheres.radius()[s],
+                body: self.spheres.body()[s] as usize,
                 center: state.position[particle],
                 velocity: state.velocity[particle],
                 spin,
@@ -125,7 +125,7 @@ impl DemContacts {
         let pairs = pairs.filter(|(c, _)| c.force != Vec3::zeros());
         let pairs = pairs.map(move |(c, shift)| {
             let (a, b) = (c.first as usize, c.second as usize);
-            let (from, to) = (self.center[a], self.center[b] + shift);
+            let (from, to) = (self.spheres.center()[a], self.spheres.center()[b] + shift);
             let scales = delay.map_or((1.0, 1.0), |(axis, s)| pair_scales(shift[axis], &s));
             touching_contact(
                 a,
@@ -144,9 +144,12 @@ impl DemContacts {
             .filter(|c| c.force != Vec3::zeros());
         let walls = walls.map(move |c| {
             let (s, w) = (c.first as usize, c.second as usize);
-            let from = self.center[s];
-            let (overlap, normal) = self.walls.get(w).overlap(&from, self.radius[s], time);
-            let to = from + (self.radius[s] - overlap) * normal;
+            let from = self.spheres.center()[s];
+            let (overlap, normal) =
+                self.walls
+                    .get(w)
+                    .overlap(&from, self.spheres.radius()[s], time);
+            let to = from + (self.spheres.radius()[s] - overlap) * normal;
             touching_contact(s, Partner::Wall(w), from, to, normal, c.force, (1.0, 1.0))
         });
         pairs.chain(walls)
@@ -166,7 +169,7 @@ impl DemContacts {
         for c in self.pairs.items.iter().filter(|c| c.force != Vec3::zeros()) {
             let (a, b) = (c.first as usize, c.second as usize);
             let overlap = 2.0 * c.half_overlap;
-            let depth = overlap / self.radius[a].min(self.radius[b]);
+            let depth = overlap / self.spheres.radius()[a].min(self.spheres.radius()[b]);
             if deepest.is_none_or(|d| depth > d.3) {
                 deepest = Some((a, b, overlap, depth));
             }

@@ -51,7 +51,7 @@ pub(super) fn run_length(n: usize) -> usize {
 impl DemContacts {
     /// The run of sphere `s`.
     fn run_of(&self, s: u32) -> usize {
-        s as usize / run_length(self.particle.len())
+        s as usize / run_length(self.spheres.len())
     }
 }
 
@@ -85,7 +85,7 @@ struct RunPlan {
 impl DemContacts {
     /// The plan of the fused pass for the current lists.
     pub(super) fn plan_runs(&mut self) {
-        let n = self.particle.len();
+        let n = self.spheres.len();
         let length = run_length(n);
         let runs = n.div_ceil(length);
         let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
@@ -140,7 +140,7 @@ impl DemContacts {
         for &s in &self.partners {
             let receives = receive.next_if_eq(&s).is_some();
             while receive.next_if_eq(&s).is_some() {}
-            let early = self.exclusive[s as usize] && !receives;
+            let early = self.spheres.exclusive(s as usize) && !receives;
             plan.early.push(early);
             if !early {
                 plan.late.push(s);
@@ -330,8 +330,8 @@ impl DemContacts {
                 None => (1.0, 1.0),
             };
             let (first, second) = (
-                pair_share(contact, &turn, true, self.now[a].radius, scale_a),
-                pair_share(contact, &turn, false, self.now[b].radius, scale_b),
+                pair_share(contact, &turn, true, self.spheres.now(a).radius, scale_a),
+                pair_share(contact, &turn, false, self.spheres.now(b).radius, scale_b),
             );
             add_to(&mut own[a - lo as usize], first);
             match (slot as usize).checked_sub(RUN_CHUNK) {
@@ -362,7 +362,7 @@ impl DemContacts {
             if SUM {
                 add_to(
                     &mut own[s - lo as usize],
-                    wall_share(contact, &turn, self.now[s].radius),
+                    wall_share(contact, &turn, self.spheres.now(s).radius),
                 );
             }
         }
@@ -427,9 +427,9 @@ impl DemContacts {
         t: &Vec3,
         (force, torque): &(Carriers, Carriers),
     ) {
-        force.add(self.particle[s] as usize, f);
-        if self.turn[s] != NOT_RIGID {
-            torque.add(self.turn[s] as usize, t);
+        force.add(self.spheres.particle()[s] as usize, f);
+        if self.spheres.turn()[s] != NOT_RIGID {
+            torque.add(self.spheres.turn()[s] as usize, t);
         }
     }
 }

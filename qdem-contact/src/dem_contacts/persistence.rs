@@ -105,7 +105,7 @@ impl DemContacts {
         saved: &SavedSprings,
         particle_of: impl Fn(u32) -> Option<usize>,
     ) -> CarriedSprings {
-        let sphere_of: HashMap<usize, u32> = (self.particle.iter().enumerate())
+        let sphere_of: HashMap<usize, u32> = (self.spheres.particle().iter().enumerate())
             .map(|(s, &p)| (p as usize, s as u32))
             .collect();
         let sphere = |p: u32| particle_of(p).and_then(|p| sphere_of.get(&p).copied());
@@ -144,7 +144,7 @@ impl Persistent for DemContacts {
     /// state.
     fn save(&self, out: &mut Encoder) {
         out.tag("contact");
-        out.u32s(&self.particle);
+        out.u32s(&self.spheres.particle());
         out.option_f64(self.last_time);
         out.bool(self.built);
         out.f64(self.built_time);
@@ -160,9 +160,9 @@ impl Persistent for DemContacts {
     }
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
         input.tag("contact")?;
-        let spheres = self.particle.len();
+        let spheres = self.spheres.len();
         let particle = input.u32s("contact sphere particles")?;
-        if particle != self.particle {
+        if particle != self.spheres.particle() {
             return Err(CheckpointError::Invalid {
                 what: "contact spheres",
                 detail: format!(

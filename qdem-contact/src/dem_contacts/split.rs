@@ -111,17 +111,8 @@ impl DemContacts {
     /// Reads the centres of the spheres `own` from `state`; returns the largest distance one
     /// has moved since the last build (infinite before it).
     pub(super) fn read_own_centers(&mut self, state: &State, own: &[u32]) -> f64 {
-        let built = self.lists_built();
-        let mut moved: f64 = if built { 0.0 } else { f64::INFINITY };
-        for &s in own {
-            let s = s as usize;
-            let center = state.position[self.particle[s] as usize];
-            if built {
-                moved = moved.max((center - self.built_at[s]).norm_squared());
-            }
-            self.center[s] = center;
-        }
-        moved.sqrt()
+        let built_at = self.lists_built().then_some(&self.built_at[..]);
+        self.spheres.read_centers_of(state, own, built_at)
     }
 
     /// After new lists: the own spheres whose motion the lists read, and zero force on the
@@ -143,11 +134,12 @@ impl DemContacts {
     /// (along a periodic axis, those with an image there), and its own spheres' wall
     /// candidates; the springs of the pairs that stay are kept.
     pub(super) fn rebuild_near(&mut self, part: &ContactPart, time: f64) {
-        let reach = 2.0 * self.radius.iter().cloned().fold(0.0, f64::max) + self.settings.skin;
+        let reach =
+            2.0 * self.spheres.radius().iter().cloned().fold(0.0, f64::max) + self.settings.skin;
         let (mut low, mut high) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
         for &s in &part.own {
-            low = low.inf(&self.center[s as usize]);
-            high = high.sup(&self.center[s as usize]);
+            low = low.inf(&self.spheres.center()[s as usize]);
+            high = high.sup(&self.spheres.center()[s as usize]);
         }
         let (start, width) = (
             low.add_scalar(-reach),
@@ -159,8 +151,8 @@ impl DemContacts {
             Some(_) => true,
             None => x >= start[k] && x - start[k] <= width[k],
         };
-        let near: Vec<u32> = (0..self.center.len() as u32)
-            .filter(|&s| (0..3).all(|k| within(k, self.center[s as usize][k])))
+        let near: Vec<u32> = (0..self.spheres.center().len() as u32)
+            .filter(|&s| (0..3).all(|k| within(k, self.spheres.center()[s as usize][k])))
             .collect();
         self.rebuild_among(part, &near, time);
     }
@@ -169,9 +161,9 @@ impl DemContacts {
     fn rebuild_among(&mut self, part: &ContactPart, near: &[u32], time: f64) {
         let skin = self.settings.skin;
         let (center, radius, body) = (
-            pick(near, &self.center),
-            pick(near, &self.radius),
-            pick(near, &self.body),
+            pick(near, &self.spheres.center()),
+            pick(near, &self.spheres.radius()),
+            pick(near, &self.spheres.body()),
         );
         let set = SphereSet {
             center: &center,
@@ -231,19 +223,23 @@ impl DemContacts {
 impl DemContacts {
     /// The particle of every contact sphere, the items whose records the ranks exchange.
     pub(super) fn sphere_particles(&self) -> Vec<usize> {
-        self.particle.iter().map(|&p| p as usize).collect()
+        self.spheres
+            .particle()
+            .iter()
+            .map(|&p| p as usize)
+            .collect()
     }
 
     /// From now on, this rank's part of the contacts (`None`: whole again).
     pub(super) fn set_part(&mut self, part: Option<Part>) {
-        self.split = part.map(|p| ContactPart::new(&self.particle, &p.owner, p.rank));
+        self.split = part.map(|p| ContactPart::new(&self.spheres.particle(), &p.owner, p.rank));
     }
 
     /// Appends the records of the spheres `items`: centre, velocity and spin.
     pub(super) fn pack_spheres(&self, items: &[u32], out: &mut Vec<f64>) {
         for &s in items {
-            let n = &self.now[s as usize];
-            for v in [self.center[s as usize], n.velocity, n.spin] {
+            let n = self.spheres.now(s as usize);
+            for v in [self.spheres.center()[s as usize], n.velocity, n.spin] {
                 out.extend_from_slice(v.as_slice());
             }
         }
@@ -252,11 +248,9 @@ impl DemContacts {
     /// Sets the records of the spheres `items` from what [`DemContacts::pack_spheres`] wrote.
     pub(super) fn unpack_spheres(&mut self, items: &[u32], values: &[f64]) {
         for (&s, v) in items.iter().zip(values.chunks_exact(SPHERE_VALUES)) {
-            let n = &mut self.now[s as usize];
-            n.center = Vec3::new(v[0], v[1], v[2]);
-            n.velocity = Vec3::new(v[3], v[4], v[5]);
-            n.spin = Vec3::new(v[6], v[7], v[8]);
-            self.center[s as usize] = n.center;
+            let (center, velocity) = (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]));
+            let spin = Vec3::new(v[6], v[7], v[8]);
+            self.spheres.set_motion(s as usize, center, velocity, spin);
         }
     }
 
@@ -332,11 +326,11 @@ impl DemContacts {
     pub(super) fn add_candidate_costs(&self, cost: &mut [f64]) {
         let half = 0.5 * CANDIDATE_WORK;
         for c in &self.pairs.items {
-            cost[self.particle[c.first as usize] as usize] += half;
-            cost[self.particle[c.second as usize] as usize] += half;
+            cost[self.spheres.particle()[c.first as usize] as usize] += half;
+            cost[self.spheres.particle()[c.second as usize] as usize] += half;
         }
         for c in &self.wall_contacts.items {
-            cost[self.particle[c.first as usize] as usize] += CANDIDATE_WORK;
+            cost[self.spheres.particle()[c.first as usize] as usize] += CANDIDATE_WORK;
         }
     }
 }

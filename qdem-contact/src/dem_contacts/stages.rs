@@ -150,7 +150,7 @@ impl DemContacts {
         if let Some(delay) = &self.time_delay {
             delay.reduction(&self.pairs, out);
         }
-        let spheres = (&self.now[..], &self.radius[..]);
+        let spheres = (self.spheres.records(), self.spheres.radius());
         let servo =
             self.walls
                 .servo_contacts(&self.wall_contacts, spheres, &self.settings.law, self.dt);

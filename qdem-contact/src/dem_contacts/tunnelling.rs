@@ -90,7 +90,7 @@ impl DemContacts {
         let spheres = match own {
             Some(own) => own,
             None => {
-                all = (0..self.particle.len() as u32).collect();
+                all = (0..self.spheres.len() as u32).collect();
                 &all
             }
         };
@@ -122,7 +122,7 @@ impl DemContacts {
 
     /// The first wall sphere `s` went into or through.
     fn through_wall(&self, s: usize, time: f64, since: Option<f64>) -> Option<Passage> {
-        let x = self.center[s];
+        let x = self.spheres.center()[s];
         self.walls.list().iter().enumerate().find_map(|(w, wall)| {
             let depth = match &wall.shape {
                 WallShape::Plane(p) => Some(-p.distance(&x, time)).filter(|d| *d > 0.0),
@@ -145,7 +145,7 @@ impl DemContacts {
         if !self.lists_built() {
             return Vec3::zeros();
         }
-        let d = self.center[s] - self.built_at[s];
+        let d = self.spheres.center()[s] - self.built_at[s];
         match &self.periodic {
             Some(p) => d + p.image_shift(&d),
             None => d,
@@ -158,14 +158,16 @@ impl DemContacts {
         let vertices: Vec<Vec3> = surface
             .spheres
             .iter()
-            .map(|&s| self.center[s as usize])
+            .map(|&s| self.spheres.center()[s as usize])
             .collect();
         let (lower, upper) = bounds(&vertices);
         let inside_box = |s: &u32| {
-            let (s, x) = (*s as usize, self.center[*s as usize]);
-            self.body[s] as usize != surface.body
-                && (0..3)
-                    .all(|k| x[k] > lower[k] + self.radius[s] && x[k] < upper[k] - self.radius[s])
+            let (s, x) = (*s as usize, self.spheres.center()[*s as usize]);
+            self.spheres.body()[s] as usize != surface.body
+                && (0..3).all(|k| {
+                    x[k] > lower[k] + self.spheres.radius()[s]
+                        && x[k] < upper[k] - self.spheres.radius()[s]
+                })
         };
         let candidates: Vec<u32> = spheres.iter().copied().filter(inside_box).collect();
         if candidates.is_empty() {
@@ -173,15 +175,17 @@ impl DemContacts {
         }
         let mesh = oriented(&vertices, &surface.triangles)?;
         candidates.into_iter().find_map(|s| {
-            let x = self.center[s as usize];
+            let x = self.spheres.center()[s as usize];
             let projection = mesh.project_local_point(Vector::new(x.x, x.y, x.z), false);
             let p = projection.point;
             let depth = (Vec3::new(p.x, p.y, p.z) - x).norm();
-            (projection.is_inside && depth > self.radius[s as usize]).then_some(Passage::Body {
-                sphere: s as usize,
-                other: surface.body,
-                depth,
-            })
+            (projection.is_inside && depth > self.spheres.radius()[s as usize]).then_some(
+                Passage::Body {
+                    sphere: s as usize,
+                    other: surface.body,
+                    depth,
+                },
+            )
         })
     }
 
@@ -227,11 +231,14 @@ impl DemContacts {
             true => self.moved_since_build(s).norm() / elapsed,
             false => 0.0,
         };
-        let (radius, x) = (self.radius[s], self.center[s]);
+        let (radius, x) = (self.spheres.radius()[s], self.spheres.center()[s]);
         let what = format!(
             "the contact sphere of body `{}` at ({:.4}, {:.4}, {:.4}) m (radius {radius:.3e} \
              m) {into}, moving at about {speed:.3e} m/s; the contact no longer holds it back.",
-            self.body_names[self.body[s] as usize], x.x, x.y, x.z,
+            self.body_names[self.spheres.body()[s] as usize],
+            x.x,
+            x.y,
+            x.z,
         );
         (what, self.fix(passage, speed, radius))
     }
@@ -267,7 +274,7 @@ impl DemContacts {
     /// another body's mesh deeper than its radius at `state` (read by
     /// [`DemContacts::check_initial_overlaps`] before): a body placed inside another.
     pub fn check_initial_passage(&self, state: &State) -> Result<(), ContactError> {
-        let all: Vec<u32> = (0..self.particle.len() as u32).collect();
+        let all: Vec<u32> = (0..self.spheres.len() as u32).collect();
         let Some(passage) = self.find_passage(&all, state.time, None) else {
             return Ok(());
         };
@@ -284,11 +291,11 @@ impl DemContacts {
             } => (sphere, format!("body `{}`", self.body_names[other]), depth),
         };
         Err(ContactError::InitialInside {
-            body: self.body_names[self.body[s] as usize].clone(),
+            body: self.body_names[self.spheres.body()[s] as usize].clone(),
             inside,
             depth,
-            radius: self.radius[s],
-            at: self.center[s].into(),
+            radius: self.spheres.radius()[s],
+            at: self.spheres.center()[s].into(),
         })
     }
 
