@@ -115,20 +115,12 @@ impl DemContacts {
             dt: 0.0,
             read_every: true,
             evaluated: Evaluated::Nothing,
-            built_at: Vec::new(),
-            anchor: None,
-            built_time: 0.0,
-            built: false,
-            pairs: ContactList::default(),
-            wall_contacts: ContactList::default(),
-            partners: Vec::new(),
+            candidates: Candidates::default(),
             sphere_force: vec![(Vec3::zeros(), Vec3::zeros()); spheres.len()],
             kernel_plan: KernelPlan::default(),
-            rebuilds: 0,
             periodic: None,
             time_delay: None,
             split: None,
-            rebuilt: false,
             surfaces: Vec::new(),
             pass_through: None,
             step: 0.0,
@@ -141,7 +133,7 @@ impl DemContacts {
         let r_max = self.spheres.radius().iter().cloned().fold(0.0, f64::max);
         periodic.check_reach(2.0 * r_max + self.settings.skin)?;
         self.periodic = Some(periodic);
-        self.built = false;
+        self.candidates.invalidate();
         Ok(self)
     }
 
@@ -181,7 +173,7 @@ impl DemContacts {
     ) -> Result<(), ContactError> {
         self.read_centers(state);
         self.rebuild_all(state.time);
-        for c in &self.pairs.items {
+        for c in &self.candidates.pairs().items {
             let (a, b) = (c.first as usize, c.second as usize);
             let radius = reduced(self.spheres.radius()[a], self.spheres.radius()[b]);
             let overlap = self.spheres.radius()[a] + self.spheres.radius()[b]
@@ -198,7 +190,7 @@ impl DemContacts {
                 });
             }
         }
-        for c in &self.wall_contacts.items {
+        for c in &self.candidates.wall_contacts().items {
             let (s, w) = (c.first as usize, c.second as usize);
             let (overlap, _) = self.walls.get(w).overlap(
                 &self.spheres.center()[s],

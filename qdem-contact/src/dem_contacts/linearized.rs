@@ -24,7 +24,7 @@ impl Linearized for DemContacts {
     /// The springs of the contacts touching at the last evaluation, at the geometry it saw.
     fn add_tangent(&self, state: &State, tangent: &mut Tangent) {
         let law = &self.settings.law;
-        for c in &self.pairs.items {
+        for c in &self.candidates.pairs().items {
             let (a, b) = (c.first as usize, c.second as usize);
             let (sa, sb) = (self.spheres.now(a), self.spheres.now(b));
             let shift = self.separation(a, b).1;
@@ -39,7 +39,7 @@ impl Linearized for DemContacts {
             add_spring(tangent, pa, Some(pb), &spring(&g.normal, kn, kt));
         }
         let time = self.last_time.unwrap_or(0.0);
-        for c in &self.wall_contacts.items {
+        for c in &self.candidates.wall_contacts().items {
             let (s, w) = (c.first as usize, c.second as usize);
             let Some((g, e)) = self.wall_contact(time, s, w) else {
                 continue;

@@ -34,7 +34,7 @@
 //! evaluation, before the scaling, and drives [`TimeDelayedBoundary`].
 //!
 //! The files: this one holds the model (its parts, the narrow phase, the [`Model`] facet
-//! and the stable step); `spheres.rs` the sphere records; `build.rs` its construction; `stages.rs` the stages of one
+//! and the stable step); `spheres.rs` the sphere records; `candidates.rs` the candidate lists and their build; `build.rs` its construction; `stages.rs` the stages of one
 //! evaluation; `pair_kernel.rs` the pair kernel; `pipeline.rs` the reading of the spheres
 //! and the building of the candidate lists; `displacement.rs` its displacement check's bound
 //! for rigid bodies; `walls.rs` the walls' part (walls, their elasticity, the narrow phase against a wall) and `servo_loads.rs` its stress-controlled walls' servos; `output_queries.rs` what the
@@ -54,6 +54,7 @@ use crate::periodic_boundary::PeriodicBox;
 use crate::spring_blocks::{add_spring, spring, Attachment};
 use crate::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
 use crate::wall::Wall;
+use candidates::Candidates;
 use pair_kernel::KernelPlan;
 use qdem_core::checkpoint::same_count;
 use qdem_core::stable_step::critical_step;
@@ -72,6 +73,7 @@ pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
 pub use tunnelling::BodySurface;
 
 mod build;
+mod candidates;
 mod displacement;
 mod linearized;
 mod output_queries;
@@ -232,6 +234,8 @@ pub struct DemContacts {
     name: String,
     /// The sphere records (`spheres.rs`).
     spheres: Spheres,
+    /// The candidate lists and their build (`candidates.rs`).
+    candidates: Candidates,
     body_names: Vec<String>,
     materials: usize,
     elasticity: Vec<PairElasticity>,
@@ -245,26 +249,13 @@ pub struct DemContacts {
     read_every: bool,
     /// How far the pair kernel has run in this evaluation (`stages.rs`).
     evaluated: Evaluated,
-    built_at: Vec<Vec3>,
-    /// The rigid bodies' poses at the step the displacement check's bound starts from
-    /// (`displacement.rs`).
-    anchor: Option<displacement::Anchor>,
-    built_time: f64,
-    built: bool,
-    pairs: ContactList,
-    wall_contacts: ContactList,
-    /// The spheres that are partners of some candidate (pair or wall contact), ascending.
-    partners: Vec<u32>,
     sphere_force: Vec<(Vec3, Vec3)>,
     /// The pair kernel's plan for the current lists (`pair_kernel.rs`).
     kernel_plan: KernelPlan,
-    rebuilds: u64,
     periodic: Option<PeriodicBox>,
     time_delay: Option<TimeDelay>,
     /// This rank's part, in a run decomposed with a halo exchange.
     split: Option<ContactPart>,
-    /// Whether the lists were rebuilt since [`SplitModel::rebuilt`] last asked.
-    rebuilt: bool,
     /// The closed surfaces of the bodies built from meshes (`tunnelling.rs`).
     surfaces: Vec<BodySurface>,
     /// The report of the first sphere found through a wall or inside another body: what
@@ -349,14 +340,23 @@ impl Model for DemContacts {
 
     fn potential_energy(&self, state: &State) -> Option<f64> {
         let law = &self.settings.law;
-        let pairs = self.pairs.with_shifts().filter_map(|(c, mut shift)| {
-            self.pair_contact(c, &mut shift)
-                .map(|(g, e)| law.energy(&g, &e, &c.history))
-        });
-        let walls = self.wall_contacts.items.iter().filter_map(|c| {
-            self.wall_contact(state.time, c.first as usize, c.second as usize)
-                .map(|(g, e)| law.energy(&g, &e, &c.history))
-        });
+        let pairs = self
+            .candidates
+            .pairs()
+            .with_shifts()
+            .filter_map(|(c, mut shift)| {
+                self.pair_contact(c, &mut shift)
+                    .map(|(g, e)| law.energy(&g, &e, &c.history))
+            });
+        let walls = self
+            .candidates
+            .wall_contacts()
+            .items
+            .iter()
+            .filter_map(|c| {
+                self.wall_contact(state.time, c.first as usize, c.second as usize)
+                    .map(|(g, e)| law.energy(&g, &e, &c.history))
+            });
         Some(pairs.chain(walls).sum())
     }
 

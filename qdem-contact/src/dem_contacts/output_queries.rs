@@ -31,7 +31,7 @@ impl DemContacts {
     /// (serial, in pair order, so it does not depend on the thread count); 0 without any.
     pub(super) fn mean_pair_force(&self, counted: impl Fn(&Contact, Vec3) -> bool) -> f64 {
         let (mut sum, mut count) = (0.0, 0usize);
-        for (c, shift) in self.pairs.with_shifts() {
+        for (c, shift) in self.candidates.pairs().with_shifts() {
             if c.force != Vec3::zeros() && counted(c, shift) {
                 sum += c.force.norm();
                 count += 1;
@@ -56,15 +56,16 @@ impl DemContacts {
 
     /// Number of candidate pairs and wall candidates in the current lists.
     pub fn candidates(&self) -> usize {
-        self.pairs.len() + self.wall_contacts.len()
+        self.candidates.pairs().len() + self.candidates.wall_contacts().len()
     }
 
     /// Number of touching contacts (sphere–sphere and sphere–wall) at the last evaluation.
     pub fn contacts(&self) -> usize {
-        self.pairs
+        self.candidates
+            .pairs()
             .items
             .iter()
-            .chain(&self.wall_contacts.items)
+            .chain(&self.candidates.wall_contacts().items)
             .filter(|c| c.force != Vec3::zeros())
             .count()
     }
@@ -121,7 +122,7 @@ impl DemContacts {
     pub fn touching(&self) -> impl Iterator<Item = TouchingContact> + '_ {
         let time = self.last_time.unwrap_or(0.0);
         let delay = self.time_delay.as_ref().map(TimeDelay::ghosts);
-        let pairs = self.pairs.with_shifts();
+        let pairs = self.candidates.pairs().with_shifts();
         let pairs = pairs.filter(|(c, _)| c.force != Vec3::zeros());
         let pairs = pairs.map(move |(c, shift)| {
             let (a, b) = (c.first as usize, c.second as usize);
@@ -138,7 +139,8 @@ impl DemContacts {
             )
         });
         let walls = self
-            .wall_contacts
+            .candidates
+            .wall_contacts()
             .items
             .iter()
             .filter(|c| c.force != Vec3::zeros());
@@ -166,7 +168,13 @@ impl DemContacts {
     /// One pass over the pair records, cheap enough for every step.
     pub fn deepest_pair(&self) -> Option<(usize, usize, f64)> {
         let mut deepest: Option<(usize, usize, f64, f64)> = None;
-        for c in self.pairs.items.iter().filter(|c| c.force != Vec3::zeros()) {
+        for c in self
+            .candidates
+            .pairs()
+            .items
+            .iter()
+            .filter(|c| c.force != Vec3::zeros())
+        {
             let (a, b) = (c.first as usize, c.second as usize);
             let overlap = 2.0 * c.half_overlap;
             let depth = overlap / self.spheres.radius()[a].min(self.spheres.radius()[b]);
@@ -179,7 +187,7 @@ impl DemContacts {
 
     /// How many times the candidate lists were rebuilt.
     pub fn rebuilds(&self) -> u64 {
-        self.rebuilds
+        self.candidates.rebuilds()
     }
 }
 

@@ -88,7 +88,10 @@ impl DemContacts {
         let n = self.spheres.len();
         let length = run_length(n);
         let runs = n.div_ceil(length);
-        let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
+        let (pairs, walls) = (
+            &self.candidates.pairs().items,
+            &self.candidates.wall_contacts().items,
+        );
         let mut plan = std::mem::take(&mut self.kernel_plan);
         plan.runs.clear();
         plan.slot.clear();
@@ -99,7 +102,7 @@ impl DemContacts {
             (
                 pairs.partition_point(|c| c.first < lo),
                 walls.partition_point(|c| c.first < lo),
-                self.partners.partition_point(|&s| s < lo),
+                self.candidates.partners().partition_point(|&s| s < lo),
             )
         };
         let mut foreign = Vec::new();
@@ -137,7 +140,7 @@ impl DemContacts {
         plan.early.clear();
         plan.late.clear();
         let mut receive = plan.receive.iter().map(|e| e.0).peekable();
-        for &s in &self.partners {
+        for &s in self.candidates.partners() {
             let receives = receive.next_if_eq(&s).is_some();
             while receive.next_if_eq(&s).is_some() {}
             let early = self.spheres.exclusive(s as usize) && !receives;
@@ -166,8 +169,8 @@ impl DemContacts {
     ) {
         let keep_turn = LAW && (!SUM || self.split.is_some());
         let mut plan = std::mem::take(&mut self.kernel_plan);
-        let mut pairs = std::mem::take(&mut self.pairs);
-        let mut walls = std::mem::take(&mut self.wall_contacts);
+        let mut pairs = std::mem::take(self.candidates.pairs_mut());
+        let mut walls = std::mem::take(self.candidates.wall_contacts_mut());
         if LAW {
             for list in [&mut pairs, &mut walls] {
                 list.turn.clear();
@@ -217,7 +220,7 @@ impl DemContacts {
                     let run = &runs[r];
                     let lo = (r * length) as u32;
                     let slots = &slot[run.pairs.clone()];
-                    let partners = &this.partners[run.partners.clone()];
+                    let partners = &this.candidates.partners()[run.partners.clone()];
                     let sums = RunSums { own, foreign, lo };
                     this.evaluate_run::<LAW, SUM>(time, dt, lists, slots, partners, sums);
                     let (true, Some(carriers)) = (SUM, &carriers) else {
@@ -235,7 +238,7 @@ impl DemContacts {
                     }
                 });
         }
-        (self.pairs, self.wall_contacts) = (pairs, walls);
+        self.candidates.set_lists(pairs, walls);
         if SUM {
             let mut receive = plan.receive.iter().peekable();
             for &s in &plan.late {
@@ -260,7 +263,12 @@ impl DemContacts {
     /// (`force`) and rotation (`torque`), in ascending sphere order: after a kernel pass that
     /// summed without them.
     pub(super) fn add_partner_sums(&self, force: &mut [Vec3], torque: &mut [Vec3]) {
-        for &s in self.partners.iter().filter(|&&s| self.adds_to(s)) {
+        for &s in self
+            .candidates
+            .partners()
+            .iter()
+            .filter(|&&s| self.adds_to(s))
+        {
             let (f, t) = &self.sphere_force[s as usize];
             self.add_sphere(s as usize, f, t, force, torque);
         }
@@ -638,7 +646,7 @@ mod tests {
         contacts.rebuild_stage(0.0);
         let plan = &contacts.kernel_plan;
         let mut crossing = 0;
-        for (k, c) in contacts.pairs.items.iter().enumerate() {
+        for (k, c) in contacts.candidates.pairs().items.iter().enumerate() {
             let slot = plan.slot[k] as usize;
             let length = run_length(contacts.spheres());
             if contacts.run_of(c.second) == contacts.run_of(c.first) {

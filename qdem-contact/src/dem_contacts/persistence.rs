@@ -126,9 +126,12 @@ impl DemContacts {
             list.dedup_by_key(|c| (c.0, c.1));
         }
         let carried = pairs.len() + wall_contacts.len();
-        self.pairs = ContactList::with_springs(pairs);
-        self.wall_contacts = ContactList::with_springs(wall_contacts);
-        self.built = false;
+        let lists = (
+            ContactList::with_springs(pairs),
+            ContactList::with_springs(wall_contacts),
+        );
+        self.candidates.set_lists(lists.0, lists.1);
+        self.candidates.invalidate();
         self.index_partners();
         CarriedSprings {
             carried,
@@ -146,12 +149,7 @@ impl Persistent for DemContacts {
         out.tag("contact");
         out.u32s(&self.spheres.particle());
         out.option_f64(self.last_time);
-        out.bool(self.built);
-        out.f64(self.built_time);
-        out.vec3s(&self.built_at);
-        out.u64(self.rebuilds);
-        self.pairs.save(out);
-        self.wall_contacts.save(out);
+        self.candidates.save(out);
         out.bool(self.time_delay.is_some());
         if let Some(delay) = &self.time_delay {
             delay.save(out);
@@ -173,17 +171,7 @@ impl Persistent for DemContacts {
             });
         }
         self.last_time = input.option_f64("the last evaluation time")?;
-        self.built = input.bool("the build flag")?;
-        self.built_time = input.f64("the build time")?;
-        self.built_at = input.vec3s("the build positions")?;
-        // The displacement bound's anchor is not kept: the next check is exact.
-        self.anchor = None;
-        if self.built {
-            same_count("contact spheres", spheres, self.built_at.len())?;
-        }
-        self.rebuilds = input.u64("the rebuild count")?;
-        self.pairs = ContactList::restore(input, spheres, spheres)?;
-        self.wall_contacts = ContactList::restore(input, spheres, self.walls.len())?;
+        self.candidates.restore(input, spheres, self.walls.len())?;
         let delayed = input.bool("the time-delay flag")?;
         same_count(
             "time-delayed boundaries",

@@ -28,7 +28,9 @@ impl DemContacts {
     /// build).
     pub(super) fn read_centers(&mut self, state: &State) -> f64 {
         if self.reads_every_sphere() {
-            let built_at = self.lists_built().then_some(&self.built_at[..]);
+            let built_at = self
+                .lists_built()
+                .then_some(&self.candidates.built_at()[..]);
             self.spheres.read_every(state, built_at)
         } else {
             self.displacement(state)
@@ -44,21 +46,19 @@ impl DemContacts {
     /// Whether [`DemContacts::read_centers`] fills every sphere's narrow-phase record in its
     /// pass: before the first build, and when most spheres are partners of candidates.
     pub(super) fn reads_every_sphere(&self) -> bool {
-        !self.lists_built() || 2 * self.partners.len() >= self.spheres.len()
+        !self.lists_built() || 2 * self.candidates.partners().len() >= self.spheres.len()
     }
 
     /// Whether the candidate lists were built for these spheres (at `built_at`).
     pub(super) fn lists_built(&self) -> bool {
-        self.built && self.built_at.len() == self.spheres.len()
+        self.candidates.built_for(self.spheres.len())
     }
 
     /// The narrow phase's record of every partner of a candidate, from `state`; serial: it
     /// runs only when fewer than half the spheres were partners (in the read, and once after
     /// a rebuild of such lists, for the new partners).
     pub(super) fn read_all_partners(&mut self, state: &State) {
-        let partners = std::mem::take(&mut self.partners);
-        self.read_motions(state, &partners);
-        self.partners = partners;
+        self.spheres.read_motions(state, self.candidates.partners());
     }
 
     /// The centres and the narrow phase's records ([`read_motion`]) of `spheres` from `state`.
@@ -69,7 +69,9 @@ impl DemContacts {
     /// Whether some pair outside the lists may have come within reach since the last build,
     /// given the largest distance a sphere has moved.
     pub(super) fn outgrew_skin(&self, moved: f64, time: f64) -> bool {
-        let wall_moved = self.walls.moved_bound((time - self.built_time).abs());
+        let wall_moved = self
+            .walls
+            .moved_bound((time - self.candidates.built_time()).abs());
         2.0 * moved >= self.settings.skin || moved + wall_moved >= self.settings.skin
     }
 
@@ -83,10 +85,14 @@ impl DemContacts {
             body: &self.spheres.body(),
             periodic: self.periodic.as_ref(),
         };
-        self.pairs
-            .rebuild(find_pairs(&set, skin), self.periodic.is_some());
+        let keys = find_pairs(&set, skin);
+        self.candidates
+            .pairs_mut()
+            .rebuild(keys, self.periodic.is_some());
         let wall_keys = self.wall_keys((0..center.len()).into_par_iter(), time);
-        self.wall_contacts.rebuild(wall_keys, false);
+        self.candidates
+            .wall_contacts_mut()
+            .rebuild(wall_keys, false);
         self.finish_build(time);
     }
 
@@ -111,29 +117,14 @@ impl DemContacts {
 
     /// After new candidate lists: their partners, and where and when they were built.
     pub(super) fn finish_build(&mut self, time: f64) {
-        self.anchor = None;
         self.index_partners();
-        self.built_at = self.spheres.center().to_vec();
-        self.built_time = time;
-        self.built = true;
-        self.rebuilds += 1;
-        self.rebuilt = true;
+        self.candidates.built(self.spheres.center(), time);
     }
 
     /// After new or changed lists: the partners of their candidates, and the pair
     /// kernel's plan for them.
     pub(super) fn index_partners(&mut self) {
-        let mut touches = vec![false; self.spheres.len()];
-        for c in &self.pairs.items {
-            touches[c.first as usize] = true;
-            touches[c.second as usize] = true;
-        }
-        for c in &self.wall_contacts.items {
-            touches[c.first as usize] = true;
-        }
-        self.partners = (0..touches.len() as u32)
-            .filter(|&s| touches[s as usize])
-            .collect();
+        self.candidates.index_partners(self.spheres.len());
         self.plan_runs();
     }
 

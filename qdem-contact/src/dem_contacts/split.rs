@@ -111,7 +111,9 @@ impl DemContacts {
     /// Reads the centres of the spheres `own` from `state`; returns the largest distance one
     /// has moved since the last build (infinite before it).
     pub(super) fn read_own_centers(&mut self, state: &State, own: &[u32]) -> f64 {
-        let built_at = self.lists_built().then_some(&self.built_at[..]);
+        let built_at = self
+            .lists_built()
+            .then_some(&self.candidates.built_at()[..]);
         self.spheres.read_centers_of(state, own, built_at)
     }
 
@@ -119,7 +121,8 @@ impl DemContacts {
     /// own spheres that touch nothing now.
     fn learn_partners(&mut self, part: &mut ContactPart) {
         part.partners = self
-            .partners
+            .candidates
+            .partners()
             .iter()
             .copied()
             .filter(|&s| part.owns(s))
@@ -176,10 +179,14 @@ impl DemContacts {
             .map(|(a, b)| (near[a as usize], near[b as usize]))
             .filter(|&(a, b)| part.owns(a) || part.owns(b))
             .collect();
-        self.pairs.rebuild(keys, self.periodic.is_some());
+        self.candidates
+            .pairs_mut()
+            .rebuild(keys, self.periodic.is_some());
         let own = part.own.par_iter().map(|&s| s as usize);
         let wall_keys = self.wall_keys(own, time);
-        self.wall_contacts.rebuild(wall_keys, false);
+        self.candidates
+            .wall_contacts_mut()
+            .rebuild(wall_keys, false);
         self.finish_build(time);
     }
 
@@ -198,7 +205,8 @@ impl DemContacts {
     /// The partners of this rank's pairs that other ranks own, ascending.
     fn ghosts_of(&self, part: &ContactPart) -> Vec<u32> {
         let mut ghosts: Vec<u32> = self
-            .pairs
+            .candidates
+            .pairs()
             .items
             .iter()
             .flat_map(|c| [c.first, c.second])
@@ -212,8 +220,10 @@ impl DemContacts {
     /// Cuts lists that hold every rank's contacts (after a merge, a restore) down to this
     /// rank's.
     pub(super) fn cut_to_rank(&mut self, part: &mut ContactPart) {
-        self.pairs.retain(|c| part.keeps(c, false));
-        self.wall_contacts.retain(|c| part.keeps(c, true));
+        self.candidates.pairs_mut().retain(|c| part.keeps(c, false));
+        self.candidates
+            .wall_contacts_mut()
+            .retain(|c| part.keeps(c, true));
         self.index_partners();
         part.whole = false;
         part.lists_changed = true;
@@ -260,7 +270,10 @@ impl DemContacts {
         if self.split.as_ref().is_none_or(|p| p.whole) {
             return false;
         }
-        for (list, tag) in [(&self.pairs, 0.0), (&self.wall_contacts, 1.0)] {
+        for (list, tag) in [
+            (&self.candidates.pairs(), 0.0),
+            (&self.candidates.wall_contacts(), 1.0),
+        ] {
             for (k, (c, shift)) in list.with_shifts().enumerate() {
                 out.extend([tag, c.first as f64, c.second as f64]);
                 for v in [c.history, c.force, list.turn[k]] {
@@ -293,16 +306,16 @@ impl DemContacts {
                 false => walls.push(contact),
             }
         }
-        for (items, list) in [(pairs, &mut self.pairs), (walls, &mut self.wall_contacts)] {
-            let mut items = items;
+        let [pairs, walls] = [pairs, walls].map(|mut items| {
             items.sort_by_key(|(c, _, _)| (c.first, c.second));
             items.dedup_by_key(|(c, _, _)| (c.first, c.second));
-            *list = ContactList {
+            ContactList {
                 items: items.iter().map(|e| e.0).collect(),
                 turn: items.iter().map(|e| e.1).collect(),
                 shift: items.iter().map(|e| e.2).collect(),
-            };
-        }
+            }
+        });
+        self.candidates.set_lists(pairs, walls);
         self.index_partners();
         self.run_kernel::<false, true>(0.0, 0.0, None);
         if let Some(part) = &mut self.split {
@@ -312,7 +325,7 @@ impl DemContacts {
 
     /// Whether the lists were rebuilt since the last call.
     pub(super) fn take_rebuilt(&mut self) -> bool {
-        std::mem::take(&mut self.rebuilt)
+        self.candidates.take_rebuilt()
     }
 
     /// This rank's work at its last evaluation: `CANDIDATE_WORK` (three) per candidate
@@ -325,11 +338,11 @@ impl DemContacts {
     /// it per wall candidate.
     pub(super) fn add_candidate_costs(&self, cost: &mut [f64]) {
         let half = 0.5 * CANDIDATE_WORK;
-        for c in &self.pairs.items {
+        for c in &self.candidates.pairs().items {
             cost[self.spheres.particle()[c.first as usize] as usize] += half;
             cost[self.spheres.particle()[c.second as usize] as usize] += half;
         }
-        for c in &self.wall_contacts.items {
+        for c in &self.candidates.wall_contacts().items {
             cost[self.spheres.particle()[c.first as usize] as usize] += CANDIDATE_WORK;
         }
     }

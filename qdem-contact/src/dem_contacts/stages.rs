@@ -148,12 +148,15 @@ impl DemContacts {
     /// when the model has neither.
     pub(super) fn reduction_stage(&mut self, out: &mut Vec<f64>) -> bool {
         if let Some(delay) = &self.time_delay {
-            delay.reduction(&self.pairs, out);
+            delay.reduction(&self.candidates.pairs(), out);
         }
         let spheres = (self.spheres.records(), self.spheres.radius());
-        let servo =
-            self.walls
-                .servo_contacts(&self.wall_contacts, spheres, &self.settings.law, self.dt);
+        let servo = self.walls.servo_contacts(
+            &self.candidates.wall_contacts(),
+            spheres,
+            &self.settings.law,
+            self.dt,
+        );
         for c in servo {
             let (sphere, wall) = (c.sphere as f64, c.wall as f64);
             out.extend([1.0, sphere, wall, c.load, c.response.0, c.response.1]);

@@ -94,7 +94,7 @@ impl DemContacts {
                 &all
             }
         };
-        let since = self.lists_built().then_some(self.built_time);
+        let since = self.lists_built().then_some(self.candidates.built_time());
         if let Some(passage) = self.find_passage(spheres, time, since) {
             self.pass_through = Some(self.describe(passage, time));
         }
@@ -145,7 +145,7 @@ impl DemContacts {
         if !self.lists_built() {
             return Vec3::zeros();
         }
-        let d = self.spheres.center()[s] - self.built_at[s];
+        let d = self.spheres.center()[s] - self.candidates.built_at()[s];
         match &self.periodic {
             Some(p) => d + p.image_shift(&d),
             None => d,
@@ -226,7 +226,7 @@ impl DemContacts {
                 ),
             ),
         };
-        let elapsed = time - self.built_time;
+        let elapsed = time - self.candidates.built_time();
         let speed = match self.lists_built() && elapsed > 0.0 {
             true => self.moved_since_build(s).norm() / elapsed,
             false => 0.0,
