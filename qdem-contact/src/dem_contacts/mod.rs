@@ -249,9 +249,9 @@ pub struct DemContacts {
     read_every: bool,
     /// How far the pair kernel has run in this evaluation (`stages.rs`).
     evaluated: Evaluated,
-    sphere_force: Vec<(Vec3, Vec3)>,
-    /// The pair kernel's plan for the current lists (`pair_kernel.rs`).
-    kernel_plan: KernelPlan,
+    /// The pair kernel's plan for the current lists and its per-sphere sums
+    /// (`pair_kernel.rs`).
+    kernel: KernelPlan,
     periodic: Option<PeriodicBox>,
     time_delay: Option<TimeDelay>,
     /// This rank's part, in a run decomposed with a halo exchange.

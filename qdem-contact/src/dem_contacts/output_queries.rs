@@ -111,7 +111,7 @@ impl DemContacts {
                 center: state.position[particle],
                 velocity: state.velocity[particle],
                 spin,
-                force: self.sphere_force[s].0,
+                force: self.kernel.sum(s).0,
             }
         })
     }

@@ -55,9 +55,11 @@ impl DemContacts {
     }
 }
 
-/// What the fused pass knows of the lists, made at each build.
+/// What the fused pass knows of the lists, made at each build, and its per-sphere sums.
 #[derive(Default)]
 pub(super) struct KernelPlan {
+    /// Per sphere, the sum of its contacts' forces and moments at the last evaluation.
+    sums: Vec<Sum>,
     /// Per run: its pairs (a slice of the pair list), wall contacts and partners (a slice of
     /// [`DemContacts::partners`]).
     runs: Vec<RunPlan>,
@@ -82,6 +84,28 @@ struct RunPlan {
     partners: Range<usize>,
 }
 
+impl KernelPlan {
+    /// No plan yet, and zero sums for `spheres` spheres.
+    pub(super) fn new(spheres: usize) -> KernelPlan {
+        KernelPlan {
+            sums: vec![(Vec3::zeros(), Vec3::zeros()); spheres],
+            ..KernelPlan::default()
+        }
+    }
+
+    /// Sphere `s`'s sum of its contacts' forces and moments at the last evaluation.
+    pub(super) fn sum(&self, s: usize) -> &Sum {
+        &self.sums[s]
+    }
+
+    /// Zero sums for `spheres` (which touch nothing now).
+    pub(super) fn clear_sums(&mut self, spheres: &[u32]) {
+        for &s in spheres {
+            self.sums[s as usize] = (Vec3::zeros(), Vec3::zeros());
+        }
+    }
+}
+
 impl DemContacts {
     /// The plan of the fused pass for the current lists.
     pub(super) fn plan_runs(&mut self) {
@@ -92,7 +116,7 @@ impl DemContacts {
             &self.candidates.pairs().items,
             &self.candidates.wall_contacts().items,
         );
-        let mut plan = std::mem::take(&mut self.kernel_plan);
+        let mut plan = std::mem::take(&mut self.kernel);
         plan.runs.clear();
         plan.slot.clear();
         plan.slot.resize(pairs.len(), 0);
@@ -149,9 +173,9 @@ impl DemContacts {
                 plan.late.push(s);
             }
         }
-        self.kernel_plan = plan;
         // Spheres that touch nothing keep a zero sum until the next build.
-        self.sphere_force.fill((Vec3::zeros(), Vec3::zeros()));
+        plan.sums.fill((Vec3::zeros(), Vec3::zeros()));
+        self.kernel = plan;
     }
 
     /// The pair kernel over every run in parallel: with `LAW`, the narrow phase and the law
@@ -168,7 +192,7 @@ impl DemContacts {
         mut out: Option<(&mut [Vec3], &mut [Vec3])>,
     ) {
         let keep_turn = LAW && (!SUM || self.split.is_some());
-        let mut plan = std::mem::take(&mut self.kernel_plan);
+        let mut plan = std::mem::take(&mut self.kernel);
         let mut pairs = std::mem::take(self.candidates.pairs_mut());
         let mut walls = std::mem::take(self.candidates.wall_contacts_mut());
         if LAW {
@@ -179,7 +203,7 @@ impl DemContacts {
                 }
             }
         }
-        let mut sums = std::mem::take(&mut self.sphere_force);
+        let mut sums = std::mem::take(&mut plan.sums);
         {
             let carriers = out
                 .as_mut()
@@ -255,8 +279,8 @@ impl DemContacts {
                 }
             }
         }
-        self.sphere_force = sums;
-        self.kernel_plan = plan;
+        plan.sums = sums;
+        self.kernel = plan;
     }
 
     /// Adds the complete sum of every partner this process or rank owns to its particle
@@ -269,7 +293,7 @@ impl DemContacts {
             .iter()
             .filter(|&&s| self.adds_to(s))
         {
-            let (f, t) = &self.sphere_force[s as usize];
+            let (f, t) = self.kernel.sum(s as usize);
             self.add_sphere(s as usize, f, t, force, torque);
         }
     }
@@ -644,7 +668,7 @@ mod tests {
         let (state, mut contacts) = packing();
         contacts.read_own_stage(&state);
         contacts.rebuild_stage(0.0);
-        let plan = &contacts.kernel_plan;
+        let plan = &contacts.kernel;
         let mut crossing = 0;
         for (k, c) in contacts.candidates.pairs().items.iter().enumerate() {
             let slot = plan.slot[k] as usize;

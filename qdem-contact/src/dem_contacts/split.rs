@@ -127,9 +127,7 @@ impl DemContacts {
             .copied()
             .filter(|&s| part.owns(s))
             .collect();
-        for &s in &part.own {
-            self.sphere_force[s as usize] = (Vec3::zeros(), Vec3::zeros());
-        }
+        self.kernel.clear_sums(&part.own);
     }
 
     /// The broad phase of one rank, once it holds every sphere's centre: the pairs that touch
