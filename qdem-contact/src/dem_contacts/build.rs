@@ -111,18 +111,13 @@ impl DemContacts {
             elasticity,
             settings,
             walls: Walls::new(walls, materials),
-            last_time: None,
-            dt: 0.0,
-            read_every: true,
-            evaluated: Evaluated::Nothing,
+            evaluation: Evaluation::new(),
             candidates: Candidates::default(),
             kernel: KernelPlan::new(spheres.len()),
             periodic: None,
             time_delay: None,
             split: None,
-            surfaces: Vec::new(),
-            pass_through: None,
-            step: 0.0,
+            passage: PassageCheck::default(),
         }
     }
 

@@ -38,7 +38,7 @@ impl Linearized for DemContacts {
             let pb = self.attachment(state, b, -(sb.radius - half) * g.normal);
             add_spring(tangent, pa, Some(pb), &spring(&g.normal, kn, kt));
         }
-        let time = self.last_time.unwrap_or(0.0);
+        let time = self.evaluation.last_time().unwrap_or(0.0);
         for c in &self.candidates.wall_contacts().items {
             let (s, w) = (c.first as usize, c.second as usize);
             let Some((g, e)) = self.wall_contact(time, s, w) else {

@@ -65,12 +65,13 @@ use qdem_core::{
 use rayon::prelude::*;
 use spheres::{SphereColumns, Spheres};
 use split::ContactPart;
-use stages::Evaluated;
+use stages::Evaluation;
 use time_delay::{pair_scales, TimeDelay};
 use walls::Walls;
 
 pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
 pub use tunnelling::BodySurface;
+use tunnelling::PassageCheck;
 
 mod build;
 mod candidates;
@@ -242,13 +243,8 @@ pub struct DemContacts {
     settings: ContactSettings,
     /// The walls, their elasticity and their servos (`walls.rs`).
     walls: Walls,
-    last_time: Option<f64>,
-    /// The time since the previous evaluation (s), from stage 1 of this one (`stages.rs`).
-    dt: f64,
-    /// Whether stage 1 of this evaluation read every sphere (else the partners only).
-    read_every: bool,
-    /// How far the pair kernel has run in this evaluation (`stages.rs`).
-    evaluated: Evaluated,
+    /// Where the evaluations stand (`stages.rs`).
+    evaluation: Evaluation,
     /// The pair kernel's plan for the current lists and its per-sphere sums
     /// (`pair_kernel.rs`).
     kernel: KernelPlan,
@@ -256,13 +252,8 @@ pub struct DemContacts {
     time_delay: Option<TimeDelay>,
     /// This rank's part, in a run decomposed with a halo exchange.
     split: Option<ContactPart>,
-    /// The closed surfaces of the bodies built from meshes (`tunnelling.rs`).
-    surfaces: Vec<BodySurface>,
-    /// The report of the first sphere found through a wall or inside another body: what
-    /// happened, and the fix.
-    pass_through: Option<(String, String)>,
-    /// The run's step (s), for that report's fix; 0 until [`Model::prepare`].
-    step: f64,
+    /// The check for spheres gone through a wall or into another body (`tunnelling.rs`).
+    passage: PassageCheck,
 }
 
 /// r_a r_b / (r_a + r_b).
@@ -365,7 +356,7 @@ impl Model for DemContacts {
     }
 
     fn prepare(&mut self, stepping: &qdem_core::Stepping) {
-        self.step = stepping.dt;
+        self.passage.set_step(stepping.dt);
     }
 
     /// A sphere found through a wall or inside another body at the last rebuild of the

@@ -120,7 +120,7 @@ impl DemContacts {
     /// wall contacts. Summed per sphere (+f on the first partner times its scale, −f on the
     /// second times its scale), their forces are [`SphereRecord::force`].
     pub fn touching(&self) -> impl Iterator<Item = TouchingContact> + '_ {
-        let time = self.last_time.unwrap_or(0.0);
+        let time = self.evaluation.last_time().unwrap_or(0.0);
         let delay = self.time_delay.as_ref().map(TimeDelay::ghosts);
         let pairs = self.candidates.pairs().with_shifts();
         let pairs = pairs.filter(|(c, _)| c.force != Vec3::zeros());

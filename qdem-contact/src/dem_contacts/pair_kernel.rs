@@ -619,7 +619,7 @@ mod tests {
                         contacts.rebuild_stage(state.time);
                     }
                     contacts.read_partners_stage(&state);
-                    let (time, dt) = (state.time, contacts.dt);
+                    let (time, dt) = (state.time, contacts.evaluation.dt());
                     contacts.run_kernel::<true, false>(time, dt, None);
                     let out = Some((&mut force[..], &mut torque[..]));
                     contacts.run_kernel::<false, true>(time, dt, out);

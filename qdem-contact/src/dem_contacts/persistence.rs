@@ -148,7 +148,7 @@ impl Persistent for DemContacts {
     fn save(&self, out: &mut Encoder) {
         out.tag("contact");
         out.u32s(&self.spheres.particle());
-        out.option_f64(self.last_time);
+        out.option_f64(self.evaluation.last_time());
         self.candidates.save(out);
         out.bool(self.time_delay.is_some());
         if let Some(delay) = &self.time_delay {
@@ -170,7 +170,8 @@ impl Persistent for DemContacts {
                 ),
             });
         }
-        self.last_time = input.option_f64("the last evaluation time")?;
+        let last_time = input.option_f64("the last evaluation time")?;
+        self.evaluation.set_last_time(last_time);
         self.candidates.restore(input, spheres, self.walls.len())?;
         let delayed = input.bool("the time-delay flag")?;
         same_count(

@@ -71,11 +71,31 @@ pub(crate) enum Passage {
     },
 }
 
+/// The check for spheres gone through a wall or into another body: the bodies' surfaces,
+/// the first pass-through found, and the run's step for its report.
+#[derive(Default)]
+pub(super) struct PassageCheck {
+    /// The closed surfaces of the bodies built from meshes.
+    surfaces: Vec<BodySurface>,
+    /// The report of the first sphere found through a wall or inside another body: what
+    /// happened, and the fix.
+    pass_through: Option<(String, String)>,
+    /// The run's step (s), for that report's fix; 0 until [`qdem_core::Model::prepare`].
+    step: f64,
+}
+
+impl PassageCheck {
+    /// The run's step (s), for the report's fix.
+    pub(super) fn set_step(&mut self, step: f64) {
+        self.step = step;
+    }
+}
+
 impl DemContacts {
     /// The surfaces of the bodies built from meshes, for the check of a centre inside
     /// another body.
     pub fn with_body_surfaces(mut self, surfaces: Vec<BodySurface>) -> DemContacts {
-        self.surfaces = surfaces;
+        self.passage.surfaces = surfaces;
         self
     }
 
@@ -83,7 +103,7 @@ impl DemContacts {
     /// keeps the first sphere of `own` (all spheres when `None`) found through a wall or
     /// inside another body, with the report [`qdem_core::Model::failure`] gives.
     pub(super) fn check_passage(&mut self, time: f64, own: Option<&[u32]>) {
-        if self.pass_through.is_some() {
+        if self.passage.pass_through.is_some() {
             return;
         }
         let all: Vec<u32>;
@@ -96,7 +116,7 @@ impl DemContacts {
         };
         let since = self.lists_built().then_some(self.candidates.built_time());
         if let Some(passage) = self.find_passage(spheres, time, since) {
-            self.pass_through = Some(self.describe(passage, time));
+            self.passage.pass_through = Some(self.describe(passage, time));
         }
     }
 
@@ -114,7 +134,8 @@ impl DemContacts {
             .with_min_len(CONTACT_CHUNK)
             .find_map_first(|&s| self.through_wall(s as usize, time, since));
         walls.or_else(|| {
-            self.surfaces
+            self.passage
+                .surfaces
                 .iter()
                 .find_map(|surface| self.inside_body(surface, spheres))
         })
@@ -246,7 +267,7 @@ impl DemContacts {
     /// What to change: a smaller step when the sphere moves more than [`STEP_FRACTION`] of
     /// its radius per step, else what holds it back better.
     fn fix(&self, passage: Passage, speed: f64, radius: f64) -> String {
-        let fraction = speed * self.step / radius;
+        let fraction = speed * self.passage.step / radius;
         let holder = match passage {
             Passage::Wall { .. } => "a thicker wall, larger contact spheres (contact_radius)",
             Passage::Body { .. } => {
@@ -301,7 +322,8 @@ impl DemContacts {
 
     /// The pass-through found at the last rebuild, if any.
     pub(super) fn passage_failure(&self, time: f64) -> Option<qdem_core::CoreError> {
-        self.pass_through
+        self.passage
+            .pass_through
             .clone()
             .map(|(detail, fix)| qdem_core::CoreError::PassThrough {
                 step: 0,
