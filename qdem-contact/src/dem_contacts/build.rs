@@ -62,10 +62,6 @@ impl DemContacts {
                 }
             })
             .collect();
-        let elasticity = materials
-            .iter()
-            .flat_map(|a| materials.iter().map(|b| PairElasticity::new(*a, Some(*b))))
-            .collect();
         // A carrier held in every direction (and, for a rigid body, in rotation) cannot
         // oscillate: it does not limit the step (infinite mass in the bound below).
         let held = |s: &ContactSphere, r: u32| {
@@ -105,10 +101,9 @@ impl DemContacts {
                 lever,
                 bound_mass,
                 now,
+                body_names,
+                materials,
             }),
-            body_names,
-            materials: materials.len(),
-            elasticity,
             settings,
             walls: Walls::new(walls, materials),
             evaluation: Evaluation::new(),
@@ -174,8 +169,8 @@ impl DemContacts {
                 - self.separation(a, b).0.norm();
             if overlap > tolerance * radius {
                 return Err(ContactError::InitialOverlap {
-                    a: self.body_names[self.spheres.body()[a] as usize].clone(),
-                    b: self.body_names[self.spheres.body()[b] as usize].clone(),
+                    a: self.spheres.body_names()[self.spheres.body()[a] as usize].clone(),
+                    b: self.spheres.body_names()[self.spheres.body()[b] as usize].clone(),
                     overlap,
                     radius,
                     tolerance: 100.0 * tolerance,
@@ -193,7 +188,7 @@ impl DemContacts {
             );
             if overlap > tolerance * self.spheres.radius()[s] {
                 return Err(ContactError::InitialWallOverlap {
-                    body: self.body_names[self.spheres.body()[s] as usize].clone(),
+                    body: self.spheres.body_names()[self.spheres.body()[s] as usize].clone(),
                     wall: w + 1,
                     overlap,
                     radius: self.spheres.radius()[s],

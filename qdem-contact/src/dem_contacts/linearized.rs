@@ -31,7 +31,7 @@ impl Linearized for DemContacts {
             let Some(g) = narrow_phase(sa, sb, shift, self.settings.friction) else {
                 continue;
             };
-            let e = self.elasticity[sa.material as usize * self.materials + sb.material as usize];
+            let e = self.spheres.pair_elasticity(sa, sb);
             let (kn, kt) = law.stiffness(g.overlap, g.radius, &e);
             let half = 0.5 * g.overlap;
             let pa = self.attachment(state, a, (sa.radius - half) * g.normal);

@@ -237,9 +237,6 @@ pub struct DemContacts {
     spheres: Spheres,
     /// The candidate lists and their build (`candidates.rs`).
     candidates: Candidates,
-    body_names: Vec<String>,
-    materials: usize,
-    elasticity: Vec<PairElasticity>,
     settings: ContactSettings,
     /// The walls, their elasticity and their servos (`walls.rs`).
     walls: Walls,

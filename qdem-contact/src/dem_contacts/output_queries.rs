@@ -87,7 +87,7 @@ impl DemContacts {
 
     /// The names of the bodies the spheres belong to ([`SphereRecord::body`] indexes them).
     pub fn body_names(&self) -> &[String] {
-        &self.body_names
+        self.spheres.body_names()
     }
 
     /// Every contact sphere at `state` (the state the last evaluation saw, after the step),

@@ -143,7 +143,7 @@ impl DemContacts {
             *shift = p.image_shift(&(sb.center - sa.center));
         }
         let geometry = narrow_phase(sa, sb, *shift, self.settings.friction)?;
-        let e = self.elasticity[sa.material as usize * self.materials + sb.material as usize];
+        let e = self.spheres.pair_elasticity(sa, sb);
         Some((geometry, e))
     }
 

@@ -2,9 +2,11 @@
 //! particle, radius, body, the rigid body or rotating particle it turns with, its carrier's
 //! mass and lever for the stable step, whether its carriers are its alone, and what the
 //! narrow phase reads of it now (centre, velocity, spin: [`SphereNow`]), read from the
-//! state at each evaluation.
+//! state at each evaluation; with them the names of their bodies and the elastic constants
+//! of each pair of their materials.
 
 use super::{SphereNow, NOT_RIGID, SPHERE_CHUNK};
+use crate::contact_law::PairElasticity;
 use qdem_core::{State, Vec3};
 use rayon::prelude::*;
 
@@ -28,10 +30,16 @@ pub(super) struct Spheres {
     center: Vec<Vec3>,
     /// What the narrow phase reads of each sphere, current for the partners of candidates.
     now: Vec<SphereNow>,
+    /// The names of the bodies (`body` indexes them).
+    body_names: Vec<String>,
+    /// Number of materials.
+    materials: usize,
+    /// The elastic constants of each pair of materials, row by row.
+    elasticity: Vec<PairElasticity>,
 }
 
 /// What [`Spheres::new`] takes, per sphere.
-pub(super) struct SphereColumns {
+pub(super) struct SphereColumns<'a> {
     pub(super) particle: Vec<u32>,
     pub(super) radius: Vec<f64>,
     pub(super) body: Vec<u32>,
@@ -41,12 +49,20 @@ pub(super) struct SphereColumns {
     pub(super) lever: Vec<f64>,
     pub(super) bound_mass: Vec<f64>,
     pub(super) now: Vec<SphereNow>,
+    pub(super) body_names: Vec<String>,
+    /// The elastic constants (E, ν) of each material.
+    pub(super) materials: &'a [(f64, f64)],
 }
 
 impl Spheres {
     /// The records of `columns`, every centre at the origin until the first read.
-    pub(super) fn new(columns: SphereColumns) -> Spheres {
+    pub(super) fn new(columns: SphereColumns<'_>) -> Spheres {
         let n = columns.particle.len();
+        let materials = columns.materials;
+        let elasticity = materials
+            .iter()
+            .flat_map(|a| materials.iter().map(|b| PairElasticity::new(*a, Some(*b))))
+            .collect();
         Spheres {
             particle: columns.particle,
             radius: columns.radius,
@@ -58,6 +74,9 @@ impl Spheres {
             bound_mass: columns.bound_mass,
             center: vec![Vec3::zeros(); n],
             now: columns.now,
+            body_names: columns.body_names,
+            materials: materials.len(),
+            elasticity,
         }
     }
 
@@ -131,6 +150,18 @@ impl Spheres {
     #[inline]
     pub(super) fn records(&self) -> &[SphereNow] {
         &self.now
+    }
+
+    /// The names of the bodies the spheres belong to.
+    #[inline]
+    pub(super) fn body_names(&self) -> &[String] {
+        &self.body_names
+    }
+
+    /// The elastic constants of the pair of spheres `a` and `b`.
+    #[inline(always)]
+    pub(super) fn pair_elasticity(&self, a: &SphereNow, b: &SphereNow) -> PairElasticity {
+        self.elasticity[a.material as usize * self.materials + b.material as usize]
     }
 
     /// Every sphere's centre and narrow-phase record from `state`, in parallel; returns the

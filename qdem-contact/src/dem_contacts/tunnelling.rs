@@ -243,7 +243,7 @@ impl DemContacts {
                 format!(
                     "is {depth:.3e} m inside body `{}`, deeper than its radius (it went between \
                      that body's contact spheres)",
-                    self.body_names[other]
+                    self.spheres.body_names()[other]
                 ),
             ),
         };
@@ -256,7 +256,7 @@ impl DemContacts {
         let what = format!(
             "the contact sphere of body `{}` at ({:.4}, {:.4}, {:.4}) m (radius {radius:.3e} \
              m) {into}, moving at about {speed:.3e} m/s; the contact no longer holds it back.",
-            self.body_names[self.spheres.body()[s] as usize],
+            self.spheres.body_names()[self.spheres.body()[s] as usize],
             x.x,
             x.y,
             x.z,
@@ -309,10 +309,14 @@ impl DemContacts {
                 sphere,
                 other,
                 depth,
-            } => (sphere, format!("body `{}`", self.body_names[other]), depth),
+            } => (
+                sphere,
+                format!("body `{}`", self.spheres.body_names()[other]),
+                depth,
+            ),
         };
         Err(ContactError::InitialInside {
-            body: self.body_names[self.spheres.body()[s] as usize].clone(),
+            body: self.spheres.body_names()[self.spheres.body()[s] as usize].clone(),
             inside,
             depth,
             radius: self.spheres.radius()[s],
