@@ -110,7 +110,7 @@ impl DemContacts {
     /// The largest distance a sphere has moved since the last build, read from every sphere
     /// (infinite before a build).
     pub(super) fn exact_displacement(&self, state: &State) -> f64 {
-        let (particle, built_at) = (&self.spheres.particle(), &self.candidates.built_at());
+        let (particle, built_at) = (self.spheres.particle(), &self.candidates.built_at());
         if !self.lists_built() {
             return f64::INFINITY;
         }

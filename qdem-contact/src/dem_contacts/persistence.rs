@@ -147,7 +147,7 @@ impl Persistent for DemContacts {
     /// state.
     fn save(&self, out: &mut Encoder) {
         out.tag("contact");
-        out.u32s(&self.spheres.particle());
+        out.u32s(self.spheres.particle());
         out.option_f64(self.evaluation.last_time());
         self.candidates.save(out);
         out.bool(self.time_delay.is_some());

@@ -28,9 +28,7 @@ impl DemContacts {
     /// build).
     pub(super) fn read_centers(&mut self, state: &State) -> f64 {
         if self.reads_every_sphere() {
-            let built_at = self
-                .lists_built()
-                .then_some(&self.candidates.built_at()[..]);
+            let built_at = self.lists_built().then_some(self.candidates.built_at());
             self.spheres.read_every(state, built_at)
         } else {
             self.displacement(state)
@@ -80,9 +78,9 @@ impl DemContacts {
         let skin = self.settings.skin;
         let center = self.spheres.center();
         let set = SphereSet {
-            center: &center,
-            radius: &self.spheres.radius(),
-            body: &self.spheres.body(),
+            center,
+            radius: self.spheres.radius(),
+            body: self.spheres.body(),
             periodic: self.periodic.as_ref(),
         };
         let keys = find_pairs(&set, skin);
@@ -103,7 +101,7 @@ impl DemContacts {
         time: f64,
     ) -> Vec<(u32, u32)> {
         let (walls, skin) = (self.walls.list(), self.settings.skin);
-        let (radius, center) = (&self.spheres.radius(), &self.spheres.center());
+        let (radius, center) = (self.spheres.radius(), self.spheres.center());
         spheres
             .with_min_len(CONTACT_CHUNK)
             .flat_map_iter(|s| {

@@ -98,8 +98,8 @@ impl Servos {
     /// touching contact on a servo wall, in the order of one process's list) of the normal
     /// forces and of the responses, keeping its plane where it is at `time`.
     pub(super) fn drive(&self, walls: &mut [Wall], time: f64, contacts: &[ServoContact]) {
-        for w in 0..self.by_wall.len() {
-            let Some(servo) = self.by_wall[w].map(|s| s.servo) else {
+        for (w, (entry, wall)) in self.by_wall.iter().zip(walls.iter_mut()).enumerate() {
+            let Some(servo) = entry.map(|s| s.servo) else {
                 continue;
             };
             let (mut force, mut response) = (0.0, 0.0);
@@ -107,7 +107,7 @@ impl Servos {
                 (force, response) = (force + c.load, response + c.response.0 + c.response.1);
             }
             let speed = servo.speed(force / servo.area, response);
-            let WallShape::Plane(plane) = &mut walls[w].shape else {
+            let WallShape::Plane(plane) = &mut wall.shape else {
                 continue;
             };
             let velocity = speed * plane.normal;

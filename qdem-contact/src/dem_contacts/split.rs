@@ -111,9 +111,7 @@ impl DemContacts {
     /// Reads the centres of the spheres `own` from `state`; returns the largest distance one
     /// has moved since the last build (infinite before it).
     pub(super) fn read_own_centers(&mut self, state: &State, own: &[u32]) -> f64 {
-        let built_at = self
-            .lists_built()
-            .then_some(&self.candidates.built_at()[..]);
+        let built_at = self.lists_built().then_some(self.candidates.built_at());
         self.spheres.read_centers_of(state, own, built_at)
     }
 
@@ -162,9 +160,9 @@ impl DemContacts {
     fn rebuild_among(&mut self, part: &ContactPart, near: &[u32], time: f64) {
         let skin = self.settings.skin;
         let (center, radius, body) = (
-            pick(near, &self.spheres.center()),
-            pick(near, &self.spheres.radius()),
-            pick(near, &self.spheres.body()),
+            pick(near, self.spheres.center()),
+            pick(near, self.spheres.radius()),
+            pick(near, self.spheres.body()),
         );
         let set = SphereSet {
             center: &center,
@@ -240,7 +238,7 @@ impl DemContacts {
 
     /// From now on, this rank's part of the contacts (`None`: whole again).
     pub(super) fn set_part(&mut self, part: Option<Part>) {
-        self.split = part.map(|p| ContactPart::new(&self.spheres.particle(), &p.owner, p.rank));
+        self.split = part.map(|p| ContactPart::new(self.spheres.particle(), &p.owner, p.rank));
     }
 
     /// Appends the records of the spheres `items`: centre, velocity and spin.
