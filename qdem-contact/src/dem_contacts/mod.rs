@@ -33,17 +33,24 @@
 //! magnitude of the contact forces through the boundary, F_Ave_current, is measured at every
 //! evaluation, before the scaling, and drives [`TimeDelayedBoundary`].
 //!
-//! The files: this one holds the model (its parts, the narrow phase, the [`Model`] facet
-//! and the stable step); `spheres.rs` the sphere records; `candidates.rs` the candidate lists and their build; `build.rs` its construction; `stages.rs` the stages of one
-//! evaluation; `pair_kernel.rs` the pair kernel; `pipeline.rs` the reading of the spheres
-//! and the building of the candidate lists; `displacement.rs` its displacement check's bound
-//! for rigid bodies; `walls.rs` the walls' part (walls, their elasticity, the narrow phase against a wall) and `servo_loads.rs` its stress-controlled walls' servos; `output_queries.rs` what the
-//! outputs read; `persistence.rs` what a checkpoint keeps; `linearized.rs` the touching
-//! contacts as springs for a modal analysis; `time_delay.rs` the time-delayed boundary's
-//! part (its reduction and ghost scales); `split.rs` one rank's part in a decomposed run,
-//! whose stages the world's exchange runs ([`qdem_core::parallel`]); `tunnelling.rs` the
-//! check, at each rebuild of the lists, for a sphere gone through a wall or into another
-//! body.
+//! The model is composed of parts, each a struct with one job, its own data and its own
+//! file, which the stages call through methods (what two parts share is passed as an
+//! argument): `spheres.rs` the sphere records (particles, radii, bodies, carriers, centres,
+//! the narrow phase's records, body names, pair elasticity); `candidates.rs` the candidate
+//! lists and their build (partners, build positions and time, the displacement bound's
+//! anchor of `displacement.rs`, the rebuild count); `pair_kernel.rs` the pair kernel, with
+//! its plan and per-sphere sums; `walls.rs` the walls (their elasticity, the narrow phase
+//! against a wall) with their servos, `servo_loads.rs`; `time_delay.rs` the time-delayed
+//! boundary (its reduction and ghost scales); `split.rs` one rank's part in a decomposed
+//! run, whose stages the world's exchange runs ([`qdem_core::parallel`]); `tunnelling.rs`
+//! the check, at each rebuild of the lists, for a sphere gone through a wall or into
+//! another body; and `stages.rs` where the evaluations stand. The other files hold what
+//! [`DemContacts`] does with them: this one the narrow phase, the [`Model`] facet and the
+//! stable step; `build.rs` its construction; `stages.rs` the stages of one evaluation;
+//! `pipeline.rs` the reading of the spheres and the building of the candidate lists;
+//! `displacement.rs` the displacement check's bound for rigid bodies; `output_queries.rs`
+//! what the outputs read; `persistence.rs` what a checkpoint keeps; `linearized.rs` the
+//! touching contacts as springs for a modal analysis.
 
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
@@ -232,11 +239,13 @@ pub(crate) fn narrow_phase(
 /// assert!((force[1].z - (k * 5e-4 - k * 1e-3)).abs() < 1e-9);
 /// ```
 pub struct DemContacts {
+    /// The model's name.
     name: String,
     /// The sphere records (`spheres.rs`).
     spheres: Spheres,
     /// The candidate lists and their build (`candidates.rs`).
     candidates: Candidates,
+    /// The law, the friction between spheres and the skin.
     settings: ContactSettings,
     /// The walls, their elasticity and their servos (`walls.rs`).
     walls: Walls,
@@ -245,7 +254,9 @@ pub struct DemContacts {
     /// The pair kernel's plan for the current lists and its per-sphere sums
     /// (`pair_kernel.rs`).
     kernel: KernelPlan,
+    /// The periodic axes, if any.
     periodic: Option<PeriodicBox>,
+    /// The time-delayed boundary, if any (`time_delay.rs`).
     time_delay: Option<TimeDelay>,
     /// This rank's part, in a run decomposed with a halo exchange.
     split: Option<ContactPart>,
