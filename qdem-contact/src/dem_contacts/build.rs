@@ -2,6 +2,7 @@
 //! axes and a time-delayed boundary, and the check of the initial overlaps.
 
 use super::*;
+use crate::servo_wall::Servo;
 
 impl DemContacts {
     /// Contacts between `spheres` (of bodies `body_names`, with elastic constants (E, ν) per
@@ -61,14 +62,6 @@ impl DemContacts {
                 }
             })
             .collect();
-        let elasticity = materials
-            .iter()
-            .flat_map(|a| materials.iter().map(|b| PairElasticity::new(*a, Some(*b))))
-            .collect();
-        let wall_elasticity = materials
-            .iter()
-            .map(|a| PairElasticity::new(*a, None))
-            .collect();
         // A carrier held in every direction (and, for a rigid body, in rotation) cannot
         // oscillate: it does not limit the step (infinite mass in the bound below).
         let held = |s: &ContactSphere, r: u32| {
@@ -98,55 +91,45 @@ impl DemContacts {
         let particle: Vec<u32> = spheres.iter().map(|s| s.particle as u32).collect();
         DemContacts {
             name: "contact".to_string(),
-            exclusive: pair_kernel::exclusive_carriers(&particle, &turn),
-            particle,
-            radius: spheres.iter().map(|s| s.radius).collect(),
-            body: spheres.iter().map(|s| s.body as u32).collect(),
-            rigid,
-            turn,
-            lever,
-            bound_mass,
-            body_names,
-            materials: materials.len(),
-            elasticity,
-            wall_elasticity,
+            spheres: Spheres::new(SphereColumns {
+                exclusive: pair_kernel::exclusive_carriers(&particle, &turn),
+                particle,
+                radius: spheres.iter().map(|s| s.radius).collect(),
+                body: spheres.iter().map(|s| s.body as u32).collect(),
+                rigid,
+                turn,
+                lever,
+                bound_mass,
+                now,
+                body_names,
+                materials,
+            }),
             settings,
-            walls,
-            last_time: None,
-            dt: 0.0,
-            read_every: true,
-            evaluated: Evaluated::Nothing,
-            center: vec![Vec3::zeros(); spheres.len()],
-            now,
-            built_at: Vec::new(),
-            anchor: None,
-            built_time: 0.0,
-            built: false,
-            pairs: ContactList::default(),
-            wall_contacts: ContactList::default(),
-            partners: Vec::new(),
-            sphere_force: vec![(Vec3::zeros(), Vec3::zeros()); spheres.len()],
-            kernel_plan: KernelPlan::default(),
-            rebuilds: 0,
+            walls: Walls::new(walls, materials),
+            evaluation: Evaluation::new(),
+            candidates: Candidates::default(),
+            kernel: KernelPlan::new(spheres.len()),
             periodic: None,
             time_delay: None,
             split: None,
-            rebuilt: false,
-            servos: Vec::new(),
-            surfaces: Vec::new(),
-            pass_through: None,
-            step: 0.0,
+            passage: PassageCheck::default(),
         }
     }
 
     /// Makes the contacts periodic along the axes of `periodic`; refused when a period is not
     /// longer than twice the reach of the largest spheres (two radii plus the skin).
     pub fn with_periodic(mut self, periodic: PeriodicBox) -> Result<DemContacts, ContactError> {
-        let r_max = self.radius.iter().cloned().fold(0.0, f64::max);
+        let r_max = self.spheres.radius().iter().cloned().fold(0.0, f64::max);
         periodic.check_reach(2.0 * r_max + self.settings.skin)?;
         self.periodic = Some(periodic);
-        self.built = false;
+        self.candidates.invalidate();
         Ok(self)
+    }
+
+    /// Makes plane wall `wall` stress-controlled by `servo`, from now on; refused for a mesh
+    /// wall or a wall out of range.
+    pub fn set_servo(&mut self, wall: usize, servo: Servo) -> Result<(), ContactError> {
+        self.walls.set_servo(wall, servo)
     }
 
     /// Scales the forces from ghosts beyond the boundaries of periodic `axis` by `boundary`'s
@@ -166,12 +149,7 @@ impl DemContacts {
                 axis: ['x', 'y', 'z'][axis.min(2)],
             });
         }
-        self.time_delay = Some(TimeDelay {
-            axis,
-            boundary,
-            scales: GhostScales::PERIODIC,
-            boundary_force: 0.0,
-        });
+        self.time_delay = Some(TimeDelay::new(axis, boundary));
         Ok(self)
     }
 
@@ -184,33 +162,38 @@ impl DemContacts {
     ) -> Result<(), ContactError> {
         self.read_centers(state);
         self.rebuild_all(state.time);
-        for c in &self.pairs.items {
+        for c in &self.candidates.pairs().items {
             let (a, b) = (c.first as usize, c.second as usize);
-            let radius = reduced(self.radius[a], self.radius[b]);
-            let overlap = self.radius[a] + self.radius[b] - self.separation(a, b).0.norm();
+            let radius = reduced(self.spheres.radius()[a], self.spheres.radius()[b]);
+            let overlap = self.spheres.radius()[a] + self.spheres.radius()[b]
+                - self.separation(a, b).0.norm();
             if overlap > tolerance * radius {
                 return Err(ContactError::InitialOverlap {
-                    a: self.body_names[self.body[a] as usize].clone(),
-                    b: self.body_names[self.body[b] as usize].clone(),
+                    a: self.spheres.body_names()[self.spheres.body()[a] as usize].clone(),
+                    b: self.spheres.body_names()[self.spheres.body()[b] as usize].clone(),
                     overlap,
                     radius,
                     tolerance: 100.0 * tolerance,
-                    at_a: self.center[a].into(),
-                    at_b: self.center[b].into(),
+                    at_a: self.spheres.center()[a].into(),
+                    at_b: self.spheres.center()[b].into(),
                 });
             }
         }
-        for c in &self.wall_contacts.items {
+        for c in &self.candidates.wall_contacts().items {
             let (s, w) = (c.first as usize, c.second as usize);
-            let (overlap, _) = self.walls[w].overlap(&self.center[s], self.radius[s], state.time);
-            if overlap > tolerance * self.radius[s] {
+            let (overlap, _) = self.walls.get(w).overlap(
+                &self.spheres.center()[s],
+                self.spheres.radius()[s],
+                state.time,
+            );
+            if overlap > tolerance * self.spheres.radius()[s] {
                 return Err(ContactError::InitialWallOverlap {
-                    body: self.body_names[self.body[s] as usize].clone(),
+                    body: self.spheres.body_names()[self.spheres.body()[s] as usize].clone(),
                     wall: w + 1,
                     overlap,
-                    radius: self.radius[s],
+                    radius: self.spheres.radius()[s],
                     tolerance: 100.0 * tolerance,
-                    at: self.center[s].into(),
+                    at: self.spheres.center()[s].into(),
                 });
             }
         }

@@ -54,19 +54,19 @@ impl DemContacts {
     /// Anchors the bound at `state`, where no sphere is farther than `moved` from its build
     /// position (0 right after a build). Without rigid bodies there is nothing to bound.
     pub(super) fn anchor(&mut self, state: &State, moved: f64) {
-        self.anchor = None;
-        if state.rigid.is_empty() || self.rigid.iter().all(|&r| r == NOT_RIGID) {
+        self.candidates.set_anchor(None);
+        if state.rigid.is_empty() || self.spheres.rigid().iter().all(|&r| r == NOT_RIGID) {
             return;
         }
         let mut reach = vec![None; state.rigid.len()];
         let mut free = Vec::new();
-        for (s, &b) in self.rigid.iter().enumerate() {
+        for (s, &b) in self.spheres.rigid().iter().enumerate() {
             if b == NOT_RIGID {
                 free.push(s as u32);
                 continue;
             }
             let c = state.position[state.rigid.center[b as usize]];
-            let arm = (state.position[self.particle[s] as usize] - c).norm();
+            let arm = (state.position[self.spheres.particle()[s] as usize] - c).norm();
             let r: &mut Option<f64> = &mut reach[b as usize];
             *r = Some(r.map_or(arm, |r| r.max(arm)));
         }
@@ -82,13 +82,13 @@ impl DemContacts {
             anchor.orientation.push(state.rigid.orientation[b]);
             anchor.reach.push(r);
         }
-        self.anchor = Some(anchor);
+        self.candidates.set_anchor(Some(anchor));
     }
 
     /// A bound, no smaller than the exact pass's value, on the largest displacement of a
     /// sphere since the last build (module doc); `None` without an anchor.
     pub(super) fn displacement_bound(&self, state: &State) -> Option<f64> {
-        let anchor = self.anchor.as_ref()?;
+        let anchor = self.candidates.anchor()?;
         let mut bound = 0.0f64;
         for (k, &b) in anchor.bodies.iter().enumerate() {
             let b = b as usize;
@@ -101,7 +101,8 @@ impl DemContacts {
         }
         let free = anchor.free.iter().map(|&s| {
             let s = s as usize;
-            (state.position[self.particle[s] as usize] - self.built_at[s]).norm_squared()
+            (state.position[self.spheres.particle()[s] as usize] - self.candidates.built_at()[s])
+                .norm_squared()
         });
         Some(bound.max(free.fold(0.0, f64::max).sqrt()))
     }
@@ -109,7 +110,7 @@ impl DemContacts {
     /// The largest distance a sphere has moved since the last build, read from every sphere
     /// (infinite before a build).
     pub(super) fn exact_displacement(&self, state: &State) -> f64 {
-        let (particle, built_at) = (&self.particle, &self.built_at);
+        let (particle, built_at) = (self.spheres.particle(), &self.candidates.built_at());
         if !self.lists_built() {
             return f64::INFINITY;
         }
@@ -205,7 +206,7 @@ mod tests {
         let (mut state, mut contacts) = bodies_and_a_grain();
         let n = state.len();
         let (mut force, mut torque) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n + 2]);
-        let sphere_particles = contacts.particle.clone();
+        let sphere_particles = contacts.spheres.particle().to_vec();
         let positions = |state: &State| -> Vec<Vec3> {
             sphere_particles
                 .iter()

@@ -33,16 +33,24 @@
 //! magnitude of the contact forces through the boundary, F_Ave_current, is measured at every
 //! evaluation, before the scaling, and drives [`TimeDelayedBoundary`].
 //!
-//! The files: this one holds the model (its records, the narrow phase, the [`Model`] facet
-//! and the stable step); `build.rs` its construction; `stages.rs` the stages of one
-//! evaluation; `pair_kernel.rs` the pair kernel; `pipeline.rs` the reading of the spheres
-//! and the building of the candidate lists; `displacement.rs` its displacement check's bound
-//! for rigid bodies; `servo_loads.rs` the stress-controlled walls' servo; `output_queries.rs` what the
-//! outputs read; `persistence.rs` what a checkpoint keeps; `linearized.rs` the touching
-//! contacts as springs for a modal analysis; `split.rs` one rank's part in a decomposed run,
-//! whose stages the world's exchange runs ([`qdem_core::parallel`]); `tunnelling.rs` the
-//! check, at each rebuild of the lists, for a sphere gone through a wall or into another
-//! body.
+//! The model is composed of parts, each a struct with one job, its own data and its own
+//! file, which the stages call through methods (what two parts share is passed as an
+//! argument): `spheres.rs` the sphere records (particles, radii, bodies, carriers, centres,
+//! the narrow phase's records, body names, pair elasticity); `candidates.rs` the candidate
+//! lists and their build (partners, build positions and time, the displacement bound's
+//! anchor of `displacement.rs`, the rebuild count); `pair_kernel.rs` the pair kernel, with
+//! its plan and per-sphere sums; `walls.rs` the walls (their elasticity, the narrow phase
+//! against a wall) with their servos, `servo_loads.rs`; `time_delay.rs` the time-delayed
+//! boundary (its reduction and ghost scales); `split.rs` one rank's part in a decomposed
+//! run, whose stages the world's exchange runs ([`qdem_core::parallel`]); `tunnelling.rs`
+//! the check, at each rebuild of the lists, for a sphere gone through a wall or into
+//! another body; and `stages.rs` where the evaluations stand. The other files hold what
+//! [`DemContacts`] does with them: this one the narrow phase, the [`Model`] facet and the
+//! stable step; `build.rs` its construction; `stages.rs` the stages of one evaluation;
+//! `pipeline.rs` the reading of the spheres and the building of the candidate lists;
+//! `displacement.rs` the displacement check's bound for rigid bodies; `output_queries.rs`
+//! what the outputs read; `persistence.rs` what a checkpoint keeps; `linearized.rs` the
+//! touching contacts as springs for a modal analysis.
 
 use crate::broad_phase::{find_pairs, SphereSet};
 use crate::contact_law::{ContactLaw, PairElasticity, PairGeometry};
@@ -53,6 +61,7 @@ use crate::periodic_boundary::PeriodicBox;
 use crate::spring_blocks::{add_spring, spring, Attachment};
 use crate::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
 use crate::wall::Wall;
+use candidates::Candidates;
 use pair_kernel::KernelPlan;
 use qdem_core::checkpoint::same_count;
 use qdem_core::continuum::stable_step::critical_step;
@@ -62,13 +71,18 @@ use qdem_core::{
     step::Tangent, Vec3,
 };
 use rayon::prelude::*;
+use spheres::{SphereColumns, Spheres};
 use split::ContactPart;
-use stages::Evaluated;
+use stages::Evaluation;
+use time_delay::{pair_scales, TimeDelay};
+use walls::Walls;
 
 pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
 pub use tunnelling::BodySurface;
+use tunnelling::PassageCheck;
 
 mod build;
+mod candidates;
 mod displacement;
 mod linearized;
 mod output_queries;
@@ -76,9 +90,12 @@ mod pair_kernel;
 mod persistence;
 mod pipeline;
 mod servo_loads;
+mod spheres;
 mod split;
 mod stages;
+mod time_delay;
 mod tunnelling;
+mod walls;
 
 /// Marks a sphere that is no part of a rigid body, or whose moments go nowhere.
 const NOT_RIGID: u32 = u32::MAX;
@@ -223,86 +240,29 @@ pub(crate) fn narrow_phase(
 /// assert!((force[1].z - (k * 5e-4 - k * 1e-3)).abs() < 1e-9);
 /// ```
 pub struct DemContacts {
+    /// The model's name.
     name: String,
-    particle: Vec<u32>,
-    radius: Vec<f64>,
-    body: Vec<u32>,
-    rigid: Vec<u32>,
-    turn: Vec<u32>,
-    /// Per sphere, whether its particle and rotation are its alone (`pair_kernel.rs`).
-    exclusive: Vec<bool>,
-    lever: Vec<f64>,
-    bound_mass: Vec<f64>,
-    body_names: Vec<String>,
-    materials: usize,
-    elasticity: Vec<PairElasticity>,
-    wall_elasticity: Vec<PairElasticity>,
+    /// The sphere records (`spheres.rs`).
+    spheres: Spheres,
+    /// The candidate lists and their build (`candidates.rs`).
+    candidates: Candidates,
+    /// The law, the friction between spheres and the skin.
     settings: ContactSettings,
-    walls: Vec<Wall>,
-    last_time: Option<f64>,
-    /// The time since the previous evaluation (s), from stage 1 of this one (`stages.rs`).
-    dt: f64,
-    /// Whether stage 1 of this evaluation read every sphere (else the partners only).
-    read_every: bool,
-    /// How far the pair kernel has run in this evaluation (`stages.rs`).
-    evaluated: Evaluated,
-    /// Every sphere's centre at the last evaluation.
-    center: Vec<Vec3>,
-    /// What the narrow phase reads of each sphere, current for the partners of candidates.
-    now: Vec<SphereNow>,
-    built_at: Vec<Vec3>,
-    /// The rigid bodies' poses at the step the displacement check's bound starts from
-    /// (`displacement.rs`).
-    anchor: Option<displacement::Anchor>,
-    built_time: f64,
-    built: bool,
-    pairs: ContactList,
-    wall_contacts: ContactList,
-    /// The spheres that are partners of some candidate (pair or wall contact), ascending.
-    partners: Vec<u32>,
-    sphere_force: Vec<(Vec3, Vec3)>,
-    /// The pair kernel's plan for the current lists (`pair_kernel.rs`).
-    kernel_plan: KernelPlan,
-    rebuilds: u64,
+    /// The walls, their elasticity and their servos (`walls.rs`).
+    walls: Walls,
+    /// Where the evaluations stand (`stages.rs`).
+    evaluation: Evaluation,
+    /// The pair kernel's plan for the current lists and its per-sphere sums
+    /// (`pair_kernel.rs`).
+    kernel: KernelPlan,
+    /// The periodic axes, if any.
     periodic: Option<PeriodicBox>,
+    /// The time-delayed boundary, if any (`time_delay.rs`).
     time_delay: Option<TimeDelay>,
     /// This rank's part, in a run decomposed with a halo exchange.
     split: Option<ContactPart>,
-    /// Whether the lists were rebuilt since [`qdem_core::step::split::Balance::rebuilt`] last asked.
-    rebuilt: bool,
-    /// The stress-controlled walls' servos, by wall (`servo_loads.rs`); empty when none.
-    servos: Vec<Option<servo_loads::ServoWall>>,
-    /// The closed surfaces of the bodies built from meshes (`tunnelling.rs`).
-    surfaces: Vec<BodySurface>,
-    /// The report of the first sphere found through a wall or inside another body: what
-    /// happened, and the fix.
-    pass_through: Option<(String, String)>,
-    /// The run's step (s), for that report's fix; 0 until [`Model::prepare`].
-    step: f64,
-}
-
-/// A time-delayed periodic boundary along one periodic axis, and its latest state.
-struct TimeDelay {
-    axis: usize,
-    boundary: TimeDelayedBoundary,
-    scales: GhostScales,
-    boundary_force: f64,
-}
-
-/// Scales of the forces on the first and second sphere of a pair whose second sphere's image
-/// was translated by `shift` along the delay axis: a negative shift means the second sphere
-/// sits near the right boundary and its image beyond the left one, so the first sphere feels
-/// a left ghost and the second (through the image of the first beyond the right boundary) a
-/// right ghost; a positive shift is the mirror case; zero is an ordinary pair.
-#[inline]
-fn pair_scales(shift: f64, scales: &GhostScales) -> (f64, f64) {
-    if shift < 0.0 {
-        (scales.left, scales.right)
-    } else if shift > 0.0 {
-        (scales.right, scales.left)
-    } else {
-        (1.0, 1.0)
-    }
+    /// The check for spheres gone through a wall or into another body (`tunnelling.rs`).
+    passage: PassageCheck,
 }
 
 /// r_a r_b / (r_a + r_b).
@@ -341,7 +301,8 @@ impl Model for DemContacts {
         let law = &self.settings.law;
         let zeta = law.damping_ratio();
         let n_rigid = self
-            .rigid
+            .spheres
+            .rigid()
             .iter()
             .filter(|&&r| r != NOT_RIGID)
             .map(|&r| r as usize + 1)
@@ -349,19 +310,19 @@ impl Model for DemContacts {
             .unwrap_or(0);
         let mut per_body = vec![(0.0, 0.0, 0usize); n_rigid];
         let mut worst = (0.0f64, 0.0f64);
-        for s in 0..self.particle.len() {
-            let r = self.radius[s];
-            let sphere = &self.now[s];
-            let e = self.wall_elasticity[sphere.material as usize];
+        for s in 0..self.spheres.len() {
+            let r = self.spheres.radius()[s];
+            let sphere = self.spheres.now(s);
+            let e = self.walls.elasticity(sphere.material);
             let (kn, kt) = law.stiffness(REFERENCE_OVERLAP * r, r, &e);
             let k = kn.max(kt);
-            let mass = self.bound_mass[s];
+            let mass = self.spheres.bound_mass()[s];
             if mass.is_infinite() {
                 continue;
             }
-            let compliance = 1.0 / mass + self.lever[s];
+            let compliance = 1.0 / mass + self.spheres.lever()[s];
             let (w, g) = (k * compliance, 2.0 * zeta * (k * mass).sqrt() * compliance);
-            match self.rigid[s] {
+            match self.spheres.rigid()[s] {
                 NOT_RIGID => worst = (worst.0.max(COORDINATION * w), worst.1.max(COORDINATION * g)),
                 b => {
                     let entry = &mut per_body[b as usize];
@@ -379,14 +340,23 @@ impl Model for DemContacts {
 
     fn potential_energy(&self, state: &State) -> Option<f64> {
         let law = &self.settings.law;
-        let pairs = self.pairs.with_shifts().filter_map(|(c, mut shift)| {
-            self.pair_contact(c, &mut shift)
-                .map(|(g, e)| law.energy(&g, &e, &c.history))
-        });
-        let walls = self.wall_contacts.items.iter().filter_map(|c| {
-            self.wall_contact(state.time, c.first as usize, c.second as usize)
-                .map(|(g, e)| law.energy(&g, &e, &c.history))
-        });
+        let pairs = self
+            .candidates
+            .pairs()
+            .with_shifts()
+            .filter_map(|(c, mut shift)| {
+                self.pair_contact(c, &mut shift)
+                    .map(|(g, e)| law.energy(&g, &e, &c.history))
+            });
+        let walls = self
+            .candidates
+            .wall_contacts()
+            .items
+            .iter()
+            .filter_map(|c| {
+                self.wall_contact(state.time, c.first as usize, c.second as usize)
+                    .map(|(g, e)| law.energy(&g, &e, &c.history))
+            });
         Some(pairs.chain(walls).sum())
     }
 
@@ -395,7 +365,7 @@ impl Model for DemContacts {
     }
 
     fn prepare(&mut self, settings: &qdem_core::step::StepSettings) {
-        self.step = settings.dt;
+        self.passage.set_step(settings.dt);
     }
 
     /// A sphere found through a wall or inside another body at the last rebuild of the

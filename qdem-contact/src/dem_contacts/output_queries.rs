@@ -9,9 +9,7 @@ impl DemContacts {
     /// The ghost scales (left, right) of the last evaluation and the average magnitude of the
     /// contact forces through the delayed boundary it measured; `None` without a time delay.
     pub fn time_delay_state(&self) -> Option<(GhostScales, f64)> {
-        self.time_delay
-            .as_ref()
-            .map(|t| (t.scales, t.boundary_force))
+        self.time_delay.as_ref().map(TimeDelay::state)
     }
 
     /// The average magnitude of the touching pairs' forces across the plane x\[axis\] = `at`
@@ -23,8 +21,8 @@ impl DemContacts {
     pub fn section_force(&self, axis: usize, at: f64) -> f64 {
         let period = self.periodic.as_ref().and_then(|p| p.length(axis));
         self.mean_pair_force(|c, shift| {
-            let a = self.center[c.first as usize][axis] - at;
-            let b = self.center[c.second as usize][axis] + shift[axis] - at;
+            let a = self.spheres.center()[c.first as usize][axis] - at;
+            let b = self.spheres.center()[c.second as usize][axis] + shift[axis] - at;
             crosses(a, b, period)
         })
     }
@@ -33,7 +31,7 @@ impl DemContacts {
     /// (serial, in pair order, so it does not depend on the thread count); 0 without any.
     pub(super) fn mean_pair_force(&self, counted: impl Fn(&Contact, Vec3) -> bool) -> f64 {
         let (mut sum, mut count) = (0.0, 0usize);
-        for (c, shift) in self.pairs.with_shifts() {
+        for (c, shift) in self.candidates.pairs().with_shifts() {
             if c.force != Vec3::zeros() && counted(c, shift) {
                 sum += c.force.norm();
                 count += 1;
@@ -48,7 +46,7 @@ impl DemContacts {
 
     /// Number of contact spheres.
     pub fn spheres(&self) -> usize {
-        self.particle.len()
+        self.spheres.len()
     }
 
     /// Number of walls.
@@ -58,27 +56,38 @@ impl DemContacts {
 
     /// Number of candidate pairs and wall candidates in the current lists.
     pub fn candidates(&self) -> usize {
-        self.pairs.len() + self.wall_contacts.len()
+        self.candidates.pairs().len() + self.candidates.wall_contacts().len()
     }
 
     /// Number of touching contacts (sphere–sphere and sphere–wall) at the last evaluation.
     pub fn contacts(&self) -> usize {
-        self.pairs
+        self.candidates
+            .pairs()
             .items
             .iter()
-            .chain(&self.wall_contacts.items)
+            .chain(&self.candidates.wall_contacts().items)
             .filter(|c| c.force != Vec3::zeros())
             .count()
     }
 
+    /// Whether some wall is stress-controlled.
+    pub fn has_servo(&self) -> bool {
+        self.walls.has_servo()
+    }
+
+    /// The displacement (m) of wall `wall` at `time` from its place at t = 0.
+    pub fn wall_displacement(&self, wall: usize, time: f64) -> Vec3 {
+        self.walls.displacement(wall, time)
+    }
+
     /// The walls.
     pub fn wall_list(&self) -> &[Wall] {
-        &self.walls
+        self.walls.list()
     }
 
     /// The names of the bodies the spheres belong to ([`SphereRecord::body`] indexes them).
     pub fn body_names(&self) -> &[String] {
-        &self.body_names
+        self.spheres.body_names()
     }
 
     /// Every contact sphere at `state` (the state the last evaluation saw, after the step),
@@ -88,21 +97,21 @@ impl DemContacts {
         state: &'a State,
     ) -> impl Iterator<Item = SphereRecord> + 'a {
         let bodies = state.rigid.len();
-        (0..self.particle.len()).map(move |s| {
-            let particle = self.particle[s] as usize;
-            let spin = match self.turn[s] as usize {
+        (0..self.spheres.len()).map(move |s| {
+            let particle = self.spheres.particle()[s] as usize;
+            let spin = match self.spheres.turn()[s] as usize {
                 t if t == NOT_RIGID as usize => None,
                 b if b < bodies => Some(state.rigid.angular_velocity[b]),
                 t => Some(state.spin.velocity[t - bodies]),
             };
             SphereRecord {
                 particle,
-                radius: self.radius[s],
-                body: self.body[s] as usize,
+                radius: self.spheres.radius()[s],
+                body: self.spheres.body()[s] as usize,
                 center: state.position[particle],
                 velocity: state.velocity[particle],
                 spin,
-                force: self.sphere_force[s].0,
+                force: self.kernel.sum(s).0,
             }
         })
     }
@@ -111,13 +120,13 @@ impl DemContacts {
     /// wall contacts. Summed per sphere (+f on the first partner times its scale, −f on the
     /// second times its scale), their forces are [`SphereRecord::force`].
     pub fn touching(&self) -> impl Iterator<Item = TouchingContact> + '_ {
-        let time = self.last_time.unwrap_or(0.0);
-        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
-        let pairs = self.pairs.with_shifts();
+        let time = self.evaluation.last_time().unwrap_or(0.0);
+        let delay = self.time_delay.as_ref().map(TimeDelay::ghosts);
+        let pairs = self.candidates.pairs().with_shifts();
         let pairs = pairs.filter(|(c, _)| c.force != Vec3::zeros());
         let pairs = pairs.map(move |(c, shift)| {
             let (a, b) = (c.first as usize, c.second as usize);
-            let (from, to) = (self.center[a], self.center[b] + shift);
+            let (from, to) = (self.spheres.center()[a], self.spheres.center()[b] + shift);
             let scales = delay.map_or((1.0, 1.0), |(axis, s)| pair_scales(shift[axis], &s));
             touching_contact(
                 a,
@@ -130,15 +139,19 @@ impl DemContacts {
             )
         });
         let walls = self
-            .wall_contacts
+            .candidates
+            .wall_contacts()
             .items
             .iter()
             .filter(|c| c.force != Vec3::zeros());
         let walls = walls.map(move |c| {
             let (s, w) = (c.first as usize, c.second as usize);
-            let from = self.center[s];
-            let (overlap, normal) = self.walls[w].overlap(&from, self.radius[s], time);
-            let to = from + (self.radius[s] - overlap) * normal;
+            let from = self.spheres.center()[s];
+            let (overlap, normal) =
+                self.walls
+                    .get(w)
+                    .overlap(&from, self.spheres.radius()[s], time);
+            let to = from + (self.spheres.radius()[s] - overlap) * normal;
             touching_contact(s, Partner::Wall(w), from, to, normal, c.force, (1.0, 1.0))
         });
         pairs.chain(walls)
@@ -155,10 +168,16 @@ impl DemContacts {
     /// One pass over the pair records, cheap enough for every step.
     pub fn deepest_pair(&self) -> Option<(usize, usize, f64)> {
         let mut deepest: Option<(usize, usize, f64, f64)> = None;
-        for c in self.pairs.items.iter().filter(|c| c.force != Vec3::zeros()) {
+        for c in self
+            .candidates
+            .pairs()
+            .items
+            .iter()
+            .filter(|c| c.force != Vec3::zeros())
+        {
             let (a, b) = (c.first as usize, c.second as usize);
             let overlap = 2.0 * c.half_overlap;
-            let depth = overlap / self.radius[a].min(self.radius[b]);
+            let depth = overlap / self.spheres.radius()[a].min(self.spheres.radius()[b]);
             if deepest.is_none_or(|d| depth > d.3) {
                 deepest = Some((a, b, overlap, depth));
             }
@@ -168,7 +187,7 @@ impl DemContacts {
 
     /// How many times the candidate lists were rebuilt.
     pub fn rebuilds(&self) -> u64 {
-        self.rebuilds
+        self.candidates.rebuilds()
     }
 }
 

@@ -51,13 +51,15 @@ pub(super) fn run_length(n: usize) -> usize {
 impl DemContacts {
     /// The run of sphere `s`.
     fn run_of(&self, s: u32) -> usize {
-        s as usize / run_length(self.particle.len())
+        s as usize / run_length(self.spheres.len())
     }
 }
 
-/// What the fused pass knows of the lists, made at each build.
+/// What the fused pass knows of the lists, made at each build, and its per-sphere sums.
 #[derive(Default)]
 pub(super) struct KernelPlan {
+    /// Per sphere, the sum of its contacts' forces and moments at the last evaluation.
+    sums: Vec<Sum>,
     /// Per run: its pairs (a slice of the pair list), wall contacts and partners (a slice of
     /// [`DemContacts::partners`]).
     runs: Vec<RunPlan>,
@@ -82,14 +84,39 @@ struct RunPlan {
     partners: Range<usize>,
 }
 
+impl KernelPlan {
+    /// No plan yet, and zero sums for `spheres` spheres.
+    pub(super) fn new(spheres: usize) -> KernelPlan {
+        KernelPlan {
+            sums: vec![(Vec3::zeros(), Vec3::zeros()); spheres],
+            ..KernelPlan::default()
+        }
+    }
+
+    /// Sphere `s`'s sum of its contacts' forces and moments at the last evaluation.
+    pub(super) fn sum(&self, s: usize) -> &Sum {
+        &self.sums[s]
+    }
+
+    /// Zero sums for `spheres` (which touch nothing now).
+    pub(super) fn clear_sums(&mut self, spheres: &[u32]) {
+        for &s in spheres {
+            self.sums[s as usize] = (Vec3::zeros(), Vec3::zeros());
+        }
+    }
+}
+
 impl DemContacts {
     /// The plan of the fused pass for the current lists.
     pub(super) fn plan_runs(&mut self) {
-        let n = self.particle.len();
+        let n = self.spheres.len();
         let length = run_length(n);
         let runs = n.div_ceil(length);
-        let (pairs, walls) = (&self.pairs.items, &self.wall_contacts.items);
-        let mut plan = std::mem::take(&mut self.kernel_plan);
+        let (pairs, walls) = (
+            &self.candidates.pairs().items,
+            &self.candidates.wall_contacts().items,
+        );
+        let mut plan = std::mem::take(&mut self.kernel);
         plan.runs.clear();
         plan.slot.clear();
         plan.slot.resize(pairs.len(), 0);
@@ -99,7 +126,7 @@ impl DemContacts {
             (
                 pairs.partition_point(|c| c.first < lo),
                 walls.partition_point(|c| c.first < lo),
-                self.partners.partition_point(|&s| s < lo),
+                self.candidates.partners().partition_point(|&s| s < lo),
             )
         };
         let mut foreign = Vec::new();
@@ -137,18 +164,18 @@ impl DemContacts {
         plan.early.clear();
         plan.late.clear();
         let mut receive = plan.receive.iter().map(|e| e.0).peekable();
-        for &s in &self.partners {
+        for &s in self.candidates.partners() {
             let receives = receive.next_if_eq(&s).is_some();
             while receive.next_if_eq(&s).is_some() {}
-            let early = self.exclusive[s as usize] && !receives;
+            let early = self.spheres.exclusive(s as usize) && !receives;
             plan.early.push(early);
             if !early {
                 plan.late.push(s);
             }
         }
-        self.kernel_plan = plan;
         // Spheres that touch nothing keep a zero sum until the next build.
-        self.sphere_force.fill((Vec3::zeros(), Vec3::zeros()));
+        plan.sums.fill((Vec3::zeros(), Vec3::zeros()));
+        self.kernel = plan;
     }
 
     /// The pair kernel over every run in parallel: with `LAW`, the narrow phase and the law
@@ -165,9 +192,9 @@ impl DemContacts {
         mut out: Option<(&mut [Vec3], &mut [Vec3])>,
     ) {
         let keep_turn = LAW && (!SUM || self.split.is_some());
-        let mut plan = std::mem::take(&mut self.kernel_plan);
-        let mut pairs = std::mem::take(&mut self.pairs);
-        let mut walls = std::mem::take(&mut self.wall_contacts);
+        let mut plan = std::mem::take(&mut self.kernel);
+        let mut pairs = std::mem::take(self.candidates.pairs_mut());
+        let mut walls = std::mem::take(self.candidates.wall_contacts_mut());
         if LAW {
             for list in [&mut pairs, &mut walls] {
                 list.turn.clear();
@@ -176,7 +203,7 @@ impl DemContacts {
                 }
             }
         }
-        let mut sums = std::mem::take(&mut self.sphere_force);
+        let mut sums = std::mem::take(&mut plan.sums);
         {
             let carriers = out
                 .as_mut()
@@ -217,7 +244,7 @@ impl DemContacts {
                     let run = &runs[r];
                     let lo = (r * length) as u32;
                     let slots = &slot[run.pairs.clone()];
-                    let partners = &this.partners[run.partners.clone()];
+                    let partners = &this.candidates.partners()[run.partners.clone()];
                     let sums = RunSums { own, foreign, lo };
                     this.evaluate_run::<LAW, SUM>(time, dt, lists, slots, partners, sums);
                     let (true, Some(carriers)) = (SUM, &carriers) else {
@@ -235,7 +262,7 @@ impl DemContacts {
                     }
                 });
         }
-        (self.pairs, self.wall_contacts) = (pairs, walls);
+        self.candidates.set_lists(pairs, walls);
         if SUM {
             let mut receive = plan.receive.iter().peekable();
             for &s in &plan.late {
@@ -252,16 +279,21 @@ impl DemContacts {
                 }
             }
         }
-        self.sphere_force = sums;
-        self.kernel_plan = plan;
+        plan.sums = sums;
+        self.kernel = plan;
     }
 
     /// Adds the complete sum of every partner this process or rank owns to its particle
     /// (`force`) and rotation (`torque`), in ascending sphere order: after a kernel pass that
     /// summed without them.
     pub(super) fn add_partner_sums(&self, force: &mut [Vec3], torque: &mut [Vec3]) {
-        for &s in self.partners.iter().filter(|&&s| self.adds_to(s)) {
-            let (f, t) = &self.sphere_force[s as usize];
+        for &s in self
+            .candidates
+            .partners()
+            .iter()
+            .filter(|&&s| self.adds_to(s))
+        {
+            let (f, t) = self.kernel.sum(s as usize);
             self.add_sphere(s as usize, f, t, force, torque);
         }
     }
@@ -283,7 +315,7 @@ impl DemContacts {
     ) {
         let law = &self.settings.law;
         let RunSums { own, foreign, lo } = sums;
-        let delay = self.time_delay.as_ref().map(|t| (t.axis, t.scales));
+        let delay = self.time_delay.as_ref().map(TimeDelay::ghosts);
         if SUM {
             for &s in partners {
                 own[(s - lo) as usize] = (Vec3::zeros(), Vec3::zeros());
@@ -330,8 +362,8 @@ impl DemContacts {
                 None => (1.0, 1.0),
             };
             let (first, second) = (
-                pair_share(contact, &turn, true, self.now[a].radius, scale_a),
-                pair_share(contact, &turn, false, self.now[b].radius, scale_b),
+                pair_share(contact, &turn, true, self.spheres.now(a).radius, scale_a),
+                pair_share(contact, &turn, false, self.spheres.now(b).radius, scale_b),
             );
             add_to(&mut own[a - lo as usize], first);
             match (slot as usize).checked_sub(RUN_CHUNK) {
@@ -362,7 +394,7 @@ impl DemContacts {
             if SUM {
                 add_to(
                     &mut own[s - lo as usize],
-                    wall_share(contact, &turn, self.now[s].radius),
+                    wall_share(contact, &turn, self.spheres.now(s).radius),
                 );
             }
         }
@@ -427,9 +459,9 @@ impl DemContacts {
         t: &Vec3,
         (force, torque): &(Carriers, Carriers),
     ) {
-        force.add(self.particle[s] as usize, f);
-        if self.turn[s] != NOT_RIGID {
-            torque.add(self.turn[s] as usize, t);
+        force.add(self.spheres.particle()[s] as usize, f);
+        if self.spheres.turn()[s] != NOT_RIGID {
+            torque.add(self.spheres.turn()[s] as usize, t);
         }
     }
 }
@@ -587,7 +619,7 @@ mod tests {
                         contacts.rebuild_stage(state.time);
                     }
                     contacts.read_partners_stage(&state);
-                    let (time, dt) = (state.time, contacts.dt);
+                    let (time, dt) = (state.time, contacts.evaluation.dt());
                     contacts.run_kernel::<true, false>(time, dt, None);
                     let out = Some((&mut force[..], &mut torque[..]));
                     contacts.run_kernel::<false, true>(time, dt, out);
@@ -636,9 +668,9 @@ mod tests {
         let (state, mut contacts) = packing();
         contacts.read_own_stage(&state);
         contacts.rebuild_stage(0.0);
-        let plan = &contacts.kernel_plan;
+        let plan = &contacts.kernel;
         let mut crossing = 0;
-        for (k, c) in contacts.pairs.items.iter().enumerate() {
+        for (k, c) in contacts.candidates.pairs().items.iter().enumerate() {
             let slot = plan.slot[k] as usize;
             let length = run_length(contacts.spheres());
             if contacts.run_of(c.second) == contacts.run_of(c.first) {

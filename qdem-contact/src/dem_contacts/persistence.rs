@@ -105,7 +105,7 @@ impl DemContacts {
         saved: &SavedSprings,
         particle_of: impl Fn(u32) -> Option<usize>,
     ) -> CarriedSprings {
-        let sphere_of: HashMap<usize, u32> = (self.particle.iter().enumerate())
+        let sphere_of: HashMap<usize, u32> = (self.spheres.particle().iter().enumerate())
             .map(|(s, &p)| (p as usize, s as u32))
             .collect();
         let sphere = |p: u32| particle_of(p).and_then(|p| sphere_of.get(&p).copied());
@@ -126,9 +126,12 @@ impl DemContacts {
             list.dedup_by_key(|c| (c.0, c.1));
         }
         let carried = pairs.len() + wall_contacts.len();
-        self.pairs = ContactList::with_springs(pairs);
-        self.wall_contacts = ContactList::with_springs(wall_contacts);
-        self.built = false;
+        let lists = (
+            ContactList::with_springs(pairs),
+            ContactList::with_springs(wall_contacts),
+        );
+        self.candidates.set_lists(lists.0, lists.1);
+        self.candidates.invalidate();
         self.index_partners();
         CarriedSprings {
             carried,
@@ -144,28 +147,20 @@ impl Persistent for DemContacts {
     /// state.
     fn save(&self, out: &mut Encoder) {
         out.tag("contact");
-        out.u32s(&self.particle);
-        out.option_f64(self.last_time);
-        out.bool(self.built);
-        out.f64(self.built_time);
-        out.vec3s(&self.built_at);
-        out.u64(self.rebuilds);
-        self.pairs.save(out);
-        self.wall_contacts.save(out);
+        out.u32s(self.spheres.particle());
+        out.option_f64(self.evaluation.last_time());
+        self.candidates.save(out);
         out.bool(self.time_delay.is_some());
         if let Some(delay) = &self.time_delay {
-            out.f64(delay.scales.left);
-            out.f64(delay.scales.right);
-            out.f64(delay.boundary_force);
-            delay.boundary.save(out);
+            delay.save(out);
         }
-        self.save_servos(out);
+        self.walls.save_servos(out);
     }
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
         input.tag("contact")?;
-        let spheres = self.particle.len();
+        let spheres = self.spheres.len();
         let particle = input.u32s("contact sphere particles")?;
-        if particle != self.particle {
+        if particle != self.spheres.particle() {
             return Err(CheckpointError::Invalid {
                 what: "contact spheres",
                 detail: format!(
@@ -175,18 +170,9 @@ impl Persistent for DemContacts {
                 ),
             });
         }
-        self.last_time = input.option_f64("the last evaluation time")?;
-        self.built = input.bool("the build flag")?;
-        self.built_time = input.f64("the build time")?;
-        self.built_at = input.vec3s("the build positions")?;
-        // The displacement bound's anchor is not kept: the next check is exact.
-        self.anchor = None;
-        if self.built {
-            same_count("contact spheres", spheres, self.built_at.len())?;
-        }
-        self.rebuilds = input.u64("the rebuild count")?;
-        self.pairs = ContactList::restore(input, spheres, spheres)?;
-        self.wall_contacts = ContactList::restore(input, spheres, self.walls.len())?;
+        let last_time = input.option_f64("the last evaluation time")?;
+        self.evaluation.set_last_time(last_time);
+        self.candidates.restore(input, spheres, self.walls.len())?;
         let delayed = input.bool("the time-delay flag")?;
         same_count(
             "time-delayed boundaries",
@@ -194,14 +180,9 @@ impl Persistent for DemContacts {
             delayed as usize,
         )?;
         if let Some(delay) = &mut self.time_delay {
-            delay.scales = GhostScales {
-                left: input.f64("the left ghost scale")?,
-                right: input.f64("the right ghost scale")?,
-            };
-            delay.boundary_force = input.f64("the boundary force")?;
-            delay.boundary.restore(input)?;
+            delay.restore(input)?;
         }
-        self.restore_servos(input)?;
+        self.walls.restore_servos(input)?;
         self.index_partners();
         if let Some(split) = &mut self.split {
             split.whole = true;

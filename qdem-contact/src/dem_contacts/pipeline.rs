@@ -9,7 +9,7 @@ impl DemContacts {
     /// x_b − x_a, the minimum image when periodic, and the translation of b's image.
     #[inline]
     pub(super) fn separation(&self, a: usize, b: usize) -> (Vec3, Vec3) {
-        let d = self.center[b] - self.center[a];
+        let d = self.spheres.center()[b] - self.spheres.center()[a];
         match &self.periodic {
             Some(p) => {
                 let shift = p.image_shift(&d);
@@ -27,94 +27,70 @@ impl DemContacts {
     /// spheres of a ballast stone touch nothing: the others' centres are read at the next
     /// build).
     pub(super) fn read_centers(&mut self, state: &State) -> f64 {
-        let (every, built) = (self.reads_every_sphere(), self.lists_built());
-        let (particle, built_at, turn) = (&self.particle, &self.built_at, &self.turn);
-        let moved = if every {
-            self.center
-                .par_iter_mut()
-                .zip(self.now.par_iter_mut())
-                .with_min_len(SPHERE_CHUNK)
-                .enumerate()
-                .map(|(s, (center, now))| {
-                    *center = state.position[particle[s] as usize];
-                    read_motion(state, *center, particle[s], turn[s], now);
-                    match built {
-                        true => (*center - built_at[s]).norm_squared(),
-                        false => f64::INFINITY,
-                    }
-                })
-                .reduce(|| 0.0, f64::max)
-                .sqrt()
+        if self.reads_every_sphere() {
+            let built_at = self.lists_built().then_some(self.candidates.built_at());
+            self.spheres.read_every(state, built_at)
         } else {
             self.displacement(state)
-        };
-        moved
+        }
     }
 
     /// Copies every sphere's centre out of the state (before a build, when the read passed
     /// over the partners only).
     pub(super) fn read_every_center(&mut self, state: &State) {
-        let particle = &self.particle;
-        self.center
-            .par_iter_mut()
-            .with_min_len(SPHERE_CHUNK)
-            .enumerate()
-            .for_each(|(s, center)| *center = state.position[particle[s] as usize]);
+        self.spheres.read_every_center(state);
     }
 
     /// Whether [`DemContacts::read_centers`] fills every sphere's narrow-phase record in its
     /// pass: before the first build, and when most spheres are partners of candidates.
     pub(super) fn reads_every_sphere(&self) -> bool {
-        !self.lists_built() || 2 * self.partners.len() >= self.particle.len()
+        !self.lists_built() || 2 * self.candidates.partners().len() >= self.spheres.len()
     }
 
     /// Whether the candidate lists were built for these spheres (at `built_at`).
     pub(super) fn lists_built(&self) -> bool {
-        self.built && self.built_at.len() == self.particle.len()
+        self.candidates.built_for(self.spheres.len())
     }
 
     /// The narrow phase's record of every partner of a candidate, from `state`; serial: it
     /// runs only when fewer than half the spheres were partners (in the read, and once after
     /// a rebuild of such lists, for the new partners).
     pub(super) fn read_all_partners(&mut self, state: &State) {
-        let partners = std::mem::take(&mut self.partners);
-        self.read_motions(state, &partners);
-        self.partners = partners;
+        self.spheres.read_motions(state, self.candidates.partners());
     }
 
     /// The centres and the narrow phase's records ([`read_motion`]) of `spheres` from `state`.
     pub(super) fn read_motions(&mut self, state: &State, spheres: &[u32]) {
-        for &s in spheres {
-            let s = s as usize;
-            let (particle, turn) = (self.particle[s], self.turn[s]);
-            self.center[s] = state.position[particle as usize];
-            read_motion(state, self.center[s], particle, turn, &mut self.now[s]);
-        }
+        self.spheres.read_motions(state, spheres);
     }
 
     /// Whether some pair outside the lists may have come within reach since the last build,
     /// given the largest distance a sphere has moved.
     pub(super) fn outgrew_skin(&self, moved: f64, time: f64) -> bool {
-        let wall_moved = (0..self.walls.len())
-            .map(|w| self.wall_speed_bound(w) * (time - self.built_time).abs())
-            .fold(0.0, f64::max);
+        let wall_moved = self
+            .walls
+            .moved_bound((time - self.candidates.built_time()).abs());
         2.0 * moved >= self.settings.skin || moved + wall_moved >= self.settings.skin
     }
 
     /// Broad phase: new candidate lists and the incidence of pairs per sphere.
     pub(super) fn rebuild_all(&mut self, time: f64) {
         let skin = self.settings.skin;
-        let center = self.center.clone();
+        let center = self.spheres.center();
         let set = SphereSet {
-            center: &center,
-            radius: &self.radius,
-            body: &self.body,
+            center,
+            radius: self.spheres.radius(),
+            body: self.spheres.body(),
             periodic: self.periodic.as_ref(),
         };
-        self.pairs
-            .rebuild(find_pairs(&set, skin), self.periodic.is_some());
+        let keys = find_pairs(&set, skin);
+        self.candidates
+            .pairs_mut()
+            .rebuild(keys, self.periodic.is_some());
         let wall_keys = self.wall_keys((0..center.len()).into_par_iter(), time);
-        self.wall_contacts.rebuild(wall_keys, false);
+        self.candidates
+            .wall_contacts_mut()
+            .rebuild(wall_keys, false);
         self.finish_build(time);
     }
 
@@ -124,8 +100,8 @@ impl DemContacts {
         spheres: impl IndexedParallelIterator<Item = usize>,
         time: f64,
     ) -> Vec<(u32, u32)> {
-        let (walls, skin) = (&self.walls, self.settings.skin);
-        let (radius, center) = (&self.radius, &self.center);
+        let (walls, skin) = (self.walls.list(), self.settings.skin);
+        let (radius, center) = (self.spheres.radius(), self.spheres.center());
         spheres
             .with_min_len(CONTACT_CHUNK)
             .flat_map_iter(|s| {
@@ -139,29 +115,14 @@ impl DemContacts {
 
     /// After new candidate lists: their partners, and where and when they were built.
     pub(super) fn finish_build(&mut self, time: f64) {
-        self.anchor = None;
         self.index_partners();
-        self.built_at = self.center.clone();
-        self.built_time = time;
-        self.built = true;
-        self.rebuilds += 1;
-        self.rebuilt = true;
+        self.candidates.built(self.spheres.center(), time);
     }
 
     /// After new or changed lists: the partners of their candidates, and the pair
     /// kernel's plan for them.
     pub(super) fn index_partners(&mut self) {
-        let mut touches = vec![false; self.particle.len()];
-        for c in &self.pairs.items {
-            touches[c.first as usize] = true;
-            touches[c.second as usize] = true;
-        }
-        for c in &self.wall_contacts.items {
-            touches[c.first as usize] = true;
-        }
-        self.partners = (0..touches.len() as u32)
-            .filter(|&s| touches[s as usize])
-            .collect();
+        self.candidates.index_partners(self.spheres.len());
         self.plan_runs();
     }
 
@@ -175,12 +136,12 @@ impl DemContacts {
         shift: &mut Vec3,
     ) -> Option<(PairGeometry, PairElasticity)> {
         let (a, b) = (contact.first as usize, contact.second as usize);
-        let (sa, sb) = (&self.now[a], &self.now[b]);
+        let (sa, sb) = (self.spheres.now(a), self.spheres.now(b));
         if let Some(p) = &self.periodic {
             *shift = p.image_shift(&(sb.center - sa.center));
         }
         let geometry = narrow_phase(sa, sb, *shift, self.settings.friction)?;
-        let e = self.elasticity[sa.material as usize * self.materials + sb.material as usize];
+        let e = self.spheres.pair_elasticity(sa, sb);
         Some((geometry, e))
     }
 
@@ -194,30 +155,7 @@ impl DemContacts {
         s: usize,
         w: usize,
     ) -> Option<(PairGeometry, PairElasticity)> {
-        let wall = &self.walls[w];
-        let sphere = &self.now[s];
-        let (overlap, normal) = wall.overlap(&sphere.center, sphere.radius, time);
-        if overlap <= 0.0 || normal == Vec3::zeros() {
-            return None;
-        }
-        let lever = sphere.radius - 0.5 * overlap;
-        let geometry = PairGeometry {
-            overlap,
-            normal,
-            velocity: sphere.velocity + lever * sphere.spin.cross(&normal) - wall.velocity(),
-            radius: sphere.radius,
-            mass: sphere.mass,
-            friction: wall.friction,
-        };
-        Some((geometry, self.wall_elasticity[sphere.material as usize]))
-    }
-
-    /// The measured force through the time-delayed boundary, and the ghost scales that
-    /// follow (paper 003 Eqs. 6–7).
-    pub(super) fn set_boundary_force(&mut self, time: f64, measured: f64) {
-        let delay = self.time_delay.as_mut().expect("a time-delayed boundary");
-        delay.boundary_force = measured;
-        delay.scales = delay.boundary.update(time, measured);
+        self.walls.contact(time, self.spheres.now(s), w)
     }
 
     /// Adds sphere `s`'s contact force `f` to its particle and its moment `t` to the rigid
@@ -231,24 +169,6 @@ impl DemContacts {
         force: &mut [Vec3],
         torque: &mut [Vec3],
     ) {
-        force[self.particle[s] as usize] += f;
-        if self.turn[s] != NOT_RIGID {
-            torque[self.turn[s] as usize] += t;
-        }
+        self.spheres.add_to(s, f, t, force, torque);
     }
-}
-
-/// Sets the centre `center`, velocity and spin of `now`, the sphere on `particle` that turns
-/// with `turn` (its rigid body's or its particle's angular velocity, zero for a vertex of a
-/// deformable body), from `state`.
-#[inline]
-fn read_motion(state: &State, center: Vec3, particle: u32, turn: u32, now: &mut SphereNow) {
-    let bodies = state.rigid.len();
-    now.center = center;
-    now.velocity = state.velocity[particle as usize];
-    now.spin = match turn as usize {
-        t if t == NOT_RIGID as usize => Vec3::zeros(),
-        b if b < bodies => state.rigid.angular_velocity[b],
-        t => state.spin.velocity[t - bodies],
-    };
 }

@@ -113,31 +113,21 @@ impl DemContacts {
     /// Reads the centres of the spheres `own` from `state`; returns the largest distance one
     /// has moved since the last build (infinite before it).
     pub(super) fn read_own_centers(&mut self, state: &State, own: &[u32]) -> f64 {
-        let built = self.lists_built();
-        let mut moved: f64 = if built { 0.0 } else { f64::INFINITY };
-        for &s in own {
-            let s = s as usize;
-            let center = state.position[self.particle[s] as usize];
-            if built {
-                moved = moved.max((center - self.built_at[s]).norm_squared());
-            }
-            self.center[s] = center;
-        }
-        moved.sqrt()
+        let built_at = self.lists_built().then_some(self.candidates.built_at());
+        self.spheres.read_centers_of(state, own, built_at)
     }
 
     /// After new lists: the own spheres whose motion the lists read, and zero force on the
     /// own spheres that touch nothing now.
     fn learn_partners(&mut self, part: &mut ContactPart) {
         part.partners = self
-            .partners
+            .candidates
+            .partners()
             .iter()
             .copied()
             .filter(|&s| part.owns(s))
             .collect();
-        for &s in &part.own {
-            self.sphere_force[s as usize] = (Vec3::zeros(), Vec3::zeros());
-        }
+        self.kernel.clear_sums(&part.own);
     }
 
     /// The broad phase of one rank, once it holds every sphere's centre: the pairs that touch
@@ -145,11 +135,12 @@ impl DemContacts {
     /// (along a periodic axis, those with an image there), and its own spheres' wall
     /// candidates; the springs of the pairs that stay are kept.
     pub(super) fn rebuild_near(&mut self, part: &ContactPart, time: f64) {
-        let reach = 2.0 * self.radius.iter().cloned().fold(0.0, f64::max) + self.settings.skin;
+        let reach =
+            2.0 * self.spheres.radius().iter().cloned().fold(0.0, f64::max) + self.settings.skin;
         let (mut low, mut high) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
         for &s in &part.own {
-            low = low.inf(&self.center[s as usize]);
-            high = high.sup(&self.center[s as usize]);
+            low = low.inf(&self.spheres.center()[s as usize]);
+            high = high.sup(&self.spheres.center()[s as usize]);
         }
         let (start, width) = (
             low.add_scalar(-reach),
@@ -161,8 +152,8 @@ impl DemContacts {
             Some(_) => true,
             None => x >= start[k] && x - start[k] <= width[k],
         };
-        let near: Vec<u32> = (0..self.center.len() as u32)
-            .filter(|&s| (0..3).all(|k| within(k, self.center[s as usize][k])))
+        let near: Vec<u32> = (0..self.spheres.center().len() as u32)
+            .filter(|&s| (0..3).all(|k| within(k, self.spheres.center()[s as usize][k])))
             .collect();
         self.rebuild_among(part, &near, time);
     }
@@ -171,9 +162,9 @@ impl DemContacts {
     fn rebuild_among(&mut self, part: &ContactPart, near: &[u32], time: f64) {
         let skin = self.settings.skin;
         let (center, radius, body) = (
-            pick(near, &self.center),
-            pick(near, &self.radius),
-            pick(near, &self.body),
+            pick(near, self.spheres.center()),
+            pick(near, self.spheres.radius()),
+            pick(near, self.spheres.body()),
         );
         let set = SphereSet {
             center: &center,
@@ -186,10 +177,14 @@ impl DemContacts {
             .map(|(a, b)| (near[a as usize], near[b as usize]))
             .filter(|&(a, b)| part.owns(a) || part.owns(b))
             .collect();
-        self.pairs.rebuild(keys, self.periodic.is_some());
+        self.candidates
+            .pairs_mut()
+            .rebuild(keys, self.periodic.is_some());
         let own = part.own.par_iter().map(|&s| s as usize);
         let wall_keys = self.wall_keys(own, time);
-        self.wall_contacts.rebuild(wall_keys, false);
+        self.candidates
+            .wall_contacts_mut()
+            .rebuild(wall_keys, false);
         self.finish_build(time);
     }
 
@@ -208,7 +203,8 @@ impl DemContacts {
     /// The partners of this rank's pairs that other ranks own, ascending.
     fn ghosts_of(&self, part: &ContactPart) -> Vec<u32> {
         let mut ghosts: Vec<u32> = self
-            .pairs
+            .candidates
+            .pairs()
             .items
             .iter()
             .flat_map(|c| [c.first, c.second])
@@ -222,8 +218,10 @@ impl DemContacts {
     /// Cuts lists that hold every rank's contacts (after a merge, a restore) down to this
     /// rank's.
     pub(super) fn cut_to_rank(&mut self, part: &mut ContactPart) {
-        self.pairs.retain(|c| part.keeps(c, false));
-        self.wall_contacts.retain(|c| part.keeps(c, true));
+        self.candidates.pairs_mut().retain(|c| part.keeps(c, false));
+        self.candidates
+            .wall_contacts_mut()
+            .retain(|c| part.keeps(c, true));
         self.index_partners();
         part.whole = false;
         part.lists_changed = true;
@@ -233,19 +231,23 @@ impl DemContacts {
 impl DemContacts {
     /// The particle of every contact sphere, the items whose records the ranks exchange.
     pub(super) fn sphere_particles(&self) -> Vec<usize> {
-        self.particle.iter().map(|&p| p as usize).collect()
+        self.spheres
+            .particle()
+            .iter()
+            .map(|&p| p as usize)
+            .collect()
     }
 
     /// From now on, this rank's part of the contacts (`None`: whole again).
     pub(super) fn set_part(&mut self, part: Option<Part>) {
-        self.split = part.map(|p| ContactPart::new(&self.particle, &p.owner, p.rank));
+        self.split = part.map(|p| ContactPart::new(self.spheres.particle(), &p.owner, p.rank));
     }
 
     /// Appends the records of the spheres `items`: centre, velocity and spin.
     pub(super) fn pack_spheres(&self, items: &[u32], out: &mut Vec<f64>) {
         for &s in items {
-            let n = &self.now[s as usize];
-            for v in [self.center[s as usize], n.velocity, n.spin] {
+            let n = self.spheres.now(s as usize);
+            for v in [self.spheres.center()[s as usize], n.velocity, n.spin] {
                 out.extend_from_slice(v.as_slice());
             }
         }
@@ -254,11 +256,9 @@ impl DemContacts {
     /// Sets the records of the spheres `items` from what [`DemContacts::pack_spheres`] wrote.
     pub(super) fn unpack_spheres(&mut self, items: &[u32], values: &[f64]) {
         for (&s, v) in items.iter().zip(values.chunks_exact(SPHERE_VALUES)) {
-            let n = &mut self.now[s as usize];
-            n.center = Vec3::new(v[0], v[1], v[2]);
-            n.velocity = Vec3::new(v[3], v[4], v[5]);
-            n.spin = Vec3::new(v[6], v[7], v[8]);
-            self.center[s as usize] = n.center;
+            let (center, velocity) = (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]));
+            let spin = Vec3::new(v[6], v[7], v[8]);
+            self.spheres.set_motion(s as usize, center, velocity, spin);
         }
     }
 
@@ -268,7 +268,10 @@ impl DemContacts {
         if self.split.as_ref().is_none_or(|p| p.whole) {
             return false;
         }
-        for (list, tag) in [(&self.pairs, 0.0), (&self.wall_contacts, 1.0)] {
+        for (list, tag) in [
+            (&self.candidates.pairs(), 0.0),
+            (&self.candidates.wall_contacts(), 1.0),
+        ] {
             for (k, (c, shift)) in list.with_shifts().enumerate() {
                 out.extend([tag, c.first as f64, c.second as f64]);
                 for v in [c.history, c.force, list.turn[k]] {
@@ -301,16 +304,16 @@ impl DemContacts {
                 false => walls.push(contact),
             }
         }
-        for (items, list) in [(pairs, &mut self.pairs), (walls, &mut self.wall_contacts)] {
-            let mut items = items;
+        let [pairs, walls] = [pairs, walls].map(|mut items| {
             items.sort_by_key(|(c, _, _)| (c.first, c.second));
             items.dedup_by_key(|(c, _, _)| (c.first, c.second));
-            *list = ContactList {
+            ContactList {
                 items: items.iter().map(|e| e.0).collect(),
                 turn: items.iter().map(|e| e.1).collect(),
                 shift: items.iter().map(|e| e.2).collect(),
-            };
-        }
+            }
+        });
+        self.candidates.set_lists(pairs, walls);
         self.index_partners();
         self.run_kernel::<false, true>(0.0, 0.0, None);
         if let Some(part) = &mut self.split {
@@ -320,7 +323,7 @@ impl DemContacts {
 
     /// Whether the lists were rebuilt since the last call.
     pub(super) fn take_rebuilt(&mut self) -> bool {
-        std::mem::take(&mut self.rebuilt)
+        self.candidates.take_rebuilt()
     }
 
     /// This rank's work at its last evaluation: `CANDIDATE_WORK` (three) per candidate
@@ -333,12 +336,12 @@ impl DemContacts {
     /// it per wall candidate.
     pub(super) fn add_candidate_costs(&self, cost: &mut [f64]) {
         let half = 0.5 * CANDIDATE_WORK;
-        for c in &self.pairs.items {
-            cost[self.particle[c.first as usize] as usize] += half;
-            cost[self.particle[c.second as usize] as usize] += half;
+        for c in &self.candidates.pairs().items {
+            cost[self.spheres.particle()[c.first as usize] as usize] += half;
+            cost[self.spheres.particle()[c.second as usize] as usize] += half;
         }
-        for c in &self.wall_contacts.items {
-            cost[self.particle[c.first as usize] as usize] += CANDIDATE_WORK;
+        for c in &self.candidates.wall_contacts().items {
+            cost[self.spheres.particle()[c.first as usize] as usize] += CANDIDATE_WORK;
         }
     }
 }

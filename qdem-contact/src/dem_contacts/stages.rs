@@ -33,6 +33,46 @@ pub(super) enum Evaluated {
     Sums,
 }
 
+/// Where the evaluations stand: when the last one ran, the time since the one before, and
+/// how far the current one has gone.
+pub(super) struct Evaluation {
+    last_time: Option<f64>,
+    /// The time since the previous evaluation (s), from stage 1 of this one.
+    dt: f64,
+    /// Whether stage 1 of this evaluation read every sphere (else the partners only).
+    read_every: bool,
+    /// How far the pair kernel has run in this evaluation.
+    evaluated: Evaluated,
+}
+
+impl Evaluation {
+    /// Before the first evaluation.
+    pub(super) fn new() -> Evaluation {
+        Evaluation {
+            last_time: None,
+            dt: 0.0,
+            read_every: true,
+            evaluated: Evaluated::Nothing,
+        }
+    }
+
+    /// The time of the last evaluation, if any.
+    pub(super) fn last_time(&self) -> Option<f64> {
+        self.last_time
+    }
+
+    /// Sets the time of the last evaluation (from a checkpoint).
+    pub(super) fn set_last_time(&mut self, time: Option<f64>) {
+        self.last_time = time;
+    }
+
+    /// The time since the previous evaluation (s), set by stage 1.
+    #[cfg(test)]
+    pub(super) fn dt(&self) -> f64 {
+        self.dt
+    }
+}
+
 /// Values per entry of the reduction: what it is (0 a pair through the time-delayed
 /// boundary, 1 a contact on a servo wall), its partners, and three values.
 const REDUCED_VALUES: usize = 6;
@@ -66,8 +106,8 @@ impl DemContacts {
     /// process, or only the partners' under a bound on the others' displacement:
     /// `displacement.rs`). Returns the largest displacement since the last build.
     pub(super) fn read_own_stage(&mut self, state: &State) -> f64 {
-        self.dt = self.last_time.map_or(0.0, |t| state.time - t);
-        self.last_time = Some(state.time);
+        self.evaluation.dt = self.evaluation.last_time.map_or(0.0, |t| state.time - t);
+        self.evaluation.last_time = Some(state.time);
         if self.split.is_some() {
             return self.with_part(|this, part| {
                 if part.whole {
@@ -76,7 +116,7 @@ impl DemContacts {
                 this.read_own_centers(state, part.own())
             });
         }
-        self.read_every = self.reads_every_sphere();
+        self.evaluation.read_every = self.reads_every_sphere();
         self.read_centers(state)
     }
 
@@ -89,7 +129,7 @@ impl DemContacts {
     /// On one process, what the exchange of every sphere's record before a rebuild gives a
     /// rank: every sphere's centre, when stage 1 read only the partners'.
     fn read_borders_one_rank(&mut self, state: &State) {
-        if !self.read_every {
+        if !self.evaluation.read_every {
             self.read_every_center(state);
         }
     }
@@ -121,7 +161,7 @@ impl DemContacts {
     pub(super) fn read_partners_stage(&mut self, state: &State) {
         if self.split.is_some() {
             self.with_part(|this, part| this.read_motions(state, part.partners()));
-        } else if !self.read_every {
+        } else if !self.evaluation.read_every {
             self.read_all_partners(state);
         }
     }
@@ -130,8 +170,8 @@ impl DemContacts {
     /// forces: without the sums when they wait for a time-delayed boundary's scales, with
     /// them for a servo wall's load alone; otherwise nothing yet.
     pub(super) fn compute_stage(&mut self, time: f64) {
-        let dt = self.dt;
-        self.evaluated = if self.time_delay.is_some() {
+        let dt = self.evaluation.dt;
+        self.evaluation.evaluated = if self.time_delay.is_some() {
             self.run_kernel::<true, false>(time, dt, None);
             Evaluated::Laws
         } else if self.has_servo() {
@@ -147,21 +187,17 @@ impl DemContacts {
     /// contacts on servo walls (sphere, wall, normal force and response: `servo_loads.rs`). False
     /// when the model has neither.
     pub(super) fn reduction_stage(&mut self, out: &mut Vec<f64>) -> bool {
-        if let Some(axis) = self.time_delay.as_ref().map(|t| t.axis) {
-            for (c, shift) in self.pairs.with_shifts() {
-                if c.force != Vec3::zeros() && shift[axis] != 0.0 {
-                    out.extend([
-                        0.0,
-                        c.first as f64,
-                        c.second as f64,
-                        c.force.norm(),
-                        0.0,
-                        0.0,
-                    ]);
-                }
-            }
+        if let Some(delay) = &self.time_delay {
+            delay.reduction(self.candidates.pairs(), out);
         }
-        for c in self.servo_contacts(self.dt) {
+        let spheres = (self.spheres.records(), self.spheres.radius());
+        let servo = self.walls.servo_contacts(
+            self.candidates.wall_contacts(),
+            spheres,
+            &self.settings.law,
+            self.evaluation.dt,
+        );
+        for c in servo {
             let (sphere, wall) = (c.sphere as f64, c.wall as f64);
             out.extend([1.0, sphere, wall, c.load, c.response.0, c.response.1]);
         }
@@ -186,30 +222,20 @@ impl DemContacts {
                 }),
             }
         }
-        if self.time_delay.is_some() {
-            pairs.sort_by_key(|&(a, b, _)| (a, b));
-            pairs.dedup_by_key(|&mut (a, b, _)| (a, b));
-            let mut sum = 0.0;
-            for &(_, _, f) in &pairs {
-                sum += f;
-            }
-            let measured = match pairs.len() {
-                0 => 0.0,
-                n => sum / n as f64,
-            };
-            self.set_boundary_force(time, measured);
+        if let Some(delay) = &mut self.time_delay {
+            delay.reduced(time, pairs);
         }
         if self.has_servo() {
             walls.sort_by_key(|c| (c.sphere, c.wall));
-            self.drive_servos(time, &walls);
+            self.walls.drive_servos(time, &walls);
         }
     }
 
     /// Stage 6: the per-sphere sums, with the law when stage 5 did not run it, added to the
     /// own spheres' particles (`force`) and rotations (`torque`).
     pub(super) fn apply_stage(&mut self, force: &mut [Vec3], torque: &mut [Vec3]) {
-        let (time, dt) = (self.last_time.unwrap_or(0.0), self.dt);
-        match std::mem::take(&mut self.evaluated) {
+        let (time, dt) = (self.evaluation.last_time.unwrap_or(0.0), self.evaluation.dt);
+        match std::mem::take(&mut self.evaluation.evaluated) {
             Evaluated::Nothing => self.run_kernel::<true, true>(time, dt, Some((force, torque))),
             Evaluated::Laws => self.run_kernel::<false, true>(time, dt, Some((force, torque))),
             Evaluated::Sums => self.add_partner_sums(force, torque),

@@ -71,11 +71,31 @@ pub(crate) enum Passage {
     },
 }
 
+/// The check for spheres gone through a wall or into another body: the bodies' surfaces,
+/// the first pass-through found, and the run's step for its report.
+#[derive(Default)]
+pub(super) struct PassageCheck {
+    /// The closed surfaces of the bodies built from meshes.
+    surfaces: Vec<BodySurface>,
+    /// The report of the first sphere found through a wall or inside another body: what
+    /// happened, and the fix.
+    pass_through: Option<(String, String)>,
+    /// The run's step (s), for that report's fix; 0 until [`qdem_core::step::Model::prepare`].
+    step: f64,
+}
+
+impl PassageCheck {
+    /// The run's step (s), for the report's fix.
+    pub(super) fn set_step(&mut self, step: f64) {
+        self.step = step;
+    }
+}
+
 impl DemContacts {
     /// The surfaces of the bodies built from meshes, for the check of a centre inside
     /// another body.
     pub fn with_body_surfaces(mut self, surfaces: Vec<BodySurface>) -> DemContacts {
-        self.surfaces = surfaces;
+        self.passage.surfaces = surfaces;
         self
     }
 
@@ -83,20 +103,20 @@ impl DemContacts {
     /// keeps the first sphere of `own` (all spheres when `None`) found through a wall or
     /// inside another body, with the report [`qdem_core::step::Model::failure`] gives.
     pub(super) fn check_passage(&mut self, time: f64, own: Option<&[u32]>) {
-        if self.pass_through.is_some() {
+        if self.passage.pass_through.is_some() {
             return;
         }
         let all: Vec<u32>;
         let spheres = match own {
             Some(own) => own,
             None => {
-                all = (0..self.particle.len() as u32).collect();
+                all = (0..self.spheres.len() as u32).collect();
                 &all
             }
         };
-        let since = self.lists_built().then_some(self.built_time);
+        let since = self.lists_built().then_some(self.candidates.built_time());
         if let Some(passage) = self.find_passage(spheres, time, since) {
-            self.pass_through = Some(self.describe(passage, time));
+            self.passage.pass_through = Some(self.describe(passage, time));
         }
     }
 
@@ -114,7 +134,8 @@ impl DemContacts {
             .with_min_len(CONTACT_CHUNK)
             .find_map_first(|&s| self.through_wall(s as usize, time, since));
         walls.or_else(|| {
-            self.surfaces
+            self.passage
+                .surfaces
                 .iter()
                 .find_map(|surface| self.inside_body(surface, spheres))
         })
@@ -122,8 +143,8 @@ impl DemContacts {
 
     /// The first wall sphere `s` went into or through.
     fn through_wall(&self, s: usize, time: f64, since: Option<f64>) -> Option<Passage> {
-        let x = self.center[s];
-        self.walls.iter().enumerate().find_map(|(w, wall)| {
+        let x = self.spheres.center()[s];
+        self.walls.list().iter().enumerate().find_map(|(w, wall)| {
             let depth = match &wall.shape {
                 WallShape::Plane(p) => Some(-p.distance(&x, time)).filter(|d| *d > 0.0),
                 WallShape::Mesh(m) => m.depth_inside(&x, time).or_else(|| {
@@ -145,7 +166,7 @@ impl DemContacts {
         if !self.lists_built() {
             return Vec3::zeros();
         }
-        let d = self.center[s] - self.built_at[s];
+        let d = self.spheres.center()[s] - self.candidates.built_at()[s];
         match &self.periodic {
             Some(p) => d + p.image_shift(&d),
             None => d,
@@ -158,14 +179,16 @@ impl DemContacts {
         let vertices: Vec<Vec3> = surface
             .spheres
             .iter()
-            .map(|&s| self.center[s as usize])
+            .map(|&s| self.spheres.center()[s as usize])
             .collect();
         let (lower, upper) = bounds(&vertices);
         let inside_box = |s: &u32| {
-            let (s, x) = (*s as usize, self.center[*s as usize]);
-            self.body[s] as usize != surface.body
-                && (0..3)
-                    .all(|k| x[k] > lower[k] + self.radius[s] && x[k] < upper[k] - self.radius[s])
+            let (s, x) = (*s as usize, self.spheres.center()[*s as usize]);
+            self.spheres.body()[s] as usize != surface.body
+                && (0..3).all(|k| {
+                    x[k] > lower[k] + self.spheres.radius()[s]
+                        && x[k] < upper[k] - self.spheres.radius()[s]
+                })
         };
         let candidates: Vec<u32> = spheres.iter().copied().filter(inside_box).collect();
         if candidates.is_empty() {
@@ -173,15 +196,17 @@ impl DemContacts {
         }
         let mesh = oriented(&vertices, &surface.triangles)?;
         candidates.into_iter().find_map(|s| {
-            let x = self.center[s as usize];
+            let x = self.spheres.center()[s as usize];
             let projection = mesh.project_local_point(Vector::new(x.x, x.y, x.z), false);
             let p = projection.point;
             let depth = (Vec3::new(p.x, p.y, p.z) - x).norm();
-            (projection.is_inside && depth > self.radius[s as usize]).then_some(Passage::Body {
-                sphere: s as usize,
-                other: surface.body,
-                depth,
-            })
+            (projection.is_inside && depth > self.spheres.radius()[s as usize]).then_some(
+                Passage::Body {
+                    sphere: s as usize,
+                    other: surface.body,
+                    depth,
+                },
+            )
         })
     }
 
@@ -218,20 +243,23 @@ impl DemContacts {
                 format!(
                     "is {depth:.3e} m inside body `{}`, deeper than its radius (it went between \
                      that body's contact spheres)",
-                    self.body_names[other]
+                    self.spheres.body_names()[other]
                 ),
             ),
         };
-        let elapsed = time - self.built_time;
+        let elapsed = time - self.candidates.built_time();
         let speed = match self.lists_built() && elapsed > 0.0 {
             true => self.moved_since_build(s).norm() / elapsed,
             false => 0.0,
         };
-        let (radius, x) = (self.radius[s], self.center[s]);
+        let (radius, x) = (self.spheres.radius()[s], self.spheres.center()[s]);
         let what = format!(
             "the contact sphere of body `{}` at ({:.4}, {:.4}, {:.4}) m (radius {radius:.3e} \
              m) {into}, moving at about {speed:.3e} m/s; the contact no longer holds it back.",
-            self.body_names[self.body[s] as usize], x.x, x.y, x.z,
+            self.spheres.body_names()[self.spheres.body()[s] as usize],
+            x.x,
+            x.y,
+            x.z,
         );
         (what, self.fix(passage, speed, radius))
     }
@@ -239,7 +267,7 @@ impl DemContacts {
     /// What to change: a smaller step when the sphere moves more than [`STEP_FRACTION`] of
     /// its radius per step, else what holds it back better.
     fn fix(&self, passage: Passage, speed: f64, radius: f64) -> String {
-        let fraction = speed * self.step / radius;
+        let fraction = speed * self.passage.step / radius;
         let holder = match passage {
             Passage::Wall { .. } => "a thicker wall, larger contact spheres (contact_radius)",
             Passage::Body { .. } => {
@@ -267,7 +295,7 @@ impl DemContacts {
     /// another body's mesh deeper than its radius at `state` (read by
     /// [`DemContacts::check_initial_overlaps`] before): a body placed inside another.
     pub fn check_initial_passage(&self, state: &State) -> Result<(), ContactError> {
-        let all: Vec<u32> = (0..self.particle.len() as u32).collect();
+        let all: Vec<u32> = (0..self.spheres.len() as u32).collect();
         let Some(passage) = self.find_passage(&all, state.time, None) else {
             return Ok(());
         };
@@ -281,27 +309,31 @@ impl DemContacts {
                 sphere,
                 other,
                 depth,
-            } => (sphere, format!("body `{}`", self.body_names[other]), depth),
+            } => (
+                sphere,
+                format!("body `{}`", self.spheres.body_names()[other]),
+                depth,
+            ),
         };
         Err(ContactError::InitialInside {
-            body: self.body_names[self.body[s] as usize].clone(),
+            body: self.spheres.body_names()[self.spheres.body()[s] as usize].clone(),
             inside,
             depth,
-            radius: self.radius[s],
-            at: self.center[s].into(),
+            radius: self.spheres.radius()[s],
+            at: self.spheres.center()[s].into(),
         })
     }
 
     /// The pass-through found at the last rebuild, if any.
     pub(super) fn passage_failure(&self, time: f64) -> Option<qdem_core::error::CoreError> {
-        self.pass_through
-            .clone()
-            .map(|(detail, fix)| qdem_core::error::CoreError::PassThrough {
+        self.passage.pass_through.clone().map(|(detail, fix)| {
+            qdem_core::error::CoreError::PassThrough {
                 step: 0,
                 time,
                 dt: 0.0,
                 detail,
                 fix,
-            })
+            }
+        })
     }
 }

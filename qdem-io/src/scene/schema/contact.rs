@@ -102,8 +102,7 @@ scene_table! {
         servo: Option<WallServo> => "inline table", optional,
             "Stress control of a plane wall: `{ stress, area, gain, max_velocity }`; after each \
              force evaluation its speed towards the bodies is clamp(G (σ_target − σ), ±v_max), σ \
-             the spheres' normal force on it over `area`. Not with `velocity`, a mesh, or MPI \
-             ranks.";
+             the spheres' normal force on it over `area`. Not with `velocity` or a mesh.";
     }
 }
 
