@@ -23,9 +23,9 @@
 use crate::build::{read_mesh, BuildError, PlacedMesh};
 use crate::scene::{Ballast, Scene};
 use nalgebra::UnitQuaternion;
-use qdem_contact::broad_phase::bounds;
-use qdem_contact::clump_sample::Grading;
-use qdem_contact::particle_packing::SplitMix64;
+use qdem_contact::bonded::particle_packing::SplitMix64;
+use qdem_contact::dem::broad_phase::bounds;
+use qdem_contact::samples::clump_sample::Grading;
 use qdem_contact::ContactSphere;
 use qdem_core::step::rigid_body::tet_mass_properties;
 use qdem_core::{error::CoreError, step::State, Mat3, Vec3};

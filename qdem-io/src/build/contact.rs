@@ -7,8 +7,8 @@
 use super::ballast::BallastInfo;
 use crate::build::{BuildError, PlacedMesh};
 use crate::scene::{Contact, ContactLawName, Scene};
-use qdem_contact::broad_phase::bounds;
-use qdem_contact::dem_contacts::BodySurface;
+use qdem_contact::dem::broad_phase::bounds;
+use qdem_contact::dem::contacts::BodySurface;
 use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, LinearSpring, MeshWall,
     PeriodicBox, PlaneWall, Wall, WallShape,

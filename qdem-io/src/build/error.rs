@@ -84,7 +84,7 @@ pub enum BuildError {
         /// The scene file.
         scene: PathBuf,
         /// What is wrong.
-        source: qdem_contact::clump_sample::SampleError,
+        source: qdem_contact::samples::clump_sample::SampleError,
     },
     /// A body's `rest_on` finds no stone beneath it.
     #[error(

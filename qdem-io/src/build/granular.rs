@@ -1,7 +1,7 @@
 //! `[granular]`: a sample of rigid stones, each a clump of spheres (paper 003 §3), added to a
 //! simulation after its mesh bodies.
 //!
-//! The stones come from a generation ([`qdem_contact::clump_sample::generate_stones`]: a grading
+//! The stones come from a generation ([`qdem_contact::samples::clump_sample::generate_stones`]: a grading
 //! curve sampled by number or by mass (`grading_basis`), stones elongated or angular (`shape`),
 //! a loose lattice in a region, a seed), to be deposited under gravity, or from a stones
 //! file: CSV with the header `stone,x,y,z,radius` and one row per sphere, the rows of a stone
@@ -32,7 +32,7 @@ use crate::build::BuildError;
 use crate::csv_rows::{finite, read_text, rows};
 use crate::output::{write_atomic, OutputError};
 use crate::scene::{ClumpShapeName, GradingBasisName, Granular, Scene};
-use qdem_contact::clump_sample::{
+use qdem_contact::samples::clump_sample::{
     clump_mass_properties, generate_stones, ClumpShape, Grading, GradingBasis, MassProperties,
     SampleError, SampleSpec, Stone,
 };

@@ -357,7 +357,7 @@ fn add_forces(
 /// ballast stones, their spheres and names added to `extra`.
 fn add_granular(
     scene: &Scene,
-    stones: (&[qdem_contact::clump_sample::Stone], usize),
+    stones: (&[qdem_contact::samples::clump_sample::Stone], usize),
     state: &mut State,
     extra: &mut ExtraSpheres,
 ) -> Result<Option<GranularInfo>, BuildError> {

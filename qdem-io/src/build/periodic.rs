@@ -6,7 +6,7 @@ use super::ballast::BallastInfo;
 use super::granular::GranularInfo;
 use crate::build::{BodyInfo, BodyKind, BuildError};
 use crate::scene::{Periodic, Scene};
-use qdem_contact::time_delayed_boundary::lag_from_spacing;
+use qdem_contact::boundaries::time_delayed_boundary::lag_from_spacing;
 use qdem_contact::{DemContacts, LoadCycle, PeriodicBox, TimeDelayedBoundary, WrapGroup};
 use qdem_core::{step::State, Vec3};
 

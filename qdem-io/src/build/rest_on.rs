@@ -18,8 +18,8 @@
 
 use crate::build::{BuildError, PlacedMesh};
 use crate::scene::Scene;
-use qdem_contact::clump_sample::Stone;
-use qdem_contact::periodic_boundary::PeriodicBox;
+use qdem_contact::boundaries::periodic_boundary::PeriodicBox;
+use qdem_contact::samples::clump_sample::Stone;
 use qdem_core::Vec3;
 
 /// Lowers every body with `rest_on` onto `stones` (the scene's `[granular]` sample).

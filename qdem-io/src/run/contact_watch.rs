@@ -16,7 +16,7 @@
 //! What it does not see: a sphere that slips between two spheres of the other body (the
 //! spheres sit at the surface vertices only, and leave gaps where the vertices are more than
 //! two radii apart) without ever overlapping one by a radius: the contacts' pass-through
-//! check (`qdem-contact/src/dem_contacts/tunnelling.rs`, at each rebuild of the lists) stops
+//! check (`qdem-contact/src/dem/contacts/tunnelling.rs`, at each rebuild of the lists) stops
 //! that once the sphere is deeper than its radius in the other body. No normal run comes
 //! near the test: the deepest overlap of the fixture scenes is a fraction of a radius
 //! (docs/reliability.md). Reading the contacts changes nothing in the state, so outputs stay

@@ -116,7 +116,7 @@ fn default_spheres_per_stone() -> [usize; 2] {
 }
 
 /// `[granular] grading_basis`: what the grading's fractions passing count
-/// (`qdem_contact::clump_sample::GradingBasis`).
+/// (`qdem_contact::samples::clump_sample::GradingBasis`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum GradingBasisName {
@@ -128,7 +128,7 @@ pub enum GradingBasisName {
 }
 
 /// `[granular] shape`: how a generated stone's spheres are arranged
-/// (`qdem_contact::clump_shape::ClumpShape`).
+/// (`qdem_contact::samples::clump_shape::ClumpShape`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ClumpShapeName {

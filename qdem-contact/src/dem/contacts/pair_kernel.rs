@@ -1,0 +1,686 @@
+//! The pair kernel, the one loop of narrow phase → contact law → per-sphere sums that every
+//! evaluation runs: one process, a rank of a decomposed run, and the evaluation with a
+//! time-delayed boundary (paper 000 §4; the law of each pair is `contact_law.rs`'s, its
+//! forces on delayed ghosts scaled by paper 003 Eqs. 6–7).
+//!
+//! The spheres are cut into fixed runs ([`run_length`]: by sphere index, whatever the number
+//! of threads or ranks; an even number of runs of at most [`RUN_CHUNK`], so that two
+//! threads share them equally). A run owns the candidate pairs whose first sphere it holds
+//! (the lists are sorted by partners, so these are one slice of the list) and the wall
+//! contacts of its spheres. It evaluates them in list order and adds each contact's force and
+//! moment straight into the sums of its own spheres (pairs, then walls) and, for a second
+//! sphere beyond the run, into a small accumulator of that run's own ("foreign" sums, one
+//! slot per distinct such sphere, planned at each build). A serial pass then adds, for every
+//! partner of a candidate, its foreign sums in ascending run order and its own run's sum
+//! last, and the total to its particle: each sphere's sum is the same sequence of additions
+//! for any thread count, without atomics. A sphere that receives no foreign sums and whose
+//! particle and rotation no other sphere shares (a one-sphere grain, a vertex of a deformable
+//! body) is complete when its run ends: the run adds it to its particle itself, so the serial
+//! pass runs over the spheres near a run's start alone.
+//!
+//! A rank's lists are the sub-sequence of one process's that touches its own spheres, so
+//! each own sphere's sum is the same sequence of additions as on one process; a rank adds
+//! only its own spheres' sums. When a reduction must read this evaluation's forces first (a
+//! time-delayed boundary's ghost scales, a servo wall's load: `stages.rs`), the kernel runs
+//! in two passes over the same runs, the law (keeping each contact's n × f beside its
+//! record) and then the sums, which add the same shares in the same order as the fused pass.
+//!
+//! Per step a candidate pair costs its record (read and written once) and two additions into
+//! sums that are in cache, and the serial add runs over the partners of candidates only.
+
+use super::*;
+use std::ops::Range;
+
+/// The most spheres in a run of the fused pass.
+pub(crate) const RUN_CHUNK: usize = 2048;
+
+/// A force and a moment.
+type Sum = (Vec3, Vec3);
+
+/// Spheres per run of `n` spheres: one run of up to [`RUN_CHUNK`], else an even number
+/// of runs of at most [`RUN_CHUNK`], as equal as can be. It depends on `n` alone, so the
+/// order of every sum does not depend on the number of threads or ranks.
+pub(super) fn run_length(n: usize) -> usize {
+    match n <= RUN_CHUNK {
+        true => RUN_CHUNK,
+        false => n.div_ceil(2 * n.div_ceil(2 * RUN_CHUNK)),
+    }
+}
+
+#[cfg(test)]
+impl DemContacts {
+    /// The run of sphere `s`.
+    fn run_of(&self, s: u32) -> usize {
+        s as usize / run_length(self.spheres.len())
+    }
+}
+
+/// What the fused pass knows of the lists, made at each build, and its per-sphere sums.
+#[derive(Default)]
+pub(super) struct KernelPlan {
+    /// Per sphere, the sum of its contacts' forces and moments at the last evaluation.
+    sums: Vec<Sum>,
+    /// Per run: its pairs (a slice of the pair list), wall contacts and partners (a slice of
+    /// [`DemContacts::partners`]).
+    runs: Vec<RunPlan>,
+    /// Per pair: where its second sphere's share goes in its run: `s − lo` for a sphere of the
+    /// run, `RUN_CHUNK + k` for the run's k-th foreign sphere.
+    slot: Vec<u32>,
+    /// The foreign sums: (sphere, run, slot in that run's accumulator), sorted.
+    receive: Vec<(u32, u32, u32)>,
+    /// Per run, its foreign accumulator (scratch).
+    foreign: Vec<Vec<Sum>>,
+    /// Per partner (as [`DemContacts::partners`]), whether its run adds it to its particle.
+    early: Vec<bool>,
+    /// The partners the serial pass adds, ascending.
+    late: Vec<u32>,
+}
+
+/// One run's share of the lists.
+#[derive(Clone, Default)]
+struct RunPlan {
+    pairs: Range<usize>,
+    walls: Range<usize>,
+    partners: Range<usize>,
+}
+
+impl KernelPlan {
+    /// No plan yet, and zero sums for `spheres` spheres.
+    pub(super) fn new(spheres: usize) -> KernelPlan {
+        KernelPlan {
+            sums: vec![(Vec3::zeros(), Vec3::zeros()); spheres],
+            ..KernelPlan::default()
+        }
+    }
+
+    /// Sphere `s`'s sum of its contacts' forces and moments at the last evaluation.
+    pub(super) fn sum(&self, s: usize) -> &Sum {
+        &self.sums[s]
+    }
+
+    /// Zero sums for `spheres` (which touch nothing now).
+    pub(super) fn clear_sums(&mut self, spheres: &[u32]) {
+        for &s in spheres {
+            self.sums[s as usize] = (Vec3::zeros(), Vec3::zeros());
+        }
+    }
+}
+
+impl DemContacts {
+    /// The plan of the fused pass for the current lists.
+    pub(super) fn plan_runs(&mut self) {
+        let n = self.spheres.len();
+        let length = run_length(n);
+        let runs = n.div_ceil(length);
+        let (pairs, walls) = (
+            &self.candidates.pairs().items,
+            &self.candidates.wall_contacts().items,
+        );
+        let mut plan = std::mem::take(&mut self.kernel);
+        plan.runs.clear();
+        plan.slot.clear();
+        plan.slot.resize(pairs.len(), 0);
+        plan.receive.clear();
+        plan.foreign.resize(runs, Vec::new());
+        let start = |lo: u32| {
+            (
+                pairs.partition_point(|c| c.first < lo),
+                walls.partition_point(|c| c.first < lo),
+                self.candidates.partners().partition_point(|&s| s < lo),
+            )
+        };
+        let mut foreign = Vec::new();
+        for r in 0..runs {
+            let (lo, hi) = ((r * length) as u32, ((r + 1) * length).min(n) as u32);
+            let (from, to) = (start(lo), start(hi));
+            let run = RunPlan {
+                pairs: from.0..to.0,
+                walls: from.1..to.1,
+                partners: from.2..to.2,
+            };
+            foreign.clear();
+            foreign.extend(
+                pairs[run.pairs.clone()]
+                    .iter()
+                    .map(|c| c.second)
+                    .filter(|&b| b >= hi),
+            );
+            foreign.sort_unstable();
+            foreign.dedup();
+            for k in run.pairs.clone() {
+                let b = pairs[k].second;
+                plan.slot[k] = match b < hi {
+                    true => b - lo,
+                    false => RUN_CHUNK as u32 + foreign.binary_search(&b).expect("planned") as u32,
+                };
+            }
+            let r32 = r as u32;
+            plan.receive
+                .extend(foreign.iter().enumerate().map(|(k, &b)| (b, r32, k as u32)));
+            plan.foreign[r].resize(foreign.len(), (Vec3::zeros(), Vec3::zeros()));
+            plan.runs.push(run);
+        }
+        plan.receive.sort_unstable();
+        plan.early.clear();
+        plan.late.clear();
+        let mut receive = plan.receive.iter().map(|e| e.0).peekable();
+        for &s in self.candidates.partners() {
+            let receives = receive.next_if_eq(&s).is_some();
+            while receive.next_if_eq(&s).is_some() {}
+            let early = self.spheres.exclusive(s as usize) && !receives;
+            plan.early.push(early);
+            if !early {
+                plan.late.push(s);
+            }
+        }
+        // Spheres that touch nothing keep a zero sum until the next build.
+        plan.sums.fill((Vec3::zeros(), Vec3::zeros()));
+        self.kernel = plan;
+    }
+
+    /// The pair kernel over every run in parallel: with `LAW`, the narrow phase and the law
+    /// of every candidate (its record, and its n × f column when a later pass or a merge
+    /// reads it); with `SUM`, each contact's shares added into the per-sphere sums, then the
+    /// serial pass that completes the sums of the spheres a run could not. With `out` (the
+    /// particle forces and the rotations' torques), each complete sum of a sphere this
+    /// process or rank owns is added there too: by its run for an early sphere, in the serial
+    /// pass for the others.
+    pub(super) fn run_kernel<const LAW: bool, const SUM: bool>(
+        &mut self,
+        time: f64,
+        dt: f64,
+        mut out: Option<(&mut [Vec3], &mut [Vec3])>,
+    ) {
+        let keep_turn = LAW && (!SUM || self.split.is_some());
+        let mut plan = std::mem::take(&mut self.kernel);
+        let mut pairs = std::mem::take(self.candidates.pairs_mut());
+        let mut walls = std::mem::take(self.candidates.wall_contacts_mut());
+        if LAW {
+            for list in [&mut pairs, &mut walls] {
+                list.turn.clear();
+                if keep_turn {
+                    list.turn.resize(list.items.len(), Vec3::zeros());
+                }
+            }
+        }
+        let mut sums = std::mem::take(&mut plan.sums);
+        {
+            let carriers = out
+                .as_mut()
+                .map(|(force, torque)| (Carriers::new(force), Carriers::new(torque)));
+            let runs = &plan.runs;
+            let pair_lengths = || runs.iter().map(|r| r.pairs.len());
+            let wall_lengths = || runs.iter().map(|r| r.walls.len());
+            let lists: Vec<RunLists<'_>> = cut(&mut pairs.items, pair_lengths())
+                .into_iter()
+                .zip(cut_column(&mut pairs.shift, pair_lengths()))
+                .zip(cut_column(&mut pairs.turn, pair_lengths()))
+                .zip(cut(&mut walls.items, wall_lengths()))
+                .zip(cut_column(&mut walls.turn, wall_lengths()))
+                .map(|((((pairs, shifts), turns), walls), wall_turns)| RunLists {
+                    pairs,
+                    shifts,
+                    turns,
+                    walls,
+                    wall_turns,
+                })
+                .collect();
+            let this = &*self;
+            let (slot, early) = (&plan.slot, &plan.early);
+            let length = run_length(sums.len());
+            // Each run a task of its own on several threads: the runs' costs differ (a
+            // packing's floor layers carry its wall contacts), and rayon's halving split put
+            // them 2 : 1 on two threads at 10⁴ spheres. On one thread the splitting is waste.
+            let per_task = match rayon::current_num_threads() {
+                1 => usize::MAX,
+                _ => 1,
+            };
+            sums.par_chunks_mut(length)
+                .zip(plan.foreign.par_iter_mut())
+                .zip(lists)
+                .enumerate()
+                .with_max_len(per_task)
+                .for_each(|(r, ((own, foreign), lists))| {
+                    let run = &runs[r];
+                    let lo = (r * length) as u32;
+                    let slots = &slot[run.pairs.clone()];
+                    let partners = &this.candidates.partners()[run.partners.clone()];
+                    let sums = RunSums { own, foreign, lo };
+                    this.evaluate_run::<LAW, SUM>(time, dt, lists, slots, partners, sums);
+                    let (true, Some(carriers)) = (SUM, &carriers) else {
+                        return;
+                    };
+                    let early = &early[run.partners.clone()];
+                    for (&s, _) in partners.iter().zip(early).filter(|(_, &e)| e) {
+                        if !this.adds_to(s) {
+                            continue;
+                        }
+                        let (f, t) = &own[(s - lo) as usize];
+                        // SAFETY: an early sphere's particle and rotation are its own
+                        // (`exclusive_carriers`), and each sphere is in one run.
+                        unsafe { this.add_exclusive(s as usize, f, t, carriers) };
+                    }
+                });
+        }
+        self.candidates.set_lists(pairs, walls);
+        if SUM {
+            let mut receive = plan.receive.iter().peekable();
+            for &s in &plan.late {
+                let mut total: Option<Sum> = None;
+                while let Some(&(_, r, k)) = receive.next_if(|e| e.0 == s) {
+                    total = Some(add_sum(total, plan.foreign[r as usize][k as usize]));
+                }
+                let total = add_sum(total, sums[s as usize]);
+                sums[s as usize] = total;
+                if let Some((force, torque)) = &mut out {
+                    if self.adds_to(s) {
+                        self.add_sphere(s as usize, &total.0, &total.1, force, torque);
+                    }
+                }
+            }
+        }
+        plan.sums = sums;
+        self.kernel = plan;
+    }
+
+    /// Adds the complete sum of every partner this process or rank owns to its particle
+    /// (`force`) and rotation (`torque`), in ascending sphere order: after a kernel pass that
+    /// summed without them.
+    pub(super) fn add_partner_sums(&self, force: &mut [Vec3], torque: &mut [Vec3]) {
+        for &s in self
+            .candidates
+            .partners()
+            .iter()
+            .filter(|&&s| self.adds_to(s))
+        {
+            let (f, t) = self.kernel.sum(s as usize);
+            self.add_sphere(s as usize, f, t, force, torque);
+        }
+    }
+
+    /// One run: its partners' sums set to zero, then each pair in list order (its shares to
+    /// its first sphere and to its second, in the run or foreign), then each wall contact.
+    /// With `LAW`, a contact's force comes from the narrow phase and the law, and a contact
+    /// found apart adds nothing; without, from its record and n × f column, scaled for a
+    /// ghost beyond a time-delayed boundary (paper 003 Eqs. 6–7).
+    #[inline(always)]
+    fn evaluate_run<const LAW: bool, const SUM: bool>(
+        &self,
+        time: f64,
+        dt: f64,
+        lists: RunLists<'_>,
+        slots: &[u32],
+        partners: &[u32],
+        sums: RunSums<'_>,
+    ) {
+        let law = &self.settings.law;
+        let RunSums { own, foreign, lo } = sums;
+        let delay = self.time_delay.as_ref().map(TimeDelay::ghosts);
+        if SUM {
+            for &s in partners {
+                own[(s - lo) as usize] = (Vec3::zeros(), Vec3::zeros());
+            }
+            foreign.fill((Vec3::zeros(), Vec3::zeros()));
+        }
+        let RunLists {
+            pairs,
+            shifts,
+            turns,
+            walls,
+            wall_turns,
+        } = lists;
+        for (k, (contact, &slot)) in pairs.iter_mut().zip(slots).enumerate() {
+            let turn = match LAW {
+                true => {
+                    let mut shift = Vec3::zeros();
+                    let touching = self.pair_contact(contact, &mut shift);
+                    if let Some(at) = shifts.get_mut(k) {
+                        *at = shift;
+                    }
+                    let Some((g, e)) = touching else {
+                        contact.part();
+                        if let Some(at) = turns.get_mut(k) {
+                            *at = Vec3::zeros();
+                        }
+                        continue;
+                    };
+                    let f = law.force(&g, &e, &mut contact.history, dt);
+                    let turn = contact.touch(f, &g.normal, g.overlap);
+                    if let Some(at) = turns.get_mut(k) {
+                        *at = turn;
+                    }
+                    turn
+                }
+                false => turns[k],
+            };
+            if !SUM {
+                continue;
+            }
+            let (a, b) = (contact.first as usize, contact.second as usize);
+            let (scale_a, scale_b) = match &delay {
+                Some((axis, scales)) => pair_scales(shifts[k][*axis], scales),
+                None => (1.0, 1.0),
+            };
+            let (first, second) = (
+                pair_share(contact, &turn, true, self.spheres.now(a).radius, scale_a),
+                pair_share(contact, &turn, false, self.spheres.now(b).radius, scale_b),
+            );
+            add_to(&mut own[a - lo as usize], first);
+            match (slot as usize).checked_sub(RUN_CHUNK) {
+                None => add_to(&mut own[slot as usize], second),
+                Some(k) => add_to(&mut foreign[k], second),
+            }
+        }
+        for (k, contact) in walls.iter_mut().enumerate() {
+            let s = contact.first as usize;
+            let turn = match LAW {
+                true => {
+                    let Some((g, e)) = self.wall_contact(time, s, contact.second as usize) else {
+                        contact.part();
+                        if let Some(at) = wall_turns.get_mut(k) {
+                            *at = Vec3::zeros();
+                        }
+                        continue;
+                    };
+                    let f = law.force(&g, &e, &mut contact.history, dt);
+                    let turn = contact.touch(f, &g.normal, g.overlap);
+                    if let Some(at) = wall_turns.get_mut(k) {
+                        *at = turn;
+                    }
+                    turn
+                }
+                false => wall_turns[k],
+            };
+            if SUM {
+                add_to(
+                    &mut own[s - lo as usize],
+                    wall_share(contact, &turn, self.spheres.now(s).radius),
+                );
+            }
+        }
+    }
+}
+
+/// Force or torque sums that the runs of the pair kernel add to in parallel, each element
+/// from one sphere only.
+struct Carriers {
+    at: *mut Vec3,
+    len: usize,
+}
+
+// SAFETY: the runs write disjoint elements (`DemContacts::add_exclusive`).
+unsafe impl Sync for Carriers {}
+
+impl Carriers {
+    fn new(sums: &mut [Vec3]) -> Carriers {
+        Carriers {
+            at: sums.as_mut_ptr(),
+            len: sums.len(),
+        }
+    }
+
+    /// `sums[i] += v`.
+    ///
+    /// # Safety
+    /// No other thread reads or writes element `i` while the `Carriers` lives.
+    #[inline]
+    unsafe fn add(&self, i: usize, v: &Vec3) {
+        assert!(i < self.len, "carrier {i} beyond {}", self.len);
+        *self.at.add(i) += v;
+    }
+}
+
+/// Per sphere on `particle` adding its moment to `turn`, whether no other sphere shares its
+/// particle or the rotation it adds to (always so for one-sphere grains and the vertices of
+/// deformable bodies; not for the spheres of a rigid body).
+pub(super) fn exclusive_carriers(particle: &[u32], turn: &[u32]) -> Vec<bool> {
+    let mut count = std::collections::HashMap::<(bool, u32), u32>::new();
+    let keys = |s: usize| [(false, particle[s]), (true, turn[s])];
+    for s in 0..particle.len() {
+        for key in keys(s).into_iter().filter(|k| k.1 != NOT_RIGID) {
+            *count.entry(key).or_default() += 1;
+        }
+    }
+    (0..particle.len())
+        .map(|s| keys(s).iter().all(|k| k.1 == NOT_RIGID || count[k] == 1))
+        .collect()
+}
+
+impl DemContacts {
+    /// [`DemContacts::add_sphere`] from a run of the fused pass.
+    ///
+    /// # Safety
+    /// No other sphere adds to sphere `s`'s particle or rotation at the same time.
+    #[inline]
+    unsafe fn add_exclusive(
+        &self,
+        s: usize,
+        f: &Vec3,
+        t: &Vec3,
+        (force, torque): &(Carriers, Carriers),
+    ) {
+        force.add(self.spheres.particle()[s] as usize, f);
+        if self.spheres.turn()[s] != NOT_RIGID {
+            torque.add(self.spheres.turn()[s] as usize, t);
+        }
+    }
+}
+
+/// The share of pair `c` (with n × f `turn`) of sphere `first` (else the second), of radius
+/// `radius`, with its ghost scale `scale`: ±`scale` f and the moment (r − δ/2) `scale` n × f.
+#[inline]
+fn pair_share(c: &Contact, turn: &Vec3, first: bool, radius: f64, scale: f64) -> Sum {
+    let f = if first { scale } else { -scale } * c.force;
+    (f, c.moment(turn, radius, scale))
+}
+
+/// The share of wall contact `c` (with n × f `turn`) of its sphere, of radius `radius`.
+#[inline]
+fn wall_share(c: &Contact, turn: &Vec3, radius: f64) -> Sum {
+    (c.force, c.moment(turn, radius, 1.0))
+}
+
+/// A run's slices of the candidate lists: its pairs, their image translations and n × f
+/// (each empty when the lists hold no such column), its wall contacts and their n × f.
+struct RunLists<'a> {
+    pairs: &'a mut [Contact],
+    shifts: &'a mut [Vec3],
+    turns: &'a mut [Vec3],
+    walls: &'a mut [Contact],
+    wall_turns: &'a mut [Vec3],
+}
+
+/// A run's sums: those of its own spheres (from sphere `lo` on) and its foreign sums.
+struct RunSums<'a> {
+    own: &'a mut [Sum],
+    foreign: &'a mut [Sum],
+    lo: u32,
+}
+
+/// `sum += share`.
+#[inline]
+fn add_to(sum: &mut Sum, share: Sum) {
+    sum.0 += share.0;
+    sum.1 += share.1;
+}
+
+/// The running total of a sphere's partial sums, in run order: the first partial itself,
+/// then each further one added.
+#[inline]
+fn add_sum(total: Option<Sum>, partial: Sum) -> Sum {
+    match total {
+        None => partial,
+        Some((f, t)) => (f + partial.0, t + partial.1),
+    }
+}
+
+/// A column of the lists (`column`, empty when the lists hold none) cut into the runs'
+/// slices of `lengths`: empty slices when empty.
+fn cut_column<T>(column: &mut [T], lengths: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
+    let empty = column.is_empty();
+    cut(column, lengths.map(|n| if empty { 0 } else { n }))
+}
+
+/// `items` cut into consecutive slices of `lengths`.
+fn cut<T>(items: &mut [T], lengths: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
+    let mut rest = items;
+    let mut out = Vec::new();
+    for len in lengths {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
+        out.push(head);
+        rest = tail;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dem::laws::hertz_mindlin::HertzMindlin;
+    use crate::dem::walls::plane_wall::PlaneWall;
+    use crate::dem::walls::wall::WallShape;
+
+    /// 18 × 18 × 16 spheres (2.5 runs) on a jittered lattice closer than their diameter,
+    /// turning, with velocities and spins, over a floor: many pairs cross a run boundary.
+    fn packing() -> (State, DemContacts) {
+        let r = 0.005;
+        let mut centers = Vec::new();
+        for k in 0..16 {
+            for j in 0..18 {
+                for i in 0..18 {
+                    let jitter = ((i * 7 + j * 13 + k * 29) % 17) as f64 / 17.0 - 0.5;
+                    centers.push(Vec3::new(
+                        (1.98 * i as f64) * r + 0.02 * r * jitter,
+                        (1.98 * j as f64) * r - 0.02 * r * jitter,
+                        (1.98 * k as f64 + 0.99) * r,
+                    ));
+                }
+            }
+        }
+        let n = centers.len();
+        let mut state = State::at_rest(centers);
+        state.mass = vec![1e-3; n];
+        for p in 0..n {
+            let f = |m: usize| ((p * m) % 101) as f64 / 101.0 - 0.5;
+            state.velocity[p] = Vec3::new(f(37), f(53), f(71));
+            state.let_turn(p, 1e-8);
+            state.spin.velocity[p] = Vec3::new(f(11), f(17), f(23)) * 10.0;
+        }
+        let spheres: Vec<ContactSphere> = (0..n)
+            .map(|p| ContactSphere {
+                particle: p,
+                radius: r,
+                body: p,
+                material: 0,
+            })
+            .collect();
+        let floor = Wall {
+            shape: WallShape::Plane(PlaneWall::new(Vec3::zeros(), Vec3::z(), Vec3::zeros())),
+            friction: 0.4,
+        };
+        let settings = ContactSettings {
+            law: ContactLaw::HertzMindlin(HertzMindlin { damping_ratio: 0.2 }),
+            friction: 0.5,
+            skin: 0.001,
+        };
+        let names = (0..n).map(|p| p.to_string()).collect();
+        let contacts = DemContacts::new(
+            &state,
+            &spheres,
+            names,
+            &[(5e7, 0.25)],
+            settings,
+            vec![floor],
+        );
+        (state, contacts)
+    }
+
+    /// Three evaluations 10 µs apart (the springs grow), by the fused pass or by a law pass
+    /// then a sum pass (as with a time-delayed boundary): the particle forces and torques of
+    /// the last.
+    fn forces(fused: bool, threads: usize) -> (Vec<Vec3>, Vec<Vec3>, usize) {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let (mut state, mut contacts) = packing();
+            let n = state.len();
+            let (mut force, mut torque) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
+            for step in 0..3 {
+                state.time = 1e-5 * step as f64;
+                force.fill(Vec3::zeros());
+                torque.fill(Vec3::zeros());
+                if fused {
+                    contacts.add_forces(&state, &mut force, &mut torque);
+                } else {
+                    let moved = contacts.read_own_stage(&state);
+                    if contacts.needs_rebuild_stage(moved, state.time) {
+                        contacts.rebuild_stage(state.time);
+                    }
+                    contacts.read_partners_stage(&state);
+                    let (time, dt) = (state.time, contacts.evaluation.dt());
+                    contacts.run_kernel::<true, false>(time, dt, None);
+                    let out = Some((&mut force[..], &mut torque[..]));
+                    contacts.run_kernel::<false, true>(time, dt, out);
+                }
+            }
+            (force, torque, contacts.contacts())
+        })
+    }
+
+    #[test]
+    fn the_law_and_the_sums_in_two_passes_sum_as_the_fused_pass_bit_for_bit_on_any_thread_count() {
+        let (_, contacts) = packing();
+        assert!(contacts.spheres() > 2 * RUN_CHUNK);
+        let apart = forces(false, 1);
+        // Most spheres touch: the comparison is not one of zeros.
+        assert!(apart.2 > 10_000, "{} touching contacts", apart.2);
+        for threads in [1, 2, 3] {
+            let fused = forces(true, threads);
+            assert_eq!(fused.2, apart.2);
+            for p in 0..fused.0.len() {
+                assert_eq!(
+                    fused.0[p], apart.0[p],
+                    "force on particle {p}, {threads} threads"
+                );
+                assert_eq!(
+                    fused.1[p], apart.1[p],
+                    "torque on particle {p}, {threads} threads"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_runs_are_an_even_number_of_at_most_run_chunk_spheres_beyond_one_run() {
+        assert_eq!(run_length(RUN_CHUNK), RUN_CHUNK);
+        for n in [2049, 4096, 4097, 10_000, 100_000, 279_074] {
+            let length = run_length(n);
+            assert!(length <= RUN_CHUNK, "{n} spheres: runs of {length}");
+            assert_eq!(n.div_ceil(length) % 2, 0, "{n} spheres: runs of {length}");
+        }
+        assert_eq!(run_length(10_000), 1667);
+    }
+
+    #[test]
+    fn the_plan_routes_second_spheres_beyond_a_run_through_its_foreign_sums() {
+        let (state, mut contacts) = packing();
+        contacts.read_own_stage(&state);
+        contacts.rebuild_stage(0.0);
+        let plan = &contacts.kernel;
+        let mut crossing = 0;
+        for (k, c) in contacts.candidates.pairs().items.iter().enumerate() {
+            let slot = plan.slot[k] as usize;
+            let length = run_length(contacts.spheres());
+            if contacts.run_of(c.second) == contacts.run_of(c.first) {
+                assert_eq!(slot, c.second as usize % length);
+            } else {
+                crossing += 1;
+                let (r, f) = (contacts.run_of(c.first) as u32, (slot - RUN_CHUNK) as u32);
+                assert!(plan.receive.binary_search(&(c.second, r, f)).is_ok());
+            }
+        }
+        assert!(crossing > 0);
+    }
+}

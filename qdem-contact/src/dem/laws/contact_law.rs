@@ -1,0 +1,101 @@
+//! What a contact law sees of one contact, and the choice of law.
+//!
+//! Both laws share the same frame: the normal n points from sphere a to sphere b (or from the
+//! sphere into the wall), the overlap δ > 0 while the surfaces interpenetrate, and v is the
+//! velocity of a's contact point relative to b's. A law returns the force on a; b gets its
+//! opposite, so every contact conserves momentum exactly.
+
+use crate::dem::laws::hertz_mindlin::HertzMindlin;
+use crate::dem::laws::linear_spring::LinearSpring;
+use qdem_core::Vec3;
+
+/// The geometry and kinematics of one contact at the current step.
+#[derive(Clone, Copy, Debug)]
+pub struct PairGeometry {
+    /// Overlap δ (m), positive in contact.
+    pub overlap: f64,
+    /// Unit normal from a to b.
+    pub normal: Vec3,
+    /// Velocity of a's contact point relative to b's (m/s).
+    pub velocity: Vec3,
+    /// Reduced radius R* = r_a r_b / (r_a + r_b) (r_a for a wall) (m).
+    pub radius: f64,
+    /// Reduced mass m* = m_a m_b / (m_a + m_b) (m_a for a wall) (kg).
+    pub mass: f64,
+    /// Coulomb friction coefficient of the pair.
+    pub friction: f64,
+}
+
+/// Elastic constants of a pair for Hertz–Mindlin: E* and G* from both sides' E and ν.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairElasticity {
+    /// Effective modulus E*, 1/E* = (1 − ν_a²)/E_a + (1 − ν_b²)/E_b (Pa).
+    pub e_star: f64,
+    /// Effective shear modulus G*, 1/G* = 2(2 − ν_a)(1 + ν_a)/E_a + (same for b) (Pa).
+    pub g_star: f64,
+}
+
+impl PairElasticity {
+    /// The pair of two elastic solids (E in Pa, ν); `None` for b makes b rigid.
+    pub fn new(a: (f64, f64), b: Option<(f64, f64)>) -> PairElasticity {
+        let compliance =
+            |(e, nu): (f64, f64)| ((1.0 - nu * nu) / e, 2.0 * (2.0 - nu) * (1.0 + nu) / e);
+        let (ca, sa) = compliance(a);
+        let (cb, sb) = b.map_or((0.0, 0.0), compliance);
+        PairElasticity {
+            e_star: 1.0 / (ca + cb),
+            g_star: 1.0 / (sa + sb),
+        }
+    }
+}
+
+/// The contact law of a scene's `[contact]` table.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ContactLaw {
+    /// Linear Voigt spring and Coulomb slider (`law = "linear"`, paper 000 §4).
+    Linear(LinearSpring),
+    /// Hertz–Mindlin with a Mohr–Coulomb limit (`law = "hertz-mindlin"`, paper 003 §3).
+    HertzMindlin(HertzMindlin),
+}
+
+impl ContactLaw {
+    /// The force on a, updating the tangential spring `history` over a step `dt`.
+    #[inline(always)]
+    pub fn force(
+        &self,
+        g: &PairGeometry,
+        elasticity: &PairElasticity,
+        history: &mut Vec3,
+        dt: f64,
+    ) -> Vec3 {
+        match self {
+            ContactLaw::Linear(law) => law.force(g, history, dt),
+            ContactLaw::HertzMindlin(law) => law.force(g, elasticity, history, dt),
+        }
+    }
+
+    /// Elastic energy stored in the contact (J): normal spring plus tangential spring.
+    pub fn energy(&self, g: &PairGeometry, elasticity: &PairElasticity, history: &Vec3) -> f64 {
+        match self {
+            ContactLaw::Linear(law) => law.energy(g, history),
+            ContactLaw::HertzMindlin(law) => law.energy(g, elasticity, history),
+        }
+    }
+
+    /// Normal and tangential stiffness (N/m) of a contact at overlap `overlap` with reduced
+    /// radius `radius`, for the stable-step bound.
+    pub fn stiffness(&self, overlap: f64, radius: f64, elasticity: &PairElasticity) -> (f64, f64) {
+        match self {
+            ContactLaw::Linear(law) => (law.normal_stiffness, law.tangential_stiffness),
+            ContactLaw::HertzMindlin(_) => HertzMindlin::stiffness(overlap, radius, elasticity),
+        }
+    }
+
+    /// The damping ratio ζ of the law.
+    pub fn damping_ratio(&self) -> f64 {
+        match self {
+            ContactLaw::Linear(law) => law.damping_ratio,
+            ContactLaw::HertzMindlin(law) => law.damping_ratio,
+        }
+    }
+}

@@ -1,0 +1,8 @@
+//! The contact laws: what a law sees of a contact ([`contact_law`]), the linear Voigt spring
+//! ([`linear_spring`], paper 000 §4), Hertz–Mindlin ([`hertz_mindlin`], paper 003 §3) and the
+//! tangential spring with its Coulomb slider both share ([`coulomb`]).
+
+pub mod contact_law;
+pub mod coulomb;
+pub mod hertz_mindlin;
+pub mod linear_spring;
