@@ -226,6 +226,9 @@ impl DemContacts {
                 })
                 .collect();
             let this = &*self;
+            // A time-delayed boundary scales the shares of pairs through it; without one the
+            // kernel is compiled with unit scales (the multiplications folded away).
+            let scaled = self.time_delay.is_some();
             let (slot, early) = (&plan.slot, &plan.early);
             let length = run_length(sums.len());
             // Each run a task of its own on several threads: the runs' costs differ (a
@@ -246,7 +249,13 @@ impl DemContacts {
                     let slots = &slot[run.pairs.clone()];
                     let partners = &this.candidates.partners()[run.partners.clone()];
                     let sums = RunSums { own, foreign, lo };
-                    this.evaluate_run::<LAW, SUM>(time, dt, lists, slots, partners, sums);
+                    match scaled {
+                        true => this
+                            .evaluate_run::<LAW, SUM, true>(time, dt, lists, slots, partners, sums),
+                        false => this.evaluate_run::<LAW, SUM, false>(
+                            time, dt, lists, slots, partners, sums,
+                        ),
+                    }
                     let (true, Some(carriers)) = (SUM, &carriers) else {
                         return;
                     };
@@ -302,9 +311,9 @@ impl DemContacts {
     /// its first sphere and to its second, in the run or foreign), then each wall contact.
     /// With `LAW`, a contact's force comes from the narrow phase and the law, and a contact
     /// found apart adds nothing; without, from its record and n × f column, scaled for a
-    /// ghost beyond a time-delayed boundary (paper 003 Eqs. 6–7).
+    /// ghost beyond a time-delayed boundary (paper 003 Eqs. 6–7) when `SCALED`.
     #[inline(always)]
-    fn evaluate_run<const LAW: bool, const SUM: bool>(
+    fn evaluate_run<const LAW: bool, const SUM: bool, const SCALED: bool>(
         &self,
         time: f64,
         dt: f64,
@@ -357,9 +366,9 @@ impl DemContacts {
                 continue;
             }
             let (a, b) = (contact.first as usize, contact.second as usize);
-            let (scale_a, scale_b) = match &delay {
-                Some((axis, scales)) => pair_scales(shifts[k][*axis], scales),
-                None => (1.0, 1.0),
+            let (scale_a, scale_b) = match (SCALED, &delay) {
+                (true, Some((axis, scales))) => pair_scales(shifts[k][*axis], scales),
+                _ => (1.0, 1.0),
             };
             let (first, second) = (
                 pair_share(contact, &turn, true, self.spheres.now(a).radius, scale_a),
