@@ -1,9 +1,11 @@
-//! Hertz–Mindlin contact with a Mohr–Coulomb limit, the law of PFC3D in paper 003 §3, in the
-//! form LIGGGHTS uses (`model hertz tangential history`), from each side's E and ν:
+//! Hertz–Mindlin contact with a Mohr–Coulomb limit, the law of PFC3D in paper 003 §3, with
+//! LIGGGHTS's stiffnesses and damping (`model hertz tangential history`), from each side's E
+//! and ν:
 //!
 //! - normal: F_n = (4/3) E* √R* δ^{3/2} + γ_n δ̇, with S_n = 2E*√(R*δ) the tangent stiffness;
 //! - tangential: spring k_t = S_t = 8G*√(R*δ) on the elongation ξ, F_t = −k_t ξ − γ_t v_t,
-//!   limited by μ F_n ([`crate::dem::laws::coulomb`]);
+//!   spring and dashpot together limited by μ F_n⁺ ([`crate::dem::laws::coulomb`]; LIGGGHTS caps the
+//!   spring alone);
 //! - optional damping γ = 2√(5/6) ζ √(S m*), which is LIGGGHTS's −2√(5/6) β √(S m*) with its
 //!   β = ln e/√(ln² e + π²) = −ζ.
 
