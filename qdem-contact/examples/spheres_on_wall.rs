@@ -101,11 +101,11 @@ fn main() -> ExitCode {
     verlet
         .initialize(&mut state, &mut models)
         .expect("no initial overlap");
-    // At rest once no sphere moves faster than 1 mm/s; three simulated seconds at most.
+    // At rest once no sphere moves faster than 0.1 mm/s; three simulated seconds at most.
     let fastest = |state: &State| state.velocity.iter().map(|v| v.norm()).fold(0.0, f64::max);
     let start = std::time::Instant::now();
     let mut steps = 0usize;
-    while (state.time < 0.3 || fastest(&state) > 1e-3) && state.time < 3.0 {
+    while (state.time < 0.3 || fastest(&state) > 1e-4) && state.time < 3.0 {
         verlet.step(&mut state, &mut models).expect("a stable step");
         steps += 1;
     }

@@ -59,7 +59,8 @@ pub enum Gather {
 /// A simulation that steps itself: state, models, stepper, hooks and stage counters.
 ///
 /// ```
-/// use qdem_core::{continuum::Material, step::Model, loads::NodalLoad, step::Scheme, step::State, step::StepRequest, step::StepSettings, ///     TetBody, loads::TimeFunction, Vec3, world::World};
+/// use qdem_core::{continuum::Material, step::Model, loads::NodalLoad, step::Scheme, step::State, step::StepRequest, step::StepSettings,
+///     continuum::TetBody, loads::TimeFunction, Vec3, world::World};
 ///
 /// // One tetrahedron with three corners held, pulled at the fourth.
 /// let nodes = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];

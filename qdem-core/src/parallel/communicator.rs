@@ -10,7 +10,8 @@
 /// Counts are per rank, in rank order; buffers hold the ranks' parts one after the other.
 ///
 /// ```
-/// use qdem_core::{parallel::Communicator, continuum::Material, step::Model, step::Scheme, step::State, step::StepRequest, step::StepSettings, ///     TetBody, Vec3, world::World};
+/// use qdem_core::{parallel::Communicator, continuum::Material, step::Model, step::Scheme, step::State, step::StepRequest, step::StepSettings,
+///     continuum::TetBody, Vec3, world::World};
 ///
 /// /// The communicator of a single process: every collective is a copy.
 /// struct Alone;

@@ -1,7 +1,7 @@
 //! [`ParallelRuntime`]: the one place where a step meets the ranks. A [`crate::world::World`] owns
 //! one: single-process by default, where every call is a plain loop or does nothing, and
 //! decomposed after [`crate::world::World::decompose`]. The steppers evaluate forces through it
-//! ([`ParallelRuntime::sum_forces`]) and end each integration with it
+//! ([`Seam::sum_forces`](crate::step::seam::Seam::sum_forces)) and end each integration with it
 //! ([`ParallelRuntime::complete`]); the world runs its gathers, its failure agreement, the
 //! post-step hooks and the re-partitions through it. Models never call a collective: a split model declares what it exchanges
 //! ([`crate::step::split::Facets`]) and the runtime runs the collectives between its stages, in
@@ -33,11 +33,12 @@ const REPARTITION_IMBALANCE: f64 = 1.1;
 const REPARTITION_REBUILDS: usize = 8;
 
 /// What a step exchanges between the ranks of a decomposed run; nothing in a run of one
-/// process ([`ParallelRuntime::default`]), where [`ParallelRuntime::sum_forces`] sums the
+/// process ([`ParallelRuntime::default`]), where [`Seam::sum_forces`](crate::step::seam::Seam::sum_forces) sums the
 /// models' forces and the rest does nothing.
 ///
 /// ```
 /// use qdem_core::{parallel::ParallelRuntime, loads::Gravity, step::Model, step::State, step::StageTimes, Vec3};
+/// use qdem_core::step::seam::Seam;
 ///
 /// let mut state = State::at_rest(vec![Vec3::zeros()]);
 /// state.mass[0] = 2.0;

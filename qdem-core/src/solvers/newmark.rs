@@ -12,7 +12,7 @@
 //! - **β = 0** (explicit; γ = ½ is central difference): x_{n+1} = x̃ needs no solve and
 //!   a_{n+1} = M⁻¹ f(t_{n+1}, x̃, ṽ), the viscous force seeing the predicted velocity ṽ. For
 //!   γ = ½, ṽ is the half-step velocity and the scheme is [`crate::solvers::Verlet`], operation for
-//!   operation; it is stable for ∆t ≤ [`crate::continuum::stable_step()`].
+//!   operation; it is stable for ∆t ≤ [`crate::step::stepper::stable_step()`].
 //! - **β > 0** (implicit): Eq. 26 linearises the force at the step's start,
 //!   f(x_{n+1}, v_{n+1}) ≈ f(x_n, v_n) − K (x_{n+1} − x_n) − C (v_{n+1} − v_n), and reads
 //!
@@ -107,7 +107,10 @@ const MIN_FRACTION: f64 = 1.0 / 16.0;
 /// The Newmark-β family: explicit for β = 0, implicit for β > 0, optionally adaptive.
 ///
 /// ```
-/// use qdem_core::{///     stable_step, step::Dofs, continuum::Material, step::Model, solvers::Newmark, loads::NodalLoad, step::State, solvers::StaticSolver, step::Stepper, ///     TetBody, loads::TimeFunction, Vec3, ///};
+/// use qdem_core::step::stepper::stable_step;
+/// use qdem_core::{continuum::Material, continuum::TetBody, loads::NodalLoad, loads::TimeFunction};
+/// use qdem_core::{solvers::Newmark, solvers::StaticSolver, step::Dofs, step::Model};
+/// use qdem_core::{step::State, step::Stepper, Vec3};
 ///
 /// // One viscous tetrahedron with three vertices clamped and a load on the fourth.
 /// let build = || {
