@@ -283,7 +283,8 @@ impl DemContacts {
                 sums[s as usize] = total;
                 if let Some((force, torque)) = &mut out {
                     if self.adds_to(s) {
-                        self.add_sphere(s as usize, &total.0, &total.1, force, torque);
+                        self.spheres
+                            .add_to(s as usize, &total.0, &total.1, force, torque);
                     }
                 }
             }
@@ -303,7 +304,7 @@ impl DemContacts {
             .filter(|&&s| self.adds_to(s))
         {
             let (f, t) = self.kernel.sum(s as usize);
-            self.add_sphere(s as usize, f, t, force, torque);
+            self.spheres.add_to(s as usize, f, t, force, torque);
         }
     }
 
@@ -456,7 +457,7 @@ pub(super) fn exclusive_carriers(particle: &[u32], turn: &[u32]) -> Vec<bool> {
 }
 
 impl DemContacts {
-    /// [`DemContacts::add_sphere`] from a run of the fused pass.
+    /// [`Spheres::add_to`](super::spheres::Spheres::add_to) from a run of the fused pass.
     ///
     /// # Safety
     /// No other sphere adds to sphere `s`'s particle or rotation at the same time.

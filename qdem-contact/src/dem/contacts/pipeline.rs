@@ -157,18 +157,4 @@ impl DemContacts {
     ) -> Option<(PairGeometry, PairElasticity)> {
         self.walls.contact(time, self.spheres.now(s), w)
     }
-
-    /// Adds sphere `s`'s contact force `f` to its particle and its moment `t` to the rigid
-    /// body or rotating particle it turns with.
-    #[inline]
-    pub(super) fn add_sphere(
-        &self,
-        s: usize,
-        f: &Vec3,
-        t: &Vec3,
-        force: &mut [Vec3],
-        torque: &mut [Vec3],
-    ) {
-        self.spheres.add_to(s, f, t, force, torque);
-    }
 }
