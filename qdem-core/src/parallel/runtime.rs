@@ -15,8 +15,7 @@ use crate::parallel::state_share::StateShare;
 use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
 use crate::step::post_step::{Halt, PostStep};
-use crate::step::rigid_body::reduce_member_forces;
-use crate::step::seam::{OneProcess, Seam};
+use crate::step::seam::{add_model_forces, Seam};
 use crate::step::split::{Balance, Facets, Part, Reads};
 use crate::step::stages::{Stage, StageTimes};
 use crate::step::state::State;
@@ -348,7 +347,7 @@ impl ParallelRuntime {
     }
 }
 
-/// The runtime is a stepper's seam: in a run of one process it evaluates as [`OneProcess`];
+/// The runtime is a stepper's seam: in a run of one process it evaluates every model whole;
 /// on a rank of a decomposed run each split model stage by stage, with the ranks' exchanges in
 /// between.
 impl Seam for ParallelRuntime {
@@ -363,22 +362,21 @@ impl Seam for ParallelRuntime {
         torque: &mut [Vec3],
         stages: &mut StageTimes,
     ) {
-        let Some(ranks) = self.ranks.as_mut() else {
-            return OneProcess.add_forces(state, models, force, torque, stages);
-        };
-        for (i, model) in models.iter_mut().enumerate() {
-            match ranks.models[i].is_some() {
-                true => {
-                    let facets = split_facets(model.as_mut()).expect("a split model");
-                    ranks.evaluate(i, facets, state, force, torque);
+        let mut ranks = self.ranks.as_mut();
+        add_model_forces(
+            state,
+            models,
+            force,
+            torque,
+            stages,
+            |i, model, f, t| match ranks.as_mut().filter(|r| r.models[i].is_some()) {
+                Some(ranks) => {
+                    let facets = split_facets(model).expect("a split model");
+                    ranks.evaluate(i, facets, state, f, t);
                 }
-                false => model.add_forces(state, force, torque),
-            }
-            stages.mark(Stage::Forces(i));
-        }
-        if !state.rigid.is_empty() {
-            reduce_member_forces(state, force, torque);
-        }
+                None => model.add_forces(state, f, t),
+            },
+        );
     }
 
     /// In a run decomposed with a halo exchange, the particles a stepper predicts (its own and

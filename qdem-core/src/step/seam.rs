@@ -102,12 +102,28 @@ impl Seam for OneProcess {
         torque: &mut [Vec3],
         stages: &mut StageTimes,
     ) {
-        for (i, model) in models.iter_mut().enumerate() {
-            model.add_forces(state, force, torque);
-            stages.mark(Stage::Forces(i));
-        }
-        if !state.rigid.is_empty() {
-            reduce_member_forces(state, force, torque);
-        }
+        add_model_forces(state, models, force, torque, stages, |_, model, f, t| {
+            model.add_forces(state, f, t)
+        });
+    }
+}
+
+/// The loop every seam runs: each model's forces in model order through `evaluate` (given the
+/// model's index), each marked as its own stage on `stages`, then the forces on members of
+/// rigid bodies moved onto their bodies.
+pub fn add_model_forces(
+    state: &State,
+    models: &mut [Box<dyn Model>],
+    force: &mut [Vec3],
+    torque: &mut [Vec3],
+    stages: &mut StageTimes,
+    mut evaluate: impl FnMut(usize, &mut dyn Model, &mut [Vec3], &mut [Vec3]),
+) {
+    for (i, model) in models.iter_mut().enumerate() {
+        evaluate(i, model.as_mut(), force, torque);
+        stages.mark(Stage::Forces(i));
+    }
+    if !state.rigid.is_empty() {
+        reduce_member_forces(state, force, torque);
     }
 }
