@@ -1,5 +1,7 @@
 //! `qdem check SCENE`: validates a scene and prints its meshes, mass, stable step (of an
-//! explicit run), an estimate of the memory the run keeps, checkpoint support, the measured
+//! explicit run), the modelling advice ([`qdem_io::advice`]: each body rigid or deformable,
+//! its formulation, the integrator, the contacts' stiffness; `--advice json` prints only
+//! that), an estimate of the memory the run keeps, checkpoint support, the measured
 //! cost of a step with the projected run time, and where a step's time goes, stage by stage of the world's step
 //! ([`qdem_core::step::stages`]). Under `mpirun` (N > 1) the run is decomposed as `qdem run`
 //! decomposes it, and rank 0 also prints each rank's tetrahedra, owned particles, halo and
@@ -34,6 +36,9 @@ pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<
     let leader = sim.world.rank() == 0;
     if leader {
         print_scene(path, &sim);
+        for advice in qdem_io::advice::advise(&sim) {
+            println!("{}", advice.line());
+        }
     }
     let (per_step, exchange) = measure_step_cost(&mut sim, 20)?;
     if let Some(d) = sim.world.decomposition().cloned() {
@@ -48,6 +53,16 @@ pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<
     if leader {
         print_cost(&sim, per_step);
     }
+    Ok(())
+}
+
+/// `qdem check --advice json`: builds the scene at `path` and prints its advice as one JSON
+/// array, nothing else.
+pub fn print_advice_json(path: &Path) -> Result<(), CliError> {
+    let scene = Scene::load(path)?;
+    let sim = progress::while_busy("building the scene", || Simulation::build(scene))?;
+    let json = qdem_io::advice::to_json(&qdem_io::advice::advise(&sim));
+    println!("{json:#}");
     Ok(())
 }
 

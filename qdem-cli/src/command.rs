@@ -3,7 +3,7 @@
 //! from the libraries are rendered once, by `main`, through [`CliError`]'s `Display`.
 
 use crate::{check, progress, run_length};
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use qdem_bench::throughput::BenchPlan;
 use qdem_bench::{implicit, throughput, verify};
 use qdem_core::{error::CoreError, parallel::Communicator, step::Halt, step::Scheme};
@@ -200,6 +200,17 @@ pub struct CheckArgs {
     /// Worker threads for the cost measurement [default: one per core]
     #[arg(long, value_name = "N", value_parser = thread_count, allow_negative_numbers = true)]
     pub threads: Option<usize>,
+    /// Print only the modelling advice, as one JSON array (`json`), for scripts; without it
+    /// the advice is part of the report
+    #[arg(long, value_name = "FORMAT")]
+    pub advice: Option<AdviceFormat>,
+}
+
+/// How `qdem check --advice` prints the advice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum AdviceFormat {
+    /// One JSON array of the advice (`qdem_io::advice::to_json`).
+    Json,
 }
 
 /// `qdem verify`.
@@ -377,9 +388,10 @@ pub fn dispatch(cli: Cli, ranks: Option<Arc<dyn Communicator>>) -> Result<(), Cl
         Command::Modes(a) => {
             thread_pool(a.threads)?.install(|| modes_of(&a.scene, a.count, a.out.as_deref()))
         }
-        Command::Check(a) => {
-            thread_pool(a.threads)?.install(|| check::check_scene(&a.scene, ranks))
-        }
+        Command::Check(a) => thread_pool(a.threads)?.install(|| match a.advice {
+            Some(AdviceFormat::Json) => check::print_advice_json(&a.scene),
+            None => check::check_scene(&a.scene, ranks),
+        }),
         Command::Analyze(a) => {
             let options = AnalyzeOptions {
                 from: a.from,

@@ -165,3 +165,41 @@ fn check_names_each_bodys_kind_and_what_limits_the_step() {
     assert!(rigid.contains("rigid stones): 1993 particles"), "{rigid}");
     assert!(limit(contacts, &rigid) > 5.0 * limit(contacts, &deformable));
 }
+
+/// `qdem check` prints the modelling advice in its report, and `--advice json` the same
+/// advice alone as a JSON array: the cantilever is held at its clamp (deformable), locks not
+/// at ν = 0.167 (standard), and its release at 2 s excites its first mode fully, so Newmark
+/// is advised over Verlet; the collision's cubes are impacted (deformable, with a contact
+/// stiffness told).
+#[test]
+fn check_prints_the_advice_and_json_gives_it_to_scripts() {
+    let fixtures = concat!(env!("CARGO_MANIFEST_DIR"), "/../fixtures/");
+    let cantilever = format!("{fixtures}cantilever/cantilever_lc100.toml");
+    let report = success(&["check", &cantilever, "--threads", "1"]);
+    for line in [
+        "advice body `beam` (rigid or deformable): keep deformable: its fixes hold every rigid motion",
+        "advice body `beam` (formulation): keep standard: poisson = 0.167 < 0.45",
+        "advice run (integrator): verlet -> newmark: dynamic",
+    ] {
+        assert!(report.contains(line), "no `{line}` in\n{report}");
+    }
+    let json = success(&["check", &cantilever, "--advice", "json"]);
+    let doc: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let topics: Vec<&str> = doc
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a["topic"].as_str().unwrap())
+        .collect();
+    assert_eq!(topics, ["rigidity", "formulation", "integrator"], "{json}");
+    assert_eq!(doc[2]["advised"], "newmark");
+    assert!(doc[2]["figures"]["advised_dt"].as_f64().unwrap() > 0.0);
+    let collision = format!("{fixtures}contact/collision.toml");
+    let doc: serde_json::Value =
+        serde_json::from_str(&success(&["check", &collision, "--advice", "json"])).unwrap();
+    let advice = doc.as_array().unwrap();
+    assert!(advice.iter().any(|a| a["subject"] == "contacts"), "{doc:#}");
+    assert!(advice
+        .iter()
+        .any(|a| a["subject"] == "body `left`" && a["advised"] == "deformable"));
+}

@@ -24,6 +24,7 @@
 
 #![warn(missing_docs)]
 
+pub mod advice;
 pub mod build;
 mod csv_rows;
 pub mod output;

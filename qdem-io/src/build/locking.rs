@@ -63,12 +63,7 @@ fn warning(body: &str, material: &Material, explicit: bool) -> Option<String> {
             )
         }),
         Formulation::Standard => {
-            let (at, ratio) = MEASURED
-                .iter()
-                .rev()
-                .find(|(at, _)| *at <= nu)
-                .copied()
-                .unwrap_or(MEASURED[0]);
+            let (at, ratio) = measured_deflection(nu);
             Some(format!(
                 "body `{body}`: material `{}` has poisson = {nu} >= {LOCKING_POISSON}: linear \
                  tetrahedra LOCK for nearly incompressible materials and the body will come out \
@@ -82,6 +77,17 @@ fn warning(body: &str, material: &Material, explicit: bool) -> Option<String> {
             ))
         }
     }
+}
+
+/// The measured (ν, deflection over beam theory) of the standard kernel at the largest
+/// tabulated ν not above `nu` (the first row below the table).
+pub(crate) fn measured_deflection(nu: f64) -> (f64, f64) {
+    MEASURED
+        .iter()
+        .rev()
+        .find(|(at, _)| *at <= nu)
+        .copied()
+        .unwrap_or(MEASURED[0])
 }
 
 /// c_d / c_s = √((λ + 2μ)/μ) = √(2(1 − ν)/(1 − 2ν)).

@@ -49,6 +49,11 @@ impl DemContacts {
         self.spheres.len()
     }
 
+    /// The smallest contact sphere's radius (m), if there is a sphere.
+    pub fn smallest_radius(&self) -> Option<f64> {
+        self.spheres.radius().iter().copied().reduce(f64::min)
+    }
+
     /// Number of walls.
     pub fn walls(&self) -> usize {
         self.walls.len()

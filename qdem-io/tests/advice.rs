@@ -1,0 +1,284 @@
+//! `qdem check`'s modelling advice (issue 58), each kind on a scene built to need it and on
+//! one built not to: a stiff stone under a slow load (rigid) and a fast one (deformable); a
+//! free beam loaded near its first mode (deformable) and far below it (rigid); ν = 0.49
+//! (averaged-pressure) and 0.3 (standard); a creep test (implicit) and a stubby block shaken
+//! at half its first mode (explicit); a light grain bed on stiff springs (softer) and a heavy
+//! body on soft ones (stiffer).
+
+mod common;
+
+use common::{fixture, test_dir};
+use qdem_io::advice::{advise, Advice, Topic};
+use qdem_io::build::Simulation;
+use qdem_io::scene::Scene;
+use std::f64::consts::PI;
+
+/// The advice of the scene `text` (written to `name.toml` in a fresh directory).
+fn advice_of(name: &str, text: &str) -> Vec<Advice> {
+    let dir = test_dir(&format!("advice-{name}"));
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    advise(&Simulation::build(Scene::load(&path).unwrap()).unwrap())
+}
+
+/// The advice on `topic` about `subject`.
+fn on<'a>(all: &'a [Advice], subject: &str, topic: Topic) -> &'a Advice {
+    all.iter()
+        .find(|a| a.topic == topic && a.subject == subject)
+        .unwrap_or_else(|| panic!("no {topic:?} advice on {subject} in {all:#?}"))
+}
+
+/// A granite cube (0.1 m, fixtures/contact/block.msh), free, pushed by 1 kN ramped on over
+/// `rise` seconds.
+fn stone(rise: f64) -> String {
+    format!(
+        r#"
+[run]
+t_end = 1.0
+gravity = [0.0, 0.0, 0.0]
+[[material]]
+name = "granite"
+density = 2700.0
+young = 5e10
+poisson = 0.25
+[[body]]
+name = "stone"
+mesh = "{}"
+material = "granite"
+[[load]]
+body = "stone"
+group = "bottom"
+total_force = [0.0, 0.0, 1000.0]
+ramp = [[0.0, 0.0], [{rise}, 1.0]]
+"#,
+        fixture("contact/block.msh").display()
+    )
+}
+
+/// The 2.4 m concrete beam of the cantilever fixture, free (no fix), its tip pushed by a load
+/// cycling at `frequency` Hz; `material` lines replace the concrete's.
+fn free_beam(cyclic: &str, poisson: f64, fix: bool, run: &str) -> String {
+    let fix = match fix {
+        true => "[[fix]]\nbody = \"beam\"\ngroup = \"clamp\"\n",
+        false => "",
+    };
+    format!(
+        r#"
+[run]
+t_end = 2.0
+gravity = [0.0, 0.0, 0.0]
+{run}
+[[material]]
+name = "concrete"
+density = 2350.0
+young = 45e9
+poisson = {poisson}
+[[body]]
+name = "beam"
+mesh = "{}"
+material = "concrete"
+{fix}
+[[load]]
+body = "beam"
+group = "tip"
+total_force = [0.0, 0.0, -200.0]
+{cyclic}
+"#,
+        fixture("cantilever/cantilever_lc100.msh").display()
+    )
+}
+
+/// A stone pushed over a second, hundreds of its periods, is advised rigid: its first mode
+/// rings at 1/(π f₁ t_r) of the static deflection, far under 1%; pushed over 20 µs, about
+/// its period, it stays deformable.
+#[test]
+fn a_stiff_stone_under_a_slow_load_is_advised_rigid_under_a_fast_one_deformable() {
+    let slow = advice_of("slow-stone", &stone(1.0));
+    let a = on(&slow, "body `stone`", Topic::Rigidity);
+    assert_eq!(
+        (a.now.as_str(), a.advised.as_str()),
+        ("deformable", "rigid"),
+        "{a:#?}"
+    );
+    let f1 = a.figure("lowest_frequency_hz").unwrap();
+    // A 0.1 m granite cube's first free mode: c_s/(2 × 0.1 m) = 2.7 km/s / 0.2 m ≈ 13.6 kHz
+    // scale; the coarse mesh is stiffer, within a factor of two.
+    assert!((6e3..3e4).contains(&f1), "{f1}");
+    let d = a.figure("dynamic_share").unwrap();
+    assert!(
+        (d - 1.0 / (PI * f1 * 1.0)).abs() < 1e-12 * d.max(1e-30),
+        "{d} {f1}"
+    );
+    let fast = advice_of("fast-stone", &stone(2e-5));
+    let a = on(&fast, "body `stone`", Topic::Rigidity);
+    assert_eq!(a.advised, "deformable", "{a:#?}");
+}
+
+/// The free beam shaken at 0.9 of its first (free-free) mode answers 4.3x its static
+/// deflection on top: deformable; shaken at 1% of it, a rigid beam misses 1e-4: rigid.
+#[test]
+fn a_free_beam_near_its_first_mode_is_advised_deformable_far_below_it_rigid() {
+    let probe = advice_of("beam-probe", &free_beam("", 0.167, false, ""));
+    let f1 = on(&probe, "body `beam`", Topic::Rigidity)
+        .figure("lowest_frequency_hz")
+        .unwrap();
+    let cyclic = |f: f64| format!("cyclic = {{ min = -1.0, max = 1.0, frequency = {f} }}");
+    let near = advice_of("beam-near", &free_beam(&cyclic(0.9 * f1), 0.167, false, ""));
+    let a = on(&near, "body `beam`", Topic::Rigidity);
+    assert_eq!(a.advised, "deformable", "{a:#?}");
+    // r = 0.9: 2 (1/(1 − 0.81) − 1) for the oscillating part w = 2 of a ±1 cycle.
+    let d = a.figure("dynamic_share").unwrap();
+    assert!((d - 2.0 * (1.0 / 0.19 - 1.0)).abs() < 1e-9, "{d}");
+    let far = advice_of("beam-far", &free_beam(&cyclic(0.01 * f1), 0.167, false, ""));
+    let a = on(&far, "body `beam`", Topic::Rigidity);
+    assert_eq!(a.advised, "rigid", "{a:#?}");
+    // Held at its clamp it has no rigid motion: its deformation is the answer.
+    let held = advice_of("beam-held", &free_beam(&cyclic(0.01 * f1), 0.167, true, ""));
+    assert_eq!(
+        on(&held, "body `beam`", Topic::Rigidity).advised,
+        "deformable"
+    );
+}
+
+/// ν = 0.49 locks the standard tetrahedron; ν = 0.3 does not, and it costs less.
+#[test]
+fn a_nearly_incompressible_body_is_advised_averaged_pressure_a_compressible_one_standard() {
+    let ramp = "ramp = [[0.0, 0.0], [1.0, 1.0]]";
+    let soft = advice_of(
+        "nu049",
+        &free_beam(ramp, 0.49, true, "integrator = \"static\""),
+    );
+    let a = on(&soft, "body `beam`", Topic::Formulation);
+    assert_eq!(
+        (a.now.as_str(), a.advised.as_str()),
+        ("standard", "averaged-pressure")
+    );
+    assert!(a.figure("predicted_error").unwrap() > 0.1, "{a:#?}");
+    let firm = advice_of(
+        "nu03",
+        &free_beam(ramp, 0.3, true, "integrator = \"static\""),
+    );
+    assert_eq!(
+        on(&firm, "body `beam`", Topic::Formulation).advised,
+        "standard"
+    );
+}
+
+/// The creep test of paper 000 §3.2 (E = 0.5 MPa, τ = 0.1 s, a step load held 0.5 s) is
+/// overdamped in its first mode: quasi-static and viscous, so newmark at τ/20; an elastic
+/// block shaken at half its first mode needs inertia, and its explicit step is near what
+/// Newmark needs for 0.1% in period: verlet.
+#[test]
+fn a_creep_test_is_advised_implicit_a_shaken_stubby_block_explicit() {
+    let creep = format!(
+        r#"
+[run]
+t_end = 1.0
+dt = 1e-3
+integrator = "newmark"
+gravity = [0.0, 0.0, 0.0]
+[[material]]
+name = "gel"
+density = 2350.0
+young = 5e5
+poisson = 0.0
+shear_viscosity = 3.75e4
+[[body]]
+name = "bar"
+mesh = "{}"
+material = "gel"
+[[fix]]
+body = "bar"
+group = "bottom"
+[[load]]
+body = "bar"
+box = [[-1.0, -1.0, 0.049], [1.0, 1.0, 1.0]]
+total_force = [0.0, 0.0, -10.0]
+ramp = [[0.0, 1.0], [0.5, 1.0], [0.5, 0.0]]
+"#,
+        fixture("contact/block.msh").display()
+    );
+    let creep = creep.replace("dt = 1e-3\nintegrator = \"newmark\"\n", "");
+    let all = advice_of("creep", &creep);
+    let a = on(&all, "run", Topic::Integrator);
+    assert_eq!(
+        (a.now.as_str(), a.advised.as_str()),
+        ("verlet", "newmark"),
+        "{a:#?}"
+    );
+    // τ = μ_D/G = 3.75e4/2.5e5 = 0.15 s; the step τ/20.
+    assert!(
+        (a.figure("advised_dt").unwrap() - 0.15 / 20.0).abs() < 1e-12,
+        "{a:#?}"
+    );
+    let shaken = creep
+        .replace("young = 5e5", "young = 5e10")
+        .replace("shear_viscosity = 3.75e4", "")
+        .replace(
+            "ramp = [[0.0, 1.0], [0.5, 1.0], [0.5, 0.0]]",
+            "cyclic = { min = -1.0, max = 1.0, frequency = FREQ }",
+        );
+    let probe = advice_of("shaken-probe", &shaken.replace("FREQ", "1.0"));
+    let f1 = on(&probe, "run", Topic::Integrator)
+        .figure("lowest_frequency_hz")
+        .unwrap();
+    let all = advice_of("shaken", &shaken.replace("FREQ", &format!("{}", 0.5 * f1)));
+    let a = on(&all, "run", Topic::Integrator);
+    assert_eq!(a.advised, "verlet", "{a:#?}");
+}
+
+/// Glass grains of 9–11 mm in a box under gravity on linear springs of stiffness `k`.
+fn grain_bed(k: f64) -> String {
+    format!(
+        r#"
+[run]
+t_end = 0.01
+gravity = [0.0, 0.0, -9.81]
+[[material]]
+name = "glass"
+density = 2500.0
+young = 5e7
+poisson = 0.25
+[contact]
+law = "linear"
+normal_stiffness = {k}
+tangential_stiffness = {}
+friction = 0.5
+[granular]
+name = "grains"
+material = "glass"
+region = [[0.0, 0.0, 0.0], [0.2, 0.2, 0.3]]
+count = 2000
+grading = [[0.009, 0.0], [0.011, 1.0]]
+spheres_per_stone = [1, 1]
+seed = 1
+[[wall]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+"#,
+        k / 2.0
+    )
+}
+
+/// On 1e4 N/m springs the bed's deepest contact overlaps a fraction of a percent of the
+/// radius while the contacts set the step: a softer spring, to 1%, steps longer by the
+/// square root of the softening; on 1e2 N/m it overlaps a quarter of the radius: stiffer.
+#[test]
+fn a_light_bed_on_stiff_springs_is_advised_softer_on_soft_ones_stiffer() {
+    let all = advice_of("stiff-springs", &grain_bed(1e4));
+    let a = on(&all, "contacts", Topic::ContactStiffness);
+    let overlap = a.figure("overlap_over_radius").unwrap();
+    let (force, radius) = (
+        a.figure("reference_force").unwrap(),
+        a.figure("radius").unwrap(),
+    );
+    assert!((overlap - force / 1e4 / radius).abs() < 1e-12, "{a:#?}");
+    assert!(overlap < 0.005, "{a:#?}");
+    let s = a.figure("softening").unwrap();
+    assert!((overlap * s - 0.01).abs() < 1e-9, "{a:#?}");
+    assert_eq!(a.advised, format!("normal_stiffness = {:.4e}", 1e4 / s));
+    let all = advice_of("soft-springs", &grain_bed(1e2));
+    let a = on(&all, "contacts", Topic::ContactStiffness);
+    assert!(a.figure("overlap_over_radius").unwrap() > 0.05, "{a:#?}");
+    assert!(a.figure("softening").unwrap() < 1.0, "{a:#?}");
+}
