@@ -9,12 +9,14 @@
 //! carries the lid's force plus the bed's weight (statics of a bed in a box with frictionless
 //! sides); a stage may still start a wall at its own `point` (`start = "scene"`), which is
 //! checked for overlaps against the checkpoint's positions, not the sample's pour positions.
+//! A stage stopped and resumed equals the uninterrupted one.
 
 mod common;
 
 use common::{build, columns, fixture, run, test_dir};
 use qdem_io::build::Simulation;
-use qdem_io::runner::RunOptions;
+use qdem_io::checkpoint::CHECKPOINT_FILE;
+use qdem_io::runner::{RunError, RunOptions};
 use qdem_io::scene::Scene;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -198,4 +200,33 @@ fn a_stage_may_start_its_lid_at_its_point_and_is_checked_where_the_bed_is() {
     let sprung = *floor(&walls).last().unwrap();
     eprintln!("lid at its point: the floor carries {sprung:.4} N after 20 ms");
     assert!(sprung < 0.5 * before);
+}
+
+#[test]
+fn a_resumed_stage_equals_the_uninterrupted_one() {
+    stages();
+    // The unloading stage stopped at three quarters, its lid carried and under its servo,
+    // then resumed: its walls come back from its own checkpoint, not the stage's start.
+    let scene = stage("unload", "unload-resumed", &[]);
+    let out = dir().join("unload-resumed");
+    let mut sim = build(&scene);
+    let stop = RunOptions {
+        stop_after: Some(sim.steps() * 3 / 4),
+        ..RunOptions::default()
+    };
+    assert!(matches!(
+        run(&mut sim, &out, stop),
+        Err(RunError::Interrupted { .. })
+    ));
+    let checkpoint = out.join(CHECKPOINT_FILE);
+    let resume = RunOptions {
+        resume: Some(&checkpoint),
+        ..RunOptions::default()
+    };
+    run(&mut build(&scene), &out, resume).unwrap();
+    for f in ["walls.csv", "stones.csv"] {
+        let whole = std::fs::read(dir().join("unload").join(f)).unwrap();
+        let resumed = std::fs::read(out.join(f)).unwrap();
+        assert!(whole == resumed, "{f} differs after a resume");
+    }
 }
