@@ -42,7 +42,7 @@ pub use boundaries::periodic_wrap::PeriodicWrap;
 pub use boundaries::time_delayed_boundary::{GhostScales, LoadCycle, TimeDelayedBoundary};
 pub use dem::contact_view::{Partner, SphereRecord, TouchingContact};
 pub use dem::contacts::{CarriedSprings, ContactSettings, ContactSphere, DemContacts};
-pub use dem::contacts::{SavedSpring, SavedSprings};
+pub use dem::contacts::{SavedSpring, SavedSprings, SavedWall};
 pub use dem::laws::contact_law::{ContactLaw, PairElasticity, PairGeometry};
 pub use dem::laws::hertz_mindlin::HertzMindlin;
 pub use dem::laws::linear_spring::LinearSpring;

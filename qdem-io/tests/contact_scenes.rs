@@ -66,6 +66,7 @@ fn a_block_sliding_on_a_mesh_wall_decelerates_at_mu_g() {
         friction: Some(0.4),
         velocity: [0.0; 3],
         servo: None,
+        start: Default::default(),
     }];
     let history = centre_velocities(scene, 0.1, 0.02);
     let (t0, v0) = history[1];

@@ -175,6 +175,14 @@ fn what_a_servo_cannot_have_is_refused_by_name() {
             "stress = 1e3, area = 1.0, max_velocity = 0.1, gain = 0.0",
             "servo.gain",
         ),
+        (
+            "stress = 1e3, area = 1.0, max_velocity = 0.1, ramp = [[0.0, 1.0], [-1.0, 2.0]]",
+            "servo: ramp times must not decrease",
+        ),
+        (
+            "stress = 1e3, area = 1.0, max_velocity = 0.1, ramp = []",
+            "servo: ramp has no points",
+        ),
     ] {
         let message = refusal("servo-bad", &servo(keys));
         assert!(

@@ -2,7 +2,8 @@
 //! `contact_radius` (interior vertices never touch anything, paper 000 §4), the `[contact]`
 //! law, and the `[[wall]]`s. A scene in which nothing can touch (no sphere, or the spheres of a
 //! single body and no wall) gets no contact model, and the initial configuration is checked
-//! for interpenetration before anything runs.
+//! for interpenetration before anything runs ([`check_start`]; for a `[run] start_from`
+//! stage, once its state and walls are the checkpoint's).
 
 use super::ballast::BallastInfo;
 use crate::build::{BuildError, PlacedMesh};
@@ -88,14 +89,37 @@ pub(crate) fn build_contacts(
     };
     for (w, wall) in scene.walls.iter().enumerate() {
         if let Some(servo) = &wall.servo {
-            model.set_servo(w, servo.servo()).map_err(contact_error)?;
+            let servo = servo.servo().map_err(|source| BuildError::Core {
+                scene: scene.path.clone(),
+                source,
+            })?;
+            model.set_servo(w, servo).map_err(contact_error)?;
         }
     }
-    model
-        .check_initial_overlaps(state, contact.overlap_tolerance)
-        .map_err(contact_error)?;
-    model.check_initial_passage(state).map_err(contact_error)?;
+    // A stage's bodies and walls are where its checkpoint left them: checked once there.
+    if scene.run.start_from.is_none() {
+        check_start(scene, &mut model, state)?;
+    }
     Ok(Some(model))
+}
+
+/// Refuses bodies that start overlapping each other or a wall beyond `overlap_tolerance`, or
+/// inside another body or a mesh wall, at the positions of `state` (a `start_from` stage's:
+/// the checkpoint's, with its walls where they begin).
+pub(crate) fn check_start(
+    scene: &Scene,
+    model: &mut DemContacts,
+    state: &State,
+) -> Result<(), BuildError> {
+    let contact_error = |source| BuildError::Contact {
+        scene: scene.path.clone(),
+        source: Box::new(source),
+    };
+    let tolerance = scene.contact.as_ref().map_or(0.0, |c| c.overlap_tolerance);
+    model
+        .check_initial_overlaps(state, tolerance)
+        .map_err(contact_error)?;
+    model.check_initial_passage(state).map_err(contact_error)
 }
 
 fn law(contact: &Contact) -> ContactLaw {

@@ -11,7 +11,10 @@
 //! restarts at 0; contact lists are rebuilt at the first step, with the tangential springs of
 //! the checkpoint's contacts between the same spheres (and walls, by their order in the scene):
 //! a sphere is known by the particle that carries it, so a spring whose sphere or wall this
-//! scene does not have is dropped, and counted in a line ([`carry_springs`]).
+//! scene does not have is dropped, and counted in a line ([`carry_springs`]). Its walls begin
+//! where the checkpoint's walls of the same order stood, a servo wall with the speed its servo
+//! had set, unless a wall says `start = "scene"` ([`carry_walls`]); the bodies' overlaps are
+//! checked there, with the checkpoint's positions (`contact::check_start`).
 //!
 //! A body's kind may differ from the checkpoint's scene (`rigid` on a `[[body]]` or on the
 //! `[ballast]`): the particles are then mapped and the bodies turned as `kind_change` says.
@@ -19,8 +22,8 @@
 use crate::build::kind_change::{self, Unit};
 use crate::build::BuildError;
 use crate::checkpoint::read_checkpoint;
-use crate::scene::Scene;
-use qdem_contact::{DemContacts, PeriodicBox, SavedSprings, WrapGroup};
+use crate::scene::{Scene, WallStart};
+use qdem_contact::{DemContacts, PeriodicBox, SavedSprings, SavedWall, WrapGroup};
 use qdem_core::checkpoint::CheckpointError;
 use qdem_core::checkpoint::{model_histories, Decoder, SavedState};
 use qdem_core::{step::State, Vec3};
@@ -31,9 +34,11 @@ use std::path::Path;
 const SAME_PLACE: f64 = 1e-9;
 
 /// Replaces the positions, velocities and accelerations of `state` with those of the
-/// checkpoint `file` (relative to the scene), with time 0, and starts `contacts` with the
-/// checkpoint's tangential springs; the bodies of `units` may have another kind there. Returns
-/// a line for each body whose kind changed, and one for springs that could not be carried.
+/// checkpoint `file` (relative to the scene), with time 0, starts the walls of `contacts`
+/// where the checkpoint's stood (those with `start = "checkpoint"`), checks the overlaps
+/// there, and starts `contacts` with the checkpoint's tangential springs; the bodies of
+/// `units` may have another kind there. Returns a line for each body whose kind changed, each
+/// wall that moved, and springs that could not be carried.
 pub(crate) fn restore_state(
     scene: &Scene,
     file: &Path,
@@ -86,11 +91,19 @@ pub(crate) fn restore_state(
     // scene let move (else those would keep the checkpoint's velocity for the whole run).
     state.hold_fixed();
     state.time = 0.0;
-    let springs = saved_springs(&mut input).map_err(|e| {
+    let (springs, walls) = saved_contacts(&mut input).map_err(|e| {
         refused(format!(
-            "{e}; its contact springs cannot be read: start from a checkpoint this qdem wrote"
+            "{e}; its contact springs and walls cannot be read: start from a checkpoint this \
+             qdem wrote"
         ))
     })?;
+    let mut contacts = contacts;
+    if let Some(contacts) = contacts.as_deref_mut() {
+        lines.extend(carry_walls(scene, &walls, saved.time, contacts).map_err(refused)?);
+        // The overlaps where this stage starts, before the springs (the check builds the
+        // lists, which the springs replace until the first evaluation rebuilds them).
+        super::contact::check_start(scene, contacts, state)?;
+    }
     lines.extend(carry_springs(&springs, &layout, saved.len(), contacts));
     let from = path.display();
     Ok(lines
@@ -102,14 +115,69 @@ pub(crate) fn restore_state(
 /// The name of the contact model ([`DemContacts`]) in a checkpoint.
 const CONTACT_MODEL: &str = "contact";
 
-/// The stretched tangential springs of the checkpoint's contact model (none without one),
-/// read after its state.
-fn saved_springs(input: &mut Decoder<'_>) -> Result<SavedSprings, CheckpointError> {
+/// The stretched tangential springs and the walls of the checkpoint's contact model (none
+/// without one), read after its state.
+fn saved_contacts(
+    input: &mut Decoder<'_>,
+) -> Result<(SavedSprings, Vec<SavedWall>), CheckpointError> {
     let histories = model_histories(input)?;
     match histories.iter().find(|(name, _)| name == CONTACT_MODEL) {
-        Some((_, history)) => SavedSprings::read(history),
-        None => Ok(SavedSprings::default()),
+        Some((_, history)) => Ok((SavedSprings::read(history)?, SavedWall::read(history)?)),
+        None => Ok((SavedSprings::default(), Vec::new())),
     }
+}
+
+/// Starts each wall of the scene whose `start` is `"checkpoint"` where the same wall (by
+/// order) of the checkpoint stood at its time `time`; a line for each that moved so, and one
+/// for walls the checkpoint does not have. Refused when a wall is a plane in one scene and a
+/// mesh in the other.
+fn carry_walls(
+    scene: &Scene,
+    saved: &[SavedWall],
+    time: f64,
+    contacts: &mut DemContacts,
+) -> Result<Vec<String>, String> {
+    let mut lines = Vec::new();
+    let carried = scene.walls.iter().enumerate().zip(saved);
+    for ((w, wall), saved) in carried.filter(|((_, w), _)| w.start == WallStart::Checkpoint) {
+        if !contacts.carry_wall(w, saved, time) {
+            let (here, there) = match saved.plane {
+                true => ("a mesh", "a plane"),
+                false => ("a plane", "a mesh"),
+            };
+            return Err(format!(
+                "[[wall]] #{}: {here} here but {there} in the checkpoint, so it cannot start \
+                 where that one stood; give it `start = \"scene\"`, or list the walls in the \
+                 checkpoint's order",
+                w + 1
+            ));
+        }
+        let at = saved.base + saved.velocity * time;
+        let moved = match (wall.point, wall.normal) {
+            (Some(p), Some(n)) => (at - Vec3::from(p)).dot(&Vec3::from(n).normalize()),
+            _ => at.norm(),
+        };
+        if moved != 0.0 {
+            lines.push(format!(
+                "[[wall]] #{} starts where the checkpoint left it, {moved:.4e} m from this \
+                 scene's place (along its normal for a plane); `start = \"scene\"` starts it \
+                 there",
+                w + 1
+            ));
+        }
+    }
+    let missing = scene.walls.len().saturating_sub(saved.len());
+    let waiting = scene.walls[saved.len().min(scene.walls.len())..]
+        .iter()
+        .any(|w| w.start == WallStart::Checkpoint);
+    if missing > 0 && waiting {
+        lines.push(format!(
+            "the checkpoint has {} walls: the last {missing} of this scene's start at their \
+             own place",
+            saved.len()
+        ));
+    }
+    Ok(lines)
 }
 
 /// Puts the `saved` springs on the same spheres of `contacts` (a sphere is known by its

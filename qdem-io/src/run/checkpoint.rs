@@ -35,8 +35,10 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.qdc";
 /// contacts keep each servo wall's point and velocity after their lists: nothing without a
 /// servo wall, so a version 7 file of a scene without one reads as before; 8: each model's history is a
 /// block (a reader may skip it) and the contacts' history starts with their spheres'
-/// particles, by which `[run] start_from` carries their springs).
-pub const FORMAT_VERSION: u64 = 8;
+/// particles, by which `[run] start_from` carries their springs; 9: the contacts keep every
+/// wall's place and velocity after their lists, in place of the servo walls' after the
+/// time-delayed boundary, by which `[run] start_from` starts the walls where they were).
+pub const FORMAT_VERSION: u64 = 9;
 
 const MAGIC: &[u8; 8] = b"QDEMCKPT";
 const HEADER: usize = 8 + 8 + 8;

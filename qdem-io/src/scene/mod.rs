@@ -50,7 +50,7 @@ pub use schema::{
     AreaLoad, Ballast, Body, Bonded, ClumpShapeName, Contact, ContactLawName, CyclicLoad,
     EventSolveName, Fix, Formulation, GradingBasisName, Granular, Integrator, Load, Material,
     Measure, MeasureRegion, Output, PackingName, Periodic, Probe, Ramp, Run, Section, Selection,
-    Series, Supports, TimeDelay, TimeStep, Wall, WallServo,
+    Series, Supports, TimeDelay, TimeStep, Wall, WallServo, WallStart,
 };
 
 use schema::RawScene;

@@ -77,7 +77,7 @@ use stages::Evaluation;
 use time_delay::{pair_scales, TimeDelay};
 use walls::Walls;
 
-pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
+pub use persistence::{CarriedSprings, SavedSpring, SavedSprings, SavedWall};
 pub use tunnelling::BodySurface;
 use tunnelling::PassageCheck;
 

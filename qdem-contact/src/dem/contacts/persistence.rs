@@ -1,7 +1,6 @@
 //! What a checkpoint keeps of a [`DemContacts`]: its spheres' particles, the candidate lists
 //! with their tangential springs, where and when they were built, the time-delayed boundary's
-//! estimates and the servo walls' planes (none written without servo walls: the layout of a
-//! run without them is unchanged).
+//! estimates, and every wall's place and velocity (a servo wall's plane as its servo left it).
 //!
 //! A scene that starts from another scene's checkpoint (`[run] start_from`) takes the
 //! stretched tangential springs out of it by stable identities ([`SavedSprings`]): a pair by
@@ -9,7 +8,9 @@
 //! wall's index. A body's contact spheres sit on its mesh nodes whether it is deformable or
 //! rigid (a rigid body's nodes are its members), so a stone keeps its springs when its kind
 //! changes; [`DemContacts::carry_springs`] puts them on the same spheres of the new stage and
-//! counts those whose sphere or wall the new stage does not have.
+//! counts those whose sphere or wall the new stage does not have. Its walls start where the
+//! checkpoint's were ([`SavedWall`], [`DemContacts::carry_wall`]), unless the stage says
+//! otherwise.
 
 use super::*;
 use std::collections::HashMap;
@@ -42,16 +43,7 @@ impl SavedSprings {
     /// [`CheckpointError`] when the history is not a contact model's.
     pub fn read(history: &[u8]) -> Result<SavedSprings, CheckpointError> {
         let mut input = Decoder::new(history);
-        input.tag("contact")?;
-        let particle = input.u32s("contact sphere particles")?;
-        input.option_f64("the last evaluation time")?;
-        input.bool("the build flag")?;
-        input.f64("the build time")?;
-        input.vec3s("the build positions")?;
-        input.u64("the rebuild count")?;
-        let spheres = particle.len();
-        let pairs = ContactList::restore(&mut input, spheres, spheres)?;
-        let walls = ContactList::restore(&mut input, spheres, u32::MAX as usize)?;
+        let (particle, pairs, walls) = read_lists(&mut input)?;
         let stretched = |list: &ContactList, second_is_sphere: bool| {
             list.springs()
                 .map(|(a, b, spring)| SavedSpring {
@@ -78,6 +70,63 @@ impl SavedSprings {
     /// Whether there is none.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+}
+
+/// The spheres' particles and the pair and wall lists at the start of a contact model's
+/// `history`.
+fn read_lists(
+    input: &mut Decoder<'_>,
+) -> Result<(Vec<u32>, ContactList, ContactList), CheckpointError> {
+    input.tag("contact")?;
+    let particle = input.u32s("contact sphere particles")?;
+    input.option_f64("the last evaluation time")?;
+    input.bool("the build flag")?;
+    input.f64("the build time")?;
+    input.vec3s("the build positions")?;
+    input.u64("the rebuild count")?;
+    let spheres = particle.len();
+    let pairs = ContactList::restore(input, spheres, spheres)?;
+    let walls = ContactList::restore(input, spheres, u32::MAX as usize)?;
+    Ok((particle, pairs, walls))
+}
+
+/// A wall as a checkpoint keeps it: its shape, its place at t = 0 of that run and its
+/// velocity (a servo wall's as its servo last set it), so that at the checkpoint's time T it
+/// stood at `base` + `velocity` T.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SavedWall {
+    /// A plane (else a mesh).
+    pub plane: bool,
+    /// A plane's point, a mesh's offset from its file's coordinates, at t = 0 (m).
+    pub base: Vec3,
+    /// Its velocity (m/s).
+    pub velocity: Vec3,
+}
+
+impl SavedWall {
+    /// The walls of the `history` a [`DemContacts`] wrote into a checkpoint, in scene order.
+    ///
+    /// # Errors
+    /// [`CheckpointError`] when the history is not a contact model's.
+    pub fn read(history: &[u8]) -> Result<Vec<SavedWall>, CheckpointError> {
+        let mut input = Decoder::new(history);
+        read_lists(&mut input)?;
+        SavedWall::read_all(&mut input)
+    }
+
+    /// What [`Walls::save`] wrote.
+    pub(super) fn read_all(input: &mut Decoder<'_>) -> Result<Vec<SavedWall>, CheckpointError> {
+        let count = input.u64("the wall count")?;
+        (0..count)
+            .map(|_| {
+                Ok(SavedWall {
+                    plane: input.bool("a wall's shape")?,
+                    base: input.vec3("a wall's place")?,
+                    velocity: input.vec3("a wall's velocity")?,
+                })
+            })
+            .collect()
     }
 }
 
@@ -140,21 +189,31 @@ impl DemContacts {
     }
 }
 
+impl DemContacts {
+    /// Starts wall `wall` where the checkpoint's wall `saved` stood at the checkpoint's time
+    /// `time`: a plane through its point there, a mesh at its offset there, a servo wall with
+    /// its velocity there (its displacement counted from there); a wall without a servo moves
+    /// on with its own velocity. False, and nothing changed, when `saved` has the other shape.
+    pub fn carry_wall(&mut self, wall: usize, saved: &SavedWall, time: f64) -> bool {
+        self.walls.carry(wall, saved, time)
+    }
+}
+
 impl Persistent for DemContacts {
     /// The spheres' particles (their identities for [`SavedSprings`]), the candidate lists
-    /// with their tangential springs, where and when they were built, and the time-delayed
-    /// boundary's estimates: everything but the sphere centres, which are read from the
-    /// state.
+    /// with their tangential springs, where and when they were built, every wall's place and
+    /// velocity, and the time-delayed boundary's estimates: everything but the sphere
+    /// centres, which are read from the state.
     fn save(&self, out: &mut Encoder) {
         out.tag("contact");
         out.u32s(self.spheres.particle());
         out.option_f64(self.evaluation.last_time());
         self.candidates.save(out);
+        self.walls.save(out);
         out.bool(self.time_delay.is_some());
         if let Some(delay) = &self.time_delay {
             delay.save(out);
         }
-        self.walls.save_servos(out);
     }
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
         input.tag("contact")?;
@@ -173,6 +232,7 @@ impl Persistent for DemContacts {
         let last_time = input.option_f64("the last evaluation time")?;
         self.evaluation.set_last_time(last_time);
         self.candidates.restore(input, spheres, self.walls.len())?;
+        self.walls.restore(input)?;
         let delayed = input.bool("the time-delay flag")?;
         same_count(
             "time-delayed boundaries",
@@ -182,7 +242,6 @@ impl Persistent for DemContacts {
         if let Some(delay) = &mut self.time_delay {
             delay.restore(input)?;
         }
-        self.walls.restore_servos(input)?;
         self.index_partners();
         if let Some(split) = &mut self.split {
             split.whole = true;
@@ -194,7 +253,7 @@ impl Persistent for DemContacts {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{LinearSpring, PlaneWall, WallShape};
+    use crate::{LinearSpring, PlaneWall, Servo, WallShape};
 
     /// Two spheres of bodies 0 and 1 overlapping by 1 mm, the second also 0.5 mm into a floor,
     /// listed in `order`, with `walls` floors.
@@ -231,6 +290,59 @@ mod tests {
         let mut force = vec![Vec3::zeros(); 2];
         model.add_forces(state, &mut force, &mut []);
         force
+    }
+
+    #[test]
+    fn a_wall_starts_where_the_checkpoint_left_it_and_a_servo_with_its_speed() {
+        let state = State::at_rest(vec![
+            Vec3::new(0.0, 0.0, 0.0285),
+            Vec3::new(0.0, 0.0, 0.0095),
+        ]);
+        // The checkpoint's floor moved down at 1 m/s for 2 ms: 2 mm below its point.
+        let mut before = model(&state, [0, 1], 1);
+        let moving = PlaneWall::new(Vec3::zeros(), Vec3::z(), Vec3::new(0.0, 0.0, -1.0));
+        before.walls = Walls::new(
+            vec![Wall {
+                shape: WallShape::Plane(moving),
+                friction: 0.5,
+            }],
+            &[(1e9, 0.25)],
+        );
+        let mut out = Encoder::new();
+        before.save(&mut out);
+        let saved = SavedWall::read(out.bytes()).unwrap();
+        assert_eq!(saved.len(), 1);
+        // A servo floor here: through the point it had reached, with its speed.
+        let mut servo = model(&state, [0, 1], 1);
+        let target = Servo {
+            stress: 1e3,
+            factor: qdem_core::loads::TimeFunction::constant(1.0),
+            area: 1e-4,
+            gain: None,
+            max_velocity: 1.0,
+        };
+        servo.set_servo(0, target).unwrap();
+        assert!(servo.carry_wall(0, &saved[0], 2e-3));
+        let WallShape::Plane(plane) = &servo.walls.get(0).shape else {
+            unreachable!()
+        };
+        assert_eq!(plane.point, Vec3::new(0.0, 0.0, -2e-3));
+        assert_eq!(plane.velocity, Vec3::new(0.0, 0.0, -1.0));
+        assert_eq!(servo.walls.displacement(0, 0.0), Vec3::zeros());
+        // A plain floor here: at the point, with its own (zero) velocity.
+        let mut plain = model(&state, [0, 1], 1);
+        assert!(plain.carry_wall(0, &saved[0], 2e-3));
+        assert_eq!(plain.walls.get(0).velocity(), Vec3::zeros());
+        // The sphere 0.5 mm into the floor at z = 0 is 1.5 mm clear of it at z = −2 mm: the
+        // forces are the pair's alone.
+        let pair_alone = forces(&mut model(&state, [0, 1], 0), &state);
+        assert_eq!(forces(&mut plain, &state), pair_alone);
+        // A mesh wall cannot start where a plane stood.
+        let saved_mesh = SavedWall {
+            plane: false,
+            ..saved[0]
+        };
+        assert!(!plain.carry_wall(0, &saved_mesh, 2e-3));
     }
 
     #[test]

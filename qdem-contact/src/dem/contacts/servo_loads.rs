@@ -3,12 +3,14 @@
 //! evaluation's law, each servo wall's stress from its touching contacts, summed in the order
 //! of one process's list (by sphere) over every rank through the evaluation's reduction
 //! (`stages.rs`), sets its velocity; its plane is re-based so that its position stays
-//! continuous. Its place and velocity are saved with the contact lists.
+//! continuous. Its place and velocity are saved with every wall's (`walls.rs`); a stage that
+//! starts from a checkpoint may put it where it was there, with the velocity it had
+//! ([`Servos::carry`]).
 
 use crate::dem::walls::servo_wall::Servo;
 use crate::dem::walls::wall::{Wall, WallShape};
 use crate::error::ContactError;
-use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, Vec3};
+use qdem_core::Vec3;
 
 /// A touching contact on a servo wall, what its load and response take of it.
 #[derive(Clone, Copy, Debug)]
@@ -24,7 +26,7 @@ pub(super) struct ServoContact {
 }
 
 /// A servo wall's settings and its plane's point at t = 0.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 struct ServoWall {
     servo: Servo,
     start: Vec3,
@@ -99,14 +101,14 @@ impl Servos {
     /// forces and of the responses, keeping its plane where it is at `time`.
     pub(super) fn drive(&self, walls: &mut [Wall], time: f64, contacts: &[ServoContact]) {
         for (w, (entry, wall)) in self.by_wall.iter().zip(walls.iter_mut()).enumerate() {
-            let Some(servo) = entry.map(|s| s.servo) else {
+            let Some(ServoWall { servo, .. }) = entry else {
                 continue;
             };
             let (mut force, mut response) = (0.0, 0.0);
             for c in contacts.iter().filter(|c| c.wall as usize == w) {
                 (force, response) = (force + c.load, response + c.response.0 + c.response.1);
             }
-            let speed = servo.speed(force / servo.area, response);
+            let speed = servo.speed(time, force / servo.area, response);
             let WallShape::Plane(plane) = &mut wall.shape else {
                 continue;
             };
@@ -116,32 +118,17 @@ impl Servos {
         }
     }
 
-    /// Saves each servo wall's plane (point and velocity), in wall order.
-    pub(super) fn save(&self, walls: &[Wall], out: &mut Encoder) {
-        for (w, wall) in walls.iter().enumerate() {
-            if let (Some(_), WallShape::Plane(p)) = (self.of(w), &wall.shape) {
-                out.vec3(&p.point);
-                out.vec3(&p.velocity);
+    /// Starts wall `wall` (a plane, of `walls`) through `point` at t = 0; a servo wall also
+    /// with `velocity`, the speed its servo had set (the next evaluation sets it anew), and its
+    /// displacement counted from there.
+    pub(super) fn carry(&mut self, walls: &mut [Wall], wall: usize, point: Vec3, velocity: Vec3) {
+        let servo = self.by_wall.get_mut(wall).and_then(Option::as_mut);
+        if let WallShape::Plane(plane) = &mut walls[wall].shape {
+            plane.point = point;
+            if let Some(servo) = servo {
+                plane.velocity = velocity;
+                servo.start = point;
             }
         }
-    }
-
-    /// Restores what [`Servos::save`] saved.
-    pub(super) fn restore(
-        &self,
-        walls: &mut [Wall],
-        input: &mut Decoder<'_>,
-    ) -> Result<(), CheckpointError> {
-        for (w, wall) in walls.iter_mut().enumerate() {
-            if self.of(w).is_none() {
-                continue;
-            }
-            let point = input.vec3("a servo wall's point")?;
-            let velocity = input.vec3("a servo wall's velocity")?;
-            if let WallShape::Plane(p) = &mut wall.shape {
-                (p.point, p.velocity) = (point, velocity);
-            }
-        }
-        Ok(())
     }
 }

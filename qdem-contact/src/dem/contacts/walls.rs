@@ -3,12 +3,14 @@
 //! the stress-controlled walls' servos (`servo_loads.rs`), which the stages drive from the
 //! evaluation's reduction.
 
+use super::persistence::SavedWall;
 use super::servo_loads::{ServoContact, Servos};
 use super::{ContactLaw, ContactList, PairElasticity, PairGeometry, SphereNow};
 use crate::dem::walls::servo_wall::Servo;
-use crate::dem::walls::wall::Wall;
+use crate::dem::walls::wall::{Wall, WallShape};
 use crate::error::ContactError;
-use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, Vec3};
+use qdem_core::checkpoint::{same_count, CheckpointError, Decoder, Encoder};
+use qdem_core::Vec3;
 
 /// The walls, their elasticity per sphere material, and their servos.
 pub(super) struct Walls {
@@ -146,16 +148,61 @@ impl Walls {
         self.servos.drive(&mut self.list, time, contacts);
     }
 
-    /// Saves the servo walls' planes.
-    pub(super) fn save_servos(&self, out: &mut Encoder) {
-        self.servos.save(&self.list, out);
+    /// Saves every wall's shape (plane or not), its place at t = 0 (a plane's point, a mesh's
+    /// offset) and its velocity, in wall order: with a servo's, the whole state of a wall.
+    pub(super) fn save(&self, out: &mut Encoder) {
+        out.u64(self.list.len() as u64);
+        for wall in &self.list {
+            let (plane, base) = match &wall.shape {
+                WallShape::Plane(p) => (true, p.point),
+                WallShape::Mesh(m) => (false, m.offset),
+            };
+            out.bool(plane);
+            out.vec3(&base);
+            out.vec3(&wall.velocity());
+        }
     }
 
-    /// Restores what [`Walls::save_servos`] saved.
-    pub(super) fn restore_servos(
-        &mut self,
-        input: &mut Decoder<'_>,
-    ) -> Result<(), CheckpointError> {
-        self.servos.restore(&mut self.list, input)
+    /// Restores what [`Walls::save`] saved (the same scene's walls).
+    pub(super) fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+        let saved = SavedWall::read_all(input)?;
+        same_count("walls", self.list.len(), saved.len())?;
+        for (wall, saved) in self.list.iter_mut().zip(saved) {
+            match &mut wall.shape {
+                WallShape::Plane(p) if saved.plane => {
+                    (p.point, p.velocity) = (saved.base, saved.velocity);
+                }
+                WallShape::Mesh(m) if !saved.plane => {
+                    (m.offset, m.velocity) = (saved.base, saved.velocity);
+                }
+                _ => {
+                    return Err(CheckpointError::Invalid {
+                        what: "walls",
+                        detail: "a wall is a plane in the checkpoint and a mesh in the scene, \
+                                 or the other way round"
+                            .into(),
+                    })
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Starts wall `wall` where `saved` was at `time` (a plane through the same point, a mesh
+    /// with the same offset), a servo wall with its velocity; false (and nothing done) when
+    /// the saved wall has another shape.
+    pub(super) fn carry(&mut self, wall: usize, saved: &SavedWall, time: f64) -> bool {
+        let at = saved.base + saved.velocity * time;
+        match &mut self.list[wall].shape {
+            WallShape::Plane(_) if saved.plane => {
+                self.servos.carry(&mut self.list, wall, at, saved.velocity);
+                true
+            }
+            WallShape::Mesh(m) if !saved.plane => {
+                m.offset = at;
+                true
+            }
+            _ => false,
+        }
     }
 }

@@ -1,5 +1,7 @@
 //! Triangulated walls: a rigid surface given by triangles (a gmsh surface mesh, or the boundary
-//! of a tetrahedral mesh), moving with a constant velocity, with its own friction. The closest
+//! of a tetrahedral mesh), moving with a constant velocity from where it starts (its offset
+//! from the mesh file's coordinates, zero unless a stage carries the wall's place over from a
+//! checkpoint), with its own friction. The closest
 //! point of the mesh to a sphere's centre comes from parry3d's bounding-volume hierarchy
 //! (`PointQuery::project_local_point`), so each sphere touches a mesh wall at one point at most,
 //! and a sphere over an edge or vertex is pushed away from that edge or vertex rather than
@@ -16,12 +18,15 @@ use parry3d_f64::query::{PointQuery, Ray, RayCast};
 use parry3d_f64::shape::{TriMesh, TriMeshFlags};
 use qdem_core::Vec3;
 
-/// A rigid triangulated surface moving with a constant velocity.
+/// A rigid triangulated surface moving with a constant velocity: at time t its points are the
+/// mesh's moved by `offset` + `velocity` t.
 #[derive(Clone)]
 pub struct MeshWall {
     mesh: TriMesh,
     /// Velocity of the wall (m/s).
     pub velocity: Vec3,
+    /// Its displacement at t = 0 from the mesh's coordinates (m).
+    pub offset: Vec3,
     lower: Vec3,
     upper: Vec3,
     /// The same triangles, outward, with pseudo-normals; `None` when they enclose no volume.
@@ -33,6 +38,7 @@ impl std::fmt::Debug for MeshWall {
         f.debug_struct("MeshWall")
             .field("triangles", &self.mesh.num_triangles())
             .field("velocity", &self.velocity)
+            .field("offset", &self.offset)
             .finish()
     }
 }
@@ -87,16 +93,23 @@ impl MeshWall {
         Ok(MeshWall {
             mesh,
             velocity,
+            offset: Vec3::zeros(),
             lower,
             upper,
             solid: oriented(vertices, triangles),
         })
     }
 
+    /// Its displacement at time `t` from the mesh's coordinates, `offset` + `velocity` t.
+    #[inline]
+    pub fn shift(&self, t: f64) -> Vec3 {
+        self.offset + self.velocity * t
+    }
+
     /// How deep the point `x` lies inside the wall's solid at time `t` (its distance to the
     /// surface), or `None` when it is outside or the wall encloses no volume.
     pub fn depth_inside(&self, x: &Vec3, t: f64) -> Option<f64> {
-        let local = x - self.velocity * t;
+        let local = x - self.shift(t);
         if !self.may_touch(&local, 0.0, 0.0) {
             return None;
         }
@@ -110,10 +123,7 @@ impl MeshWall {
     /// Whether a point that moved from `from` at time `from_time` to `to` at time `to_time`
     /// crossed the wall's surface on the way, along the straight path in the wall's frame.
     pub fn crossed(&self, (from, from_time): (&Vec3, f64), (to, to_time): (&Vec3, f64)) -> bool {
-        let (a, b) = (
-            from - self.velocity * from_time,
-            to - self.velocity * to_time,
-        );
+        let (a, b) = (from - self.shift(from_time), to - self.shift(to_time));
         let reach = (b - a).norm();
         if reach == 0.0 || !self.may_touch(&b, reach, 0.0) {
             return false;
@@ -125,14 +135,14 @@ impl MeshWall {
     /// Whether a sphere at `x` with reach `reach` (radius plus skin) can touch the wall's
     /// bounding box at time `t`.
     pub fn may_touch(&self, x: &Vec3, reach: f64, t: f64) -> bool {
-        let local = x - self.velocity * t;
+        let local = x - self.shift(t);
         (0..3).all(|k| local[k] > self.lower[k] - reach && local[k] < self.upper[k] + reach)
     }
 
-    /// The wall's triangles at time `t`: its vertices moved by v t, and three vertex indices
-    /// per triangle.
+    /// The wall's triangles at time `t`: its vertices moved by its shift, and three vertex
+    /// indices per triangle.
     pub fn surface(&self, t: f64) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-        let shift = self.velocity * t;
+        let shift = self.shift(t);
         let vertices = self.mesh.vertices().iter().map(|&v| from_parry(v) + shift);
         (vertices.collect(), self.mesh.indices().to_vec())
     }
@@ -140,7 +150,7 @@ impl MeshWall {
     /// Overlap δ = r − |x − p| with p the closest point of the wall at time `t`, and the unit
     /// normal from the sphere towards p.
     pub fn overlap(&self, x: &Vec3, radius: f64, t: f64) -> (f64, Vec3) {
-        let shift = self.velocity * t;
+        let shift = self.shift(t);
         let local = x - shift;
         let projection = self.mesh.project_local_point(to_parry(&local), false);
         let towards = from_parry(projection.point) - local;

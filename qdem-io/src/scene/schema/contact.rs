@@ -77,6 +77,20 @@ fn default_overlap_tolerance() -> f64 {
     0.05
 }
 
+/// `[[wall]] start`: where a wall of a scene that starts from a checkpoint (`[run]
+/// start_from`) begins.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum WallStart {
+    /// Where the same wall (by its order) stood in the checkpoint, a servo wall with the
+    /// velocity its servo had set: a stage goes on where the last one left its walls.
+    #[default]
+    #[serde(rename = "checkpoint")]
+    Checkpoint,
+    /// Where this scene places it (`point`, or the mesh as it is): a stage moves the wall.
+    #[serde(rename = "scene")]
+    Scene,
+}
+
 scene_table! {
     /// `[[wall]]`: a rigid plane (`point`, `normal`) or triangulated surface (`mesh`).
     #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -100,21 +114,34 @@ scene_table! {
             "Constant velocity of the wall (m/s); default zero.";
         #[serde(default)]
         servo: Option<WallServo> => "inline table", optional,
-            "Stress control of a plane wall: `{ stress, area, gain, max_velocity }`; after each \
+            "Stress control of a plane wall: `{ stress, area, gain, max_velocity, ramp }`; after each \
              force evaluation its speed towards the bodies is clamp(G (σ_target − σ), ±v_max), σ \
              the spheres' normal force on it over `area`. Not with `velocity` or a mesh.";
+        #[serde(default)]
+        start: WallStart => "\"checkpoint\" or \"scene\"", optional = "\"checkpoint\"",
+            "With `[run] start_from`: where the wall begins. \"checkpoint\" (default): where the \
+             checkpoint's wall of the same order stood at its end (a plane through its point \
+             there, a mesh at its displacement there; a servo wall with its speed there), then \
+             moving with `velocity` or its servo. \"scene\": at `point` (or the mesh as it is), \
+             moving the wall for this stage.";
     }
 }
 
 scene_table! {
     /// `[[wall]] servo`: a plane wall whose speed along its normal is set after each force
     /// evaluation to clamp(G (σ_target − σ), ±v_max), σ the compressive stress the spheres put on
-    /// it (their normal force over `area`), positive towards the bodies.
-    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    /// it (their normal force over `area`), positive towards the bodies. σ_target may follow a
+    /// load path in time, `ramp` (a factor on `stress`, as a `[[load]]`'s ramp).
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
     #[serde(deny_unknown_fields)]
     pub struct WallServo in "[[wall]] servo" {
         stress: f64 => "number", required,
-            "Target compressive normal stress σ_target (Pa).";
+            "Target compressive normal stress σ_target (Pa), times `ramp`.";
+        #[serde(default)]
+        ramp: Option<Vec<[f64; 2]>> => "[[t, factor], …]", optional,
+            "Time factor on `stress`, a load path: `[t, factor]` points, linear between, held \
+             outside, two points at one time a step (as a `[[load]]`'s ramp; t from this run's \
+             start); default a constant 1.";
         area: f64 => "number", required,
             "The area A the wall's normal force is divided by (m², > 0).";
         #[serde(default)]
@@ -128,13 +155,17 @@ scene_table! {
 }
 
 impl WallServo {
-    /// The contact model's servo.
-    pub fn servo(&self) -> qdem_contact::Servo {
-        qdem_contact::Servo {
+    /// The contact model's servo. The scene's validation has already refused ramps the core
+    /// would refuse.
+    pub fn servo(&self) -> Result<qdem_contact::Servo, qdem_core::error::CoreError> {
+        let points = self.ramp.clone().unwrap_or_default();
+        let factor = super::fix_load::Ramp { points }.time_function()?;
+        Ok(qdem_contact::Servo {
             stress: self.stress,
+            factor,
             area: self.area,
             gain: self.gain,
             max_velocity: self.max_velocity,
-        }
+        })
     }
 }

@@ -85,7 +85,7 @@ mod run;
 pub use ballast::Ballast;
 pub use body::Body;
 pub use bonded::{Bonded, EventSolveName, PackingName, Supports};
-pub use contact::{Contact, ContactLawName, Wall, WallServo};
+pub use contact::{Contact, ContactLawName, Wall, WallServo, WallStart};
 pub use fix_load::{AreaLoad, CyclicLoad, Fix, Load, Ramp, Selection, Series};
 pub(crate) use fix_load::{RawFix, RawLoad};
 pub use granular::{ClumpShapeName, GradingBasisName, Granular};

@@ -51,7 +51,8 @@ scene_table! {
              bodies, e.g. a deposition run), relative to the scene file: positions, velocities and \
              reference positions are taken from it, time restarts at 0, and the tangential contact \
              springs are carried between the same spheres and walls (a spring whose sphere or wall \
-             this scene lacks is dropped and counted).";
+             this scene lacks is dropped and counted); the walls begin where the checkpoint left \
+             them (`[[wall]] start`), and overlaps are checked at the checkpoint's positions.";
     }
 }
 

@@ -3,7 +3,7 @@
 //! non-negative friction, damping in [0, 1), local damping and contacts only with an explicit
 //! integrator, a positive skin and overlap tolerance; each wall a plane (point and non-zero
 //! normal) or a mesh; a servo only on a plane without a velocity, with a positive area and
-//! maximum speed.
+//! maximum speed and a load path (`ramp`) as a `[[load]]`'s.
 
 use super::super::schema::{Contact, ContactLawName, Integrator, RawScene, Wall, WallServo};
 use super::checker::{fraction, label, Checker};
@@ -174,7 +174,7 @@ fn wall(c: &mut Checker<'_>, i: usize, w: &Wall) {
 }
 
 /// A `[[wall]] servo`: on a plane without a `velocity`, a finite stress, a positive area and
-/// maximum speed, a positive gain when given.
+/// maximum speed, a positive gain when given, a `ramp` as a `[[load]]`'s.
 fn wall_servo(c: &mut Checker<'_>, idx: &str, l: &str, w: &Wall, servo: &WallServo) {
     if w.mesh.is_some() {
         c.error(
@@ -195,6 +195,8 @@ fn wall_servo(c: &mut Checker<'_>, idx: &str, l: &str, w: &Wall, servo: &WallSer
     if let Some(gain) = servo.gain {
         c.positive(&at, l, "servo.gain", gain, "m/(s·Pa)");
     }
+    let owner = format!("{l} servo");
+    super::fix_load::ramp(c, &["wall", idx, "servo", "ramp"], &owner, &servo.ramp);
 }
 
 /// `restitution`: in (0, 1], and not beside a `damping_ratio` (one of them sets the dashpots).

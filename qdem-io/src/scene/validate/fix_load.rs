@@ -100,7 +100,7 @@ fn load(
     let body = bodies.reference(c, &["load", &idx, "body"], &l, &ld.body);
     let sel = selection(c, "load", &idx, &l, &ld.group, &ld.bbox);
     let (total_force, area) = load_force(c, &idx, &l, ld);
-    let ramp = ramp(c, &idx, &l, &ld.ramp);
+    let ramp = ramp(c, &["load", &idx, "ramp"], &l, &ld.ramp);
     if let Some(cyclic) = &ld.cyclic {
         cyclic_load(c, &idx, &l, cyclic, ld.ramp.is_some());
     }
@@ -284,15 +284,20 @@ fn dofs(c: &mut Checker<'_>, at: &[&str], owner: &str, dofs: &str) -> Option<[bo
     Some(mask)
 }
 
-/// `ramp` of a `[[load]]`: finite points, times that do not decrease, at most two at a time.
-fn ramp(c: &mut Checker<'_>, idx: &str, owner: &str, points: &Option<Vec<[f64; 2]>>) -> Ramp {
+/// A `ramp` (of a `[[load]]`, a servo's) at the key path `at`: finite points, times that do
+/// not decrease, at most two at a time.
+pub(super) fn ramp(
+    c: &mut Checker<'_>,
+    at: &[&str],
+    owner: &str,
+    points: &Option<Vec<[f64; 2]>>,
+) -> Ramp {
     let Some(points) = points else {
         return Ramp::constant();
     };
-    let at = ["load", idx, "ramp"];
     if points.is_empty() {
         c.error(
-            &at,
+            at,
             format!(
                 "{owner}: ramp has no points; give at least one [t, factor] point, or remove \
                  `ramp` for a constant factor 1"
@@ -301,14 +306,14 @@ fn ramp(c: &mut Checker<'_>, idx: &str, owner: &str, points: &Option<Vec<[f64; 2
         return Ramp::constant();
     }
     let flat: Vec<f64> = points.iter().flatten().copied().collect();
-    if !c.finite(&at, owner, "ramp", &flat) {
+    if !c.finite(at, owner, "ramp", &flat) {
         return Ramp::constant();
     }
     for (k, w) in points.windows(2).enumerate() {
         if w[1][0] < w[0][0] {
             let i = (k + 1).to_string();
             c.error(
-                &["load", idx, "ramp", &i],
+                &[at, &[i.as_str()]].concat(),
                 format!(
                     "{owner}: ramp times must not decrease, but point {} (t = {}) comes after \
                      t = {}; sort the points by time",
@@ -323,7 +328,7 @@ fn ramp(c: &mut Checker<'_>, idx: &str, owner: &str, points: &Option<Vec<[f64; 2
         if w[0][0] == w[1][0] && w[1][0] == w[2][0] {
             let i = (k + 2).to_string();
             c.error(
-                &["load", idx, "ramp", &i],
+                &[at, &[i.as_str()]].concat(),
                 format!(
                     "{owner}: ramp has more than two points at t = {}; a jump needs exactly two \
                      (the value before and the value after)",
