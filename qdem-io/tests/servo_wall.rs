@@ -88,6 +88,18 @@ fn a_servo_lid_holds_its_target_stress_on_a_bed() {
         uz[rows - 1]
     );
     assert!((uz[rows - 1] - uz[last.start]).abs() < 1e-3);
+    // Its position is its point at the start moved by uz along its normal (to the ten
+    // significant digits walls.csv writes, 1.3e-10 m at 0.26 m), the floor's stays.
+    for k in 0..rows {
+        assert_eq!([walls["wall2.x"][k], walls["wall2.y"][k]], [0.0, 0.0]);
+        let z = walls["wall2.z"][k];
+        assert!(
+            (z - (0.26 + uz[k])).abs() < 3e-10,
+            "lid at {z}, uz {}",
+            uz[k]
+        );
+        assert_eq!(walls["wall1.z"][k], 0.0);
+    }
     // Statics of the bed: the floor carries the lid's force and the weight.
     let weight = weight(&out);
     let floor = mean(&walls["wall1.fz"][last.clone()]);

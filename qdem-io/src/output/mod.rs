@@ -44,7 +44,7 @@ use std::io::{self, Write};
 /// The version of the output files' layout a run writes, in `summary.json` as
 /// `output_format`: 1 until `probes.csv` named its time column `t` (the other CSVs `time`)
 /// and had no angular velocity; 2: `probes.csv`'s time column is `time` and every probe has
-/// `wx,wy,wz`.
+/// `wx,wy,wz`, `walls.csv` has each wall's position `wallK.x,y,z`.
 pub const OUTPUT_FORMAT: u32 = 2;
 
 /// Writes `x` in the shortest decimal form that parses back to the same `f64`: plain
