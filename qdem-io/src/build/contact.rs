@@ -91,10 +91,18 @@ pub(crate) fn build_contacts(
             model.set_servo(w, servo.servo()).map_err(contact_error)?;
         }
     }
+    let start_error = |source| match super::overlap_advice::advice(scene, &source) {
+        Some(fix) => BuildError::InitialOverlap {
+            scene: scene.path.clone(),
+            source: Box::new(source),
+            fix,
+        },
+        None => contact_error(source),
+    };
     model
         .check_initial_overlaps(state, contact.overlap_tolerance)
-        .map_err(contact_error)?;
-    model.check_initial_passage(state).map_err(contact_error)?;
+        .map_err(start_error)?;
+    model.check_initial_passage(state).map_err(start_error)?;
     Ok(Some(model))
 }
 
