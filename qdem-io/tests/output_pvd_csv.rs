@@ -189,3 +189,26 @@ fn probe_csv_rejects_bad_names_and_drop_leaves_nothing() {
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "time\n0.5\n");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_probe_csv_of_output_format_one_is_not_resumed() {
+    let dir = test_dir("probes-format-one");
+    let path = dir.join("probes.csv");
+    let old =
+        "t,tip.ux,tip.uy,tip.uz,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az\n0,0,0,0,0,0,0,0,0,0\n";
+    std::fs::write(&path, old).unwrap();
+    let err = ProbeCsv::resume(&path, &["tip".to_string()], 1).unwrap_err();
+    let message = err.to_string();
+    assert!(matches!(err, OutputError::Resume { .. }), "{err:?}");
+    assert!(
+        message.contains("output format 1 (time column `t`"),
+        "{message}"
+    );
+    assert!(message.contains("without --resume"), "{message}");
+    assert_eq!(
+        std::fs::read_to_string(&path).unwrap(),
+        old,
+        "left as it was"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
