@@ -43,7 +43,7 @@ def load(kind, tag):
             rows = list(csv.DictReader(f))
     except OSError:
         return None
-    history = [(float(r["t"]), float(r["midspan.uy"])) for r in rows]
+    history = [(float(r["time"]), float(r["midspan.uy"])) for r in rows]
     return summary, history
 
 

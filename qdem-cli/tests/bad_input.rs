@@ -550,6 +550,8 @@ fn interpenetrating_bodies_are_refused_before_the_run() {
         &[
             "bodies `left` and `right` overlap by 5.000e-3 m",
             "move them apart",
+            "in this scene: [[body]] `translate` or `contact_radius`; or a larger [contact] \
+             `overlap_tolerance` (now 0.05)",
         ],
     );
 }

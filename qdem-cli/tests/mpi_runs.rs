@@ -270,13 +270,16 @@ fn a_measure_over_a_packing_of_clumps_is_byte_identical_on_any_number_of_ranks()
 
 /// A lid held at 1 kPa by its servo over the poured grains: its force is the sum over every
 /// rank's contacts on it, in one process's order, so `walls.csv` (the lid's force and where
-/// its servo moved it) is byte-identical too; by 0.1 s the lid has come down onto the grains
-/// (a force and a displacement in the file, so the comparison is not of zeros).
+/// its servo moved it) is byte-identical too, and so is `measure_top.csv`, a layer that
+/// follows the lid (`follow_wall`); by 0.1 s the lid has come down onto the grains (a force
+/// and a displacement in the file, stones in the layer, so the comparison is not of zeros).
 #[test]
 fn a_servo_wall_over_poured_grains_is_byte_identical_on_any_number_of_ranks() {
     let fixture = "contact/grains.toml";
     let lid = "[[wall]]\npoint = [0.0, 0.0, 0.12]\nnormal = [0.0, 0.0, -1.0]\n\
-               servo = { stress = 1e3, area = 0.04, max_velocity = 1.0 }\n\n[[section]]";
+               servo = { stress = 1e3, area = 0.04, max_velocity = 1.0 }\n\n\
+               [[measure]]\nname = \"top\"\nbox = [[0.0, 0.0, 0.09], [0.2, 0.2, 0.12]]\n\
+               follow_wall = 6\nevery = 0.01\n\n[[section]]";
     let edits = [("t_end = ", "t_end = 0.1"), ("[[section]]", lid)];
     let scene = ShortScene::edited(fixture, "servo", &edits);
     same_as_one_process(
@@ -289,6 +292,8 @@ fn a_servo_wall_over_poured_grains_is_byte_identical_on_any_number_of_ranks() {
                 column("wall6.fz") > 0.0 && column("wall6.uz") < 0.0,
                 "{text}"
             );
+            let (column, text) = last_row(dir, "measure_top.csv");
+            assert!(column("stones") > 0.0 && column("szz") < 0.0, "{text}");
         },
     );
 }

@@ -251,7 +251,8 @@ fn a_stone_placed_inside_a_block_is_refused_before_the_run() {
         &[
             "body `stones stone 1` starts inside body `block`",
             "5.000e-2 m inside it",
-            "fix: place it outside body `block`",
+            "fix: place it outside body `block`; in this scene: [granular] `sample` (the \
+             stones' rows) or `crop`",
         ],
     );
     assert!(!out.join("probes.csv").exists(), "the run started");

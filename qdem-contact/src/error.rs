@@ -44,7 +44,7 @@ pub enum ContactError {
     #[error(
         "bodies `{a}` and `{b}` overlap by {overlap:.3e} m at the start (spheres at {at_a:?} and \
          {at_b:?}), more than {tolerance:.0}% of their reduced radius {radius:.3e} m; fix: move \
-         them apart (`translate` in [[body]]) or use a smaller `contact_radius`"
+         them apart, use smaller contact spheres or allow a larger initial overlap"
     )]
     InitialOverlap {
         /// First body.
@@ -65,8 +65,8 @@ pub enum ContactError {
     /// A body penetrates a wall at the start beyond the tolerance.
     #[error(
         "body `{body}` penetrates wall {wall} by {overlap:.3e} m at the start (sphere at {at:?}), \
-         more than {tolerance:.0}% of the contact radius {radius:.3e} m; fix: move the body \
-         (`translate`) or the wall (`point`)"
+         more than {tolerance:.0}% of the contact radius {radius:.3e} m; fix: move the body or \
+         the wall, or allow a larger initial overlap"
     )]
     InitialWallOverlap {
         /// The body.
@@ -86,8 +86,7 @@ pub enum ContactError {
     #[error(
         "body `{body}` starts inside {inside}: the centre of its contact sphere at {at:?} is \
          {depth:.3e} m inside it (the sphere radius is {radius:.3e} m), where no contact \
-         holds the two apart; fix: place it outside {inside} (a [[body]]'s `translate`, a \
-         stone's rows in the sample)"
+         holds the two apart; fix: place it outside {inside}"
     )]
     InitialInside {
         /// The body.

@@ -342,7 +342,7 @@ fn analyze_finds_a_sine_in_the_acceleration_and_the_scale_of_a_proportional_resp
     let path = series_scene(&dir, &series);
     // The velocity is 3e-6 (m/s)/N times the total input (2 × the series), so the mobility
     // is 3e-6 at every frequency; the acceleration carries a 120 Hz sine.
-    let mut probes = String::from("t,S2.ux,S2.uy,S2.uz,S2.vx,S2.vy,S2.vz,S2.ax,S2.ay,S2.az\n");
+    let mut probes = String::from("time,S2.ux,S2.uy,S2.uz,S2.vx,S2.vy,S2.vz,S2.ax,S2.ay,S2.az\n");
     for i in 0..n {
         let t = i as f64 * dt;
         let vz = 3e-6 * 2.0 * force(t);

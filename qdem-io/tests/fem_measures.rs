@@ -91,7 +91,7 @@ fn analyze_sizes_a_pressure_series_by_its_resultant() {
     let got = load_resultant(&scene, 0).unwrap();
     let want = qdem_core::Vec3::new(-P * AREA, 0.0, 0.0);
     assert!((got - want).norm() <= 1e-12 * P * AREA, "{got} vs {want}");
-    let mut probes = String::from("t,c.ux,c.uy,c.uz,c.vx,c.vy,c.vz,c.ax,c.ay,c.az\n");
+    let mut probes = String::from("time,c.ux,c.uy,c.uz,c.vx,c.vy,c.vz,c.ax,c.ay,c.az\n");
     for i in 0..n {
         let t = i as f64 * dt;
         let vz = 3e-6 * P * AREA * factor(t);

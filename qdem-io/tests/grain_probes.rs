@@ -126,7 +126,7 @@ box = [[5.0, 5.0, 5.0], [6.0, 6.0, 6.0]]
     );
     assert_eq!(c["all.vx"][0], 5.0);
     // After the bounce (the last row): the impulse laws, e measured.
-    let last = c["t"].len() - 1;
+    let last = c["time"].len() - 1;
     let (vx, vz) = (c["ball.vx"][last], c["ball.vz"][last]);
     assert_eq!(
         c["near.vx"][last], vx,
@@ -136,8 +136,17 @@ box = [[5.0, 5.0, 5.0], [6.0, 6.0, 6.0]]
     assert!(e > 0.99 && e < 1.01, "undamped: e = {e}");
     let impulse = FRICTION * (1.0 + e) * 1.0;
     let dv = 5.0 - vx;
+    // The spin as the probe reads it (rad/s): about y only, the start's exactly, and the
+    // magnitude the box probe's rotational energy gives.
+    assert_eq!(c["ball.wy"][0], 40.0);
+    let (wx, wz) = (c["ball.wx"][last], c["ball.wz"][last]);
+    assert!(wx.abs() < 1e-9 && wz.abs() < 1e-9, "ω = ({wx}, _, {wz})");
+    let omega = c["ball.wy"][last];
     let spin_energy = c["all.ke"][last] - 0.5 * mass * (vx * vx + vz * vz);
-    let omega = (2.0 * spin_energy / inertia).sqrt();
+    assert!(
+        (0.5 * inertia * omega * omega / spin_energy - 1.0).abs() < 1e-9,
+        "ω = {omega}, rotational energy {spin_energy}"
+    );
     let dw = omega - 40.0;
     // The contact point sits at the middle of the overlap, so the lever arm is R − δ̄/2, δ̄
     // the overlap averaged over the friction impulse: π/4 δ_max, δ_max = v_n √(m/k) for the
@@ -156,7 +165,7 @@ box = [[5.0, 5.0, 5.0], [6.0, 6.0, 6.0]]
 /// Largest |a − (v(t + h) − v(t − h)) / 2h| over the rows and axes of probe `name`, and the
 /// largest |a|, from row `from` on.
 fn central_difference_gap(c: &HashMap<String, Vec<f64>>, name: &str, from: usize) -> (f64, f64) {
-    let t = &c["t"];
+    let t = &c["time"];
     let (mut gap, mut largest) = (0.0f64, 0.0f64);
     for axis in ["x", "y", "z"] {
         let v = &c[&format!("{name}.v{axis}")];
@@ -174,7 +183,7 @@ fn central_difference_gap(c: &HashMap<String, Vec<f64>>, name: &str, from: usize
 /// the trapezoid rule over the rows, which is how Verlet's half kicks add up), and the largest
 /// |v(t) − v(t_from)|.
 fn integration_gap(c: &HashMap<String, Vec<f64>>, name: &str, from: usize) -> (f64, f64) {
-    let t = &c["t"];
+    let t = &c["time"];
     let (mut gap, mut change) = (0.0f64, 0.0f64);
     for axis in ["x", "y", "z"] {
         let v = &c[&format!("{name}.v{axis}")];
@@ -249,6 +258,15 @@ point = [0.0, 0.0, 0.0]
     );
     assert!(largest > 15.0, "the corner turns: |a| = {largest}");
     assert!(gap < 1e-3 * largest, "{gap} of {largest}");
+    // A cube's principal moments are equal: free of torque it spins at a constant ω, which a
+    // probe on its vertex and one on its centre read.
+    for probe in ["corner", "center"] {
+        for (axis, want) in ["wx", "wy", "wz"].iter().zip(w) {
+            for got in &c[&format!("{probe}.{axis}")] {
+                assert!((got - want).abs() < 1e-12 * 18.0, "{probe}.{axis} = {got}");
+            }
+        }
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -270,7 +288,7 @@ fn a_probe_on_a_sliding_rigid_bodys_vertex_reads_the_rigid_acceleration() {
         .replace("vtu_every = 0.05", "vtu_every = 0.0");
     let c = run_scene(&dir, &scene);
     // After the first 0.05 s, in which the block drops 1 mm onto the plane and settles.
-    let settled = c["t"].iter().position(|&t| t >= 0.05).unwrap();
+    let settled = c["time"].iter().position(|&t| t >= 0.05).unwrap();
     // The contacts chatter (spheres touch and let go, stick and slip), so the acceleration
     // jumps from step to step: its integral, not its central difference, is the velocity.
     let (gap, change) = integration_gap(&c, "corner", settled);
@@ -284,9 +302,9 @@ fn a_probe_on_a_sliding_rigid_bodys_vertex_reads_the_rigid_acceleration() {
     // corner's differs by the block's rocking, ω × r at the ends over the window).
     let theta = 25f64.to_radians();
     let (down_x, down_z) = (-theta.cos(), -theta.sin());
-    let rows = (settled..c["t"].len()).len() as f64;
+    let rows = (settled..c["time"].len()).len() as f64;
     let mean = |name: &str| {
-        (settled..c["t"].len())
+        (settled..c["time"].len())
             .map(|k| c[&format!("{name}.ax")][k] * down_x + c[&format!("{name}.az")][k] * down_z)
             .sum::<f64>()
             / rows

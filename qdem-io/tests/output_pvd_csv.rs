@@ -69,12 +69,13 @@ fn probe_csv_header_and_exact_values() {
     assert!(!path.exists(), "the file appears only on finish");
 
     let v = |x: f64, y: f64, z: f64| Vector3::new(x, y, z);
-    let rows: Vec<(f64, Vec<[Vector3<f64>; 3]>)> = vec![
+    let nan = Vector3::repeat(f64::NAN);
+    let rows: Vec<(f64, Vec<[Vector3<f64>; 4]>)> = vec![
         (
             0.0,
             vec![
-                [Vector3::zeros(); 3],
-                [v(-0.0, 0.0, 1.0), Vector3::zeros(), v(0.0, 0.0, -9.81)],
+                [Vector3::zeros(); 4],
+                [v(-0.0, 0.0, 1.0), Vector3::zeros(), v(0.0, 0.0, -9.81), nan],
             ],
         ),
         (
@@ -84,11 +85,13 @@ fn probe_csv_header_and_exact_values() {
                     v(1.0 / 3.0, -2.5e-7, 5e-324),
                     v(1e300, -1e-300, 0.1),
                     v(f64::MAX, f64::MIN_POSITIVE, 123456.789),
+                    v(0.0, -40.0, 1.0 / 7.0),
                 ],
                 [
                     v(std::f64::consts::PI, 1e16, 9.999999999999999e-6),
                     v(1e-5, -7.0, 2.0 / 3.0),
                     v(0.2, 0.3, 0.7),
+                    nan,
                 ],
             ],
         ),
@@ -99,8 +102,9 @@ fn probe_csv_header_and_exact_values() {
                     v(f64::NAN, f64::INFINITY, f64::NEG_INFINITY),
                     Vector3::zeros(),
                     Vector3::zeros(),
+                    Vector3::zeros(),
                 ],
-                [Vector3::zeros(); 3],
+                [Vector3::zeros(); 4],
             ],
         ),
     ];
@@ -124,9 +128,10 @@ fn probe_csv_header_and_exact_values() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "t,tip.ux,tip.uy,tip.uz,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az,\
+        "time,tip.ux,tip.uy,tip.uz,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az,\
+         tip.wx,tip.wy,tip.wz,\
          mid span.ux,mid span.uy,mid span.uz,mid span.vx,mid span.vy,mid span.vz,\
-         mid span.ax,mid span.ay,mid span.az"
+         mid span.ax,mid span.ay,mid span.az,mid span.wx,mid span.wy,mid span.wz"
     );
     for (t, samples) in &rows {
         let line = lines.next().expect("a row per call");
@@ -144,7 +149,7 @@ fn probe_csv_header_and_exact_values() {
                 want.push(x.to_bits());
             }
         }
-        assert_eq!(got.len(), 19);
+        assert_eq!(got.len(), 25);
         // NaN compares by bits too: the standard NaN is written and read back.
         assert_eq!(got, want, "{line}");
     }
@@ -181,6 +186,29 @@ fn probe_csv_rejects_bad_names_and_drop_leaves_nothing() {
     let mut csv = ProbeCsv::create(&path, &[]).unwrap();
     csv.row(0.5, &[]).unwrap();
     csv.finish().unwrap();
-    assert_eq!(std::fs::read_to_string(&path).unwrap(), "t\n0.5\n");
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "time\n0.5\n");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_probe_csv_of_output_format_one_is_not_resumed() {
+    let dir = test_dir("probes-format-one");
+    let path = dir.join("probes.csv");
+    let old =
+        "t,tip.ux,tip.uy,tip.uz,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az\n0,0,0,0,0,0,0,0,0,0\n";
+    std::fs::write(&path, old).unwrap();
+    let err = ProbeCsv::resume(&path, &["tip".to_string()], 1).unwrap_err();
+    let message = err.to_string();
+    assert!(matches!(err, OutputError::Resume { .. }), "{err:?}");
+    assert!(
+        message.contains("output format 1 (time column `t`"),
+        "{message}"
+    );
+    assert!(message.contains("without --resume"), "{message}");
+    assert_eq!(
+        std::fs::read_to_string(&path).unwrap(),
+        old,
+        "left as it was"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -54,12 +54,24 @@ fn mean(xs: &[f64]) -> f64 {
     xs.iter().sum::<f64>() / xs.len() as f64
 }
 
+/// The layer of thickness `LAYER` (m) under the lid at its start, measured where it starts
+/// (`fixed`) and following the lid (`top`).
+const LAYER: f64 = 0.03;
+
 #[test]
 fn a_servo_lid_holds_its_target_stress_on_a_bed() {
     let dir = test_dir("servo-lid");
-    let scene = bed_scene(&dir, 1.0, "");
+    let layer = |name: &str, follow: &str| {
+        format!(
+            "\n[[measure]]\nname = \"{name}\"\nbox = [[0.0, 0.0, {}], [{WIDTH}, {WIDTH}, 0.26]]\n{follow}\n",
+            0.26 - LAYER
+        )
+    };
+    let measures = layer("top", "follow_wall = 2") + &layer("fixed", "");
+    let scene = bed_scene(&dir, 1.0, &measures);
     let out = dir.join("out");
-    run(&mut build(&scene), &out, RunOptions::default()).unwrap();
+    let mut sim = build(&scene);
+    run(&mut sim, &out, RunOptions::default()).unwrap();
     let walls = columns(&out.join("walls.csv"));
     let rows = walls["time"].len();
     // The last quarter of the run, long after the lid reached the bed.
@@ -88,6 +100,18 @@ fn a_servo_lid_holds_its_target_stress_on_a_bed() {
         uz[rows - 1]
     );
     assert!((uz[rows - 1] - uz[last.start]).abs() < 1e-3);
+    // Its position is its point at the start moved by uz along its normal (to the ten
+    // significant digits walls.csv writes, 1.3e-10 m at 0.26 m), the floor's stays.
+    for k in 0..rows {
+        assert_eq!([walls["wall2.x"][k], walls["wall2.y"][k]], [0.0, 0.0]);
+        let z = walls["wall2.z"][k];
+        assert!(
+            (z - (0.26 + uz[k])).abs() < 3e-10,
+            "lid at {z}, uz {}",
+            uz[k]
+        );
+        assert_eq!(walls["wall1.z"][k], 0.0);
+    }
     // Statics of the bed: the floor carries the lid's force and the weight.
     let weight = weight(&out);
     let floor = mean(&walls["wall1.fz"][last.clone()]);
@@ -96,6 +120,40 @@ fn a_servo_lid_holds_its_target_stress_on_a_bed() {
     assert!(
         ((-floor) / (lid_force + weight) - 1.0).abs() < 0.02,
         "floor {floor} N vs lid {lid_force} N + weight {weight} N"
+    );
+    // The layer that follows the lid holds, at the end, exactly the stones whose centres lie
+    // between the lid and LAYER below it; the one left where the lid started holds none.
+    let (top, fixed) = (
+        columns(&out.join("measure_top.csv")),
+        columns(&out.join("measure_fixed.csv")),
+    );
+    let end = top["time"].len() - 1;
+    let state = &sim.world.state;
+    let written = top["time"][end];
+    assert!(
+        (written - state.time).abs() < 1e-9,
+        "the last row ({written} s) is the end"
+    );
+    let lid_z = 0.26 + sim.contacts().unwrap().wall_displacement(1, state.time).z;
+    let info = sim.granular.as_ref().unwrap();
+    let under = info
+        .stones
+        .iter()
+        .filter(|(c, _)| (lid_z - LAYER..=lid_z).contains(&state.position[*c].z))
+        .count();
+    eprintln!(
+        "layer under the lid: {under} stones, measured {}, σzz {:.1} Pa; at the lid's start {}",
+        top["stones"][end], top["szz"][end], fixed["stones"][end]
+    );
+    assert!(under > 10, "the layer holds stones: {under}");
+    assert_eq!(top["stones"][end], under as f64);
+    assert_eq!(fixed["stones"][end], 0.0);
+    // Its stress is the lid's, plus the weight of about half the layer (3% of it), to the
+    // scatter of a layer 2.5 grains thick (README: 0.91-1.04 of the weight above).
+    let szz = top["szz"][end];
+    assert!(
+        (szz / -TARGET - 1.0).abs() < 0.1,
+        "σzz {szz} Pa under the lid"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -197,5 +255,14 @@ fn what_a_servo_cannot_have_is_refused_by_name() {
     assert!(
         mesh.contains("[[wall]] #3") && mesh.contains("mesh wall"),
         "{mesh}"
+    );
+    // A measure can follow only a wall the scene has (two here).
+    let follow = refusal(
+        "servo-follow",
+        "[[measure]]\nname = \"top\"\nbox = [[0.0, 0.0, 0.2], [0.06, 0.06, 0.26]]\nfollow_wall = 3",
+    );
+    assert!(
+        follow.contains("follow_wall = 3") && follow.contains("has 2 [[wall]]s"),
+        "{follow}"
     );
 }

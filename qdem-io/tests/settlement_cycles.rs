@@ -58,7 +58,9 @@ fn cycles_match_probes(tag: &str, t_end: f64) {
     assert_eq!(cycles["cycle"], vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
     assert_eq!(bodies, vec!["beam"; 6]);
     let row_at = |t: f64| {
-        let k = probes["t"].iter().position(|&p| (p - t).abs() < 0.5 * dt);
+        let k = probes["time"]
+            .iter()
+            .position(|&p| (p - t).abs() < 0.5 * dt);
         k.unwrap_or_else(|| panic!("no probe row at t = {t}"))
     };
     let extrema = cycles["time_min"].iter().zip(&cycles["time_max"]);

@@ -111,15 +111,22 @@ pub(crate) fn check_start(
     model: &mut DemContacts,
     state: &State,
 ) -> Result<(), BuildError> {
-    let contact_error = |source| BuildError::Contact {
-        scene: scene.path.clone(),
-        source: Box::new(source),
+    let start_error = |source| match super::overlap_advice::advice(scene, &source) {
+        Some(fix) => BuildError::InitialOverlap {
+            scene: scene.path.clone(),
+            source: Box::new(source),
+            fix,
+        },
+        None => BuildError::Contact {
+            scene: scene.path.clone(),
+            source: Box::new(source),
+        },
     };
     let tolerance = scene.contact.as_ref().map_or(0.0, |c| c.overlap_tolerance);
     model
         .check_initial_overlaps(state, tolerance)
-        .map_err(contact_error)?;
-    model.check_initial_passage(state).map_err(contact_error)
+        .map_err(start_error)?;
+    model.check_initial_passage(state).map_err(start_error)
 }
 
 fn law(contact: &Contact) -> ContactLaw {

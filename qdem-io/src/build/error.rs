@@ -45,6 +45,17 @@ pub enum BuildError {
         /// What is wrong.
         source: Box<qdem_contact::ContactError>,
     },
+    /// The start is refused by the contact set-up: two bodies overlap, a body penetrates a
+    /// wall or starts inside another; `fix` names the scene keys of their tables.
+    #[error("{scene}: {source}; in this scene: {fix}")]
+    InitialOverlap {
+        /// The scene file.
+        scene: PathBuf,
+        /// What the contact set-up refused.
+        source: Box<qdem_contact::ContactError>,
+        /// The keys to change, table by table.
+        fix: String,
+    },
     /// A body's contact radius is too large for it.
     #[error(
         "{scene}: body `{body}`: contact_radius = {radius} m is more than half its smallest \

@@ -16,7 +16,8 @@
 //!   load's pressure or traction on the selected faces, lumped to their nodes;
 //! - [`probes`]: the `[[probe]]`s on particles, stones and boxes; `initial_motion`: the
 //!   bodies' and stones' initial velocity and angular velocity;
-//! - `contact`: contact spheres, the `[contact]` law and the `[[wall]]`s;
+//! - `contact`: contact spheres, the `[contact]` law and the `[[wall]]`s; `overlap_advice`:
+//!   the scene keys that fix a start the contact set-up refuses;
 //! - [`granular`]: the rigid stones of `[granular]`; [`ballast`]: the deformable stones of
 //!   `[ballast]`; `bonded`: a `[bonded]` body (built instead of everything else);
 //! - `periodic`: the `[periodic]` cell, its wrap groups and time delay;
@@ -40,6 +41,7 @@ mod kind_change;
 pub(crate) mod load_series;
 pub mod locking;
 pub mod memory;
+mod overlap_advice;
 mod periodic;
 pub mod pose_from;
 pub mod probes;

@@ -13,7 +13,7 @@
 //! | `*.vtu` (VTK XML UnstructuredGrid, linear tets, binary base64) | [`write_vtu`] |
 //! | `*.vtu` of vertices, lines or triangles (spheres, contacts, bonds, walls) | [`write_vtu_mesh`] |
 //! | `*.pvd` (ParaView time-series collection) | [`PvdIndex`] |
-//! | `probes.csv` (per-probe u, v, a over time, streamed) | [`ProbeCsv`] |
+//! | `probes.csv` (per-probe u, v, a, ω over time, streamed) | [`ProbeCsv`] |
 //! | `summary.json` | [`write_summary`] |
 //!
 //! Floating-point numbers written as text (CSV, PVD times) use the shortest decimal form
@@ -31,7 +31,7 @@ mod vtu;
 pub use atomic::{remove_stale_temporaries, write_atomic, AtomicFile};
 pub use error::{IoStage, OutputError};
 pub use folder_lock::{FolderLock, LockError, LOCK_FILE};
-pub use probes_csv::{ProbeCsv, PROBE_COLUMNS, REGION_COLUMNS};
+pub use probes_csv::{ProbeCsv, ProbeSample, PROBE_COLUMNS, REGION_COLUMNS, TIME_COLUMN};
 pub use pvd::PvdIndex;
 pub use summary::write_summary;
 pub use vtu::{
@@ -40,6 +40,12 @@ pub use vtu::{
 
 use std::borrow::Cow;
 use std::io::{self, Write};
+
+/// The version of the output files' layout a run writes, in `summary.json` as
+/// `output_format`: 1 until `probes.csv` named its time column `t` (the other CSVs `time`)
+/// and had no angular velocity; 2: `probes.csv`'s time column is `time` and every probe has
+/// `wx,wy,wz`, `walls.csv` has each wall's position `wallK.x,y,z`.
+pub const OUTPUT_FORMAT: u32 = 2;
 
 /// Writes `x` in the shortest decimal form that parses back to the same `f64`: plain
 /// notation for zero and magnitudes in `[1e-5, 1e16)`, scientific (`1.5e-7`) otherwise;

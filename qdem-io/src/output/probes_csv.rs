@@ -1,9 +1,11 @@
 //! Probe time histories as CSV, written row by row during a run.
 //!
-//! Layout: a header line `t,P.ux,P.uy,P.uz,P.vx,P.vy,P.vz,P.ax,P.ay,P.az,...` (nine columns
-//! per probe `P`: displacement, velocity, acceleration), then five per box probe `R`
-//! (`R.vx,R.vy,R.vz,R.ke,R.count`: mean velocity, kinetic energy, count of the stones inside),
-//! then one line per sample time.
+//! Layout ([`OUTPUT_FORMAT`](super::OUTPUT_FORMAT) 2): a header line
+//! `time,P.ux,P.uy,P.uz,P.vx,P.vy,P.vz,P.ax,P.ay,P.az,P.wx,P.wy,P.wz,...` (twelve columns per
+//! probe `P`: displacement, velocity, acceleration, angular velocity), then five per box probe
+//! `R` (`R.vx,R.vy,R.vz,R.ke,R.count`: mean velocity, kinetic energy, count of the stones
+//! inside), then one line per sample time. Format 1 named the time column `t` and had no
+//! angular velocity; [`ProbeCsv::resume`] refuses such a file by name.
 //! Numbers are written with the shortest decimal form that parses back to the same `f64`
 //! (plain notation for magnitudes in `[1e-5, 1e16)` and zero, scientific `1.5e-7`
 //! otherwise; NaN and infinities as `NaN`, `inf`, `-inf`), so nothing is lost.
@@ -20,8 +22,17 @@ use super::atomic::AtomicFile;
 use super::error::{IoStage, OutputError};
 use super::write_f64;
 
+/// The name of the time column, the first of every row (`t` in output format 1).
+pub const TIME_COLUMN: &str = "time";
+
 /// The column suffixes written for each probe, in order.
-pub const PROBE_COLUMNS: [&str; 9] = ["ux", "uy", "uz", "vx", "vy", "vz", "ax", "ay", "az"];
+pub const PROBE_COLUMNS: [&str; 12] = [
+    "ux", "uy", "uz", "vx", "vy", "vz", "ax", "ay", "az", "wx", "wy", "wz",
+];
+
+/// One probe's sample: displacement (m), velocity (m/s), acceleration (m/s²) and angular
+/// velocity (rad/s), the order of [`PROBE_COLUMNS`].
+pub type ProbeSample = [Vector3<f64>; 4];
 
 /// The column suffixes written for each box probe, in order.
 pub const REGION_COLUMNS: [&str; 5] = ["vx", "vy", "vz", "ke", "count"];
@@ -35,17 +46,19 @@ pub const REGION_COLUMNS: [&str; 5] = ["vx", "vy", "vz", "ke", "count"];
 /// let path = std::env::temp_dir().join(format!("qdem-doc-{}-probes.csv", std::process::id()));
 /// let mut csv = ProbeCsv::create(&path, &["tip".to_string()]).unwrap();
 /// let (u, v, a) = (Vector3::new(0.0, 0.0, -1e-4), Vector3::zeros(), Vector3::zeros());
-/// csv.row(0.5, &[[u, v, a]]).unwrap();
+/// let w = Vector3::new(0.0, 2.0, 0.0);
+/// csv.row(0.5, &[[u, v, a, w]]).unwrap();
 /// csv.finish().unwrap();
 /// let text = std::fs::read_to_string(&path).unwrap();
-/// assert!(text.starts_with("t,tip.ux,tip.uy,"));
+/// assert!(text.starts_with("time,tip.ux,tip.uy,"));
+/// assert!(text.contains(",tip.wx,tip.wy,tip.wz\n0.5,"));
 /// # std::fs::remove_file(&path).unwrap();
 /// ```
 #[derive(Debug)]
 pub struct ProbeCsv {
     /// The file being written.
     file: AtomicFile,
-    /// The number of probes (columns per row: `1 + 9 * num_probes`).
+    /// The number of probes (twelve columns each, [`PROBE_COLUMNS`]).
     num_probes: usize,
     /// The number of box probes (five columns each, after the probes').
     num_regions: usize,
@@ -128,15 +141,15 @@ impl ProbeCsv {
         self.file.path()
     }
 
-    /// Writes one row: time `t`, then for each probe its displacement, velocity and
-    /// acceleration (`samples[i] = [u, v, a]`).
+    /// Writes one row: time `t`, then for each probe its displacement, velocity,
+    /// acceleration and angular velocity (`samples[i] = [u, v, a, ω]`).
     ///
     /// # Errors
     /// [`OutputError::Length`] if `samples.len()` is not the number of probes,
     /// [`OutputError::NonFinite`] if `t` is NaN or infinite (sample values may be
     /// non-finite: a diverging run should still be visible), [`OutputError::Io`] if writing
     /// fails. Nothing is written on a validation error.
-    pub fn row(&mut self, t: f64, samples: &[[Vector3<f64>; 3]]) -> Result<(), OutputError> {
+    pub fn row(&mut self, t: f64, samples: &[ProbeSample]) -> Result<(), OutputError> {
         self.row_with_regions(t, samples, &[])
     }
 
@@ -148,7 +161,7 @@ impl ProbeCsv {
     pub fn row_with_regions(
         &mut self,
         t: f64,
-        samples: &[[Vector3<f64>; 3]],
+        samples: &[ProbeSample],
         regions: &[[f64; 5]],
     ) -> Result<(), OutputError> {
         for (name, expected, found) in [
@@ -217,6 +230,13 @@ impl ProbeCsv {
         let mut lines = text.lines();
         let header = lines.next().unwrap_or("");
         let expected = self::header(probe_names, region_names);
+        if header.split(',').next() == Some("t") {
+            return Err(resume_error(format!(
+                "it is a probes.csv of output format 1 (time column `t`, no angular velocity), \
+                 this qdem writes format {}; fix: start the run afresh (without --resume)",
+                super::OUTPUT_FORMAT
+            )));
+        }
         if header != expected {
             return Err(resume_error(format!(
                 "its header `{header}` is not that of the scene's probes `{expected}`"
@@ -254,7 +274,8 @@ impl ProbeCsv {
     }
 }
 
-/// The header line (without its newline): `t`, each probe's nine columns, each box probe's five.
+/// The header line (without its newline): `time`, each probe's twelve columns, each box
+/// probe's five.
 fn header(probe_names: &[String], region_names: &[String]) -> String {
     let columns = |names: &[String], suffixes: &'static [&'static str]| {
         names
@@ -262,7 +283,7 @@ fn header(probe_names: &[String], region_names: &[String]) -> String {
             .flat_map(move |n| suffixes.iter().map(move |c| format!("{n}.{c}")))
             .collect::<Vec<_>>()
     };
-    std::iter::once("t".to_string())
+    std::iter::once(TIME_COLUMN.to_string())
         .chain(columns(probe_names, &PROBE_COLUMNS))
         .chain(columns(region_names, &REGION_COLUMNS))
         .collect::<Vec<_>>()

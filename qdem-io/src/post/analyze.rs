@@ -14,7 +14,7 @@
 use crate::build::BuildError;
 use crate::linear_spectrum::{linear_spectrum, mobility, parzen_smooth};
 use crate::mode_marks::{read_mode_marks, ModeMark, ModeMarksError};
-use crate::output::{write_atomic, OutputError};
+use crate::output::{write_atomic, OutputError, OUTPUT_FORMAT, PROBE_COLUMNS, TIME_COLUMN};
 use crate::plot::{line_plot_svg, marked_plot_svg, Labels, Mark, Series};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
@@ -262,16 +262,7 @@ fn read_probes(path: &Path, options: &AnalyzeOptions) -> Result<Probes, AnalyzeE
     };
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    if header.first() != Some(&"t") || !(header.len() - 1).is_multiple_of(9) || header.len() < 10 {
-        return Err(bad(
-            1,
-            "not a probe file: the header must be `t` and nine columns per probe".to_string(),
-        ));
-    }
-    let names: Vec<String> = header[1..]
-        .chunks(9)
-        .map(|c| c[0].trim_end_matches(".ux").to_string())
-        .collect();
+    let (names, at) = probe_columns(&header).map_err(|message| bad(1, message))?;
     let mut probes = Probes {
         columns: vec![std::array::from_fn(|_| Vec::new()); names.len()],
         names,
@@ -296,9 +287,9 @@ fn read_probes(path: &Path, options: &AnalyzeOptions) -> Result<Probes, AnalyzeE
             continue;
         }
         probes.time.push(t);
-        for (p, chunk) in values[1..].chunks(9).enumerate() {
-            for (k, &v) in chunk.iter().enumerate() {
-                probes.columns[p][k].push(v);
+        for (columns, at) in probes.columns.iter_mut().zip(&at) {
+            for (column, &k) in columns.iter_mut().zip(at) {
+                column.push(values[k]);
             }
         }
     }
@@ -312,6 +303,44 @@ fn read_probes(path: &Path, options: &AnalyzeOptions) -> Result<Probes, AnalyzeE
         ));
     }
     Ok(probes)
+}
+
+/// The probes of a `probes.csv` header (output format 2): their names and, per probe, where its
+/// nine columns u, v, a in x, y, z are; refuses a header that is not a probe file's, naming
+/// format 1's `t`.
+fn probe_columns(header: &[&str]) -> Result<(Vec<String>, Vec<[usize; 9]>), String> {
+    match header.first() {
+        Some(&TIME_COLUMN) => {}
+        Some(&"t") => {
+            return Err(format!(
+                "a probes.csv of output format 1 (time column `t`); this qdem reads format \
+                 {OUTPUT_FORMAT}, whose time column is `{TIME_COLUMN}`; fix: run the scene again, \
+                 or rename the first column to `{TIME_COLUMN}`"
+            ))
+        }
+        _ => {
+            return Err(format!(
+                "not a probe file: the header must start with `{TIME_COLUMN}`"
+            ))
+        }
+    }
+    let mut names = Vec::new();
+    let mut at = Vec::new();
+    for cell in header.iter().filter_map(|c| c.strip_suffix(".ux")) {
+        let mut columns = [0; 9];
+        for (k, suffix) in PROBE_COLUMNS[..9].iter().enumerate() {
+            let name = format!("{cell}.{suffix}");
+            columns[k] = header.iter().position(|&c| c == name).ok_or_else(|| {
+                format!("not a probe file: probe `{cell}` has no column `{name}`")
+            })?;
+        }
+        names.push(cell.to_string());
+        at.push(columns);
+    }
+    if names.is_empty() {
+        return Err("not a probe file: no probe on a particle (no `NAME.ux` column)".to_string());
+    }
+    Ok((names, at))
 }
 
 /// The rows' common time step; refuses uneven sampling (an FFT needs even steps).
@@ -453,4 +482,25 @@ fn named_series<'a>(labels: &'a [String], data: &'a [Vec<(f64, f64)>]) -> Vec<Se
             points: d,
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_format_two_header_is_read_by_name_and_format_one_is_refused_by_name() {
+        let header = "time,tip.ux,tip.uy,tip.uz,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az,\
+                      tip.wx,tip.wy,tip.wz,bed.vx,bed.vy,bed.vz,bed.ke,bed.count";
+        let cells: Vec<&str> = header.split(',').collect();
+        let (names, at) = probe_columns(&cells).unwrap();
+        assert_eq!(names, ["tip"]);
+        assert_eq!(at, [[1, 2, 3, 4, 5, 6, 7, 8, 9]]);
+        let old = "t,tip.ux,tip.uy,tip.uz,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az";
+        let err = probe_columns(&old.split(',').collect::<Vec<_>>()).unwrap_err();
+        assert!(err.contains("output format 1 (time column `t`)"), "{err}");
+        assert!(err.contains("rename the first column to `time`"), "{err}");
+        let err = probe_columns(&["time", "tip.ux", "tip.uy"]).unwrap_err();
+        assert!(err.contains("probe `tip` has no column `tip.uz`"), "{err}");
+    }
 }

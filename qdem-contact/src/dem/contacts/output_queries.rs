@@ -4,6 +4,7 @@
 //! `contact_view.rs`'s).
 
 use super::*;
+use crate::dem::walls::wall::WallShape;
 
 impl DemContacts {
     /// The ghost scales (left, right) of the last evaluation and the average magnitude of the
@@ -83,6 +84,25 @@ impl DemContacts {
     /// The displacement (m) of wall `wall` at `time` from its place at t = 0.
     pub fn wall_displacement(&self, wall: usize, time: f64) -> Vec3 {
         self.walls.displacement(wall, time)
+    }
+
+    /// Where wall `wall` is at `time` (m): a plane's point, its point at t = 0 moved by its
+    /// velocity or its servo ([`DemContacts::wall_displacement`] is this less that point);
+    /// a mesh's centre of the bounding box of its triangles.
+    pub fn wall_position(&self, wall: usize, time: f64) -> Vec3 {
+        match &self.walls.list()[wall].shape {
+            WallShape::Plane(p) => p.point + p.velocity * time,
+            WallShape::Mesh(m) => {
+                let (vertices, _) = m.surface(time);
+                let lower = vertices
+                    .iter()
+                    .fold(Vec3::repeat(f64::MAX), |l, v| l.inf(v));
+                let upper = vertices
+                    .iter()
+                    .fold(Vec3::repeat(f64::MIN), |u, v| u.sup(v));
+                0.5 * (lower + upper)
+            }
+        }
     }
 
     /// The walls.

@@ -2,7 +2,9 @@
 //! tensor, solid fraction, porosity, coordination number and kinetic energy of the stones in
 //! its region, [`crate::post::contact_stress`]) and, at the end, `measure_NAME.svg` (the
 //! normal stresses against time) and `measure_NAME_energy.svg` (the kinetic energy: when
-//! has a pour settled).
+//! has a pour settled). A region with `follow_wall` is translated by that wall's
+//! displacement at each row ([`qdem_contact::DemContacts::wall_displacement`], the same on
+//! every rank of a decomposed run).
 
 use super::schedule::{probe_interval, Schedule};
 use super::{Recorder, StateRead, StepInfo};
@@ -37,6 +39,8 @@ const COLUMNS: [&str; 14] = [
 struct One {
     name: String,
     region: MeasureRegion,
+    /// The wall the region moves with (from 0).
+    follow: Option<usize>,
     schedule: Schedule,
     /// The rows, flat: the time, then [`COLUMNS`].
     rows: Vec<f64>,
@@ -67,6 +71,7 @@ impl Measures {
             .map(|m| One {
                 name: m.name.clone(),
                 region: m.shape(),
+                follow: m.follow_wall.map(|k| k - 1),
                 schedule: Schedule::new(m.every.unwrap_or_else(|| probe_interval(sim))),
                 rows: Vec::new(),
             })
@@ -116,9 +121,15 @@ impl Recorder for Measures {
         };
         for m in &mut self.measures {
             if m.schedule.due(state.time, step.dt) {
+                let region = match m.follow {
+                    Some(w) => m
+                        .region
+                        .shifted(contacts.wall_displacement(w, state.time).into()),
+                    None => m.region,
+                };
                 m.rows.push(state.time);
                 m.rows
-                    .extend(cells(&measure(&m.region, stones, contacts, state)));
+                    .extend(cells(&measure(&region, stones, contacts, state)));
             }
         }
         Ok(())

@@ -1,6 +1,11 @@
-//! [`Probes`]: `probes.csv` (each probe's displacement, velocity and acceleration, then each
-//! box probe's mean velocity, kinetic energy and count of stones, every `probe_every`,
-//! streamed) and, at the end, `probes.svg` (the displacements against time).
+//! [`Probes`]: `probes.csv` (each probe's displacement, velocity, acceleration and angular
+//! velocity, then each box probe's mean velocity, kinetic energy and count of stones, every
+//! `probe_every`, streamed) and, at the end, `probes.svg` (the displacements against time).
+//!
+//! The angular velocity ω (rad/s, world frame) is the rigid body's for a probe on a rigid
+//! body's member or centre (a clump stone, a rigid `[[body]]`), the particle's own for a
+//! particle that rotates (a one-sphere stone, a bonded particle), and NaN for a particle
+//! without rotation (a deformable body's node: its material turns, the node carries none).
 //!
 //! A probe on a rigid body's member (a surface vertex, a clump's sphere) reads the rigid
 //! motion's acceleration a_c + α × r + ω × (ω × r) ([`qdem_core::step::RigidBodies::point_acceleration`]):
@@ -12,9 +17,10 @@ use super::schedule::{probe_interval, Schedule};
 use super::{Recorder, RunFigures, StateRead, StepInfo};
 use crate::build::probes::region_sample;
 use crate::build::Simulation;
-use crate::output::{OutputError, ProbeCsv};
+use crate::output::{OutputError, ProbeCsv, ProbeSample};
 use crate::plot::{line_plot_svg, Labels, Series};
 use qdem_core::checkpoint::same_count;
+use qdem_core::step::State;
 use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -24,6 +30,8 @@ pub(crate) struct Probes {
     names: Vec<String>,
     /// The box probes' names.
     regions: Vec<String>,
+    /// Where each probe's angular velocity comes from.
+    spins: Vec<Spin>,
     /// Whether a sample needs the whole state (module docs).
     whole: bool,
     csv_path: PathBuf,
@@ -38,17 +46,20 @@ pub(crate) struct Probes {
 impl Probes {
     pub(crate) fn new(sim: &Simulation, out_dir: &Path) -> Probes {
         let names: Vec<String> = sim.probes.iter().map(|p| p.name.clone()).collect();
-        let rigid = &sim.world.state.rigid;
-        let on_member = sim
+        let state = &sim.world.state;
+        let spins: Vec<Spin> = sim
             .probes
             .iter()
-            .any(|p| rigid.body_of_member(p.particle).is_some());
+            .map(|p| Spin::of(state, p.particle))
+            .collect();
+        let on_body = spins.iter().any(|s| matches!(s, Spin::Body(_)));
         Probes {
             schedule: Schedule::new(probe_interval(sim)),
             history: vec![Vec::new(); 3 * names.len()],
             names,
             regions: sim.regions.iter().map(|r| r.name.clone()).collect(),
-            whole: on_member || !sim.regions.is_empty(),
+            spins,
+            whole: on_body || !sim.regions.is_empty(),
             csv_path: out_dir.join("probes.csv"),
             svg_path: out_dir.join("probes.svg"),
             csv: None,
@@ -57,16 +68,53 @@ impl Probes {
     }
 }
 
-/// Displacement, velocity and acceleration of every probe's particle.
-fn samples(sim: &Simulation) -> Vec<[Vec3; 3]> {
+/// Where a probe's angular velocity comes from (module docs).
+#[derive(Clone, Copy, Debug)]
+enum Spin {
+    /// The rigid body's, of which the particle is the centre or a member.
+    Body(usize),
+    /// The particle's own rotational degrees of freedom.
+    Particle,
+    /// None: the particle does not rotate (NaN).
+    None,
+}
+
+impl Spin {
+    /// The source of particle `p`'s angular velocity in `state`.
+    fn of(state: &State, p: usize) -> Spin {
+        let rigid = &state.rigid;
+        let body = rigid
+            .body_of_member(p)
+            .or_else(|| rigid.center.iter().position(|&c| c == p));
+        match body {
+            Some(b) => Spin::Body(b),
+            None if state.spin.inertia.get(p).is_some_and(|&j| j > 0.0) => Spin::Particle,
+            None => Spin::None,
+        }
+    }
+
+    /// The angular velocity (rad/s) it reads of particle `p` in `state`.
+    fn read(self, state: &State, p: usize) -> Vec3 {
+        match self {
+            Spin::Body(b) => state.rigid.angular_velocity[b],
+            Spin::Particle => state.spin.velocity[p],
+            Spin::None => Vec3::repeat(f64::NAN),
+        }
+    }
+}
+
+/// Displacement, velocity, acceleration and angular velocity of every probe's particle.
+fn samples(sim: &Simulation, spins: &[Spin]) -> Vec<ProbeSample> {
     let s = &sim.world.state;
     sim.probes
         .iter()
-        .map(|p| {
+        .zip(spins)
+        .map(|(p, spin)| {
             [
                 s.displacement(p.particle),
                 s.velocity[p.particle],
                 acceleration(sim, p.particle),
+                spin.read(s, p.particle),
             ]
         })
         .collect()
@@ -124,7 +172,7 @@ impl Recorder for Probes {
         if !self.schedule.due(time, step.dt) {
             return Ok(());
         }
-        let samples = samples(sim);
+        let samples = samples(sim, &self.spins);
         for (p, sample) in samples.iter().enumerate() {
             for (axis, u) in sample[0].iter().enumerate() {
                 self.history[3 * p + axis].push((time, *u));

@@ -1,11 +1,12 @@
-//! `summary.json` of a finished run: the run's figures (steps, step, stable bound, wall time,
+//! `summary.json` of a finished run: the version of the outputs' layout
+//! ([`crate::output::OUTPUT_FORMAT`]), the run's figures (steps, step, stable bound, wall time,
 //! rates, the stage counters of [`qdem_core::world::World`], a static run's linear solves), the
 //! bodies and probes, the contact set and the periodic cell, then each recorder's part
 //! ([`super::Recorder::summarize`]).
 
 use super::{Recorder, RunFigures};
 use crate::build::Simulation;
-use crate::output::{write_summary, OutputError};
+use crate::output::{write_summary, OutputError, OUTPUT_FORMAT};
 use crate::runner::RunReport;
 use qdem_core::step::Scheme;
 use serde_json::json;
@@ -58,6 +59,7 @@ fn base(sim: &Simulation, report: &RunReport) -> serde_json::Value {
     let world = &sim.world;
     let settings = world.settings();
     json!({
+        "output_format": OUTPUT_FORMAT,
         "scene": sim.scene.path.display().to_string(),
         "integrator": report.integrator,
         "steps": report.steps,

@@ -1,8 +1,10 @@
 //! [`Walls`]: `walls.csv`: every `probe_every`, each `[[wall]]`'s total contact force (N, the
-//! force the spheres exert on it: the reaction a support measures) and its displacement from
-//! its place at t = 0 (m: a servo wall's from where its servo moved it), columns `wallK.fx, fy, fz, ux, uy, uz` for the K-th `[[wall]]`
-//! (from 1, in scene order), read from the touching contacts of the last evaluation
-//! ([`qdem_contact::DemContacts::touching`]).
+//! force the spheres exert on it: the reaction a support measures), read from the touching
+//! contacts of the last evaluation ([`qdem_contact::DemContacts::touching`]), its
+//! displacement from its place at t = 0 (m: a servo wall's as its servo moved it) and its
+//! position (m, [`qdem_contact::DemContacts::wall_position`]: a plane's point, a mesh's
+//! bounding-box centre), columns `wallK.fx, fy, fz, ux, uy, uz, x, y, z` for the K-th
+//! `[[wall]]` (from 1, in scene order).
 
 use super::schedule::{probe_interval, Schedule};
 use super::{write_rows, Recorder, StateRead, StepInfo};
@@ -17,7 +19,7 @@ pub(crate) struct Walls {
     schedule: Schedule,
     path: PathBuf,
     walls: usize,
-    /// The rows, flat: the time, then per wall its force and displacement.
+    /// The rows, flat: the time, then per wall its force, displacement and position.
     rows: Vec<f64>,
 }
 
@@ -63,7 +65,9 @@ impl Recorder for Walls {
         self.rows.push(time);
         for (w, force) in wall_forces(contacts).iter().enumerate() {
             let moved = contacts.wall_displacement(w, time);
-            self.rows.extend(force.iter().chain(moved.iter()));
+            let at = contacts.wall_position(w, time);
+            self.rows
+                .extend(force.iter().chain(moved.iter()).chain(at.iter()));
         }
         Ok(())
     }
@@ -71,7 +75,8 @@ impl Recorder for Walls {
     fn finish(&mut self, _sim: &Simulation) -> Result<(), OutputError> {
         let mut header = vec!["time".to_string()];
         for k in 1..=self.walls {
-            header.extend(["fx", "fy", "fz", "ux", "uy", "uz"].map(|c| format!("wall{k}.{c}")));
+            let columns = ["fx", "fy", "fz", "ux", "uy", "uz", "x", "y", "z"];
+            header.extend(columns.map(|c| format!("wall{k}.{c}")));
         }
         write_rows(&self.path, &header, &self.rows)
     }

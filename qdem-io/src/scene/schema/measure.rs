@@ -15,6 +15,7 @@ scene_table! {
     /// name = "bed"
     /// box = [[0.0, 0.0, 0.05], [0.3, 0.7, 0.15]]   # or center = [x, y, z] and radius = r
     /// every = 1e-3                                  # s; default as probes.csv's rows
+    /// follow_wall = 2                               # optional: moves with the 2nd [[wall]]
     /// ```
     #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
     #[serde(deny_unknown_fields)]
@@ -35,6 +36,11 @@ scene_table! {
         #[serde(default)]
         every: Option<f64> => "number", optional,
             "Simulated time between two rows of `measure_NAME.csv`, s; default `probe_every`.";
+        #[serde(default)]
+        follow_wall: Option<usize> => "integer", optional,
+            "The K-th `[[wall]]` (from 1, `walls.csv`'s `wallK`) the region moves with: at each \
+             row it is `box` or `center` translated by that wall's displacement since t = 0 \
+             (`wallK.ux,uy,uz`), its volume unchanged (a layer under a servo lid).";
     }
 }
 
@@ -59,6 +65,15 @@ impl Measure {
 }
 
 impl MeasureRegion {
+    /// The region translated by `d` (m).
+    pub fn shifted(&self, d: [f64; 3]) -> MeasureRegion {
+        let add = |x: [f64; 3]| std::array::from_fn(|k| x[k] + d[k]);
+        match *self {
+            MeasureRegion::Box([lo, hi]) => MeasureRegion::Box([add(lo), add(hi)]),
+            MeasureRegion::Sphere(c, r) => MeasureRegion::Sphere(add(c), r),
+        }
+    }
+
     /// Its volume (m³).
     pub fn volume(&self) -> f64 {
         match self {

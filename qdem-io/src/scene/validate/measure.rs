@@ -1,6 +1,6 @@
 //! `[[measure]]`: unique names, one region (a box, or a centre and a radius), a positive
-//! interval, a `[granular]` sample whose stones it measures and a `[contact]` whose forces
-//! make its stress.
+//! interval, a wall to follow that the scene has, a `[granular]` sample whose stones it
+//! measures and a `[contact]` whose forces make its stress.
 
 use super::super::schema::RawScene;
 use super::checker::{box_corners, label, unique_names, Checker};
@@ -27,6 +27,19 @@ pub(super) fn measure_tables(c: &mut Checker<'_>, raw: &RawScene) {
         }
         if let Some(every) = m.every {
             c.positive(&["measure", &idx, "every"], &l, "every", every, "s");
+        }
+        if let Some(k) = m.follow_wall {
+            let walls = raw.walls.len();
+            if k == 0 || k > walls {
+                c.error(
+                    &["measure", &idx, "follow_wall"],
+                    format!(
+                        "{l}: follow_wall = {k}, but the scene has {walls} [[wall]]s; fix: give \
+                         the wall's number from 1 in scene order (walls.csv's wallK), or drop \
+                         follow_wall"
+                    ),
+                );
+            }
         }
         if raw.granular.is_none() {
             c.error(
