@@ -89,12 +89,12 @@ pub(super) fn advise(
         ("deformable".into(), format!("{why}; {modes}"))
     } else if d <= NEGLIGIBLE_DYNAMICS {
         let steps = match rigid_dt.is_finite() {
-            true => format!("the contacts' step {rigid_dt:.3e} s"),
-            false => "no step bound of its own".to_string(),
+            true => format!("at the contacts' step {rigid_dt:.3e} s"),
+            false => "with no bound of its own".to_string(),
         };
         let mut text = format!(
             "{modes} (at most {NEGLIGIBLE_DYNAMICS}): rigid, it misses that much; it would step \
-             at {steps} instead of its own {:.3e} s, without its {} tetrahedra",
+             {steps} instead of its own {:.3e} s, without its {} tetrahedra",
             m.stable_dt, m.tets
         );
         text += &damping_note(sim, m.damping_ratio);
