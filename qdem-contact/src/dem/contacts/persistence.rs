@@ -1,7 +1,8 @@
 //! What a checkpoint keeps of a [`DemContacts`]: its spheres' particles, the candidate lists
 //! with their tangential springs, where and when they were built, the time-delayed boundary's
-//! estimates and the servo walls' planes (none written without servo walls: the layout of a
-//! run without them is unchanged).
+//! estimates, the servo walls' planes (none written without servo walls: the layout of a
+//! run without them is unchanged) and the rolling springs (none written without rolling
+//! friction: `rolling.rs`).
 //!
 //! A scene that starts from another scene's checkpoint (`[run] start_from`) takes the
 //! stretched tangential springs out of it by stable identities ([`SavedSprings`]): a pair by
@@ -155,6 +156,7 @@ impl Persistent for DemContacts {
             delay.save(out);
         }
         self.walls.save_servos(out);
+        self.save_rolling(out);
     }
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
         input.tag("contact")?;
@@ -183,6 +185,7 @@ impl Persistent for DemContacts {
             delay.restore(input)?;
         }
         self.walls.restore_servos(input)?;
+        self.restore_rolling(input)?;
         self.index_partners();
         if let Some(split) = &mut self.split {
             split.whole = true;
