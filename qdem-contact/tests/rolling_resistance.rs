@@ -56,7 +56,9 @@ fn on_a_slope(theta: f64, v0: f64, mu_r: f64) -> (State, Vec<Box<dyn Model>>, f6
     state.position[0] = (RADIUS - static_overlap) * normal;
     state.velocity[0] = v0 * downhill;
     // Rolling: the contact point v + ω × (−R n) at rest.
-    state.rigid.set_angular_velocity(0, normal.cross(&downhill) * (v0 / RADIUS));
+    state
+        .rigid
+        .set_angular_velocity(0, normal.cross(&downhill) * (v0 / RADIUS));
     let wall = Wall {
         shape: WallShape::Plane(PlaneWall::new(Vec3::zeros(), normal, Vec3::zeros())),
         friction: MU,
@@ -92,7 +94,11 @@ fn a_rolling_sphere_decelerates_at_five_sevenths_mu_r_g_and_stops_where_the_clos
     assert!((measured / a - 1.0).abs() < 1e-3, "a = {measured} vs {a}");
     // Still rolling without slip: ω R = v.
     let w = state.rigid.angular_velocity[0].y;
-    assert!((w * RADIUS / speed(&state) - 1.0).abs() < 1e-3, "ω R = {}", w * RADIUS);
+    assert!(
+        (w * RADIUS / speed(&state) - 1.0).abs() < 1e-3,
+        "ω R = {}",
+        w * RADIUS
+    );
     while speed(&state) > 0.0 {
         s.step(&mut state, &mut models).unwrap();
     }
@@ -102,7 +108,10 @@ fn a_rolling_sphere_decelerates_at_five_sevenths_mu_r_g_and_stops_where_the_clos
         "stopped after {stop:.6} m at {at:.4} s vs v0²/(2a) = {expected:.6} m, v0/a = {:.4} s",
         v0 / a
     );
-    assert!((stop / expected - 1.0).abs() < 1e-3, "{stop} m vs {expected} m");
+    assert!(
+        (stop / expected - 1.0).abs() < 1e-3,
+        "{stop} m vs {expected} m"
+    );
     // Held by the rolling spring: its swing, 2 M/k_r = 2 μ_r m g / (k_t R) ≈ 2e-5 rad, moves
     // the centre by about R · 2e-5 = 0.2 µm; model A's constant torque would flip the spin by
     // μ_r R m g ∆t / I at every step and the sphere would creep.
@@ -159,8 +168,12 @@ fn a_sphere_stays_on_a_slope_flatter_than_tan_theta_mu_r_and_rolls_down_a_steepe
 fn pair_loads(mu_r: f64) -> (Vec<Vec3>, Vec<Vec3>) {
     let centers = [Vec3::zeros(), Vec3::new(0.0, 0.0, 2.0 * RADIUS - 1e-5)];
     let (mut state, spheres) = rigid_spheres(&centers, RADIUS, DENSITY);
-    state.rigid.set_angular_velocity(0, Vec3::new(3.0, 0.0, 1.0));
-    state.rigid.set_angular_velocity(1, Vec3::new(-1.0, 2.0, 0.0));
+    state
+        .rigid
+        .set_angular_velocity(0, Vec3::new(3.0, 0.0, 1.0));
+    state
+        .rigid
+        .set_angular_velocity(1, Vec3::new(-1.0, 2.0, 0.0));
     let mut model: DemContacts = contacts(&state, &spheres, (1e9, 0.25), settings(), vec![])
         .with_rolling_friction(mu_r)
         .unwrap();
@@ -183,6 +196,12 @@ fn a_pairs_rolling_torques_are_equal_and_opposite_against_the_relative_rolling()
     // growth k_r = k_t R*² = 1e5 · 0.005² = 2.5 N m/rad: M_r = 2.5 · 1e-6 · (4, −2, 0), below
     // the cap μ_r R* F_n = 0.1 · 0.005 · 1 N.
     let expected = 2.5 * 1e-6 * Vec3::new(4.0, -2.0, 0.0);
-    assert!((on_a + expected).norm() < 1e-12 * expected.norm(), "{on_a:?}");
-    assert!((on_a + on_b).norm() < 1e-12 * expected.norm(), "the pair adds a moment");
+    assert!(
+        (on_a + expected).norm() < 1e-12 * expected.norm(),
+        "{on_a:?}"
+    );
+    assert!(
+        (on_a + on_b).norm() < 1e-12 * expected.norm(),
+        "the pair adds a moment"
+    );
 }

@@ -10,7 +10,7 @@
 //! −f, is (r_b − δ/2) n × f. The pair kernel adds the moments as it evaluates; when its sums
 //! run apart from its law (a time-delayed boundary, a servo wall) or a rank's records are
 //! merged, it keeps n × f in a column beside the records. The image translation of the second partner, only through a periodic boundary, is
-//! a column too.
+//! a column too, and so is the rolling spring torque, only with rolling friction.
 
 use qdem_core::checkpoint::same_count;
 use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, Vec3};

@@ -91,9 +91,13 @@ impl DemContacts {
         };
         let pairs = self.candidates.pairs();
         let walls = self.candidates.wall_contacts();
-        let pairs = pairs.with_shifts().zip(&pairs.roll).filter_map(|((c, mut shift), m)| {
-            self.pair_contact(c, &mut shift).map(|contact| energy(contact, m))
-        });
+        let pairs = pairs
+            .with_shifts()
+            .zip(&pairs.roll)
+            .filter_map(|((c, mut shift), m)| {
+                self.pair_contact(c, &mut shift)
+                    .map(|contact| energy(contact, m))
+            });
         let walls = walls.items.iter().zip(&walls.roll).filter_map(|(c, m)| {
             self.wall_contact(time, c.first as usize, c.second as usize)
                 .map(|contact| energy(contact, m))
@@ -113,9 +117,20 @@ impl DemContacts {
     }
 
     /// Reads back what [`DemContacts::save_rolling`] wrote.
-    pub(super) fn restore_rolling(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
+    pub(super) fn restore_rolling(
+        &mut self,
+        input: &mut Decoder<'_>,
+    ) -> Result<(), CheckpointError> {
         if self.rolling.is_none() {
             return Ok(());
+        }
+        if input.is_done() {
+            return Err(CheckpointError::Invalid {
+                what: "contact history",
+                detail: "it was written without `rolling_friction`; resume it with \
+                         the scene that wrote it, or start a stage from it (`[run] start_from`)"
+                    .to_string(),
+            });
         }
         input.tag("rolling")?;
         let n = self.candidates.pairs().len();
@@ -143,5 +158,102 @@ pub(super) fn second_rolls(share: (Vec3, Vec3), roll: Option<&Vec3>, scale: f64)
     match roll {
         Some(m) => (share.0, share.1 + scale * m),
         None => share,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dem::laws::linear_spring::LinearSpring;
+    use crate::{PlaneWall, WallShape};
+    use qdem_core::Mat3;
+
+    /// Two one-sphere rigid bodies pressed together (1 µm) and the lower one into a floor,
+    /// spinning, with rolling friction `mu_r`.
+    fn spinning_pair(mu_r: f64) -> (State, DemContacts) {
+        let r = 0.01;
+        let centers = vec![
+            Vec3::new(0.0, 0.0, r - 1e-6),
+            Vec3::new(0.0, 0.0, 3.0 * r - 2e-6),
+        ];
+        let mut state = State::at_rest(centers);
+        state.mass = vec![0.01, 0.01];
+        for b in 0..2 {
+            let inertia = Mat3::identity() * (0.4 * 0.01 * r * r);
+            state.add_rigid_body("sphere", b, &[], inertia).unwrap();
+        }
+        state
+            .rigid
+            .set_angular_velocity(0, Vec3::new(0.0, 5.0, 0.0));
+        state
+            .rigid
+            .set_angular_velocity(1, Vec3::new(-2.0, 0.0, 1.0));
+        let spheres: Vec<ContactSphere> = (0..2)
+            .map(|b| ContactSphere {
+                particle: b,
+                radius: r,
+                body: b,
+                material: 0,
+            })
+            .collect();
+        let floor = Wall {
+            shape: WallShape::Plane(PlaneWall::new(Vec3::zeros(), Vec3::z(), Vec3::zeros())),
+            friction: 0.5,
+        };
+        let settings = ContactSettings {
+            law: ContactLaw::Linear(LinearSpring {
+                normal_stiffness: 1e5,
+                tangential_stiffness: 1e5,
+                damping_ratio: 0.0,
+            }),
+            friction: 0.5,
+            skin: 0.001,
+        };
+        let names = vec!["a".to_string(), "b".to_string()];
+        let contacts = DemContacts::new(
+            &state,
+            &spheres,
+            names,
+            &[(1e9, 0.25)],
+            settings,
+            vec![floor],
+        )
+        .with_rolling_friction(mu_r)
+        .unwrap();
+        (state, contacts)
+    }
+
+    fn torques(model: &mut DemContacts, state: &State) -> Vec<Vec3> {
+        let (mut force, mut torque) = (vec![Vec3::zeros(); 2], vec![Vec3::zeros(); 2]);
+        model.add_forces(state, &mut force, &mut torque);
+        torque
+    }
+
+    #[test]
+    fn a_checkpoint_keeps_the_rolling_springs_and_one_without_them_is_refused() {
+        let (mut state, mut saved) = spinning_pair(0.1);
+        for k in 0..3 {
+            state.time = 1e-6 * k as f64;
+            torques(&mut saved, &state);
+        }
+        assert!(saved.candidates.pairs().roll[0].norm() > 0.0);
+        assert!(saved.candidates.wall_contacts().roll[0].norm() > 0.0);
+        let mut out = Encoder::new();
+        saved.save(&mut out);
+        let (_, mut restored) = spinning_pair(0.1);
+        restored.restore(&mut Decoder::new(out.bytes())).unwrap();
+        state.time = 3e-6;
+        assert_eq!(torques(&mut restored, &state), torques(&mut saved, &state));
+        // A checkpoint of the same scene without rolling friction has no springs to give.
+        let (_, without) = spinning_pair(0.0);
+        let mut out = Encoder::new();
+        without.save(&mut out);
+        let refused = restored
+            .restore(&mut Decoder::new(out.bytes()))
+            .unwrap_err();
+        assert!(
+            refused.to_string().contains("without `rolling_friction`"),
+            "{refused}"
+        );
     }
 }

@@ -114,7 +114,10 @@ mod tests {
         assert!((m - Vec3::new(0.01, 0.0, 0.0)).norm() < 1e-15, "{m:?}");
         // Rolling back unloads the spring elastically from the cap.
         rolling.update(&n, 0.02, &-spin, 1.0, 1e4, &mut m, 1e-4);
-        assert!((m - Vec3::new(0.01 - 8e-4, 0.0, 0.0)).norm() < 1e-15, "{m:?}");
+        assert!(
+            (m - Vec3::new(0.01 - 8e-4, 0.0, 0.0)).norm() < 1e-15,
+            "{m:?}"
+        );
         // A contact that pulls (F_n < 0) carries no rolling torque.
         rolling.update(&n, 0.02, &spin, -1.0, 1e4, &mut m, 1e-4);
         assert_eq!(m, Vec3::zeros());
