@@ -192,7 +192,7 @@ fn a_pairs_rolling_torques_are_equal_and_opposite_against_the_relative_rolling()
     let (f1, t1) = pair_loads(MU_R);
     assert_eq!(f0, f1, "rolling resistance adds no force");
     let (on_a, on_b) = (t1[0] - t0[0], t1[1] - t0[1]);
-    // ω_a − ω_b = (4, −2, 1), its rolling part (4, −2, 0); over 1 µm of rolling spring
+    // ω_a − ω_b = (4, −2, 1), its rolling part (4, −2, 0); over 1 µs of rolling spring
     // growth k_r = k_t R*² = 1e5 · 0.005² = 2.5 N m/rad: M_r = 2.5 · 1e-6 · (4, −2, 0), below
     // the cap μ_r R* F_n = 0.1 · 0.005 · 1 N.
     let expected = 2.5 * 1e-6 * Vec3::new(4.0, -2.0, 0.0);
