@@ -139,4 +139,10 @@ pub enum ContactError {
         /// The axis.
         axis: char,
     },
+    /// A rolling friction coefficient that is negative or not a number.
+    #[error("rolling friction {coefficient} is not a non-negative number; fix: set `rolling_friction` in [contact] to μ_r ≥ 0 (0 or absent: none)")]
+    RollingFriction {
+        /// The coefficient given.
+        coefficient: f64,
+    },
 }

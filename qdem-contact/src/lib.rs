@@ -46,6 +46,7 @@ pub use dem::contacts::{SavedSpring, SavedSprings, SavedWall};
 pub use dem::laws::contact_law::{ContactLaw, PairElasticity, PairGeometry};
 pub use dem::laws::hertz_mindlin::HertzMindlin;
 pub use dem::laws::linear_spring::LinearSpring;
+pub use dem::laws::rolling_resistance::RollingResistance;
 pub use dem::walls::mesh_wall::MeshWall;
 pub use dem::walls::plane_wall::PlaneWall;
 pub use dem::walls::servo_wall::Servo;

@@ -1191,3 +1191,22 @@ fn a_granular_generation_of_zero_stones_is_refused() {
     let one = granular.replace("count = 0", "count = 1");
     Scene::parse(&one, Path::new(PATH)).unwrap();
 }
+
+#[test]
+fn a_negative_rolling_friction_is_refused_at_its_key() {
+    let scene = format!(
+        "{BASE}\n[contact]\nnormal_stiffness = 1e6\ntangential_stiffness = 1e6\n\
+         rolling_friction = -0.1\n\n[granular]\nname = \"ballast\"\nmaterial = \"concrete\"\n\
+         region = [[0, 0, 0], [0.3, 0.7, 1.0]]\ncount = 10\ngrading = [[0.05, 0.0], [0.1, 1.0]]\n"
+    );
+    let line = BASE.lines().count() + 5;
+    let (_, msg) = error(&scene);
+    assert_has(
+        &msg,
+        &[
+            &format!("scenes/scene.toml:{line}:20:"),
+            "[contact]: rolling_friction = -0.1",
+            "must not be negative",
+        ],
+    );
+}

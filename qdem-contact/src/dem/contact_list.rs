@@ -10,7 +10,7 @@
 //! −f, is (r_b − δ/2) n × f. The pair kernel adds the moments as it evaluates; when its sums
 //! run apart from its law (a time-delayed boundary, a servo wall) or a rank's records are
 //! merged, it keeps n × f in a column beside the records. The image translation of the second partner, only through a periodic boundary, is
-//! a column too.
+//! a column too, and so is the rolling spring torque, only with rolling friction.
 
 use qdem_core::checkpoint::same_count;
 use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, Vec3};
@@ -70,13 +70,19 @@ pub(crate) struct ContactList {
     /// n × f of each contact at the last evaluation (N), when the kernel keeps it (a sum
     /// pass apart from the law, a rank's records); else none.
     pub(crate) turn: Vec<Vec3>,
+    /// The rolling spring torque M_r of each contact (N m, as it acts against the first
+    /// partner: [`crate::dem::laws::rolling_resistance`]): one per record with rolling
+    /// resistance, else none.
+    pub(crate) roll: Vec<Vec3>,
 }
 
 impl ContactList {
-    /// Replaces the list by `keys`, sorted, keeping the springs of contacts that stay; with
-    /// an image translation per record when `periodic`.
+    /// Replaces the list by `keys`, sorted, keeping the springs (and rolling springs) of
+    /// contacts that stay; with an image translation per record when `periodic`.
     pub(crate) fn rebuild(&mut self, keys: Vec<(u32, u32)>, periodic: bool) {
         let old = std::mem::take(&mut self.items);
+        let old_roll = std::mem::take(&mut self.roll);
+        let rolling = !old_roll.is_empty();
         let mut at = 0;
         self.items = keys
             .iter()
@@ -87,6 +93,10 @@ impl ContactList {
                 let kept = old
                     .get(at)
                     .filter(|c| (c.first, c.second) == (first, second));
+                if rolling {
+                    let roll = kept.map_or(Vec3::zeros(), |_| old_roll[at]);
+                    self.roll.push(roll);
+                }
                 Contact {
                     first,
                     second,
@@ -109,6 +119,9 @@ impl ContactList {
         retain_by(&mut self.items, &kept);
         if !self.shift.is_empty() {
             retain_by(&mut self.shift, &kept);
+        }
+        if !self.roll.is_empty() {
+            retain_by(&mut self.roll, &kept);
         }
         self.turn.clear();
     }
@@ -149,6 +162,12 @@ impl ContactList {
     #[inline]
     pub(crate) fn shift(&self, k: usize) -> Vec3 {
         self.shift.get(k).copied().unwrap_or_default()
+    }
+
+    /// Gives every record a rolling spring (zero where it has none yet): the column of a
+    /// list built, restored or carried without one.
+    pub(crate) fn keep_rolling(&mut self) {
+        self.roll.resize(self.items.len(), Vec3::zeros());
     }
 
     /// The records with their image translations.
@@ -207,7 +226,7 @@ impl ContactList {
         Ok(ContactList {
             items,
             shift,
-            turn: Vec::new(),
+            ..ContactList::default()
         })
     }
 }

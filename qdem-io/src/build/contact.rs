@@ -78,15 +78,17 @@ pub(crate) fn build_contacts(
         .map(|b| b.name.clone())
         .chain(extra.names)
         .collect();
-    let mut model = DemContacts::new(state, &spheres, names, &materials, settings, walls)
-        .with_body_surfaces(surfaces);
-    if let (Some(cell), Some(periodic)) = (extra.periodic, &scene.periodic) {
-        model = super::periodic::periodic_contacts(scene, periodic, &cell, model)?;
-    }
     let contact_error = |source| BuildError::Contact {
         scene: scene.path.clone(),
         source: Box::new(source),
     };
+    let mut model = DemContacts::new(state, &spheres, names, &materials, settings, walls)
+        .with_body_surfaces(surfaces)
+        .with_rolling_friction(contact.rolling_friction)
+        .map_err(contact_error)?;
+    if let (Some(cell), Some(periodic)) = (extra.periodic, &scene.periodic) {
+        model = super::periodic::periodic_contacts(scene, periodic, &cell, model)?;
+    }
     for (w, wall) in scene.walls.iter().enumerate() {
         if let Some(servo) = &wall.servo {
             let servo = servo.servo().map_err(|source| BuildError::Core {

@@ -44,7 +44,8 @@
 //! boundary (its reduction and ghost scales); `split.rs` one rank's part in a decomposed
 //! run, whose stages the world's exchange runs ([`qdem_core::parallel`]); `tunnelling.rs`
 //! the check, at each rebuild of the lists, for a sphere gone through a wall or into
-//! another body; and `stages.rs` where the evaluations stand. The other files hold what
+//! another body; `rolling.rs` the rolling resistance of the contacts; and `stages.rs` where
+//! the evaluations stand. The other files hold what
 //! [`DemContacts`] does with them: this one the narrow phase, the [`Model`] facet and the
 //! stable step; `build.rs` its construction; `stages.rs` the stages of one evaluation;
 //! `pipeline.rs` the reading of the spheres and the building of the candidate lists;
@@ -58,6 +59,7 @@ use crate::dem::broad_phase::{find_pairs, SphereSet};
 use crate::dem::contact_list::{Contact, ContactList};
 use crate::dem::contact_view::{Partner, SphereRecord, TouchingContact};
 use crate::dem::laws::contact_law::{ContactLaw, PairElasticity, PairGeometry};
+use crate::dem::laws::rolling_resistance::RollingResistance;
 use crate::dem::spring_blocks::{add_spring, spring, Attachment};
 use crate::dem::walls::wall::Wall;
 use crate::error::ContactError;
@@ -89,6 +91,7 @@ mod output_queries;
 mod pair_kernel;
 mod persistence;
 mod pipeline;
+mod rolling;
 mod servo_loads;
 mod spheres;
 mod split;
@@ -263,6 +266,8 @@ pub struct DemContacts {
     split: Option<ContactPart>,
     /// The check for spheres gone through a wall or into another body (`tunnelling.rs`).
     passage: PassageCheck,
+    /// The rolling resistance of every contact, if any (`rolling.rs`).
+    rolling: Option<RollingResistance>,
 }
 
 /// r_a r_b / (r_a + r_b).
@@ -296,7 +301,9 @@ impl Model for DemContacts {
     /// rest on one wall). k is the stiffest of the normal and tangential springs (Hertz's at an
     /// overlap of [`REFERENCE_OVERLAP`] of the radius), m the carrier's mass, ℓ the lever arm
     /// of a contact on a rigid body about its centre and I its smallest principal moment (ℓ = 0
-    /// for a body whose rotation is held). Carriers held in every direction are left out.
+    /// for a body whose rotation is held). With rolling friction a contact's rolling spring
+    /// k_r = k_t R*² adds k_r/I ≤ k ℓ²/I to its carrier's rotation: ℓ²/I is counted twice.
+    /// Carriers held in every direction are left out.
     fn stable_dt(&self, _state: &State) -> Option<f64> {
         let law = &self.settings.law;
         let zeta = law.damping_ratio();
@@ -320,7 +327,8 @@ impl Model for DemContacts {
             if mass.is_infinite() {
                 continue;
             }
-            let compliance = 1.0 / mass + self.spheres.lever()[s];
+            let rolls = 1.0 + self.rolling.is_some() as u8 as f64;
+            let compliance = 1.0 / mass + rolls * self.spheres.lever()[s];
             let (w, g) = (k * compliance, 2.0 * zeta * (k * mass).sqrt() * compliance);
             match self.spheres.rigid()[s] {
                 NOT_RIGID => worst = (worst.0.max(COORDINATION * w), worst.1.max(COORDINATION * g)),
@@ -357,7 +365,11 @@ impl Model for DemContacts {
                 self.wall_contact(state.time, c.first as usize, c.second as usize)
                     .map(|(g, e)| law.energy(&g, &e, &c.history))
             });
-        Some(pairs.chain(walls).sum())
+        let springs: f64 = pairs.chain(walls).sum();
+        match self.rolling_energy(state.time) {
+            Some(rolling) => Some(springs + rolling),
+            None => Some(springs),
+        }
     }
 
     fn persistence(&self) -> Persistence<'_> {

@@ -28,6 +28,7 @@
 //! Per step a candidate pair costs its record (read and written once) and two additions into
 //! sums that are in cache, and the serial add runs over the partners of candidates only.
 
+use super::rolling::{first_rolls, second_rolls};
 use super::*;
 use std::ops::Range;
 
@@ -201,6 +202,9 @@ impl DemContacts {
                 if keep_turn {
                     list.turn.resize(list.items.len(), Vec3::zeros());
                 }
+                if self.rolling().is_some() {
+                    list.keep_rolling();
+                }
             }
         }
         let mut sums = std::mem::take(&mut plan.sums);
@@ -217,13 +221,21 @@ impl DemContacts {
                 .zip(cut_column(&mut pairs.turn, pair_lengths()))
                 .zip(cut(&mut walls.items, wall_lengths()))
                 .zip(cut_column(&mut walls.turn, wall_lengths()))
-                .map(|((((pairs, shifts), turns), walls), wall_turns)| RunLists {
-                    pairs,
-                    shifts,
-                    turns,
-                    walls,
-                    wall_turns,
-                })
+                .zip(cut_column(&mut pairs.roll, pair_lengths()))
+                .zip(cut_column(&mut walls.roll, wall_lengths()))
+                .map(
+                    |((((((pairs, shifts), turns), walls), wall_turns), rolls), wall_rolls)| {
+                        RunLists {
+                            pairs,
+                            shifts,
+                            turns,
+                            walls,
+                            wall_turns,
+                            rolls,
+                            wall_rolls,
+                        }
+                    },
+                )
                 .collect();
             let this = &*self;
             // A time-delayed boundary scales the shares of pairs through it; without one the
@@ -338,6 +350,8 @@ impl DemContacts {
             turns,
             walls,
             wall_turns,
+            rolls,
+            wall_rolls,
         } = lists;
         for (k, (contact, &slot)) in pairs.iter_mut().zip(slots).enumerate() {
             let turn = match LAW {
@@ -349,12 +363,15 @@ impl DemContacts {
                     }
                     let Some((g, e)) = touching else {
                         contact.part();
-                        if let Some(at) = turns.get_mut(k) {
+                        for at in [turns.get_mut(k), rolls.get_mut(k)].into_iter().flatten() {
                             *at = Vec3::zeros();
                         }
                         continue;
                     };
                     let f = law.force(&g, &e, &mut contact.history, dt);
+                    if let Some(roll) = rolls.get_mut(k) {
+                        self.roll_pair(contact, (&g, &e), &f, roll, dt);
+                    }
                     let turn = contact.touch(f, &g.normal, g.overlap);
                     if let Some(at) = turns.get_mut(k) {
                         *at = turn;
@@ -375,6 +392,10 @@ impl DemContacts {
                 pair_share(contact, &turn, true, self.spheres.now(a).radius, scale_a),
                 pair_share(contact, &turn, false, self.spheres.now(b).radius, scale_b),
             );
+            let (first, second) = (
+                first_rolls(first, rolls.get(k), scale_a),
+                second_rolls(second, rolls.get(k), scale_b),
+            );
             add_to(&mut own[a - lo as usize], first);
             match (slot as usize).checked_sub(RUN_CHUNK) {
                 None => add_to(&mut own[slot as usize], second),
@@ -387,12 +408,18 @@ impl DemContacts {
                 true => {
                     let Some((g, e)) = self.wall_contact(time, s, contact.second as usize) else {
                         contact.part();
-                        if let Some(at) = wall_turns.get_mut(k) {
+                        for at in [wall_turns.get_mut(k), wall_rolls.get_mut(k)]
+                            .into_iter()
+                            .flatten()
+                        {
                             *at = Vec3::zeros();
                         }
                         continue;
                     };
                     let f = law.force(&g, &e, &mut contact.history, dt);
+                    if let Some(roll) = wall_rolls.get_mut(k) {
+                        self.roll_wall(contact, (&g, &e), &f, roll, dt);
+                    }
                     let turn = contact.touch(f, &g.normal, g.overlap);
                     if let Some(at) = wall_turns.get_mut(k) {
                         *at = turn;
@@ -402,9 +429,10 @@ impl DemContacts {
                 false => wall_turns[k],
             };
             if SUM {
+                let share = wall_share(contact, &turn, self.spheres.now(s).radius);
                 add_to(
                     &mut own[s - lo as usize],
-                    wall_share(contact, &turn, self.spheres.now(s).radius),
+                    first_rolls(share, wall_rolls.get(k), 1.0),
                 );
             }
         }
@@ -491,13 +519,16 @@ fn wall_share(c: &Contact, turn: &Vec3, radius: f64) -> Sum {
 }
 
 /// A run's slices of the candidate lists: its pairs, their image translations and n × f
-/// (each empty when the lists hold no such column), its wall contacts and their n × f.
+/// (each empty when the lists hold no such column), its wall contacts and their n × f, and
+/// the rolling springs of both (empty without rolling friction).
 struct RunLists<'a> {
     pairs: &'a mut [Contact],
     shifts: &'a mut [Vec3],
     turns: &'a mut [Vec3],
     walls: &'a mut [Contact],
     wall_turns: &'a mut [Vec3],
+    rolls: &'a mut [Vec3],
+    wall_rolls: &'a mut [Vec3],
 }
 
 /// A run's sums: those of its own spheres (from sphere `lo` on) and its foreign sums.

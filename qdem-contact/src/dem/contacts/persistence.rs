@@ -1,6 +1,7 @@
 //! What a checkpoint keeps of a [`DemContacts`]: its spheres' particles, the candidate lists
 //! with their tangential springs, where and when they were built, the time-delayed boundary's
-//! estimates, and every wall's place and velocity (a servo wall's plane as its servo left it).
+//! estimates, every wall's place and velocity (a servo wall's plane as its servo left it),
+//! and the rolling springs (none written without rolling friction: `rolling.rs`).
 //!
 //! A scene that starts from another scene's checkpoint (`[run] start_from`) takes the
 //! stretched tangential springs out of it by stable identities ([`SavedSprings`]): a pair by
@@ -214,6 +215,7 @@ impl Persistent for DemContacts {
         if let Some(delay) = &self.time_delay {
             delay.save(out);
         }
+        self.save_rolling(out);
     }
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
         input.tag("contact")?;
@@ -242,6 +244,7 @@ impl Persistent for DemContacts {
         if let Some(delay) = &mut self.time_delay {
             delay.restore(input)?;
         }
+        self.restore_rolling(input)?;
         self.index_partners();
         if let Some(split) = &mut self.split {
             split.whole = true;

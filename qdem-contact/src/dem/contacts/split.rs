@@ -28,7 +28,7 @@ use qdem_core::step::split::{
 const SPHERE_VALUES: usize = 9;
 
 /// Values per contact record in a merge: the list (0 pairs, 1 walls), partners, spring,
-/// force, n × f, δ/2, image shift.
+/// force, n × f, δ/2, image shift; then, with rolling friction, the rolling spring.
 const CONTACT_VALUES: usize = 16;
 
 /// One rank's part of a contact set.
@@ -279,6 +279,10 @@ impl DemContacts {
                 }
                 out.push(c.half_overlap);
                 out.extend_from_slice(shift.as_slice());
+                if self.rolling().is_some() {
+                    let roll = list.roll.get(k).copied().unwrap_or_default();
+                    out.extend_from_slice(roll.as_slice());
+                }
             }
         }
         true
@@ -290,7 +294,9 @@ impl DemContacts {
     pub(super) fn merge_records(&mut self, all: &[f64]) {
         let at = |v: &[f64], k: usize| Vec3::new(v[k], v[k + 1], v[k + 2]);
         let (mut pairs, mut walls) = (Vec::new(), Vec::new());
-        for v in all.chunks_exact(CONTACT_VALUES) {
+        let rolling = self.rolling().is_some();
+        let values = CONTACT_VALUES + 3 * rolling as usize;
+        for v in all.chunks_exact(values) {
             let contact = Contact {
                 first: v[1] as u32,
                 second: v[2] as u32,
@@ -298,19 +304,21 @@ impl DemContacts {
                 force: at(v, 6),
                 half_overlap: v[12],
             };
-            let contact = (contact, at(v, 9), at(v, 13));
+            let roll = rolling.then(|| at(v, CONTACT_VALUES));
+            let contact = (contact, at(v, 9), at(v, 13), roll);
             match v[0] == 0.0 {
                 true => pairs.push(contact),
                 false => walls.push(contact),
             }
         }
         let [pairs, walls] = [pairs, walls].map(|mut items| {
-            items.sort_by_key(|(c, _, _)| (c.first, c.second));
-            items.dedup_by_key(|(c, _, _)| (c.first, c.second));
+            items.sort_by_key(|(c, _, _, _)| (c.first, c.second));
+            items.dedup_by_key(|(c, _, _, _)| (c.first, c.second));
             ContactList {
                 items: items.iter().map(|e| e.0).collect(),
                 turn: items.iter().map(|e| e.1).collect(),
                 shift: items.iter().map(|e| e.2).collect(),
+                roll: items.iter().filter_map(|e| e.3).collect(),
             }
         });
         self.candidates.set_lists(pairs, walls);

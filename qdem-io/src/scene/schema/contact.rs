@@ -34,6 +34,11 @@ scene_table! {
         friction: f64 => "number", optional = "0.0",
             "Coulomb friction coefficient between bodies (and walls that give none); default 0.";
         #[serde(default)]
+        rolling_friction: f64 => "number", optional = "0.0",
+            "Coefficient of rolling friction μ_r between bodies and against walls: a rolling \
+             spring torque k_t R*² θ_r capped at μ_r R* F_n (LIGGGHTS `epsd2`, docs/contact.md); \
+             default 0, none.";
+        #[serde(default)]
         damping_ratio: f64 => "number", optional = "0.0",
             "Damping ratio ζ of the contact dashpots, in [0, 1); default 0 (paper 000: the \
              viscosity is in the bulk).";

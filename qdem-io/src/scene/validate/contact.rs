@@ -1,6 +1,6 @@
 //! `[contact]` and `[[wall]]`: a contact table exactly when something can touch (bodies with
 //! `contact_radius`, stones); the linear law's stiffnesses (and none for Hertz–Mindlin), a
-//! non-negative friction, damping in [0, 1), local damping and contacts only with an explicit
+//! non-negative friction and rolling friction, damping in [0, 1), local damping and contacts only with an explicit
 //! integrator, a positive skin and overlap tolerance; each wall a plane (point and non-zero
 //! normal) or a mesh; a servo only on a plane without a velocity, with a positive area and
 //! maximum speed and a load path (`ramp`) as a `[[load]]`'s.
@@ -93,6 +93,13 @@ fn contact_numbers(c: &mut Checker<'_>, raw: &RawScene, contact: &Contact, spher
         "friction",
         contact.friction,
         "",
+    );
+    c.non_negative(
+        &["contact", "rolling_friction"],
+        l,
+        "rolling_friction",
+        contact.rolling_friction,
+        "0 for none",
     );
     fraction(
         c,
