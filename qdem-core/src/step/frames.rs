@@ -214,9 +214,9 @@ fn rotate_entry(
         }
     };
     if i != j {
-        for p in 0..3 {
-            for q in 0..3 {
-                push(p, q, wa[p] * e.val * wb[q]);
+        for (p, a) in wa.iter().enumerate() {
+            for (q, b) in wb.iter().enumerate() {
+                push(p, q, a * e.val * b);
             }
         }
         return;
