@@ -218,6 +218,13 @@ impl World {
             )));
         }
         refuse_averaged_pressure(&self.models)?;
+        if let Some((particle, _, _)) = self.state.frames.iter().next() {
+            return Err(CoreError::Decomposition(format!(
+                "particle {particle} is held in a local frame (a [[fix]] with `frame`), which \
+                 a run over ranks does not support yet; run it as one process (without mpirun), \
+                 or hold it on the x, y, z axes"
+            )));
+        }
         let steps_in_part = self.stepper.steps_in_part();
         let (state, models, hooks) = (&mut self.state, &mut self.models, &mut self.hooks);
         self.parallel

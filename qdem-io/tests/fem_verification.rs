@@ -2,7 +2,8 @@
 //! thick-walled cylinder under internal pressure and Kirsch's plate with a hole under a
 //! remote traction, each a quarter model with symmetry fixes in plane strain
 //! (`fixtures/fem/{lame,kirsch}.toml` on their coarse gmsh meshes), solved by the static
-//! integrator as a user runs them.
+//! integrator as a user runs them; and the cylinder again with its symmetry planes held in its
+//! cylindrical frame (`lame_cylindrical.toml`).
 //!
 //! Two references, both without CalculiX (which `scripts/fem_verify.py` runs where it is
 //! installed):
@@ -44,12 +45,19 @@ struct Solved {
     reference: Vec<Vec3>,
     displacement: Vec<Vec3>,
     nodal_stress: Vec<Mat3>,
+    /// The columns of `reactions.csv`.
+    reactions: std::collections::HashMap<String, Vec<f64>>,
 }
 
 /// The fixture scene `name` solved statically, its nodal stresses the volume-weighted mean of
 /// the small-strain stresses (what the VTU's `stress` holds) of the tetrahedra around each node.
 fn solve(name: &str) -> Solved {
-    let dir = test_dir(&format!("fem-verification-{name}"));
+    solve_in(name, name)
+}
+
+/// [`solve`] in a folder of its own, named by `tag` (tests run at once).
+fn solve_in(name: &str, tag: &str) -> Solved {
+    let dir = test_dir(&format!("fem-verification-{tag}"));
     let scene = Scene::load(&fixture(&format!("fem/{name}.toml"))).unwrap();
     let mut sim = Simulation::build(scene).unwrap();
     run(&mut sim, &dir.join("out"), &mut |_| {}).unwrap();
@@ -75,6 +83,7 @@ fn solve(name: &str) -> Solved {
         reference: state.reference.clone(),
         displacement: (0..state.len()).map(|i| state.displacement(i)).collect(),
         nodal_stress: sum.iter().zip(&weight).map(|(s, w)| s / *w).collect(),
+        reactions: common::columns(&dir.join("out/reactions.csv")),
     };
     let _ = std::fs::remove_dir_all(&dir);
     solved
@@ -230,4 +239,68 @@ fn kirsch_plate_matches_c3d4_and_the_closed_form() {
         "edge σ_xx off 3σ by {s_error:+e}, beyond {bias:e}"
     );
     assert!(u_error.abs() <= 0.02, "edge u_y off Kirsch by {u_error:+e}");
+}
+
+/// The cylinder with both cut faces held in its cylindrical frame (u_θ = 0,
+/// `fixtures/fem/lame_cylindrical.toml`) holds the same directions as the axis fixes (on
+/// x = 0, e_θ = −x; on y = 0, e_θ = y), so it gives the axis model's displacements to
+/// rounding (the framed DOFs are eliminated in rotated coordinates: 10⁻⁹ of the largest,
+/// measured 10⁻¹⁴), the bore's u_r within the same 1% of Lamé's, and reactions in the frame:
+/// each cut face's tangential force is the hoop force ±p a L (along the face's outward
+/// normal), exactly by equilibrium (the bore polygon's projection on a cut face is a × L),
+/// the radial one zero there, the axial fix's unchanged.
+#[test]
+fn lame_cylinder_held_in_its_cylindrical_frame() {
+    let axes = solve_in("lame", "lame-axes");
+    let framed = solve("lame_cylindrical");
+    let largest = axes
+        .displacement
+        .iter()
+        .map(|u| u.amax())
+        .fold(0.0, f64::max);
+    let du = axes
+        .displacement
+        .iter()
+        .zip(&framed.displacement)
+        .map(|(a, b)| (a - b).amax())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "Lamé in the cylindrical frame vs on the axes: u {:.2e} of max",
+        du / largest
+    );
+    assert!(du <= 1e-9 * largest, "displacements differ by {du:e} m");
+
+    let bore = framed.nodes_where(|x| (x.xy().norm() - BORE).abs() < 1e-9);
+    let radial = |i: usize| {
+        let n = framed.reference[i].xy().normalize();
+        framed.displacement[i].xy().dot(&n)
+    };
+    let u_error =
+        bore.iter().map(|&i| radial(i)).sum::<f64>() / bore.len() as f64 / lame(BORE).1 - 1.0;
+    assert!(u_error.abs() <= 0.01, "bore u_r off Lamé by {u_error:+e}");
+
+    let length = framed.reference.iter().map(|x| x.z).fold(0.0, f64::max);
+    let hoop = PRESSURE * BORE * length;
+    let (r, a) = (&framed.reactions, &axes.reactions);
+    let last = |c: &std::collections::HashMap<String, Vec<f64>>, k: &str| {
+        *c.get(k)
+            .unwrap_or_else(|| panic!("no column {k}"))
+            .last()
+            .unwrap()
+    };
+    // The hoop tension pulls each cut face along its outward normal: +e_θ at θ = 90°
+    // (x = 0, fix 1), −e_θ at θ = 0 (y = 0, fix 2).
+    for (fix, sign) in [(1, 1.0), (2, -1.0)] {
+        let ft = last(r, &format!("fix{fix}_ft"));
+        let fr = last(r, &format!("fix{fix}_fr"));
+        assert!(
+            (sign * ft / hoop - 1.0).abs() < 1e-6,
+            "fix{fix}_ft = {ft} N, p a L = {hoop} N"
+        );
+        assert!(fr.abs() < 1e-6 * hoop, "fix{fix}_fr = {fr} N");
+    }
+    // On the axes: x = 0's e_θ is −x, y = 0's is +y.
+    assert!((last(r, "fix1_ft") + last(a, "fix1_fx")).abs() < 1e-6 * hoop);
+    assert!((last(r, "fix2_ft") - last(a, "fix2_fy")).abs() < 1e-6 * hoop);
+    assert!((last(r, "fix3_fz") - last(a, "fix3_fz")).abs() < 1e-6 * hoop);
 }

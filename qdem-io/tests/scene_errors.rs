@@ -688,6 +688,54 @@ fn dofs_are_checked() {
     assert_has(&msg, &["`X` is not a direction"]);
 }
 
+/// A `[[fix]]`'s `frame`: a known name with its axis, an orthonormal basis, directions named in
+/// the frame, the axis keys only with a cylindrical frame.
+#[test]
+fn fix_frames_are_checked() {
+    let framed = |keys: &str| with("dofs = \"xyz\"", keys);
+    let (_, msg) = error(&framed("frame = \"cylindrical\"\ndofs = \"t\""));
+    assert_has(
+        &msg,
+        &["[[fix]] #1", "needs `axis`", "axis = [0.0, 0.0, 1.0]"],
+    );
+    let (_, msg) = error(&framed(
+        "frame = \"cylindrical\"\naxis = [0.0, 0.0, 0.0]\ndofs = \"t\"",
+    ));
+    assert_has(&msg, &["[[fix]] #1", "non-zero axis"]);
+    let (_, msg) = error(&framed("frame = \"spherical\"\ndofs = \"t\""));
+    assert_has(&msg, &["frame", "\"cylindrical\" or a basis [[x, y, z]"]);
+    let (_, msg) = error(&framed(
+        "frame = [[1.0, 0.0, 0.0], [0.1, 1.0, 0.0], [0.0, 0.0, 1.0]]\ndofs = \"1\"",
+    ));
+    assert_has(&msg, &["[[fix]] #1", "not orthonormal", "right angles"]);
+    // With a frame, `dofs` names its directions; the default "xyz" does not.
+    let (_, msg) = error(&framed("frame = \"cylindrical\"\naxis = [0.0, 0.0, 1.0]"));
+    assert_has(&msg, &["`x` is not a direction", "r, t, z", "with `frame`"]);
+    let (_, msg) = error(&framed(
+        "frame = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\ndofs = \"x\"",
+    ));
+    assert_has(&msg, &["`x` is not a direction", "1, 2, 3"]);
+    let (_, msg) = error(&framed("axis = [0.0, 0.0, 1.0]"));
+    assert_has(
+        &msg,
+        &["`axis` is the axis of a cylindrical frame", "drop `axis`"],
+    );
+    // A valid one parses, its axis normalised.
+    let scene = Scene::parse(
+        &framed("frame = \"cylindrical\"\naxis = [0.0, 0.0, 2.0]\ndofs = \"rt\""),
+        Path::new(PATH),
+    )
+    .unwrap();
+    assert_eq!(
+        scene.fixes[0].frame,
+        qdem_io::scene::FixFrame::Cylindrical {
+            origin: [0.0; 3],
+            axis: [0.0, 0.0, 1.0]
+        }
+    );
+    assert_eq!(scene.fixes[0].dofs, [true, true, false]);
+}
+
 #[test]
 fn ramps_are_checked() {
     let ramp = "ramp = [[0.0, 0.0], [1.0, 1.0]]";

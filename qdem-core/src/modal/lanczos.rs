@@ -333,7 +333,10 @@ impl Problem {
             }
         }
         let fixity = reduction.fixity(state, fixity);
-        let dofs = FreeDofs::new(&fixity);
+        // A particle held in a local frame has its DOFs, and K's rows and columns, in that
+        // frame (`crate::step::frames`); the lumped mass is the same in any frame.
+        let dofs = FreeDofs::new(&fixity).in_frames(state.frames.clone());
+        let tangent = dofs.local_tangent(&tangent).into_owned();
         let limp = tangent.stiffness_entries().is_empty() && state.rigid.is_empty();
         if dofs.len() == 0 || limp {
             return Err(ModalError::NothingDeformable);
@@ -391,10 +394,16 @@ impl Problem {
                 self.global
                     .iter()
                     .map(|&d| match self.kind(d) {
-                        Dof::Translation(p, axis) if included(p) => match k < 3 {
-                            true => f64::from(u8::from(axis == k)),
-                            false => omega.cross(&(state.position[p] - centre))[axis],
-                        },
+                        Dof::Translation(p, axis) if included(p) => {
+                            let w = match k < 3 {
+                                true => Vec3::ith(k, 1.0),
+                                false => omega.cross(&(state.position[p] - centre)),
+                            };
+                            match self.dofs.frame(p) {
+                                Some(r) => r.column(axis).dot(&w),
+                                None => w[axis],
+                            }
+                        }
                         Dof::Spin(p, axis) if included(p) && k >= 3 => omega[axis],
                         Dof::Body(b, j) if only.is_none() && k >= 3 => {
                             self.reduction.psi(b, &omega)[j]
@@ -435,6 +444,7 @@ impl Problem {
                     &state.position,
                     &particles,
                     &|d| self.dofs.index(d),
+                    &|p| self.dofs.frame(p).copied(),
                     &self.global,
                 );
                 if free.len() != modes {
@@ -627,11 +637,19 @@ impl Problem {
         for ((&d, v), m) in self.global.iter().zip(&x).zip(&self.mass) {
             match self.kind(d) {
                 Dof::Translation(p, axis) => {
-                    motion[axis] += m * v * v;
+                    if self.dofs.frame(p).is_none() {
+                        motion[axis] += m * v * v;
+                    }
                     shape[p][axis] = *v;
                 }
                 Dof::Body(b, k) => psi[b][k] = *v,
                 Dof::Spin(..) => {}
+            }
+        }
+        for (p, r, _) in state.frames.iter() {
+            shape[p] = r * shape[p];
+            for (axis, total) in motion.iter_mut().enumerate() {
+                *total += self.node_mass[p] * shape[p][axis] * shape[p][axis];
             }
         }
         let theta: Vec<Vec3> = psi

@@ -10,7 +10,7 @@
 //! makes in `unconstrained_bodies`, which also checks that no stiffness resists them).
 
 use crate::solvers::sparse::rigid_motion;
-use crate::Vec3;
+use crate::{Mat3, Vec3};
 use nalgebra::{Matrix6, SymmetricEigen};
 
 /// Eigenvalue of the Gram matrix, per fixed DOF, below which a rigid motion counts as free
@@ -19,11 +19,13 @@ const FREE: f64 = 1e-10;
 
 /// The rigid motions of `particles` that vanish in their fixed directions, each over the
 /// system DOFs (`index`: the system DOF of a global one, `None` where fixed; `global`: the
-/// global DOF of each system DOF), not normalised.
+/// global DOF of each system DOF; `frame`: a particle's local basis where its DOFs are
+/// numbered in one, whose rows R then gives as Rᵀ R), not normalised.
 pub(crate) fn free_rigid_motions(
     position: &[Vec3],
     particles: &[usize],
     index: &dyn Fn(usize) -> Option<usize>,
+    frame: &dyn Fn(usize) -> Option<Mat3>,
     global: &[usize],
 ) -> Vec<Vec<f64>> {
     if particles.is_empty() {
@@ -34,7 +36,13 @@ pub(crate) fn free_rigid_motions(
         .iter()
         .map(|&p| (position[p] - centre).norm())
         .fold(f64::MIN_POSITIVE, f64::max);
-    let motion = |p: usize| rigid_motion((position[p] - centre) / size);
+    let motion = |p: usize| {
+        let rows = rigid_motion((position[p] - centre) / size);
+        match frame(p) {
+            Some(r) => r.transpose() * rows,
+            None => rows,
+        }
+    };
     let mut gram = Matrix6::zeros();
     let mut rows = 0usize;
     for &p in particles {

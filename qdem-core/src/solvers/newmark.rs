@@ -340,10 +340,13 @@ impl Newmark {
             damping: self.gamma * h,
             stiffness: self.beta * h * h,
         };
-        let dofs = FreeDofs::new(&state.node_fixity());
-        system
-            .assembler
-            .assemble(&system.tangent, &state.node_mass(), &dofs, scales)?;
+        let dofs = FreeDofs::of(state);
+        system.assembler.assemble(
+            &dofs.local_tangent(&system.tangent),
+            &state.node_mass(),
+            &dofs,
+            scales,
+        )?;
         system.assembled = Some(h);
         system.dofs = Some(dofs);
         Ok(())
@@ -369,7 +372,7 @@ impl Newmark {
                 dofs,
                 state,
                 models,
-                &system.tangent,
+                &dofs.local_tangent(&system.tangent),
             ));
         }
         factor.step = Some(h);
@@ -828,7 +831,7 @@ impl Stepper for Newmark {
             self.system.damping.build(&self.system.tangent, dofs);
             self.system.assembler.restore(input)?;
             self.system.assembled = None;
-            self.system.dofs = Some(FreeDofs::new(&state.node_fixity()));
+            self.system.dofs = Some(FreeDofs::of(state));
             for nominal in [true, false] {
                 let step = input.option_f64("a factorised step")?;
                 let stale = input.bool("a factor's staleness")?;

@@ -18,6 +18,7 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
+use crate::step::frames::ParticleFrames;
 use crate::step::model::Model;
 use crate::step::solve_report::FactorStats;
 use crate::step::state::{Dofs, State};
@@ -198,14 +199,44 @@ pub const FIX_HINT: &str = "fix at least 3 non-collinear particles of it, or a f
 const GENERIC_CAUSE: &str = "a body is probably not constrained against rigid motion (fix some \
                              of its nodes) or a free particle belongs to no tetrahedron";
 
-/// The numbering of the free DOFs: fixed DOFs (Eqs. 23, 27) are eliminated.
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// The numbering of the free DOFs: fixed DOFs (Eqs. 23, 27) are eliminated. A particle held
+/// in a local frame has its DOFs numbered in that frame ([`crate::step::frames`]): vectors
+/// are rotated into it when gathered and out of it when scattered, and the tangent is
+/// transformed to it before assembly ([`FreeDofs::local_tangent`]).
+#[derive(Clone, Debug, PartialEq)]
 pub struct FreeDofs {
     index: Vec<usize>,
     count: usize,
+    frames: ParticleFrames,
 }
 
 impl FreeDofs {
+    /// The numbering of `state`'s free DOFs (its [`State::node_fixity`]), in the local frames
+    /// of its framed particles.
+    pub fn of(state: &State) -> FreeDofs {
+        FreeDofs::new(&state.node_fixity()).in_frames(state.frames.clone())
+    }
+
+    /// The same numbering with the particles of `frames` in their local frames (their entries
+    /// of the fixity given to [`FreeDofs::new`] are their held local directions).
+    pub fn in_frames(mut self, frames: ParticleFrames) -> FreeDofs {
+        self.frames = frames;
+        self
+    }
+
+    /// The local basis of particle `node`, if it is framed.
+    pub fn frame(&self, node: usize) -> Option<&Mat3> {
+        self.frames.get(node).map(|(r, _)| r)
+    }
+
+    /// `tangent` in the numbering's frames (itself when no particle is framed).
+    pub fn local_tangent<'a>(&self, tangent: &'a Tangent) -> std::borrow::Cow<'a, Tangent> {
+        match self.frames.is_empty() {
+            true => std::borrow::Cow::Borrowed(tangent),
+            false => std::borrow::Cow::Owned(self.frames.tangent_in_frames(tangent)),
+        }
+    }
+
     /// Numbers the free directions of every particle in ascending DOF order.
     pub fn new(fixed: &[Dofs]) -> FreeDofs {
         let mut count = 0;
@@ -221,7 +252,24 @@ impl FreeDofs {
                 }
             })
             .collect();
-        FreeDofs { index, count }
+        FreeDofs {
+            index,
+            count,
+            frames: ParticleFrames::default(),
+        }
+    }
+
+    /// `rows` (3 × k, one row per world axis of particle `node`) in the particle's local
+    /// frame when it is framed (Rᵀ rows), else unchanged.
+    pub fn local_rows<const K: usize>(
+        &self,
+        node: usize,
+        rows: SMatrix<f64, 3, K>,
+    ) -> SMatrix<f64, 3, K> {
+        match self.frame(node) {
+            Some(r) => r.transpose() * rows,
+            None => rows,
+        }
     }
 
     /// Number of free DOFs (the size of the system).
@@ -261,6 +309,14 @@ impl FreeDofs {
                 out[i] = v[dof % 3];
             }
         }
+        for (node, frame, _) in self.frames.iter() {
+            let local = frame.transpose() * parts.0[node];
+            for axis in 0..3 {
+                if let Some(i) = self.index(3 * node + axis) {
+                    out[i] = local[axis];
+                }
+            }
+        }
     }
 
     /// [`FreeDofs::scatter`] over generalised nodes, as [`FreeDofs::gather_nodes`] reads them.
@@ -274,6 +330,9 @@ impl FreeDofs {
                 &mut parts.1[node - n]
             };
             v[dof % 3] = if i == FIXED { 0.0 } else { x[i] };
+        }
+        for (node, frame, _) in self.frames.iter() {
+            parts.0[node] = frame * parts.0[node];
         }
     }
 }
@@ -967,8 +1026,9 @@ fn free_rigid_modes(
     if size.is_nan() || size <= 0.0 {
         return 0;
     }
-    // The arm is scaled so that every mode is of order one.
-    let modes = |i: usize| rigid_motion((state.position[i] - centre) / size);
+    // The arm is scaled so that every mode is of order one; a framed particle's rows in its
+    // frame, as its DOFs are numbered.
+    let modes = |i: usize| dofs.local_rows(i, rigid_motion((state.position[i] - centre) / size));
     let fixed = |i: usize, axis: usize| dofs.index(3 * i + axis).is_none();
     let mut gram = Matrix6::zeros();
     let mut rows = 0usize;

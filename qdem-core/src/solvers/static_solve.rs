@@ -193,8 +193,8 @@ impl StaticSolver {
         state: &State,
         models: &[Box<dyn Model>],
     ) -> Result<(), CoreError> {
-        let tangent = &self.tangent;
-        let dofs = FreeDofs::new(&state.node_fixity());
+        let dofs = FreeDofs::of(state);
+        let tangent = &*dofs.local_tangent(&self.tangent);
         if let Some((body, modes)) = unconstrained_bodies(state, models, tangent, &dofs)
             .into_iter()
             .next()

@@ -30,7 +30,7 @@ use crate::step::rigid_body::{place_member_velocities, place_members, place_memb
 use crate::step::seam::Seam;
 use crate::step::stages::{Stage, StageTimes};
 use crate::step::state::State;
-use crate::step::stepper::{check_finite_torque, check_masses, Stepper};
+use crate::step::stepper::{check_finite_torque, check_masses, hold_in_frames, Stepper};
 use crate::Vec3;
 
 /// Velocity Verlet with a fixed step.
@@ -122,6 +122,7 @@ impl Verlet {
         let ranges = verlet_sweeps::cover(state.len(), seam.computed());
         let (particles, rigid_bodies) = particles(state, &mut self.force, moment);
         let (bad, bad_spin) = verlet_sweeps::kick(particles, &ranges, rigid_bodies, settings);
+        hold_in_frames(state);
         let time = state.time;
         match bad.min(bad_spin) {
             usize::MAX => check_finite_torque(state, rigid),

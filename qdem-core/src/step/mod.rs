@@ -6,6 +6,7 @@
 //! the step settings resolved once ([`step_settings`]). It names no other area but the
 //! split facets' `Reads` of [`crate::parallel`], until those facets move here.
 
+pub mod frames;
 pub(crate) mod instability;
 pub mod local_particles;
 pub mod model;
@@ -20,6 +21,7 @@ pub mod step_settings;
 pub mod stepper;
 pub mod tangent;
 
+pub use frames::ParticleFrames;
 pub use model::Deformable;
 pub use model::Linearized;
 pub use model::Model;

@@ -5,8 +5,9 @@
 //! shares it, §2.4) and a per-direction fixity mask. Models read the state and write forces;
 //! steppers advance it. All numerical code works on the slices directly.
 
+use crate::step::frames::{FrameError, ParticleFrames};
 use crate::step::rigid_body::RigidBodies;
-use crate::Vec3;
+use crate::{Mat3, Vec3};
 
 /// A subset of the three translational directions, stored as a bit mask (x = 1, y = 2, z = 4).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -97,7 +98,11 @@ pub struct State {
     /// Lumped masses (kg).
     pub mass: Vec<f64>,
     /// Fixed directions per particle: a fixed direction keeps zero velocity and acceleration.
+    /// Axes x, y, z; a particle held in a local frame has none here (its held directions are
+    /// in `frames`).
     pub fixed: Vec<Dofs>,
+    /// The particles held in a local frame ([`State::fix_in_frame`]); empty in most scenes.
+    pub frames: ParticleFrames,
     /// Rotation of the rigid bodies (empty when the scene has none).
     pub rigid: RigidBodies,
     /// Rotational degrees of freedom of the particles (empty unless some particles rotate:
@@ -171,6 +176,7 @@ impl State {
             acceleration: vec![Vec3::zeros(); n],
             mass: vec![0.0; n],
             fixed: vec![Dofs::NONE; n],
+            frames: ParticleFrames::default(),
             rigid: RigidBodies::default(),
             spin: ParticleSpin::default(),
         }
@@ -196,8 +202,14 @@ impl State {
 
     /// Fixity of every generalised node: the particles' translations, then their rotations
     /// (node `len() + i` is the rotation of particle `i`), the layout of the implicit system.
+    /// A particle held in a local frame gives its held local directions (the system numbers
+    /// its DOFs in that frame, [`crate::step::frames`]).
     pub fn node_fixity(&self) -> Vec<Dofs> {
-        self.fixed.iter().chain(&self.spin.fixed).copied().collect()
+        let mut fixity: Vec<Dofs> = self.fixed.iter().chain(&self.spin.fixed).copied().collect();
+        for (i, _, held) in self.frames.iter() {
+            fixity[i] = held;
+        }
+        fixity
     }
 
     /// The generalised node that stands for the small rotation θ (world axes) of rigid body
@@ -295,8 +307,46 @@ impl State {
     /// Adds `dofs` to the fixed directions of particle `i` and zeroes its velocity and
     /// acceleration there.
     pub fn fix(&mut self, i: usize, dofs: Dofs) {
+        if self.frames.get(i).is_some() {
+            self.hold_in_frame(i, &Mat3::identity(), dofs);
+            return;
+        }
         self.fixed[i] = self.fixed[i].union(dofs);
         at_rest_in(&mut self.velocity[i], &mut self.acceleration[i], dofs);
+    }
+
+    /// Holds particle `i` in the local directions `dofs` of `frame` (columns: the local basis
+    /// e₁, e₂, e₃ in world axes, orthonormal): e_k · u = 0 for each k in `dofs`
+    /// ([`crate::step::frames`]), and zeroes its velocity and acceleration there. Directions
+    /// already held (on axes or in another frame) stay held: the particle is then held in
+    /// the span of all of them, in a basis of that span. Holding all three directions is
+    /// [`State::fix`] with [`Dofs::ALL`].
+    ///
+    /// # Errors
+    /// [`FrameError::NotOrthonormal`] for a basis that is not orthonormal.
+    pub fn fix_in_frame(&mut self, i: usize, frame: Mat3, dofs: Dofs) -> Result<(), FrameError> {
+        crate::step::frames::check_orthonormal(&frame)?;
+        self.hold_in_frame(i, &frame, dofs);
+        Ok(())
+    }
+
+    /// [`State::fix_in_frame`] of a checked basis.
+    fn hold_in_frame(&mut self, i: usize, frame: &Mat3, dofs: Dofs) {
+        if dofs.is_empty() {
+            return;
+        }
+        let (basis, held) = self.frames.merged(i, self.fixed[i], frame, dofs);
+        if held == Dofs::ALL {
+            self.frames.set(i, basis, Dofs::NONE);
+            self.fixed[i] = Dofs::ALL;
+            at_rest_in(&mut self.velocity[i], &mut self.acceleration[i], Dofs::ALL);
+            return;
+        }
+        self.fixed[i] = Dofs::NONE;
+        self.frames.set(i, basis, held);
+        let (v, a) = (&mut self.velocity[i], &mut self.acceleration[i]);
+        *v = crate::step::frames::project_free(&basis, held, *v);
+        *a = crate::step::frames::project_free(&basis, held, *a);
     }
 
     /// Zeroes the velocity and acceleration of every fixed direction: of the particles, of
@@ -315,6 +365,8 @@ impl State {
     /// ```
     pub fn hold_fixed(&mut self) {
         all_at_rest_in(&mut self.velocity, &mut self.acceleration, &self.fixed);
+        self.frames.hold(&mut self.velocity);
+        self.frames.hold(&mut self.acceleration);
         let spin = &mut self.spin;
         all_at_rest_in(&mut spin.velocity, &mut spin.acceleration, &spin.fixed);
         for b in 0..self.rigid.len() {

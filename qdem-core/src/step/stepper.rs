@@ -302,7 +302,18 @@ pub(crate) fn accelerate(
         |i| rigid.body_of_member(i).is_some(),
         only,
     );
+    hold_in_frames(state);
     non_finite_at(first_bad, state.time)
+}
+
+/// Projects the acceleration and velocity of every particle held in a local frame onto its
+/// free directions (a ← a − Σ_held (e_k·a) e_k, [`crate::step::frames`]): what zeroing a
+/// fixed axis's components does for a particle held on axes.
+pub(crate) fn hold_in_frames(state: &mut State) {
+    if !state.frames.is_empty() {
+        state.frames.hold(&mut state.acceleration);
+        state.frames.hold(&mut state.velocity);
+    }
 }
 
 /// θ̈ = M/J for the particles' rotations, zero about fixed axes, then ω += h θ̈ with `kick`

@@ -115,6 +115,7 @@ pub(crate) fn build_bonded(
         granular: None,
         ballast: None,
         fix_particles: Vec::new(),
+        fix_frames: Vec::new(),
     })
 }
 

@@ -177,6 +177,15 @@ pub enum BuildError {
         /// What is wrong and how to fix it.
         message: String,
     },
+    /// A `[[fix]]`'s local frame cannot hold a node: a node on a cylindrical frame's axis,
+    /// or a node two fixes hold in oblique directions (`super::fix_frames`).
+    #[error("{scene}: {message}")]
+    FixFrame {
+        /// The scene file.
+        scene: PathBuf,
+        /// The fixes, the node, and the fix.
+        message: String,
+    },
     /// A fix or load selects no particle.
     #[error("{scene}: {what} on body `{body}` selects no particle: {fix}")]
     EmptySelection {

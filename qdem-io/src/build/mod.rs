@@ -35,6 +35,7 @@ pub mod ballast;
 mod bonded;
 mod contact;
 mod error;
+pub(crate) mod fix_frames;
 pub mod granular;
 mod initial_motion;
 mod kind_change;
@@ -65,7 +66,7 @@ use qdem_core::step::rigid_body::tet_mass_properties;
 use qdem_core::{
     continuum::Material, continuum::TetBody, error::CoreError, loads::Gravity, loads::NodalLoad,
     loads::TimeFunction, step::Dofs, step::EventSolve, step::Model, step::Scheme, step::State,
-    step::StepRequest, step::StepSettings, world::World, Vec3,
+    step::StepRequest, step::StepSettings, world::World, Mat3, Vec3,
 };
 use qdem_mesh::{read_msh, FileIds, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
@@ -160,7 +161,13 @@ pub struct Simulation {
     /// The particles each `[[fix]]` selects (state indices, increasing), in scene order: what
     /// `reactions.csv` sums.
     pub fix_particles: Vec<Vec<usize>>,
+    /// For each `[[fix]]` with a `frame`, its basis (columns e₁, e₂, e₃ in world axes) at
+    /// each of its particles, in `fix_particles`' order; `None` for a fix on the axes.
+    pub fix_frames: Vec<Option<Vec<Mat3>>>,
 }
+
+/// Each `[[fix]]`'s particles and, for a framed one, its basis at each.
+type FixedParticles = (Vec<Vec<usize>>, Vec<Option<Vec<Mat3>>>);
 
 /// A body's mesh as read and placed, with its file and its particles' place in the state.
 pub(crate) struct PlacedMesh {
@@ -221,7 +228,7 @@ impl Simulation {
                 initial_motion::move_rigidly(&mut state, stone.clone(), v, w);
             }
         }
-        let fix_particles = apply_fixes(&scene, &meshes, &mut state)?;
+        let (fix_particles, fix_frames) = apply_fixes(&scene, &meshes, &mut state)?;
         fix_rigid_bodies(&scene, &bodies, &mut state);
         let mut extra = ExtraSpheres::of_ballast(ballast.as_ref());
         let granular = add_granular(&scene, (&stones, sampled), &mut state, &mut extra)?;
@@ -264,6 +271,7 @@ impl Simulation {
             granular,
             ballast,
             fix_particles,
+            fix_frames,
         })
     }
 
@@ -635,15 +643,19 @@ fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], state: &mut State) {
     }
 }
 
-/// Fixes the selected directions of the selected particles of every `[[fix]]`; returns each
-/// fix's particles.
+/// Fixes the selected directions of the selected particles of every `[[fix]]`, on the axes
+/// or in its frame (`fix_frames`); returns each fix's particles and, for a fix with a frame,
+/// the basis at each of them.
 fn apply_fixes(
     scene: &Scene,
     meshes: &[PlacedMesh],
     state: &mut State,
-) -> Result<Vec<Vec<usize>>, BuildError> {
+) -> Result<FixedParticles, BuildError> {
     let on = &scene.refs().fix_bodies;
     let mut fixed = Vec::with_capacity(scene.fixes.len());
+    let mut frames = Vec::with_capacity(scene.fixes.len());
+    // Per particle, each held direction (world axes) with its fix's number.
+    let mut held = vec![Vec::new(); state.len()];
     for (i, (fix, &body)) in scene.fixes.iter().zip(on).enumerate() {
         let placed = &meshes[body];
         let what = format!("[[fix]] #{}", i + 1);
@@ -652,12 +664,29 @@ fn apply_fixes(
             .iter()
             .map(|&n| placed.particles.start + n as usize)
             .collect();
+        let dofs = Dofs::from_mask(fix.dofs);
+        let mut bases = Vec::new();
         for &p in &particles {
-            state.fix(p, Dofs::from_mask(fix.dofs));
+            let basis = fix_frames::basis_at(&scene.path, fix, &what, p, state.reference[p])?;
+            match basis {
+                None => state.fix(p, dofs),
+                Some(r) => {
+                    state
+                        .fix_in_frame(p, r, dofs)
+                        .map_err(|e| BuildError::FixFrame {
+                            scene: scene.path.clone(),
+                            message: format!("{what}: {e}"),
+                        })?;
+                    bases.push(r);
+                }
+            }
+            held[p].extend(fix_frames::held_vectors(basis.as_ref(), dofs).map(|e| (i + 1, e)));
         }
         fixed.push(particles);
+        frames.push((!fix.frame.is_axes()).then_some(bases));
     }
-    Ok(fixed)
+    fix_frames::check_aligned(&scene.path, &held)?;
+    Ok((fixed, frames))
 }
 
 /// A [`NodalLoad`] per `[[load]]`: its total force shared by the selected particles, or its

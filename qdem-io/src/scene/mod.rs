@@ -48,9 +48,9 @@ pub use error::{Diagnostic, SceneError};
 pub use refs::{ProbeTarget, Refs};
 pub use schema::{
     AreaLoad, Ballast, Body, Bonded, ClumpShapeName, Contact, ContactLawName, CyclicLoad,
-    EventSolveName, Fix, Formulation, GradingBasisName, Granular, Integrator, Load, Material,
-    Measure, MeasureRegion, Output, PackingName, Periodic, Probe, Ramp, Run, Section, Selection,
-    Series, Supports, TimeDelay, TimeStep, Wall, WallServo, WallStart,
+    EventSolveName, Fix, FixFrame, Formulation, GradingBasisName, Granular, Integrator, Load,
+    Material, Measure, MeasureRegion, Output, PackingName, Periodic, Probe, Ramp, Run, Section,
+    Selection, Series, Supports, TimeDelay, TimeStep, Wall, WallServo, WallStart,
 };
 
 use schema::RawScene;

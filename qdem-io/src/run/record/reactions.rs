@@ -6,7 +6,11 @@
 //! f − K u), and the moment M = Σ (X_i − c) × R_i about the centroid c of the fix's particles
 //! in the reference configuration (X_i their reference positions). Columns
 //! `fixK_fx, fixK_fy, fixK_fz, fixK_mx, fixK_my, fixK_mz` (N, N·m) for the K-th `[[fix]]`
-//! (from 1, in scene order). A direction that n fixes hold on one particle is shared equally,
+//! (from 1, in scene order). A fix with a `frame` gives its force in that frame, summed over
+//! its particles of each one's components there: `fixK_fr, fixK_ft, fixK_fz` (radial,
+//! tangential, axial) for a cylindrical frame, `fixK_f1, fixK_f2, fixK_f3` along e₁, e₂, e₃
+//! of a basis; its moment is about the axes. A direction that n fixes hold on one particle
+//! (directions parallel, in any frame, count as one) is shared equally,
 //! 1/n of its force to each, so the fixes' reactions sum to the supports' total whatever
 //! their overlap (over-constrained in no physical sense: a held direction stays at rest
 //! whichever fix holds it, so no fix has a better claim to its force). Fixes on a rigid
@@ -18,15 +22,18 @@
 //! particle, as CalculiX's `*NODE PRINT … RF` does per node: a row per time, fix and particle,
 //! `time, fix, gmsh_node_id, particle, x, y, z, fx, fy, fz` (the fix's number, the node's tag
 //! in its .msh file or −1, the particle's index in the state and the VTU, its reference
-//! position, m, and the force, N); a fix's rows sum to its `reactions.csv` force.
+//! position, m, and the force, N, on the axes, also for a fix with a frame); a fix's rows sum
+//! to its `reactions.csv` force (for a fix with a frame, each row read in the node's frame).
 
 use super::schedule::{probe_interval, Schedule};
 use super::{write_rows, Recorder, StateRead, StepInfo};
+use crate::build::fix_frames::{held_vectors, parallel};
 use crate::build::{BodyKind, Simulation};
 use crate::output::{write_atomic, OutputError};
+use crate::scene::FixFrame;
 use qdem_core::{
     checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, step::Dofs, step::State,
-    Vec3,
+    Mat3, Vec3,
 };
 use std::path::{Path, PathBuf};
 
@@ -39,6 +46,10 @@ struct FixGroup {
     /// Per particle, the share of each direction's force this fix carries: 1/n for a
     /// direction it holds with n − 1 other fixes, 0 for one it does not hold.
     shares: Vec<Vec3>,
+    /// For a fix with a frame, its basis at each particle (columns in world axes).
+    frames: Option<Vec<Mat3>>,
+    /// The names of its force columns' directions (`fx`, `fr`, `f1`, …).
+    columns: [&'static str; 3],
     /// The centroid of the particles' reference positions.
     centroid: Vec3,
 }
@@ -67,27 +78,45 @@ impl Reactions {
     pub(crate) fn new(sim: &Simulation, out_dir: &Path) -> Option<Reactions> {
         let state = &sim.world.state;
         let scene = &sim.scene;
-        let held: Vec<(usize, &Vec<usize>, Dofs)> = sim
+        let held: Vec<Held<'_>> = sim
             .fix_particles
             .iter()
             .zip(&scene.refs().fix_bodies)
-            .zip(&scene.fixes)
+            .zip(scene.fixes.iter().zip(&sim.fix_frames))
             .enumerate()
             .filter(|(_, ((_, &b), _))| matches!(sim.bodies[b].kind, BodyKind::Deformable { .. }))
-            .map(|(k, ((particles, _), fix))| (k + 1, particles, Dofs::from_mask(fix.dofs)))
+            .map(|(k, ((particles, _), (fix, frames)))| Held {
+                number: k + 1,
+                particles,
+                dofs: Dofs::from_mask(fix.dofs),
+                frames: frames.as_ref(),
+                columns: columns(&fix.frame),
+            })
             .collect();
-        let holders = holders_per_direction(state.len(), &held);
+        let directions = held_per_particle(state.len(), &held);
         let groups: Vec<FixGroup> = held
             .into_iter()
-            .map(|(number, particles, dofs)| FixGroup {
-                number,
-                particles: particles.clone(),
-                shares: particles
+            .map(|h| FixGroup {
+                number: h.number,
+                particles: h.particles.clone(),
+                shares: h
+                    .particles
                     .iter()
-                    .map(|&i| Vec3::from_fn(|k, _| share(dofs, k, holders[i][k])))
+                    .enumerate()
+                    .map(|(n, &i)| {
+                        let basis = h.frames.map(|f| &f[n]);
+                        let held = &directions[i];
+                        Vec3::from_fn(|k, _| share(basis, h.dofs, k, held))
+                    })
                     .collect(),
-                centroid: particles.iter().map(|&i| state.reference[i]).sum::<Vec3>()
-                    / particles.len() as f64,
+                frames: h.frames.cloned(),
+                columns: h.columns,
+                centroid: h
+                    .particles
+                    .iter()
+                    .map(|&i| state.reference[i])
+                    .sum::<Vec3>()
+                    / h.particles.len() as f64,
             })
             .collect();
         (!groups.is_empty()).then(|| Reactions {
@@ -133,38 +162,73 @@ impl Reactions {
     }
 }
 
+/// One `[[fix]]` of a deformable body as the record reads it.
+struct Held<'a> {
+    number: usize,
+    particles: &'a Vec<usize>,
+    dofs: Dofs,
+    frames: Option<&'a Vec<Mat3>>,
+    columns: [&'static str; 3],
+}
+
+/// The names of a fix's force columns in its frame.
+fn columns(frame: &FixFrame) -> [&'static str; 3] {
+    match frame {
+        FixFrame::Axes => ["fx", "fy", "fz"],
+        FixFrame::Cylindrical { .. } => ["fr", "ft", "fz"],
+        FixFrame::Basis(_) => ["f1", "f2", "f3"],
+    }
+}
+
 /// The force a fix carries at one particle of total force `force`: −f in the directions it
-/// holds, times its `share` of each.
-fn particle_reaction(force: Vec3, share: &Vec3) -> Vec3 {
-    Vec3::from_fn(|k, _| {
+/// holds, times its `share` of each; with a `basis`, in its directions (and on the axes).
+/// Returns the components in the fix's frame and the force on the axes.
+fn particle_reaction(force: Vec3, share: &Vec3, basis: Option<&Mat3>) -> (Vec3, Vec3) {
+    let Some(r) = basis else {
+        let f = Vec3::from_fn(|k, _| {
+            if share[k] > 0.0 {
+                -force[k] * share[k]
+            } else {
+                0.0
+            }
+        });
+        return (f, f);
+    };
+    let local = Vec3::from_fn(|k, _| {
         if share[k] > 0.0 {
-            -force[k] * share[k]
+            -r.column(k).dot(&force) * share[k]
         } else {
             0.0
         }
-    })
+    });
+    (local, r * local)
 }
 
-/// Per particle of a state of `particles`, how many of the fixes `held` (number, particles,
-/// directions) hold each direction.
-fn holders_per_direction(particles: usize, held: &[(usize, &Vec<usize>, Dofs)]) -> Vec<[u32; 3]> {
-    let mut holders = vec![[0u32; 3]; particles];
-    for (_, fix_particles, dofs) in held {
-        for &i in fix_particles.iter() {
-            for (k, count) in holders[i].iter_mut().enumerate() {
-                *count += u32::from(dofs.contains(k));
-            }
+/// Per particle of a state of `particles`, every direction (world axes) that one of the
+/// fixes `held` holds there.
+fn held_per_particle(particles: usize, held: &[Held<'_>]) -> Vec<Vec<Vec3>> {
+    let mut directions = vec![Vec::new(); particles];
+    for h in held {
+        for (n, &i) in h.particles.iter().enumerate() {
+            let basis = h.frames.map(|f| &f[n]);
+            directions[i].extend(held_vectors(basis, h.dofs));
         }
     }
-    holders
+    directions
 }
 
-/// The share of direction `k`'s force of a fix holding `dofs`, where `holders` fixes hold it.
-fn share(dofs: Dofs, k: usize, holders: u32) -> f64 {
-    match dofs.contains(k) {
-        true => 1.0 / f64::from(holders),
-        false => 0.0,
+/// The share of direction `k`'s force of a fix holding `dofs` in `basis` (`None`: the
+/// axes), at a particle where the fixes hold `held`: 1/n where n of them are parallel to it.
+fn share(basis: Option<&Mat3>, dofs: Dofs, k: usize, held: &[Vec3]) -> f64 {
+    if !dofs.contains(k) {
+        return 0.0;
     }
+    let e = match basis {
+        Some(r) => r.column(k).into_owned(),
+        None => Vec3::ith(k, 1.0),
+    };
+    let holders = held.iter().filter(|h| parallel(h, &e)).count() as u32;
+    1.0 / f64::from(holders)
 }
 
 /// The force and moment `group` carries, from the particles' total forces `force` (zero
@@ -178,12 +242,13 @@ fn reaction(
 ) -> (Vec3, Vec3) {
     let evaluated = force.len() == state.len();
     let mut total = (Vec3::zeros(), Vec3::zeros());
-    for (&i, share) in group.particles.iter().zip(&group.shares) {
-        let r = match evaluated {
-            true => particle_reaction(force[i], share),
-            false => Vec3::zeros(),
+    for (n, (&i, share)) in group.particles.iter().zip(&group.shares).enumerate() {
+        let basis = group.frames.as_ref().map(|f| &f[n]);
+        let (local, r) = match evaluated {
+            true => particle_reaction(force[i], share, basis),
+            false => (Vec3::zeros(), Vec3::zeros()),
         };
-        total.0 += r;
+        total.0 += local;
         total.1 += (state.reference[i] - group.centroid).cross(&r);
         if let Some(rows) = per_node.as_deref_mut() {
             rows.extend(r.iter());
@@ -223,7 +288,8 @@ impl Recorder for Reactions {
         let mut header = vec!["time".to_string()];
         for g in &self.groups {
             let k = g.number;
-            header.extend(["fx", "fy", "fz", "mx", "my", "mz"].map(|c| format!("fix{k}_{c}")));
+            let [a, b, c] = g.columns;
+            header.extend([a, b, c, "mx", "my", "mz"].map(|c| format!("fix{k}_{c}")));
         }
         write_rows(&self.path, &header, &self.rows)?;
         self.write_nodes(&sim.world.state)

@@ -22,11 +22,71 @@ pub struct Fix {
     pub body: String,
     /// The particles that are fixed.
     pub selection: Selection,
-    /// Fixed directions as an `[x, y, z]` mask, from `dofs = "xyz"` (default all three).
+    /// Fixed directions as a mask of the frame's three directions (x, y, z on the axes;
+    /// r, θ, z in a cylindrical frame; e₁, e₂, e₃ of a basis), from `dofs` (default all three).
     pub dofs: [bool; 3],
     /// Also hold the rotation of the (rigid) body: `rotation = true`, e.g. a sleeper guided
     /// vertically by `dofs = "xy"`. Default false.
     pub rotation: bool,
+    /// The frame `dofs` names directions of: the axes unless `frame` is given.
+    #[serde(skip_serializing_if = "FixFrame::is_axes")]
+    pub frame: FixFrame,
+}
+
+/// The frame a `[[fix]]` holds its directions in.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum FixFrame {
+    /// x, y, z (no `frame` key).
+    #[default]
+    Axes,
+    /// `frame = [[e1], [e2], [e3]]`: one orthonormal basis for every node; `dofs` of "123".
+    Basis([[f64; 3]; 3]),
+    /// `frame = "cylindrical"` with `axis_origin` and `axis`: at each node its radial (r),
+    /// tangential (θ, `t`) and axial (z) directions; `dofs` of "rtz".
+    Cylindrical {
+        /// A point of the axis (m).
+        origin: [f64; 3],
+        /// The axis's direction (a unit vector).
+        axis: [f64; 3],
+    },
+}
+
+impl FixFrame {
+    /// Whether this is the axes' frame.
+    pub fn is_axes(&self) -> bool {
+        *self == FixFrame::Axes
+    }
+
+    /// The letters that name the frame's three directions in `dofs`.
+    pub fn letters(&self) -> [char; 3] {
+        match self {
+            FixFrame::Axes => ['x', 'y', 'z'],
+            FixFrame::Basis(_) => ['1', '2', '3'],
+            FixFrame::Cylindrical { .. } => ['r', 't', 'z'],
+        }
+    }
+}
+
+/// `frame = …` as written: a name or a basis.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(
+    untagged,
+    expecting = "\"cylindrical\" or a basis [[x, y, z], [x, y, z], [x, y, z]] (e1, e2, e3)"
+)]
+pub(crate) enum RawFrame {
+    /// `frame = "cylindrical"`.
+    Name(FrameName),
+    /// `frame = [[e1], [e2], [e3]]`.
+    Basis([[f64; 3]; 3]),
+}
+
+/// The frames `frame` names.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub(crate) enum FrameName {
+    /// r, θ, z about an axis.
+    Cylindrical,
 }
 
 /// `[[load]]`: a total force shared equally by the selected particles, or a pressure or
@@ -79,11 +139,25 @@ scene_table! {
             "Instead of `group`: the particles inside the closed box (lower and upper corner, m).";
         #[serde(default = "default_dofs")]
         dofs: String => "string", optional = "\"xyz\"",
-            "The held directions, a subset of \"xyz\"; default \"xyz\". `reactions.csv` gives the \
-             force the fix carries.";
+            "The held directions, a subset of \"xyz\"; default \"xyz\". With `frame`, of the \
+             frame's directions: \"rtz\" (radial, tangential, axial) in a cylindrical frame, \
+             \"123\" of a basis (then required). `reactions.csv` gives the force the fix carries.";
         #[serde(default)]
         rotation: bool => "bool", optional = "false",
             "Also hold a rigid body's rotation; default false.";
+        #[serde(default)]
+        frame: Option<RawFrame> => "\"cylindrical\" or [[x, y, z], [x, y, z], [x, y, z]]", optional,
+            "Hold `dofs` in a local frame of a deformable body: \"cylindrical\" (about `axis` \
+             through `axis_origin`; at each node r, θ, z), or an orthonormal basis e₁, e₂, e₃ \
+             (rows); e.g. a roller on a skewed face, the symmetry planes of a cylinder \
+             (`dofs = \"t\"`). Its reactions are given in the frame. Not in a run over MPI ranks \
+             (refused); a node on a cylindrical frame's axis is refused.";
+        #[serde(default)]
+        axis_origin: Option<[f64; 3]> => "[x, y, z]", optional,
+            "With `frame = \"cylindrical\"`: a point of the axis, m; default the origin.";
+        #[serde(default)]
+        axis: Option<[f64; 3]> => "[x, y, z]", optional,
+            "With `frame = \"cylindrical\"` (required there): the axis's direction (any length).";
     }
 }
 

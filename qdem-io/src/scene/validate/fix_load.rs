@@ -1,13 +1,16 @@
 //! `[[fix]]` and `[[load]]`: a defined body, particles selected by a physical `group` or a
 //! `box` (one of the two; a box with its lower corner below its upper one), and for a fix
-//! `dofs` (a subset of "xyz") and `rotation` only on a rigid body; for a load one finite
+//! `dofs` (a subset of "xyz", or of its frame's letters), `rotation` only on a rigid body and
+//! a `frame` (cylindrical with a non-zero `axis`, or an orthonormal basis) only on a
+//! deformable one; for a load one finite
 //! `total_force`, `pressure` or `traction` and one time factor: a `ramp` (non-decreasing times, at most two points at a
 //! time), a `cyclic` factor or a `series` file.
 
 use std::collections::HashSet;
 
 use super::super::schema::{
-    AreaLoad, CyclicLoad, Fix, Load, Ramp, RawFix, RawLoad, RawScene, Selection, Series,
+    AreaLoad, CyclicLoad, Fix, FixFrame, FrameName, Load, Ramp, RawFix, RawFrame, RawLoad,
+    RawScene, Selection, Series,
 };
 use super::body::Bodies;
 use super::checker::{label, Checker};
@@ -50,7 +53,9 @@ fn fix(
     let l = label("fix", i, None);
     let body = bodies.reference(c, &["fix", &idx, "body"], &l, &f.body);
     let sel = selection(c, "fix", &idx, &l, &f.group, &f.bbox);
-    let mask = dofs(c, &["fix", &idx, "dofs"], &l, &f.dofs);
+    let frame = fix_frame(c, &idx, &l, f, rigid);
+    let mask =
+        frame.and_then(|frame| dofs(c, &["fix", &idx, "dofs"], &l, &f.dofs, &frame.letters()));
     if f.rotation && !rigid {
         c.error(
             &["fix", &idx, "rotation"],
@@ -61,13 +66,102 @@ fn fix(
             ),
         );
     }
-    let fix = sel.zip(mask).map(|(selection, dofs)| Fix {
-        body: f.body.clone(),
-        selection,
-        dofs,
-        rotation: f.rotation,
-    });
+    let fix = sel
+        .zip(mask)
+        .zip(frame)
+        .map(|((selection, dofs), frame)| Fix {
+            body: f.body.clone(),
+            selection,
+            dofs,
+            rotation: f.rotation,
+            frame,
+        });
     (body, fix)
+}
+
+/// The frame of a `[[fix]]`: the axes without `frame`; a cylindrical frame with a finite
+/// `axis_origin` and a finite, non-zero `axis` (normalised here); an orthonormal basis.
+/// `axis` and `axis_origin` only with `frame = "cylindrical"`; no frame on a rigid body.
+fn fix_frame(c: &mut Checker<'_>, idx: &str, l: &str, f: &RawFix, rigid: bool) -> Option<FixFrame> {
+    let at = |key| ["fix", idx, key];
+    let cylindrical = matches!(&f.frame, Some(RawFrame::Name(_)));
+    for (key, given) in [
+        ("axis", f.axis.is_some()),
+        ("axis_origin", f.axis_origin.is_some()),
+    ] {
+        if given && !cylindrical {
+            c.error(
+                &at(key),
+                format!(
+                    "{l}: `{key}` is the axis of a cylindrical frame, but the fix has no \
+                     `frame = \"cylindrical\"`; fix: add it, or drop `{key}`"
+                ),
+            );
+            return None;
+        }
+    }
+    let Some(frame) = f.frame.as_ref() else {
+        return Some(FixFrame::Axes);
+    };
+    if rigid {
+        c.error(
+            &at("frame"),
+            format!(
+                "{l}: body {:?} is rigid, and a local frame holds the nodes of a deformable \
+                 body only; fix: drop `frame` (a rigid body is held on x, y, z)",
+                f.body
+            ),
+        );
+        return None;
+    }
+    match frame {
+        RawFrame::Name(FrameName::Cylindrical) => {
+            let origin = f.axis_origin.unwrap_or([0.0; 3]);
+            let Some(axis) = f.axis else {
+                c.error(
+                    &at("frame"),
+                    format!(
+                        "{l}: frame = \"cylindrical\" needs `axis`, the direction of the \
+                         cylinder's axis, e.g. axis = [0.0, 0.0, 1.0] (and `axis_origin`, a point \
+                         of it, default the origin)"
+                    ),
+                );
+                return None;
+            };
+            let length = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+            let finite = origin.iter().all(|v| v.is_finite()) && length.is_finite();
+            if !finite || length == 0.0 {
+                c.error(
+                    &at("axis"),
+                    format!(
+                        "{l}: axis = {axis:?} with axis_origin = {origin:?}: give finite \
+                         numbers and a non-zero axis"
+                    ),
+                );
+                return None;
+            }
+            let axis = axis.map(|v| v / length);
+            Some(FixFrame::Cylindrical { origin, axis })
+        }
+        RawFrame::Basis(rows) => {
+            let basis = qdem_core::Mat3::from_fn(|r, k| rows[k][r]);
+            let finite = basis.iter().all(|v| v.is_finite());
+            match finite.then(|| qdem_core::step::frames::check_orthonormal(&basis)) {
+                Some(Ok(())) => Some(FixFrame::Basis(*rows)),
+                Some(Err(e)) => {
+                    c.error(&at("frame"), format!("{l}: frame = {rows:?}: {e}"));
+                    None
+                }
+                None => {
+                    c.error(
+                        &at("frame"),
+                        format!("{l}: frame = {rows:?}: give finite numbers"),
+                    );
+                    None
+                }
+            }
+        }
+    }
 }
 
 /// Every `[[load]]` as validated; fills their bodies' indices.
@@ -244,33 +338,48 @@ fn box_selection(
     ok.then_some(Selection::Box(*b))
 }
 
-/// Parse `dofs` ("xyz", "xz", …) into an `[x, y, z]` mask.
-fn dofs(c: &mut Checker<'_>, at: &[&str], owner: &str, dofs: &str) -> Option<[bool; 3]> {
+/// Parse `dofs` ("xyz", "xz", …, or of the frame's `letters`: "t" of "rtz") into a mask of the
+/// frame's three directions.
+fn dofs(
+    c: &mut Checker<'_>,
+    at: &[&str],
+    owner: &str,
+    dofs: &str,
+    letters: &[char; 3],
+) -> Option<[bool; 3]> {
+    let names: String = letters.iter().collect();
+    let framed = names != "xyz";
     if dofs.is_empty() {
         c.error(
             at,
             format!(
-                "{owner}: dofs is empty; give a non-empty subset of \"xyz\", e.g. \"xyz\" or \"z\""
+                "{owner}: dofs is empty; give a non-empty subset of \"{names}\", e.g. \
+                 \"{names}\" or \"{}\"",
+                letters[2]
             ),
         );
         return None;
     }
     let mut mask = [false; 3];
     for ch in dofs.chars() {
-        let axis = match ch {
-            'x' => 0,
-            'y' => 1,
-            'z' => 2,
-            other => {
-                c.error(
-                    at,
-                    format!(
-                        "{owner}: dofs = {dofs:?}: `{other}` is not a direction; use only the \
-                         letters x, y, z (lower case)"
-                    ),
-                );
-                return None;
-            }
+        let Some(axis) = letters.iter().position(|&l| l == ch) else {
+            let hint = match framed {
+                true => format!(
+                    "; with `frame`, dofs names the frame's directions (default \"xyz\" does \
+                     not: give them, e.g. dofs = \"{}\")",
+                    letters[1]
+                ),
+                false => String::new(),
+            };
+            c.error(
+                at,
+                format!(
+                    "{owner}: dofs = {dofs:?}: `{ch}` is not a direction; use only the letters \
+                     {} (lower case){hint}",
+                    letters.map(String::from).join(", ")
+                ),
+            );
+            return None;
         };
         if mask[axis] {
             c.error(

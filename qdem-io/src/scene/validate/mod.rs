@@ -32,7 +32,9 @@ mod run;
 use std::path::Path;
 
 use super::error::SceneError;
-use super::schema::{AreaLoad, RawFix, RawLoad, RawScene, Selection};
+use super::schema::{
+    AreaLoad, FixFrame, FrameName, RawFix, RawFrame, RawLoad, RawScene, Selection,
+};
 use super::spans::SpanIndex;
 use super::{Refs, Scene};
 use checker::Checker;
@@ -105,18 +107,32 @@ pub(crate) fn to_raw(scene: &Scene) -> RawScene {
             .iter()
             .map(|f| {
                 let (group, bbox) = split(&f.selection);
-                let dofs = ['x', 'y', 'z']
+                let dofs = f
+                    .frame
+                    .letters()
                     .iter()
                     .zip(f.dofs)
                     .filter(|(_, on)| *on)
                     .map(|(c, _)| *c)
                     .collect();
+                let (frame, axis_origin, axis) = match f.frame {
+                    FixFrame::Axes => (None, None, None),
+                    FixFrame::Basis(rows) => (Some(RawFrame::Basis(rows)), None, None),
+                    FixFrame::Cylindrical { origin, axis } => (
+                        Some(RawFrame::Name(FrameName::Cylindrical)),
+                        Some(origin),
+                        Some(axis),
+                    ),
+                };
                 RawFix {
                     body: f.body.clone(),
                     group,
                     bbox,
                     dofs,
                     rotation: f.rotation,
+                    frame,
+                    axis_origin,
+                    axis,
                 }
             })
             .collect(),
