@@ -113,6 +113,7 @@ impl DemContacts {
             time_delay: None,
             split: None,
             passage: PassageCheck::default(),
+            step_short: None,
         }
     }
 
