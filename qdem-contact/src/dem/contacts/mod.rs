@@ -78,7 +78,9 @@ use time_delay::{pair_scales, TimeDelay};
 use walls::Walls;
 
 pub use persistence::{CarriedSprings, SavedSpring, SavedSprings};
-pub use stable_step::{impact_overlap, FLOOR_CONTACTS, FLOOR_OVERLAP, OVERLAP_MARGIN};
+pub use stable_step::{
+    impact_overlap, rayleigh_time, FLOOR_CONTACTS, FLOOR_OVERLAP, OVERLAP_MARGIN,
+};
 pub use tunnelling::BodySurface;
 use tunnelling::PassageCheck;
 
