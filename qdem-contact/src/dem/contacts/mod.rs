@@ -45,8 +45,9 @@
 //! run, whose stages the world's exchange runs ([`qdem_core::parallel`]); `tunnelling.rs`
 //! the check, at each rebuild of the lists, for a sphere gone through a wall or into
 //! another body; and `stages.rs` where the evaluations stand. The other files hold what
-//! [`DemContacts`] does with them: this one the narrow phase, the [`Model`] facet and the
-//! stable step; `build.rs` its construction; `stages.rs` the stages of one evaluation;
+//! [`DemContacts`] does with them: this one the narrow phase and the [`Model`] facet;
+//! `stable_step.rs` the step estimated from the contacts present and its check at each
+//! rebuild; `build.rs` its construction; `stages.rs` the stages of one evaluation;
 //! `pipeline.rs` the reading of the spheres and the building of the candidate lists;
 //! `displacement.rs` the displacement check's bound for rigid bodies; `output_queries.rs`
 //! what the outputs read; `persistence.rs` what a checkpoint keeps; `linearized.rs` the
