@@ -9,6 +9,8 @@
 
 use crate::command::CliError;
 use crate::progress;
+use crate::run_length;
+use qdem_contact::{rayleigh_time, DemContacts};
 use qdem_core::{
     parallel::Communicator, parallel::RankFigures, step::Model as _, step::Scheme, step::Stage,
 };
@@ -179,8 +181,39 @@ fn print_step_limits(sim: &Simulation) {
         };
         println!("step limit of body `{}`: {limit}", body.name);
     }
-    if let Some(dt) = sim.contacts().and_then(|c| c.stable_dt(state)) {
-        println!("step limit of the contacts: {dt:.4e} s");
+    if let Some(contacts) = sim.contacts() {
+        print_contact_step(sim, contacts);
+    }
+}
+
+/// The contacts' step estimated from the contacts present, the step one contact alone cannot
+/// be stepped above, and beside them Rayleigh's time of the smallest sphere and 20% of it,
+/// the step LIGGGHTS's and EDEM's users usually take.
+fn print_contact_step(sim: &Simulation, contacts: &DemContacts) {
+    let state = &sim.world.state;
+    if let Some(dt) = contacts.stable_dt(state) {
+        let alone = contacts.unstable_above(state).map_or(String::new(), |u| {
+            format!("; a step above {u:.4e} s, which one of them alone cannot take, is refused")
+        });
+        println!(
+            "step limit of the contacts: {dt:.4e} s, estimated from the {} contacts present \
+             (a larger dt is warned of, and the run stops if a contact comes to need a \
+             shorter one){alone}",
+            contacts.contacts()
+        );
+    }
+    let materials = &sim.scene.materials;
+    let rayleigh = contacts
+        .radii_and_materials()
+        .filter_map(|(r, m)| materials.get(m).map(|m| (r, m)))
+        .map(|(r, m)| rayleigh_time(r, m.density, m.young, m.poisson))
+        .fold(f64::INFINITY, f64::min);
+    if rayleigh.is_finite() {
+        println!(
+            "Rayleigh time of the smallest sphere: {rayleigh:.4e} s; 20% of it, the step \
+             LIGGGHTS's and EDEM's users usually take: {:.4e} s",
+            0.2 * rayleigh
+        );
     }
 }
 
@@ -207,12 +240,23 @@ fn print_cost(sim: &Simulation, per_step: f64) {
         ),
         tets => format!("{:.3e} tet-steps/s", tets as f64 / per_step),
     };
+    let threads = rayon::current_num_threads();
+    let settling = run_length::settled_contacts(sim, threads);
+    let least = if settling.is_some() { "at least " } else { "" };
     println!(
-        "measured {:.3e} s/step on {} threads ({rate}): estimated run time {} (outputs not counted)",
-        per_step,
-        rayon::current_num_threads(),
+        "measured {per_step:.3e} s/step on {threads} threads ({rate}): estimated run time \
+         {least}{} (outputs not counted)",
         progress::clock(total)
     );
+    if let Some(s) = settling {
+        println!(
+            "the step was measured with {} contacts; as a bed settles to about {} (6 per \
+             grain) its steps cost more: about {} in all",
+            s.now,
+            s.settled,
+            progress::clock((per_step + s.extra_step) * sim.steps() as f64)
+        );
+    }
     print_stages(sim);
 }
 

@@ -24,6 +24,42 @@ const SPHERE_STEP: f64 = 4e-8;
 /// Wall seconds of a step, at the least, however small its scene.
 const STEP_FLOOR: f64 = 1e-7;
 
+/// Contact pairs per grain of a settled bed: a coordination of about 6 contacts per grain,
+/// each shared by two.
+pub const SETTLED_PAIRS_PER_GRAIN: f64 = 3.0;
+
+/// Wall seconds of a touching pair's evaluation on one thread (the narrow phase, the law and
+/// the sums): 60 ns a candidate on the 10⁵ grains split over 2 ranks (docs/scaling.md), about
+/// one candidate per touching pair in a settled bed.
+const PAIR_STEP: f64 = 6e-8;
+
+/// What a step of `sim` costs more once its contacts have grown from those present now to
+/// a settled bed's ([`SETTLED_PAIRS_PER_GRAIN`] per body with contact spheres), on `threads`
+/// threads: `None` when they are already as many (a step measured before a pour's contacts
+/// form is a lower bound of its steps after; issue of `qdem check`'s 9 s for a 49.7 s pour).
+#[must_use]
+pub fn settled_contacts(sim: &Simulation, threads: usize) -> Option<SettledContacts> {
+    let contacts = sim.contacts()?;
+    let now = contacts.contacts();
+    let settled = (SETTLED_PAIRS_PER_GRAIN * contacts.body_names().len() as f64).round() as usize;
+    (settled > now).then(|| SettledContacts {
+        now,
+        settled,
+        extra_step: (settled - now) as f64 * PAIR_STEP / threads.max(1) as f64,
+    })
+}
+
+/// A scene whose contacts will grow (a pour), and what its step costs more then.
+#[derive(Clone, Copy, Debug)]
+pub struct SettledContacts {
+    /// The contacts touching now.
+    pub now: usize,
+    /// The contacts of the settled bed.
+    pub settled: usize,
+    /// The wall seconds a step costs more with them.
+    pub extra_step: f64,
+}
+
 /// A run modelled to take more than [`LONGEST_UNASKED`].
 #[derive(Debug, thiserror::Error)]
 #[error(

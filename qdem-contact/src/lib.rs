@@ -41,6 +41,9 @@ pub use boundaries::periodic_boundary::{PeriodicBox, WrapGroup};
 pub use boundaries::periodic_wrap::PeriodicWrap;
 pub use boundaries::time_delayed_boundary::{GhostScales, LoadCycle, TimeDelayedBoundary};
 pub use dem::contact_view::{Partner, SphereRecord, TouchingContact};
+pub use dem::contacts::{
+    impact_overlap, rayleigh_time, FLOOR_CONTACTS, FLOOR_OVERLAP, OVERLAP_MARGIN,
+};
 pub use dem::contacts::{CarriedSprings, ContactSettings, ContactSphere, DemContacts};
 pub use dem::contacts::{SavedSpring, SavedSprings, SavedWall};
 pub use dem::laws::contact_law::{ContactLaw, PairElasticity, PairGeometry};

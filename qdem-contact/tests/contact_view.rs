@@ -36,7 +36,7 @@ fn touching_contacts_sum_per_sphere_to_the_applied_contact_force() {
     let contacts = model(&state, &spheres, vec![floor])
         .with_time_delay(0, TimeDelayedBoundary::new(cycle, lag))
         .unwrap();
-    let (state, models) = run(state, contacts, 30);
+    let (state, models) = run(state, contacts, 10);
     let any: &dyn std::any::Any = models[0].as_ref();
     let contacts = any.downcast_ref::<DemContacts>().unwrap();
 

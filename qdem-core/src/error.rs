@@ -234,6 +234,21 @@ pub enum CoreError {
         /// that here instead).
         fix: String,
     },
+    /// A contact found, at a rebuild of the contact lists, to need a shorter step than the
+    /// run's: its own oscillation, whatever the other contacts do, is unstable at the run's
+    /// step ([`crate::step::Model::failure`]).
+    #[error(
+        "{contact} needs dt <= {needed:.4e} s (2/omega of that contact alone, a step above \
+         which no run is stable), and the run steps at dt = {dt:.4e} s"
+    )]
+    ContactStep {
+        /// The contact: its two spheres and bodies (or the wall), overlap and reduced mass.
+        contact: String,
+        /// The step it needs (s).
+        needed: f64,
+        /// The run's step (s).
+        dt: f64,
+    },
     /// The sparse linear algebra failed for a reason other than definiteness.
     #[error("sparse factorisation failed: {0}")]
     Sparse(String),

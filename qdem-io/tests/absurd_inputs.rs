@@ -91,3 +91,25 @@ fn a_cyclic_load_with_min_above_max_is_refused() {
         assert!(message.contains(part), "{part:?} not in {message:?}");
     }
 }
+
+/// The poured grains of `fixtures/contact/grains.toml` at dt = 2e-4 s, above the 5.9e-5 s the
+/// contacts estimate: no grain touches at the start, so no contact alone is shown unstable
+/// there, and the step is accepted with a warning of what the run does if one comes to need
+/// a shorter step (the fixed worst case refused it).
+#[test]
+fn a_step_above_the_contacts_estimate_is_accepted_and_warned_of() {
+    let dir = test_dir("absurd-contact-step");
+    let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/../fixtures/contact/grains.toml");
+    let text = std::fs::read_to_string(fixture).unwrap();
+    let path = dir.join("grains.toml");
+    std::fs::write(&path, text.replace("dt = 2e-5", "dt = 2e-4")).unwrap();
+    let sim = Simulation::build(Scene::load(&path).unwrap()).expect("accepted");
+    assert_one_warning(
+        &sim.warnings,
+        &[
+            "[run] dt = 2e-4 s",
+            "estimates from the contacts present",
+            "the run stops, naming the contact",
+        ],
+    );
+}

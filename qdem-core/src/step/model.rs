@@ -52,6 +52,15 @@ pub trait Model: std::any::Any + Send + Sync {
         None
     }
 
+    /// The step (s) above which explicit stepping of this model is unstable at `state`
+    /// whatever else happens, so that a requested step above it is refused; a model whose
+    /// [`Model::stable_dt`] is an estimate rather than a rigorous bound (the contacts present)
+    /// gives a lower bound of the highest frequency here, and a step between the two is
+    /// warned of only. The default is [`Model::stable_dt`].
+    fn unstable_above(&self, state: &State) -> Option<f64> {
+        self.stable_dt(state)
+    }
+
     /// How the model takes part in a run decomposed over ranks ([`crate::parallel`]): what
     /// it reads of the particles' motion, and its split facet if a rank computes it in part.
     /// With [`Reads::Own`] or [`Reads::Split`] from every model and hook, a rank keeps only

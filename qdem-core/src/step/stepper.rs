@@ -361,8 +361,18 @@ pub fn stable_step(state: &State, models: &[Box<dyn Model>]) -> Option<(f64, Str
         .min_by(|a, b| a.0.total_cmp(&b.0))
 }
 
+/// The smallest step above which some model is unstable whatever else happens
+/// ([`Model::unstable_above`]) and the name of that model.
+pub fn unstable_step(state: &State, models: &[Box<dyn Model>]) -> Option<(f64, String)> {
+    models
+        .iter()
+        .filter_map(|m| m.unstable_above(state).map(|dt| (dt, m.name().to_string())))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+}
+
 /// Chooses the step: `safety` times the stable bound when `requested` is `None`, otherwise the
-/// requested step, refused if it exceeds the bound.
+/// requested step, refused if it exceeds the step some model cannot be stepped above
+/// ([`unstable_step`]; the stable bound, except where a model's bound is an estimate).
 pub fn choose_step(
     state: &State,
     models: &[Box<dyn Model>],
@@ -371,8 +381,14 @@ pub fn choose_step(
 ) -> Result<f64, CoreError> {
     let (bound, limiter) =
         stable_step(state, models).unwrap_or((f64::INFINITY, "nothing".to_string()));
+    let (refused_above, refuser) =
+        unstable_step(state, models).unwrap_or((f64::INFINITY, "nothing".to_string()));
     match requested {
-        Some(dt) if dt > bound => Err(CoreError::StepTooLarge { dt, bound, limiter }),
+        Some(dt) if dt > refused_above => Err(CoreError::StepTooLarge {
+            dt,
+            bound: refused_above,
+            limiter: refuser,
+        }),
         Some(dt) => Ok(dt),
         None if bound.is_finite() => Ok(safety * bound),
         None => Err(CoreError::NoStableBound { bound, limiter }),

@@ -1,12 +1,14 @@
 //! Warnings for inputs that are valid but almost certainly not meant, each naming the value,
 //! what it leads to and the likely intent (`qdem check` and `qdem run` print them before the
-//! run): a fixed time step far below the stable bound (a run of absurdly many steps), a probe
+//! run): a fixed time step far below the stable bound (a run of absurdly many steps), or above
+//! the contacts' estimate (accepted, not shown stable), a probe
 //! far from every particle (a point in the wrong units or frame), a Young's modulus whose
 //! wave speed √(E/ρ) is below that of any solid (a modulus in the wrong unit). A cyclic load
 //! with `min` above `max` is refused at validation instead (`scene/validate/fix_load.rs`).
 
 use super::Simulation;
 use crate::scene::TimeStep;
+use qdem_core::step::stepper::unstable_step;
 use qdem_core::Vec3;
 
 /// A fixed `dt` below this fraction of the explicit stable bound is warned of.
@@ -24,6 +26,7 @@ pub const SLOWEST_WAVE: f64 = 1.0;
 pub(crate) fn warnings(sim: &Simulation) -> Vec<String> {
     let mut out = Vec::new();
     out.extend(tiny_step(sim));
+    out.extend(above_estimate(sim));
     out.extend(far_probes(sim));
     out.extend(soft_materials(sim));
     let file = sim.scene.path.display();
@@ -49,6 +52,31 @@ fn tiny_step(sim: &Simulation) -> Option<String> {
         dt / bound,
         sim.scene.run.t_end / dt,
         sim.scene.run.t_end,
+        bound * sim.scene.run.dt_safety
+    ))
+}
+
+/// A fixed explicit step above the estimate of the contacts present, accepted because no
+/// contact alone is unstable at it (a requested step above a rigorous bound is refused
+/// before): what the run does if the contacts come to need a shorter one.
+fn above_estimate(sim: &Simulation) -> Option<String> {
+    let TimeStep::Fixed(dt) = sim.scene.run.dt else {
+        return None;
+    };
+    let settings = sim.world.settings();
+    let (bound, limiter) = &settings.stable_dt;
+    if settings.is_implicit() || dt <= *bound {
+        return None;
+    }
+    let alone = unstable_step(&sim.world.state, &sim.world.models)
+        .map_or(String::new(), |(u, _)| {
+            format!(" (one of them alone is unstable above {u:.3e} s)")
+        });
+    Some(format!(
+        "[run] dt = {dt:e} s is above the step {bound:.3e} s `{limiter}` estimates from the \
+         contacts present{alone}: accepted, but not shown stable; the run stops, naming the \
+         contact and the step it needs, if at a rebuild of the contact lists a contact needs a \
+         shorter step than dt; dt = \"auto\" takes {:.3e} s",
         bound * sim.scene.run.dt_safety
     ))
 }

@@ -114,6 +114,7 @@ impl DemContacts {
             split: None,
             passage: PassageCheck::default(),
             rolling: None,
+            step_short: None,
         }
     }
 

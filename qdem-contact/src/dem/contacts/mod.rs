@@ -46,8 +46,9 @@
 //! the check, at each rebuild of the lists, for a sphere gone through a wall or into
 //! another body; `rolling.rs` the rolling resistance of the contacts; and `stages.rs` where
 //! the evaluations stand. The other files hold what
-//! [`DemContacts`] does with them: this one the narrow phase, the [`Model`] facet and the
-//! stable step; `build.rs` its construction; `stages.rs` the stages of one evaluation;
+//! [`DemContacts`] does with them: this one the narrow phase and the [`Model`] facet;
+//! `stable_step.rs` the step estimated from the contacts present and its check at each
+//! rebuild; `build.rs` its construction; `stages.rs` the stages of one evaluation;
 //! `pipeline.rs` the reading of the spheres and the building of the candidate lists;
 //! `displacement.rs` the displacement check's bound for rigid bodies; `output_queries.rs`
 //! what the outputs read; `persistence.rs` what a checkpoint keeps; `linearized.rs` the
@@ -80,6 +81,9 @@ use time_delay::{pair_scales, TimeDelay};
 use walls::Walls;
 
 pub use persistence::{CarriedSprings, SavedSpring, SavedSprings, SavedWall};
+pub use stable_step::{
+    impact_overlap, rayleigh_time, FLOOR_CONTACTS, FLOOR_OVERLAP, OVERLAP_MARGIN,
+};
 pub use tunnelling::BodySurface;
 use tunnelling::PassageCheck;
 
@@ -95,6 +99,7 @@ mod rolling;
 mod servo_loads;
 mod spheres;
 mod split;
+mod stable_step;
 mod stages;
 mod time_delay;
 mod tunnelling;
@@ -117,13 +122,6 @@ const SPHERE_CHUNK: usize = 16384;
 /// contact stage took about 60 ns per candidate and its prediction and integration about 18
 /// ns per particle.
 const CANDIDATE_WORK: f64 = 3.0;
-
-/// Overlap, as a fraction of the reduced radius, at which the stable step evaluates Hertz's
-/// stiffness (which grows as √δ).
-pub const REFERENCE_OVERLAP: f64 = 0.05;
-
-/// Contacts per sphere assumed by the stable-step bound.
-pub const COORDINATION: f64 = 6.0;
 
 /// One contact sphere as the builder describes it.
 #[derive(Clone, Copy, Debug)]
@@ -268,6 +266,9 @@ pub struct DemContacts {
     passage: PassageCheck,
     /// The rolling resistance of every contact, if any (`rolling.rs`).
     rolling: Option<RollingResistance>,
+    /// The first contact found at a rebuild to need a shorter step than the run's
+    /// (`stable_step.rs`).
+    step_short: Option<stable_step::StepNeed>,
 }
 
 /// r_a r_b / (r_a + r_b).
@@ -293,57 +294,19 @@ impl Model for DemContacts {
         Reads::Split(self)
     }
 
-    /// The critical step 2/(√(ω² + γ²/4) + γ/2) of Gershgorin's bounds on M⁻¹K and M⁻¹C
-    /// ([`qdem_core::continuum::stable_step::critical_step`]) for the worst carrier of spheres: ω² =
-    /// 2 Σ k (1/m + ℓ²/I), γ = 2 Σ c (1/m + ℓ²/I) with c = 2ζ√(k m), summed over the contacts
-    /// a carrier can have at once: [`COORDINATION`] for a vertex sphere of a deformable body or
-    /// a rigid single sphere, one per sphere for a rigid body with several (all of them may
-    /// rest on one wall). k is the stiffest of the normal and tangential springs (Hertz's at an
-    /// overlap of [`REFERENCE_OVERLAP`] of the radius), m the carrier's mass, ℓ the lever arm
-    /// of a contact on a rigid body about its centre and I its smallest principal moment (ℓ = 0
-    /// for a body whose rotation is held). With rolling friction a contact's rolling spring
-    /// k_r = k_t R*² adds k_r/I ≤ k ℓ²/I to its carrier's rotation: ℓ²/I is counted twice.
-    /// Carriers held in every direction are left out.
-    fn stable_dt(&self, _state: &State) -> Option<f64> {
-        let law = &self.settings.law;
-        let zeta = law.damping_ratio();
-        let n_rigid = self
-            .spheres
-            .rigid()
-            .iter()
-            .filter(|&&r| r != NOT_RIGID)
-            .map(|&r| r as usize + 1)
-            .max()
-            .unwrap_or(0);
-        let mut per_body = vec![(0.0, 0.0, 0usize); n_rigid];
-        let mut worst = (0.0f64, 0.0f64);
-        for s in 0..self.spheres.len() {
-            let r = self.spheres.radius()[s];
-            let sphere = self.spheres.now(s);
-            let e = self.walls.elasticity(sphere.material);
-            let (kn, kt) = law.stiffness(REFERENCE_OVERLAP * r, r, &e);
-            let k = kn.max(kt);
-            let mass = self.spheres.bound_mass()[s];
-            if mass.is_infinite() {
-                continue;
-            }
-            let rolls = 1.0 + self.rolling.is_some() as u8 as f64;
-            let compliance = 1.0 / mass + rolls * self.spheres.lever()[s];
-            let (w, g) = (k * compliance, 2.0 * zeta * (k * mass).sqrt() * compliance);
-            match self.spheres.rigid()[s] {
-                NOT_RIGID => worst = (worst.0.max(COORDINATION * w), worst.1.max(COORDINATION * g)),
-                b => {
-                    let entry = &mut per_body[b as usize];
-                    *entry = (entry.0 + w, entry.1 + g, entry.2 + 1);
-                }
-            }
-        }
-        for (w, g, count) in per_body {
-            let scale = if count == 1 { COORDINATION } else { 1.0 };
-            worst = (worst.0.max(scale * w), worst.1.max(scale * g));
-        }
-        let (omega_squared, damping_rate) = (2.0 * worst.0, 2.0 * worst.1);
-        (omega_squared > 0.0).then(|| critical_step(omega_squared, damping_rate))
+    /// The step estimated from the contacts touching at `state` (`stable_step.rs`): a true
+    /// bound of the linearised system's highest frequency for those contacts, at
+    /// [`OVERLAP_MARGIN`] times their overlaps, every carrier counted with at least
+    /// [`FLOOR_CONTACTS`] contacts at the floor overlap. Carriers held in every direction are
+    /// left out.
+    fn stable_dt(&self, state: &State) -> Option<f64> {
+        self.estimated_step(state)
+    }
+
+    /// The step one contact touching at `state` cannot be stepped above, whatever the others
+    /// (`stable_step.rs`); a step between it and [`Model::stable_dt`] is warned of only.
+    fn unstable_above(&self, state: &State) -> Option<f64> {
+        self.unstable_step(state)
     }
 
     fn potential_energy(&self, state: &State) -> Option<f64> {
@@ -378,12 +341,17 @@ impl Model for DemContacts {
 
     fn prepare(&mut self, settings: &qdem_core::step::StepSettings) {
         self.passage.set_step(settings.dt);
+        if self.lists_built() {
+            self.check_step_need(self.candidates.built_time());
+        }
     }
 
     /// A sphere found through a wall or inside another body at the last rebuild of the
-    /// lists (`tunnelling.rs`).
+    /// lists (`tunnelling.rs`), or a contact found there to need a shorter step than the
+    /// run's (`stable_step.rs`).
     fn failure(&self, state: &State) -> Option<qdem_core::error::CoreError> {
         self.passage_failure(state.time)
+            .or_else(|| self.step_failure())
     }
 
     fn persistent_mut(&mut self) -> Option<&mut dyn Persistent> {

@@ -115,6 +115,16 @@ impl DemContacts {
         self.spheres.body_names()
     }
 
+    /// Every contact sphere's radius (m) and the index of its material.
+    pub fn radii_and_materials(&self) -> impl Iterator<Item = (f64, usize)> + '_ {
+        (0..self.spheres.len()).map(|s| {
+            (
+                self.spheres.radius()[s],
+                self.spheres.now(s).material as usize,
+            )
+        })
+    }
+
     /// Every contact sphere at `state` (the state the last evaluation saw, after the step),
     /// in sphere order, with the contact force the model applied to it.
     pub fn sphere_records<'a>(

@@ -135,11 +135,13 @@ impl DemContacts {
     }
 
     /// Stage 2: the check for spheres gone through a wall or into another body, then new
-    /// lists near the own spheres (every sphere's on one process).
+    /// lists near the own spheres (every sphere's on one process), and the check of the step
+    /// their touching contacts need (`stable_step.rs`).
     pub(super) fn rebuild_stage(&mut self, time: f64) {
         if self.split.is_none() {
             self.check_passage(time, None);
             self.rebuild_all(time);
+            self.check_step_need(time);
             return;
         }
         self.with_part(|this, part| {
@@ -147,6 +149,7 @@ impl DemContacts {
             this.rebuild_near(part, time);
             part.lists_changed = true;
         });
+        self.check_step_need(time);
     }
 
     /// Stage 3: on a rank, the spheres of other ranks its new lists read (ascending); `None`

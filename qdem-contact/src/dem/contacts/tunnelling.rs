@@ -89,6 +89,11 @@ impl PassageCheck {
     pub(super) fn set_step(&mut self, step: f64) {
         self.step = step;
     }
+
+    /// The run's step (s); 0 until [`qdem_core::step::Model::prepare`].
+    pub(super) fn step(&self) -> f64 {
+        self.step
+    }
 }
 
 impl DemContacts {

@@ -91,6 +91,17 @@ impl ContactLaw {
         }
     }
 
+    /// The dashpot (N s/m) the law puts beside a spring of stiffness `stiffness` (N/m) on a
+    /// pair of reduced mass `mass` (kg): 2ζ√(k m*) for the linear law, 2√(5/6) ζ √(S m*) for
+    /// Hertz–Mindlin; 0 without damping.
+    pub fn dashpot(&self, stiffness: f64, mass: f64) -> f64 {
+        let prefactor = match self {
+            ContactLaw::Linear(_) => 2.0,
+            ContactLaw::HertzMindlin(_) => crate::dem::laws::hertz_mindlin::DAMPING_PREFACTOR,
+        };
+        prefactor * self.damping_ratio() * (stiffness * mass).sqrt()
+    }
+
     /// The damping ratio ζ of the law.
     pub fn damping_ratio(&self) -> f64 {
         match self {

@@ -21,7 +21,7 @@ pub struct HertzMindlin {
 }
 
 /// 2√(5/6), the damping prefactor of LIGGGHTS's Hertz model.
-const DAMPING_PREFACTOR: f64 = 1.825_741_858_350_553_8;
+pub(crate) const DAMPING_PREFACTOR: f64 = 1.825_741_858_350_553_8;
 
 impl HertzMindlin {
     /// Tangent stiffnesses (S_n, S_t) = (2E*√(R*δ), 8G*√(R*δ)) (N/m).
