@@ -202,6 +202,7 @@ fn check_prints_the_advice_and_json_gives_it_to_scripts() {
     assert!(advice
         .iter()
         .any(|a| a["subject"] == "body `left`" && a["advised"] == "deformable"));
+}
 
 #[test]
 fn check_prints_the_rayleigh_time_beside_the_contacts_step_and_a_pours_settled_run_time() {
