@@ -71,6 +71,7 @@ use qdem_core::{
     step::Tangent, Vec3,
 };
 use rayon::prelude::*;
+use spatial_order::SphereOrder;
 use spheres::{SphereColumns, Spheres};
 use split::ContactPart;
 use stages::Evaluation;
@@ -90,6 +91,7 @@ mod pair_kernel;
 mod persistence;
 mod pipeline;
 mod servo_loads;
+mod spatial_order;
 mod spheres;
 mod split;
 mod stages;
@@ -242,8 +244,10 @@ pub(crate) fn narrow_phase(
 pub struct DemContacts {
     /// The model's name.
     name: String,
-    /// The sphere records (`spheres.rs`).
+    /// The sphere records (`spheres.rs`), by slot.
     spheres: Spheres,
+    /// The spheres' slots in spatial order and their stable ids (`spatial_order.rs`).
+    order: SphereOrder,
     /// The candidate lists and their build (`candidates.rs`).
     candidates: Candidates,
     /// The law, the friction between spheres and the skin.

@@ -134,14 +134,16 @@ impl DemContacts {
         }
     }
 
-    /// Stage 2: the check for spheres gone through a wall or into another body, then new
-    /// lists near the own spheres (every sphere's on one process).
+    /// Stage 2: the check for spheres gone through a wall or into another body, then the
+    /// spheres in spatial order (`spatial_order.rs`) and new lists near the own spheres
+    /// (every sphere's on one process).
     pub(super) fn rebuild_stage(&mut self, time: f64) {
         if self.split.is_none() {
             self.check_passage(time, None);
             self.rebuild_all(time);
             return;
         }
+        self.sort_spheres();
         self.with_part(|this, part| {
             this.check_passage(time, Some(part.own()));
             this.rebuild_near(part, time);
@@ -149,11 +151,16 @@ impl DemContacts {
         });
     }
 
-    /// Stage 3: on a rank, the spheres of other ranks its new lists read (ascending); `None`
-    /// when the lists did not change, and always on one process.
+    /// Stage 3: on a rank, the spheres of other ranks its new lists read, by stable id
+    /// (ascending); `None` when the lists did not change, and always on one process.
     pub(super) fn new_ghosts_stage(&mut self) -> Option<Vec<u32>> {
         self.split.as_ref()?;
-        self.with_part(|this, part| this.declare_ghosts(part))
+        let mut ghosts = self.with_part(|this, part| this.declare_ghosts(part))?;
+        for g in &mut ghosts {
+            *g = self.id_of(*g as usize) as u32;
+        }
+        ghosts.sort_unstable();
+        Some(ghosts)
     }
 
     /// Stage 4: the motion of the own partners of candidates (on one process, unless stage 1
