@@ -11,7 +11,7 @@
 //! the stable id is the sphere's index as the builder gave it. The order is thus a function of
 //! the centres at the build alone: one process and every rank of a decomposed run (which
 //! holds every sphere's centre at a rebuild) find the same, and a run resumed from a
-//! checkpoint finds it again from the saved build positions ([`DemContacts::restore`]).
+//! checkpoint finds it again from the saved build positions (`persistence.rs`).
 //!
 //! Inside the engine a sphere is its *slot*, its place in this order: the sphere records
 //! (`spheres.rs`), the build positions and the candidate lists (`candidates.rs`), a rank's
@@ -254,8 +254,9 @@ mod tests {
         evaluations
             .map(|e| {
                 state.time = e as f64 * DT;
-                for p in 0..state.len() {
-                    state.position[p] = start[p] + state.time * state.velocity[p];
+                let time = state.time;
+                for ((x, x0), v) in state.position.iter_mut().zip(&start).zip(&state.velocity) {
+                    *x = x0 + time * v;
                 }
                 let mut force = vec![Vec3::zeros(); state.len()];
                 model.add_forces(state, &mut force, &mut []);
