@@ -112,6 +112,47 @@ impl ContactList {
         self.turn.clear();
     }
 
+    /// Renumbers the spheres: the sphere `t` becomes `to[t]` (and so does a second partner
+    /// when `pairs`, the pair then turned so that its first partner is the lower: its spring,
+    /// force and image translation change sign, n × f stays); the list sorted again.
+    pub(crate) fn renumber(&mut self, to: &[u32], pairs: bool) {
+        for (k, c) in self.items.iter_mut().enumerate() {
+            c.first = to[c.first as usize];
+            if !pairs {
+                continue;
+            }
+            c.second = to[c.second as usize];
+            if c.first > c.second {
+                std::mem::swap(&mut c.first, &mut c.second);
+                c.history = -c.history;
+                c.force = -c.force;
+                if let Some(shift) = self.shift.get_mut(k) {
+                    *shift = -*shift;
+                }
+                // M_r acts against the first partner: the other one's is its opposite.
+                if let Some(roll) = self.roll.get_mut(k) {
+                    *roll = -*roll;
+                }
+            }
+        }
+        let mut order: Vec<u32> = (0..self.items.len() as u32).collect();
+        order.sort_unstable_by_key(|&k| {
+            let c = &self.items[k as usize];
+            (c.first, c.second)
+        });
+        let pick = |column: &[Vec3]| order.iter().map(|&k| column[k as usize]).collect();
+        if !self.shift.is_empty() {
+            self.shift = pick(&self.shift);
+        }
+        if !self.turn.is_empty() {
+            self.turn = pick(&self.turn);
+        }
+        if !self.roll.is_empty() {
+            self.roll = pick(&self.roll);
+        }
+        self.items = order.iter().map(|&k| self.items[k as usize]).collect();
+    }
+
     /// Keeps the records (and their image translations) for which `keep` holds; the n × f
     /// column is dropped (the next evaluation rewrites it).
     pub(crate) fn retain(&mut self, keep: impl Fn(&Contact) -> bool) {
@@ -180,10 +221,12 @@ impl ContactList {
 
     /// Writes the list into a checkpoint: partners, springs, forces and image translations
     /// (n × f and δ/2 are rewritten by every evaluation before they are read).
-    pub(crate) fn save(&self, out: &mut Encoder) {
+    /// The spheres are written as `id` names them (and a second partner too when `pairs`).
+    pub(crate) fn save(&self, out: &mut Encoder, id: impl Fn(u32) -> u32, pairs: bool) {
         let column = |f: fn(&Contact) -> Vec3| self.items.iter().map(f).collect::<Vec<_>>();
-        out.u32s(&self.items.iter().map(|c| c.first).collect::<Vec<_>>());
-        out.u32s(&self.items.iter().map(|c| c.second).collect::<Vec<_>>());
+        let second = |c: &Contact| if pairs { id(c.second) } else { c.second };
+        out.u32s(&self.items.iter().map(|c| id(c.first)).collect::<Vec<_>>());
+        out.u32s(&self.items.iter().map(second).collect::<Vec<_>>());
         out.vec3s(&column(|c| c.history));
         out.vec3s(&column(|c| c.force));
         out.vec3s(&(0..self.len()).map(|k| self.shift(k)).collect::<Vec<_>>());

@@ -104,6 +104,7 @@ impl DemContacts {
                 body_names,
                 materials,
             }),
+            order: SphereOrder::default(),
             settings,
             walls: Walls::new(walls, materials),
             evaluation: Evaluation::new(),

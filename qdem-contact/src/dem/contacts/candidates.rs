@@ -4,6 +4,7 @@
 //! reference), the displacement bound's anchor (`displacement.rs`), and the rebuild count.
 
 use super::displacement::Anchor;
+use super::spatial_order::{permuted, SphereOrder};
 use crate::dem::contact_list::ContactList;
 use qdem_core::checkpoint::same_count;
 use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, Vec3};
@@ -123,14 +124,18 @@ impl Candidates {
         self.rebuilt = true;
     }
 
-    /// Saves the build (flag, time, positions, count) and the lists.
-    pub(super) fn save(&self, out: &mut Encoder) {
+    /// Saves the build (flag, time, positions, count) and the lists, the spheres by their
+    /// stable ids (`order`: `spatial_order.rs`), each pair as it is oriented here.
+    pub(super) fn save(&self, out: &mut Encoder, order: &SphereOrder) {
         out.bool(self.built);
         out.f64(self.built_time);
-        out.vec3s(&self.built_at);
+        let built_at: Vec<Vec3> = (0..self.built_at.len() as u32)
+            .map(|id| self.built_at[order.slot(id) as usize])
+            .collect();
+        out.vec3s(&built_at);
         out.u64(self.rebuilds);
-        self.pairs.save(out);
-        self.wall_contacts.save(out);
+        self.pairs.save(out, |s| order.id(s), true);
+        self.wall_contacts.save(out, |s| order.id(s), false);
     }
 
     /// Restores what [`Candidates::save`] saved, for `spheres` spheres and `walls` walls;
@@ -153,6 +158,26 @@ impl Candidates {
         self.pairs = ContactList::restore(input, spheres, spheres)?;
         self.wall_contacts = ContactList::restore(input, spheres, walls)?;
         Ok(())
+    }
+
+    /// Renumbers the spheres (`spatial_order.rs`): slot `s` takes the build position of slot
+    /// `from[s]`, and the sphere of slot `t` in a list goes to slot `to[t]`, each pair with
+    /// its lower slot first and the lists sorted again.
+    pub(super) fn renumber(&mut self, from: &[u32], to: &[u32]) {
+        if self.built_at.len() == from.len() {
+            self.built_at = permuted(&self.built_at, from);
+        }
+        self.pairs.renumber(to, true);
+        self.wall_contacts.renumber(to, false);
+        self.partners.clear();
+    }
+
+    /// Each pair with its lower sphere first, and the lists sorted, for `spheres` spheres
+    /// (after a restore: a checkpoint keeps each pair as its run numbered it).
+    pub(super) fn sort_lists(&mut self, spheres: usize) {
+        let same: Vec<u32> = (0..spheres as u32).collect();
+        self.pairs.renumber(&same, true);
+        self.wall_contacts.renumber(&same, false);
     }
 
     /// Marks the lists out of date: they are rebuilt at the next evaluation.

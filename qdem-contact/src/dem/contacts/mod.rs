@@ -36,7 +36,9 @@
 //! The model is composed of parts, each a struct with one job, its own data and its own
 //! file, which the stages call through methods (what two parts share is passed as an
 //! argument): `spheres.rs` the sphere records (particles, radii, bodies, carriers, centres,
-//! the narrow phase's records, body names, pair elasticity); `candidates.rs` the candidate
+//! the narrow phase's records, body names, pair elasticity), by *slot*, their place in the
+//! spatial order that `spatial_order.rs` gives them at every build of the lists (outside the
+//! engine a sphere keeps its stable id, the builder's index); `candidates.rs` the candidate
 //! lists and their build (partners, build positions and time, the displacement bound's
 //! anchor of `displacement.rs`, the rebuild count); `pair_kernel.rs` the pair kernel, with
 //! its plan and per-sphere sums; `walls.rs` the walls (their elasticity, the narrow phase
@@ -74,6 +76,7 @@ use qdem_core::{
     step::Tangent, Vec3,
 };
 use rayon::prelude::*;
+use spatial_order::SphereOrder;
 use spheres::{SphereColumns, Spheres};
 use split::ContactPart;
 use stages::Evaluation;
@@ -97,6 +100,7 @@ mod persistence;
 mod pipeline;
 mod rolling;
 mod servo_loads;
+mod spatial_order;
 mod spheres;
 mod split;
 mod stable_step;
@@ -243,8 +247,10 @@ pub(crate) fn narrow_phase(
 pub struct DemContacts {
     /// The model's name.
     name: String,
-    /// The sphere records (`spheres.rs`).
+    /// The sphere records (`spheres.rs`), by slot.
     spheres: Spheres,
+    /// The spheres' slots in spatial order and their stable ids (`spatial_order.rs`).
+    order: SphereOrder,
     /// The candidate lists and their build (`candidates.rs`).
     candidates: Candidates,
     /// The law, the friction between spheres and the skin.

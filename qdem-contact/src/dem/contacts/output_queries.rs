@@ -126,13 +126,15 @@ impl DemContacts {
     }
 
     /// Every contact sphere at `state` (the state the last evaluation saw, after the step),
-    /// in sphere order, with the contact force the model applied to it.
+    /// in sphere order (the builder's, whatever the engine's spatial order), with the contact
+    /// force the model applied to it.
     pub fn sphere_records<'a>(
         &'a self,
         state: &'a State,
     ) -> impl Iterator<Item = SphereRecord> + 'a {
         let bodies = state.rigid.len();
-        (0..self.spheres.len()).map(move |s| {
+        (0..self.spheres.len()).map(move |id| {
+            let s = self.slot_of(id);
             let particle = self.spheres.particle()[s] as usize;
             let spin = match self.spheres.turn()[s] as usize {
                 t if t == NOT_RIGID as usize => None,
@@ -151,45 +153,57 @@ impl DemContacts {
         })
     }
 
-    /// Every contact that touched at the last evaluation: the pairs in list order, then the
-    /// wall contacts. Summed per sphere (+f on the first partner times its scale, −f on the
-    /// second times its scale), their forces are [`SphereRecord::force`].
+    /// Every contact that touched at the last evaluation: the pairs, then the wall contacts,
+    /// each named by the spheres' stable ids (the builder's order), a pair with its lower
+    /// id first, sorted by them. Summed per sphere (+f on the first partner times its scale,
+    /// −f on the second times its scale), their forces are [`SphereRecord::force`].
     pub fn touching(&self) -> impl Iterator<Item = TouchingContact> + '_ {
         let time = self.evaluation.last_time().unwrap_or(0.0);
         let delay = self.time_delay.as_ref().map(TimeDelay::ghosts);
         let pairs = self.candidates.pairs().with_shifts();
         let pairs = pairs.filter(|(c, _)| c.force != Vec3::zeros());
-        let pairs = pairs.map(move |(c, shift)| {
-            let (a, b) = (c.first as usize, c.second as usize);
-            let (from, to) = (self.spheres.center()[a], self.spheres.center()[b] + shift);
-            let scales = delay.map_or((1.0, 1.0), |(axis, s)| pair_scales(shift[axis], &s));
-            touching_contact(
-                a,
-                Partner::Sphere(b),
-                from,
-                to,
-                (to - from).normalize(),
-                c.force,
-                scales,
-            )
-        });
+        let mut pairs: Vec<TouchingContact> = pairs
+            .map(|(c, shift)| {
+                let (mut a, mut b) = (c.first as usize, c.second as usize);
+                let (mut shift, mut force) = (shift, c.force);
+                if self.id_of(a) > self.id_of(b) {
+                    (a, b, shift, force) = (b, a, -shift, -force);
+                }
+                let (from, to) = (self.spheres.center()[a], self.spheres.center()[b] + shift);
+                let scales = delay.map_or((1.0, 1.0), |(axis, s)| pair_scales(shift[axis], &s));
+                touching_contact(
+                    self.id_of(a),
+                    Partner::Sphere(self.id_of(b)),
+                    from,
+                    to,
+                    (to - from).normalize(),
+                    force,
+                    scales,
+                )
+            })
+            .collect();
+        pairs.sort_by_key(|c| (c.first, partner_key(&c.second)));
         let walls = self
             .candidates
             .wall_contacts()
             .items
             .iter()
             .filter(|c| c.force != Vec3::zeros());
-        let walls = walls.map(move |c| {
-            let (s, w) = (c.first as usize, c.second as usize);
-            let from = self.spheres.center()[s];
-            let (overlap, normal) =
-                self.walls
-                    .get(w)
-                    .overlap(&from, self.spheres.radius()[s], time);
-            let to = from + (self.spheres.radius()[s] - overlap) * normal;
-            touching_contact(s, Partner::Wall(w), from, to, normal, c.force, (1.0, 1.0))
-        });
-        pairs.chain(walls)
+        let mut walls: Vec<TouchingContact> = walls
+            .map(|c| {
+                let (s, w) = (c.first as usize, c.second as usize);
+                let from = self.spheres.center()[s];
+                let (overlap, normal) =
+                    self.walls
+                        .get(w)
+                        .overlap(&from, self.spheres.radius()[s], time);
+                let to = from + (self.spheres.radius()[s] - overlap) * normal;
+                let (first, wall) = (self.id_of(s), Partner::Wall(w));
+                touching_contact(first, wall, from, to, normal, c.force, (1.0, 1.0))
+            })
+            .collect();
+        walls.sort_by_key(|c| (c.first, partner_key(&c.second)));
+        pairs.into_iter().chain(walls)
     }
 
     /// The spheres of other ranks whose motion this rank receives at each evaluation, in a
@@ -199,7 +213,8 @@ impl DemContacts {
     }
 
     /// The touching pair of spheres whose overlap at the last evaluation is the largest part
-    /// of the smaller radius: (first, second, overlap in m); `None` without touching pairs.
+    /// of the smaller radius: (first, second by stable id, the lower first, overlap in m);
+    /// `None` without touching pairs.
     /// One pass over the pair records, cheap enough for every step.
     pub fn deepest_pair(&self) -> Option<(usize, usize, f64)> {
         let mut deepest: Option<(usize, usize, f64, f64)> = None;
@@ -213,7 +228,10 @@ impl DemContacts {
             let (a, b) = (c.first as usize, c.second as usize);
             let overlap = 2.0 * c.half_overlap;
             let depth = overlap / self.spheres.radius()[a].min(self.spheres.radius()[b]);
-            if deepest.is_none_or(|d| depth > d.3) {
+            let (a, b) = (self.id_of(a), self.id_of(b));
+            let (a, b) = (a.min(b), a.max(b));
+            // Of equally deep pairs the one of lowest ids, whatever the engine's order.
+            if deepest.is_none_or(|d| depth > d.3 || (depth == d.3 && (a, b) < (d.0, d.1))) {
                 deepest = Some((a, b, overlap, depth));
             }
         }
@@ -247,6 +265,13 @@ fn touching_contact(
         normal_force,
         tangential_force: force - normal_force,
         scales,
+    }
+}
+
+/// The order of a contact's second partner: a sphere by its id, a wall by its index.
+fn partner_key(p: &Partner) -> usize {
+    match p {
+        Partner::Sphere(s) | Partner::Wall(s) => *s,
     }
 }
 

@@ -202,14 +202,15 @@ impl DemContacts {
 
 impl Persistent for DemContacts {
     /// The spheres' particles (their identities for [`SavedSprings`]), the candidate lists
-    /// with their tangential springs, where and when they were built, every wall's place and
-    /// velocity, and the time-delayed boundary's estimates: everything but the sphere
-    /// centres, which are read from the state.
+    /// with their tangential springs by the spheres' stable ids (`spatial_order.rs`), where
+    /// and when they were built, every wall's place and velocity, the time-delayed boundary's
+    /// estimates and the rolling springs: everything but the sphere centres, which are read
+    /// from the state.
     fn save(&self, out: &mut Encoder) {
         out.tag("contact");
-        out.u32s(self.spheres.particle());
+        out.u32s(&self.stable_particles());
         out.option_f64(self.evaluation.last_time());
-        self.candidates.save(out);
+        self.candidates.save(out, &self.order);
         self.walls.save(out);
         out.bool(self.time_delay.is_some());
         if let Some(delay) = &self.time_delay {
@@ -220,6 +221,10 @@ impl Persistent for DemContacts {
     fn restore(&mut self, input: &mut Decoder<'_>) -> Result<(), CheckpointError> {
         input.tag("contact")?;
         let spheres = self.spheres.len();
+        // The checkpoint names the spheres by their stable ids: read in that numbering, then
+        // renumbered in the order of the saved build (`spatial_order.rs`), which is the
+        // order the saving run had.
+        self.reorder((0..spheres as u32).collect());
         let particle = input.u32s("contact sphere particles")?;
         if particle != self.spheres.particle() {
             return Err(CheckpointError::Invalid {
@@ -244,7 +249,14 @@ impl Persistent for DemContacts {
         if let Some(delay) = &mut self.time_delay {
             delay.restore(input)?;
         }
+        // The rolling springs are in the saved lists' order: read before the lists are
+        // sorted, so that they move with their records.
         self.restore_rolling(input)?;
+        self.candidates.sort_lists(spheres);
+        if self.lists_built() {
+            let built_at = self.candidates.built_at().to_vec();
+            self.sort_spheres_at(&built_at);
+        }
         self.index_partners();
         if let Some(split) = &mut self.split {
             split.whole = true;

@@ -73,8 +73,10 @@ impl DemContacts {
         2.0 * moved >= self.settings.skin || moved + wall_moved >= self.settings.skin
     }
 
-    /// Broad phase: new candidate lists and the incidence of pairs per sphere.
+    /// Broad phase: the spheres in spatial order (`spatial_order.rs`), new candidate lists
+    /// and the incidence of pairs per sphere.
     pub(super) fn rebuild_all(&mut self, time: f64) {
+        self.sort_spheres();
         let skin = self.settings.skin;
         let center = self.spheres.center();
         let set = SphereSet {

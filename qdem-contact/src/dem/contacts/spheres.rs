@@ -5,6 +5,7 @@
 //! state at each evaluation; with them the names of their bodies and the elastic constants
 //! of each pair of their materials.
 
+use super::spatial_order::permuted;
 use super::{SphereNow, NOT_RIGID, SPHERE_CHUNK};
 use crate::dem::laws::contact_law::PairElasticity;
 use qdem_core::{step::State, Vec3};
@@ -78,6 +79,21 @@ impl Spheres {
             materials: materials.len(),
             elasticity,
         }
+    }
+
+    /// Renumbers the spheres (`spatial_order.rs`): slot `s` takes the records of slot
+    /// `from[s]`.
+    pub(super) fn permute(&mut self, from: &[u32]) {
+        self.particle = permuted(&self.particle, from);
+        self.radius = permuted(&self.radius, from);
+        self.body = permuted(&self.body, from);
+        self.rigid = permuted(&self.rigid, from);
+        self.turn = permuted(&self.turn, from);
+        self.exclusive = permuted(&self.exclusive, from);
+        self.lever = permuted(&self.lever, from);
+        self.bound_mass = permuted(&self.bound_mass, from);
+        self.center = permuted(&self.center, from);
+        self.now = permuted(&self.now, from);
     }
 
     /// Number of spheres.

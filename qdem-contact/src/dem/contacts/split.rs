@@ -69,6 +69,17 @@ impl ContactPart {
         }
     }
 
+    /// Renumbers the spheres (`spatial_order.rs`): slot `s` takes the owner of slot
+    /// `from[s]`; the own spheres follow (the partners at the next declaration of ghosts).
+    pub(super) fn renumber(&mut self, from: &[u32]) {
+        self.owner = super::spatial_order::permuted(&self.owner, from);
+        self.own = (0..self.owner.len() as u32)
+            .filter(|&s| self.owner[s as usize] == self.me)
+            .collect();
+        self.partners.clear();
+        self.lists_changed = true;
+    }
+
     /// Whether this rank owns sphere `s`.
     #[inline]
     fn owns(&self, s: u32) -> bool {
@@ -229,10 +240,11 @@ impl DemContacts {
 }
 
 impl DemContacts {
-    /// The particle of every contact sphere, the items whose records the ranks exchange.
+    /// The particle of every contact sphere, the items whose records the ranks exchange, by
+    /// stable id (the runtime keeps the items; the engine's slots change at every build:
+    /// `spatial_order.rs`).
     pub(super) fn sphere_particles(&self) -> Vec<usize> {
-        self.spheres
-            .particle()
+        self.stable_particles()
             .iter()
             .map(|&p| p as usize)
             .collect()
@@ -243,11 +255,12 @@ impl DemContacts {
         self.split = part.map(|p| ContactPart::new(self.spheres.particle(), &p.owner, p.rank));
     }
 
-    /// Appends the records of the spheres `items`: centre, velocity and spin.
+    /// Appends the records of the spheres of stable ids `items`: centre, velocity and spin.
     pub(super) fn pack_spheres(&self, items: &[u32], out: &mut Vec<f64>) {
-        for &s in items {
-            let n = self.spheres.now(s as usize);
-            for v in [self.spheres.center()[s as usize], n.velocity, n.spin] {
+        for &id in items {
+            let s = self.slot_of(id as usize);
+            let n = self.spheres.now(s);
+            for v in [self.spheres.center()[s], n.velocity, n.spin] {
                 out.extend_from_slice(v.as_slice());
             }
         }
@@ -255,10 +268,11 @@ impl DemContacts {
 
     /// Sets the records of the spheres `items` from what [`DemContacts::pack_spheres`] wrote.
     pub(super) fn unpack_spheres(&mut self, items: &[u32], values: &[f64]) {
-        for (&s, v) in items.iter().zip(values.chunks_exact(SPHERE_VALUES)) {
+        for (&id, v) in items.iter().zip(values.chunks_exact(SPHERE_VALUES)) {
             let (center, velocity) = (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]));
             let spin = Vec3::new(v[6], v[7], v[8]);
-            self.spheres.set_motion(s as usize, center, velocity, spin);
+            let s = self.slot_of(id as usize);
+            self.spheres.set_motion(s, center, velocity, spin);
         }
     }
 

@@ -134,9 +134,10 @@ impl DemContacts {
         }
     }
 
-    /// Stage 2: the check for spheres gone through a wall or into another body, then new
-    /// lists near the own spheres (every sphere's on one process), and the check of the step
-    /// their touching contacts need (`stable_step.rs`).
+    /// Stage 2: the check for spheres gone through a wall or into another body, then the
+    /// spheres in spatial order (`spatial_order.rs`), new lists near the own spheres (every
+    /// sphere's on one process), and the check of the step their touching contacts need
+    /// (`stable_step.rs`).
     pub(super) fn rebuild_stage(&mut self, time: f64) {
         if self.split.is_none() {
             self.check_passage(time, None);
@@ -144,6 +145,7 @@ impl DemContacts {
             self.check_step_need(time);
             return;
         }
+        self.sort_spheres();
         self.with_part(|this, part| {
             this.check_passage(time, Some(part.own()));
             this.rebuild_near(part, time);
@@ -152,11 +154,16 @@ impl DemContacts {
         self.check_step_need(time);
     }
 
-    /// Stage 3: on a rank, the spheres of other ranks its new lists read (ascending); `None`
-    /// when the lists did not change, and always on one process.
+    /// Stage 3: on a rank, the spheres of other ranks its new lists read, by stable id
+    /// (ascending); `None` when the lists did not change, and always on one process.
     pub(super) fn new_ghosts_stage(&mut self) -> Option<Vec<u32>> {
         self.split.as_ref()?;
-        self.with_part(|this, part| this.declare_ghosts(part))
+        let mut ghosts = self.with_part(|this, part| this.declare_ghosts(part))?;
+        for g in &mut ghosts {
+            *g = self.id_of(*g as usize) as u32;
+        }
+        ghosts.sort_unstable();
+        Some(ghosts)
     }
 
     /// Stage 4: the motion of the own partners of candidates (on one process, unless stage 1

@@ -94,12 +94,26 @@ impl PassageCheck {
     pub(super) fn step(&self) -> f64 {
         self.step
     }
+
+    /// Renumbers the spheres (`spatial_order.rs`): the sphere of slot `t` goes to `to[t]`.
+    pub(super) fn renumber(&mut self, to: &[u32]) {
+        for s in self
+            .surfaces
+            .iter_mut()
+            .flat_map(|surface| &mut surface.spheres)
+        {
+            *s = to[*s as usize];
+        }
+    }
 }
 
 impl DemContacts {
     /// The surfaces of the bodies built from meshes, for the check of a centre inside
     /// another body.
-    pub fn with_body_surfaces(mut self, surfaces: Vec<BodySurface>) -> DemContacts {
+    pub fn with_body_surfaces(mut self, mut surfaces: Vec<BodySurface>) -> DemContacts {
+        for s in surfaces.iter_mut().flat_map(|surface| &mut surface.spheres) {
+            *s = self.slot_of(*s as usize) as u32;
+        }
         self.passage.surfaces = surfaces;
         self
     }
