@@ -99,7 +99,10 @@ fn a_cyclic_load_with_min_above_max_is_refused() {
 #[test]
 fn a_step_above_the_contacts_estimate_is_accepted_and_warned_of() {
     let dir = test_dir("absurd-contact-step");
-    let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/../fixtures/contact/grains.toml");
+    let fixture = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../fixtures/contact/grains.toml"
+    );
     let text = std::fs::read_to_string(fixture).unwrap();
     let path = dir.join("grains.toml");
     std::fs::write(&path, text.replace("dt = 2e-5", "dt = 2e-4")).unwrap();
