@@ -217,7 +217,7 @@ fn stack_torques(reverse: bool, resume: bool) -> Vec<Vec3> {
     let mut centers: Vec<Vec3> = (0..3)
         .map(|k| Vec3::new(0.0, 0.0, k as f64 * gap))
         .collect();
-    let mut spins = vec![
+    let mut spins = [
         Vec3::new(3.0, 0.0, 1.0),
         Vec3::new(-1.0, 2.0, 0.0),
         Vec3::new(0.5, -4.0, 2.0),
