@@ -24,8 +24,10 @@
 //! `[granular]` or `[ballast]` stones: reading every touching contact after every step
 //! (through the output view, before [`qdem_contact::DemContacts::deepest_pair`]) cost the
 //! 2,000 grains of `fixtures/contact/grains.toml` a quarter of their run time (1.24× and
-//! 1.29×, A B A B), where stones, not bodies, touch. A run decomposed over MPI ranks has no
-//! watch (each rank sees only its own contacts).
+//! 1.29×, A B A B), where stones, not bodies, touch: a stone's sphere deep in another body's
+//! is stopped instead by the contacts' pass-through check at each rebuild of the lists
+//! (`qdem-contact/src/dem/contacts/tunnelling.rs`), on one process and over ranks. A run
+//! decomposed over MPI ranks has no watch (each rank sees only its own contacts).
 
 use crate::build::{BodyInfo, Simulation};
 use crate::run::load_cause::load_cause;

@@ -16,10 +16,10 @@
 //! since the last build is tested against the mesh too (for a plane, a centre beyond it is
 //! beyond it however fast it went). The check reads the positions only, so results stay
 //! bit-identical; its cost is that of a broad phase's wall test again at each rebuild, plus a
-//! point query per sphere inside a body's bounding box. What it leaves: a body thinner than
-//! twice a sphere radius plus a step's motion, crossed between two checks; a sphere of a stone
-//! (a clump, whose volume is its spheres) deep in another sphere (the run's interpenetration
-//! watch, `qdem-io/src/run/contact_watch.rs`, covers that for `[[body]]`s).
+//! point query per sphere inside a body's bounding box, and a pass over the lists' pairs for
+//! a stone's sphere overlapping another body's by more than the smaller radius (which no
+//! surface sees: a clump's volume is its spheres), on one process and over ranks alike. What it leaves: a body thinner
+//! than twice a sphere radius plus a step's motion, crossed between two checks.
 //!
 //! The first finding is kept and reported by [`qdem_core::step::Model::failure`] after the step, so
 //! the world stops the run (in a decomposed run every rank agrees on it).
@@ -58,6 +58,16 @@ pub(crate) enum Passage {
         /// The wall.
         wall: usize,
         /// How far inside (m).
+        depth: f64,
+    },
+    /// Overlapping a sphere of another body by more than the smaller radius: its centre is
+    /// inside that sphere, and once the centres cross the contact pulls the two through.
+    Sphere {
+        /// The sphere.
+        sphere: usize,
+        /// The other sphere.
+        other: usize,
+        /// The overlap (m).
         depth: f64,
     },
     /// Inside another body's mesh by more than its radius.
@@ -134,7 +144,10 @@ impl DemContacts {
             }
         };
         let since = self.lists_built().then_some(self.candidates.built_time());
-        if let Some(passage) = self.find_passage(spheres, time, since) {
+        let found = self
+            .find_passage(spheres, time, since)
+            .or_else(|| self.deep_pair());
+        if let Some(passage) = found {
             self.passage.pass_through = Some(self.describe(passage, time));
         }
     }
@@ -157,6 +170,41 @@ impl DemContacts {
                 .surfaces
                 .iter()
                 .find_map(|surface| self.inside_body(surface, spheres))
+        })
+    }
+
+    /// The first pair of the lists (a rank's, in a decomposed run, whose centres are all
+    /// current before a rebuild) whose spheres overlap by more than the smaller radius. Between
+    /// two rebuilds a sphere moves at most half the skin (a quarter of the smallest radius by
+    /// default), so a pair found at one rebuild under that depth cannot have crossed its
+    /// centres by the next: the check stops it while the contact still pushes the right way.
+    /// A pair of two bodies built from meshes is left to the run's interpenetration watch
+    /// (`qdem-io`, every step, `[[body]]`s on one process), which reports it with its cause;
+    /// this covers every pair with a stone's sphere (`[granular]`, `[ballast]`), on one
+    /// process and over ranks.
+    fn deep_pair(&self) -> Option<Passage> {
+        let center = self.spheres.center();
+        let radius = self.spheres.radius();
+        let body = self.spheres.body();
+        let mut meshed = vec![false; self.spheres.body_names().len()];
+        for surface in &self.passage.surfaces {
+            meshed[surface.body] = true;
+        }
+        self.candidates.pairs().items.iter().find_map(|c| {
+            let (a, b) = (c.first as usize, c.second as usize);
+            if meshed[body[a] as usize] && meshed[body[b] as usize] {
+                return None;
+            }
+            let mut d = center[b] - center[a];
+            if let Some(p) = &self.periodic {
+                d += p.image_shift(&d);
+            }
+            let depth = radius[a] + radius[b] - d.norm();
+            (depth > radius[a].min(radius[b])).then_some(Passage::Sphere {
+                sphere: a,
+                other: b,
+                depth,
+            })
         })
     }
 
@@ -265,6 +313,19 @@ impl DemContacts {
                     self.spheres.body_names()[other]
                 ),
             ),
+            Passage::Sphere {
+                sphere,
+                other,
+                depth,
+            } => (
+                sphere,
+                format!(
+                    "overlaps the contact sphere of body `{}` (radius {:.3e} m) by {depth:.3e} \
+                     m, more than the smaller radius: its centre is inside that sphere",
+                    self.spheres.body_names()[self.spheres.body()[other] as usize],
+                    self.spheres.radius()[other]
+                ),
+            ),
         };
         let elapsed = time - self.candidates.built_time();
         let speed = match self.lists_built() && elapsed > 0.0 {
@@ -293,6 +354,7 @@ impl DemContacts {
                 "larger contact spheres (contact_radius) or a finer mesh of the body, to close \
                  the gaps between its spheres"
             }
+            Passage::Sphere { .. } => "larger contact spheres",
         };
         let stiffer = "a stiffer contact ([contact] normal_stiffness, or young with \
                        hertz-mindlin)";
@@ -331,6 +393,20 @@ impl DemContacts {
             } => (
                 sphere,
                 format!("body `{}`", self.spheres.body_names()[other]),
+                depth,
+            ),
+            // The initial check reads walls and bodies only: overlapping spheres are
+            // `check_initial_overlaps`'s, with its tolerance.
+            Passage::Sphere {
+                sphere,
+                other,
+                depth,
+            } => (
+                sphere,
+                format!(
+                    "a contact sphere of body `{}`",
+                    self.spheres.body_names()[self.spheres.body()[other] as usize]
+                ),
                 depth,
             ),
         };
