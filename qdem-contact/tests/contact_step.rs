@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{contacts, rigid_spheres};
+use common::{contacts, rigid_spheres, verlet_world};
 use qdem_contact::{
     ContactLaw, ContactSettings, ContactSphere, DemContacts, HertzMindlin, LinearSpring, PlaneWall,
     Wall, WallShape,
@@ -15,7 +15,7 @@ use qdem_contact::{
 use qdem_core::continuum::stable_step::critical_step;
 use qdem_core::error::CoreError;
 use qdem_core::loads::Gravity;
-use qdem_core::step::{Model, Scheme, State, StepRequest, StepSettings};
+use qdem_core::step::{Model, State};
 use qdem_core::world::World;
 use qdem_core::{Mat3, Vec3};
 
@@ -100,20 +100,7 @@ fn world(state: State, model: DemContacts, dt: Option<f64>) -> Result<World, Cor
         Box::new(model),
         Box::new(Gravity::new(Vec3::new(0.0, 0.0, -9.81))),
     ];
-    let request = StepRequest {
-        scheme: Scheme::Verlet,
-        dt,
-        safety: 0.9,
-        local_damping: 0.0,
-        adaptive: false,
-        event_solve: Default::default(),
-        implicit_default: None,
-        fit_to: None,
-    };
-    let settings = StepSettings::resolve(&request, &state, &models)?;
-    let mut world = World::new(state, models, settings)?;
-    world.initialize()?;
-    Ok(world)
+    verlet_world(state, models, dt)
 }
 
 /// Steps `world` to `t_end`; the first failure stops it.

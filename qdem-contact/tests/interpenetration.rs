@@ -7,11 +7,10 @@
 
 mod common;
 
-use common::{contacts, rigid_spheres};
+use common::{contacts, rigid_spheres, verlet_world};
 use qdem_contact::{ContactLaw, ContactSettings, LinearSpring};
 use qdem_core::error::CoreError;
-use qdem_core::step::{Model, Scheme, StepRequest, StepSettings};
-use qdem_core::world::World;
+use qdem_core::step::Model;
 use qdem_core::Vec3;
 
 const R: f64 = 0.005;
@@ -42,19 +41,7 @@ fn collide(speed: f64, k: f64) -> Result<[Vec3; 2], CoreError> {
         settings,
         vec![],
     ))];
-    let request = StepRequest {
-        scheme: Scheme::Verlet,
-        dt: Some(1e-6),
-        safety: 0.9,
-        local_damping: 0.0,
-        adaptive: false,
-        event_solve: Default::default(),
-        implicit_default: None,
-        fit_to: None,
-    };
-    let settings = StepSettings::resolve(&request, &state, &models)?;
-    let mut world = World::new(state, models, settings)?;
-    world.initialize()?;
+    let mut world = verlet_world(state, models, Some(1e-6))?;
     while world.state.time < 0.01 {
         world.step()?;
     }

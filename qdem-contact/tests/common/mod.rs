@@ -4,6 +4,9 @@
 pub mod packing;
 
 use qdem_contact::{ContactSettings, ContactSphere, DemContacts, Wall};
+use qdem_core::error::CoreError;
+use qdem_core::step::{Scheme, StepRequest, StepSettings};
+use qdem_core::world::World;
 use qdem_core::{solvers::Verlet, step::Model, step::State, step::Stepper, Mat3, Vec3};
 
 /// A state of rigid spheres: one centre particle per sphere, each its own body.
@@ -52,4 +55,27 @@ pub fn total_energy(state: &State, models: &[Box<dyn Model>]) -> f64 {
             .iter()
             .map(|m| m.potential_energy(state).unwrap_or(0.0))
             .sum::<f64>()
+}
+
+/// A world of `models` over `state`, stepped by Verlet at `dt` (automatic, at 0.9 of the
+/// stable step, when `None`), initialised.
+pub fn verlet_world(
+    state: State,
+    models: Vec<Box<dyn Model>>,
+    dt: Option<f64>,
+) -> Result<World, CoreError> {
+    let request = StepRequest {
+        scheme: Scheme::Verlet,
+        dt,
+        safety: 0.9,
+        local_damping: 0.0,
+        adaptive: false,
+        event_solve: Default::default(),
+        implicit_default: None,
+        fit_to: None,
+    };
+    let settings = StepSettings::resolve(&request, &state, &models)?;
+    let mut world = World::new(state, models, settings)?;
+    world.initialize()?;
+    Ok(world)
 }

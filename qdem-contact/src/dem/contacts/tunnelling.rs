@@ -60,16 +60,6 @@ pub(crate) enum Passage {
         /// How far inside (m).
         depth: f64,
     },
-    /// Overlapping a sphere of another body by more than the smaller radius: its centre is
-    /// inside that sphere, and once the centres cross the contact pulls the two through.
-    Sphere {
-        /// The sphere.
-        sphere: usize,
-        /// The other sphere.
-        other: usize,
-        /// The overlap (m).
-        depth: f64,
-    },
     /// Inside another body's mesh by more than its radius.
     Body {
         /// The sphere.
@@ -79,6 +69,17 @@ pub(crate) enum Passage {
         /// How far inside (m).
         depth: f64,
     },
+}
+
+/// Two spheres of different bodies overlapping by more than the smaller radius: the centre
+/// of `sphere` is inside `other`, and once the centres cross the contact pulls the two
+/// through each other.
+#[derive(Clone, Copy, Debug)]
+struct DeepPair {
+    sphere: usize,
+    other: usize,
+    /// The overlap (m).
+    depth: f64,
 }
 
 /// The check for spheres gone through a wall or into another body: the bodies' surfaces,
@@ -130,7 +131,8 @@ impl DemContacts {
 
     /// Before a rebuild at `time` (every centre current, the last build's at `built_at`):
     /// keeps the first sphere of `own` (all spheres when `None`) found through a wall or
-    /// inside another body, with the report [`qdem_core::step::Model::failure`] gives.
+    /// inside another body, else the first pair of the lists overlapping past a radius
+    /// ([`DemContacts::deep_pair`]), with the report [`qdem_core::step::Model::failure`] gives.
     pub(super) fn check_passage(&mut self, time: f64, own: Option<&[u32]>) {
         if self.passage.pass_through.is_some() {
             return;
@@ -144,12 +146,10 @@ impl DemContacts {
             }
         };
         let since = self.lists_built().then_some(self.candidates.built_time());
-        let found = self
-            .find_passage(spheres, time, since)
-            .or_else(|| self.deep_pair());
-        if let Some(passage) = found {
-            self.passage.pass_through = Some(self.describe(passage, time));
-        }
+        self.passage.pass_through = match self.find_passage(spheres, time, since) {
+            Some(passage) => Some(self.describe(passage, time)),
+            None => self.deep_pair().map(|pair| self.describe_deep(pair, time)),
+        };
     }
 
     /// The first of `spheres` whose centre is through a wall or inside another body at
@@ -182,7 +182,7 @@ impl DemContacts {
     /// (`qdem-io`, every step, `[[body]]`s on one process), which reports it with its cause;
     /// this covers every pair with a stone's sphere (`[granular]`, `[ballast]`), on one
     /// process and over ranks.
-    fn deep_pair(&self) -> Option<Passage> {
+    fn deep_pair(&self) -> Option<DeepPair> {
         let center = self.spheres.center();
         let radius = self.spheres.radius();
         let body = self.spheres.body();
@@ -200,7 +200,7 @@ impl DemContacts {
                 d += p.image_shift(&d);
             }
             let depth = radius[a] + radius[b] - d.norm();
-            (depth > radius[a].min(radius[b])).then_some(Passage::Sphere {
+            (depth > radius[a].min(radius[b])).then_some(DeepPair {
                 sphere: a,
                 other: b,
                 depth,
@@ -313,20 +313,33 @@ impl DemContacts {
                     self.spheres.body_names()[other]
                 ),
             ),
-            Passage::Sphere {
-                sphere,
-                other,
-                depth,
-            } => (
-                sphere,
-                format!(
-                    "overlaps the contact sphere of body `{}` (radius {:.3e} m) by {depth:.3e} \
-                     m, more than the smaller radius: its centre is inside that sphere",
-                    self.spheres.body_names()[self.spheres.body()[other] as usize],
-                    self.spheres.radius()[other]
-                ),
-            ),
         };
+        let holder = match passage {
+            Passage::Wall { .. } => "a thicker wall, larger contact spheres (contact_radius)",
+            Passage::Body { .. } => {
+                "larger contact spheres (contact_radius) or a finer mesh of the body, to close \
+                 the gaps between its spheres"
+            }
+        };
+        self.report(s, &into, holder, time)
+    }
+
+    /// The report of `pair` at `time`, as [`DemContacts::describe`] gives a passage's.
+    fn describe_deep(&self, pair: DeepPair, time: f64) -> (String, String) {
+        let other = pair.other;
+        let into = format!(
+            "overlaps the contact sphere of body `{}` (radius {:.3e} m) by {:.3e} m, more than \
+             the smaller radius: its centre is inside that sphere",
+            self.spheres.body_names()[self.spheres.body()[other] as usize],
+            self.spheres.radius()[other],
+            pair.depth
+        );
+        self.report(pair.sphere, &into, "larger contact spheres", time)
+    }
+
+    /// What happened to sphere `s` (where it went: `into`) at `time`, with its speed since the
+    /// last build; and the fix, `holder` being what holds it back better.
+    fn report(&self, s: usize, into: &str, holder: &str, time: f64) -> (String, String) {
         let elapsed = time - self.candidates.built_time();
         let speed = match self.lists_built() && elapsed > 0.0 {
             true => self.moved_since_build(s).norm() / elapsed,
@@ -341,21 +354,13 @@ impl DemContacts {
             x.y,
             x.z,
         );
-        (what, self.fix(passage, speed, radius))
+        (what, self.fix(holder, speed, radius))
     }
 
     /// What to change: a smaller step when the sphere moves more than [`STEP_FRACTION`] of
-    /// its radius per step, else what holds it back better.
-    fn fix(&self, passage: Passage, speed: f64, radius: f64) -> String {
+    /// its radius per step, else `holder`, what holds it back better.
+    fn fix(&self, holder: &str, speed: f64, radius: f64) -> String {
         let fraction = speed * self.passage.step / radius;
-        let holder = match passage {
-            Passage::Wall { .. } => "a thicker wall, larger contact spheres (contact_radius)",
-            Passage::Body { .. } => {
-                "larger contact spheres (contact_radius) or a finer mesh of the body, to close \
-                 the gaps between its spheres"
-            }
-            Passage::Sphere { .. } => "larger contact spheres",
-        };
         let stiffer = "a stiffer contact ([contact] normal_stiffness, or young with \
                        hertz-mindlin)";
         if fraction > STEP_FRACTION {
@@ -393,20 +398,6 @@ impl DemContacts {
             } => (
                 sphere,
                 format!("body `{}`", self.spheres.body_names()[other]),
-                depth,
-            ),
-            // The initial check reads walls and bodies only: overlapping spheres are
-            // `check_initial_overlaps`'s, with its tolerance.
-            Passage::Sphere {
-                sphere,
-                other,
-                depth,
-            } => (
-                sphere,
-                format!(
-                    "a contact sphere of body `{}`",
-                    self.spheres.body_names()[self.spheres.body()[other] as usize]
-                ),
                 depth,
             ),
         };
