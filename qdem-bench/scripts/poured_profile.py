@@ -1,0 +1,148 @@
+#!/usr/bin/env python3
+"""Where the time of a poured, periodic bed run through `qdem run` goes beyond the lattice
+benchmark, in instructions (callgrind: independent of the machine's load), per function.
+
+Usage (from the workspace root; valgrind installed; the binaries of one build):
+
+    python3 qdem-bench/scripts/poured_profile.py [--spheres 2000] [--steps 20,70]
+        [--qdem target/release/qdem] [--study target/release/study] [--work out/poured_profile]
+
+Two beds of the same sphere count and material (r = 5 mm, E = 50 MPa, Hertz-Mindlin with
+friction and restitution 0.5, skin 1 mm, the common step 20% of the Rayleigh time):
+- poured: poured_compare.py's insertion poured by `qdem run` in a cell periodic in x and y on
+  a floor, then run from its checkpoint by `qdem run` (the run's own per-step work included:
+  the periodic wrap and images, the contact watch, the recorders' schedules);
+- lattice: `study packing --spheres N --settle 0.2` (a lattice poured into a box of a floor
+  and four walls) timed by `study dem-throughput` (the engine's step loop alone).
+Each is run under `valgrind --tool=callgrind` for the two step counts on one thread; the
+difference of the two runs, over spheres x the steps between them, takes the set-up out and
+gives instructions per sphere-step, per function (exclusive, `callgrind_annotate`). Writes
+WORK/poured_profile.json and a markdown table (stdout and WORK/poured_profile.md).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import poured_compare as pcmp  # noqa: E402
+
+ROOT = pcmp.ROOT
+LINE_RE = re.compile(r"^\s*([\d,]+)\s+(?:\([\d.]+%\)\s+)?(\S.*)$")
+
+
+def log(msg: str) -> None:
+    print(f"[poured_profile] {msg}", file=sys.stderr, flush=True)
+
+
+def callgrind(cmd: list[str], cwd: Path, out: Path) -> dict[str, int]:
+    """Runs cmd under callgrind on one thread; returns exclusive Ir per function."""
+    env = dict(os.environ, RAYON_NUM_THREADS="1")
+    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", *cmd],
+                   cwd=cwd, check=True, env=env, capture_output=True)
+    text = subprocess.run(["callgrind_annotate", "--threshold=100", "--inclusive=no", str(out)],
+                          check=True, capture_output=True, text=True).stdout
+    costs: dict[str, int] = {}
+    started = False
+    for line in text.splitlines():
+        if "file:function" in line:
+            started = True
+            continue
+        if not started:
+            continue
+        m = LINE_RE.match(line)
+        if m:
+            name = re.sub(r"\s+\[[^\]]*\]$", "", m.group(2))
+            name = name.split(":", 1)[1] if ":" in name and not name.startswith("<") else name
+            costs[name] = costs.get(name, 0) + int(m.group(1).replace(",", ""))
+    return costs
+
+
+def per_step(short: dict, long: dict, sphere_steps: int) -> dict[str, float]:
+    return {k: (long.get(k, 0) - short.get(k, 0)) / sphere_steps for k in set(short) | set(long)}
+
+
+def short_name(name: str, width: int = 90) -> str:
+    name = re.sub(r"::h[0-9a-f]{16}$", "", name)
+    return name if len(name) <= width else "…" + name[-width:]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--spheres", type=int, default=2000)
+    ap.add_argument("--steps", default="20,70")
+    ap.add_argument("--qdem", default=str(ROOT / "target" / "release" / "qdem"))
+    ap.add_argument("--study", default=str(ROOT / "target" / "release" / "study"))
+    ap.add_argument("--work", default="out/poured_profile")
+    ap.add_argument("--top", type=int, default=25)
+    args = ap.parse_args()
+    s0, s1 = (int(s) for s in args.steps.split(","))
+    n = args.spheres
+    work = Path(args.work) if Path(args.work).is_absolute() else ROOT / args.work
+    work.mkdir(parents=True, exist_ok=True)
+    qdem, study = work / "qdem", work / "study"
+    shutil.copy2(args.qdem, qdem)
+    shutil.copy2(args.study, study)
+
+    # the poured bed, poured once without valgrind
+    d = work / f"poured_n{n}"
+    d.mkdir(exist_ok=True)
+    side, pts = pcmp.insertion(n)
+    if not (d / "qdem_pour" / "checkpoint.qdc").exists():
+        pcmp.qdem_pour(qdem, d, side, pts, 0.25, 2)
+    poured = {}
+    for s in (s0, s1):
+        scene = d / f"profile_{s}.toml"
+        scene.write_text(pcmp.qdem_scene(side, pcmp.common_dt(), s * pcmp.common_dt(),
+                                         f"profile_{s}", sample="insert.csv",
+                                         start_from="qdem_pour/checkpoint.qdc"))
+        log(f"callgrind: qdem run, poured bed, {s} steps")
+        poured[s] = callgrind([str(qdem), "run", scene.name, "--threads", "1", "--yes"], d,
+                              work / f"callgrind.poured.{s}")
+        steps = json.loads((d / f"profile_{s}" / "summary.json").read_text())["steps"]
+        if steps != s:
+            sys.exit(f"error: the poured run took {steps} steps, not {s}")
+
+    # the lattice bed of the same size
+    lat = work / f"lattice_n{n}"
+    if not (lat / "packing.json").exists():
+        subprocess.run([str(study), "packing", "--spheres", str(n), "--out", str(lat),
+                        "--settle", "0.2"], check=True, cwd=ROOT)
+    lattice = {}
+    for s in (s0, s1):
+        log(f"callgrind: study dem-throughput, lattice bed, {s} steps")
+        lattice[s] = callgrind([str(study), "dem-throughput", "--packing", str(lat), "--steps",
+                                str(s)], ROOT, work / f"callgrind.lattice.{s}")
+
+    sphere_steps = n * (s1 - s0)
+    p = per_step(poured[s0], poured[s1], sphere_steps)
+    q = per_step(lattice[s0], lattice[s1], sphere_steps)
+    names = sorted(set(p) | set(q), key=lambda k: -max(abs(p.get(k, 0)), abs(q.get(k, 0))))
+    total_p, total_q = sum(p.values()), sum(q.values())
+    lines = [f"Instructions per sphere-step ({n:,} spheres, steps {s0} to {s1}, one thread; "
+             "callgrind, exclusive per function):", "",
+             "| function | poured, periodic (`qdem run`) | lattice (`dem-throughput`) | "
+             "poured − lattice |", "| --- | --- | --- | --- |",
+             f"| **all** | **{total_p:,.0f}** | **{total_q:,.0f}** | "
+             f"**{total_p - total_q:+,.0f}** |"]
+    for k in names[:args.top]:
+        a, b = p.get(k, 0.0), q.get(k, 0.0)
+        lines.append(f"| `{short_name(k)}` | {a:,.1f} | {b:,.1f} | {a - b:+,.1f} |")
+    table = "\n".join(lines) + "\n"
+    (work / "poured_profile.md").write_text(table)
+    (work / "poured_profile.json").write_text(json.dumps({
+        "spheres": n, "steps": [s0, s1], "poured_total": total_p, "lattice_total": total_q,
+        "poured": dict(sorted(p.items(), key=lambda t: -abs(t[1]))),
+        "lattice": dict(sorted(q.items(), key=lambda t: -abs(t[1])))}, indent=2) + "\n")
+    print(table)
+
+
+if __name__ == "__main__":
+    main()
