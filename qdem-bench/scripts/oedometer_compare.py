@@ -185,7 +185,7 @@ def run_qdem(exe: Path, d: Path, side: float, pts, dt: float, seconds: float) ->
     probes = read_csv(d / "qdem" / "probes.csv")
     walls = read_csv(d / "qdem" / "walls.csv")
     stones = pcmp.read_stones(d / "qdem" / "stones.csv")
-    lid_z = walls[-1]["wall6.z"]
+    lid_z = walls[-1]["wall6.z"]  # PFC's servo holds its target without ringing: the last row
     touched = next((w["time"] for w in walls if abs(w["wall6.fz"]) > 0), None)
     ke_after = [r["all.ke"] for r in probes if touched is not None and r["time"] >= touched]
     r = {"code": "qdem", "dt": summary["dt"], "accepted": True, "steps": summary["steps"],
@@ -251,7 +251,8 @@ def run_liggghts(exe: str, d: Path, side: float, pts, dt: float, seconds: float)
     lines = p.stdout.splitlines()
     for i, line in enumerate(lines):
         if line.split()[:1] == ["Step"]:
-            names = line.split()
+            # LIGGGHTS cuts a long column name to its width ("lidavg[1" for f_lidavg[1])
+            names = [c + "]" if "[" in c and not c.endswith("]") else c for c in line.split()]
             for row in lines[i + 1:]:
                 v = row.split()
                 if len(v) != len(names) or not v[0].isdigit():
@@ -273,7 +274,8 @@ def run_liggghts(exe: str, d: Path, side: float, pts, dt: float, seconds: float)
          "kinetic_energy_end": last["ket"] + last["erot"],
          "kinetic_energy_max_after_lid_touch": max(ke) if ke else None,
          "lid_first_touch_s": touched, "servo_kp": kp}
-    r.update(end_state(spheres, side, last["lid[9]"], abs(last["lid[3]"]), len(pts)))
+    r.update(end_state(spheres, side, last["lidavg[2]"], abs(last["lidavg[1]"]), len(pts)))
+    r["lid_force_last_step"] = abs(last["lid[3]"])
     return r
 
 

@@ -155,6 +155,19 @@ def insertion(n: int, seed: int = 57) -> tuple[float, list[tuple[float, float, f
     return side, pts
 
 
+def cached_insertion(n: int, d: Path) -> tuple[float, list[tuple[float, float, float]]]:
+    """The insertion of `insertion(n)`, kept in d/insert.csv (qdem's sample) so that a second
+    run of the script (another part, more repeats) pours nothing again and draws nothing."""
+    path = d / "insert.csv"
+    if path.exists():
+        pts = [(r[1], r[2], r[3]) for r in read_stones(path)]
+        if len(pts) == n:
+            return cell_side(n), pts
+    side, pts = insertion(n)
+    write_stones(path, pts)
+    return side, pts
+
+
 def pour_seconds(pts) -> float:
     top = max(p[2] for p in pts)
     return math.sqrt(2.0 * top / GRAVITY)
@@ -235,8 +248,7 @@ def qdem_run(exe: Path, scene: Path, threads: int) -> dict:
 
 
 def qdem_pour(exe: Path, d: Path, side: float, pts, settle: float, threads: int) -> Path:
-    """Pours the insertion with qdem; returns the checkpoint of the settled bed."""
-    write_stones(d / "insert.csv", pts)
+    """Pours the insertion (d/insert.csv) with qdem; returns the checkpoint of the settled bed."""
     t = pour_seconds(pts) + settle
     scene = d / "qdem_pour.toml"
     scene.write_text(qdem_scene(side, common_dt(), t, "qdem_pour", sample="insert.csv",
@@ -735,7 +747,7 @@ def main() -> None:
     for n in [int(s) for s in args.spheres.split(",")]:
         d = work / f"n{n}"
         d.mkdir(parents=True, exist_ok=True)
-        side, pts = insertion(n)
+        side, pts = cached_insertion(n, d)
         beds[n] = {"side": side, "insert_top": max(p[2] for p in pts),
                    "pour_seconds": pour_seconds(pts) + args.settle}
         if "pour" in parts or "second" in parts:

@@ -94,7 +94,7 @@ def main() -> None:
     # the poured bed, poured once without valgrind
     d = work / f"poured_n{n}"
     d.mkdir(exist_ok=True)
-    side, pts = pcmp.insertion(n)
+    side, pts = pcmp.cached_insertion(n, d)
     if not (d / "qdem_pour" / "checkpoint.qdc").exists():
         pcmp.qdem_pour(qdem, d, side, pts, 0.25, 2)
     poured = {}
