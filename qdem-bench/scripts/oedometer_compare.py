@@ -6,6 +6,7 @@ Usage (from the workspace root, after `cargo build --release -p qdem-cli --bin q
 
     python3 qdem-bench/scripts/oedometer_compare.py [--spheres 3000] [--dt 2e-5]
         [--seconds 2.0] [--work out/oedometer_peers] [--qdem target/release/qdem]
+        [--threads 2]
 
 The test is stage 1 of fixtures/oedometer/ (load.toml: grains poured into a square box with
 frictionless sides, a floor with friction, a servo lid driven to 20 kPa from the start) with the
@@ -167,7 +168,8 @@ def read_csv(path: Path) -> list[dict]:
         return [dict(zip(head, map(float, line.split(",")))) for line in f if line.strip()]
 
 
-def run_qdem(exe: Path, d: Path, side: float, pts, dt: float, seconds: float) -> dict:
+def run_qdem(exe: Path, d: Path, side: float, pts, dt: float, seconds: float,
+             threads: int) -> dict:
     with open(d / "insert.csv", "w") as f:
         f.write("stone,x,y,z,radius\n")
         for i, (x, y, z, r) in enumerate(pts, 1):
@@ -176,8 +178,8 @@ def run_qdem(exe: Path, d: Path, side: float, pts, dt: float, seconds: float) ->
     scene.write_text(qdem_scene(side, dt, seconds, lid_start(pts)))
     check = subprocess.run([str(exe), "check", str(scene)], cwd=d, capture_output=True, text=True)
     (d / "qdem_check.stdout").write_text(check.stdout + check.stderr)
-    p = subprocess.run([str(exe), "run", str(scene), "--yes"], cwd=d, capture_output=True,
-                       text=True)
+    p = subprocess.run([str(exe), "run", str(scene), "--yes", "--threads", str(threads)],
+                       cwd=d, capture_output=True, text=True)
     (d / "qdem_run.stdout").write_text(p.stdout + p.stderr)
     if p.returncode != 0:
         return {"code": "qdem", "dt": dt, "accepted": False, "refusal": (p.stdout + p.stderr)[-2000:]}
@@ -285,6 +287,7 @@ def main() -> None:
     ap.add_argument("--dt", type=float, default=2e-5)
     ap.add_argument("--seconds", type=float, default=2.0)
     ap.add_argument("--work", default="out/oedometer_peers")
+    ap.add_argument("--threads", type=int, default=2, help="qdem's (LIGGGHTS runs on one rank)")
     ap.add_argument("--qdem", default=str(ROOT / "target" / "release" / "qdem"))
     args = ap.parse_args()
     work = Path(args.work) if Path(args.work).is_absolute() else ROOT / args.work
@@ -294,7 +297,7 @@ def main() -> None:
     liggghts = lc.ensure_liggghts()
     side, pts = insertion(args.spheres)
     log(f"{len(pts)} spheres in a {side:.4f} m box, lid from z = {lid_start(pts):.4f} m")
-    rows = [run_qdem(qdem, work, side, pts, args.dt, args.seconds),
+    rows = [run_qdem(qdem, work, side, pts, args.dt, args.seconds, args.threads),
             run_liggghts(liggghts, work, side, pts, args.dt, args.seconds)]
     doc = {"machine": lc.cpu_model(), "spheres": len(pts), "box_side": side, "dt": args.dt,
            "seconds": args.seconds, "versions": {"liggghts": lc.liggghts_version(liggghts)},

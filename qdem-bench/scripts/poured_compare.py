@@ -3,8 +3,7 @@
 spheres in a box periodic in x and y on a floor, then a timed window runs from the settled
 state (issue 57, "Benchmarks of the beds users pour").
 
-Usage (from the workspace root, after
-`cargo build --release -p qdem-cli --bin qdem -p qdem-bench --bin study`):
+Usage (from the workspace root, after `cargo build --release -p qdem-cli --bin qdem`):
 
     python3 qdem-bench/scripts/poured_compare.py [--spheres 10000,100000] [--steps 2000]
         [--np 1,2] [--repeats 2] [--parts pour,order,second,clumps] [--work out/poured]

@@ -35,34 +35,54 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import poured_compare as pcmp  # noqa: E402
 
 ROOT = pcmp.ROOT
-LINE_RE = re.compile(r"^\s*([\d,]+)\s+(?:\([\d.]+%\)\s+)?(\S.*)$")
+LINE_RE = re.compile(r"^\s*([\d,]+)\s+(?:\(\s*[\d.]+%\)\s+)?(\S.*)$")
 
 
 def log(msg: str) -> None:
     print(f"[poured_profile] {msg}", file=sys.stderr, flush=True)
 
 
-def callgrind(cmd: list[str], cwd: Path, out: Path) -> dict[str, int]:
-    """Runs cmd under callgrind on one thread; returns exclusive Ir per function."""
-    env = dict(os.environ, RAYON_NUM_THREADS="1")
-    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", *cmd],
-                   cwd=cwd, check=True, env=env, capture_output=True)
-    text = subprocess.run(["callgrind_annotate", "--threshold=100", "--inclusive=no", str(out)],
+def callgrind(cmd: list[str], cwd: Path, out: Path) -> tuple[dict[str, int], dict[str, int]]:
+    """Runs cmd under callgrind on one thread (unless `out` is there from an earlier run);
+    returns the exclusive Ir per function and per source file (the file an instruction's line
+    is in: code inlined from another file counts there)."""
+    if not out.exists():
+        env = dict(os.environ, RAYON_NUM_THREADS="1")
+        subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", *cmd],
+                       cwd=cwd, check=True, env=env, capture_output=True)
+    text = subprocess.run(["callgrind_annotate", "--threshold=100", "--inclusive=no",
+                           "--auto=no", str(out)],
                           check=True, capture_output=True, text=True).stdout
-    costs: dict[str, int] = {}
+    functions: dict[str, int] = {}
+    files: dict[str, int] = {}
     started = False
     for line in text.splitlines():
         if "file:function" in line:
             started = True
             continue
-        if not started:
+        if not started or line.startswith("---"):
+            continue
+        if not line.strip():
+            if functions:
+                break
             continue
         m = LINE_RE.match(line)
         if m:
-            name = re.sub(r"\s+\[[^\]]*\]$", "", m.group(2))
-            name = name.split(":", 1)[1] if ":" in name and not name.startswith("<") else name
-            costs[name] = costs.get(name, 0) + int(m.group(1).replace(",", ""))
-    return costs
+            where = re.sub(r"\s+\[[^\]]*\]$", "", m.group(2))
+            path, _, name = where.partition(":")
+            cost = int(m.group(1).replace(",", ""))
+            functions[name] = functions.get(name, 0) + cost
+            files[source(path)] = files.get(source(path), 0) + cost
+    return functions, files
+
+
+def source(path: str) -> str:
+    """A source file's path from its crate (qdem-contact/src/...) or its library."""
+    for marker in ("/work/", "/library/", "/src/"):
+        if marker in path:
+            tail = path.split(marker, 1)[1]
+            return tail.split("/", 1)[1] if marker == "/work/" else tail
+    return path
 
 
 def per_step(short: dict, long: dict, sphere_steps: int) -> dict[str, float]:
@@ -121,26 +141,45 @@ def main() -> None:
         lattice[s] = callgrind([str(study), "dem-throughput", "--packing", str(lat), "--steps",
                                 str(s)], ROOT, work / f"callgrind.lattice.{s}")
 
+    # candidates (pairs and wall contacts in the lists) per sphere, to compare per candidate
+    check = subprocess.run([str(qdem), "check", f"profile_{s0}.toml", "--threads", "1"], cwd=d,
+                           capture_output=True, text=True).stdout
+    m = re.search(r"(\d+) candidate pairs and wall contacts", check)
+    cand_p = int(m.group(1)) / n if m else None
+    out = subprocess.run([str(study), "dem-throughput", "--packing", str(lat), "--steps", "1"],
+                         cwd=ROOT, capture_output=True, text=True,
+                         env=dict(os.environ, RAYON_NUM_THREADS="1")).stdout
+    cand_q = json.loads([line for line in out.splitlines() if line.startswith("{")][-1])[
+        "candidates_per_sphere"]
     sphere_steps = n * (s1 - s0)
-    p = per_step(poured[s0], poured[s1], sphere_steps)
-    q = per_step(lattice[s0], lattice[s1], sphere_steps)
-    names = sorted(set(p) | set(q), key=lambda k: -max(abs(p.get(k, 0)), abs(q.get(k, 0))))
-    total_p, total_q = sum(p.values()), sum(q.values())
     lines = [f"Instructions per sphere-step ({n:,} spheres, steps {s0} to {s1}, one thread; "
-             "callgrind, exclusive per function):", "",
-             "| function | poured, periodic (`qdem run`) | lattice (`dem-throughput`) | "
-             "poured − lattice |", "| --- | --- | --- | --- |",
-             f"| **all** | **{total_p:,.0f}** | **{total_q:,.0f}** | "
-             f"**{total_p - total_q:+,.0f}** |"]
-    for k in names[:args.top]:
-        a, b = p.get(k, 0.0), q.get(k, 0.0)
-        lines.append(f"| `{short_name(k)}` | {a:,.1f} | {b:,.1f} | {a - b:+,.1f} |")
+             "callgrind, exclusive), by function and by the source file of each instruction "
+             "(code inlined from another file counts there):", ""]
+    doc = {"spheres": n, "steps": [s0, s1], "candidates_per_sphere": {"poured": cand_p,
+                                                                        "lattice": cand_q}}
+    if cand_p:
+        lines += [f"Candidates per sphere (pairs and wall contacts in the lists): poured "
+                  f"{cand_p:.2f} (`qdem check`, at the start), lattice {cand_q:.2f} "
+                  "(`dem-throughput`).", ""]
+    for view, k in (("function", 0), ("source file", 1)):
+        p = per_step(poured[s0][k], poured[s1][k], sphere_steps)
+        q = per_step(lattice[s0][k], lattice[s1][k], sphere_steps)
+        names = sorted(set(p) | set(q), key=lambda x: -max(abs(p.get(x, 0)), abs(q.get(x, 0))))
+        total_p, total_q = sum(p.values()), sum(q.values())
+        lines += [f"| {view} | poured, periodic (`qdem run`) | lattice (`dem-throughput`) | "
+                  "poured − lattice |", "| --- | --- | --- | --- |",
+                  f"| **all** | **{total_p:,.0f}** | **{total_q:,.0f}** | "
+                  f"**{total_p - total_q:+,.0f}** |"]
+        for name in names[:args.top]:
+            a, b = p.get(name, 0.0), q.get(name, 0.0)
+            lines.append(f"| `{short_name(name)}` | {a:,.1f} | {b:,.1f} | {a - b:+,.1f} |")
+        lines.append("")
+        doc[view] = {"poured_total": total_p, "lattice_total": total_q,
+                     "poured": dict(sorted(p.items(), key=lambda t: -abs(t[1]))),
+                     "lattice": dict(sorted(q.items(), key=lambda t: -abs(t[1])))}
     table = "\n".join(lines) + "\n"
     (work / "poured_profile.md").write_text(table)
-    (work / "poured_profile.json").write_text(json.dumps({
-        "spheres": n, "steps": [s0, s1], "poured_total": total_p, "lattice_total": total_q,
-        "poured": dict(sorted(p.items(), key=lambda t: -abs(t[1]))),
-        "lattice": dict(sorted(q.items(), key=lambda t: -abs(t[1])))}, indent=2) + "\n")
+    (work / "poured_profile.json").write_text(json.dumps(doc, indent=2) + "\n")
     print(table)
 
 
