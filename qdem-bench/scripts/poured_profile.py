@@ -6,6 +6,7 @@ Usage (from the workspace root; valgrind installed; the binaries of one build):
 
     python3 qdem-bench/scripts/poured_profile.py [--spheres 2000] [--steps 20,70]
         [--qdem target/release/qdem] [--study target/release/study] [--work out/poured_profile]
+        [--orders [--ll 262144,8,64]]
 
 Two beds of the same sphere count and material (r = 5 mm, E = 50 MPa, Hertz-Mindlin with
 friction and restitution 0.5, skin 1 mm, the common step 20% of the Rayleigh time):
@@ -16,7 +17,11 @@ friction and restitution 0.5, skin 1 mm, the common step 20% of the Rayleigh tim
   and four walls) timed by `study dem-throughput` (the engine's step loop alone).
 Each is run under `valgrind --tool=callgrind` for the two step counts on one thread; the
 difference of the two runs, over spheres x the steps between them, takes the set-up out and
-gives instructions per sphere-step, per function (exclusive, `callgrind_annotate`). Writes
+gives instructions per sphere-step, per function (exclusive, `callgrind_annotate`). With
+`--orders`, the poured bed's settled positions in lattice, poured and random order
+(poured_compare.py's `order` part) are run from rest under `valgrind --tool=cachegrind` with a
+last-level cache of `--ll` (smaller than the machine's, so that a small bed leaves it as a large
+one leaves the real one): instructions and misses per sphere-step, load-independent. Writes
 WORK/poured_profile.json and a markdown table (stdout and WORK/poured_profile.md).
 """
 
@@ -76,6 +81,49 @@ def callgrind(cmd: list[str], cwd: Path, out: Path) -> tuple[dict[str, int], dic
     return functions, files
 
 
+def cachegrind(cmd: list[str], cwd: Path, out: Path, ll: str) -> dict[str, int]:
+    """Runs cmd under cachegrind (one thread, a last-level cache of `ll`, unless `out` is there
+    from an earlier run); returns the program's totals: Ir, D1 misses (D1mr + D1mw) and
+    last-level misses (DLmr + DLmw)."""
+    if not out.exists():
+        env = dict(os.environ, RAYON_NUM_THREADS="1")
+        subprocess.run(["valgrind", "--tool=cachegrind", "--cache-sim=yes", f"--LL={ll}",
+                        f"--cachegrind-out-file={out}", *cmd], cwd=cwd, check=True, env=env,
+                       capture_output=True)
+    events, totals = [], []
+    for line in out.read_text().splitlines():
+        if line.startswith("events:"):
+            events = line.split()[1:]
+        elif line.startswith("summary:"):
+            totals = [int(v) for v in line.split()[1:]]
+    t = dict(zip(events, totals))
+    return {"Ir": t["Ir"], "D1 misses": t["D1mr"] + t["D1mw"], "LL misses": t["DLmr"] + t["DLmw"]}
+
+
+def orders_study(qdem: Path, d: Path, side: float, n: int, s0: int, s1: int, work: Path,
+                 ll: str) -> list[str]:
+    """The settled bed's positions in lattice, poured and random order (poured_compare.py's
+    `order` part), each run by `qdem run` from rest under cachegrind: per sphere-step, the
+    instructions and the misses, which the order changes and the load does not."""
+    settled = pcmp.read_stones(d / "qdem_pour" / "stones.csv")
+    rows = ["| order | instructions | D1 misses | misses past a "
+            f"{int(ll.split(',')[0]) // 1024} KiB cache |", "| --- | --- | --- | --- |"]
+    for name, rs in pcmp.orders(settled, side).items():
+        pcmp.write_stones(d / f"order_{name}.csv", [(r[1], r[2], r[3]) for r in rs])
+        runs = {}
+        for s in (s0, s1):
+            scene = d / f"order_{name}_{s}.toml"
+            scene.write_text(pcmp.qdem_scene(side, pcmp.common_dt(), s * pcmp.common_dt(),
+                                             f"order_{name}_{s}", sample=f"order_{name}.csv"))
+            log(f"cachegrind: qdem run, {name} order, {s} steps")
+            runs[s] = cachegrind([str(qdem), "run", scene.name, "--threads", "1", "--yes"], d,
+                                 work / f"cachegrind.{name}.{s}", ll)
+        per = {k: (runs[s1][k] - runs[s0][k]) / (n * (s1 - s0)) for k in runs[s0]}
+        rows.append(f"| {name} | {per['Ir']:,.1f} | {per['D1 misses']:,.2f} | "
+                    f"{per['LL misses']:,.2f} |")
+    return rows
+
+
 def source(path: str) -> str:
     """A source file's path from its crate (qdem-contact/src/...) or its library."""
     for marker in ("/work/", "/library/", "/src/"):
@@ -102,6 +150,10 @@ def main() -> None:
     ap.add_argument("--study", default=str(ROOT / "target" / "release" / "study"))
     ap.add_argument("--work", default="out/poured_profile")
     ap.add_argument("--top", type=int, default=25)
+    ap.add_argument("--orders", action="store_true",
+                    help="also the bed in lattice, poured and random order under cachegrind")
+    ap.add_argument("--ll", default="262144,8,64",
+                    help="cachegrind's last-level cache for --orders (size,assoc,line)")
     args = ap.parse_args()
     s0, s1 = (int(s) for s in args.steps.split(","))
     n = args.spheres
@@ -177,6 +229,11 @@ def main() -> None:
         doc[view] = {"poured_total": total_p, "lattice_total": total_q,
                      "poured": dict(sorted(p.items(), key=lambda t: -abs(t[1]))),
                      "lattice": dict(sorted(q.items(), key=lambda t: -abs(t[1])))}
+    if args.orders:
+        lines += [f"The same settled positions in three orders (`qdem run` from rest, one "
+                  f"thread, cachegrind, per sphere-step from steps {s0} to {s1}):", ""]
+        lines += orders_study(qdem, d, side, n, s0, s1, work, args.ll)
+        lines.append("")
     table = "\n".join(lines) + "\n"
     (work / "poured_profile.md").write_text(table)
     (work / "poured_profile.json").write_text(json.dumps(doc, indent=2) + "\n")
