@@ -98,10 +98,12 @@ def rayleigh_time(r: float = RADIUS) -> float:
 
 
 def common_dt() -> float:
+    """The step of every code in the timed windows: 20% of the Rayleigh time."""
     return 0.2 * rayleigh_time()
 
 
 def cell_side(n: int) -> float:
+    """The side of the square cell that a settled bed of n spheres fills about as high as wide."""
     v = 4.0 / 3.0 * math.pi * RADIUS ** 3
     return (n * v / BED_FRACTION) ** (1.0 / 3.0)
 
@@ -168,11 +170,13 @@ def cached_insertion(n: int, d: Path) -> tuple[float, list[tuple[float, float, f
 
 
 def pour_seconds(pts) -> float:
+    """The fall time of the highest sphere of the insertion onto the floor."""
     top = max(p[2] for p in pts)
     return math.sqrt(2.0 * top / GRAVITY)
 
 
 def write_stones(path: Path, centres) -> None:
+    """Writes one-sphere stones (qdem's sample format) in the order given."""
     with open(path, "w") as f:
         f.write("stone,x,y,z,radius\n")
         for i, (x, y, z) in enumerate(centres, 1):
@@ -180,6 +184,7 @@ def write_stones(path: Path, centres) -> None:
 
 
 def read_stones(path: Path) -> list[tuple[int, float, float, float, float]]:
+    """The rows (stone, x, y, z, radius) of a stones file."""
     rows = []
     with open(path) as f:
         f.readline()
@@ -227,6 +232,7 @@ def qdem_scene(side: float, dt, t_end: float, out: str, sample: str | None = Non
 
 
 def qdem_run(exe: Path, scene: Path, threads: int) -> dict:
+    """Runs `qdem run` on a scene; returns the figures of its summary.json."""
     out = subprocess.run([str(exe), "run", str(scene), "--threads", str(threads), "--yes"],
                          cwd=scene.parent, capture_output=True, text=True,
                          env=dict(os.environ, RAYON_NUM_THREADS=str(threads)))
@@ -272,6 +278,7 @@ def qdem_window(exe: Path, d: Path, side: float, steps: int, threads: int, dt, n
 # ----------------------------------------------------------------------------- peers
 
 def peer_meta(side: float, pts) -> dict:
+    """The material, step and floor in the form of liggghts_compare.py's packing.json."""
     return {"youngs_modulus": YOUNG, "poisson_ratio": POISSON, "density": DENSITY,
             "friction": FRICTION, "restitution": RESTITUTION,
             "damping_ratio": damping_ratio(RESTITUTION), "gravity": [0.0, 0.0, -GRAVITY],
@@ -303,8 +310,9 @@ def fill(template: Path, subs: dict, out: Path) -> Path:
     return out
 
 
-def peer_subs(peer: str, meta: dict, side: float, pts, dt: float) -> dict:
-    """The placeholders both of a peer's decks share."""
+def peer_subs(peer: str, meta: dict, side: float, dt: float) -> dict:
+    """The placeholders both of a peer's decks share (the LAMMPS damping's reference overlap
+    from a bed as high as the cell is wide)."""
     subs = {"SKIN": fmt(SKIN), "DT": fmt(dt), "G_MAG": fmt(GRAVITY),
             "WALL_OVERLAPS": lc.wall_overlaps(meta)}
     if peer == "liggghts":
@@ -367,7 +375,7 @@ def peer_pour(peer: str, exe: str, d: Path, side: float, pts, settle: float, wid
     meta = peer_meta(side, pts)
     write_data(pd / "insert.data", side, pts, f"{peer} poured bed, poured_compare.py")
     steps = math.ceil((pour_seconds(pts) + settle) / common_dt())
-    subs = dict(peer_subs(peer, meta, side, pts, common_dt()), DATA="insert.data",
+    subs = dict(peer_subs(peer, meta, side, common_dt()), DATA="insert.data",
                 POUR_STEPS=steps, RESTART="settled.restart", THERMO=max(1000, steps // 10))
     deck = fill(HERE / peer / "pour.in.template", subs, pd / "in.pour")
     log(f"{peer}: pouring {len(pts)} spheres for {steps} steps on {width} ranks")
@@ -377,19 +385,22 @@ def peer_pour(peer: str, exe: str, d: Path, side: float, pts, settle: float, wid
 
 
 def peer_window(peer: str, exe: str, d: Path, side: float, pts, steps: int, width: int) -> dict:
+    """Times `steps` steps of a peer from its settled bed on `width` MPI ranks."""
     pd = d / peer
     meta = peer_meta(side, pts)
-    subs = dict(peer_subs(peer, meta, side, pts, common_dt()), RESTART="settled.restart",
+    subs = dict(peer_subs(peer, meta, side, common_dt()), RESTART="settled.restart",
                 STEPS=steps, THERMO=max(1000, steps // 4))
     deck = fill(HERE / peer / "settled.in.template", subs, pd / "in.settled")
     return run_deck(exe, pc_launcher(width), deck, len(pts))
 
 
 def pc_launcher(width: int) -> list[str]:
+    """The mpirun prefix for `width` ranks (none for one)."""
     return lc.mpi_launcher(width)[0]
 
 
 def has_style(exe: str, style: str) -> bool:
+    """Whether the LIGGGHTS binary lists `style` among its styles."""
     out = subprocess.run([exe, "-log", "none", "-h"], capture_output=True, text=True,
                          timeout=60).stdout
     return re.search(rf"\b{re.escape(style)}\b", out) is not None
@@ -397,14 +408,13 @@ def has_style(exe: str, style: str) -> bool:
 
 # ----------------------------------------------------------------------------- parts
 
-def part_pour(args, n, d, side, pts, qdem, peers, rows) -> Path:
-    ckpt = d / "qdem_pour" / "checkpoint.qdc"
-    if not ckpt.exists():
-        ckpt = qdem_pour(qdem, d, side, pts, args.settle, max(args.np))
-    restarts = {}
+def part_pour(args, n, d, side, pts, qdem, peers, rows) -> None:
+    """Each code pours the insertion (unless an earlier run left its settled bed), then the
+    timed windows from the settled beds; one row per code and width."""
+    if not (d / "qdem_pour" / "checkpoint.qdc").exists():
+        qdem_pour(qdem, d, side, pts, args.settle, max(args.np))
     for peer, exe in peers.items():
-        restarts[peer] = d / peer / "settled.restart"
-        if not restarts[peer].exists():
+        if not (d / peer / "settled.restart").exists():
             peer_pour(peer, exe, d, side, pts, args.settle, max(args.np))
     for width in args.np:
         runs: dict[str, list] = {}
@@ -431,7 +441,6 @@ def part_pour(args, n, d, side, pts, qdem, peers, rows) -> Path:
                          "contacts": r.get("contacts"), "kinetic_energy": r.get("kinetic_energy"),
                          "all_wall_s": [t[0]["wall_s"] for t in rs],
                          "other_cores_during": [round(t[1], 2) for t in rs]})
-    return ckpt
 
 
 def orders(rows_in, side: float, seed: int = 7) -> dict[str, list]:
@@ -447,6 +456,7 @@ def orders(rows_in, side: float, seed: int = 7) -> dict[str, list]:
 
 
 def part_order(args, n, d, side, qdem, rows) -> None:
+    """qdem on its settled positions in three orders; one row per order and width."""
     stones = d / "qdem_pour" / "stones.csv"
     if not stones.exists():
         sys.exit(f"error: the order part needs {stones} (run the pour part first)")
@@ -588,7 +598,7 @@ def liggghts_clumps(exe: str, cd: Path, side: float, stones, settle: float, step
                      f"type {k - 1}")  # each template its own body type
     dist = " ".join(f"t{k} 0.2" for k in clump_templates())
     pour_steps = math.ceil((math.sqrt(2.0 * top / GRAVITY) + settle) / clump_dt())
-    subs = dict(peer_subs("liggghts", meta, side, [], clump_dt()), SIDE=fmt(side),
+    subs = dict(peer_subs("liggghts", meta, side, clump_dt()), SIDE=fmt(side),
                 ZLO=fmt(-4 * CLUMP_RADIUS), ZHI=fmt(top + 4 * CLUMP_RADIUS),
                 INS_LO=fmt(CLUMP_RADIUS), INS_HI=fmt(top), TEMPLATES="\n".join(temps),
                 DIST=f"fix pdd all particledistribution/discrete/numberbased 32452843 5 {dist}",
@@ -620,6 +630,7 @@ def liggghts_clumps(exe: str, cd: Path, side: float, stones, settle: float, step
 
 
 def part_clumps(args, n, d, side, qdem, liggghts, rows) -> None:
+    """qdem's clump bed beside LIGGGHTS's multisphere one; one row per code and width."""
     cd = d / "clumps"
     cd.mkdir(exist_ok=True)
     stones = clump_insertion(n, side)
@@ -665,6 +676,7 @@ def part_clumps(args, n, d, side, qdem, liggghts, rows) -> None:
 # ----------------------------------------------------------------------------- report
 
 def markdown(rows: list[dict]) -> str:
+    """The tables of the rows, one per part."""
     out = []
     pour = [r for r in rows if r["part"] == "pour"]
     if pour:
