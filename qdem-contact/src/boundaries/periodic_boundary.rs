@@ -17,6 +17,42 @@
 use crate::error::ContactError;
 use qdem_core::{step::State, Vec3};
 
+/// `s.round()` (half away from zero), bit for bit, without the library call that baseline
+/// x86-64 makes of it (no SSE4.1 `roundsd`): the minimum image takes it for every candidate
+/// pair at every step. The cast truncates toward zero and s − trunc(s) is exact, so the
+/// remainder decides the rounding without error; the sign of a zero result follows `s` as
+/// `round` has it. Beyond 2^52 every double is whole, and NaN goes to `round` itself.
+#[inline]
+fn round_half_away(s: f64) -> f64 {
+    if s.is_nan() || s.abs() >= 4.5e15 {
+        return s.round();
+    }
+    let whole = ((s as i64) as f64).copysign(s);
+    let rest = s - whole;
+    if rest >= 0.5 {
+        whole + 1.0
+    } else if rest <= -0.5 {
+        whole - 1.0
+    } else {
+        whole
+    }
+}
+
+/// `s.floor()`, bit for bit, without the library call (as [`round_half_away`]): every body's
+/// anchor is tested against the cell at every step.
+#[inline]
+fn floor_inline(s: f64) -> f64 {
+    if s.is_nan() || s.abs() >= 4.5e15 {
+        return s.floor();
+    }
+    let whole = ((s as i64) as f64).copysign(s);
+    if s - whole < 0.0 {
+        whole - 1.0
+    } else {
+        whole
+    }
+}
+
 /// The periodic axes of a scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PeriodicBox {
@@ -77,7 +113,7 @@ impl PeriodicBox {
         let mut t = Vec3::zeros();
         for k in 0..3 {
             if let Some(l) = self.length[k] {
-                t[k] = -l * (d[k] / l).round();
+                t[k] = -l * round_half_away(d[k] / l);
             }
         }
         t
@@ -89,7 +125,7 @@ impl PeriodicBox {
         let mut t = Vec3::zeros();
         for k in 0..3 {
             if let Some(l) = self.length[k] {
-                t[k] = -l * ((x[k] - self.origin[k]) / l).floor();
+                t[k] = -l * floor_inline((x[k] - self.origin[k]) / l);
             }
         }
         t
@@ -159,6 +195,50 @@ mod tests {
             p.image_shift(&Vec3::new(-3.1, 0.0, 0.0)),
             Vec3::new(4.0, 0.0, 0.0)
         );
+    }
+
+    #[test]
+    fn the_inline_rounding_is_round_and_floor_bit_for_bit() {
+        let mut cases = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            -2.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+            1.0 - f64::EPSILON,
+            4503599627370495.5,
+            4.5e15,
+            -4.5e15,
+            1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+        ];
+        // A fixed sequence (xorshift) of values over many magnitudes, and their halves.
+        let mut x = 0x9E37_79B9_7F4A_7C15_u64;
+        for _ in 0..100_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = f64::from_bits(x);
+            if v.is_finite() {
+                cases.push(v);
+            }
+            let scaled = (x >> 11) as f64 / (1u64 << 53) as f64 * 8.0 - 4.0;
+            cases.push(scaled);
+            cases.push((scaled * 2.0).round() / 2.0);
+        }
+        for s in cases {
+            assert_eq!(round_half_away(s).to_bits(), s.round().to_bits(), "{s:e}");
+            assert_eq!(floor_inline(s).to_bits(), s.floor().to_bits(), "{s:e}");
+        }
+        assert!(round_half_away(f64::NAN).is_nan() && floor_inline(f64::NAN).is_nan());
     }
 
     #[test]
