@@ -397,7 +397,8 @@ impl DemContacts {
                         continue;
                     }
                     let f = law.force(&g, &e, &mut contact.history, dt);
-                    self.record_pair(k, (&g, &e), f, &mut lists, dt)
+                    let touching = (g.normal, g.overlap);
+                    self.record_pair(k, f, touching, || (g, e), &mut lists, dt)
                 }
                 false => lists.turns[k],
             };
@@ -466,8 +467,9 @@ impl DemContacts {
         batch.lanes.evaluate(&self.settings.law, batch.set, dt);
         for (l, &k) in batch.pairs[..batch.lanes.len()].iter().enumerate() {
             lists.pairs[k].history = batch.lanes.history(l);
-            let (g, e) = (batch.lanes.geometry(l), batch.lanes.elasticity(l));
-            let turn = self.record_pair(k, (&g, &e), batch.lanes.force(l), lists, dt);
+            let (f, lanes) = (batch.lanes.force(l), &batch.lanes);
+            let touching = (lanes.normal(l), lanes.overlap(l));
+            let turn = self.record_pair(k, f, touching, || lanes.contact(l), lists, dt);
             if SUM {
                 self.add_pair::<SCALED>(k, &turn, lists, slots[k], delay, sums);
             }
@@ -475,22 +477,26 @@ impl DemContacts {
         batch.lanes.clear();
     }
 
-    /// Records touching pair `k`'s force `f` (its spring already updated), and its rolling
-    /// spring; returns n × f, kept in the run's column when the lists hold one.
+    /// Records touching pair `k`'s force `f` with its (normal, overlap) (its spring already
+    /// updated), and its rolling spring from its geometry and elasticity (`contact`, read
+    /// only with rolling friction); returns n × f, kept in the run's column when the lists
+    /// hold one.
     #[inline(always)]
     fn record_pair(
         &self,
         k: usize,
-        (g, e): (&PairGeometry, &PairElasticity),
         f: Vec3,
+        (normal, overlap): (Vec3, f64),
+        contact: impl FnOnce() -> (PairGeometry, PairElasticity),
         lists: &mut RunLists<'_>,
         dt: f64,
     ) -> Vec3 {
-        let contact = &mut lists.pairs[k];
+        let record = &mut lists.pairs[k];
         if let Some(roll) = lists.rolls.get_mut(k) {
-            self.roll_pair(contact, (g, e), &f, roll, dt);
+            let (g, e) = contact();
+            self.roll_pair(record, (&g, &e), &f, roll, dt);
         }
-        let turn = contact.touch(f, &g.normal, g.overlap);
+        let turn = record.touch(f, &normal, overlap);
         if let Some(at) = lists.turns.get_mut(k) {
             *at = turn;
         }

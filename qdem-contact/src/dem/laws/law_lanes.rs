@@ -99,26 +99,34 @@ impl LawLanes {
         l
     }
 
-    /// The geometry of the contact in lane `l`.
+    /// The geometry and elasticity of the contact in lane `l`, as pushed.
     #[inline(always)]
-    pub(crate) fn geometry(&self, l: usize) -> PairGeometry {
-        PairGeometry {
+    pub(crate) fn contact(&self, l: usize) -> (PairGeometry, PairElasticity) {
+        let g = PairGeometry {
             overlap: self.overlap[l],
-            normal: lane_vector(&self.normal, l),
+            normal: self.normal(l),
             velocity: lane_vector(&self.velocity, l),
             radius: self.radius[l],
             mass: self.mass[l],
             friction: self.friction[l],
-        }
-    }
-
-    /// The elasticity of the contact in lane `l`.
-    #[inline(always)]
-    pub(crate) fn elasticity(&self, l: usize) -> PairElasticity {
-        PairElasticity {
+        };
+        let e = PairElasticity {
             e_star: self.e_star[l],
             g_star: self.g_star[l],
-        }
+        };
+        (g, e)
+    }
+
+    /// The unit normal of the contact in lane `l`.
+    #[inline(always)]
+    pub(crate) fn normal(&self, l: usize) -> Vec3 {
+        lane_vector(&self.normal, l)
+    }
+
+    /// The overlap of the contact in lane `l`.
+    #[inline(always)]
+    pub(crate) fn overlap(&self, l: usize) -> f64 {
+        self.overlap[l]
     }
 
     /// The spring of the contact in lane `l` (after [`LawLanes::evaluate`], its update).
@@ -135,16 +143,16 @@ impl LawLanes {
     }
 
     /// The law over a step `dt` for every contact of the batch, with the lanes of `set`: the
-    /// same bits as [`ContactLaw::force`] on each contact (module doc).
+    /// same bits as [`ContactLaw::force`] on each contact (module doc). A law without a lane
+    /// form, or the scalar set, runs the scalar law on each contact.
     pub(crate) fn evaluate(&mut self, law: &ContactLaw, set: LaneSet, dt: f64) {
-        let params = Params::of(law);
-        match set {
+        match (set, Params::of(law)) {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `detected` chooses a set only when the CPU has its features.
-            LaneSet::Avx512 => unsafe { evaluate_avx512(self, &params, dt) },
+            (LaneSet::Avx512, Some(params)) => unsafe { evaluate_avx512(self, &params, dt) },
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
-            LaneSet::Avx2 => unsafe { evaluate_avx2(self, &params, dt) },
+            (LaneSet::Avx2, Some(params)) => unsafe { evaluate_avx2(self, &params, dt) },
             _ => self.evaluate_scalar(law, dt),
         }
     }
@@ -153,7 +161,8 @@ impl LawLanes {
     fn evaluate_scalar(&mut self, law: &ContactLaw, dt: f64) {
         for l in 0..self.len {
             let mut history = self.history(l);
-            let f = law.force(&self.geometry(l), &self.elasticity(l), &mut history, dt);
+            let (g, e) = self.contact(l);
+            let f = law.force(&g, &e, &mut history, dt);
             for k in 0..3 {
                 self.history[k][l] = history[k];
                 self.force[k][l] = f[k];
@@ -182,11 +191,12 @@ enum Params {
 }
 
 impl Params {
-    /// The factors of `law`, each computed as its scalar `force` computes it.
-    fn of(law: &ContactLaw) -> Params {
-        match law {
+    /// The factors of `law`, each computed as its scalar `force` computes it; `None` for a
+    /// law without a lane form (none yet: a new law may start so).
+    fn of(law: &ContactLaw) -> Option<Params> {
+        Some(match law {
             ContactLaw::HertzMindlin(law) => Params::Hertz {
-                damping: (law.damping_ratio > 0.0).then(|| DAMPING_PREFACTOR * law.damping_ratio),
+                damping: (law.damping_ratio > 0.0).then_some(DAMPING_PREFACTOR * law.damping_ratio),
             },
             ContactLaw::Linear(law) => Params::Linear {
                 normal: law.normal_stiffness,
@@ -199,7 +209,7 @@ impl Params {
                     )
                 }),
             },
-        }
+        })
     }
 }
 
