@@ -6,7 +6,7 @@
 //! item (tetrahedra, particles, contact spheres, candidate pairs), two ranks (threads of this
 //! process) cut the stones and their contacts between them, a re-partition in the middle of
 //! the run cuts the bodies' blocks anew by the lists then built, and the run keeps one
-//! process's bits.
+//! process's bits (the motion, the touching contacts and the checkpoint).
 
 mod common;
 
@@ -17,8 +17,8 @@ use qdem_contact::{
 };
 use qdem_core::parallel::thread_ranks::on_thread_ranks;
 use qdem_core::{
-    continuum::Material, continuum::TetBody, loads::Gravity, step::Model, step::Scheme,
-    step::State, step::StepRequest, step::StepSettings, world::World, Vec3,
+    checkpoint::Encoder, continuum::Material, continuum::TetBody, loads::Gravity, step::Model,
+    step::Scheme, step::State, step::StepRequest, step::StepSettings, world::World, Vec3,
 };
 use qdem_mesh::structured_box;
 
@@ -121,6 +121,13 @@ fn motion(state: &State) -> Vec<u64> {
         .collect()
 }
 
+/// The bytes of `world`'s checkpoint (the contacts' springs among them).
+fn checkpoint(world: &World) -> Vec<u8> {
+    let mut out = Encoder::new();
+    world.save(&mut out).unwrap();
+    out.into_bytes()
+}
+
 /// What a rank holds after [`STEPS`] steps: its tetrahedra, spheres and candidates before
 /// the whole gather, the partition's work per rank, the re-partitions, and the gathered
 /// motion and touching contacts.
@@ -131,6 +138,7 @@ struct RankRun {
     work: Vec<f64>,
     repartitions: usize,
     motion: Vec<u64>,
+    checkpoint: Vec<u8>,
     touching: usize,
 }
 
@@ -172,6 +180,7 @@ fn two_ranks_cut_the_stones_and_their_contacts_by_their_work_and_keep_one_proces
             work: figures.work,
             repartitions: world.repartitions(),
             motion: motion(&world.state),
+            checkpoint: checkpoint(&world),
             touching: world.model::<DemContacts>().unwrap().contacts(),
         }
     });
@@ -181,6 +190,10 @@ fn two_ranks_cut_the_stones_and_their_contacts_by_their_work_and_keep_one_proces
             run.tets, run.spheres, run.candidates, run.work
         );
         assert!(run.motion == motion(&alone.state), "rank {rank}: motion");
+        assert!(
+            run.checkpoint == checkpoint(&alone),
+            "rank {rank}: checkpoint"
+        );
         assert_eq!(run.touching, touching, "rank {rank}: touching contacts");
         assert!(run.repartitions >= 1, "re-partitioned");
         // Both ranks compute stones: each owns at least a fifth of the spheres and
