@@ -262,9 +262,10 @@ fn print_cost(sim: &Simulation, per_step: f64) {
 
 /// Each rank's share of a decomposed step, gathered to every rank (a collective: every rank
 /// calls it): tetrahedra, owned particles, halo (block sums received per step), particles
-/// whose motion it receives per step, the candidate contacts it evaluates and the contact
-/// spheres of other ranks it receives (ghosts) after the measured steps, its step and kernel
-/// seconds, and the imbalance of the kernel (the slowest rank's kernel time over the mean).
+/// whose motion it receives per step, the candidate contacts it evaluates, the contact
+/// spheres of other ranks it receives (ghosts) and those it owns after the measured steps,
+/// the work the partition gave it (in particle steps), its step and kernel seconds,
+/// and the imbalance of the kernel (the slowest rank's kernel time over the mean).
 fn rank_table(sim: &Simulation, d: &RankFigures, per_step: f64, exchange: f64) -> String {
     let world = &sim.world;
     let steps = world.stages().steps().max(1) as f64;
@@ -279,35 +280,47 @@ fn rank_table(sim: &Simulation, d: &RankFigures, per_step: f64, exchange: f64) -
         .sum();
     let kernel = (bodies - exchange).max(0.0);
     let share = world.stages().seconds(Stage::Share);
-    // The contacts this rank evaluates and the ghosts it receives (split contacts).
-    let (contacts, ghosts) = sim
+    // The spheres this rank owns, the contacts it evaluates and the ghosts it receives
+    // (split contacts).
+    let (spheres, contacts, ghosts) = sim
         .contacts()
-        .map_or((0, 0), |c| (c.candidates(), c.ghosts()));
+        .map_or((0, 0, 0), |c| (c.own_spheres(), c.candidates(), c.ghosts()));
     let mine = [
         per_step,
         kernel / steps,
         share / steps,
         contacts as f64,
         ghosts as f64,
+        spheres as f64,
     ];
     let all = world.rank_rows(&mine);
     let mut table = format!(
-        "decomposed over {} ranks ({} bodies cut between ranks):\n  rank  tets      owned     halo      received  contacts  ghosts    step (s)   kernel (s) share (s)\n",
+        "decomposed over {} ranks ({} bodies cut between ranks):\n  rank  tets      owned     halo      received  contacts  ghosts    spheres   work      step (s)   kernel (s) share (s)\n",
         d.ranks, d.cut_bodies
     );
-    for (r, row) in all.chunks_exact(5).enumerate() {
+    for (r, row) in all.chunks_exact(6).enumerate() {
         table += &format!(
-            "  {r:<5} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9} {:.3e}  {:.3e}  {:.3e}\n",
-            d.tets[r], d.owned[r], d.halo[r], d.received[r], row[3], row[4], row[0], row[1], row[2]
+            "  {r:<5} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9.0} {:.3e}  {:.3e}  {:.3e}\n",
+            d.tets[r],
+            d.owned[r],
+            d.halo[r],
+            d.received[r],
+            row[3],
+            row[4],
+            row[5],
+            d.work[r],
+            row[0],
+            row[1],
+            row[2]
         );
     }
     if world.repartitions() > 0 {
         table += &format!(
-            "  re-partitioned {} times in the measured steps (grains and rigid bodies by their work)\n",
+            "  re-partitioned {} times in the measured steps (by the work of the lists then built)\n",
             world.repartitions()
         );
     }
-    let column = |k: usize| all.chunks_exact(5).map(|row| row[k]).collect::<Vec<_>>();
+    let column = |k: usize| all.chunks_exact(6).map(|row| row[k]).collect::<Vec<_>>();
     match d.tets.iter().sum::<usize>() {
         0 => {
             let contacts = imbalance(&column(3));

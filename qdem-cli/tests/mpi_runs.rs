@@ -471,7 +471,7 @@ fn check_on_two_ranks_reports_each_ranks_share_of_the_tetrahedra() {
 }
 
 #[test]
-fn check_on_two_ranks_reports_each_ranks_contacts_and_ghosts() {
+fn check_on_two_ranks_reports_each_ranks_contacts_ghosts_and_spheres() {
     let scene = workspace().join("fixtures/contact/grains.toml");
     let (ok, out, err) = on_two_ranks(&["check", scene.to_str().unwrap(), "--threads", "1"]);
     assert!(ok, "{err}");
@@ -488,7 +488,7 @@ fn check_on_two_ranks_reports_each_ranks_contacts_and_ghosts() {
         .take(2)
         .map(|l| {
             l.split_whitespace()
-                .take(7)
+                .take(8)
                 .map(|v| v.parse().unwrap())
                 .collect()
         })
@@ -496,6 +496,8 @@ fn check_on_two_ranks_reports_each_ranks_contacts_and_ghosts() {
     assert_eq!(rows.len(), 2, "{out}");
     let owned: usize = rows.iter().map(|r| r[2]).sum();
     assert_eq!(owned, 2000, "every grain owned once: {out}");
+    let spheres: usize = rows.iter().map(|r| r[7]).sum();
+    assert_eq!(spheres, 2000, "every grain's sphere owned once: {out}");
     // Each rank evaluates its grains' contacts, fewer than all, and receives ghosts; the
     // pairs across the cut are evaluated on both.
     for row in &rows {

@@ -232,14 +232,16 @@ impl World {
         Ok(self.decomposition().expect("decomposed").clone())
     }
 
-    /// Gives the particles no deformable body holds (grains, rigid bodies) new owners, in
-    /// runs of particle order of about equal measured work (each particle's step, and its
-    /// share of the split models' work, [`crate::step::split::Balance::add_costs`]): a collective,
-    /// which every rank calls after the same step, in a run decomposed with a halo exchange
-    /// (a no-op otherwise). The state and the split models are gathered first and split
-    /// again by the new owners, so the run goes on bit for bit as before. A step calls it at
-    /// a rebuild of a split model's lists when the busiest rank has more than 1.1 times the
-    /// mean work (at most once every 8 rebuilds).
+    /// Decomposes the run again by the work of its items now: the deformable bodies' blocks
+    /// and the particles no deformable body holds (grains, rigid bodies, in runs of particle
+    /// order) cut into ranges of about equal work, each tetrahedron, each particle's step and
+    /// its share of the split models' work ([`crate::step::split::Balance::add_costs`]: the
+    /// contact spheres and their candidates) counted ([`crate::parallel::decomposition`]): a
+    /// collective, which every rank calls after the same step, in a run decomposed with a
+    /// halo exchange (a no-op otherwise). The state and the split models are gathered first
+    /// and split again by the new owners, so the run goes on bit for bit as before. A step
+    /// calls it at a rebuild of a split model's lists when the busiest rank has more than 1.1
+    /// times the mean work (at most once every 8 rebuilds).
     pub fn repartition(&mut self) {
         let torques = self.stepper.rigid_torques_mut();
         let (state, models, hooks) = (&mut self.state, &mut self.models, &mut self.hooks);

@@ -2,12 +2,22 @@
 //!
 //! Every deformable body's blocks ([`crate::continuum::tet_blocks`]), taken in model order and then
 //! block order (their spatial order: recursive bisection), are cut into one contiguous range
-//! per rank of about equal cost; a body whose blocks all fall on one rank is computed there
+//! per rank of about equal work; a body whose blocks all fall on one rank is computed there
 //! alone. A particle of a deformable body is **owned** by the rank of the block of its first
 //! entry; its **halo** ranks are the others whose blocks hold it. The particles that split
 //! models ([`crate::step::split::Facets`]: DEM contacts) move and no deformable body holds are given
-//! out in runs of particle order, a rigid body whole to one rank, and given out again by
-//! their measured work at a re-partition ([`crate::world::World::repartition`]). Each step:
+//! out in runs of particle order, a rigid body whole to one rank.
+//!
+//! **The work of an item**, in units of one particle's step (predict and integrate): a
+//! tetrahedron `TET_WORK` (1.2) times its body's cost relative to an elastic one, a particle one,
+//! and what a split model's items add to the particles they sit on
+//! ([`crate::step::split::Balance::add_costs`]: DEM contacts, a contact sphere and its share of
+//! each candidate pair). A block weighs its tetrahedra and the particles it owns, so the
+//! contact spheres on a deformable body's vertices and their candidates count where they are
+//! computed: a bed of deformable stones beside a deformable sleeper is cut through the stones
+//! when the contacts make them the heavier part (where weighing the tetrahedra alone left
+//! every stone and contact on one rank). A re-partition ([`crate::world::World::repartition`])
+//! decomposes again by the work of the lists then built. Each step:
 //!
 //! 1. each rank predicts the particles it steps (the same arithmetic on the same values
 //!    everywhere, so the predicted positions and half-step velocities agree bit for bit);
@@ -46,7 +56,7 @@ use crate::parallel::communicator::Communicator;
 use crate::parallel::state_share::{StateHalo, StateShare};
 use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
-use crate::step::split::{BodyLayout, BodySplit, Reads, SumExchange};
+use crate::step::split::{BodyLayout, BodySplit, Facets, Reads, SumExchange};
 use crate::step::state::State;
 use crate::Vec3;
 use std::sync::Arc;
@@ -70,16 +80,32 @@ pub struct RankFigures {
     pub received: Vec<usize>,
     /// The bodies cut between ranks (an exchange of block sums each step).
     pub cut_bodies: usize,
+    /// Per rank, the work the partition gave it (units of one particle's step, see the module
+    /// documentation): its tetrahedra, the particles it owns and their items (in a run that
+    /// shares only the halo; a particle every rank steps counts on none).
+    pub work: Vec<f64>,
 }
 
-/// What [`decompose`] gives: the exchange, the figures, in halo mode this rank's particles
-/// and the partition, and per model its blocks for this rank if it is a deformable body.
-pub(crate) type Decomposed = (
-    StateShare,
-    RankFigures,
-    Option<(LocalParticles, Partition)>,
-    Vec<Option<BodySplit>>,
-);
+/// What one elastic tetrahedron's evaluation costs, in units of one particle's step (its
+/// prediction and integration), measured on the paper-size loading step
+/// (`fixtures/ballast/full_load.toml`, docs/ballast.md, one thread, a quiet machine): the
+/// sleeper's kernel 16 ns and the stones' 18.5 ns a viscoelastic tetrahedron (1.6 elastic
+/// ones), against 9 ns a particle for the rest of the step.
+pub(crate) const TET_WORK: f64 = 1.2;
+
+/// What [`decompose`] gives.
+pub(crate) struct Decomposed {
+    /// The exchange that ends each step.
+    pub share: StateShare,
+    /// The figures of the decomposition.
+    pub figures: RankFigures,
+    /// In a run that shares only the halo, the particles this rank steps.
+    pub local: Option<LocalParticles>,
+    /// Per model, its blocks for this rank if it is a deformable body.
+    pub splits: Vec<Option<BodySplit>>,
+    /// This rank's tetrahedra's work ([`TET_WORK`] each, times its body's cost).
+    pub tet_work: f64,
+}
 
 impl SumExchange {
     /// Sends the sums this rank computed for other ranks' particles, and writes those the
@@ -174,29 +200,60 @@ fn slot_blocks(node_start: &[u32]) -> Vec<u32> {
     block
 }
 
-/// Cuts the blocks of every deformable body (`bodies`: per body, the cost of one of its
-/// tetrahedra and the tetrahedra of each block; model order, then block order) into `ranks`
-/// contiguous ranges of about equal cost; per body, the rank of each block.
-fn assign_blocks(bodies: &[(f64, Vec<usize>)], ranks: usize) -> Vec<Vec<u32>> {
-    let total: f64 = bodies
-        .iter()
-        .map(|(w, blocks)| w * blocks.iter().sum::<usize>() as f64)
-        .sum();
+/// Cuts the blocks of every deformable body (`bodies`: per body, the work of each block;
+/// model order, then block order) into `ranks` contiguous ranges of about equal work; per
+/// body, the rank of each block.
+fn assign_blocks(bodies: &[Vec<f64>], ranks: usize) -> Vec<Vec<u32>> {
+    let total: f64 = bodies.iter().flatten().sum();
     let mut done = 0.0;
     bodies
         .iter()
-        .map(|(w, blocks)| {
+        .map(|blocks| {
             blocks
                 .iter()
-                .map(|&tets| {
-                    let cost = w * tets as f64;
-                    let middle = done + 0.5 * cost;
-                    done += cost;
+                .map(|&work| {
+                    let middle = done + 0.5 * work;
+                    done += work;
                     ((middle / total * ranks as f64) as usize).min(ranks - 1) as u32
                 })
                 .collect()
         })
         .collect()
+}
+
+/// The work of each of a body's blocks, in block order: its tetrahedra ([`TET_WORK`] each,
+/// times the body's cost) and the `cost` of the particles it owns (those whose first entry
+/// is in it).
+fn block_work(layout: &BodyLayout<'_>, cost: &[f64]) -> Vec<f64> {
+    let mut work: Vec<f64> = block_tets(layout)
+        .into_iter()
+        .map(|tets| TET_WORK * layout.tet_cost * tets as f64)
+        .collect();
+    let block_of_slot = slot_blocks(layout.node_start);
+    for (i, first) in layout.entry_start[..layout.entry_start.len() - 1]
+        .iter()
+        .enumerate()
+    {
+        let block = block_of_slot[layout.entries[*first as usize] as usize];
+        work[block as usize] += cost[layout.first + i];
+    }
+    work
+}
+
+/// Each particle's work (see the module documentation): one for its step, plus what the
+/// split models and hooks (`split`: whether each is, models first) add for the items on it,
+/// from their whole records.
+pub(crate) fn particle_costs<'a>(
+    len: usize,
+    split: impl Iterator<Item = &'a mut dyn Facets>,
+) -> Vec<f64> {
+    let mut cost = vec![1.0; len];
+    for facets in split {
+        if let Some(balance) = facets.balance() {
+            balance.add_costs(&mut cost);
+        }
+    }
+    cost
 }
 
 /// The blocks a deformable body declares ([`crate::step::split::Facets::body`]); `None` for
@@ -220,25 +277,31 @@ fn block_tets(layout: &BodyLayout<'_>) -> Vec<usize> {
         .collect()
 }
 
-/// Decomposes `models`' deformable bodies over `comm`'s ranks: per model, the blocks of a
-/// deformable body this rank computes and the particles it owns, and the exchange that ends
-/// each step, the decomposition's figures and, when every model reads only what a rank steps
-/// itself and `halo_allowed` (no hook reads more), the particles this rank steps and the
-/// partition to re-assign the free particles by.
+/// Decomposes `models`' deformable bodies over `comm`'s ranks by the work of their items
+/// (`cost`: per particle, [`particle_costs`]): per model, the blocks of a deformable body
+/// this rank computes and the particles it owns, and the exchange that ends each step, the
+/// decomposition's figures and, when every model reads only what a rank steps itself and
+/// `halo_allowed` (no hook reads more), the particles this rank steps, with the free
+/// particles given out by `cost` too.
 pub(crate) fn decompose(
     state: &State,
     models: &mut [Box<dyn Model>],
     comm: Arc<dyn Communicator>,
     halo_allowed: bool,
+    cost: &[f64],
 ) -> Result<Decomposed, CoreError> {
     let ranks = comm.size();
-    let bodies: Vec<(f64, Vec<usize>)> = models
+    let halo = halo_allowed && models.iter_mut().all(|m| !matches!(m.reads(), Reads::All));
+    // Without a halo exchange every rank steps every particle and computes every split
+    // model whole: only the tetrahedra are shared out.
+    let unit = vec![0.0; cost.len()];
+    let cost = if halo { cost } else { &unit[..] };
+    let bodies: Vec<Vec<f64>> = models
         .iter_mut()
         .filter_map(|m| body_of(m.as_mut()))
-        .map(|layout| (layout.tet_cost, block_tets(&layout)))
+        .map(|layout| block_work(&layout, cost))
         .collect();
     let block_ranks = assign_blocks(&bodies, ranks);
-    let halo = halo_allowed && models.iter_mut().all(|m| !matches!(m.reads(), Reads::All));
     let mut figures = RankFigures {
         ranks,
         tets: vec![0; ranks],
@@ -246,19 +309,25 @@ pub(crate) fn decompose(
         halo: vec![0; ranks],
         received: vec![0; ranks],
         cut_bodies: 0,
+        work: vec![0.0; ranks],
     };
     let mut owner = vec![u32::MAX; state.len()];
     let mut needs = Vec::new();
-    let mut block_ranks = block_ranks.into_iter();
+    let mut tet_work = 0.0;
     let mut splits = Vec::with_capacity(models.len());
+    let mut blocks = bodies.iter().zip(block_ranks);
     for model in models.iter_mut() {
         let Some(layout) = body_of(model.as_mut()) else {
             splits.push(None);
             continue;
         };
-        let block_rank = block_ranks.next().expect("one block assignment per body");
-        for (tets, &r) in block_tets(&layout).into_iter().zip(&block_rank) {
+        let (work, block_rank) = blocks.next().expect("one block assignment per body");
+        for ((tets, &r), w) in block_tets(&layout).into_iter().zip(&block_rank).zip(work) {
             figures.tets[r as usize] += tets;
+            figures.work[r as usize] += w;
+            if r as usize == comm.rank() {
+                tet_work += TET_WORK * layout.tet_cost * tets as f64;
+            }
         }
         figures.cut_bodies += usize::from(block_rank.iter().any(|&r| r != block_rank[0]));
         let split = split_body(layout, &block_rank, &comm);
@@ -283,68 +352,44 @@ pub(crate) fn decompose(
     if !halo {
         let mut share = StateShare::new(&owner, state, None, comm);
         share.share_whole_every_step(&mut figures);
-        return Ok((share, figures, None, splits));
+        return Ok(Decomposed {
+            share,
+            figures,
+            local: None,
+            splits,
+            tet_work,
+        });
     }
     needs.sort_unstable();
     needs.dedup();
     for &(q, _) in &needs {
         figures.received[q as usize] += 1;
     }
-    let partition = Partition {
-        comm,
-        body_owner: owner,
-        body_owned: figures.owned.clone(),
-        needs,
-    };
-    let (share, owned, local) = partition.assign(state, models, None);
-    figures.owned = owned;
-    Ok((share, figures, Some((local, partition)), splits))
-}
-
-/// The part of a halo-exchanged decomposition that does not change as bodies move: the
-/// deformable bodies' owners and halo. The rest (the grains' and rigid bodies' owners) is
-/// assigned again at a re-partition ([`crate::world::World::repartition`]).
-pub(crate) struct Partition {
-    pub comm: Arc<dyn Communicator>,
-    /// Per particle, the rank of the deformable body's block that owns it (`u32::MAX` for
-    /// the others).
-    body_owner: Vec<u32>,
-    /// Per rank, the deformable bodies' particles it owns.
-    body_owned: Vec<usize>,
-    /// Every rank's halo, (rank, particle), sorted.
-    needs: Vec<(u32, u32)>,
-}
-
-impl Partition {
-    /// Owners for the free particles by `cost` ([`own_in_runs`]), and the exchange, the
-    /// particles owned per rank and this rank's particles that follow.
-    pub fn assign(
-        &self,
-        state: &State,
-        models: &mut [Box<dyn Model>],
-        cost: Option<&[f64]>,
-    ) -> (StateShare, Vec<usize>, LocalParticles) {
-        let (mut owner, mut owned) = (self.body_owner.clone(), self.body_owned.clone());
-        own_in_runs(state, models, &mut owner, &mut owned, cost);
-        let me = self.comm.rank() as u32;
-        let (exchange, local) = halo_exchange(&owner, &self.needs, me, self.comm.size());
-        let share = StateShare::new(&owner, state, Some(exchange), self.comm.clone());
-        (share, owned, local)
-    }
+    own_in_runs(state, models, &mut owner, &mut figures, cost);
+    let me = comm.rank() as u32;
+    let (exchange, local) = halo_exchange(&owner, &needs, me, ranks);
+    let share = StateShare::new(&owner, state, Some(exchange), comm);
+    Ok(Decomposed {
+        share,
+        figures,
+        local: Some(local),
+        splits,
+        tet_work,
+    })
 }
 
 /// Gives owners to the particles that split models move and no deformable body holds
 /// ([`crate::step::split::Ownership::free_particles`], `owner` `u32::MAX`): runs of particle
-/// order of about equal `cost` (one per particle without it), a rigid body (its centre and members) whole to one rank.
+/// order of about equal `cost`, a rigid body (its centre and members) whole to one rank.
 /// The builders place grains layer by layer, so a run is a slab of the packing (its ghosts
 /// are one layer at each cut) and a rank streams contiguous memory when it steps its
-/// grains; counts them in `owned`.
+/// grains; counts them and their work in `figures`.
 fn own_in_runs(
     state: &State,
     models: &mut [Box<dyn Model>],
     owner: &mut [u32],
-    owned: &mut [usize],
-    cost: Option<&[f64]>,
+    figures: &mut RankFigures,
+    cost: &[f64],
 ) {
     let mut free: Vec<usize> = models
         .iter_mut()
@@ -379,11 +424,8 @@ fn own_in_runs(
             None => units.push(vec![p]),
         }
     }
-    let weight = |unit: &[usize]| match cost {
-        Some(cost) => unit.iter().map(|&p| cost[p]).sum(),
-        None => unit.len() as f64,
-    };
-    let ranks = owned.len();
+    let weight = |unit: &[usize]| unit.iter().map(|&p| cost[p]).sum::<f64>();
+    let ranks = figures.ranks;
     let total: f64 = units.iter().map(|u| weight(u)).sum();
     let mut before = 0.0;
     for unit in &units {
@@ -392,7 +434,8 @@ fn own_in_runs(
         for &p in unit {
             owner[p] = r as u32;
         }
-        owned[r] += unit.len();
+        figures.owned[r] += unit.len();
+        figures.work[r] += w;
         before += w;
     }
 }

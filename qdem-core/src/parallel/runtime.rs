@@ -9,21 +9,21 @@
 
 use crate::error::CoreError;
 use crate::parallel::communicator::{max_over_ranks, Communicator};
-use crate::parallel::decomposition::{decompose, Partition, RankFigures};
+use crate::parallel::decomposition::{decompose, particle_costs, Decomposed, RankFigures};
 use crate::parallel::ghosts::GhostTable;
 use crate::parallel::state_share::StateShare;
 use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
 use crate::step::post_step::{Halt, PostStep};
 use crate::step::seam::{add_model_forces, Seam};
-use crate::step::split::{Balance, Facets, Part, Reads};
+use crate::step::split::{Balance, BodySplit, Facets, Part, Reads};
 use crate::step::stages::{Stage, StageTimes};
 use crate::step::state::State;
 use crate::Vec3;
 use std::sync::Arc;
 
 /// The ratio of the busiest rank's work to the mean above which a rebuild of a split
-/// model's lists re-partitions the free particles ([`crate::world::World::repartition`]).
+/// model's lists re-partitions ([`crate::world::World::repartition`]).
 const REPARTITION_IMBALANCE: f64 = 1.1;
 
 /// Rebuilds between two re-partitions at least: a re-partition gathers the whole state, and
@@ -58,10 +58,11 @@ struct Ranks {
     comm: Arc<dyn Communicator>,
     share: StateShare,
     figures: RankFigures,
-    /// The particles this rank steps, when a step shares only the halo.
+    /// The particles this rank steps, when a step shares only the halo (the only run that
+    /// re-partitions).
     local: Option<LocalParticles>,
-    /// What a re-partition keeps, when a step shares only the halo.
-    partition: Option<Partition>,
+    /// This rank's tetrahedra's work (units of one particle's step).
+    tet_work: f64,
     /// Per model: whether a deformable body (split by its blocks in any mode).
     bodies: Vec<bool>,
     /// Per model, its split state when this rank computes it in part.
@@ -132,15 +133,15 @@ impl ParallelRuntime {
         steps_in_part: bool,
     ) -> Result<(), CoreError> {
         let halo_allowed = hooks.iter_mut().all(|h| !matches!(h.reads(), Reads::All));
-        let (share, figures, halo, bodies) = decompose(state, models, comm.clone(), halo_allowed)?;
-        let (local, partition) = halo.unzip();
+        let cost = particle_costs(state.len(), split_models(models, hooks));
+        let decomposed = decompose(state, models, comm.clone(), halo_allowed, &cost)?;
         let mut ranks = Ranks {
             comm,
-            share,
-            figures,
-            local,
-            partition,
-            bodies: bodies.iter().map(Option::is_some).collect(),
+            share: decomposed.share,
+            figures: decomposed.figures,
+            local: decomposed.local,
+            tet_work: decomposed.tet_work,
+            bodies: decomposed.splits.iter().map(Option::is_some).collect(),
             models: (0..models.len()).map(|_| None).collect(),
             hooks: vec![false; hooks.len()],
             repartitions: 0,
@@ -148,17 +149,7 @@ impl ParallelRuntime {
             mine: Vec::new(),
             all: Vec::new(),
         };
-        for ((model, body), slot) in models.iter_mut().zip(bodies).zip(&mut ranks.models) {
-            if let Some(body) = body {
-                let facets = split_facets(model.as_mut()).expect("a deformable body splits");
-                facets.split(Some(Part {
-                    owner: Arc::from([]),
-                    rank: ranks.comm.rank() as u32,
-                    body: Some(body),
-                }));
-                *slot = Some(None);
-            }
-        }
+        ranks.split_bodies(models, decomposed.splits);
         if ranks.local.is_some() && !steps_in_part {
             ranks.step_whole(&mut [], &mut []);
         }
@@ -278,12 +269,12 @@ impl ParallelRuntime {
     /// Whether a step ends with [`ParallelRuntime::rebalance`] (a run decomposed with a halo
     /// exchange).
     pub(crate) fn rebalances(&self) -> bool {
-        self.ranks.as_ref().is_some_and(|r| r.partition.is_some())
+        self.ranks.as_ref().is_some_and(|r| r.local.is_some())
     }
 
     /// The ranks of a run decomposed with a halo exchange, the only one that re-partitions.
     fn halo_ranks(&mut self) -> Option<&mut Ranks> {
-        self.ranks.as_mut().filter(|r| r.partition.is_some())
+        self.ranks.as_mut().filter(|r| r.local.is_some())
     }
 
     /// After a step: re-partitions when a split model rebuilt its lists and the ranks' work
@@ -299,7 +290,8 @@ impl ParallelRuntime {
             return;
         };
         let mut rebuilt = false;
-        let mut work = ranks.local.as_ref().map_or(0, |l| l.computed.len()) as f64;
+        let computed = ranks.local.as_ref().map_or(0, |l| l.computed.len());
+        let mut work = ranks.tet_work + computed as f64;
         for balance in balances(models, hooks, &ranks.models, &ranks.hooks) {
             rebuilt |= balance.rebuilt();
             work += balance.work();
@@ -319,7 +311,7 @@ impl ParallelRuntime {
         }
     }
 
-    /// Gives the free particles new owners by their measured work (see
+    /// Decomposes the run again by the work of its items now (see
     /// [`crate::world::World::repartition`]); a no-op unless the run shares only the halo.
     pub(crate) fn repartition(
         &mut self,
@@ -332,15 +324,21 @@ impl ParallelRuntime {
             return;
         };
         ranks.gather(state, models, torques);
-        let mut cost = vec![1.0; state.len()];
-        for balance in balances(models, hooks, &ranks.models, &ranks.hooks) {
-            balance.add_costs(&mut cost);
-        }
-        let partition = ranks.partition.as_ref().expect("checked above");
-        let (share, owned, local) = partition.assign(state, models, Some(&cost));
+        let cost = particle_costs(state.len(), split_models(models, hooks));
+        let decomposed = decompose(state, models, ranks.comm.clone(), true, &cost)
+            .expect("the bodies decomposed once decompose again");
+        let Decomposed {
+            share,
+            figures,
+            local,
+            splits,
+            tet_work,
+        } = decomposed;
         ranks.share = share;
-        ranks.figures.owned = owned;
-        ranks.local = Some(local);
+        ranks.figures = figures;
+        ranks.local = local;
+        ranks.tet_work = tet_work;
+        ranks.split_bodies(models, splits);
         ranks.split_by_owners(models, hooks);
         ranks.repartitions += 1;
         ranks.rebuilds_since = 0;
@@ -422,6 +420,22 @@ impl Seam for ParallelRuntime {
 }
 
 impl Ranks {
+    /// Hands each deformable body its blocks for this rank (`splits`, per model).
+    fn split_bodies(&mut self, models: &mut [Box<dyn Model>], splits: Vec<Option<BodySplit>>) {
+        let me = self.comm.rank() as u32;
+        for ((model, body), slot) in models.iter_mut().zip(splits).zip(&mut self.models) {
+            if let Some(body) = body {
+                let facets = split_facets(model.as_mut()).expect("a deformable body splits");
+                facets.split(Some(Part {
+                    owner: Arc::from([]),
+                    rank: me,
+                    body: Some(body),
+                }));
+                *slot = Some(None);
+            }
+        }
+    }
+
     /// One force evaluation of split model `i` (its `facets`), its stages with the
     /// collectives in between ([`crate::step::split`]).
     fn evaluate(
@@ -531,7 +545,6 @@ impl Ranks {
         }
         self.share.share_whole_every_step(&mut self.figures);
         self.local = None;
-        self.partition = None;
     }
 
     /// The whole state on every rank, and every split model merged.
@@ -588,4 +601,18 @@ fn balances<'a>(
             _ => None,
         });
     models.chain(hooks).filter_map(|facets| facets.balance())
+}
+
+/// The facets of every split model and hook, models first, whether or not this rank computes
+/// it in part yet.
+fn split_models<'a>(
+    models: &'a mut [Box<dyn Model>],
+    hooks: &'a mut [Box<dyn PostStep>],
+) -> impl Iterator<Item = &'a mut dyn Facets> {
+    let models = models.iter_mut().filter_map(|m| split_facets(m.as_mut()));
+    let hooks = hooks.iter_mut().filter_map(|h| match h.reads() {
+        Reads::Split(facets) => Some(facets),
+        _ => None,
+    });
+    models.chain(hooks)
 }

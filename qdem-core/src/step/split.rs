@@ -309,7 +309,8 @@ pub trait Merge {
     fn merge(&mut self, all: &[f64]);
 }
 
-/// A split model's work, which a re-partition ([`crate::world::World::repartition`]) balances.
+/// A split model's work, which the decomposition weighs ([`crate::parallel::decomposition`])
+/// and a re-partition ([`crate::world::World::repartition`]) balances.
 pub trait Balance {
     /// Whether the model has rebuilt what decides its work (DEM contacts: their candidate
     /// lists) since the last call, the same on every rank: a decomposed world may then
@@ -317,11 +318,11 @@ pub trait Balance {
     fn rebuilt(&mut self) -> bool;
 
     /// This rank's work in the model at its last evaluation, in units of one particle's
-    /// step (DEM contacts: three per candidate contact).
+    /// step (DEM contacts: five per own contact sphere and three per candidate contact).
     fn work(&self) -> f64;
 
     /// Adds each particle's share of the model's work to `cost` (one entry per particle),
-    /// from the whole records after a gather.
+    /// from the whole records (before the decomposition, or after a gather).
     fn add_costs(&self, cost: &mut [f64]);
 }
 

@@ -127,6 +127,16 @@ const SPHERE_CHUNK: usize = 16384;
 /// ns per particle.
 const CANDIDATE_WORK: f64 = 3.0;
 
+/// A contact sphere's work at each evaluation, without its candidates, in units of one
+/// particle's step: on the paper-size loading step (docs/ballast.md, one thread, a quiet
+/// machine, `qdem check`'s 20 steps) the contact stage took 2.17 ms for 42,073 spheres and
+/// 7,837 candidates, against 9 ns a particle's step: less `CANDIDATE_WORK` per candidate,
+/// 5 steps a sphere. About half a step is the read of its centre and the check of its
+/// displacement (docs/BENCHMARKS.md, the ballast's contact stage); the rest is its share
+/// of the rebuild of the lists among those 20 steps (about 3,200 instructions a sphere), so
+/// a run that rebuilds less often spends less per sphere.
+const SPHERE_WORK: f64 = 5.0;
+
 /// One contact sphere as the builder describes it.
 #[derive(Clone, Copy, Debug)]
 pub struct ContactSphere {

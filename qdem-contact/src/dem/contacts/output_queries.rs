@@ -206,6 +206,14 @@ impl DemContacts {
         pairs.into_iter().chain(walls)
     }
 
+    /// The spheres this rank owns (and evaluates the candidates of), in a run decomposed
+    /// with split contacts ([`qdem_core::step::split::Facets`]); every sphere otherwise.
+    pub fn own_spheres(&self) -> usize {
+        self.split
+            .as_ref()
+            .map_or(self.spheres.particle().len(), |p| p.own().len())
+    }
+
     /// The spheres of other ranks whose motion this rank receives at each evaluation, in a
     /// run decomposed with split contacts ([`qdem_core::step::split::Facets`]); 0 otherwise.
     pub fn ghosts(&self) -> usize {

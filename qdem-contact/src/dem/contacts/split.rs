@@ -348,22 +348,26 @@ impl DemContacts {
         self.candidates.take_rebuilt()
     }
 
-    /// This rank's work at its last evaluation: `CANDIDATE_WORK` (three) per candidate
-    /// contact.
+    /// This rank's work at its last evaluation: `SPHERE_WORK` per own sphere and
+    /// `CANDIDATE_WORK` per candidate contact.
     pub(super) fn candidate_work(&self) -> f64 {
-        CANDIDATE_WORK * self.candidates() as f64
+        SPHERE_WORK * self.own_spheres() as f64 + CANDIDATE_WORK * self.candidates() as f64
     }
 
-    /// Adds half of `CANDIDATE_WORK` per candidate pair to each partner's particle, all of
-    /// it per wall candidate.
+    /// Adds `SPHERE_WORK` per sphere to its particle, half of `CANDIDATE_WORK` per candidate
+    /// pair to each partner's, all of it per wall candidate.
     pub(super) fn add_candidate_costs(&self, cost: &mut [f64]) {
+        let particle = self.spheres.particle();
+        for &p in particle {
+            cost[p as usize] += SPHERE_WORK;
+        }
         let half = 0.5 * CANDIDATE_WORK;
         for c in &self.candidates.pairs().items {
-            cost[self.spheres.particle()[c.first as usize] as usize] += half;
-            cost[self.spheres.particle()[c.second as usize] as usize] += half;
+            cost[particle[c.first as usize] as usize] += half;
+            cost[particle[c.second as usize] as usize] += half;
         }
         for c in &self.candidates.wall_contacts().items {
-            cost[self.spheres.particle()[c.first as usize] as usize] += CANDIDATE_WORK;
+            cost[particle[c.first as usize] as usize] += CANDIDATE_WORK;
         }
     }
 }
