@@ -402,3 +402,67 @@ fn a_grain_bed_on_soft_springs_stays_rigid_on_stiff_ones_is_advised_deformable()
         "{stiff:#?}"
     );
 }
+
+/// A granite cube (27 kg) on a floor of linear springs, pushed down by a `[[load]]` of
+/// `total_force` 1 N scaled by `factor` (a ramp or series to 2000).
+fn pushed_block(factor: &str) -> String {
+    format!(
+        r#"
+[run]
+t_end = 0.1
+gravity = [0.0, 0.0, -9.81]
+[[material]]
+name = "granite"
+density = 2700.0
+young = 5e10
+poisson = 0.25
+[contact]
+law = "linear"
+normal_stiffness = 1e7
+tangential_stiffness = 5e6
+friction = 0.5
+[[body]]
+name = "block"
+mesh = "{}"
+material = "granite"
+contact_radius = 0.01
+translate = [0.0, 0.0, 0.0601]
+[[wall]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[[load]]
+body = "block"
+box = [[-1.0, -1.0, 0.109], [1.0, 1.0, 1.0]]
+total_force = [0.0, 0.0, -1.0]
+{factor}
+"#,
+        fixture("contact/block.msh").display()
+    )
+}
+
+/// The force a `[[load]]` puts on one contact is its `total_force` times its time factor's
+/// peak: 2000 N, not the 1 N of `total_force` alone (nor the block's 265 N weight), for a ramp
+/// and for a series (whose fastest change, 2000 over 10 ms, is its segment).
+#[test]
+fn a_loads_force_on_the_contacts_is_its_total_force_times_its_peak_factor() {
+    let ramp = advice_of(
+        "pushed-ramp",
+        &pushed_block("ramp = [[0.0, 0.0], [0.05, 2000.0]]"),
+    );
+    let dir = test_dir("advice-pushed-series-csv");
+    let csv = dir.join("push.csv");
+    std::fs::write(&csv, "time,f\n0,0\n0.04,0\n0.05,2000\n0.1,2000\n").unwrap();
+    let series = advice_of(
+        "pushed-series",
+        &pushed_block(&format!(
+            "series = {{ file = \"{}\", column = \"f\" }}",
+            csv.display()
+        )),
+    );
+    for all in [&ramp, &series] {
+        let a = on(all, "contacts", Topic::ContactStiffness);
+        assert_eq!(a.figure("reference_force"), Some(2000.0), "{a:#?}");
+        let overlap = 2000.0 / 1e7 / a.figure("radius").unwrap();
+        assert!((a.figure("overlap_over_radius").unwrap() - overlap).abs() < 1e-15);
+    }
+}

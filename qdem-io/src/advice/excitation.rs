@@ -22,7 +22,7 @@
 //! The body's own weight is left out: it is not an excitation a rigid body would miss.
 
 use crate::build::load_series::read_series;
-use crate::scene::{Body, ContactLawName, Material, Scene};
+use crate::scene::{Body, ContactLawName, Load, Material, Scene};
 use std::f64::consts::PI;
 
 /// What a body's loads and impacts do to its first mode.
@@ -157,13 +157,18 @@ fn impact(
     })
 }
 
-/// The loads' shortest ramp segment that changes their value, or shortest cycle period (s);
-/// the run's length if there is none.
+/// The loads' shortest ramp segment that changes their value, shortest cycle period, or the
+/// shortest time a series takes to change by its peak at its fastest rate (s); the run's
+/// length if there is none.
 pub(super) fn shortest_load_segment(scene: &Scene) -> f64 {
     let mut shortest = scene.run.t_end;
     for load in &scene.loads {
         if let Some(c) = &load.cyclic {
             shortest = shortest.min(1.0 / c.frequency);
+        } else if let Some(s) = &load.series {
+            if let Ok(points) = read_series(&scene.resolve(&s.file), &s.column) {
+                shortest = shortest.min(time_to_peak(&points));
+            }
         }
         for w in load.ramp.points.windows(2) {
             let dt = w[1][0] - w[0][0];
@@ -173,6 +178,34 @@ pub(super) fn shortest_load_segment(scene: &Scene) -> f64 {
         }
     }
     shortest
+}
+
+/// The largest magnitude of `load`'s time factor: the peak of its ramp (1 without one), of
+/// its cycle or of its series (1 where the series cannot be read: the build refuses it).
+pub(super) fn peak_factor(scene: &Scene, load: &Load) -> f64 {
+    let peak = |points: &mut dyn Iterator<Item = f64>| points.map(f64::abs).fold(0.0, f64::max);
+    if let Some(c) = &load.cyclic {
+        c.max.abs().max(c.min.abs())
+    } else if let Some(s) = &load.series {
+        read_series(&scene.resolve(&s.file), &s.column)
+            .map_or(1.0, |points| peak(&mut points.iter().map(|p| p.1)))
+    } else if load.ramp.points.is_empty() {
+        1.0
+    } else {
+        peak(&mut load.ramp.points.iter().map(|p| p[1]))
+    }
+}
+
+/// The time a piecewise-linear function takes to change by its peak at its fastest rate
+/// (infinite for a constant one).
+fn time_to_peak(points: &[(f64, f64)]) -> f64 {
+    let peak = points.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
+    let rate = points
+        .windows(2)
+        .filter(|w| w[1].0 > w[0].0)
+        .map(|w| (w[1].1 - w[0].1).abs() / (w[1].0 - w[0].0))
+        .fold(0.0, f64::max);
+    peak / rate
 }
 
 /// The overshoot e^(−ζπ/√(1 − ζ²)) of a mode's step response over its static deflection; zero
