@@ -466,3 +466,25 @@ fn a_loads_force_on_the_contacts_is_its_total_force_times_its_peak_factor() {
         assert!((a.figure("overlap_over_radius").unwrap() - overlap).abs() < 1e-15);
     }
 }
+
+/// A body advised rigid is told the run's step with it rigid, that of the scene built with
+/// `rigid = true` (its contacts then act on its whole mass), not the bound its contacts set
+/// on its vertex particles now: the granite cube pushed over 50 ms, hundreds of its periods.
+#[test]
+fn a_body_advised_rigid_is_told_the_step_of_the_scene_with_it_rigid() {
+    let text = pushed_block("ramp = [[0.0, 0.0], [0.05, 2000.0]]");
+    let all = advice_of("pushed-slow", &text);
+    let a = on(&all, "body `block`", Topic::Rigidity);
+    assert_eq!(a.advised, "rigid", "{a:#?}");
+    let rigid = text.replace(
+        "material = \"granite\"\ncontact_radius",
+        "material = \"granite\"\nrigid = true\ncontact_radius",
+    );
+    assert_ne!(rigid, text);
+    let dir = test_dir("advice-pushed-rigid");
+    std::fs::write(dir.join("scene.toml"), rigid).unwrap();
+    let sim = common::build(&dir.join("scene.toml"));
+    let step = sim.world.settings().stable_dt.0;
+    assert_eq!(a.figure("rigid_dt"), Some(step), "{a:#?}");
+    assert!(step > a.figure("deformable_dt").unwrap(), "{a:#?}");
+}

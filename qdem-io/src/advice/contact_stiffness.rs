@@ -98,7 +98,11 @@ pub(super) fn advise(sim: &Simulation) -> Option<Advice> {
             false => (0.1 * segment / contact_time).powi(2),
         };
         let s = (TARGET_OVERLAP / overlap).min(limit).max(1.0);
-        (s, format!("it sets the run's step: a spring {s:.3e}x softer overlaps {:.2}% and steps {:.2}x longer", overlap * s * 100.0, s.sqrt()))
+        let why = match s > 1.0 {
+            true => format!("it sets the run's step: a spring {s:.3e}x softer overlaps {:.2}% and steps {:.2}x longer", overlap * s * 100.0, s.sqrt()),
+            false => format!("it sets the run's step, but a softer spring's contact, {contact_time:.3e} s now, would last longer than a tenth of the loads' fastest change ({segment:.3e} s): the stiffness stands"),
+        };
+        (s, why)
     } else if overlap > 0.05 {
         let s = TARGET_OVERLAP / overlap;
         (s, format!("more than 5% of the radius distorts the contact geometry: a spring {:.2}x stiffer overlaps 1% and steps {:.2}x shorter", 1.0 / s, 1.0 / s.sqrt()))

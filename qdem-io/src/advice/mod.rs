@@ -19,6 +19,7 @@ mod rigidity;
 mod stones;
 
 use crate::build::{BodyKind, Simulation};
+use crate::scene::Scene;
 use serde::Serialize;
 
 /// The largest dynamic share ([`excitation::Excitation::dynamic_share`]) at which a body's
@@ -150,6 +151,16 @@ pub fn advise(sim: &Simulation) -> Vec<Advice> {
     advice.extend(integrator::advise(sim, &lowest));
     advice.extend(contact_stiffness::advise(sim));
     advice
+}
+
+/// The run's explicit stable bound (s) of `sim`'s scene changed by `change`, the scene built
+/// again (a body or stone set turned rigid or deformable, contact dashpots added): the step a
+/// change gives, with every model's bound, not a guess at the one it relieves. NaN where the
+/// changed scene does not build.
+fn changed_step(sim: &Simulation, change: impl FnOnce(&mut Scene)) -> f64 {
+    let mut scene = sim.scene.clone();
+    change(&mut scene);
+    Simulation::build(scene).map_or(f64::NAN, |s| s.world.settings().stable_dt.0)
 }
 
 /// The advice as JSON for scripts (`qdem check --advice json`): an array of objects with
