@@ -84,8 +84,30 @@ fn error(value: f64, reference: f64) -> f64 {
     100.0 * (value / reference - 1.0).abs()
 }
 
+/// The heading from which `speed-vs-error.md` is written by hand (the modelling advice
+/// checked against runs): [`write_report`] keeps it and all that follows.
+pub const KEPT_FROM: &str = "## Modelling advice against runs";
+
 /// Writes `speed-vs-error.md` into `docs` and its plots into `docs/figures`; the reference
-/// of "finest mesh" is the explicit run on the mesh with the most tetrahedra.
+/// of "finest mesh" is the explicit run on the mesh with the most tetrahedra. The page's
+/// hand-written part, from [`KEPT_FROM`] on, is kept.
+///
+/// ```
+/// use qdem_bench::speed_vs_error::{write_report, StudyRow, KEPT_FROM};
+/// let docs = std::env::temp_dir().join(format!("qdem-svr-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&docs).unwrap();
+/// let page = docs.join("speed-vs-error.md");
+/// std::fs::write(&page, format!("# old table\n\n{KEPT_FROM}\n\nchecked by hand\n")).unwrap();
+/// let row = |integrator, tets| StudyRow {
+///     mesh: "100".into(), tets, integrator, dt: 1e-3, steps: 3000, wall_seconds: 1.0,
+///     tip_uz_um: -63.4, f1_hz: 32.3,
+/// };
+/// write_report(&[row("verlet", 915), row("newmark", 915)], "test", &docs).unwrap();
+/// let text = std::fs::read_to_string(&page).unwrap();
+/// assert!(!text.contains("old table"));
+/// assert!(text.ends_with(&format!("{KEPT_FROM}\n\nchecked by hand\n")));
+/// # std::fs::remove_dir_all(&docs).unwrap();
+/// ```
 pub fn write_report(rows: &[StudyRow], machine: &str, docs: &Path) -> Result<(), StudyError> {
     let finest = rows
         .iter()
@@ -139,9 +161,12 @@ pub fn write_report(rows: &[StudyRow], machine: &str, docs: &Path) -> Result<(),
          ![frequency error against wall time](figures/speed_vs_error_f1.svg)\n",
         finest.tets, finest.tip_uz_um, finest.f1_hz,
     );
-    write_atomic(&docs.join("speed-vs-error.md"), |w| {
-        w.write_all(text.as_bytes())
-    })?;
+    let page = docs.join("speed-vs-error.md");
+    let kept = std::fs::read_to_string(&page)
+        .ok()
+        .and_then(|old| old.find(KEPT_FROM).map(|i| format!("\n{}", &old[i..])))
+        .unwrap_or_default();
+    write_atomic(&page, |w| w.write_all((text + &kept).as_bytes()))?;
     Ok(())
 }
 

@@ -1,6 +1,6 @@
 //! `qdem check SCENE`: validates a scene and prints its meshes, mass, stable step (of an
-//! explicit run), the modelling advice ([`qdem_io::advice`]: each body rigid or deformable,
-//! its formulation, the integrator, the contacts' stiffness; `--advice json` prints only
+//! explicit run), the modelling advice ([`qdem_io::advice`]: each body and stone set rigid or
+//! deformable, a body's formulation, the integrator, the contacts' stiffness; `--advice json` prints only
 //! that), an estimate of the memory the run keeps, checkpoint support, the measured
 //! cost of a step with the projected run time, and where a step's time goes, stage by stage of the world's step
 //! ([`qdem_core::step::stages`]). Under `mpirun` (N > 1) the run is decomposed as `qdem run`

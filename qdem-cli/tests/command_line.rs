@@ -170,7 +170,8 @@ fn check_names_each_bodys_kind_and_what_limits_the_step() {
 /// advice alone as a JSON array: the cantilever is held at its clamp (deformable), locks not
 /// at ν = 0.167 (standard), and its release at 2 s excites its first mode fully, so Newmark
 /// is advised over Verlet; the collision's cubes are impacted (deformable, with a contact
-/// stiffness told).
+/// stiffness told); the grains of `fixtures/contact/grains.toml`, a `[granular]` set, are
+/// advised as a set.
 #[test]
 fn check_prints_the_advice_and_json_gives_it_to_scripts() {
     let fixtures = concat!(env!("CARGO_MANIFEST_DIR"), "/../fixtures/");
@@ -202,6 +203,10 @@ fn check_prints_the_advice_and_json_gives_it_to_scripts() {
     assert!(advice
         .iter()
         .any(|a| a["subject"] == "body `left`" && a["advised"] == "deformable"));
+    let grains = format!("{fixtures}contact/grains.toml");
+    let report = success(&["check", &grains, "--threads", "1"]);
+    let line = "advice [granular] `grains` (rigid or deformable): ";
+    assert!(report.contains(line), "no `{line}` in\n{report}");
 }
 
 #[test]

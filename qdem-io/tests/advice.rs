@@ -3,7 +3,9 @@
 //! free beam loaded near its first mode (deformable) and far below it (rigid); ν = 0.49
 //! (averaged-pressure) and 0.3 (standard); a creep test (implicit) and a stubby block shaken
 //! at half its first mode (explicit); a light grain bed on stiff springs (softer) and a heavy
-//! body on soft ones (stiffer).
+//! body on soft ones (stiffer); a `[ballast]` stone set on soft contacts (rigid) and on Table
+//! 1's (deformable); a `[granular]` bed on soft springs (rigid) and on stiff ones
+//! (deformable).
 
 mod common;
 
@@ -281,4 +283,208 @@ fn a_light_bed_on_stiff_springs_is_advised_softer_on_soft_ones_stiffer() {
     let a = on(&all, "contacts", Topic::ContactStiffness);
     assert!(a.figure("overlap_over_radius").unwrap() > 0.05, "{a:#?}");
     assert!(a.figure("softening").unwrap() < 1.0, "{a:#?}");
+}
+
+/// Four coarse ballast stones (two shapes, 5 cm) of granite with shear viscosity `viscosity`,
+/// falling onto a floor on linear springs of stiffness `k`.
+fn stone_set(k: f64, viscosity: f64) -> String {
+    format!(
+        r#"
+[run]
+t_end = 0.01
+gravity = [0.0, 0.0, -9.81]
+[[material]]
+name = "granite"
+density = 2700.0
+young = 3e10
+poisson = 0.2
+shear_viscosity = {viscosity}
+[contact]
+law = "linear"
+normal_stiffness = {k}
+tangential_stiffness = {}
+friction = 0.5
+[ballast]
+name = "ballast"
+material = "granite"
+meshes = ["{}", "{}"]
+contact_radius = 0.012
+count = 4
+region = [[0.0, 0.0, 0.0], [0.4, 0.4, 0.6]]
+seed = 1
+[[wall]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+"#,
+        k / 2.0,
+        fixture("ballast/stones/coarse/stone_00.msh").display(),
+        fixture("ballast/stones/coarse/stone_01.msh").display()
+    )
+}
+
+/// A stone set is judged by its most excited shape. On 1e5 N/m springs a 5 cm granite stone's
+/// contact lasts about 4 ms, hundreds of its first periods: rigid, stepping longer than the
+/// deformable stones' vertex contacts and tetrahedra allow; ten times stiffer, the share grows
+/// as √10 (the contact time goes as 1/√k); on Table 1's 1.61e9 N/m the contact lasts about
+/// the stone's own period: deformable. Viscous stones made rigid lose their damping, and the
+/// advice gives the contacts dashpots of that damping ratio, which shorten the rigid step.
+#[test]
+fn a_stone_set_on_soft_contacts_is_advised_rigid_on_stiff_ones_deformable() {
+    let all = advice_of("stones-soft", &stone_set(1e5, 0.0));
+    let soft = on(&all, "[ballast] `ballast`", Topic::Rigidity);
+    assert_eq!(
+        (soft.now.as_str(), soft.advised.as_str()),
+        ("deformable", "rigid"),
+        "{soft:#?}"
+    );
+    assert_eq!(soft.figure("shapes"), Some(2.0), "{soft:#?}");
+    let f1 = soft.figure("lowest_frequency_hz").unwrap();
+    // A free 5 cm granite stone: a sphere of 2.5 cm radius rings at 2.5 c_s/(2π a) = 34 kHz
+    // (c_s = 2.15 km/s); an elongated coarse stone lower, within a factor of three.
+    assert!((1e4..6e4).contains(&f1), "{f1}");
+    let (deformable, rigid) = (
+        soft.figure("deformable_dt").unwrap(),
+        soft.figure("rigid_dt").unwrap(),
+    );
+    assert!(rigid > 2.0 * deformable, "{soft:#?}");
+    assert_eq!(soft.figure("rigid_speed_up"), Some(rigid / deformable));
+    let d = soft.figure("dynamic_share").unwrap();
+    let all = advice_of("stones-firmer", &stone_set(1e6, 0.0));
+    let firmer = on(&all, "[ballast] `ballast`", Topic::Rigidity);
+    let ratio = firmer.figure("dynamic_share").unwrap() / d;
+    assert!((ratio - 10f64.sqrt()).abs() < 1e-9, "{ratio}");
+    let all = advice_of("stones-stiff", &stone_set(1.61e9, 0.0));
+    let stiff = on(&all, "[ballast] `ballast`", Topic::Rigidity);
+    assert_eq!(stiff.advised, "deformable", "{stiff:#?}");
+    assert!(stiff.figure("dynamic_share").unwrap() >= 0.1, "{stiff:#?}");
+    let all = advice_of("stones-viscous", &stone_set(1e5, 1e4));
+    let viscous = on(&all, "[ballast] `ballast`", Topic::Rigidity);
+    let zeta = viscous.figure("kelvin_voigt_damping_ratio").unwrap();
+    // ζ = π f₁ μ_D/G, G = 3e10/2.4.
+    let f1 = viscous.figure("lowest_frequency_hz").unwrap();
+    assert!(
+        (zeta - PI * f1 * 1e4 / 1.25e10).abs() < 1e-12,
+        "{viscous:#?}"
+    );
+    let z = (zeta * 100.0).ceil() / 100.0;
+    assert!(z > 0.01, "{viscous:#?}");
+    assert_eq!(
+        viscous.advised,
+        format!("rigid, [contact] damping_ratio = {z}"),
+        "{viscous:#?}"
+    );
+    let damped = viscous.figure("rigid_advised_dt").unwrap();
+    assert!(damped < viscous.figure("rigid_dt").unwrap(), "{viscous:#?}");
+}
+
+/// Glass grains are rigid spheres: the heaviest, taken as a sphere of its mass, has the 9–11 mm
+/// grading's radius, and its first free mode (Lamb's torsional one, 2.5011 c_s/(2π a), about
+/// 6.5 kHz here) is struck by contacts lasting π√(m/k): on 1e4 N/m, 1.3 ms, a share of 0.075,
+/// rigid; on 1e6 N/m ten times that, deformable.
+#[test]
+fn a_grain_bed_on_soft_springs_stays_rigid_on_stiff_ones_is_advised_deformable() {
+    let all = advice_of("grains-soft", &grain_bed(1e4));
+    let soft = on(&all, "[granular] `grains`", Topic::Rigidity);
+    assert_eq!(soft.advised, "rigid", "{soft:#?}");
+    let a = soft.figure("radius").unwrap();
+    assert!((0.0045..=0.0055 * (1.0 + 1e-9)).contains(&a), "{soft:#?}");
+    let f1 = soft.figure("lowest_frequency_hz").unwrap();
+    let m = 2500.0 * 4.0 / 3.0 * PI * a.powi(3);
+    let d = 2.0 / (PI * f1 * PI * (m / 1e4f64).sqrt());
+    let share = soft.figure("dynamic_share").unwrap();
+    assert!((share / d - 1.0).abs() < 1e-9, "{share} against {d}");
+    assert!((0.01..0.1).contains(&share), "{soft:#?}");
+    let all = advice_of("grains-stiff", &grain_bed(1e6));
+    let stiff = on(&all, "[granular] `grains`", Topic::Rigidity);
+    assert_eq!(
+        (stiff.now.as_str(), stiff.advised.as_str()),
+        ("rigid", "deformable"),
+        "{stiff:#?}"
+    );
+}
+
+/// A granite cube (27 kg) on a floor of linear springs, pushed down by a `[[load]]` of
+/// `total_force` 1 N scaled by `factor` (a ramp or series to 2000).
+fn pushed_block(factor: &str) -> String {
+    format!(
+        r#"
+[run]
+t_end = 0.1
+gravity = [0.0, 0.0, -9.81]
+[[material]]
+name = "granite"
+density = 2700.0
+young = 5e10
+poisson = 0.25
+[contact]
+law = "linear"
+normal_stiffness = 1e7
+tangential_stiffness = 5e6
+friction = 0.5
+[[body]]
+name = "block"
+mesh = "{}"
+material = "granite"
+contact_radius = 0.01
+translate = [0.0, 0.0, 0.0601]
+[[wall]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[[load]]
+body = "block"
+box = [[-1.0, -1.0, 0.109], [1.0, 1.0, 1.0]]
+total_force = [0.0, 0.0, -1.0]
+{factor}
+"#,
+        fixture("contact/block.msh").display()
+    )
+}
+
+/// The force a `[[load]]` puts on one contact is its `total_force` times its time factor's
+/// peak: 2000 N, not the 1 N of `total_force` alone (nor the block's 265 N weight), for a ramp
+/// and for a series (whose fastest change, 2000 over 10 ms, is its segment).
+#[test]
+fn a_loads_force_on_the_contacts_is_its_total_force_times_its_peak_factor() {
+    let ramp = advice_of(
+        "pushed-ramp",
+        &pushed_block("ramp = [[0.0, 0.0], [0.05, 2000.0]]"),
+    );
+    let dir = test_dir("advice-pushed-series-csv");
+    let csv = dir.join("push.csv");
+    std::fs::write(&csv, "time,f\n0,0\n0.04,0\n0.05,2000\n0.1,2000\n").unwrap();
+    let series = advice_of(
+        "pushed-series",
+        &pushed_block(&format!(
+            "series = {{ file = \"{}\", column = \"f\" }}",
+            csv.display()
+        )),
+    );
+    for all in [&ramp, &series] {
+        let a = on(all, "contacts", Topic::ContactStiffness);
+        assert_eq!(a.figure("reference_force"), Some(2000.0), "{a:#?}");
+        let overlap = 2000.0 / 1e7 / a.figure("radius").unwrap();
+        assert!((a.figure("overlap_over_radius").unwrap() - overlap).abs() < 1e-15);
+    }
+}
+
+/// A body advised rigid is told the run's step with it rigid, that of the scene built with
+/// `rigid = true` (its contacts then act on its whole mass), not the bound its contacts set
+/// on its vertex particles now: the granite cube pushed over 50 ms, hundreds of its periods.
+#[test]
+fn a_body_advised_rigid_is_told_the_step_of_the_scene_with_it_rigid() {
+    let text = pushed_block("ramp = [[0.0, 0.0], [0.05, 2000.0]]");
+    let all = advice_of("pushed-slow", &text);
+    let a = on(&all, "body `block`", Topic::Rigidity);
+    assert_eq!(a.advised, "rigid", "{a:#?}");
+    let rigid = text.replace(
+        "material = \"granite\"\ncontact_radius",
+        "material = \"granite\"\nrigid = true\ncontact_radius",
+    );
+    assert_ne!(rigid, text);
+    let dir = test_dir("advice-pushed-rigid");
+    std::fs::write(dir.join("scene.toml"), rigid).unwrap();
+    let sim = common::build(&dir.join("scene.toml"));
+    let step = sim.world.settings().stable_dt.0;
+    assert_eq!(a.figure("rigid_dt"), Some(step), "{a:#?}");
+    assert!(step > a.figure("deformable_dt").unwrap(), "{a:#?}");
 }

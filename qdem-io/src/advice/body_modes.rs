@@ -5,13 +5,15 @@
 //!
 //! The body is taken out of the scene (its particles and tetrahedra alone, nothing touching
 //! it) so that a rigid body is asked what it would be if deformable, and so that the solve
-//! costs one body's factorisation, not the scene's.
+//! costs one body's factorisation, not the scene's. A `[ballast]` stone is asked the same way,
+//! free ([`of_part`]).
 
 use crate::build::{core_material, BodyInfo, Simulation};
 use crate::scene::Material;
 use qdem_core::continuum::TetBody;
 use qdem_core::modal::lanczos::natural_modes;
 use qdem_core::step::{Dofs, Model, State};
+use qdem_core::Vec3;
 use std::f64::consts::PI;
 
 /// Rigid modes a free body has, plus the elastic one sought.
@@ -43,25 +45,50 @@ pub(super) fn of_body(
 ) -> Result<BodyModes, String> {
     let range = body.particles.clone();
     let start = range.start as u32;
-    let reference = sim.world.state.reference[range.clone()].to_vec();
     let tets: Vec<[u32; 4]> = sim
         .body_tets(body)
         .iter()
         .map(|t| t.map(|n| n - start))
         .collect();
-    let count = tets.len();
-    let model = TetBody::new(&body.name, &reference, tets, core_material(material))
-        .map_err(|e| e.to_string())?
-        .with_formulation(material.formulation.core());
-    let mut state = State::at_rest(reference);
-    model.lump_mass(&mut state.mass);
+    let mut fixed = Vec::new();
     for (fix, particles) in sim.scene.fixes.iter().zip(&sim.fix_particles) {
         if fix.body != body.name {
             continue;
         }
-        for &p in particles.iter().filter(|p| range.contains(p)) {
-            state.fix(p - range.start, Dofs::from_mask(fix.dofs));
-        }
+        fixed.extend(
+            particles
+                .iter()
+                .filter(|p| range.contains(p))
+                .map(|&p| (p - range.start, Dofs::from_mask(fix.dofs))),
+        );
+    }
+    of_part(
+        &body.name,
+        &sim.world.state.reference[range],
+        tets,
+        material,
+        &fixed,
+    )
+}
+
+/// The part of a body made of the particles at `reference` and the tetrahedra `tets` (indices
+/// into `reference`) of `material`, its particles `fixed` in the given directions: a `[[body]]`
+/// or one stone of a `[ballast]`.
+pub(super) fn of_part(
+    name: &str,
+    reference: &[Vec3],
+    tets: Vec<[u32; 4]>,
+    material: &Material,
+    fixed: &[(usize, Dofs)],
+) -> Result<BodyModes, String> {
+    let count = tets.len();
+    let model = TetBody::new(name, reference, tets, core_material(material))
+        .map_err(|e| e.to_string())?
+        .with_formulation(material.formulation.core());
+    let mut state = State::at_rest(reference.to_vec());
+    model.lump_mass(&mut state.mass);
+    for &(p, dofs) in fixed {
+        state.fix(p, dofs);
     }
     let stable_dt = model.stable_dt(&state).unwrap_or(f64::INFINITY);
     let models: Vec<Box<dyn Model>> = vec![Box::new(model)];
@@ -74,13 +101,17 @@ pub(super) fn of_body(
         .find(|m| !m.rigid)
         .map(|m| m.frequency_hz)
         .ok_or_else(|| format!("its {wanted} lowest modes are all rigid-body motions"))?;
-    let shear_modulus = material.young / (2.0 * (1.0 + material.poisson));
-    let tau = material.shear_viscosity / shear_modulus;
     Ok(BodyModes {
         lowest_hz,
         held,
         stable_dt,
         tets: count,
-        damping_ratio: PI * lowest_hz * tau,
+        damping_ratio: PI * lowest_hz * relaxation_time(material),
     })
+}
+
+/// The shear relaxation time τ = μ_D/G of `material`'s Kelvin–Voigt viscosity (s).
+pub(super) fn relaxation_time(material: &Material) -> f64 {
+    let shear_modulus = material.young / (2.0 * (1.0 + material.poisson));
+    material.shear_viscosity / shear_modulus
 }

@@ -4,12 +4,14 @@
 //! The reference force is the largest of the heaviest `[[body]]`'s weight, the weight of a
 //! column of the heaviest stone (of `[granular]` or `[ballast]`) as many layers high as the
 //! sample (its height along gravity over the smallest sphere's diameter), and the largest
-//! `[[load]]` total force, carried by one contact (the worst case of a body resting on one
-//! sphere, of a stone at the bottom of a column): δ = F/k_n. A softer spring k_n/s lets δ grow s-fold and the step √s-fold (the
-//! contact's frequency √(k/m)), and lengthens a contact's duration π√(m/k) √s-fold:
+//! `[[load]]` force (its `total_force` times its time factor's peak), carried by one contact
+//! (the worst case of a body resting on one sphere, of a stone at the bottom of a column):
+//! δ = F/k_n. A softer spring k_n/s lets δ grow s-fold and the step √s-fold (the contact's
+//! frequency √(k/m)), and lengthens a contact's duration π√(m/k) √s-fold:
 //! - δ/R below 0.5% and the contacts setting the step: softer, to δ/R = 1% (s = 0.01 R/δ),
 //!   unless that would make the contact time longer than a tenth of the loads' shortest
-//!   segment (where the scene has `[[load]]`s);
+//!   segment (where the scene has `[[load]]`s; a series' segment is the time it takes to
+//!   change by its peak at its fastest rate);
 //! - δ/R above 5%: stiffer, back to 1%: overlaps that large distort the geometry the law
 //!   assumes (the fixed 5% of the radius the contacts' step bound was first taken at);
 //! - otherwise the stiffness stands.
@@ -35,7 +37,10 @@ pub(super) fn advise(sim: &Simulation) -> Option<Advice> {
         .scene
         .loads
         .iter()
-        .map(|l| nalgebra::Vector3::from(l.total_force).norm())
+        .map(|l| {
+            nalgebra::Vector3::from(l.total_force).norm()
+                * super::excitation::peak_factor(&sim.scene, l)
+        })
         .fold(0.0, f64::max);
     let force = (mass * g).max(load);
     let (bound, limiter) = &sim.world.settings().stable_dt;
@@ -93,7 +98,11 @@ pub(super) fn advise(sim: &Simulation) -> Option<Advice> {
             false => (0.1 * segment / contact_time).powi(2),
         };
         let s = (TARGET_OVERLAP / overlap).min(limit).max(1.0);
-        (s, format!("it sets the run's step: a spring {s:.3e}x softer overlaps {:.2}% and steps {:.2}x longer", overlap * s * 100.0, s.sqrt()))
+        let why = match s > 1.0 {
+            true => format!("it sets the run's step: a spring {s:.3e}x softer overlaps {:.2}% and steps {:.2}x longer", overlap * s * 100.0, s.sqrt()),
+            false => format!("it sets the run's step, but a softer spring's contact, {contact_time:.3e} s now, would last longer than a tenth of the loads' fastest change ({segment:.3e} s): the stiffness stands"),
+        };
+        (s, why)
     } else if overlap > 0.05 {
         let s = TARGET_OVERLAP / overlap;
         (s, format!("more than 5% of the radius distorts the contact geometry: a spring {:.2}x stiffer overlaps 1% and steps {:.2}x shorter", 1.0 / s, 1.0 / s.sqrt()))

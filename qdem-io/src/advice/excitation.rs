@@ -11,6 +11,10 @@
 //! - an impact of contact time t_c (the Hertz or linear-spring time at the body's starting
 //!   speed against a rigid wall): a pulse rising over t_c/2, d = min(1, 2/(π f₁ t_c)).
 //!
+//! A stone of a `[ballast]` or `[granular]` set ([`of_stone`]) is excited by every load of the
+//! scene, which reaches it through the bed, and by its contacts, which strike it however it
+//! starts.
+//!
 //! The body's Kelvin–Voigt damping ratio ζ at f₁ lowers these: the cyclic share becomes
 //! w |1/√((1 − r²)² + (2ζr)²) − 1|, and the transient ones are scaled by the step response's
 //! overshoot e^(−ζπ/√(1 − ζ²)), zero for an overdamped mode (ζ ≥ 1: a creep test).
@@ -18,7 +22,7 @@
 //! The body's own weight is left out: it is not an excitation a rigid body would miss.
 
 use crate::build::load_series::read_series;
-use crate::scene::{Body, ContactLawName, Material, Scene};
+use crate::scene::{Body, ContactLawName, Load, Material, Scene};
 use std::f64::consts::PI;
 
 /// What a body's loads and impacts do to its first mode.
@@ -31,7 +35,7 @@ pub(super) struct Excitation {
 }
 
 /// The excitation of `body` (of `material`, of mass `mass`) in `scene`, for a first mode at
-/// `f1` Hz with damping ratio `zeta`.
+/// `f1` Hz with damping ratio `zeta`: its own loads and its impact at its starting speed.
 pub(super) fn of_body(
     scene: &Scene,
     body: &Body,
@@ -39,21 +43,58 @@ pub(super) fn of_body(
     mass: f64,
     (f1, zeta): (f64, f64),
 ) -> Excitation {
+    let mut worst = loads(scene, Some(&body.name), (f1, zeta));
+    let speed = nalgebra::Vector3::from(body.velocity).norm();
+    if speed > 0.0 {
+        let radius = body.contact_radius.unwrap_or(0.0);
+        worst.consider(impact(scene, material, (mass, radius), speed, (f1, zeta)));
+    }
+    worst
+}
+
+/// The excitation of one stone of a `[ballast]` or `[granular]` set (of `material`, of mass
+/// `mass`, its contact spheres of radius `radius`) in `scene`, for a first mode at `f1` Hz
+/// with damping ratio `zeta`. A stone has no load of its own: every `[[load]]` of the scene
+/// reaches it through the bed, at the load's own rate. Its contacts strike it: a linear
+/// spring over π√(m/k_n) whatever the speed (the contact's half period, the shortest a
+/// stone's contact force can change over), a Hertz contact at `speed` (the set's starting
+/// speed, or a fall as high as the stone, the least a pour or a rearranging stone strikes at).
+pub(super) fn of_stone(
+    scene: &Scene,
+    material: &Material,
+    (mass, radius): (f64, f64),
+    speed: f64,
+    (f1, zeta): (f64, f64),
+) -> Excitation {
+    let mut worst = loads(scene, None, (f1, zeta));
+    worst.consider(impact(scene, material, (mass, radius), speed, (f1, zeta)));
+    worst
+}
+
+impl Excitation {
+    /// Keeps `other` where it excites more.
+    fn consider(&mut self, other: Option<Excitation>) {
+        if let Some(other) = other.filter(|o| o.dynamic_share > self.dynamic_share) {
+            *self = other;
+        }
+    }
+}
+
+/// The largest dynamic share of the `[[load]]`s on `body` (every load where `None`).
+fn loads(scene: &Scene, body: Option<&str>, (f1, zeta): (f64, f64)) -> Excitation {
     let overshoot = overshoot(zeta);
     let mut worst = Excitation {
         dynamic_share: 0.0,
         source: "nothing time-varying (no cyclic, ramped or series load, no impact)".to_string(),
     };
     let mut consider = |share: f64, source: String| {
-        if share > worst.dynamic_share {
-            worst = Excitation {
-                dynamic_share: share,
-                source,
-            };
-        }
+        worst.consider(Some(Excitation {
+            dynamic_share: share,
+            source,
+        }))
     };
     for (k, load) in scene.loads.iter().enumerate() {
-        if load.body != body.name {
+        if body.is_some_and(|b| load.body != b) {
             continue;
         }
         let name = format!("[[load]] #{}", k + 1);
@@ -85,35 +126,49 @@ pub(super) fn of_body(
             );
         }
     }
-    let speed = nalgebra::Vector3::from(body.velocity).norm();
-    if let (Some(contact), true) = (&scene.contact, speed > 0.0) {
-        let radius = body.contact_radius.unwrap_or(0.0);
-        let t_c = match contact.law {
-            ContactLawName::HertzMindlin => {
-                hertz_contact_time(mass, radius, material.young, material.poisson, speed)
-            }
-            ContactLawName::Linear => contact
-                .normal_stiffness
-                .map_or(f64::INFINITY, |k| PI * (mass / k).sqrt()),
-        };
-        if t_c.is_finite() && t_c > 0.0 {
-            let share = overshoot * (2.0 / (PI * f1 * t_c)).min(1.0);
-            consider(
-                share,
-                format!("an impact at {speed:.3} m/s lasting about {t_c:.3e} s"),
-            );
-        }
-    }
     worst
 }
 
-/// The loads' shortest ramp segment that changes their value, or shortest cycle period (s);
-/// the run's length if there is none.
+/// The dynamic share of an impact at `speed` of a carrier of mass `mass` on spheres of
+/// `radius` under `scene`'s contact law; none without `[contact]` or a contact time.
+fn impact(
+    scene: &Scene,
+    material: &Material,
+    (mass, radius): (f64, f64),
+    speed: f64,
+    (f1, zeta): (f64, f64),
+) -> Option<Excitation> {
+    let contact = scene.contact.as_ref()?;
+    let t_c = match contact.law {
+        ContactLawName::HertzMindlin if speed > 0.0 => {
+            hertz_contact_time(mass, radius, material.young, material.poisson, speed)
+        }
+        ContactLawName::HertzMindlin => f64::INFINITY,
+        ContactLawName::Linear => contact
+            .normal_stiffness
+            .map_or(f64::INFINITY, |k| PI * (mass / k).sqrt()),
+    };
+    (t_c.is_finite() && t_c > 0.0).then(|| Excitation {
+        dynamic_share: overshoot(zeta) * (2.0 / (PI * f1 * t_c)).min(1.0),
+        source: match speed > 0.0 {
+            true => format!("an impact at {speed:.3} m/s lasting about {t_c:.3e} s"),
+            false => format!("its contacts, each lasting about {t_c:.3e} s"),
+        },
+    })
+}
+
+/// The loads' shortest ramp segment that changes their value, shortest cycle period, or the
+/// shortest time a series takes to change by its peak at its fastest rate (s); the run's
+/// length if there is none.
 pub(super) fn shortest_load_segment(scene: &Scene) -> f64 {
     let mut shortest = scene.run.t_end;
     for load in &scene.loads {
         if let Some(c) = &load.cyclic {
             shortest = shortest.min(1.0 / c.frequency);
+        } else if let Some(s) = &load.series {
+            if let Ok(points) = read_series(&scene.resolve(&s.file), &s.column) {
+                shortest = shortest.min(time_to_peak(&points));
+            }
         }
         for w in load.ramp.points.windows(2) {
             let dt = w[1][0] - w[0][0];
@@ -123,6 +178,34 @@ pub(super) fn shortest_load_segment(scene: &Scene) -> f64 {
         }
     }
     shortest
+}
+
+/// The largest magnitude of `load`'s time factor: the peak of its ramp (1 without one), of
+/// its cycle or of its series (1 where the series cannot be read: the build refuses it).
+pub(super) fn peak_factor(scene: &Scene, load: &Load) -> f64 {
+    let peak = |points: &mut dyn Iterator<Item = f64>| points.map(f64::abs).fold(0.0, f64::max);
+    if let Some(c) = &load.cyclic {
+        c.max.abs().max(c.min.abs())
+    } else if let Some(s) = &load.series {
+        read_series(&scene.resolve(&s.file), &s.column)
+            .map_or(1.0, |points| peak(&mut points.iter().map(|p| p.1)))
+    } else if load.ramp.points.is_empty() {
+        1.0
+    } else {
+        peak(&mut load.ramp.points.iter().map(|p| p[1]))
+    }
+}
+
+/// The time a piecewise-linear function takes to change by its peak at its fastest rate
+/// (infinite for a constant one).
+fn time_to_peak(points: &[(f64, f64)]) -> f64 {
+    let peak = points.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
+    let rate = points
+        .windows(2)
+        .filter(|w| w[1].0 > w[0].0)
+        .map(|w| (w[1].1 - w[0].1).abs() / (w[1].0 - w[0].0))
+        .fold(0.0, f64::max);
+    peak / rate
 }
 
 /// The overshoot e^(−ζπ/√(1 − ζ²)) of a mode's step response over its static deflection; zero

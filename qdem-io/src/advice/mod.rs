@@ -1,13 +1,14 @@
 //! What a scene needs modelled, told by the program (issue 58): `qdem check` advises each
-//! `[[body]]`'s kind (rigid or deformable) and formulation, the integrator, and the contacts'
-//! stiffness, each with its reasoning and the figures behind it.
+//! `[[body]]`'s kind (rigid or deformable) and formulation, a `[ballast]` or `[granular]`
+//! stone set's kind, the integrator, and the contacts' stiffness, each with its reasoning and
+//! the figures behind it.
 //!
 //! Advice is advice: nothing in the scene changes; [`Advice::now`] says what the scene does,
 //! [`Advice::advised`] what the figures point to. The figures come from the bodies' own
 //! natural modes with their fixes ([`body_modes`], Lanczos as `qdem modes`), the loads' time
 //! functions and the impacts' contact times ([`excitation`]), and measured costs cited where
-//! they are used. One file per kind of advice: [`rigidity`], [`formulation`], [`integrator`],
-//! [`contact_stiffness`].
+//! they are used. One file per kind of advice: [`rigidity`], [`stones`], [`formulation`],
+//! [`integrator`], [`contact_stiffness`].
 
 mod body_modes;
 mod contact_stiffness;
@@ -15,8 +16,10 @@ mod excitation;
 mod formulation;
 mod integrator;
 mod rigidity;
+mod stones;
 
 use crate::build::{BodyKind, Simulation};
+use crate::scene::Scene;
 use serde::Serialize;
 
 /// The largest dynamic share ([`excitation::Excitation::dynamic_share`]) at which a body's
@@ -91,7 +94,7 @@ impl Advice {
 }
 
 /// Every piece of advice for `sim`'s scene, in the order: each `[[body]]` (rigidity, then
-/// formulation), the integrator, the contacts.
+/// formulation), the stone sets (`[ballast]`, `[granular]`), the integrator, the contacts.
 ///
 /// ```
 /// # let dir = std::env::temp_dir().join(format!("qdem-advice-doc-{}", std::process::id()));
@@ -144,9 +147,20 @@ pub fn advise(sim: &Simulation) -> Vec<Advice> {
             advice.push(formulation::advise(&body.name, material));
         }
     }
+    advice.extend(stones::advise(sim));
     advice.extend(integrator::advise(sim, &lowest));
     advice.extend(contact_stiffness::advise(sim));
     advice
+}
+
+/// The run's explicit stable bound (s) of `sim`'s scene changed by `change`, the scene built
+/// again (a body or stone set turned rigid or deformable, contact dashpots added): the step a
+/// change gives, with every model's bound, not a guess at the one it relieves. NaN where the
+/// changed scene does not build.
+fn changed_step(sim: &Simulation, change: impl FnOnce(&mut Scene)) -> f64 {
+    let mut scene = sim.scene.clone();
+    change(&mut scene);
+    Simulation::build(scene).map_or(f64::NAN, |s| s.world.settings().stable_dt.0)
 }
 
 /// The advice as JSON for scripts (`qdem check --advice json`): an array of objects with

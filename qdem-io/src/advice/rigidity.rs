@@ -5,8 +5,9 @@
 //!   deformation is all the motion it has, a rigid one would not move.
 //! - Otherwise a body whose first mode the loads and impacts excite to at most
 //!   [`super::NEGLIGIBLE_DYNAMICS`] of its quasi-static deflection can be rigid: the predicted
-//!   error is that dynamic share; the step becomes the one the rest of the scene sets (the
-//!   contacts' bound) instead of the body's own, and its tetrahedra leave the step. Its
+//!   error is that dynamic share; the step becomes the one the scene built again with the
+//!   body rigid sets ([`super::changed_step`]: its contacts then act on its whole mass, not on
+//!   its vertex particles), and its tetrahedra leave the step. Its
 //!   Kelvin–Voigt damping at that frequency, ζ = π f₁ μ_D/G, goes with it: where ζ exceeds 1%
 //!   and the contacts have no damping of their own, the advice says to give them some (the
 //!   5 cm bed of docs/ballast.md failed with undamped rigid stones and held with ζ = 0.1).
@@ -17,7 +18,6 @@ use super::body_modes::BodyModes;
 use super::excitation;
 use super::{Advice, Topic, NEGLIGIBLE_DYNAMICS};
 use crate::build::{BodyInfo, Simulation};
-use qdem_core::step::Model as _;
 
 /// The dynamic share from which a body's vibration matters.
 const DYNAMIC: f64 = 0.1;
@@ -65,16 +65,22 @@ pub(super) fn advise(
         (m.lowest_hz, m.damping_ratio),
     );
     let d = exc.dynamic_share;
-    let rigid_dt = sim
-        .contacts()
-        .and_then(|c| c.stable_dt(&sim.world.state))
-        .unwrap_or(f64::INFINITY);
+    let run_dt = sim.world.settings().stable_dt.0;
+    let turned = match m.held {
+        true => f64::NAN,
+        false => super::changed_step(sim, |scene| scene.bodies[i].rigid = !scene_body.rigid),
+    };
+    let (deformable_dt, rigid_dt) = match scene_body.rigid {
+        true => (turned, run_dt),
+        false => (run_dt, turned),
+    };
     advice.figures = vec![
         ("lowest_frequency_hz".into(), m.lowest_hz),
         ("dynamic_share".into(), d),
         ("predicted_error".into(), if m.held { f64::NAN } else { d }),
-        ("deformable_dt".into(), m.stable_dt),
+        ("deformable_dt".into(), deformable_dt),
         ("rigid_dt".into(), rigid_dt),
+        ("body_dt".into(), m.stable_dt),
         ("tets".into(), m.tets as f64),
         ("kelvin_voigt_damping_ratio".into(), m.damping_ratio),
     ];
@@ -88,14 +94,15 @@ pub(super) fn advise(
                    has (rigid, it would not move)";
         ("deformable".into(), format!("{why}; {modes}"))
     } else if d <= NEGLIGIBLE_DYNAMICS {
-        let steps = match rigid_dt.is_finite() {
-            true => format!("at the contacts' step {rigid_dt:.3e} s"),
-            false => "with no bound of its own".to_string(),
+        let steps = match (rigid_dt.is_nan(), rigid_dt.is_finite()) {
+            (true, _) => "the scene with it rigid does not build".to_string(),
+            (false, true) => format!("the run would step at {rigid_dt:.3e} s"),
+            (false, false) => "the run would have no step bound".to_string(),
         };
         let mut text = format!(
-            "{modes} (at most {NEGLIGIBLE_DYNAMICS}): rigid, it misses that much; it would step \
-             {steps} instead of its own {:.3e} s, without its {} tetrahedra",
-            m.stable_dt, m.tets
+            "{modes} (at most {NEGLIGIBLE_DYNAMICS}): rigid, it misses that much; {steps} \
+             instead of {deformable_dt:.3e} s, without its {} tetrahedra",
+            m.tets
         );
         text += &damping_note(sim, m.damping_ratio);
         ("rigid".into(), text)
