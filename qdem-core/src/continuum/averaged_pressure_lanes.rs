@@ -23,6 +23,19 @@ use crate::continuum::tet_lanes::{
 use crate::Vec3;
 use std::cmp::Ordering::Greater;
 
+/// Floating-point operations of one elastic tet-step of the averaged-pressure tetrahedron, a
+/// multiply-add counted as two: the standard kernel's
+/// ([`crate::continuum::tet_lanes::FLOPS_ELASTIC`], the deviatoric law costing what the Lamé
+/// law does), the strain pass (edges 9, F 45, tr ε 21, the weight 3, the slot sums 4) and the
+/// corners' mean pressure (8).
+pub const FLOPS_AVERAGED_ELASTIC: usize = crate::continuum::tet_lanes::FLOPS_ELASTIC + 90;
+/// Floating-point operations of one viscoelastic tet-step of the averaged-pressure
+/// tetrahedron: the standard viscoelastic kernel's, the elastic strain pass and pressure
+/// (90), and the strain pass's rate (cofactor and volume 32, velocity edges 9, 1/det 1,
+/// tr D 18, weight and slot sums 7) and its mean (6).
+pub const FLOPS_AVERAGED_VISCOELASTIC: usize =
+    crate::continuum::tet_lanes::FLOPS_VISCOELASTIC + 90 + 73;
+
 /// What the strain pass reads: the block's node positions (and velocities, read only when
 /// viscous), each pack's reference volumes / 4 by lane, and the number of real tetrahedra.
 pub(crate) struct StrainInput<'a> {
@@ -325,4 +338,142 @@ unsafe fn lane_forces<S: Simd, const VISCOUS: bool>(
         *f0 = S::neg(S::add(S::add(f[0][k], f[1][k]), f[2][k]));
     }
     ([f0, f[0], f[1], f[2]], six_volume)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::continuum::tet_blocks::HotTet;
+    use crate::continuum::tet_lanes::packs;
+    use crate::Mat3;
+
+    /// `count` tetrahedra along a chain (each sharing a corner with the next: every node in
+    /// one or two), strained by a smooth map and moving, with their packs' quarter volumes;
+    /// and the block's positions and velocities.
+    fn block(count: usize) -> (Vec<HotTet>, Vec<[f64; PACK]>, Vec<Vec3>, Vec<Vec3>) {
+        let nodes = 3 * count + 1;
+        let wobble = |i: usize, k: f64| ((i as f64 + 1.0) * k).sin() * 0.1;
+        let reference: Vec<Vec3> = (0..nodes)
+            .map(|i| {
+                let corner = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)][i % 3];
+                Vec3::new(i as f64 * 0.3 + wobble(i, 1.3), corner.0 + wobble(i, 2.1), corner.1)
+            })
+            .collect();
+        let x: Vec<Vec3> = reference
+            .iter()
+            .map(|p| p + 0.02 * Vec3::new((2.0 * p.y).sin(), (3.0 * p.z).sin(), p.x.sin()))
+            .collect();
+        let v: Vec<Vec3> = (0..nodes)
+            .map(|i| Vec3::new(wobble(i, 0.7), wobble(i, 1.9), wobble(i, 3.1)) * 30.0)
+            .collect();
+        let mut volume = Vec::new();
+        let hot: Vec<HotTet> = (0..count)
+            .map(|e| {
+                let mut local = [3 * e, 3 * e + 1, 3 * e + 2, 3 * e + 3].map(|n| n as u16);
+                let edge = |l: [u16; 4]| {
+                    Mat3::from_columns(
+                        &[1, 2, 3].map(|k| reference[l[k] as usize] - reference[l[0] as usize]),
+                    )
+                };
+                if edge(local).determinant() < 0.0 {
+                    local.swap(1, 2);
+                }
+                volume.push(edge(local).determinant() / 6.0);
+                let dm_inv = edge(local).try_inverse().unwrap();
+                HotTet { dm_inv, local }
+            })
+            .collect();
+        let quarter = volume
+            .chunks(PACK)
+            .map(|c| std::array::from_fn(|l| 0.25 * c[l.min(c.len() - 1)]))
+            .collect();
+        (hot, quarter, x, v)
+    }
+
+    /// The lane sets this CPU runs, the scalar lane first.
+    fn sets() -> Vec<LaneSet> {
+        let mut sets = vec![LaneSet::Scalar];
+        for set in [LaneSet::Avx2, LaneSet::Avx512] {
+            if set.width() <= LaneSet::detected().width() {
+                sets.push(set);
+            }
+        }
+        sets
+    }
+
+    /// Both passes give the same bits on every lane set (the scalar lane included), and agree
+    /// with the stress of Bonet & Burton computed with matrices to round-off.
+    fn passes_agree<const VISCOUS: bool>() {
+        let count = 45; // five packs, the last with 5 of 8 lanes
+        let (hot, quarter, x, v) = block(count);
+        let packs = packs(&hot);
+        let (kappa, mu, kappa_d, mu_d) = (5.0e9, 2.0e9, 3.0e4, 7.0e4);
+        let mut results = Vec::new();
+        for set in sets() {
+            let strain = StrainInput { x: &x, v: &v, quarter: &quarter, count };
+            let mut sums = vec![Vec3::zeros(); x.len()];
+            strain_sums::<VISCOUS>(set, &packs, &strain, &mut sums);
+            // Nodal volumes of the chain: the quarters of the node's tetrahedra.
+            let mut nodal_volume = vec![0.0; x.len()];
+            for (e, t) in hot.iter().enumerate() {
+                for &l in &t.local {
+                    nodal_volume[l as usize] += quarter[e / PACK][e % PACK];
+                }
+            }
+            let averages: Vec<Vec3> = sums.iter().zip(&nodal_volume).map(|(s, w)| s / *w).collect();
+            let input = ForceInput {
+                x: &x,
+                v: &v,
+                averages: &averages,
+                deviatoric: (-2.0 / 3.0 * mu, mu),
+                viscous_deviatoric: (-2.0 / 3.0 * mu_d, mu_d),
+                bulk: (kappa, kappa_d),
+                count,
+            };
+            let mut forces = vec![Vec3::zeros(); x.len()];
+            assert_eq!(force_sums::<VISCOUS>(set, &packs, &input, &mut forces), None);
+            results.push((set, averages, forces));
+        }
+        let (_, averages, forces) = &results[0];
+        for (set, a, f) in &results[1..] {
+            assert!(a == averages && f == forces, "{set:?} differs from the scalar lane");
+        }
+        // The matrix form: T = κ θ̄ I + 2μ dev ε (+ κ_D tr(D)‾ I + 2μ_D dev D), forces −T c/6.
+        use crate::continuum::tet_kernel::{cofactor, edge_matrix, velocity_gradient};
+        let dev = |m: Mat3| m - Mat3::from_diagonal_element(m.trace() / 3.0);
+        let mut want = vec![Vec3::zeros(); x.len()];
+        for t in &hot {
+            let c4 = t.local.map(|l| x[l as usize]);
+            let dx = edge_matrix(&c4);
+            let f = dx * t.dm_inv;
+            let eps = (f * f.transpose() - Mat3::identity()) * 0.5;
+            let mean = |k: usize| t.local.iter().map(|&l| averages[l as usize][k]).sum::<f64>() / 4.0;
+            let mut stress = Mat3::from_diagonal_element(kappa * mean(0)) + dev(eps) * (2.0 * mu);
+            let cof = cofactor(&dx);
+            if VISCOUS {
+                let l = velocity_gradient(&t.local.map(|l| v[l as usize]), &cof, dx.determinant());
+                let d = (l + l.transpose()) * 0.5;
+                stress += Mat3::from_diagonal_element(kappa_d * mean(1)) + dev(d) * (2.0 * mu_d);
+            }
+            let fc = stress * cof * (-1.0 / 6.0);
+            let f3: [Vec3; 3] = std::array::from_fn(|j| fc.column(j).into());
+            for (l, f) in t.local.iter().zip([-(f3[0] + f3[1] + f3[2]), f3[0], f3[1], f3[2]]) {
+                want[*l as usize] += f;
+            }
+        }
+        let scale = want.iter().map(|f| f.norm()).fold(0.0, f64::max);
+        for (got, want) in forces.iter().zip(&want) {
+            assert!((got - want).norm() <= 1e-12 * scale, "{got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn elastic_passes_agree_on_every_lane_set_and_with_the_matrix_form() {
+        passes_agree::<false>();
+    }
+
+    #[test]
+    fn viscous_passes_agree_on_every_lane_set_and_with_the_matrix_form() {
+        passes_agree::<true>();
+    }
 }
