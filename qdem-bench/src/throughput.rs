@@ -12,8 +12,8 @@ use qdem_core::continuum::averaged_pressure_lanes::{
 };
 use qdem_core::continuum::tet_lanes::{LaneSet, FLOPS_ELASTIC, FLOPS_VISCOELASTIC};
 use qdem_core::{
-    continuum::Formulation, continuum::Material, continuum::TetBody, solvers::Verlet, step::Model, step::State,
-    step::Stepper, Vec3,
+    continuum::Formulation, continuum::Material, continuum::TetBody, solvers::Verlet, step::Model,
+    step::State, step::Stepper, Vec3,
 };
 use qdem_io::build::memory;
 use qdem_mesh::{structured_box, GridError, TetMesh};

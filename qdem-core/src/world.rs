@@ -476,4 +476,3 @@ fn prepare(models: &mut [Box<dyn Model>], settings: &StepSettings) {
         model.prepare(settings);
     }
 }
-

@@ -152,7 +152,10 @@ fn a_decomposed_run_is_bit_identical_to_one_process() {
             one.step().unwrap();
         }
         let tip = one.state.len() - 1;
-        assert!(one.state.displacement(tip).norm() > 0.0, "the load moved the tip");
+        assert!(
+            one.state.displacement(tip).norm() > 0.0,
+            "the load moved the tip"
+        );
         let reference = motion_bits(&one.state);
         for size in [1, 2, 3] {
             let runs = on_thread_ranks(size, move |comm| {

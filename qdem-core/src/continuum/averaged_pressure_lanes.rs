@@ -17,8 +17,8 @@
 //! ([`Scalar`]: one lane): the sums are the same bits on any CPU, for any thread or rank count.
 
 use crate::continuum::tet_lanes::{
-    cross, dot, edges, face_force, gather, green_strain, lame, rate_of_deformation, LaneSet,
-    Simd, TetPack, V3, PACK,
+    cross, dot, edges, face_force, gather, green_strain, lame, rate_of_deformation, LaneSet, Simd,
+    TetPack, PACK, V3,
 };
 use crate::Vec3;
 use std::cmp::Ordering::Greater;
@@ -110,7 +110,11 @@ unsafe fn strain_avx512<const VISCOUS: bool>(
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn strain_avx2<const VISCOUS: bool>(packs: &[TetPack], input: &StrainInput, out: &mut [Vec3]) {
+unsafe fn strain_avx2<const VISCOUS: bool>(
+    packs: &[TetPack],
+    input: &StrainInput,
+    out: &mut [Vec3],
+) {
     strain_pass::<crate::continuum::tet_lanes::x86::Avx2, VISCOUS>(packs, input, out)
 }
 
@@ -232,7 +236,10 @@ unsafe fn strain_pass<S: Simd, const VISCOUS: bool>(
             let d = edges::<S>(&gather::<S>(input.x, &corners));
             let e = green_strain::<S>(&d, &dm);
             let quarter = S::load(&input.quarter[p][o..]);
-            S::store(S::mul(quarter, S::add(S::add(e[0], e[1]), e[2])), &mut theta);
+            S::store(
+                S::mul(quarter, S::add(S::add(e[0], e[1]), e[2])),
+                &mut theta,
+            );
             if VISCOUS {
                 let (c, six_volume) = cofactor::<S>(&d);
                 let dv = edges::<S>(&gather::<S>(input.v, &corners));
@@ -356,7 +363,11 @@ mod tests {
         let reference: Vec<Vec3> = (0..nodes)
             .map(|i| {
                 let corner = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)][i % 3];
-                Vec3::new(i as f64 * 0.3 + wobble(i, 1.3), corner.0 + wobble(i, 2.1), corner.1)
+                Vec3::new(
+                    i as f64 * 0.3 + wobble(i, 1.3),
+                    corner.0 + wobble(i, 2.1),
+                    corner.1,
+                )
             })
             .collect();
         let x: Vec<Vec3> = reference
@@ -410,7 +421,12 @@ mod tests {
         let (kappa, mu, kappa_d, mu_d) = (5.0e9, 2.0e9, 3.0e4, 7.0e4);
         let mut results = Vec::new();
         for set in sets() {
-            let strain = StrainInput { x: &x, v: &v, quarter: &quarter, count };
+            let strain = StrainInput {
+                x: &x,
+                v: &v,
+                quarter: &quarter,
+                count,
+            };
             let mut sums = vec![Vec3::zeros(); x.len()];
             strain_sums::<VISCOUS>(set, &packs, &strain, &mut sums);
             // Nodal volumes of the chain: the quarters of the node's tetrahedra.
@@ -420,7 +436,11 @@ mod tests {
                     nodal_volume[l as usize] += quarter[e / PACK][e % PACK];
                 }
             }
-            let averages: Vec<Vec3> = sums.iter().zip(&nodal_volume).map(|(s, w)| s / *w).collect();
+            let averages: Vec<Vec3> = sums
+                .iter()
+                .zip(&nodal_volume)
+                .map(|(s, w)| s / *w)
+                .collect();
             let input = ForceInput {
                 x: &x,
                 v: &v,
@@ -431,12 +451,18 @@ mod tests {
                 count,
             };
             let mut forces = vec![Vec3::zeros(); x.len()];
-            assert_eq!(force_sums::<VISCOUS>(set, &packs, &input, &mut forces), None);
+            assert_eq!(
+                force_sums::<VISCOUS>(set, &packs, &input, &mut forces),
+                None
+            );
             results.push((set, averages, forces));
         }
         let (_, averages, forces) = &results[0];
         for (set, a, f) in &results[1..] {
-            assert!(a == averages && f == forces, "{set:?} differs from the scalar lane");
+            assert!(
+                a == averages && f == forces,
+                "{set:?} differs from the scalar lane"
+            );
         }
         // The matrix form: T = κ θ̄ I + 2μ dev ε (+ κ_D tr(D)‾ I + 2μ_D dev D), forces −T c/6.
         use crate::continuum::tet_kernel::{cofactor, edge_matrix, velocity_gradient};
@@ -447,7 +473,13 @@ mod tests {
             let dx = edge_matrix(&c4);
             let f = dx * t.dm_inv;
             let eps = (f * f.transpose() - Mat3::identity()) * 0.5;
-            let mean = |k: usize| t.local.iter().map(|&l| averages[l as usize][k]).sum::<f64>() / 4.0;
+            let mean = |k: usize| {
+                t.local
+                    .iter()
+                    .map(|&l| averages[l as usize][k])
+                    .sum::<f64>()
+                    / 4.0
+            };
             let mut stress = Mat3::from_diagonal_element(kappa * mean(0)) + dev(eps) * (2.0 * mu);
             let cof = cofactor(&dx);
             if VISCOUS {
@@ -457,7 +489,11 @@ mod tests {
             }
             let fc = stress * cof * (-1.0 / 6.0);
             let f3: [Vec3; 3] = std::array::from_fn(|j| fc.column(j).into());
-            for (l, f) in t.local.iter().zip([-(f3[0] + f3[1] + f3[2]), f3[0], f3[1], f3[2]]) {
+            for (l, f) in t
+                .local
+                .iter()
+                .zip([-(f3[0] + f3[1] + f3[2]), f3[0], f3[1], f3[2]])
+            {
                 want[*l as usize] += f;
             }
         }

@@ -125,10 +125,12 @@ impl Scratch {
     /// Copies the positions of `nodes`, and their velocities when `viscous`.
     fn load(&mut self, nodes: &[u32], state: &State, viscous: bool) {
         self.x.clear();
-        self.x.extend(nodes.iter().map(|&n| state.position[n as usize]));
+        self.x
+            .extend(nodes.iter().map(|&n| state.position[n as usize]));
         if viscous {
             self.v.clear();
-            self.v.extend(nodes.iter().map(|&n| state.velocity[n as usize]));
+            self.v
+                .extend(nodes.iter().map(|&n| state.velocity[n as usize]));
         }
     }
 }
@@ -262,7 +264,8 @@ impl AveragedPressure {
         out: &mut [Vec3],
     ) -> usize {
         SCRATCH.with_borrow_mut(|scratch| {
-            let nodes = &blocks.nodes[blocks.node_start[b] as usize..blocks.node_start[b + 1] as usize];
+            let nodes =
+                &blocks.nodes[blocks.node_start[b] as usize..blocks.node_start[b + 1] as usize];
             scratch.load(nodes, state, VISCOUS);
             scratch.averages.clear();
             let nodal = &self.nodal;
@@ -282,7 +285,8 @@ impl AveragedPressure {
                 bulk: (m.kappa, m.kappa_d),
                 count: tets.len(),
             };
-            let packs = &blocks.packs[blocks.pack_start[b] as usize..blocks.pack_start[b + 1] as usize];
+            let packs =
+                &blocks.packs[blocks.pack_start[b] as usize..blocks.pack_start[b + 1] as usize];
             let inverted = force_sums::<VISCOUS>(LaneSet::detected(), packs, &input, out);
             inverted.map_or(usize::MAX, |k| blocks.order[tets.start + k] as usize)
         })

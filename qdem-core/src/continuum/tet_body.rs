@@ -26,8 +26,8 @@ use crate::continuum::tet_kernel::{
 use crate::continuum::tet_lanes::{block_forces, BlockInput, LaneSet};
 use crate::error::CoreError;
 use crate::step::model::{Deformable, Linearized, Model, Persistence};
-use crate::step::split::{BodyLayout, BodySplit};
 use crate::step::split::{Averaging, NodalValues};
+use crate::step::split::{BodyLayout, BodySplit};
 use crate::step::split::{Evaluation, Facets, Ownership, Part, PartialSums, Reads};
 use crate::step::state::State;
 use crate::step::tangent::Tangent;

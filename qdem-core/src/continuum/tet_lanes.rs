@@ -473,7 +473,11 @@ pub(crate) unsafe fn green_strain<S: Simd>(d: &[V3<S>; 3], dm: &[S::V; 9]) -> Sy
 
 /// D = sym(Σ_k dv_k ⊗ c_k) / det of Eqs. 5–6.
 #[inline(always)]
-pub(crate) unsafe fn rate_of_deformation<S: Simd>(dv: &[V3<S>; 3], c: &[V3<S>; 3], inv_det: S::V) -> Sym<S> {
+pub(crate) unsafe fn rate_of_deformation<S: Simd>(
+    dv: &[V3<S>; 3],
+    c: &[V3<S>; 3],
+    inv_det: S::V,
+) -> Sym<S> {
     // l[i][j] = Σ_k dv_k[i] c_k[j] = det · L_ij.
     let mut l = [[S::splat(0.0); 3]; 3];
     for (i, row) in l.iter_mut().enumerate() {

@@ -465,7 +465,9 @@ impl Ranks {
             }
             averaging.average();
             if let Some(nodal) = averaging.averages() {
-                nodal.plan.run_forward(comm, nodal.nodes, nodal.first, nodal.values);
+                nodal
+                    .plan
+                    .run_forward(comm, nodal.nodes, nodal.first, nodal.values);
             }
         }
         let evaluation = facets.evaluation().expect("a split model evaluates");
