@@ -66,6 +66,7 @@ pub(crate) fn strain_sums<const VISCOUS: bool>(
     input: &StrainInput,
     out: &mut [Vec3],
 ) {
+    assert_eq!(out.len(), input.x.len(), "a slot per node of the block");
     match set {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: `LaneSet::detected` chooses a set only when the CPU has its features.
@@ -249,7 +250,10 @@ unsafe fn strain_pass<S: Simd, const VISCOUS: bool>(
             }
             for l in 0..S::N.min(input.count - base) {
                 for local in &pack.local {
-                    let slot = &mut out[local[o + l] as usize];
+                    // SAFETY: `o + l < PACK`, and a corner indexes the block's nodes, which
+                    // `out` holds as `input.x` does (checked in `strain_sums`; the gathers
+                    // read `input.x` at the same indices).
+                    let slot = out.get_unchecked_mut(*local.get_unchecked(o + l) as usize);
                     slot.x += theta[l];
                     if VISCOUS {
                         slot.y += rate[l];
