@@ -7,10 +7,13 @@
 //! one JSON document.
 
 use crate::vector_peak::vector_peak_flops;
+use qdem_core::continuum::averaged_pressure_lanes::{
+    FLOPS_AVERAGED_ELASTIC, FLOPS_AVERAGED_VISCOELASTIC,
+};
 use qdem_core::continuum::tet_lanes::{LaneSet, FLOPS_ELASTIC, FLOPS_VISCOELASTIC};
 use qdem_core::{
-    continuum::Material, continuum::TetBody, solvers::Verlet, step::Model, step::State,
-    step::Stepper, Vec3,
+    continuum::Formulation, continuum::Material, continuum::TetBody, solvers::Verlet, step::Model,
+    step::State, step::Stepper, Vec3,
 };
 use qdem_io::build::memory;
 use qdem_mesh::{structured_box, GridError, TetMesh};
@@ -26,6 +29,8 @@ pub struct BenchPlan {
     pub threads: Vec<usize>,
     /// Steps per measurement (default: enough for about one second, at least 3).
     pub steps: Option<usize>,
+    /// The tetrahedron measured.
+    pub formulation: Formulation,
 }
 
 impl BenchPlan {
@@ -34,11 +39,13 @@ impl BenchPlan {
         tets: Option<Vec<usize>>,
         threads: Option<Vec<usize>>,
         steps: Option<usize>,
+        formulation: Formulation,
     ) -> BenchPlan {
         BenchPlan {
             tets: tets.unwrap_or_else(|| vec![10_000, 100_000, 1_000_000]),
             threads: threads.unwrap_or_else(|| vec![1, 2]),
             steps,
+            formulation,
         }
     }
 }
@@ -54,6 +61,8 @@ pub struct BenchResult {
     pub block_nodes: usize,
     /// Whether the viscous path ran.
     pub viscous: bool,
+    /// The tetrahedron measured.
+    pub formulation: Formulation,
     /// Threads.
     pub threads: usize,
     /// Steps timed.
@@ -77,10 +86,27 @@ impl BenchResult {
     /// - per particle: the gather's range (4 B); the force zeroed, added to and read by the
     ///   accelerations (96 B); the drift and first half kick reading x, v, a and writing x, v
     ///   (120 B); a = f/m with mass and fixity (33 B); the second half kick (72 B).
+    ///
+    /// The averaged-pressure tetrahedron
+    /// ([`qdem_core::continuum::averaged_pressure_tet`]) adds its strain pass and average:
+    /// per tetrahedron the pack read again and its volume (88 B); per block node its index
+    /// and position copied in again (28 B, 52 B with velocities), its slot sum written and
+    /// read back (48 B), the average's entry index (4 B) and the average copied into the force
+    /// pass (24 B); per particle the average's range, inverse volume and average written
+    /// (36 B).
     pub fn bytes_per_tet_step(&self) -> f64 {
-        let per_block_node = 80.0 + if self.viscous { 24.0 } else { 0.0 };
-        let per_particle = 4.0 + 96.0 + 120.0 + 33.0 + 72.0;
-        (80.0 * self.tets as f64
+        let visco = if self.viscous { 24.0 } else { 0.0 };
+        let (per_tet, mut per_block_node, mut per_particle) =
+            (80.0, 80.0 + visco, 4.0 + 96.0 + 120.0 + 33.0 + 72.0);
+        let per_tet = match self.formulation {
+            Formulation::Standard => per_tet,
+            Formulation::AveragedPressure => {
+                per_block_node += 28.0 + visco + 48.0 + 4.0 + 24.0;
+                per_particle += 36.0;
+                per_tet + 88.0
+            }
+        };
+        (per_tet * self.tets as f64
             + per_block_node * self.block_nodes as f64
             + per_particle * self.particles as f64)
             / self.tets as f64
@@ -89,10 +115,11 @@ impl BenchResult {
     /// Floating-point operations of one tet-step in the kernel (a multiply-add counted as two;
     /// `qdem_core::continuum::tet_lanes::FLOPS_ELASTIC`): what the vector peak is set against.
     pub fn flops_per_tet_step(&self) -> usize {
-        if self.viscous {
-            FLOPS_VISCOELASTIC
-        } else {
-            FLOPS_ELASTIC
+        match (self.formulation, self.viscous) {
+            (Formulation::Standard, false) => FLOPS_ELASTIC,
+            (Formulation::Standard, true) => FLOPS_VISCOELASTIC,
+            (Formulation::AveragedPressure, false) => FLOPS_AVERAGED_ELASTIC,
+            (Formulation::AveragedPressure, true) => FLOPS_AVERAGED_VISCOELASTIC,
         }
     }
 }
@@ -232,6 +259,18 @@ pub fn measure(tets: usize, viscous: bool, threads: usize, steps: Option<usize>)
     measure_ordered(tets, Ordering::Structured, viscous, threads, steps)
 }
 
+/// Times Verlet steps of `block(tets, viscous)` in `formulation` on `threads` threads.
+pub fn measure_formulation(
+    tets: usize,
+    viscous: bool,
+    formulation: Formulation,
+    threads: usize,
+    steps: Option<usize>,
+) -> BenchResult {
+    let mesh = block_mesh(tets, Ordering::Structured);
+    measure_body(mesh, viscous, formulation, threads, steps)
+}
+
 /// Times Verlet steps of a block in the given node ordering on `threads` threads.
 pub fn measure_ordered(
     tets: usize,
@@ -240,8 +279,22 @@ pub fn measure_ordered(
     threads: usize,
     steps: Option<usize>,
 ) -> BenchResult {
+    let mesh = block_mesh(tets, ordering);
+    measure_body(mesh, viscous, Formulation::Standard, threads, steps)
+}
+
+/// Times Verlet steps of the body of [`body_on`] over `mesh` in `formulation` on `threads`
+/// threads.
+fn measure_body(
+    mesh: TetMesh,
+    viscous: bool,
+    formulation: Formulation,
+    threads: usize,
+    steps: Option<usize>,
+) -> BenchResult {
     on_threads(threads, || {
-        let (body, mut state) = body_on(block_mesh(tets, ordering), viscous);
+        let (body, mut state) = body_on(mesh, viscous);
+        let body = body.with_formulation(formulation);
         let tets = body.tets().len();
         let block_nodes = body.block_layout().block_nodes;
         let dt = 0.9 * body.stable_dt(&state).expect("a body bounds the step");
@@ -263,6 +316,7 @@ pub fn measure_ordered(
             particles: state.len(),
             block_nodes,
             viscous,
+            formulation,
             threads,
             steps,
             seconds: start.elapsed().as_secs_f64(),
@@ -333,6 +387,7 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
             cpu_model(),
             std::thread::available_parallelism().map_or(0, |n| n.get())
         );
+        println!("tetrahedron: {}", plan.formulation.name());
         for (t, bw) in &bandwidth {
             println!("triad bandwidth, {t} threads: {:.2} GB/s", bw / 1e9);
         }
@@ -359,7 +414,7 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
     for &tets in &plan.tets {
         for viscous in [false, true] {
             for &threads in &plan.threads {
-                let r = measure(tets, viscous, threads, plan.steps);
+                let r = measure_formulation(tets, viscous, plan.formulation, threads, plan.steps);
                 let bw = bandwidth
                     .iter()
                     .find(|b| b.0 == threads)
@@ -387,6 +442,7 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
                 results.push(json!({
                     "tets": r.tets, "particles": r.particles, "block_nodes": r.block_nodes,
                     "material": if viscous { "viscoelastic" } else { "elastic" },
+                    "formulation": r.formulation.name(),
                     "threads": r.threads, "steps": r.steps, "seconds": r.seconds,
                     "tet_steps_per_second": r.tet_steps_per_second(),
                     "particle_steps_per_second": (r.particles * r.steps) as f64 / r.seconds,

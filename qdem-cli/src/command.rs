@@ -6,6 +6,7 @@ use crate::{check, progress, run_length};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use qdem_bench::throughput::BenchPlan;
 use qdem_bench::{implicit, throughput, verify};
+use qdem_core::continuum::Formulation;
 use qdem_core::{error::CoreError, parallel::Communicator, step::Halt, step::Scheme};
 use qdem_io::analyze::AnalyzeOptions;
 use qdem_io::build::{BuildError, Simulation};
@@ -248,6 +249,29 @@ pub struct BenchArgs {
     /// Measure the implicit path (sparse Cholesky) against the number of unknowns instead
     #[arg(long)]
     pub implicit: bool,
+    /// The tetrahedron measured: `standard` or `averaged-pressure` (the `[[material]]`
+    /// formulation)
+    #[arg(long, value_name = "NAME", default_value = "standard")]
+    pub formulation: BenchFormulation,
+}
+
+/// The tetrahedron `qdem bench` measures (`[[material]] formulation`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BenchFormulation {
+    /// The standard QDEM tetrahedron.
+    Standard,
+    /// The average nodal pressure tetrahedron.
+    AveragedPressure,
+}
+
+impl BenchFormulation {
+    /// The core's formulation.
+    fn core(self) -> Formulation {
+        match self {
+            BenchFormulation::Standard => Formulation::Standard,
+            BenchFormulation::AveragedPressure => Formulation::AveragedPressure,
+        }
+    }
 }
 
 /// `qdem analyze`.
@@ -421,7 +445,7 @@ pub fn dispatch(cli: Cli, ranks: Option<Arc<dyn Communicator>>) -> Result<(), Cl
                 }
                 return Ok(implicit::run_and_print(Some(sizes), threads, a.json)?);
             }
-            let plan = BenchPlan::new(a.tets, a.threads, a.steps);
+            let plan = BenchPlan::new(a.tets, a.threads, a.steps, a.formulation.core());
             for &tets in &plan.tets {
                 throughput::check_block(tets, false)?;
             }

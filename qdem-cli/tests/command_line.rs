@@ -83,6 +83,42 @@ fn version_prints_the_version() {
     assert_eq!(stdout.trim(), format!("qdem {}", env!("CARGO_PKG_VERSION")));
 }
 
+/// `--formulation averaged-pressure` measures the averaged-pressure tetrahedron (issue 62:
+/// `qdem bench` measured the standard one only), whose step does the standard kernel's work
+/// and its strain pass and averages: more floating-point operations and modelled bytes per
+/// tet-step than the standard tetrahedron's on the same block.
+#[test]
+fn bench_measures_the_averaged_pressure_tetrahedron() {
+    let rows = |formulation: &str| {
+        let args = [
+            "bench",
+            "--json",
+            "--tets",
+            "750",
+            "--threads",
+            "1",
+            "--steps",
+            "3",
+        ];
+        let stdout = success(&[&args[..], &["--formulation", formulation]].concat());
+        let doc: serde_json::Value = serde_json::from_str(&stdout).expect("JSON");
+        doc["results"].as_array().expect("results").clone()
+    };
+    let (standard, averaged) = (rows("standard"), rows("averaged-pressure"));
+    assert_eq!(averaged.len(), 2, "elastic and viscoelastic: {averaged:?}");
+    for (s, a) in standard.iter().zip(&averaged) {
+        assert_eq!(a["formulation"], "averaged-pressure", "{a}");
+        assert_eq!(
+            (s["material"].clone(), s["tets"].clone()),
+            (a["material"].clone(), a["tets"].clone())
+        );
+        for key in ["flops_per_tet_step", "bytes_per_tet_step"] {
+            let (s, a) = (s[key].as_f64().unwrap(), a[key].as_f64().unwrap());
+            assert!(a > 1.2 * s, "{key}: averaged {a} against standard {s}");
+        }
+    }
+}
+
 #[test]
 fn bench_takes_comma_separated_lists() {
     let stdout = success(&[
@@ -110,6 +146,7 @@ fn bench_takes_comma_separated_lists() {
     assert_eq!(results.len(), 8, "{doc:#}");
     for row in results {
         assert_eq!(row["steps"], 3, "{row}");
+        assert_eq!(row["formulation"], "standard", "{row}");
         for key in [
             "tets",
             "particles",

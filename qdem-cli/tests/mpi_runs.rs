@@ -193,6 +193,23 @@ fn the_cantilever_stepped_by_explicit_newmark_is_byte_identical_on_any_number_of
     same_scene_for_any_ranks(scene, fixture, "newmark");
 }
 
+/// The cantilever of a nearly incompressible viscoelastic material in the averaged-pressure
+/// formulation (issue 62: refused over ranks before): its nodal averages sum over blocks of
+/// different ranks, through the reverse exchange to their owners and back.
+#[test]
+fn an_averaged_pressure_cantilever_is_byte_identical_on_any_number_of_ranks() {
+    let fixture = "cantilever/cantilever_lc100.toml";
+    let material = "poisson = 0.45\nformulation = \"averaged-pressure\"";
+    let edits = [
+        ("t_end = ", "t_end = 0.01"),
+        ("poisson = ", material),
+        ("shear_viscosity = ", "shear_viscosity = 1e5"),
+        ("bulk_viscosity = ", "bulk_viscosity = 1e5"),
+    ];
+    let scene = ShortScene::edited(fixture, "averaged", &edits);
+    same_scene_for_any_ranks(scene, fixture, "averaged");
+}
+
 #[test]
 fn the_collision_is_byte_identical_on_any_number_of_ranks() {
     same_for_any_ranks("contact/collision.toml", 0.01, "collision");

@@ -217,7 +217,6 @@ impl World {
                 self.stepper.name()
             )));
         }
-        refuse_averaged_pressure(&self.models)?;
         if let Some((particle, _, _)) = self.state.frames.iter().next() {
             return Err(CoreError::Decomposition(format!(
                 "particle {particle} is held in a local frame (a [[fix]] with `frame`), which \
@@ -477,23 +476,5 @@ impl World {
 fn prepare(models: &mut [Box<dyn Model>], settings: &StepSettings) {
     for model in models.iter_mut() {
         model.prepare(settings);
-    }
-}
-
-/// A decomposed run refuses a body of averaged-pressure tetrahedra: its nodal averages would
-/// need an exchange of their own between the ranks, which the split path does not have.
-fn refuse_averaged_pressure(models: &[Box<dyn Model>]) -> Result<(), CoreError> {
-    let averaged = models
-        .iter()
-        .filter_map(|m| m.deformable())
-        .find(|b| b.averages_pressure());
-    match averaged {
-        Some(body) => Err(CoreError::Decomposition(format!(
-            "body `{}` uses formulation = \"averaged-pressure\", which a run decomposed over \
-             processes does not support yet; run it as one process (without mpirun, threads \
-             give the same result bit for bit)",
-            body.name()
-        ))),
-        None => Ok(()),
     }
 }

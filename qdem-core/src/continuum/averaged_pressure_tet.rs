@@ -29,17 +29,30 @@
 //! still bounds M⁻¹K: the bulk wave sets the step as before (the option removes the locking,
 //! not the short step).
 //!
-//! Every sum runs in a fixed order (a particle's tetrahedra ascending), in parallel over
-//! tetrahedra and over particles with no shared accumulator: results are bit-identical for
-//! any number of threads. A run decomposed over processes refuses it ([`crate::world::World::decompose`]).
+//! A step runs in the body's blocks ([`crate::continuum::tet_blocks`]), vectorised as the
+//! standard kernel ([`crate::continuum::averaged_pressure_lanes`]), in three passes: the
+//! **strain pass** sums each block's (V_e/4) θ_e per node slot; the **average** adds each
+//! particle's slots in ascending block order over V̄_a; the **force pass** (the standard
+//! kernel's place) adds each block's forces per node slot, which the body's per-particle sums
+//! add as for the standard tetrahedron. Every sum runs in an order fixed by the mesh, with no
+//! shared accumulator: results are bit-identical for any number of threads. In a run
+//! decomposed over processes the strain pass's slot sums of a particle another rank owns go
+//! to the owner in a reverse exchange and the owner's averages come back forward
+//! ([`crate::step::split::Averaging`]), so the owner averages as one process does and every
+//! rank's force pass reads the same bits: byte-identical for any rank count.
 
+use crate::continuum::averaged_pressure_lanes::{force_sums, strain_sums, ForceInput, StrainInput};
 use crate::continuum::material::Material;
-use crate::continuum::tet_body::{current_gradients, lame_block};
-use crate::continuum::tet_kernel::{cofactor, edge_matrix, velocity_gradient, vertex_forces};
+use crate::continuum::tet_blocks::TetBlocks;
+use crate::continuum::tet_body::{current_gradients, for_blocks, lame_block};
+use crate::continuum::tet_kernel::{cofactor, edge_matrix, velocity_gradient};
+use crate::continuum::tet_lanes::{LaneSet, PACK};
 use crate::step::state::State;
 use crate::step::tangent::Tangent;
 use crate::{Mat3, Vec3};
 use rayon::prelude::*;
+use std::cell::RefCell;
+use std::ops::Range;
 
 /// Tetrahedra per parallel task.
 const TET_CHUNK: usize = 512;
@@ -67,8 +80,9 @@ impl Formulation {
     }
 }
 
-/// The averaged-pressure forces of one body: the particles' tetrahedra, the nodal volumes and
-/// the per-step buffers.
+/// The averaged-pressure forces of one body: per block pack the reference volumes, the
+/// nodal volumes, the per-step slot sums and nodal averages; and per tetrahedron and
+/// particle's corners what the outputs, the energy and the tangent read.
 #[derive(Clone, Debug)]
 pub(crate) struct AveragedPressure {
     moduli: Moduli,
@@ -77,6 +91,8 @@ pub(crate) struct AveragedPressure {
     dm_inv: Vec<Mat3>,
     /// Reference volume / 4 of each tetrahedron.
     quarter: Vec<f64>,
+    /// Reference volume / 4 of the tetrahedra of the blocks' packs, by lane.
+    quarter_packs: Vec<[f64; PACK]>,
     /// The first particle any tetrahedron uses.
     first: usize,
     /// Per particle from `first`, the range of its corners in `corners`.
@@ -85,26 +101,53 @@ pub(crate) struct AveragedPressure {
     corners: Vec<u32>,
     /// 1 / V̄_a per particle from `first` (0 for a particle of no tetrahedron).
     inv_nodal_volume: Vec<f64>,
-    /// Per tetrahedron: tr ε, tr D and, after the force pass, its four forces.
-    theta: Vec<(f64, f64)>,
-    forces: Vec<[Vec3; 4]>,
-    /// Per particle from `first`: the averages θ̄_a and tr(D)‾_a.
-    nodal: Vec<(f64, f64)>,
+    /// Per block node slot (laid out as the blocks' node lists): its block's Σ (V_e/4) θ_e
+    /// and Σ (V_e/4) tr D_e, written by the strain pass.
+    partial: Vec<Vec3>,
+    /// Per particle from `first`: the averages (θ̄_a, tr(D)‾_a, 0).
+    nodal: Vec<Vec3>,
+}
+
+thread_local! {
+    /// A worker's copy of one block's node positions, velocities and averages.
+    static SCRATCH: RefCell<Scratch> = RefCell::default();
+}
+
+/// One block's node values, copied from the particles' arrays.
+#[derive(Default)]
+struct Scratch {
+    x: Vec<Vec3>,
+    v: Vec<Vec3>,
+    averages: Vec<Vec3>,
+}
+
+impl Scratch {
+    /// Copies the positions of `nodes`, and their velocities when `viscous`.
+    fn load(&mut self, nodes: &[u32], state: &State, viscous: bool) {
+        self.x.clear();
+        self.x
+            .extend(nodes.iter().map(|&n| state.position[n as usize]));
+        if viscous {
+            self.v.clear();
+            self.v
+                .extend(nodes.iter().map(|&n| state.velocity[n as usize]));
+        }
+    }
 }
 
 impl AveragedPressure {
-    /// The averaging of `tets` with their inverse reference edge matrices and reference
-    /// volumes.
+    /// The averaging of `tets` with their inverse reference edge matrices, reference volumes
+    /// and blocks.
     pub(crate) fn new(
         tets: &[[u32; 4]],
         dm_inv: Vec<Mat3>,
         volume: &[f64],
         material: &Material,
+        blocks: &TetBlocks,
     ) -> AveragedPressure {
         let (elastic, viscous) = (material.elastic_lame(), material.viscous_lame());
-        let first = tets.iter().flatten().min().copied().unwrap_or(0) as usize;
-        let last = tets.iter().flatten().max().copied().unwrap_or(0) as usize;
-        let count = last + 1 - first;
+        let first = blocks.first;
+        let count = blocks.entry_start.len() - 1;
         let mut corner_start = vec![0u32; count + 1];
         for &n in tets.iter().flatten() {
             corner_start[n as usize - first + 1] += 1;
@@ -134,6 +177,7 @@ impl AveragedPressure {
             tets: tets.to_vec(),
             dm_inv,
             quarter: volume.iter().map(|v| 0.25 * v).collect(),
+            quarter_packs: quarter_packs(blocks, volume),
             first,
             corner_start,
             corners,
@@ -141,81 +185,115 @@ impl AveragedPressure {
                 .iter()
                 .map(|&v| if v > 0.0 { 1.0 / v } else { 0.0 })
                 .collect(),
-            theta: vec![(0.0, 0.0); tets.len()],
-            forces: vec![[Vec3::zeros(); 4]; tets.len()],
-            nodal: vec![(0.0, 0.0); count],
+            partial: vec![Vec3::zeros(); blocks.nodes.len()],
+            nodal: vec![Vec3::zeros(); count],
         }
     }
 
-    /// The forces of every tetrahedron at `state` (three parallel passes: element strains,
-    /// nodal averages, element forces); returns the first inverted tetrahedron, if any.
-    pub(crate) fn compute(&mut self, state: &State) -> Option<usize> {
-        let (tets, dm_inv, viscous) = (&self.tets, &self.dm_inv, self.viscous);
-        self.theta
-            .par_iter_mut()
-            .with_min_len(TET_CHUNK)
-            .enumerate()
-            .for_each(|(e, theta)| {
-                let x = tets[e].map(|n| state.position[n as usize]);
-                let dx = edge_matrix(&x);
-                let eps = green_strain(&(dx * dm_inv[e]));
-                let rate = if viscous {
-                    let v = tets[e].map(|n| state.velocity[n as usize]);
-                    let cof = cofactor(&dx);
-                    velocity_gradient(&v, &cof, dx.determinant()).trace()
-                } else {
-                    0.0
+    /// The strain pass over the blocks `range` at `state`: each block's Σ (V_e/4) θ_e (and
+    /// tr D_e) per node slot, the blocks in parallel.
+    pub(crate) fn strain_pass(&mut self, blocks: &TetBlocks, range: Range<usize>, state: &State) {
+        if range.is_empty() {
+            return;
+        }
+        let start = &blocks.node_start;
+        let slots = start[range.start] as usize..start[range.end] as usize;
+        let (quarter, viscous) = (&self.quarter_packs, self.viscous);
+        for_blocks(&mut self.partial[slots], range, start, &|b, out| {
+            SCRATCH.with_borrow_mut(|scratch| {
+                let nodes = &blocks.nodes[start[b] as usize..start[b + 1] as usize];
+                scratch.load(nodes, state, viscous);
+                out.fill(Vec3::zeros());
+                let packs = blocks.pack_start[b] as usize..blocks.pack_start[b + 1] as usize;
+                let input = StrainInput {
+                    x: &scratch.x,
+                    v: &scratch.v,
+                    quarter: &quarter[packs.clone()],
+                    count: (blocks.tet_start[b + 1] - blocks.tet_start[b]) as usize,
                 };
-                *theta = (eps.trace(), rate);
-            });
-        let (theta, quarter, corners, starts) = (
-            &self.theta,
-            &self.quarter,
-            &self.corners,
-            &self.corner_start,
-        );
-        let inv_volume = &self.inv_nodal_volume;
-        average_per_particle(theta, quarter, corners, starts, inv_volume, &mut self.nodal);
-        let (nodal, first, moduli) = (&self.nodal, self.first, &self.moduli);
-        let inverted = self
-            .forces
-            .par_iter_mut()
-            .with_min_len(TET_CHUNK)
-            .enumerate()
-            .map(|(e, out)| {
-                let tet = tets[e];
-                let x = tet.map(|n| state.position[n as usize]);
-                let dx = edge_matrix(&x);
-                let cof = cofactor(&dx);
-                let det = dx.column(0).dot(&cof.column(0));
-                let mean = |f: fn(&(f64, f64)) -> f64| {
-                    0.25 * tet
-                        .iter()
-                        .map(|&n| f(&nodal[n as usize - first]))
-                        .sum::<f64>()
-                };
-                let eps = green_strain(&(dx * dm_inv[e]));
-                let rate = viscous.then(|| {
-                    let v = tet.map(|n| state.velocity[n as usize]);
-                    let l = velocity_gradient(&v, &cof, det);
-                    ((l + l.transpose()) * 0.5, mean(|a| a.1))
-                });
-                let t = moduli.stress(&eps, mean(|a| a.0), rate);
-                *out = vertex_forces(&t, &cof);
-                // B = FFᵀ cannot tell an inverted tetrahedron from its mirror image.
-                if det.partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater) {
-                    usize::MAX
-                } else {
-                    e
+                let (set, packs) = (LaneSet::detected(), &blocks.packs[packs]);
+                match viscous {
+                    true => strain_sums::<true>(set, packs, &input, out),
+                    false => strain_sums::<false>(set, packs, &input, out),
                 }
-            })
-            .min()
-            .unwrap_or(usize::MAX);
-        (inverted != usize::MAX).then_some(inverted)
+            });
+            usize::MAX
+        });
+    }
+
+    /// The averages θ̄_a (and tr(D)‾_a) of the particles `owned` (all when `None`; else those
+    /// whose owner is `me`): each particle's slot sums in ascending block order (Eq. 11's
+    /// order, the same bits for any thread or rank count) over its nodal volume.
+    pub(crate) fn average(&mut self, blocks: &TetBlocks, owned: Option<(u32, &[u32])>) {
+        let (starts, entries, partial) = (&blocks.entry_start, &blocks.entries, &self.partial);
+        let inv_volume = &self.inv_nodal_volume;
+        self.nodal
+            .par_iter_mut()
+            .with_min_len(PARTICLE_CHUNK)
+            .enumerate()
+            .for_each(|(i, average)| {
+                if owned.is_some_and(|(me, owner)| owner[i] != me) {
+                    return;
+                }
+                let mut sum = Vec3::zeros();
+                for &entry in &entries[starts[i] as usize..starts[i + 1] as usize] {
+                    sum += partial[entry as usize];
+                }
+                *average = sum * inv_volume[i];
+            });
+    }
+
+    /// The per-slot sums of the strain pass, for the reverse exchange of a decomposed run.
+    pub(crate) fn partial_mut(&mut self) -> &mut [Vec3] {
+        &mut self.partial
+    }
+
+    /// The particles' averages (from `first`), for the forward exchange of a decomposed run.
+    pub(crate) fn nodal_mut(&mut self) -> &mut [Vec3] {
+        &mut self.nodal
+    }
+
+    /// The force pass of block `b` at `state` with the particles' averages, its forces added
+    /// into `out` (the block's node sums); returns the body's index of its first inverted
+    /// tetrahedron, `usize::MAX` if none.
+    pub(crate) fn block_forces<const VISCOUS: bool>(
+        &self,
+        blocks: &TetBlocks,
+        b: usize,
+        state: &State,
+        out: &mut [Vec3],
+    ) -> usize {
+        SCRATCH.with_borrow_mut(|scratch| {
+            let nodes =
+                &blocks.nodes[blocks.node_start[b] as usize..blocks.node_start[b + 1] as usize];
+            scratch.load(nodes, state, VISCOUS);
+            scratch.averages.clear();
+            let nodal = &self.nodal;
+            let first = self.first;
+            scratch
+                .averages
+                .extend(nodes.iter().map(|&n| nodal[n as usize - first]));
+            out.fill(Vec3::zeros());
+            let m = &self.moduli;
+            let tets = blocks.tet_start[b] as usize..blocks.tet_start[b + 1] as usize;
+            let input = ForceInput {
+                x: &scratch.x,
+                v: &scratch.v,
+                averages: &scratch.averages,
+                deviatoric: (-2.0 / 3.0 * m.mu, m.mu),
+                viscous_deviatoric: (-2.0 / 3.0 * m.mu_d, m.mu_d),
+                bulk: (m.kappa, m.kappa_d),
+                count: tets.len(),
+            };
+            let packs =
+                &blocks.packs[blocks.pack_start[b] as usize..blocks.pack_start[b + 1] as usize];
+            let inverted = force_sums::<VISCOUS>(LaneSet::detected(), packs, &input, out);
+            inverted.map_or(usize::MAX, |k| blocks.order[tets.start + k] as usize)
+        })
     }
 
     /// The stress (Pa) of every tetrahedron at `state`: the tensor its forces follow from
-    /// ([`AveragedPressure::compute`]: the corners' averaged volumetric strain with the
+    /// ([`AveragedPressure::block_forces`]: the corners' averaged volumetric strain with the
     /// element's own deviatoric strain), not Hooke's law on the element's own strain, whose
     /// pressure checkerboards as ν → ½. With `small_strain`, the linear ε = sym ∇u of a
     /// static solve in place of Eq. 4's, elastic only (the stress that belongs to the
@@ -269,24 +347,6 @@ impl AveragedPressure {
                 self.moduli.stress(&eps, mean(tet, |a| a.0), rate)
             })
             .collect()
-    }
-
-    /// Adds each particle's tetrahedron forces of the last [`AveragedPressure::compute`] to
-    /// `force`, its tetrahedra in ascending order.
-    pub(crate) fn add_particle_sums(&self, force: &mut [Vec3]) {
-        let count = self.corner_start.len() - 1;
-        let (starts, corners, forces) = (&self.corner_start, &self.corners, &self.forces);
-        force[self.first..self.first + count]
-            .par_iter_mut()
-            .with_min_len(PARTICLE_CHUNK)
-            .enumerate()
-            .for_each(|(i, f)| {
-                let mut sum = Vec3::zeros();
-                for &k in &corners[starts[i] as usize..starts[i + 1] as usize] {
-                    sum += forces[k as usize / 4][k as usize % 4];
-                }
-                *f += sum;
-            });
     }
 
     /// The elastic energy Σ_e V_e μ dev ε:dev ε + Σ_a V̄_a κ θ̄_a²/2 at `state`.
@@ -439,4 +499,18 @@ fn green_strain(f: &Mat3) -> Mat3 {
 /// The deviator e − ⅓ tr(e) I.
 fn deviator(e: &Mat3) -> Mat3 {
     e - Mat3::from_diagonal_element(e.trace() / 3.0)
+}
+
+/// Reference volume / 4 of each tetrahedron of the blocks' packs, by lane: a block's last pack
+/// repeats its last tetrahedron's, as [`crate::continuum::tet_lanes::packs`] does.
+fn quarter_packs(blocks: &TetBlocks, volume: &[f64]) -> Vec<[f64; PACK]> {
+    let mut packs = Vec::with_capacity(blocks.packs.len());
+    for range in blocks.tet_start.windows(2) {
+        let order = &blocks.order[range[0] as usize..range[1] as usize];
+        for chunk in order.chunks(PACK) {
+            let lane = |l: usize| 0.25 * volume[chunk[l.min(chunk.len() - 1)] as usize];
+            packs.push(std::array::from_fn(lane));
+        }
+    }
+    packs
 }

@@ -3,9 +3,10 @@
 //! [`tet_subdomain`], the deformable body ([`tet_body::TetBody`]) and its blocks
 //! ([`tet_blocks`]), the linear-tet stiffness ([`linear_tet`]), [`material`]s and the rigorous
 //! explicit step bound ([`stable_step`]); the locking-free average nodal pressure option in
-//! [`averaged_pressure_tet`]. Rigid bodies are part of the state
+//! [`averaged_pressure_tet`] (across SIMD lanes in [`averaged_pressure_lanes`]). Rigid bodies are part of the state
 //! ([`crate::step::rigid_body`]).
 
+pub mod averaged_pressure_lanes;
 pub mod averaged_pressure_tet;
 pub mod linear_tet;
 pub mod material;

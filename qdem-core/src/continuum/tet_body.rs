@@ -26,6 +26,7 @@ use crate::continuum::tet_kernel::{
 use crate::continuum::tet_lanes::{block_forces, BlockInput, LaneSet};
 use crate::error::CoreError;
 use crate::step::model::{Deformable, Linearized, Model, Persistence};
+use crate::step::split::{Averaging, NodalValues};
 use crate::step::split::{BodyLayout, BodySplit};
 use crate::step::split::{Evaluation, Facets, Ownership, Part, PartialSums, Reads};
 use crate::step::state::State;
@@ -174,6 +175,7 @@ impl TetBody {
                     dm_inv.collect(),
                     &self.volume,
                     &self.material,
+                    &self.blocks,
                 );
                 Some(Box::new(averaged))
             }
@@ -197,6 +199,13 @@ impl TetBody {
     /// How the tetrahedra are cut into blocks for the force pass ([`crate::continuum::tet_blocks`]).
     pub fn block_layout(&self) -> BlockLayout {
         self.blocks.layout()
+    }
+
+    /// The blocks this process computes: in a decomposed run its share, else all.
+    fn my_blocks(&self) -> std::ops::Range<usize> {
+        self.split
+            .as_ref()
+            .map_or(0..self.blocks.len(), |s| s.mine.clone())
     }
 
     /// What a decomposition reads of the blocks.
@@ -307,10 +316,7 @@ impl TetBody {
     /// forces summed per block node into `self.sums` ([`crate::continuum::tet_blocks`]), the blocks in
     /// parallel.
     fn compute_block_sums<const VISCOUS: bool>(&mut self, state: &State) {
-        let range = self
-            .split
-            .as_ref()
-            .map_or(0..self.blocks.len(), |s| s.mine.clone());
+        let range = self.my_blocks();
         self.inverted = None;
         if range.is_empty() {
             return;
@@ -323,9 +329,12 @@ impl TetBody {
             &mut sums[start[range.start] as usize..start[range.end] as usize],
             range,
             start,
-            &|b, out| {
-                let mut scratch = this.scratch.for_this_thread();
-                this.block_pass::<VISCOUS>(b, state, out, &mut scratch)
+            &|b, out| match &this.averaged {
+                Some(averaged) => averaged.block_forces::<VISCOUS>(&this.blocks, b, state, out),
+                None => {
+                    let mut scratch = this.scratch.for_this_thread();
+                    this.block_pass::<VISCOUS>(b, state, out, &mut scratch)
+                }
             },
         );
         self.sums = sums;
@@ -387,9 +396,6 @@ impl TetBody {
     /// Stage 2: per-particle sums of its block entries, in ascending block order (Eq. 11);
     /// in a decomposed run, of the particles this process owns only.
     fn add_particle_sums(&self, force: &mut [Vec3]) {
-        if let Some(averaged) = &self.averaged {
-            return averaged.add_particle_sums(force);
-        }
         let blocks = &self.blocks;
         let count = blocks.entry_start.len() - 1;
         let (starts, entries, sums) = (&blocks.entry_start, &blocks.entries, &self.sums);
@@ -425,7 +431,7 @@ fn corners(values: &[Vec3], local: [u16; 4]) -> [Vec3; 4] {
 
 /// Runs `pass(b, sums of b)` for the blocks in `range` in parallel, splitting `sums` (laid out
 /// per block by `node_start`) between them; returns the smallest index `pass` returned.
-fn for_blocks(
+pub(crate) fn for_blocks(
     sums: &mut [Vec3],
     range: std::ops::Range<usize>,
     node_start: &[u32],
@@ -564,6 +570,11 @@ impl Model for TetBody {
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [Vec3], _torque: &mut [Vec3]) {
+        // One process runs a decomposed run's stages, each exchange over one rank.
+        if self.averaged.is_some() {
+            self.partial(state);
+            self.average();
+        }
         self.compute(state);
         self.add_particle_sums(force);
     }
@@ -619,6 +630,10 @@ impl Facets for TetBody {
         Some(self)
     }
 
+    fn averaging(&mut self) -> Option<&mut dyn Averaging> {
+        self.averaged.is_some().then_some(self)
+    }
+
     fn reverse_sums(&mut self) -> Option<PartialSums<'_>> {
         let plan = self.split.as_mut().and_then(|s| s.exchange.as_mut())?;
         Some(PartialSums {
@@ -629,11 +644,10 @@ impl Facets for TetBody {
 }
 
 impl Evaluation for TetBody {
-    /// Stage 1 of Eqs. 9–11: the block sums of this rank's blocks.
+    /// Stage 1 of Eqs. 9–11: the block sums of this rank's blocks (of an averaged-pressure
+    /// body, with the averages of [`Averaging`] at `state`).
     fn compute(&mut self, state: &State) {
-        if let Some(averaged) = &mut self.averaged {
-            self.inverted = averaged.compute(state);
-        } else if self.material.is_elastic() {
+        if self.material.is_elastic() {
             self.compute_block_sums::<false>(state);
         } else {
             self.compute_block_sums::<true>(state);
@@ -642,6 +656,42 @@ impl Evaluation for TetBody {
 
     fn apply(&mut self, force: &mut [Vec3], _torque: &mut [Vec3]) {
         self.add_particle_sums(force);
+    }
+}
+
+/// The nodal averages of an averaged-pressure body in a decomposed run: the strain pass over
+/// this rank's blocks, whose slot sums for other ranks' particles go to their owners; each
+/// owner's averages, which come back to the ranks whose blocks hold the particle.
+impl Averaging for TetBody {
+    fn partial(&mut self, state: &State) {
+        let range = self.my_blocks();
+        if let Some(averaged) = &mut self.averaged {
+            averaged.strain_pass(&self.blocks, range, state);
+        }
+    }
+
+    fn partial_sums(&mut self) -> Option<PartialSums<'_>> {
+        let plan = self.split.as_mut().and_then(|s| s.exchange.as_mut())?;
+        let sums = self.averaged.as_mut()?.partial_mut();
+        Some(PartialSums { sums, plan })
+    }
+
+    fn average(&mut self) {
+        let owned = self.split.as_ref().map(|s| (s.me, &s.owner[..]));
+        if let Some(averaged) = &mut self.averaged {
+            averaged.average(&self.blocks, owned);
+        }
+    }
+
+    fn averages(&mut self) -> Option<NodalValues<'_>> {
+        let plan = self.split.as_mut().and_then(|s| s.exchange.as_mut())?;
+        let values = self.averaged.as_mut()?.nodal_mut();
+        Some(NodalValues {
+            values,
+            nodes: &self.blocks.nodes,
+            first: self.blocks.first,
+            plan,
+        })
     }
 }
 

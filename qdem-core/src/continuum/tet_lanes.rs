@@ -41,8 +41,8 @@ pub const FLOPS_VISCOELASTIC: usize = FLOPS_ELASTIC + 83;
 #[derive(Clone, Debug)]
 #[repr(C, align(64))]
 pub(crate) struct TetPack {
-    dm_inv: [[f64; PACK]; 9],
-    local: [[u16; PACK]; 4],
+    pub(crate) dm_inv: [[f64; PACK]; 9],
+    pub(crate) local: [[u16; PACK]; 4],
 }
 
 /// The packs of one block's tetrahedra, in order.
@@ -181,7 +181,7 @@ unsafe fn pass_avx2<const VISCOUS: bool>(
 /// The vector operations of the lane kernel, one implementation per instruction set. Every
 /// method is `unsafe`: it may run only on a CPU with the set's features, inlined into a
 /// function that enables them.
-trait Simd {
+pub(crate) trait Simd {
     /// Lanes per vector.
     const N: usize;
     /// A vector of `N` f64.
@@ -206,14 +206,14 @@ trait Simd {
 }
 
 #[cfg(target_arch = "x86_64")]
-mod x86 {
+pub(crate) mod x86 {
     use super::Simd;
     use std::arch::x86_64::*;
 
     /// AVX-512: 8 lanes.
-    pub(super) struct Avx512;
+    pub(crate) struct Avx512;
     /// AVX2 with FMA: 4 lanes.
-    pub(super) struct Avx2;
+    pub(crate) struct Avx2;
 
     impl Simd for Avx512 {
         const N: usize = 8;
@@ -373,17 +373,17 @@ unsafe fn pass<S: Simd, const VISCOUS: bool>(
 use std::cmp::Ordering::Greater;
 
 /// A 3-vector (or a matrix column) of lane vectors.
-type V3<S> = [<S as Simd>::V; 3];
+pub(crate) type V3<S> = [<S as Simd>::V; 3];
 
 /// A symmetric tensor of lane vectors: xx, yy, zz, xy, yz, xz.
-type Sym<S> = [<S as Simd>::V; 6];
+pub(crate) type Sym<S> = [<S as Simd>::V; 6];
 
 // No closures below: a closure does not inherit the target features of the function it is
 // inlined into, and one left out of line would call the intrinsics out of line.
 
 /// The corner values of every lane, x[local] (`values` as flat f64, 3 per node).
 #[inline(always)]
-unsafe fn gather<S: Simd>(values: &[Vec3], corners: &[S::Idx; 4]) -> [V3<S>; 4] {
+pub(crate) unsafe fn gather<S: Simd>(values: &[Vec3], corners: &[S::Idx; 4]) -> [V3<S>; 4] {
     let base = values.as_ptr().cast::<f64>();
     let mut g = [[S::splat(0.0); 3]; 4];
     for (corner, &offsets) in g.iter_mut().zip(corners) {
@@ -396,7 +396,7 @@ unsafe fn gather<S: Simd>(values: &[Vec3], corners: &[S::Idx; 4]) -> [V3<S>; 4] 
 
 /// The edges x₁−x₀, x₂−x₀, x₃−x₀.
 #[inline(always)]
-unsafe fn edges<S: Simd>(g: &[V3<S>; 4]) -> [V3<S>; 3] {
+pub(crate) unsafe fn edges<S: Simd>(g: &[V3<S>; 4]) -> [V3<S>; 3] {
     let mut e = [[S::splat(0.0); 3]; 3];
     for (edge, corner) in e.iter_mut().zip(&g[1..]) {
         for k in 0..3 {
@@ -408,25 +408,25 @@ unsafe fn edges<S: Simd>(g: &[V3<S>; 4]) -> [V3<S>; 3] {
 
 /// a₀b₀ + a₁b₁ + a₂b₂ of three lane vectors each.
 #[inline(always)]
-unsafe fn dot3<S: Simd>(a: [S::V; 3], b: [S::V; 3]) -> S::V {
+pub(crate) unsafe fn dot3<S: Simd>(a: [S::V; 3], b: [S::V; 3]) -> S::V {
     S::mul_add(a[2], b[2], S::mul_add(a[1], b[1], S::mul(a[0], b[0])))
 }
 
 /// ab − cd.
 #[inline(always)]
-unsafe fn mul_sub<S: Simd>(a: S::V, b: S::V, c: S::V, d: S::V) -> S::V {
+pub(crate) unsafe fn mul_sub<S: Simd>(a: S::V, b: S::V, c: S::V, d: S::V) -> S::V {
     S::mul_add(a, b, S::neg(S::mul(c, d)))
 }
 
 /// a · b.
 #[inline(always)]
-unsafe fn dot<S: Simd>(a: &V3<S>, b: &V3<S>) -> S::V {
+pub(crate) unsafe fn dot<S: Simd>(a: &V3<S>, b: &V3<S>) -> S::V {
     dot3::<S>(*a, *b)
 }
 
 /// a × b.
 #[inline(always)]
-unsafe fn cross<S: Simd>(a: &V3<S>, b: &V3<S>) -> V3<S> {
+pub(crate) unsafe fn cross<S: Simd>(a: &V3<S>, b: &V3<S>) -> V3<S> {
     [
         mul_sub::<S>(a[1], b[2], a[2], b[1]),
         mul_sub::<S>(a[2], b[0], a[0], b[2]),
@@ -436,7 +436,7 @@ unsafe fn cross<S: Simd>(a: &V3<S>, b: &V3<S>) -> V3<S> {
 
 /// The isotropic law of Eqs. 2 and 7: λ tr(e) I + 2μ e.
 #[inline(always)]
-unsafe fn lame<S: Simd>(e: &Sym<S>, (lambda, mu): (f64, f64)) -> Sym<S> {
+pub(crate) unsafe fn lame<S: Simd>(e: &Sym<S>, (lambda, mu): (f64, f64)) -> Sym<S> {
     let p = S::mul(S::splat(lambda), S::add(S::add(e[0], e[1]), e[2]));
     let two_mu = S::splat(2.0 * mu);
     [
@@ -452,7 +452,7 @@ unsafe fn lame<S: Simd>(e: &Sym<S>, (lambda, mu): (f64, f64)) -> Sym<S> {
 /// ε = (F Fᵀ − I)/2 of Eq. 4, with row r of F = [d₁ d₂ d₃] dX⁻¹ the sum Σ_k d_k[r] · (row k
 /// of dX⁻¹) (dm: dX⁻¹ row major).
 #[inline(always)]
-unsafe fn green_strain<S: Simd>(d: &[V3<S>; 3], dm: &[S::V; 9]) -> Sym<S> {
+pub(crate) unsafe fn green_strain<S: Simd>(d: &[V3<S>; 3], dm: &[S::V; 9]) -> Sym<S> {
     let mut f = [[S::splat(0.0); 3]; 3];
     for (r, row) in f.iter_mut().enumerate() {
         for (j, entry) in row.iter_mut().enumerate() {
@@ -473,7 +473,11 @@ unsafe fn green_strain<S: Simd>(d: &[V3<S>; 3], dm: &[S::V; 9]) -> Sym<S> {
 
 /// D = sym(Σ_k dv_k ⊗ c_k) / det of Eqs. 5–6.
 #[inline(always)]
-unsafe fn rate_of_deformation<S: Simd>(dv: &[V3<S>; 3], c: &[V3<S>; 3], inv_det: S::V) -> Sym<S> {
+pub(crate) unsafe fn rate_of_deformation<S: Simd>(
+    dv: &[V3<S>; 3],
+    c: &[V3<S>; 3],
+    inv_det: S::V,
+) -> Sym<S> {
     // l[i][j] = Σ_k dv_k[i] c_k[j] = det · L_ij.
     let mut l = [[S::splat(0.0); 3]; 3];
     for (i, row) in l.iter_mut().enumerate() {
@@ -494,7 +498,7 @@ unsafe fn rate_of_deformation<S: Simd>(dv: &[V3<S>; 3], c: &[V3<S>; 3], inv_det:
 
 /// −(T · a)/6 for the symmetric T.
 #[inline(always)]
-unsafe fn face_force<S: Simd>(t: &Sym<S>, a: &V3<S>) -> V3<S> {
+pub(crate) unsafe fn face_force<S: Simd>(t: &Sym<S>, a: &V3<S>) -> V3<S> {
     let sixth = S::splat(-1.0 / 6.0);
     [
         S::mul(dot3::<S>([t[0], t[3], t[5]], *a), sixth),

@@ -129,6 +129,36 @@ impl SumExchange {
         }
         self.seconds += start.elapsed().as_secs_f64();
     }
+
+    /// The forward exchange of per-particle `values` (from `first`) over the slots of the
+    /// reverse one: each owner sends the values of its particles whose slots it receives in
+    /// [`SumExchange::run`], and writes those it receives into the particles of the slots it
+    /// sends there (`nodes`: the particle of each slot); a copy, no arithmetic.
+    pub(crate) fn run_forward(
+        &mut self,
+        comm: &dyn Communicator,
+        nodes: &[u32],
+        first: usize,
+        values: &mut [Vec3],
+    ) {
+        let start = std::time::Instant::now();
+        self.send.clear();
+        for &s in &self.recv_slots {
+            let value = values[nodes[s as usize] as usize - first];
+            self.send.extend_from_slice(value.as_slice());
+        }
+        self.recv.resize(3 * self.send_slots.len(), 0.0);
+        comm.all_to_all(
+            &self.send,
+            &self.recv_counts,
+            &mut self.recv,
+            &self.send_counts,
+        );
+        for (&s, v) in self.send_slots.iter().zip(self.recv.chunks_exact(3)) {
+            values[nodes[s as usize] as usize - first] = Vec3::new(v[0], v[1], v[2]);
+        }
+        self.seconds += start.elapsed().as_secs_f64();
+    }
 }
 
 /// This rank's [`BodySplit`] of a body whose block `b` is computed by rank `block_rank[b]`.

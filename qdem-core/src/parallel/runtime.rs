@@ -472,6 +472,18 @@ impl Ranks {
             halo.read_partners(state);
             table.forward(comm, halo);
         }
+        if let Some(averaging) = facets.averaging() {
+            averaging.partial(state);
+            if let Some(sums) = averaging.partial_sums() {
+                sums.plan.run(comm, sums.sums);
+            }
+            averaging.average();
+            if let Some(nodal) = averaging.averages() {
+                nodal
+                    .plan
+                    .run_forward(comm, nodal.nodes, nodal.first, nodal.values);
+            }
+        }
         let evaluation = facets.evaluation().expect("a split model evaluates");
         evaluation.compute(state);
         if let Some(reduction) = facets.reduction() {

@@ -10,6 +10,8 @@
 //! - [`Facets::body`]: a deformable body's blocks, which the decomposition cuts between
 //!   the ranks ([`BodyLayout`]);
 //! - [`Evaluation`]: its force evaluation in two stages, computing and adding;
+//! - [`Facets::averaging`]: nodal averages a body's forces read, summed over ranks first
+//!   ([`Averaging`]: the averaged-pressure tetrahedron's volumetric strain);
 //! - [`Lists`]: neighbour lists and when they are rebuilt;
 //! - [`Halo`]: the item records it exchanges forward (contact spheres), and its ghosts;
 //! - [`Reduction`]: what the ranks reduce together within an evaluation;
@@ -32,7 +34,9 @@
 //!    they changed; the runtime learns who sends what to whom;
 //! 4. [`Halo::read_partners`], then the **forward** exchange: each rank packs the items
 //!    others read as ghosts, and unpacks its own ghosts;
-//! 5. [`Evaluation::compute`], then a **reduction** when the model has one
+//! 5. for a body with nodal averages ([`Averaging`]): its partial sums, their **reverse**
+//!    exchange to the particles' owners, the owners' averages and their **forward** exchange
+//!    back to the ranks whose blocks read them; then [`Evaluation::compute`], then a **reduction** when the model has one
 //!    ([`Reduction::mine`], [`Reduction::reduced`]: a time-delayed boundary's force,
 //!    measured over every rank's pairs);
 //! 6. the **reverse** exchange of [`Facets::reverse_sums`] (a deformable body's block sums
@@ -198,6 +202,12 @@ pub trait Facets: Ownership {
         None
     }
 
+    /// The nodal averages a deformable body's forces read (the averaged-pressure
+    /// tetrahedron), run before [`Evaluation::compute`].
+    fn averaging(&mut self) -> Option<&mut dyn Averaging> {
+        None
+    }
+
     /// The stages of a model's force evaluation (every split model has them; a hook not).
     fn evaluation(&mut self) -> Option<&mut dyn Evaluation> {
         None
@@ -248,6 +258,40 @@ pub trait Evaluation {
 
     /// Adds the forces (and moments) on this rank's own particles.
     fn apply(&mut self, force: &mut [Vec3], torque: &mut [Vec3]);
+}
+
+/// Nodal averages that a deformable body's forces read, each a sum over the blocks that hold
+/// the particle (the averaged-pressure tetrahedron's θ̄_a): stage 5, before
+/// [`Evaluation::compute`]. The runtime calls, in order, [`Averaging::partial`], the reverse
+/// exchange of [`Averaging::partial_sums`], [`Averaging::average`] and the forward exchange
+/// of [`Averaging::averages`].
+pub trait Averaging {
+    /// Computes this rank's blocks' partial sums at `state`.
+    fn partial(&mut self, state: &State);
+
+    /// The partial sums for particles other ranks own (laid out as the block sums), which
+    /// the reverse exchange sends to the owners; `None` when the body is not cut.
+    fn partial_sums(&mut self) -> Option<PartialSums<'_>>;
+
+    /// Averages the particles this rank owns from their complete partial sums.
+    fn average(&mut self);
+
+    /// The averages, which the forward exchange copies from each owner to the ranks whose
+    /// blocks hold the particle; `None` when the body is not cut.
+    fn averages(&mut self) -> Option<NodalValues<'_>>;
+}
+
+/// A deformable body's per-particle values that owners send forward to the ranks whose
+/// blocks hold the particle ([`Averaging::averages`]), by the slots of its [`SumExchange`].
+pub struct NodalValues<'a> {
+    /// Per particle of the body (from `first`), its value.
+    pub values: &'a mut [Vec3],
+    /// The particle of each block slot (the body's [`BodyLayout::nodes`]).
+    pub nodes: &'a [u32],
+    /// The body's first particle.
+    pub first: usize,
+    /// The slots exchanged, as the reverse exchange lists them.
+    pub plan: &'a mut SumExchange,
 }
 
 /// A split model's neighbour lists: stages 1 and 2.

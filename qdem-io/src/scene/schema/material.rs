@@ -25,7 +25,7 @@ scene_table! {
         formulation: Formulation =>
             "\"standard\" or \"averaged-pressure\"", optional = "\"standard\"",
             "`\"standard\"` (default) or `\"averaged-pressure\"`: the average nodal pressure \
-             tetrahedron (Bonet & Burton 1998) that does not lock as ν → 0.5; refused under MPI.";
+             tetrahedron (Bonet & Burton 1998) that does not lock as ν → 0.5.";
     }
 }
 
