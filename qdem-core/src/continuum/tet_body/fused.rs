@@ -178,10 +178,12 @@ impl TetBody {
         let Scratch { x, v, f } = scratch;
         x.clear();
         x.extend(nodes.iter().map(|&n| unsafe { *arrays.x.add(n as usize) }));
-        v.clear();
-        match VISCOUS {
-            true => v.extend(nodes.iter().map(|&n| unsafe { *arrays.v.add(n as usize) })),
-            false => v.resize(nodes.len(), Vec3::zeros()),
+        if VISCOUS {
+            v.clear();
+            v.extend(nodes.iter().map(|&n| unsafe { *arrays.v.add(n as usize) }));
+        } else if v.len() < nodes.len() {
+            // The elastic path reads only the interior nodes' entries, written below.
+            v.resize(nodes.len(), Vec3::zeros());
         }
         for &l in interior {
             let (l, n) = (l as usize, nodes[l as usize] as usize);
@@ -195,7 +197,7 @@ impl TetBody {
             unsafe { *arrays.x.add(n) = x[l] };
         }
         f.resize(nodes.len(), Vec3::zeros());
-        let inverted = self.forces_of_block::<VISCOUS>(b, x, v, f);
+        let inverted = self.forces_of_block::<VISCOUS>(b, x, &v[..nodes.len()], f);
         for &l in blocks.owners.shared(b) {
             out[l as usize] = f[l as usize];
         }
