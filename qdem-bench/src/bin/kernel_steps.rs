@@ -1,7 +1,8 @@
 //! `kernel_steps [--tets N | --stones N] [--viscous] [--separate-passes] [--steps S]`: the
 //! Verlet steps of one `qdem bench` body (a cube of about N tetrahedra, or N stones of 108 as
-//! one body; `qdem_bench::throughput`) on the calling thread, untimed, for counting what a
-//! step costs with a tool that does not depend on the machine's load:
+//! one body; `qdem_bench::throughput`) on a pool of one thread (so that every pass runs on the
+//! thread that calls `steps`), untimed, for counting what a step costs with a tool that does
+//! not depend on the machine's load:
 //!
 //! ```sh
 //! valgrind --tool=callgrind --cache-sim=yes --toggle-collect='kernel_steps::steps' \
@@ -13,7 +14,7 @@
 //! stepper's sweeps (the traffic before the fused step). Prints one JSON line: the body and a
 //! checksum of its final positions (the same for both ways of integrating).
 
-use qdem_bench::throughput::{block, stones_body};
+use qdem_bench::throughput::{block, on_threads, stones_body};
 use qdem_core::{solvers::Verlet, step::Model, step::State, step::Stepper};
 use serde_json::json;
 
@@ -63,6 +64,11 @@ fn main() {
             std::process::exit(2);
         }
     };
+    on_threads(1, || run(tets, stones, viscous, separate, count));
+}
+
+/// Builds the body, steps it `count` times and prints the line.
+fn run(tets: usize, stones: Option<usize>, viscous: bool, separate: bool, count: usize) {
     let (body, mut state) = match stones {
         Some(n) => stones_body(n, viscous),
         None => block(tets, viscous),
