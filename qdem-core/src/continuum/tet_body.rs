@@ -464,7 +464,7 @@ fn for_blocks<const N: usize>(
 struct Scratch {
     x: Vec<Vec3>,
     v: Vec<Vec3>,
-    /// The block's node sums in a fused step ([`fused`]), kept in cache.
+    /// The block's node sums in a fused step ([`crate::step::fused`]), kept in cache.
     f: Vec<Vec3>,
 }
 
@@ -591,7 +591,7 @@ impl Model for TetBody {
     }
 
     /// The standard tetrahedron of a body evaluated whole (not the averaged pressure, not a
-    /// rank's share): its blocks integrate their interior particles ([`fused`]).
+    /// rank's share): its blocks integrate their interior particles ([`crate::step::fused`]).
     fn fused(&mut self) -> Option<&mut dyn FusedStep> {
         (self.averaged.is_none() && self.split.is_none()).then_some(self)
     }
