@@ -2,8 +2,11 @@
 //! a bar held at one end swings as a compound pendulum, with its pivot where it started to
 //! round-off; a bar held in one direction at its members keeps them in that plane and moves
 //! freely otherwise; a block resting on held members carries its weight on them; and a run is
-//! the same bits on one and two threads.
+//! the same bits on one and two threads, and on one process and two or three ranks.
 
+use qdem_core::parallel::thread_ranks::on_thread_ranks;
+use qdem_core::step::{Scheme, StepRequest, StepSettings};
+use qdem_core::world::World;
 use qdem_core::{
     loads::Gravity, solvers::Verlet, step::Dofs, step::MemberHold, step::Model, step::State,
     step::Stepper, Mat3, Vec3,
@@ -231,4 +234,78 @@ fn a_held_body_gives_the_same_bits_on_one_and_two_threads() {
     let one = pendulum_on(1);
     assert!(one.rigid.angular_velocity[0].norm() > 0.1);
     assert!(one == pendulum_on(2));
+}
+
+/// Four bars held at one end each, swinging in different planes, as a world stepped by
+/// Verlet at ∆t = 10⁻³ s under gravity.
+fn pendulums() -> World {
+    let mut points = Vec::new();
+    let mut bars = Vec::new();
+    for k in 0..4 {
+        let pivot = Vec3::new(k as f64, 0.0, 1.0);
+        let axis = Vec3::new(0.2 * (k as f64 - 1.5), 0.1 * k as f64, -1.0).normalize();
+        let centre = pivot + 0.5 * axis;
+        let first = points.len();
+        points.extend([centre, pivot, centre + 0.5 * axis]);
+        bars.push((first, axis));
+    }
+    let mut s = State::at_rest(points);
+    let mut holds = Vec::new();
+    for (k, &(c, axis)) in bars.iter().enumerate() {
+        s.mass[c] = 2.0;
+        let inertia = Mat3::identity() * 0.5 - 0.48 * axis * axis.transpose();
+        s.add_rigid_body("bar", c, &[c + 1, c + 2], inertia)
+            .unwrap();
+        s.rigid
+            .set_angular_velocity(k, Vec3::new(0.3, 1.0 + k as f64, 0.2));
+        holds.push(MemberHold {
+            particle: c + 1,
+            dofs: Dofs::ALL,
+            fix: k + 1,
+        });
+    }
+    s.hold_members(&holds);
+    let models: Vec<Box<dyn Model>> = vec![Box::new(Gravity::new(Vec3::new(0.0, 0.0, -G)))];
+    let request = StepRequest {
+        scheme: Scheme::Verlet,
+        dt: Some(1e-3),
+        safety: 0.9,
+        local_damping: 0.0,
+        adaptive: false,
+        event_solve: Default::default(),
+        implicit_default: None,
+        fit_to: None,
+    };
+    let settings = StepSettings::resolve(&request, &s, &models).unwrap();
+    World::new(s, models, settings).unwrap()
+}
+
+/// The pendulums' state and the stepper's forces (the holds' reactions at the pivots) after
+/// 500 steps.
+fn pendulums_stepped(world: &mut World) -> (State, Vec<Vec3>) {
+    world.initialize().unwrap();
+    for _ in 0..500 {
+        world.step().unwrap();
+    }
+    world.gather();
+    (world.state.clone(), world.stepper().forces().to_vec())
+}
+
+/// Over two and three ranks (each body owned whole by one rank), the held bodies' motion and
+/// their reactions are one process's bits.
+#[test]
+fn held_bodies_over_ranks_give_one_processs_bits() {
+    let (one, forces) = pendulums_stepped(&mut pendulums());
+    assert!(forces[1].norm() > 1.0, "the pivot carries the bar");
+    for size in [2, 3] {
+        let runs = on_thread_ranks(size, |comm| {
+            let mut world = pendulums();
+            world.decompose(comm).unwrap();
+            pendulums_stepped(&mut world)
+        });
+        for (rank, (state, f)) in runs.iter().enumerate() {
+            assert!(*state == one, "{size} ranks, rank {rank}: the state");
+            assert!(*f == forces, "{size} ranks, rank {rank}: the reactions");
+        }
+    }
 }
