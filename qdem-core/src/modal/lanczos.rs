@@ -250,8 +250,8 @@ pub fn natural_modes(
     if count == 0 {
         return Err(ModalError::ZeroCount);
     }
-    let moving = state.rigid.holds.bodies();
-    if let Some((b, fix)) = moving.filter(|&(b, _)| !state.rigid.spin_fixed[b]).next() {
+    let mut held = state.rigid.holds.bodies();
+    if let Some((b, fix)) = held.find(|&(b, _)| !state.rigid.spin_fixed[b]) {
         return Err(ModalError::HeldAtPoints {
             body: format!("rigid body {b}"),
             fix,

@@ -167,14 +167,14 @@ impl Metric {
     }
 
     /// y = M^½ q̇ of the velocity `v` and the angular velocity `w` (world).
-    fn to_y(&self, v: Vec3, w: Vec3) -> Vector6<f64> {
+    fn scaled(&self, v: Vec3, w: Vec3) -> Vector6<f64> {
         let t = v * self.root_mass;
         let r = (self.rotation.inverse() * w).component_mul(&self.root_inertia);
         Vector6::new(t.x, t.y, t.z, r.x, r.y, r.z)
     }
 
     /// The velocity and angular velocity (world) of y = M^½ q̇.
-    fn from_y(&self, y: &Vector6<f64>) -> (Vec3, Vec3) {
+    fn unscaled(&self, y: &Vector6<f64>) -> (Vec3, Vec3) {
         let v = y.fixed_rows::<3>(0) / self.root_mass;
         let body = y.fixed_rows::<3>(3).component_div(&self.root_inertia);
         (v, self.rotation * body)
@@ -318,7 +318,7 @@ impl State {
                         holds.anchor[k] - holds.direction[k].dot(&x)
                     })
                     .collect();
-                let (shift, turn) = metric.from_y(&metric.least_norm(&miss));
+                let (shift, turn) = metric.unscaled(&metric.least_norm(&miss));
                 self.position[c] += shift;
                 self.rigid.orientation[b] =
                     UnitQuaternion::from_scaled_axis(turn) * metric.rotation;
@@ -335,8 +335,8 @@ impl State {
             let metric = Metric::new(self, &self.rigid.holds, j);
             let b = self.rigid.holds.body[j];
             let c = self.rigid.center[b];
-            let y = metric.to_y(self.velocity[c], self.rigid.angular_velocity[b]);
-            let (v, w) = metric.from_y(&metric.project(&y));
+            let y = metric.scaled(self.velocity[c], self.rigid.angular_velocity[b]);
+            let (v, w) = metric.unscaled(&metric.project(&y));
             self.velocity[c] = v;
             self.rigid.set_angular_velocity(b, w);
         }
