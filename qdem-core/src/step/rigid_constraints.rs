@@ -32,7 +32,14 @@
 //!   stay at their anchors to round-off over any number of steps.                      (4)
 //!
 //! This is RATTLE (Andersen 1983) for the linear point constraints of a rigid body, with (4)
-//! in place of its iterated position solve. A body whose holds leave it no motion (rank 6)
+//! in place of its iterated position solve.
+//!
+//! Singular poses: where the held points allow a motion at first order that they forbid at
+//! second order, (2) lets it start and (4) stops it, the points then off their anchors by
+//! the square of the motion's first step. A face's nodes held along the face (a sleeper's
+//! rail seats held in y) are such a pose: the face may roll about a line in it at first
+//! order (qdem-io's `rigid_holds.rs` measured 2·10⁻⁹ m for a cube thrown across its held
+//! face at 0.5 m/s with ∆t = 2·10⁻⁴ s). A body whose holds leave it no motion (rank 6)
 //! is held whole instead, its centre fixed and its rotation held as before; (3) then gives
 //! only the reactions. The reactions μ_k e_k go into the stepper's force buffer at each held
 //! member as −μ_k e_k, the sign of a fixed node's force, so that `reactions.csv` sums a rigid
