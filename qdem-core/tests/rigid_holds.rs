@@ -2,8 +2,10 @@
 //! a bar held at one end swings as a compound pendulum, with its pivot where it started to
 //! round-off; a bar held in one direction at its members keeps them in that plane and moves
 //! freely otherwise; a block resting on held members carries its weight on them; and a run is
-//! the same bits on one and two threads, and on one process and two or three ranks.
+//! the same bits on one and two threads, on one process and two or three ranks, and resumed
+//! from a checkpoint.
 
+use qdem_core::checkpoint::{Decoder, Encoder};
 use qdem_core::parallel::thread_ranks::on_thread_ranks;
 use qdem_core::step::{Scheme, StepRequest, StepSettings};
 use qdem_core::world::World;
@@ -308,4 +310,27 @@ fn held_bodies_over_ranks_give_one_processs_bits() {
             assert!(*f == forces, "{size} ranks, rank {rank}: the reactions");
         }
     }
+}
+
+/// A checkpoint of held bodies resumes bit for bit: the holds come from the scene (built
+/// again), the pose, momenta and the torques with the holds' part from the checkpoint.
+#[test]
+fn held_bodies_resume_from_a_checkpoint_bit_for_bit() {
+    let mut straight = pendulums();
+    straight.initialize().unwrap();
+    let mut saved = Vec::new();
+    for step in 1..=400 {
+        straight.step().unwrap();
+        if step == 150 {
+            let mut out = Encoder::new();
+            straight.save(&mut out).unwrap();
+            saved = out.into_bytes();
+        }
+    }
+    let mut resumed = pendulums();
+    resumed.restore(&mut Decoder::new(&saved), 150).unwrap();
+    for _ in 150..400 {
+        resumed.step().unwrap();
+    }
+    assert!(resumed.state == straight.state);
 }
