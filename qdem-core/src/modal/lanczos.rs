@@ -12,7 +12,8 @@
 //! - A rigid body takes part with its six DOFs, its centre's translation and its rotations
 //!   about its principal axes: its members' entries of K are condensed onto them
 //!   (`rigid_reduction.rs`), and its members follow in the mode shapes. One that nothing
-//!   touches and nothing fixes reports its six rigid-body modes.
+//!   touches and nothing fixes reports its six rigid-body modes. One held at points and free
+//!   to turn about them ([`crate::step::rigid_constraints`]) is refused.
 //! - Shift and invert (Ericsson & Ruhe 1980): with A = K − σM, σ = −(2π · 1 Hz)² < 0 so that A
 //!   is positive definite even for a body free to move rigidly, the eigenvalues θ of the
 //!   operator A⁻¹M, self-adjoint in the M inner product ⟨x, y⟩ = xᵀMy, are θ = 1/(ω² − σ):
@@ -129,6 +130,21 @@ pub enum ModalError {
         /// Its free DOFs.
         modes: usize,
     },
+    /// A rigid body held at points ([`crate::step::rigid_constraints`]) and free to turn
+    /// about them: the analysis moves a rigid body by its centre's translation and its whole
+    /// rotation, and cannot hold it at a point.
+    #[error(
+        "{body} is held at points by [[fix]] #{fix}, which leave it free to turn about them, \
+         and a modal analysis holds a rigid body only at its centre and its whole rotation; \
+         fix: hold its rotation too (rotation = true on the fix), or hold it whole (members \
+         at three points not on one line, in x, y and z)"
+    )]
+    HeldAtPoints {
+        /// The body (`rigid body K`, K its index in [`State::rigid`], or its scene name).
+        body: String,
+        /// The number of the first fix holding it.
+        fix: usize,
+    },
     /// Lanczos stopped before the wanted modes converged.
     #[error(
         "Lanczos did not converge: {converged} of {wanted} modes after {steps} steps; ask for \
@@ -233,6 +249,13 @@ pub fn natural_modes(
 ) -> Result<Modes, ModalError> {
     if count == 0 {
         return Err(ModalError::ZeroCount);
+    }
+    let mut held = state.rigid.holds.bodies();
+    if let Some((b, fix)) = held.find(|&(b, _)| !state.rigid.spin_fixed[b]) {
+        return Err(ModalError::HeldAtPoints {
+            body: format!("rigid body {b}"),
+            fix,
+        });
     }
     let problem = Problem::new(state, models)?;
     if count > problem.dofs.len() {

@@ -9,7 +9,10 @@
 //! integrated the same way, ω_{n+½} = ω_n + ½∆t M_n/J, θ_{n+1} = θ_n + ∆t ω_{n+½},
 //! ω_{n+1} = ω_{n+½} + ½∆t M_{n+1}/J. Rigid bodies ([`crate::step::rigid_body`]) ride along: their
 //! angular momentum gets the same two half kicks from the torque and their orientation the
-//! drift, and their members are placed after each. An optional local damping
+//! drift, and their members are placed after each; bodies held at points
+//! ([`crate::step::rigid_constraints`]) get the forces that hold them before the second half
+//! kick, their pose corrected after the drift and their velocity projected after each kick. An
+//! optional local damping
 //! ([`crate::solvers::local_damping`]) acts on the summed forces before they become accelerations.
 //!
 //! A step is two sweeps over the particles besides the forces
@@ -181,6 +184,10 @@ impl Verlet {
         if !state.rigid.is_empty() {
             state.rigid.kick_and_rotate(rigid, dt);
             rigid.fill(Vec3::zeros());
+            if !state.rigid.holds.is_empty() {
+                state.hold_pose();
+                state.hold_velocities();
+            }
             place_members_keeping_arms(state, &mut self.arms);
         }
         stages.mark(Stage::Predict);
@@ -265,12 +272,24 @@ impl Verlet {
     }
 
     /// The half kick of the rotations and the members' new velocities (the kick leaves the
-    /// poses, and so the members' positions and arms, as the prediction placed them).
-    fn kick_rigid(&self, state: &mut State) {
-        if !state.rigid.is_empty() {
-            state.rigid.kick(&self.torque, 0.5 * self.dt);
-            place_member_velocities(state, &self.arms);
+    /// poses, and so the members' positions and arms, as the prediction placed them); the
+    /// forces that hold bodies at points before it and the projection of their velocities
+    /// after it ([`crate::step::rigid_constraints`]).
+    fn kick_rigid(&mut self, state: &mut State) {
+        if state.rigid.is_empty() {
+            return;
         }
+        let h = 0.5 * self.dt;
+        let held = !state.rigid.holds.is_empty();
+        if held {
+            let torque = &mut self.torque[..self.rigid_bodies];
+            state.hold_forces(&mut self.force, torque, Some(h));
+        }
+        state.rigid.kick(&self.torque, h);
+        if held {
+            state.hold_velocities();
+        }
+        place_member_velocities(state, &self.arms);
     }
 
     /// The force buffer of the last evaluation (N per particle).
@@ -298,7 +317,14 @@ impl Stepper for Verlet {
         if !state.rigid.is_empty() {
             place_members(state);
         }
-        self.evaluate(state, models, (&mut StageTimes::off(), seam), None, false)
+        self.evaluate(state, models, (&mut StageTimes::off(), seam), None, false)?;
+        if !state.rigid.holds.is_empty() {
+            let torque = &mut self.torque[..self.rigid_bodies];
+            state.hold_forces(&mut self.force, torque, None);
+            state.hold_velocities();
+            place_members(state);
+        }
+        Ok(())
     }
 
     /// The torques of the last evaluation: the rigid bodies', which the next step's first

@@ -1,5 +1,5 @@
 //! The bottom layer of the crate, what every other area builds on: the [`state::State`] (with
-//! its [`rigid_body`]s and the [`local_particles`] a rank steps), [`model::Model`] (a source
+//! its [`rigid_body`]s, held at points by [`rigid_constraints`], and the [`local_particles`] a rank steps), [`model::Model`] (a source
 //! of forces) and its facets, the [`post_step`] hooks, [`stepper::Stepper`] (advances a state
 //! under the models) with the [`seam`] it evaluates forces through and the [`solve_report`]
 //! it gives, the [`tangent`] of implicit solves, the named, timed [`stages`] of a step and
@@ -14,6 +14,7 @@ pub mod local_particles;
 pub mod model;
 pub mod post_step;
 pub mod rigid_body;
+pub mod rigid_constraints;
 pub mod seam;
 pub mod solve_report;
 pub mod split;
@@ -33,6 +34,7 @@ pub use model::StepEvents;
 pub use post_step::Halt;
 pub use post_step::PostStep;
 pub use rigid_body::RigidBodies;
+pub use rigid_constraints::{MemberHold, PointHolds};
 pub use solve_report::FactorStats;
 pub use solve_report::SolveReport;
 pub use solve_report::StepCounts;

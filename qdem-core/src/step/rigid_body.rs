@@ -16,6 +16,7 @@
 //! principal moments spins at a constant rate.
 
 use crate::error::CoreError;
+use crate::step::rigid_constraints::PointHolds;
 use crate::step::state::State;
 use crate::{Mat3, Vec3};
 use nalgebra::{Rotation3, SymmetricEigen, UnitQuaternion};
@@ -40,6 +41,8 @@ pub struct RigidBodies {
     pub angular_velocity: Vec<Vec3>,
     /// Bodies whose rotation is held fixed (a body fixed in all three directions).
     pub spin_fixed: Vec<bool>,
+    /// Members held at points in some directions ([`crate::step::rigid_constraints`]).
+    pub holds: PointHolds,
     member_start: Vec<usize>,
     member: Vec<usize>,
     member_body: Vec<u32>,
@@ -70,6 +73,19 @@ impl RigidBodies {
     /// The member particles of body `b`.
     pub fn members(&self, b: usize) -> &[usize] {
         &self.member[self.member_start[b]..self.member_start[b + 1]]
+    }
+
+    /// The slot of particle `i` among the members (the index of its offset), if it is one.
+    pub(crate) fn member_slot(&self, i: usize) -> Option<usize> {
+        let b = self.body_of_member(i)?;
+        let slots = self.member_start[b]..self.member_start[b + 1];
+        slots.into_iter().find(|&slot| self.member[slot] == i)
+    }
+
+    /// The offset s of member slot `slot` from its body's centre, in the body's principal
+    /// frame (its arm is R s).
+    pub(crate) fn offset(&self, slot: usize) -> Vec3 {
+        self.offset[slot]
     }
 
     /// Rotational kinetic energy ½ Σ ω·L (J).

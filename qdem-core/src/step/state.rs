@@ -350,7 +350,8 @@ impl State {
     }
 
     /// Zeroes the velocity and acceleration of every fixed direction: of the particles, of
-    /// their rotations, and of the rigid bodies whose rotation is held. [`State::fix`] does this
+    /// their rotations, and of the rigid bodies whose rotation is held; rigid bodies held at
+    /// points are held where they are now ([`State::anchor_holds`]). [`State::fix`] does this
     /// when a direction is fixed; this does it again after motion was written from elsewhere
     /// (the checkpoint of another scene), so that every fixed direction starts at rest.
     ///
@@ -373,6 +374,9 @@ impl State {
             if self.rigid.spin_fixed[b] {
                 self.rigid.set_angular_velocity(b, Vec3::zeros());
             }
+        }
+        if !self.rigid.holds.is_empty() {
+            self.anchor_holds();
         }
     }
 

@@ -94,7 +94,9 @@ pub trait Stepper: Send {
     /// The total force on each particle (N) at the current state, from the step's last force
     /// evaluation (every model's; local damping leaves a fixed DOF's alone, as it does not
     /// move): at a fixed DOF, where the fixity
-    /// holds the particle, minus the force the fix carries (its reaction). Empty (the
+    /// holds the particle, minus the force the fix carries (its reaction); at a member of a
+    /// rigid body held at points ([`crate::step::rigid_constraints`]), minus the force its
+    /// holds carry there. Empty (the
     /// default) for a stepper that keeps none.
     fn forces(&self) -> &[Vec3] {
         &[]

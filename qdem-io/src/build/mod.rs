@@ -65,8 +65,8 @@ use qdem_core::step::model::Deformable;
 use qdem_core::step::rigid_body::tet_mass_properties;
 use qdem_core::{
     continuum::Material, continuum::TetBody, error::CoreError, loads::Gravity, loads::NodalLoad,
-    loads::TimeFunction, step::Dofs, step::EventSolve, step::Model, step::Scheme, step::State,
-    step::StepRequest, step::StepSettings, world::World, Mat3, Vec3,
+    loads::TimeFunction, step::Dofs, step::EventSolve, step::MemberHold, step::Model, step::Scheme,
+    step::State, step::StepRequest, step::StepSettings, world::World, Mat3, Vec3,
 };
 use qdem_mesh::{read_msh, FileIds, MeshError, MeshStats, TetMesh};
 use std::ops::Range;
@@ -229,7 +229,7 @@ impl Simulation {
             }
         }
         let (fix_particles, fix_frames) = apply_fixes(&scene, &meshes, &mut state)?;
-        fix_rigid_bodies(&scene, &bodies, &mut state);
+        fix_rigid_bodies(&scene, &bodies, &fix_particles, &mut state);
         let mut extra = ExtraSpheres::of_ballast(ballast.as_ref());
         let granular = add_granular(&scene, (&stones, sampled), &mut state, &mut extra)?;
         let periodic = periodic_box.map(|p| {
@@ -616,31 +616,43 @@ fn rigid_ballast_body(
     })
 }
 
-/// A rigid body is fixed in every direction any of its particles is fixed in, and its
-/// rotation too when all three are or a `[[fix]]` on it says `rotation = true`.
-fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], state: &mut State) {
+/// The `[[fix]]`es on rigid bodies' members (a rigid `[[body]]`, the `[ballast]`'s rigid
+/// stones): a body with `rotation = true` on one of its fixes only moves along, its rotation
+/// held and its centre fixed in every direction a member is held in; any other is held at its
+/// members in their directions ([`State::hold_members`]: free to turn about them, or held
+/// whole where they leave it no motion), each stone at its own members. `fixed` holds each
+/// fix's particles.
+fn fix_rigid_bodies(scene: &Scene, bodies: &[BodyInfo], fixed: &[Vec<usize>], state: &mut State) {
+    let on = &scene.refs().fix_bodies;
+    let mut holds = Vec::new();
     for (k, body) in bodies.iter().enumerate() {
-        let BodyKind::Rigid {
-            body: b, center, ..
-        } = body.kind
-        else {
+        if matches!(body.kind, BodyKind::Deformable { .. }) {
             continue;
+        }
+        let fixes = || {
+            scene
+                .fixes
+                .iter()
+                .zip(on)
+                .enumerate()
+                .filter(move |(_, (_, &b))| b == k)
         };
-        let dofs = body
-            .particles
-            .clone()
-            .fold(Dofs::NONE, |d, i| d.union(state.fixed[i]));
-        state.fix(center, dofs);
-        let held = scene
-            .fixes
-            .iter()
-            .zip(&scene.refs().fix_bodies)
-            .any(|(f, &on)| on == k && f.rotation);
-        if dofs == Dofs::ALL || held {
-            state.rigid.spin_fixed[b] = true;
-            state.rigid.set_angular_velocity(b, Vec3::zeros());
+        if let BodyKind::Rigid { body: b, .. } = body.kind {
+            if fixes().any(|(_, (f, _))| f.rotation) {
+                state.rigid.spin_fixed[b] = true;
+                state.rigid.set_angular_velocity(b, Vec3::zeros());
+            }
+        }
+        for (i, (fix, _)) in fixes() {
+            let dofs = Dofs::from_mask(fix.dofs);
+            holds.extend(fixed[i].iter().map(|&particle| MemberHold {
+                particle,
+                dofs,
+                fix: i + 1,
+            }));
         }
     }
+    state.hold_members(&holds);
 }
 
 /// Fixes the selected directions of the selected particles of every `[[fix]]`, on the axes

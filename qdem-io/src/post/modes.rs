@@ -139,6 +139,10 @@ pub fn compute_and_write(
 
 /// A refusal of a rigid body by its index, given the body's scene name instead.
 fn named(sim: &Simulation, error: ModalError) -> ModalError {
+    if let ModalError::HeldAtPoints { fix, .. } = error {
+        let body = format!("body `{}`", sim.scene.fixes[fix - 1].body);
+        return ModalError::HeldAtPoints { body, fix };
+    }
     let ModalError::PartlyConstrainedRigid { body, modes } = error else {
         return error;
     };

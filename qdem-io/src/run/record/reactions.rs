@@ -13,8 +13,12 @@
 //! (directions parallel, in any frame, count as one) is shared equally,
 //! 1/n of its force to each, so the fixes' reactions sum to the supports' total whatever
 //! their overlap (over-constrained in no physical sense: a held direction stays at rest
-//! whichever fix holds it, so no fix has a better claim to its force). Fixes on a rigid
-//! body (which its centre holds) are left out. In a run over MPI ranks the forces are
+//! whichever fix holds it, so no fix has a better claim to its force). A fix on a rigid
+//! body's members holds the body at those points ([`qdem_core::step::rigid_constraints`]):
+//! the stepper puts at each held member the force −μ e (μ the least-norm constraint forces
+//! of the body's holds), so the same sums give its reaction; the fixes of a body whose
+//! rotation `rotation = true` holds (its centre holds it then, not its points) are left out.
+//! In a run over MPI ranks the forces are
 //! gathered from the particles' owners with the state ([`qdem_core::world::World::gather`]), so the
 //! file is the same for any rank count. A wall's force is `walls.csv`'s.
 //!
@@ -74,7 +78,8 @@ struct NodeRows {
 }
 
 impl Reactions {
-    /// The record of `sim`'s fixes on deformable bodies; `None` when there is none.
+    /// The record of `sim`'s fixes on deformable bodies and of those holding rigid bodies at
+    /// points; `None` when there is none.
     pub(crate) fn new(sim: &Simulation, out_dir: &Path) -> Option<Reactions> {
         let state = &sim.world.state;
         let scene = &sim.scene;
@@ -84,7 +89,10 @@ impl Reactions {
             .zip(&scene.refs().fix_bodies)
             .zip(scene.fixes.iter().zip(&sim.fix_frames))
             .enumerate()
-            .filter(|(_, ((_, &b), _))| matches!(sim.bodies[b].kind, BodyKind::Deformable { .. }))
+            .filter(|(k, ((_, &b), _))| {
+                let deformable = matches!(sim.bodies[b].kind, BodyKind::Deformable { .. });
+                deformable || state.rigid.holds.holds_fix(k + 1)
+            })
             .map(|(k, ((particles, _), (fix, frames)))| Held {
                 number: k + 1,
                 particles,

@@ -26,7 +26,8 @@ pub struct Fix {
     /// r, θ, z in a cylindrical frame; e₁, e₂, e₃ of a basis), from `dofs` (default all three).
     pub dofs: [bool; 3],
     /// Also hold the rotation of the (rigid) body: `rotation = true`, e.g. a sleeper guided
-    /// vertically by `dofs = "xy"`. Default false.
+    /// vertically by `dofs = "xy"`; its centre is then held in `dofs`. Default false: the
+    /// body is held at the selected members (`qdem_core::step::rigid_constraints`).
     pub rotation: bool,
     /// The frame `dofs` names directions of: the axes unless `frame` is given.
     #[serde(skip_serializing_if = "FixFrame::is_axes")]
@@ -144,7 +145,10 @@ scene_table! {
              \"123\" of a basis (then required). `reactions.csv` gives the force the fix carries.";
         #[serde(default)]
         rotation: bool => "bool", optional = "false",
-            "Also hold a rigid body's rotation; default false.";
+            "Also hold a rigid body's rotation, its centre then held in `dofs`; default false: \
+             a fix on a rigid body's members holds the body at those points in `dofs`, free to \
+             turn about them (held at one point it swings as a pendulum, along a line as a \
+             hinge), and `reactions.csv` gives its reaction.";
         #[serde(default)]
         frame: Option<RawFrame> => "\"cylindrical\" or [[x, y, z], [x, y, z], [x, y, z]]", optional,
             "Hold `dofs` in a local frame of a deformable body: \"cylindrical\" (about `axis` \

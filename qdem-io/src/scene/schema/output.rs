@@ -25,8 +25,8 @@ scene_table! {
         #[serde(default)]
         node_reactions: bool => "bool", optional = "false",
             "Whether to write `node_reactions.csv`: every `probe_every`, the force each `[[fix]]` \
-             of a deformable body carries at each of its particles, with the particle's gmsh node \
-             id and reference position; default false.";
+             of a deformable body, or holding a rigid body at points, carries at each of its \
+             particles, with the particle's gmsh node id and reference position; default false.";
     }
 }
 
