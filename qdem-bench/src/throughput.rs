@@ -31,12 +31,6 @@ pub struct BenchPlan {
     pub steps: Option<usize>,
     /// The tetrahedron measured.
     pub formulation: Formulation,
-    /// Integrate in the stepper's separate sweeps instead of inside the block pass
-    /// (`qdem_core::solvers::Verlet::with_separate_passes`): the same bits, the previous traffic.
-    pub separate_passes: bool,
-    /// Instead of the cubes: this many stones of 108 tetrahedra as one body, as `[ballast]`
-    /// builds them, against one cube of about the same total ([`stones_body`]).
-    pub stones: Option<usize>,
 }
 
 impl BenchPlan {
@@ -52,8 +46,6 @@ impl BenchPlan {
             threads: threads.unwrap_or_else(|| vec![1, 2]),
             steps,
             formulation,
-            separate_passes: false,
-            stones: None,
         }
     }
 }
@@ -67,10 +59,6 @@ pub struct BenchResult {
     pub particles: usize,
     /// Entries of the block sums (`qdem_core::continuum::tet_blocks::BlockLayout::block_nodes`).
     pub block_nodes: usize,
-    /// Particles interior to one block (`BlockLayout::interior`).
-    pub interior: usize,
-    /// Whether the body integrated its particles in its block pass (`qdem_core::step::fused`).
-    pub fused: bool,
     /// Whether the viscous path ran.
     pub viscous: bool,
     /// The tetrahedron measured.
@@ -89,59 +77,39 @@ impl BenchResult {
         (self.tets * self.steps) as f64 / self.seconds
     }
 
-    /// Compulsory memory traffic of one step divided by the tetrahedra (bytes): each array
-    /// element read or written once per pass that touches it, for the blocked kernel of
-    /// `qdem_core::continuum::tet_blocks`.
-    ///
-    /// In separate passes (the stepper's two sweeps around the force pass):
-    /// - per tetrahedron its pack record, dX⁻¹ and four local corners (80 B);
+    /// Compulsory memory traffic of one step divided by the tetrahedra (bytes), for the blocked
+    /// kernel of `qdem_core::continuum::tet_blocks`:
+    /// - per tetrahedron its hot record, dX⁻¹ and four local corners (80 B);
     /// - per block node (a particle counted once per block that touches it): its index (4 B),
     ///   its position copied in (24 B, 48 B with velocities), its block sum written and read
-    ///   back (48 B) and the sum's entry index (4 B);
-    /// - per particle: the sum's range (4 B); the drift sweep reading x, v, a, writing x, v and
-    ///   zeroing f (144 B); the sum added into f (48 B); the kick sweep reading f, m, the
-    ///   fixity, v and writing a, v (105 B): 301 B.
+    ///   back by the gather (48 B) and the gather's entry index (4 B);
+    /// - per particle: the gather's range (4 B); the force zeroed, added to and read by the
+    ///   accelerations (96 B); the drift and first half kick reading x, v, a and writing x, v
+    ///   (120 B); a = f/m with mass and fixity (33 B); the second half kick (72 B).
     ///
     /// The averaged-pressure tetrahedron
-    /// ([`qdem_core::continuum::averaged_pressure_tet`], always in separate passes) adds its
-    /// strain pass and average: per tetrahedron the pack read again and its volume (88 B); per
-    /// block node its index and position copied in again (28 B, 52 B with velocities), its slot
-    /// sum written and read back (48 B), the average's entry index (4 B) and the average copied
-    /// into the force pass (24 B); per particle the average's range, inverse volume and average
-    /// written (36 B).
-    ///
-    /// Fused (`qdem_core::step::fused`), where a particle interior to one block is integrated
-    /// in that block's pass:
-    /// - per tetrahedron 80 B; per block node its index and position (28 B, 52 B with
-    ///   velocities); per block node of a shared particle its sum out and back and its entry
-    ///   index (52 B);
-    /// - per interior particle: v (elastic; viscous, with its block node) and a read (24 +
-    ///   24 B), m and the fixity (9 B), x, v, a and f written (96 B): 153 B elastic, 129 B
-    ///   viscous;
-    /// - per other particle: the range (4 B), the drift (x, v, a in, x, v out: 120 B), f, a
-    ///   written (48 B), m and the fixity (9 B), v in and out in the kick (48 B): 229 B.
+    /// ([`qdem_core::continuum::averaged_pressure_tet`]) adds its strain pass and average:
+    /// per tetrahedron the pack read again and its volume (88 B); per block node its index
+    /// and position copied in again (28 B, 52 B with velocities), its slot sum written and
+    /// read back (48 B), the average's entry index (4 B) and the average copied into the force
+    /// pass (24 B); per particle the average's range, inverse volume and average written
+    /// (36 B).
     pub fn bytes_per_tet_step(&self) -> f64 {
-        let velocities = if self.viscous { 24.0 } else { 0.0 };
-        let (tets, nodes) = (self.tets as f64, self.block_nodes as f64);
-        let particles = self.particles as f64;
-        if !self.fused {
-            let (mut per_tet, mut per_block_node, mut per_particle) =
-                (80.0, 80.0 + velocities, 301.0);
-            if self.formulation == Formulation::AveragedPressure {
-                per_tet += 88.0;
-                per_block_node += 28.0 + velocities + 48.0 + 4.0 + 24.0;
+        let visco = if self.viscous { 24.0 } else { 0.0 };
+        let (per_tet, mut per_block_node, mut per_particle) =
+            (80.0, 80.0 + visco, 4.0 + 96.0 + 120.0 + 33.0 + 72.0);
+        let per_tet = match self.formulation {
+            Formulation::Standard => per_tet,
+            Formulation::AveragedPressure => {
+                per_block_node += 28.0 + visco + 48.0 + 4.0 + 24.0;
                 per_particle += 36.0;
+                per_tet + 88.0
             }
-            return (per_tet * tets + per_block_node * nodes + per_particle * particles) / tets;
-        }
-        let interior = self.interior as f64;
-        let per_interior = 129.0 + 24.0 - velocities;
-        (80.0 * tets
-            + (28.0 + velocities) * nodes
-            + 52.0 * (nodes - interior)
-            + per_interior * interior
-            + 229.0 * (particles - interior))
-            / tets
+        };
+        (per_tet * self.tets as f64
+            + per_block_node * self.block_nodes as f64
+            + per_particle * self.particles as f64)
+            / self.tets as f64
     }
 
     /// Floating-point operations of one tet-step in the kernel (a multiply-add counted as two;
@@ -263,42 +231,6 @@ fn shuffled(n: usize, seed: &mut u64) -> Vec<u32> {
     p
 }
 
-/// Tetrahedra of one stone of [`stones_mesh`]: a brick of 3 × 3 × 2 cells of 10 mm (paper
-/// 000 §4: about 100 tetrahedra of 10 mm edges a stone).
-pub const STONE_TETS: usize = 108;
-
-/// `count` stones of [`STONE_TETS`] tetrahedra, each its own brick of 3 × 3 × 2 cells of
-/// 10 mm in its own cell of a cubic lattice with 5 mm gaps, stone after stone in the node and
-/// tetrahedron order, as `[ballast]` builds its stones into one mesh.
-pub fn stones_mesh(count: usize) -> TetMesh {
-    let stone = structured_box([0.0; 3], [0.03, 0.03, 0.02], [3, 3, 2]).expect("a brick");
-    let side = (count as f64).cbrt().ceil() as usize;
-    let (mut nodes, mut tets) = (Vec::new(), Vec::new());
-    for k in 0..count {
-        let cell = [k % side, (k / side) % side, k / (side * side)];
-        let shift = cell.map(|c| 0.035 * c as f64);
-        let first = nodes.len() as u32;
-        nodes.extend(
-            stone
-                .nodes
-                .iter()
-                .map(|p| std::array::from_fn(|c| p[c] + shift[c])),
-        );
-        tets.extend(stone.tets.iter().map(|t| t.map(|n| n + first)));
-    }
-    TetMesh {
-        nodes,
-        tets,
-        groups: Vec::new(),
-        file_ids: Default::default(),
-    }
-}
-
-/// [`body_on`] over [`stones_mesh`]`(count)`: the stones as one body.
-pub fn stones_body(count: usize, viscous: bool) -> (TetBody, State) {
-    body_on(stones_mesh(count), viscous)
-}
-
 /// A body over `mesh` with the cantilever's material (viscous: μ_D = 10⁴, κ_D = 10³ Pa s) and
 /// its state with a small smooth velocity, so that the kernel works on a deformed state.
 pub fn body_on(mesh: TetMesh, viscous: bool) -> (TetBody, State) {
@@ -322,70 +254,59 @@ pub fn block(tets: usize, viscous: bool) -> (TetBody, State) {
     body_on(block_mesh(tets, Ordering::Structured), viscous)
 }
 
-/// How one measurement steps its body.
-#[derive(Clone, Copy, Debug)]
-pub struct Stepping {
-    /// Threads.
-    pub threads: usize,
-    /// Steps timed (default: about one second's worth, at least 3).
-    pub steps: Option<usize>,
-    /// Integrate in the stepper's separate sweeps ([`BenchPlan::separate_passes`]).
-    pub separate_passes: bool,
-    /// The tetrahedron measured (an averaged-pressure body always takes the separate passes).
-    pub formulation: Formulation,
-}
-
 /// Times Verlet steps of `block(tets, viscous)` on `threads` threads.
 pub fn measure(tets: usize, viscous: bool, threads: usize, steps: Option<usize>) -> BenchResult {
-    let how = Stepping {
-        threads,
-        steps,
-        separate_passes: false,
-        formulation: Formulation::Standard,
-    };
-    measure_ordered(tets, Ordering::Structured, viscous, how)
+    measure_ordered(tets, Ordering::Structured, viscous, threads, steps)
 }
 
-/// Times Verlet steps of a block in the given node ordering.
+/// Times Verlet steps of `block(tets, viscous)` in `formulation` on `threads` threads.
+pub fn measure_formulation(
+    tets: usize,
+    viscous: bool,
+    formulation: Formulation,
+    threads: usize,
+    steps: Option<usize>,
+) -> BenchResult {
+    let mesh = block_mesh(tets, Ordering::Structured);
+    measure_body(mesh, viscous, formulation, threads, steps)
+}
+
+/// Times Verlet steps of a block in the given node ordering on `threads` threads.
 pub fn measure_ordered(
     tets: usize,
     ordering: Ordering,
     viscous: bool,
-    how: Stepping,
+    threads: usize,
+    steps: Option<usize>,
 ) -> BenchResult {
-    measure_body(
-        || body_on(block_mesh(tets, ordering), viscous),
-        viscous,
-        how,
-    )
+    let mesh = block_mesh(tets, ordering);
+    measure_body(mesh, viscous, Formulation::Standard, threads, steps)
 }
 
-/// Times Verlet steps of the body `build` gives (built on the measurement's threads).
-pub fn measure_body(
-    build: impl FnOnce() -> (TetBody, State) + Send,
+/// Times Verlet steps of the body of [`body_on`] over `mesh` in `formulation` on `threads`
+/// threads.
+fn measure_body(
+    mesh: TetMesh,
     viscous: bool,
-    how: Stepping,
+    formulation: Formulation,
+    threads: usize,
+    steps: Option<usize>,
 ) -> BenchResult {
-    on_threads(how.threads, || {
-        let (body, mut state) = build();
-        let body = body.with_formulation(how.formulation);
+    on_threads(threads, || {
+        let (body, mut state) = body_on(mesh, viscous);
+        let body = body.with_formulation(formulation);
         let tets = body.tets().len();
-        let layout = body.block_layout();
+        let block_nodes = body.block_layout().block_nodes;
         let dt = 0.9 * body.stable_dt(&state).expect("a body bounds the step");
         let mut models: Vec<Box<dyn Model>> = vec![Box::new(body)];
-        let mut stepper = match how.separate_passes {
-            true => Verlet::new(dt).with_separate_passes(),
-            false => Verlet::new(dt),
-        };
+        let mut stepper = Verlet::new(dt);
         stepper.initialize(&mut state, &mut models).expect("stable");
         let warm = Instant::now();
         for _ in 0..3 {
             stepper.step(&mut state, &mut models).expect("stable");
         }
         let per_step = warm.elapsed().as_secs_f64() / 3.0;
-        let steps = how
-            .steps
-            .unwrap_or(((1.0 / per_step) as usize).clamp(3, 2000));
+        let steps = steps.unwrap_or(((1.0 / per_step) as usize).clamp(3, 2000));
         let start = Instant::now();
         for _ in 0..steps {
             stepper.step(&mut state, &mut models).expect("stable");
@@ -393,12 +314,10 @@ pub fn measure_body(
         BenchResult {
             tets,
             particles: state.len(),
-            block_nodes: layout.block_nodes,
-            interior: layout.interior,
-            fused: !how.separate_passes && how.formulation == Formulation::Standard,
+            block_nodes,
             viscous,
-            formulation: how.formulation,
-            threads: how.threads,
+            formulation,
+            threads,
             steps,
             seconds: start.elapsed().as_secs_f64(),
         }
@@ -480,8 +399,7 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
             );
         }
         println!(
-            "{:>7} {:>9} {:>9} {:>8} {:>7} {:>6} {:>14} {:>10} {:>10} {:>10}",
-            "body",
+            "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14} {:>10} {:>10} {:>10}",
             "tets",
             "particles",
             "material",
@@ -493,16 +411,10 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
             "% of peak"
         );
     }
-    for shape in shapes(plan) {
+    for &tets in &plan.tets {
         for viscous in [false, true] {
             for &threads in &plan.threads {
-                let how = Stepping {
-                    threads,
-                    steps: plan.steps,
-                    separate_passes: plan.separate_passes,
-                    formulation: plan.formulation,
-                };
-                let r = measure_body(|| shape.body(viscous), viscous, how);
+                let r = measure_formulation(tets, viscous, plan.formulation, threads, plan.steps);
                 let bw = bandwidth
                     .iter()
                     .find(|b| b.0 == threads)
@@ -515,8 +427,7 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
                 let of_peak = r.tet_steps_per_second() * r.flops_per_tet_step() as f64 / peak;
                 if !as_json {
                     println!(
-                        "{:>7} {:>9} {:>9} {:>8} {:>7} {:>6} {:>14.4e} {:>10.0} {:>9.0}% {:>9.0}%",
-                        shape.label(),
+                        "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14.4e} {:>10.0} {:>9.0}% {:>9.0}%",
                         r.tets,
                         r.particles,
                         if viscous { "visco" } else { "elastic" },
@@ -529,7 +440,6 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
                     );
                 }
                 results.push(json!({
-                    "body": shape.label(), "fused": r.fused, "interior_particles": r.interior,
                     "tets": r.tets, "particles": r.particles, "block_nodes": r.block_nodes,
                     "material": if viscous { "viscoelastic" } else { "elastic" },
                     "formulation": r.formulation.name(),
@@ -558,55 +468,11 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
     }
 }
 
-/// A body `qdem bench` times.
-#[derive(Clone, Copy, Debug)]
-enum Shape {
-    /// A structured cube of about this many tetrahedra ([`block_mesh`]).
-    Cube(usize),
-    /// This many stones as one body ([`stones_body`]).
-    Stones(usize),
-}
-
-impl Shape {
-    fn body(self, viscous: bool) -> (TetBody, State) {
-        match self {
-            Shape::Cube(tets) => block(tets, viscous),
-            Shape::Stones(count) => stones_body(count, viscous),
-        }
-    }
-
-    fn label(self) -> &'static str {
-        match self {
-            Shape::Cube(_) => "cube",
-            Shape::Stones(_) => "stones",
-        }
-    }
-}
-
-/// The bodies of `plan`: the cubes of its sizes, or its stones and a cube of about their
-/// total.
-fn shapes(plan: &BenchPlan) -> Vec<Shape> {
-    match plan.stones {
-        Some(count) => vec![Shape::Stones(count), Shape::Cube(count * STONE_TETS)],
-        None => plan.tets.iter().map(|&t| Shape::Cube(t)).collect(),
-    }
-}
-
 /// Effect of node ordering: the largest planned block, elastic, on the most threads, in
-/// generator order, shuffled, and shuffled then reordered (reverse Cuthill–McKee); none for
-/// a plan of stones.
+/// generator order, shuffled, and shuffled then reordered (reverse Cuthill–McKee).
 fn locality_rows(plan: &BenchPlan, as_json: bool) -> Vec<serde_json::Value> {
     let (Some(&tets), Some(&threads)) = (plan.tets.iter().max(), plan.threads.iter().max()) else {
         return Vec::new();
-    };
-    if plan.stones.is_some() {
-        return Vec::new();
-    }
-    let how = Stepping {
-        threads,
-        steps: plan.steps,
-        separate_passes: plan.separate_passes,
-        formulation: Formulation::Standard,
     };
     if !as_json {
         println!("node ordering, {tets} tets, elastic, {threads} threads:");
@@ -614,7 +480,7 @@ fn locality_rows(plan: &BenchPlan, as_json: bool) -> Vec<serde_json::Value> {
     [Ordering::Structured, Ordering::Shuffled, Ordering::Reordered]
         .into_iter()
         .map(|ordering| {
-            let r = measure_ordered(tets, ordering, false, how);
+            let r = measure_ordered(tets, ordering, false, threads, plan.steps);
             if !as_json {
                 println!("{:>12?} {:>14.4e} tet-steps/s", ordering, r.tet_steps_per_second());
             }

@@ -253,15 +253,6 @@ pub struct BenchArgs {
     /// formulation)
     #[arg(long, value_name = "NAME", default_value = "standard")]
     pub formulation: BenchFormulation,
-    /// Integrate in the stepper's separate sweeps instead of inside the block pass (the same
-    /// results; the traffic before the fused step)
-    #[arg(long)]
-    pub separate_passes: bool,
-    /// Instead of the cubes of --tets: N stones of 108 tetrahedra as one body (as [ballast]
-    /// builds them) against one cube of about the same total
-    #[arg(long, value_name = "N", value_parser = positive_whole, allow_negative_numbers = true,
-          conflicts_with_all = ["tets", "implicit"])]
-    pub stones: Option<usize>,
 }
 
 /// The tetrahedron `qdem bench` measures (`[[material]] formulation`).
@@ -454,14 +445,8 @@ pub fn dispatch(cli: Cli, ranks: Option<Arc<dyn Communicator>>) -> Result<(), Cl
                 }
                 return Ok(implicit::run_and_print(Some(sizes), threads, a.json)?);
             }
-            let mut plan = BenchPlan::new(a.tets, a.threads, a.steps, a.formulation.core());
-            plan.separate_passes = a.separate_passes;
-            plan.stones = a.stones;
-            let sizes = match a.stones {
-                Some(stones) => vec![stones.saturating_mul(throughput::STONE_TETS)],
-                None => plan.tets.clone(),
-            };
-            for &tets in &sizes {
+            let plan = BenchPlan::new(a.tets, a.threads, a.steps, a.formulation.core());
+            for &tets in &plan.tets {
                 throughput::check_block(tets, false)?;
             }
             throughput::run_and_print(&plan, a.json);

@@ -170,50 +170,6 @@ fn bench_takes_comma_separated_lists() {
 }
 
 #[test]
-fn bench_times_stones_against_one_body_and_models_the_fused_traffic() {
-    // 20 stones of 108 tetrahedra and 48 particles each as one body, and a cube of about
-    // their 2,160 tetrahedra; fused (the default) and in the separate passes. The fused step
-    // moves fewer bytes on every row (each block's interior particles cross memory once).
-    let rows = |extra: &[&str]| -> Vec<serde_json::Value> {
-        let mut args = vec![
-            "bench",
-            "--json",
-            "--stones",
-            "20",
-            "--threads",
-            "1",
-            "--steps",
-            "2",
-        ];
-        args.extend(extra);
-        let stdout = success(&args);
-        let doc: serde_json::Value = serde_json::from_str(&stdout)
-            .unwrap_or_else(|e| panic!("stdout is not JSON ({e}):\n{stdout}"));
-        assert_eq!(doc["locality"].as_array().map(Vec::len), Some(0), "{doc:#}");
-        doc["results"].as_array().expect("results").clone()
-    };
-    let (fused, separate) = (rows(&[]), rows(&["--separate-passes"]));
-    assert_eq!((fused.len(), separate.len()), (4, 4));
-    for (f, s) in fused.iter().zip(&separate) {
-        assert_eq!((&f["body"], &f["tets"]), (&s["body"], &s["tets"]));
-        assert_eq!(
-            (f["fused"].as_bool(), s["fused"].as_bool()),
-            (Some(true), Some(false))
-        );
-        if f["body"] == "stones" {
-            assert_eq!(
-                (f["tets"].as_u64(), f["particles"].as_u64()),
-                (Some(2160), Some(960))
-            );
-        } else {
-            assert_eq!(f["body"], "cube", "{f}");
-        }
-        let bytes = |row: &serde_json::Value| row["bytes_per_tet_step"].as_f64().unwrap();
-        assert!(bytes(f) < bytes(s), "{f}\n{s}");
-    }
-}
-
-#[test]
 fn check_names_each_bodys_kind_and_what_limits_the_step() {
     let fixtures = concat!(env!("CARGO_MANIFEST_DIR"), "/../fixtures/ballast/");
     let limit = |line: &str, out: &str| -> f64 {

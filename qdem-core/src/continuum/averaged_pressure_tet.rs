@@ -217,7 +217,7 @@ impl AveragedPressure {
                     false => strain_sums::<false>(set, packs, &input, out),
                 }
             });
-            [usize::MAX]
+            usize::MAX
         });
     }
 

@@ -37,7 +37,7 @@ const MIN_BLOCK: usize = 256;
 /// let nodes = vec![Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()];
 /// let body = TetBody::new("tet", &nodes, vec![[0, 1, 2, 3]], Material::elastic(1.0, 1.0, 0.25))?;
 /// let layout = body.block_layout();
-/// assert_eq!((layout.blocks, layout.block_nodes, layout.interior), (1, 4, 4));
+/// assert_eq!((layout.blocks, layout.block_nodes), (1, 4));
 /// # Ok::<(), qdem_core::error::CoreError>(())
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,9 +47,6 @@ pub struct BlockLayout {
     /// Sum over the blocks of the particles each touches: the entries of the block sums, at
     /// least the body's particle count (each particle shared by k blocks counts k times).
     pub block_nodes: usize,
-    /// Particles that only one block touches: those a fused step integrates in the block
-    /// pass ([`crate::step::fused`]).
-    pub interior: usize,
 }
 
 /// One tetrahedron as the hot loop reads it: the inverse reference edge matrix and the four
@@ -87,68 +84,6 @@ pub(crate) struct TetBlocks {
     /// Indices into `nodes` (and the sums laid out like it) of each particle's block entries,
     /// in ascending block order.
     pub entries: Vec<u32>,
-    /// Each block's nodes split by who touches them: [`Owners::interior`], those of no other
-    /// block, which a fused step integrates in the block's pass
-    /// ([`crate::step::fused`]), and [`Owners::shared`].
-    pub owners: Owners,
-}
-
-/// Which of a block's nodes it owns alone, as local indices into the block's nodes.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Owners {
-    /// Per block, the range of its interior nodes in `interior`.
-    pub interior_start: Vec<u32>,
-    /// The local indices of the nodes that no other block touches, ascending per block.
-    pub interior: Vec<u16>,
-    /// Per block, the range of its shared nodes in `shared`.
-    pub shared_start: Vec<u32>,
-    /// The local indices of the nodes another block touches too, ascending per block.
-    pub shared: Vec<u16>,
-    /// The particles from `first` to the last node that are interior to no block (shared by
-    /// blocks, or used by no tetrahedron), ascending.
-    pub outside: Vec<u32>,
-}
-
-impl Owners {
-    /// The owners of the blocks laid out by `node_start` over `nodes`, from the entry counts.
-    fn new(node_start: &[u32], nodes: &[u32], first: usize, entry_start: &[u32]) -> Owners {
-        let alone = |n: u32| {
-            let i = n as usize - first;
-            entry_start[i + 1] - entry_start[i] == 1
-        };
-        let mut owners = Owners {
-            interior_start: vec![0],
-            shared_start: vec![0],
-            ..Owners::default()
-        };
-        for range in node_start.windows(2) {
-            let block = &nodes[range[0] as usize..range[1] as usize];
-            for (l, &n) in block.iter().enumerate() {
-                match alone(n) {
-                    true => owners.interior.push(l as u16),
-                    false => owners.shared.push(l as u16),
-                }
-            }
-            owners.interior_start.push(owners.interior.len() as u32);
-            owners.shared_start.push(owners.shared.len() as u32);
-        }
-        let count = entry_start.len() - 1;
-        owners.outside = (0..count)
-            .filter(|&i| entry_start[i + 1] - entry_start[i] != 1)
-            .map(|i| (first + i) as u32)
-            .collect();
-        owners
-    }
-
-    /// Block `b`'s interior nodes (local indices).
-    pub fn interior(&self, b: usize) -> &[u16] {
-        &self.interior[self.interior_start[b] as usize..self.interior_start[b + 1] as usize]
-    }
-
-    /// Block `b`'s shared nodes (local indices).
-    pub fn shared(&self, b: usize) -> &[u16] {
-        &self.shared[self.shared_start[b] as usize..self.shared_start[b + 1] as usize]
-    }
 }
 
 impl TetBlocks {
@@ -172,7 +107,6 @@ impl TetBlocks {
         }
         let (node_start, nodes, hot) = block_nodes(tets, dm_inv, &order, &tet_start);
         let (first, entry_start, entries) = entry_lists(&nodes);
-        let owners = Owners::new(&node_start, &nodes, first, &entry_start);
         let (mut packs, mut pack_start) = (Vec::new(), vec![0u32]);
         for range in tet_start.windows(2) {
             packs.extend(tet_lanes::packs(&hot[range[0] as usize..range[1] as usize]));
@@ -190,7 +124,6 @@ impl TetBlocks {
             first,
             entry_start,
             entries,
-            owners,
         }
     }
 
@@ -204,7 +137,6 @@ impl TetBlocks {
         BlockLayout {
             blocks: self.len(),
             block_nodes: self.nodes.len(),
-            interior: self.owners.interior.len(),
         }
     }
 
@@ -373,35 +305,5 @@ mod tests {
         // nodes to two, so the entries exceed the particles by a few cut planes.
         let extra = blocks.entries.len() - x.len();
         assert!(extra <= 4 * 2 * (blocks.len() - 1), "{extra}");
-    }
-
-    #[test]
-    fn a_particle_is_interior_to_one_block_or_outside_all_of_them() {
-        // Each particle is either one block's interior node (one entry) or on the outside
-        // list (several entries): never both, never neither.
-        let (x, tets) = bar(700);
-        let blocks = TetBlocks::new(&x, &tets, &vec![Mat3::identity(); tets.len()]);
-        let owners = &blocks.owners;
-        let mut interior_of = vec![None; x.len()];
-        for b in 0..blocks.len() {
-            let nodes = &blocks.nodes[blocks.node_start[b] as usize..];
-            let mut locals: Vec<u16> = owners.interior(b).to_vec();
-            locals.extend(owners.shared(b));
-            locals.sort_unstable();
-            let count = (blocks.node_start[b + 1] - blocks.node_start[b]) as usize;
-            assert_eq!(locals, (0..count as u16).collect::<Vec<_>>(), "block {b}");
-            for &l in owners.interior(b) {
-                let n = nodes[l as usize] as usize;
-                assert_eq!(interior_of[n], None);
-                interior_of[n] = Some(b);
-            }
-        }
-        for (i, owner) in interior_of.iter().enumerate() {
-            let entries = blocks.entry_start[i + 1] - blocks.entry_start[i];
-            let outside = owners.outside.binary_search(&(i as u32)).is_ok();
-            assert_eq!(owner.is_some(), entries == 1, "particle {i}");
-            assert_eq!(outside, owner.is_none(), "particle {i}");
-        }
-        assert!(blocks.layout().interior > x.len() / 2);
     }
 }

@@ -25,7 +25,6 @@ use crate::continuum::tet_kernel::{
 };
 use crate::continuum::tet_lanes::{block_forces, BlockInput, LaneSet};
 use crate::error::CoreError;
-use crate::step::fused::FusedStep;
 use crate::step::model::{Deformable, Linearized, Model, Persistence};
 use crate::step::split::{Averaging, NodalValues};
 use crate::step::split::{BodyLayout, BodySplit};
@@ -45,8 +44,6 @@ const PARTICLE_CHUNK: usize = 1024;
 /// the blocks: the viscous path costs about 1.6 times the elastic one (docs/BENCHMARKS.md,
 /// kernel section).
 const VISCOUS_COST: f64 = 1.6;
-
-mod fused;
 
 /// A deformable body of linear QDEM tetrahedra.
 ///
@@ -328,15 +325,15 @@ impl TetBody {
         let mut sums = std::mem::take(&mut self.sums);
         let this = &*self;
         let start = &self.blocks.node_start;
-        let [inverted] = for_blocks(
+        let inverted = for_blocks(
             &mut sums[start[range.start] as usize..start[range.end] as usize],
             range,
             start,
             &|b, out| match &this.averaged {
-                Some(averaged) => [averaged.block_forces::<VISCOUS>(&this.blocks, b, state, out)],
+                Some(averaged) => averaged.block_forces::<VISCOUS>(&this.blocks, b, state, out),
                 None => {
                     let mut scratch = this.scratch.for_this_thread();
-                    [this.block_pass::<VISCOUS>(b, state, out, &mut scratch)]
+                    this.block_pass::<VISCOUS>(b, state, out, &mut scratch)
                 }
             },
         );
@@ -361,28 +358,13 @@ impl TetBody {
             &state.position,
             VISCOUS.then_some(&state.velocity[..]),
         );
-        self.forces_of_block::<VISCOUS>(b, &scratch.x, &scratch.v, out)
-    }
-
-    /// The forces of block `b`'s tetrahedra at its nodes' positions `x` (and velocities `v`,
-    /// read on the viscous path only), added into `out` (zeroed first; one sum per node of
-    /// the block). Returns the body's index of its first inverted tetrahedron, `usize::MAX`
-    /// if none.
-    fn forces_of_block<const VISCOUS: bool>(
-        &self,
-        b: usize,
-        x: &[Vec3],
-        v: &[Vec3],
-        out: &mut [Vec3],
-    ) -> usize {
-        let blocks = &self.blocks;
         out.fill(Vec3::zeros());
         let (elastic, viscous) = (self.pair(), self.vpair());
         let range = blocks.tet_start[b] as usize..blocks.tet_start[b + 1] as usize;
         let packs = &blocks.packs[blocks.pack_start[b] as usize..blocks.pack_start[b + 1] as usize];
         let input = BlockInput {
-            x,
-            v,
+            x: &scratch.x,
+            v: &scratch.v,
             elastic,
             viscous,
             count: range.len(),
@@ -392,10 +374,13 @@ impl TetBody {
         }
         let mut first_inverted = usize::MAX;
         for (k, hot) in range.clone().zip(&blocks.hot[range]) {
-            let xs = corners(x, hot.local);
-            let vs = if VISCOUS { corners(v, hot.local) } else { xs };
-            let (forces, six_volume) =
-                tet_forces::<VISCOUS>(&xs, &vs, &hot.dm_inv, elastic, viscous);
+            let x = corners(&scratch.x, hot.local);
+            let v = if VISCOUS {
+                corners(&scratch.v, hot.local)
+            } else {
+                x
+            };
+            let (forces, six_volume) = tet_forces::<VISCOUS>(&x, &v, &hot.dm_inv, elastic, viscous);
             for (&l, f) in hot.local.iter().zip(forces) {
                 out[l as usize] += f;
             }
@@ -445,14 +430,13 @@ fn corners(values: &[Vec3], local: [u16; 4]) -> [Vec3; 4] {
 }
 
 /// Runs `pass(b, sums of b)` for the blocks in `range` in parallel, splitting `sums` (laid out
-/// per block by `node_start`) between them; returns the element-wise smallest of the indices
-/// `pass` returned.
-pub(crate) fn for_blocks<const N: usize>(
+/// per block by `node_start`) between them; returns the smallest index `pass` returned.
+pub(crate) fn for_blocks(
     sums: &mut [Vec3],
     range: std::ops::Range<usize>,
     node_start: &[u32],
-    pass: &(dyn Fn(usize, &mut [Vec3]) -> [usize; N] + Sync),
-) -> [usize; N] {
+    pass: &(dyn Fn(usize, &mut [Vec3]) -> usize + Sync),
+) -> usize {
     if range.len() == 1 {
         return pass(range.start, sums);
     }
@@ -462,7 +446,7 @@ pub(crate) fn for_blocks<const N: usize>(
         || for_blocks(left, range.start..mid, node_start, pass),
         || for_blocks(right, mid..range.end, node_start, pass),
     );
-    std::array::from_fn(|k| a[k].min(b[k]))
+    a.min(b)
 }
 
 /// A worker's copy of one block's node positions and velocities.
@@ -470,8 +454,6 @@ pub(crate) fn for_blocks<const N: usize>(
 struct Scratch {
     x: Vec<Vec3>,
     v: Vec<Vec3>,
-    /// The block's node sums in a fused step ([`crate::step::fused`]), kept in cache.
-    f: Vec<Vec3>,
 }
 
 impl Scratch {
@@ -599,12 +581,6 @@ impl Model for TetBody {
 
     fn deformable(&self) -> Option<&dyn Deformable> {
         Some(self)
-    }
-
-    /// The standard tetrahedron of a body evaluated whole (not the averaged pressure, not a
-    /// rank's share): its blocks integrate their interior particles ([`crate::step::fused`]).
-    fn fused(&mut self) -> Option<&mut dyn FusedStep> {
-        (self.averaged.is_none() && self.split.is_none()).then_some(self)
     }
 
     fn stable_dt(&self, _state: &State) -> Option<f64> {

@@ -21,17 +21,12 @@
 //! the accelerations, the second half kick and the finiteness check. In a run decomposed with
 //! a halo exchange ([`Seam::stepped`]) the sweeps cover only the rank's own
 //! particles and its halo ([`crate::step::local_particles`]), and the force sums are
-//! zeroed whole by [`Seam::sum_forces`]. Where one model adds all the forces (a deformable
-//! body alone, with a uniform field at most) in a run of one process without rigid bodies,
-//! rotations or local damping, the model integrates its own particles inside its force pass
-//! ([`crate::step::fused`]: the same arithmetic, fewer passes over memory) and the sweeps the
-//! rest.
+//! zeroed whole by [`Seam::sum_forces`].
 
 use crate::checkpoint::{same_count, CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
 use crate::solvers::local_damping;
 use crate::solvers::verlet_sweeps::{self, DofArrays, KickSettings, Particles};
-use crate::step::fused::{FusedKick, Motion};
 use crate::step::model::Model;
 use crate::step::rigid_body::RigidBodies;
 use crate::step::rigid_body::{place_member_velocities, place_members, place_members_keeping_arms};
@@ -40,7 +35,6 @@ use crate::step::stages::{Stage, StageTimes};
 use crate::step::state::State;
 use crate::step::stepper::{check_finite_torque, check_masses, hold_in_frames, Stepper};
 use crate::Vec3;
-use std::ops::Range;
 
 /// Velocity Verlet with a fixed step.
 ///
@@ -73,8 +67,6 @@ pub struct Verlet {
     rigid_bodies: usize,
     /// The members' arms R s at this step's pose, kept by the prediction for the kick.
     arms: Vec<Vec3>,
-    /// Whether a model may integrate its particles in its force pass ([`crate::step::fused`]).
-    fused: bool,
 }
 
 impl Verlet {
@@ -87,16 +79,7 @@ impl Verlet {
             torque: Vec::new(),
             rigid_bodies: 0,
             arms: Vec::new(),
-            fused: true,
         }
-    }
-
-    /// The same stepper integrating every particle in its own sweeps, also where a model
-    /// could do it in its force pass ([`crate::step::fused`]; on by default, where it
-    /// applies). The results are the same bits either way; this is the comparison.
-    pub fn with_separate_passes(mut self) -> Verlet {
-        self.fused = false;
-        self
     }
 
     /// The same stepper with local non-viscous damping of fraction `alpha` (PFC's 0.7 for
@@ -163,9 +146,6 @@ impl Verlet {
         stages: &mut StageTimes,
         seam: &mut dyn Seam,
     ) -> Result<(), CoreError> {
-        if let Some(body) = self.fusable(state, models, seam) {
-            return self.advance_fused(state, models, stages, body);
-        }
         let dt = self.dt;
         let stepped = seam.stepped();
         // After a resume the force sums are not there yet.
@@ -195,80 +175,6 @@ impl Verlet {
         self.kick_rigid(state);
         stages.mark(Stage::Integrate);
         Ok(())
-    }
-
-    /// The particles of the only model that adds forces, where it integrates them in its
-    /// force pass ([`crate::step::fused`]): in a run of one process without rigid bodies,
-    /// particle rotations or local damping; `None` otherwise.
-    fn fusable(
-        &self,
-        state: &State,
-        models: &mut [Box<dyn Model>],
-        seam: &dyn Seam,
-    ) -> Option<Range<usize>> {
-        let plain = state.rigid.is_empty() && state.spin.is_empty() && self.local_damping == 0.0;
-        let one_process = seam.stepped().is_none() && seam.computed().is_none();
-        if !(self.fused && plain && one_process) {
-            return None;
-        }
-        let summed = match deferred_field(state, models) {
-            Some(_) => models.len() - 1,
-            None => models.len(),
-        };
-        match &mut models[..summed] {
-            [only] => only.fused().map(|f| f.particles()),
-            _ => None,
-        }
-    }
-
-    /// [`Verlet::advance`] with the only model integrating `body`'s particles in its force
-    /// pass and the sweeps the others, each particle's arithmetic as in the separate passes.
-    fn advance_fused(
-        &mut self,
-        state: &mut State,
-        models: &mut [Box<dyn Model>],
-        stages: &mut StageTimes,
-        body: Range<usize>,
-    ) -> Result<(), CoreError> {
-        let dt = self.dt;
-        self.force.resize(state.len(), Vec3::zeros());
-        self.torque.clear();
-        self.rigid_bodies = 0;
-        let rest = [0..body.start, body.end..state.len()];
-        let (others, _) = particles(state, &mut self.force, &mut []);
-        verlet_sweeps::drift(others, &rest, dt, true);
-        state.time += dt;
-        stages.mark(Stage::Predict);
-        let field = deferred_field(state, models);
-        let motion = Motion {
-            position: &mut state.position,
-            velocity: &mut state.velocity,
-            acceleration: &mut state.acceleration,
-            force: &mut self.force,
-            mass: &state.mass,
-            fixed: &state.fixed,
-        };
-        let fused = models[0].fused().expect("checked by `fusable`");
-        let bad_body = fused.step_fused(motion, FusedKick { dt, field });
-        stages.mark(Stage::Forces(0));
-        let settings = KickSettings {
-            h: Some(0.5 * dt),
-            field,
-            damping: 0.0,
-        };
-        let (others, rigid) = particles(state, &mut self.force, &mut []);
-        let (bad, _) = verlet_sweeps::kick(others, &rest, rigid, settings);
-        hold_in_frames(state);
-        match bad.min(bad_body) {
-            usize::MAX => {
-                stages.mark(Stage::Integrate);
-                Ok(())
-            }
-            particle => Err(CoreError::NonFinite {
-                time: state.time,
-                particle,
-            }),
-        }
     }
 
     /// The half kick of the rotations and the members' new velocities (the kick leaves the

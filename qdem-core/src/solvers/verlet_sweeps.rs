@@ -11,15 +11,13 @@
 //!   rigid bodies, which follow their body), the second half kick v += ½∆t a and the check
 //!   that every acceleration is finite; θ̈ = M/J and ω likewise.
 //!
-//! Each particle's arithmetic is that of the separate passes it replaces, in the same order
-//! (the functions of [`crate::step::fused`], which a model's fused pass runs too), so a step
-//! is bit-identical to theirs; and it involves no other particle, so the result does
+//! Each particle's arithmetic is that of the separate passes it replaces, in the same order,
+//! so a step is bit-identical to theirs; and it involves no other particle, so the result does
 //! not depend on how the particles are cut among the threads. A sweep splits into at most one
 //! task per thread, each of at least [`SWEEP_TASK`] particles: at 10⁴ particles two threads
 //! each take half.
 
 use crate::solvers::local_damping::damp;
-use crate::step::fused::{accelerate, add_field, drift_component};
 use crate::step::local_particles::ParticleRuns;
 use crate::step::rigid_body::RigidBodies;
 use crate::step::state::Dofs;
@@ -200,8 +198,9 @@ pub(crate) fn drift(particles: Particles<'_>, ranges: &[Range<usize>], dt: f64, 
 fn drift_dofs(d: DofArrays<'_>, dt: f64, half: f64, zero: bool) {
     // Component by component, so that the loop runs in SIMD lanes.
     let (x, v, a) = (flat_mut(d.x), flat_mut(d.v), flat(d.a));
-    for ((x, v), &a) in x.iter_mut().zip(v.iter_mut()).zip(a) {
-        drift_component(x, v, a, dt, half);
+    for ((x, v), a) in x.iter_mut().zip(v.iter_mut()).zip(a) {
+        *x += dt * (*v + half * a);
+        *v += half * a;
     }
     if zero {
         d.load.fill(Vec3::zeros());
@@ -288,7 +287,9 @@ fn kick_dofs(
         let mut f = [load[0], load[1], load[2]];
         if completes {
             if let Some(g) = settings.field {
-                add_field(&mut f, m, &g);
+                for c in 0..3 {
+                    f[c] += m * g[c];
+                }
             }
             if settings.damping > 0.0 {
                 damp_components(&mut f, v, settings.damping);
@@ -299,7 +300,21 @@ fn kick_dofs(
             *a = [0.0; 3];
             continue;
         }
-        if !accelerate(&f, a, v, m, fixed, settings.h) && bad == usize::MAX {
+        let mut acc = [f[0] / m, f[1] / m, f[2] / m];
+        if fixed != Dofs::NONE {
+            for (c, acc) in acc.iter_mut().enumerate() {
+                if fixed.contains(c) {
+                    *acc = 0.0;
+                }
+            }
+        }
+        *a = acc;
+        if let Some(h) = settings.h {
+            for c in 0..3 {
+                v[c] += h * acc[c];
+            }
+        }
+        if bad == usize::MAX && !acc.iter().all(|c| c.is_finite()) {
             bad = start + k;
         }
     }

@@ -3,12 +3,10 @@
 //! of forces) and its facets, the [`post_step`] hooks, [`stepper::Stepper`] (advances a state
 //! under the models) with the [`seam`] it evaluates forces through and the [`solve_report`]
 //! it gives, the [`tangent`] of implicit solves, the named, timed [`stages`] of a step and
-//! the step settings resolved once ([`step_settings`]); the per-particle Verlet arithmetic a
-//! model can run inside its own force pass ([`fused`]). It names no other area but the
+//! the step settings resolved once ([`step_settings`]). It names no other area but the
 //! split facets' `Reads` of [`crate::parallel`], until those facets move here.
 
 pub mod frames;
-pub mod fused;
 pub(crate) mod instability;
 pub mod local_particles;
 pub mod model;

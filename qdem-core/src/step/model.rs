@@ -15,8 +15,6 @@
 //!   run to continue bit for bit;
 //! - [`Deformable`] ([`Model::deformable`]): a deformable body of tetrahedra, what the outputs,
 //!   the modal analysis, the checks and a decomposed run read of it without its type;
-//! - [`FusedStep`] ([`Model::fused`]): the Verlet step of the particles only it acts on,
-//!   taken inside its force pass;
 //! - [`Reads`] ([`Model::reads`]): what the model reads of the particles' motion in a run
 //!   decomposed over ranks, and for a model that one rank computes in part (deformable
 //!   bodies, DEM contacts) its [`crate::step::split::Facets`]: the stages of its
@@ -25,7 +23,6 @@
 
 use crate::checkpoint::{CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::step::fused::FusedStep;
 use crate::step::split::Reads;
 use crate::step::state::State;
 use crate::step::step_settings::StepSettings;
@@ -122,12 +119,6 @@ pub trait Model: std::any::Any + Send + Sync {
     /// The model as a deformable body of tetrahedra; `None` (the default) for every other
     /// model (loads, contacts, bonds).
     fn deformable(&self) -> Option<&dyn Deformable> {
-        None
-    }
-
-    /// The velocity Verlet step the model can take inside its force pass for its particles
-    /// ([`crate::step::fused`]); `None` (the default): the stepper integrates them.
-    fn fused(&mut self) -> Option<&mut dyn FusedStep> {
         None
     }
 
