@@ -373,6 +373,20 @@ def write_liggghts_inputs(meta: dict, spheres, steps: int, d: Path) -> Path:
 LOOP_RE = re.compile(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
 
 
+def final_thermo(stdout: str) -> dict | None:
+    """The thermo row under the last `Step` header that has the contact sums, by column name
+    with the c_/v_ prefixes dropped (LIGGGHTS prints c_csum as "csum", LAMMPS keeps
+    "c_csum"); None if no such header."""
+    final = None
+    lines = stdout.splitlines()
+    for i, line in enumerate(lines):
+        cols = line.split()
+        if cols[:1] == ["Step"] and ("csum" in cols or "c_csum" in cols) and i + 1 < len(lines):
+            names = [c.split("_", 1)[1] if c[:2] in ("c_", "v_") else c for c in cols]
+            final = dict(zip(names, (float(v) for v in lines[i + 1].split())))
+    return final
+
+
 def run_liggghts(exe: str, launcher: list[str], deck: Path, meta: dict, spheres) -> dict:
     cmd = [*launcher, exe, "-in", deck.name, "-log", "log.liggghts", "-nocite"]
     log(f"LIGGGHTS: {' '.join(cmd)} (in {deck.parent})")
@@ -386,14 +400,7 @@ def run_liggghts(exe: str, launcher: list[str], deck: Path, meta: dict, spheres)
     if not loops:
         sys.exit(f"error: no 'Loop time' line in {deck.parent}/liggghts.stdout")
     t, procs, steps, atoms = loops[0]  # the first run is the timed one; the second is `run 0`
-    # thermo of the final `run 0` (LIGGGHTS prints the column of c_csum as "csum", v_xlo as "xlo")
-    final = None
-    lines = p.stdout.splitlines()
-    for i, line in enumerate(lines):
-        cols = line.split()
-        if cols[:1] == ["Step"] and ("csum" in cols or "c_csum" in cols) and i + 1 < len(lines):
-            names = [c.split("_", 1)[1] if c[:2] in ("c_", "v_") else c for c in cols]
-            final = dict(zip(names, (float(v) for v in lines[i + 1].split())))
+    final = final_thermo(p.stdout)  # the final `run 0`
     if final is None:
         sys.exit(f"error: no final thermo line in {deck.parent}/liggghts.stdout")
     pair_contacts = int(round(final["csum"] / 2))

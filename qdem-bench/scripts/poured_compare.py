@@ -330,9 +330,6 @@ def peer_subs(peer: str, meta: dict, side: float, dt: float) -> dict:
     return subs
 
 
-LOOP_RE = re.compile(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
-
-
 def run_deck(exe: str, launcher: list[str], deck: Path, n: int) -> dict:
     """Runs a deck; returns the first run's loop time and the thermo of the last `Step` header
     that has the contact sums (the untimed `run 0` at the end)."""
@@ -343,17 +340,11 @@ def run_deck(exe: str, launcher: list[str], deck: Path, n: int) -> dict:
     if p.returncode != 0:
         sys.exit(f"error: {' '.join(cmd)} failed (exit {p.returncode}) in {deck.parent}:\n"
                  + (p.stdout + p.stderr)[-3000:])
-    loops = LOOP_RE.findall(p.stdout)
+    loops = lc.LOOP_RE.findall(p.stdout)
     if not loops:
         sys.exit(f"error: no 'Loop time' line in {deck.parent}/{deck.name}.stdout")
     t, procs, steps, atoms = loops[0]
-    final = None
-    lines = p.stdout.splitlines()
-    for i, line in enumerate(lines):
-        cols = line.split()
-        if cols[:1] == ["Step"] and ("csum" in cols or "c_csum" in cols) and i + 1 < len(lines):
-            names = [c.split("_", 1)[1] if c[:2] in ("c_", "v_") else c for c in cols]
-            final = dict(zip(names, (float(v) for v in lines[i + 1].split())))
+    final = lc.final_thermo(p.stdout)
     r = {"wall_s": float(t), "procs": int(procs), "steps": int(steps), "atoms": int(atoms)}
     if final is not None:
         left = int(final["Atoms"])
@@ -613,14 +604,9 @@ def liggghts_clumps(exe: str, cd: Path, side: float, stones, settle: float, step
     if p.returncode != 0:
         sys.exit(f"error: LIGGGHTS multisphere failed (exit {p.returncode}) in {ld}:\n"
                  + (p.stdout + p.stderr)[-3000:])
-    loops = LOOP_RE.findall(p.stdout)
+    loops = lc.LOOP_RE.findall(p.stdout)
     windows = [lp for lp in loops if int(lp[2]) == steps][:repeats]
-    final = None
-    lines = p.stdout.splitlines()
-    for i, line in enumerate(lines):
-        cols = line.split()
-        if cols[:1] == ["Step"] and "csum" in cols and i + 1 < len(lines):
-            final = dict(zip(cols, (float(v) for v in lines[i + 1].split())))
+    final = lc.final_thermo(p.stdout)
     if final is None:
         sys.exit(f"error: no final thermo line in {ld}/in.clumps.stdout")
     return [{"wall_s": float(t), "procs": int(pr), "steps": int(st), "atoms": int(at),
