@@ -6,8 +6,8 @@ state (issue 57, "Benchmarks of the beds users pour").
 Usage (from the workspace root, after `cargo build --release -p qdem-cli --bin qdem`):
 
     python3 qdem-bench/scripts/poured_compare.py [--spheres 10000,100000] [--steps 2000]
-        [--np 1,2] [--repeats 2] [--parts pour,order,second,clumps] [--work out/poured]
-        [--qdem target/release/qdem] [--settle 0.25] [--wait-idle 0]
+        [--np 1,2] [--repeats 2] [--parts pour,order,second,clumps,tiled] [--work out/poured]
+        [--qdem target/release/qdem] [--settle 0.25] [--tile 3] [--wait-idle 0]
 
 The bed (per sphere count N): monodisperse spheres of r = 5 mm with the material of the
 lattice benchmark (`study packing`: rho = 2700 kg/m3, E = 50 MPa, nu = 0.25, mu = 0.5,
@@ -41,6 +41,14 @@ Parts:
   `[granular] sample` and times the window from its checkpoint; LIGGGHTS `fix multisphere`
   pours the same templates with its own random insertion (`insert/pack`, equal weights) and
   times `--repeats` consecutive windows in the same deck (multisphere bodies are not restarted).
+- `tiled`: a larger poured bed without pouring it: qdem's settled bed of N spheres (its
+  `stones.csv` after the pour) copied K x K times across the periodic cell (`--tile`, a cell K
+  times as wide, the bed as high; 3 x 3 copies of 10^4 make 90,000 spheres), each copy in its
+  poured order. All three codes start from those positions at rest (qdem as a `[granular]
+  sample`, the peers from a data file through their pour deck's set-up) and time `--steps`
+  steps as in `pour`, with contacts and kinetic energy at the end. Pouring 10^5 spheres costs
+  each code about ten times the 10^4 pour; the copies are settled already, and every code runs
+  the same positions.
 
 Everything goes to WORK (the decks, data, restarts, qdem's scenes and outputs), the rows to
 WORK/poured_compare.json and a markdown table to stdout and WORK/poured_section.md. The Debian
@@ -496,6 +504,68 @@ def part_second(args, n, d, side, qdem, rows) -> None:
                          "contacts": r["contacts"], "kinetic_energy": r["kinetic_energy"]})
 
 
+def tiled_positions(rows, side: float, k: int) -> list[tuple[float, float, float]]:
+    """The settled rows copied k x k times across the periodic cell, copy after copy, each in
+    its poured order."""
+    return [((r[1] % side) + i * side, (r[2] % side) + j * side, r[3])
+            for j in range(k) for i in range(k) for r in rows]
+
+
+def window_deck(peer: str) -> str:
+    """A peer's deck that times a window from a data file: the pour deck's set-up with the
+    settled deck's thermo, timed run and untimed contact count."""
+    pour = (HERE / peer / "pour.in.template").read_text()
+    settled = (HERE / peer / "settled.in.template").read_text()
+    return pour[:pour.index("thermo_style")] + settled[settled.index("variable zlo"):]
+
+
+def part_tiled(args, n, d, side, qdem, peers, rows) -> None:
+    """All three codes time a window from qdem's settled bed copied `--tile` x `--tile` times;
+    one row per code and width."""
+    stones = d / "qdem_pour" / "stones.csv"
+    if not stones.exists():
+        sys.exit(f"error: the tiled part needs {stones} (run the pour part first)")
+    k = args.tile
+    pts = tiled_positions(read_stones(stones), side, k)
+    big = k * side
+    td = d.parent / f"n{n}_tiled{k}"
+    td.mkdir(parents=True, exist_ok=True)
+    write_stones(td / "tiled.csv", pts)
+    for peer in peers:
+        (td / peer).mkdir(exist_ok=True)
+        write_data(td / peer / "tiled.data", big, pts, f"{peer} tiled bed, poured_compare.py")
+    log(f"tiled: {len(pts)} spheres ({k} x {k} copies of {n}), cell {big:.4f} m")
+    for width in args.np:
+        runs: dict[str, list] = {}
+        for _ in range(args.repeats):
+            if args.wait_idle:
+                lc.wait_idle(args.wait_idle)
+            q = qdem_window(qdem, td, big, args.steps, width, common_dt(), "qdem_tiled",
+                            sample="tiled.csv")
+            runs.setdefault("qdem", []).append(q)
+            log(f"qdem tiled n={len(pts)} width={width}: {q['wall_s']:.3f} s")
+            for peer, exe in peers.items():
+                if args.wait_idle:
+                    lc.wait_idle(args.wait_idle)
+                meta = peer_meta(big, pts)
+                # the bed is as high as the copied one: its height sets LAMMPS's damping
+                subs = dict(peer_subs(peer, meta, side, common_dt()), DATA="tiled.data",
+                            STEPS=args.steps, THERMO=max(1000, args.steps // 4))
+                deck = td / peer / "in.tiled"
+                template = td / peer / "tiled.in.template"
+                template.write_text(window_deck(peer))
+                p = run_deck(exe, pc_launcher(width), fill(template, subs, deck), len(pts))
+                runs.setdefault(peer, []).append(p)
+                log(f"{peer} tiled n={len(pts)} width={width}: {p['wall_s']:.3f} s")
+        for code, rs in runs.items():
+            r = min(rs, key=lambda t: t["wall_s"])
+            rows.append({"part": "tiled", "code": code, "spheres": len(pts), "width": width,
+                         "steps": args.steps, "dt": common_dt(), "wall_s": r["wall_s"],
+                         "particle_steps_per_s": len(pts) * args.steps / r["wall_s"],
+                         "contacts": r.get("contacts"), "kinetic_energy": r.get("kinetic_energy"),
+                         "all_wall_s": [t["wall_s"] for t in rs]})
+
+
 CLUMP_RADIUS = 0.004    # the clumps' spheres (m)
 
 
@@ -664,10 +734,13 @@ def part_clumps(args, n, d, side, qdem, liggghts, rows) -> None:
 def markdown(rows: list[dict]) -> str:
     """The tables of the rows, one per part."""
     out = []
-    pour = [r for r in rows if r["part"] == "pour"]
-    if pour:
-        out += ["| spheres | threads / ranks | code | wall (s) | particle-steps/s | contacts at end "
-                "| KE at end (J) | qdem / code |", "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for part in ("pour", "tiled"):
+        pour = [r for r in rows if r["part"] == part]
+        if not pour:
+            continue
+        out += [f"{part}:", "", "| spheres | threads / ranks | code | wall (s) | particle-steps/s "
+                "| contacts at end | KE at end (J) | qdem / code |",
+                "| --- | --- | --- | --- | --- | --- | --- | --- |"]
         for r in pour:
             q = next(x for x in pour if x["code"] == "qdem" and x["spheres"] == r["spheres"]
                      and x["width"] == r["width"])
@@ -720,6 +793,8 @@ def main() -> None:
     ap.add_argument("--settle", type=float, default=0.25,
                     help="seconds of settling after the highest sphere's fall")
     ap.add_argument("--peers", default="liggghts,lammps")
+    ap.add_argument("--tile", type=int, default=3,
+                    help="copies of the settled bed along x and along y (the tiled part)")
     ap.add_argument("--wait-idle", type=float, default=0.0)
     args = ap.parse_args()
     args.np = [int(s) for s in args.np.split(",")]
@@ -753,6 +828,8 @@ def main() -> None:
             part_order(args, n, d, side, qdem, rows)
         if "second" in parts:
             part_second(args, n, d, side, qdem, rows)
+        if "tiled" in parts:
+            part_tiled(args, n, d, side, qdem, peers, rows)
         if "clumps" in parts:
             part_clumps(args, n, d, side, qdem, peers.get("liggghts"), rows)
     section = markdown(rows)
