@@ -34,8 +34,8 @@ pub struct Sweep {
 }
 
 impl Sweep {
-    /// Quick: 0.25, 1 and 4 GPa, one cycle; full: 0.25 to 4 GPa by factors of 2, three
-    /// cycles.
+    /// Quick: 0.25, 1 and 4 GPa, three cycles; full: 0.25 to 4 GPa by factors of 2, ten
+    /// cycles (docs/boxtest.md's stiffness check).
     pub fn of(size: Size) -> Sweep {
         match size {
             Size::Quick => Sweep {
@@ -44,7 +44,7 @@ impl Sweep {
             },
             Size::Full => Sweep {
                 youngs: vec![0.25e9, 0.5e9, 1e9, 2e9, 4e9],
-                cycles: 3,
+                cycles: 10,
             },
         }
     }
