@@ -29,8 +29,8 @@ pub struct Sweep {
 }
 
 impl Sweep {
-    /// Quick (the tests): 0.1 and 0.05 m to 0.05 s at ∆t = 5 and 1 ms; full: 0.1 and
-    /// 0.05 m to 0.2 s (docs/bbm.md's finest run breaks its first bond at 0.232 s) at 5, 2.5
+    /// Quick (the tests): 0.1 and 0.05 m to 0.05 s at ∆t = 5 and 1 ms; full: 0.1, 0.05 and
+    /// 0.025 m to 0.2 s (docs/bbm.md's finest run breaks its first bond at 0.232 s) at 5, 2.5
     /// and 1 ms.
     pub fn of(size: Size) -> Sweep {
         match size {
@@ -40,7 +40,7 @@ impl Sweep {
                 seconds: 0.05,
             },
             Size::Full => Sweep {
-                sizes: vec![0.1, 0.05],
+                sizes: vec![0.1, 0.05, 0.025],
                 dts: vec![5e-3, 2.5e-3, 1e-3],
                 seconds: 0.2,
             },
@@ -211,7 +211,7 @@ pub fn section(rows: &[Row], machine: &str, figures: &Path) -> Result<String, St
     Ok(format!(
         "## The BBM beam: element size, ∆t, explicit or implicit\n\n\
          Paper 001 §5's beam (`fixtures/bbm`, [bbm.md](bbm.md)): 3 m × 0.5 m, pinned, 230 kN/m \
-         ramped over 0.25 s, run to {seconds} s, before its first bond breaks. Explicit at \
+         ramped over 0.25 s, run to {seconds:.3} s, before its first bond breaks. Explicit at \
          0.2 ∆t_crit (Eq. 28) and implicit Newmark (β = ¼, γ = ½) at each element size. \
          Deviation = max |u(t) − u_ref(t)| / max |u_ref| of the midspan deflection, against \
          the explicit run at {finest} m (the finest) and against the explicit run of the same \

@@ -32,7 +32,7 @@ pub struct Sweep {
 
 impl Sweep {
     /// The sweep of a size: 27 spheres for 0.03 s at 0.05, 0.2 and 0.8 T_R (quick, for the
-    /// tests), or 343 spheres for 0.1 s at 0.025 to 0.8 T_R.
+    /// tests), or 1,000 spheres for 0.15 s at 0.025 to 0.8 T_R.
     pub fn of(size: Size) -> Sweep {
         match size {
             Size::Quick => Sweep {
@@ -41,8 +41,8 @@ impl Sweep {
                 fractions: vec![0.05, 0.2, 0.8],
             },
             Size::Full => Sweep {
-                spheres: 343,
-                seconds: 0.1,
+                spheres: 1000,
+                seconds: 0.15,
                 fractions: vec![0.025, 0.05, 0.1, 0.2, 0.4, 0.8],
             },
         }
