@@ -32,6 +32,9 @@ pub enum StudyError {
     /// The run failed.
     #[error(transparent)]
     Run(#[from] RunError),
+    /// A run stepped by the library directly failed.
+    #[error(transparent)]
+    Core(#[from] qdem_core::error::CoreError),
     /// An output (a plot, a report) could not be written.
     #[error(transparent)]
     Output(#[from] OutputError),
@@ -120,7 +123,7 @@ pub fn cantilever(scene: Scene, out: &Path) -> Result<CantileverRun, StudyError>
 }
 
 /// (t, value in µm) of one column of a probe CSV.
-fn read_column(csv: &Path, name: &str) -> Result<Vec<(f64, f64)>, StudyError> {
+pub(crate) fn read_column(csv: &Path, name: &str) -> Result<Vec<(f64, f64)>, StudyError> {
     let problem = |message: String| StudyError::Probes {
         path: csv.to_path_buf(),
         message,

@@ -126,11 +126,18 @@ impl Packing {
 
     /// The state (one rotating particle per sphere) and the models: contacts, gravity.
     pub fn build(&self) -> (State, Vec<Box<dyn Model>>) {
-        self.build_with(damping_ratio(RESTITUTION))
+        self.build_with(damping_ratio(RESTITUTION), FRICTION)
     }
 
-    /// The same with contact damping ratio `zeta`.
-    fn build_with(&self, zeta: f64) -> (State, Vec<Box<dyn Model>>) {
+    /// The same without contact damping and without friction: an elastic packing whose
+    /// equations conserve the energy (kinetic, the contacts' elastic energy and gravity's
+    /// potential), which the speed-versus-error study's energy drift measures.
+    pub fn build_elastic(&self) -> (State, Vec<Box<dyn Model>>) {
+        self.build_with(0.0, 0.0)
+    }
+
+    /// The same with contact damping ratio `zeta` and Coulomb friction `friction`.
+    fn build_with(&self, zeta: f64, friction: f64) -> (State, Vec<Box<dyn Model>>) {
         let mut state = State::at_rest(self.centers.clone());
         let mass = DENSITY * 4.0 / 3.0 * std::f64::consts::PI * RADIUS.powi(3);
         for i in 0..self.centers.len() {
@@ -146,7 +153,7 @@ impl Packing {
             })
             .collect();
         let names = vec!["sphere".to_string(); self.centers.len()];
-        let models = self.models(&state, &spheres, names, zeta);
+        let models = self.models(&state, &spheres, names, zeta, friction);
         (state, models)
     }
 
@@ -158,20 +165,21 @@ impl Packing {
         spheres: &[ContactSphere],
         names: Vec<String>,
         zeta: f64,
+        friction: f64,
     ) -> Vec<Box<dyn Model>> {
         let walls = self
             .walls()
             .into_iter()
             .map(|(p, n)| Wall {
                 shape: WallShape::Plane(PlaneWall::new(p, n, Vec3::zeros())),
-                friction: FRICTION,
+                friction,
             })
             .collect();
         let settings = ContactSettings {
             law: ContactLaw::HertzMindlin(HertzMindlin {
                 damping_ratio: zeta,
             }),
-            friction: FRICTION,
+            friction,
             skin: SKIN,
         };
         let contacts =
@@ -247,7 +255,13 @@ impl Packing {
         }
         let count = spheres.len();
         let names = vec!["clump".to_string(); self.centers.len()];
-        let models = self.models(&state, &spheres, names, damping_ratio(RESTITUTION));
+        let models = self.models(
+            &state,
+            &spheres,
+            names,
+            damping_ratio(RESTITUTION),
+            FRICTION,
+        );
         (state, models, count)
     }
 
@@ -255,7 +269,7 @@ impl Packing {
     /// centres. The pouring dissipates by local damping 0.7 instead of contact dashpots, whose
     /// step bound is three times shorter, so that it takes a third of the steps.
     pub fn settle(&mut self, seconds: f64) -> Result<(), GranularError> {
-        let (mut state, mut models) = self.build_with(0.0);
+        let (mut state, mut models) = self.build_with(0.0, FRICTION);
         let mut stepper = Verlet::new(time_step(&state, &models)).with_local_damping(0.7);
         stepper.initialize(&mut state, &mut models)?;
         while state.time < seconds {

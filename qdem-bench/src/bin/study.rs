@@ -1,6 +1,9 @@
 //! - `study speed-vs-error [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]`:
-//!   regenerates `docs/speed-vs-error.md` and its plots (about 25 minutes on 2 cores, dominated
-//!   by the explicit run on the finest mesh).
+//!   regenerates the cantilever's section of `docs/speed-vs-error.md` and its plots (about 25
+//!   minutes on 2 cores, dominated by the explicit run on the finest mesh).
+//! - `study speed-vs-error --all` (every family) or `--families bbm,packing` (those, keeping
+//!   the others' sections), with `--quick` for the tests' small sweeps and `--threads N`
+//!   (default: rayon's): regenerates those sections and their SVGs.
 //! - `study packing --spheres N --out DIR [--settle SECONDS]`: pours and settles N rigid
 //!   spheres and writes `DIR/packing.csv` and `DIR/packing.json` (the granular benchmark).
 //! - `study dem-throughput --packing DIR --steps S [--grains spheres|clumps]`: times qdem on
@@ -9,12 +12,12 @@
 
 use qdem_bench::cantilever::fixtures_dir;
 use qdem_bench::granular::{clump_throughput, throughput, Packing};
-use qdem_bench::speed_vs_error::{run_study, write_report};
+use qdem_bench::speed_vs_error::{run_family, write_page, Family, Setting, Size};
 use qdem_bench::throughput::{cpu_model, on_threads};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-const USAGE: &str = "usage: study speed-vs-error [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]
+const USAGE: &str = "usage: study speed-vs-error [--all | --families cantilever,bbm,boxtest,packing] [--quick] [--threads N] [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]
        study packing --spheres N --out DIR [--settle SECONDS]
        study dem-throughput --packing DIR --steps S [--grains spheres|clumps]";
 
@@ -26,9 +29,17 @@ fn main() -> ExitCode {
             .and_then(|i| args.get(i + 1))
             .cloned()
     };
-    // Inside a pool of rayon's default size, as `qdem run` runs.
-    on_threads(0, || match args.first().map(String::as_str) {
-        Some("speed-vs-error") => speed_vs_error(&option),
+    let flag = |name: &str| args.iter().any(|a| a == name);
+    let threads = match number(&option, "--threads", Some(0)) {
+        Ok(n) => n,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    // Inside a pool of rayon's default size unless told, as `qdem run` runs.
+    on_threads(threads, || match args.first().map(String::as_str) {
+        Some("speed-vs-error") => speed_vs_error(&option, &flag),
         Some("packing") => packing(&option),
         Some("dem-throughput") => dem_throughput(&option),
         _ => {
@@ -100,7 +111,37 @@ fn dem_throughput(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
     }
 }
 
-fn speed_vs_error(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
+/// The families to run: `--all`, `--families a,b`, or the cantilever alone.
+fn families(
+    option: &dyn Fn(&str) -> Option<String>,
+    flag: &dyn Fn(&str) -> bool,
+) -> Result<Vec<Family>, String> {
+    match (flag("--all"), option("--families")) {
+        (true, Some(_)) => Err("--all and --families: give one".into()),
+        (true, None) => Ok(Family::ALL.to_vec()),
+        (false, Some(names)) => names.split(',').map(Family::parse).collect(),
+        (false, None) => Ok(vec![Family::Cantilever]),
+    }
+}
+
+/// The machine line of a section: the CPU, the threads and the load when the family started.
+fn machine() -> String {
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|l| l.split_whitespace().next().map(str::to_string))
+        .unwrap_or_else(|| "unknown".into());
+    let cpus = std::thread::available_parallelism().map_or(0, |n| n.get());
+    format!(
+        "Machine: {}, {} thread(s) of {cpus} CPUs, load average {load} when the family started",
+        cpu_model(),
+        rayon::current_num_threads()
+    )
+}
+
+fn speed_vs_error(
+    option: &dyn Fn(&str) -> Option<String>,
+    flag: &dyn Fn(&str) -> bool,
+) -> ExitCode {
     let docs =
         option("--docs").map_or_else(|| fixtures_dir().join("..").join("docs"), PathBuf::from);
     let work = option("--work").map_or_else(|| PathBuf::from("out/study"), PathBuf::from);
@@ -115,8 +156,39 @@ fn speed_vs_error(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
         eprintln!("error: --dts takes numbers of seconds, e.g. 1e-3,3e-4");
         return ExitCode::FAILURE;
     };
-    let machine = format!("{}, {} threads", cpu_model(), rayon::current_num_threads());
-    match run_study(&meshes, &dts, &work).and_then(|rows| write_report(&rows, &machine, &docs)) {
+    let families = match families(option, flag) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}\n{USAGE}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let size = if flag("--quick") {
+        Size::Quick
+    } else {
+        Size::Full
+    };
+    let figures = docs.join("figures");
+    let mut sections = Vec::new();
+    for family in families {
+        let machine = machine();
+        let setting = Setting {
+            size,
+            work: &work,
+            figures: &figures,
+            machine: &machine,
+            cantilever: (&meshes, &dts),
+        };
+        eprintln!("{}: running ({machine})", family.name());
+        match run_family(family, &setting) {
+            Ok(markdown) => sections.push((family, markdown)),
+            Err(e) => {
+                eprintln!("error: {}: {e}", family.name());
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+    match write_page(&docs, &sections) {
         Ok(()) => {
             eprintln!("wrote {}", docs.join("speed-vs-error.md").display());
             ExitCode::SUCCESS

@@ -2,14 +2,16 @@
 //! 1 s, hold, release at 2 s, run to 3 s): on each mesh, explicit Verlet at the automatic step
 //! and implicit Newmark (average acceleration, paper 001) at several ∆t. Each run's steady tip
 //! deflection and first frequency are compared with the finest-mesh explicit run, with
-//! CalculiX C3D10 and with Eqs. 12–13, against its wall time; the report is
-//! `speed-vs-error.md` with two SVG plots.
+//! CalculiX C3D10 and with Eqs. 12–13, against its CPU seconds; its section of
+//! `speed-vs-error.md` has two SVG plots.
 
+use super::cpu::timed;
+use super::page::write_page;
+use super::Family;
 use crate::cantilever::{
     cantilever, cantilever_scene, newmark_variant, StudyError, CALCULIX_F1_HZ, CALCULIX_TIP_UZ_UM,
     EQ12_TIP_UZ_UM, EQ13_F1_HZ,
 };
-use qdem_io::output::write_atomic;
 use qdem_io::plot::{line_plot_svg, Labels, Series};
 use qdem_io::scene::Scene;
 use std::path::Path;
@@ -27,8 +29,8 @@ pub struct StudyRow {
     pub dt: f64,
     /// Steps.
     pub steps: u64,
-    /// Wall seconds.
-    pub wall_seconds: f64,
+    /// CPU seconds of the run (all threads).
+    pub cpu_seconds: f64,
     /// Steady tip deflection (µm).
     pub tip_uz_um: f64,
     /// First bending frequency (Hz).
@@ -67,14 +69,14 @@ fn row(
     scene: Scene,
     out: &Path,
 ) -> Result<StudyRow, StudyError> {
-    let r = cantilever(scene, out)?;
+    let (r, cpu_seconds) = timed(|| cantilever(scene, out))?;
     Ok(StudyRow {
         mesh: mesh.to_string(),
         tets: r.tets,
         integrator,
         dt: r.dt,
         steps: r.steps,
-        wall_seconds: r.wall_seconds,
+        cpu_seconds,
         tip_uz_um: r.tip_uz_um,
         f1_hz: r.f1_hz,
     })
@@ -84,13 +86,9 @@ fn error(value: f64, reference: f64) -> f64 {
     100.0 * (value / reference - 1.0).abs()
 }
 
-/// The heading from which `speed-vs-error.md` is written by hand (the modelling advice
-/// checked against runs): [`write_report`] keeps it and all that follows.
-pub const KEPT_FROM: &str = "## Modelling advice against runs";
-
-/// Writes `speed-vs-error.md` into `docs` and its plots into `docs/figures`; the reference
-/// of "finest mesh" is the explicit run on the mesh with the most tetrahedra. The page's
-/// hand-written part, from [`KEPT_FROM`] on, is kept.
+/// Writes the cantilever's section of `speed-vs-error.md` into `docs` ([`write_page`]: the
+/// other families' sections and the hand-written part are kept) and its plots into
+/// `docs/figures`.
 ///
 /// ```
 /// use qdem_bench::speed_vs_error::{write_report, StudyRow, KEPT_FROM};
@@ -99,39 +97,47 @@ pub const KEPT_FROM: &str = "## Modelling advice against runs";
 /// let page = docs.join("speed-vs-error.md");
 /// std::fs::write(&page, format!("# old table\n\n{KEPT_FROM}\n\nchecked by hand\n")).unwrap();
 /// let row = |integrator, tets| StudyRow {
-///     mesh: "100".into(), tets, integrator, dt: 1e-3, steps: 3000, wall_seconds: 1.0,
+///     mesh: "100".into(), tets, integrator, dt: 1e-3, steps: 3000, cpu_seconds: 1.0,
 ///     tip_uz_um: -63.4, f1_hz: 32.3,
 /// };
 /// write_report(&[row("verlet", 915), row("newmark", 915)], "test", &docs).unwrap();
 /// let text = std::fs::read_to_string(&page).unwrap();
 /// assert!(!text.contains("old table"));
+/// assert!(text.contains("| 100 | 915 | verlet |"));
 /// assert!(text.ends_with(&format!("{KEPT_FROM}\n\nchecked by hand\n")));
 /// # std::fs::remove_dir_all(&docs).unwrap();
 /// ```
 pub fn write_report(rows: &[StudyRow], machine: &str, docs: &Path) -> Result<(), StudyError> {
+    let figures = docs.join("figures");
+    std::fs::create_dir_all(&figures).map_err(|e| StudyError::Probes {
+        path: figures.clone(),
+        message: e.to_string(),
+    })?;
+    let markdown = section(rows, machine, &figures)?;
+    write_page(docs, &[(Family::Cantilever, markdown)])
+}
+
+/// The cantilever's section of the page, its plots written into `figures`; the reference of
+/// "finest mesh" is the explicit run on the mesh with the most tetrahedra.
+pub fn section(rows: &[StudyRow], machine: &str, figures: &Path) -> Result<String, StudyError> {
     let finest = rows
         .iter()
         .filter(|r| r.integrator == "verlet")
         .max_by_key(|r| r.tets)
         .cloned()
         .ok_or_else(|| StudyError::Probes {
-            path: docs.to_path_buf(),
+            path: figures.to_path_buf(),
             message: "no explicit run".into(),
         })?;
     let mut table = String::new();
     for r in rows {
         table += &format!(
             "| {} | {} | {} | {:.3e} | {} | {:.1} | {:.4} | {:.3}% | {:.2}% | {:.2}% | {:.3} | {:.3}% | {:.2}% | {:.2}% |\n",
-            r.mesh, r.tets, r.integrator, r.dt, r.steps, r.wall_seconds, r.tip_uz_um,
+            r.mesh, r.tets, r.integrator, r.dt, r.steps, r.cpu_seconds, r.tip_uz_um,
             error(r.tip_uz_um, finest.tip_uz_um), error(r.tip_uz_um, CALCULIX_TIP_UZ_UM), error(r.tip_uz_um, EQ12_TIP_UZ_UM),
             r.f1_hz, error(r.f1_hz, finest.f1_hz), error(r.f1_hz, CALCULIX_F1_HZ), error(r.f1_hz, EQ13_F1_HZ),
         );
     }
-    let figures = docs.join("figures");
-    std::fs::create_dir_all(&figures).map_err(|e| StudyError::Probes {
-        path: figures.clone(),
-        message: e.to_string(),
-    })?;
     plot(
         rows,
         &figures.join("speed_vs_error_tip.svg"),
@@ -144,33 +150,24 @@ pub fn write_report(rows: &[StudyRow], machine: &str, docs: &Path) -> Result<(),
         "f1 error against the finest-mesh explicit run (%)",
         |r| error(r.f1_hz, finest.f1_hz),
     )?;
-    let text = format!(
-        "# Speed versus error: the cantilever's dynamic response\n\n\
-         Regenerate with `cargo run --release -p qdem-bench --bin study -- speed-vs-error` \
-         (this page and `figures/speed_vs_error_*.svg`).\n\n\
+    Ok(format!(
+        "## The cantilever: mesh and integrator\n\n\
          The paper's cantilever (§3.1): 200 N ramped over 1 s, held, released at 2 s, run to 3 s. \
          On each fixture mesh, explicit Verlet at 0.9 × the stable bound and implicit Newmark \
          (β = ¼, γ = ½, paper 001) at several ∆t. Tip deflection = mean over 1–2 s; f₁ = FFT of \
          the free vibration after release. References: the finest-mesh explicit run ({} tets: \
          {:.4} µm, {:.3} Hz), CalculiX C3D10 ({CALCULIX_TIP_UZ_UM} µm, {CALCULIX_F1_HZ} Hz) and \
-         Eqs. 12–13 ({EQ12_TIP_UZ_UM} µm, {EQ13_F1_HZ} Hz). Machine: {machine}; wall seconds \
-         include writing the probe CSV.\n\n\
-         | mesh lc | tets | integrator | ∆t (s) | steps | wall s | tip uz (µm) | vs finest | vs CalculiX | vs Eq. 12 | f₁ (Hz) | vs finest | vs CalculiX | vs Eq. 13 |\n\
+         Eqs. 12–13 ({EQ12_TIP_UZ_UM} µm, {EQ13_F1_HZ} Hz). {machine}; CPU seconds include \
+         writing the probe CSV.\n\n\
+         | mesh lc | tets | integrator | ∆t (s) | steps | CPU s | tip uz (µm) | vs finest | vs CalculiX | vs Eq. 12 | f₁ (Hz) | vs finest | vs CalculiX | vs Eq. 13 |\n\
          | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n{table}\n\
-         ![tip error against wall time](figures/speed_vs_error_tip.svg)\n\
-         ![frequency error against wall time](figures/speed_vs_error_f1.svg)\n",
+         ![tip error against CPU time](figures/speed_vs_error_tip.svg)\n\
+         ![frequency error against CPU time](figures/speed_vs_error_f1.svg)\n",
         finest.tets, finest.tip_uz_um, finest.f1_hz,
-    );
-    let page = docs.join("speed-vs-error.md");
-    let kept = std::fs::read_to_string(&page)
-        .ok()
-        .and_then(|old| old.find(KEPT_FROM).map(|i| format!("\n{}", &old[i..])))
-        .unwrap_or_default();
-    write_atomic(&page, |w| w.write_all((text + &kept).as_bytes()))?;
-    Ok(())
+    ))
 }
 
-/// One series per integrator and step: `measure` against log₁₀ of the wall seconds.
+/// One series per integrator and step: `measure` against log₁₀ of the CPU seconds.
 fn plot(
     rows: &[StudyRow],
     path: &Path,
@@ -202,7 +199,7 @@ fn plot(
         .map(|(i, dt)| {
             rows.iter()
                 .filter(|r| r.integrator == *i && (*i == "verlet" || r.dt == *dt))
-                .map(|r| (r.wall_seconds.log10(), measure(r)))
+                .map(|r| (r.cpu_seconds.max(0.01).log10(), measure(r)))
                 .collect()
         })
         .collect();
@@ -213,7 +210,7 @@ fn plot(
         .collect();
     let labels = Labels {
         title: "cantilever: speed versus error (each curve: lc 0.10, 0.07, 0.05)",
-        x: "log10(wall seconds)",
+        x: "log10(CPU seconds)",
         y,
     };
     Ok(line_plot_svg(path, &labels, &series)?)
