@@ -165,7 +165,8 @@ fn a_step_on_a_team_is_four_phases_and_at_most_one_wake_up() {
     assert_eq!(rayon.regions.phases, 0);
     // A team whose worker parks as soon as a step ends and never inside one: every region
     // is a phase of the team, four a step, and a step wakes the worker once at most (its
-    // first phase, or none when the worker had not parked yet).
+    // first phase, or none when the worker had not parked yet); a worker that parked
+    // between the phases of a step would make it up to four.
     let waits = Waits {
         spin: Duration::ZERO,
         patience: Duration::from_secs(3600),
@@ -175,5 +176,4 @@ fn a_step_on_a_team_is_four_phases_and_at_most_one_wake_up() {
     assert_eq!(team.regions.regions, team.regions.phases);
     assert_eq!(team.regions.holds, steps);
     assert!(team.regions.wakeups <= steps, "{:?}", team.regions);
-    assert!(team.regions.wakeups > 0, "the worker parks between steps");
 }
