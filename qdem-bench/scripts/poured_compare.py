@@ -7,7 +7,7 @@ Usage (from the workspace root, after `cargo build --release -p qdem-cli --bin q
 
     python3 qdem-bench/scripts/poured_compare.py [--spheres 10000,100000] [--steps 2000]
         [--np 1,2] [--repeats 2] [--parts pour,order,second,clumps,tiled] [--work out/poured]
-        [--qdem target/release/qdem] [--settle 0.25] [--tile 3] [--wait-idle 0]
+        [--qdem target/release/qdem] [--settle 0.25] [--tile 3] [--wait-idle 0] [--team]
 
 The bed (per sphere count N): monodisperse spheres of r = 5 mm with the material of the
 lattice benchmark (`study packing`: rho = 2700 kg/m3, E = 50 MPa, nu = 0.25, mu = 0.5,
@@ -26,6 +26,8 @@ Parts:
   `--repeats` times, the fastest counting: qdem's `summary.json` (`wall_seconds`: the
   initial force evaluation and the step loop), the peers' `Loop time`. Per code:
   particle-steps/s, contacts (sphere-sphere + sphere-floor) and kinetic energy at the end.
+  With `--team`, qdem's window runs a second time with `QDEM_TEAM=1` (the step's parallel
+  regions on a persistent team of threads), alternated with the default, as code `qdem_team`.
 - `order`: qdem's settled positions (its `stones.csv` after the pour, at rest) run by qdem in
   three orders of the rows: `lattice` (sorted by a grid of one diameter, z then y then x),
   `poured` (as the pour left them: the insertion order) and `random` (a seeded shuffle).
@@ -239,11 +241,12 @@ def qdem_scene(side: float, dt, t_end: float, out: str, sample: str | None = Non
     return "\n".join(lines) + "\n"
 
 
-def qdem_run(exe: Path, scene: Path, threads: int) -> dict:
-    """Runs `qdem run` on a scene; returns the figures of its summary.json."""
+def qdem_run(exe: Path, scene: Path, threads: int, team: bool = False) -> dict:
+    """Runs `qdem run` on a scene (with a step's parallel regions on a persistent team of
+    threads, `QDEM_TEAM=1`, when `team`); returns the figures of its summary.json."""
+    env = dict(os.environ, RAYON_NUM_THREADS=str(threads), QDEM_TEAM="1" if team else "0")
     out = subprocess.run([str(exe), "run", str(scene), "--threads", str(threads), "--yes"],
-                         cwd=scene.parent, capture_output=True, text=True,
-                         env=dict(os.environ, RAYON_NUM_THREADS=str(threads)))
+                         cwd=scene.parent, capture_output=True, text=True, env=env)
     (scene.parent / (scene.stem + ".stdout")).write_text(out.stdout + out.stderr)
     if out.returncode != 0:
         sys.exit(f"error: qdem run {scene} failed (exit {out.returncode}):\n"
@@ -274,13 +277,14 @@ def qdem_pour(exe: Path, d: Path, side: float, pts, settle: float, threads: int)
 
 
 def qdem_window(exe: Path, d: Path, side: float, steps: int, threads: int, dt, name: str,
-                sample: str | None = "insert.csv", start_from: str | None = None) -> dict:
+                sample: str | None = "insert.csv", start_from: str | None = None,
+                team: bool = False) -> dict:
     """Times `steps` steps of qdem (dt a number, or "auto" with a t_end of `steps` of the
-    common step) from the checkpoint or a sample."""
+    common step) from the checkpoint or a sample (on a team of threads when `team`)."""
     t_end = steps * (common_dt() if isinstance(dt, str) else dt)
     scene = d / f"{name}.toml"
     scene.write_text(qdem_scene(side, dt, t_end, name, sample=sample, start_from=start_from))
-    return qdem_run(exe, scene, threads)
+    return qdem_run(exe, scene, threads, team)
 
 
 # ----------------------------------------------------------------------------- peers
@@ -420,11 +424,15 @@ def part_pour(args, n, d, side, pts, qdem, peers, rows) -> None:
         for _ in range(args.repeats):
             if args.wait_idle:
                 lc.wait_idle(args.wait_idle)
-            with lc.OtherLoad() as ol:
-                q = qdem_window(qdem, d, side, args.steps, width, common_dt(), "qdem_settled",
-                                sample="insert.csv", start_from="qdem_pour/checkpoint.qdc")
-            runs.setdefault("qdem", []).append((q, ol.cores))
-            log(f"qdem n={n} width={width}: {q['wall_s']:.3f} s")
+            for code, team in [("qdem", False), ("qdem_team", True)][:1 + args.team]:
+                if args.wait_idle:
+                    lc.wait_idle(args.wait_idle)
+                with lc.OtherLoad() as ol:
+                    q = qdem_window(qdem, d, side, args.steps, width, common_dt(),
+                                    "qdem_settled" + "_team" * team, sample="insert.csv",
+                                    start_from="qdem_pour/checkpoint.qdc", team=team)
+                runs.setdefault(code, []).append((q, ol.cores))
+                log(f"{code} n={n} width={width}: {q['wall_s']:.3f} s")
             for peer, exe in peers.items():
                 if args.wait_idle:
                     lc.wait_idle(args.wait_idle)
@@ -540,10 +548,11 @@ def part_tiled(args, n, d, side, qdem, peers, rows) -> None:
         for _ in range(args.repeats):
             if args.wait_idle:
                 lc.wait_idle(args.wait_idle)
-            q = qdem_window(qdem, td, big, args.steps, width, common_dt(), "qdem_tiled",
-                            sample="tiled.csv")
-            runs.setdefault("qdem", []).append(q)
-            log(f"qdem tiled n={len(pts)} width={width}: {q['wall_s']:.3f} s")
+            for code, team in [("qdem", False), ("qdem_team", True)][:1 + args.team]:
+                q = qdem_window(qdem, td, big, args.steps, width, common_dt(),
+                                "qdem_tiled" + "_team" * team, sample="tiled.csv", team=team)
+                runs.setdefault(code, []).append(q)
+                log(f"{code} tiled n={len(pts)} width={width}: {q['wall_s']:.3f} s")
             for peer, exe in peers.items():
                 if args.wait_idle:
                     lc.wait_idle(args.wait_idle)
@@ -796,6 +805,9 @@ def main() -> None:
     ap.add_argument("--tile", type=int, default=3,
                     help="copies of the settled bed along x and along y (the tiled part)")
     ap.add_argument("--wait-idle", type=float, default=0.0)
+    ap.add_argument("--team", action="store_true",
+                    help="in the pour and tiled parts, also time qdem with QDEM_TEAM=1 (code qdem_team), "
+                         "alternated with the default")
     args = ap.parse_args()
     args.np = [int(s) for s in args.np.split(",")]
     parts = set(args.parts.split(","))

@@ -7,6 +7,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use qdem_bench::throughput::BenchPlan;
 use qdem_bench::{implicit, throughput, verify};
 use qdem_core::continuum::Formulation;
+use qdem_core::step::team::Team;
 use qdem_core::{error::CoreError, parallel::Communicator, step::Halt, step::Scheme};
 use qdem_io::analyze::AnalyzeOptions;
 use qdem_io::build::{BuildError, Simulation};
@@ -75,6 +76,15 @@ pub enum CliError {
         threads: usize,
         /// Why.
         message: String,
+    },
+    /// A value of the environment variable `QDEM_TEAM` other than 0 and 1.
+    #[error(
+        "QDEM_TEAM={value:?} in the environment: give 1 to run a step's parallel regions on \
+         a persistent team of threads, or 0 (or leave it unset) for the default"
+    )]
+    Team {
+        /// The value given.
+        value: String,
     },
 }
 
@@ -401,6 +411,18 @@ fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, CliError> {
         })
 }
 
+/// Runs `f` with a persistent team of the pool's threads installed on this thread
+/// ([`qdem_core::step::team`]) when the environment sets `QDEM_TEAM=1`: each step's parallel
+/// regions are then phases of the team, which wake its workers at most once a step.
+fn with_team<R>(f: impl FnOnce() -> Result<R, CliError>) -> Result<R, CliError> {
+    let value = std::env::var("QDEM_TEAM").unwrap_or_default();
+    match value.trim() {
+        "" | "0" => f(),
+        "1" => Team::new(rayon::current_num_threads()).install(f),
+        _ => Err(CliError::Team { value }),
+    }
+}
+
 /// Runs the parsed command; `ranks`: the processes of an `mpirun` (of more than one), over
 /// which `qdem run` decomposes its run.
 pub fn dispatch(cli: Cli, ranks: Option<Arc<dyn Communicator>>) -> Result<(), CliError> {
@@ -408,13 +430,13 @@ pub fn dispatch(cli: Cli, ranks: Option<Arc<dyn Communicator>>) -> Result<(), Cl
         return Err(CliError::NotDecomposed { command });
     }
     match cli.command {
-        Command::Run(a) => thread_pool(a.threads)?.install(|| run_scene(&a, ranks)),
+        Command::Run(a) => thread_pool(a.threads)?.install(|| with_team(|| run_scene(&a, ranks))),
         Command::Modes(a) => {
             thread_pool(a.threads)?.install(|| modes_of(&a.scene, a.count, a.out.as_deref()))
         }
         Command::Check(a) => thread_pool(a.threads)?.install(|| match a.advice {
             Some(AdviceFormat::Json) => check::print_advice_json(&a.scene),
-            None => check::check_scene(&a.scene, ranks),
+            None => with_team(|| check::check_scene(&a.scene, ranks)),
         }),
         Command::Analyze(a) => {
             let options = AnalyzeOptions {

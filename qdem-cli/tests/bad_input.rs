@@ -374,6 +374,35 @@ fn run_and_check_without_a_scene() {
 }
 
 #[test]
+fn a_bad_qdem_team_value() {
+    // The persistent team of threads is opt-in through the environment: a value other than
+    // 0 and 1 is refused before anything is written.
+    let tmp = TempDir::new("team");
+    let out_dir = tmp.path().join("out");
+    let scene = good_scene();
+    for command in ["run", "check"] {
+        let out = Command::new(QDEM)
+            .args([OsStr::new(command), scene.as_os_str()])
+            .args(
+                [OsStr::new("--out"), out_dir.as_os_str()]
+                    .into_iter()
+                    .take(match command {
+                        "run" => 2,
+                        _ => 0,
+                    }),
+            )
+            .current_dir(workspace())
+            .env("CI", "1")
+            .env("QDEM_TEAM", "yes")
+            .output()
+            .expect("start the qdem binary");
+        let what = format!("QDEM_TEAM=yes qdem {command} SCENE");
+        assert_clean_error(&what, &out, &["QDEM_TEAM=\"yes\"", "give 1", "0"]);
+        assert!(!out_dir.exists(), "{what} created its output directory");
+    }
+}
+
+#[test]
 fn zero_threads() {
     let tmp = TempDir::new("threads0");
     let out_dir = tmp.path().join("out");

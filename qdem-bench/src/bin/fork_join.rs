@@ -2,15 +2,18 @@
 //! measurement behind the Verlet sweeps' task size (`qdem_core::solvers::verlet_sweeps`).
 //!
 //! A pass over N particles (x += h v, the shape of a drift) is timed on one thread, as a rayon
-//! `join` of two halves on a pool of two threads, and as the same halves on a persistent team
-//! of two threads (the caller and one helper that spins for a while after each job, then
-//! parks), each after a serial gap of 0, 20, 100 and 400 µs (the rest of a step, during which
-//! an idle worker may fall asleep); and an empty `join` alone. Prints one JSON object: the
-//! median time per region in µs of each, for each gap.
+//! `join` of two halves on a pool of two threads, and as the same halves in one phase of the
+//! steps' persistent team of two threads (`qdem_core::step::team`: the caller and one worker
+//! that spins for a while after each phase, then parks), each after a serial gap of 0, 20,
+//! 100 and 400 µs (the rest of a step, during which an idle worker may fall asleep); and an
+//! empty `join` and an empty phase alone. The team runs with its worker spinning 50 µs, its
+//! default 100 µs and 1 ms, each between steps (the worker parks after the spin) and inside a
+//! held step (`Team::hold`: the worker yields after the spin and parks only after its
+//! patience, as between the phases of one step). Prints one JSON object: the median time per
+//! region in µs of each, for each gap.
 
+use qdem_core::step::team::{Team, Waits};
 use serde_json::json;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 type V = [f64; 3];
@@ -47,72 +50,6 @@ fn median_after_gap(reps: usize, gap: f64, mut region: impl FnMut()) -> f64 {
     times[reps / 2]
 }
 
-/// A team of the calling thread and one helper that owns the second half of the particles:
-/// a job is an epoch the helper waits for, spinning for `spin` after its last job, then parked.
-struct Team {
-    epoch: Arc<AtomicU64>,
-    done: Arc<AtomicU64>,
-    helper: Option<std::thread::JoinHandle<()>>,
-}
-
-impl Team {
-    fn new(mut x: Vec<V>, v: Vec<V>, spin: Duration) -> Team {
-        let (epoch, done) = (Arc::new(AtomicU64::new(0)), Arc::new(AtomicU64::new(0)));
-        let (e, d) = (epoch.clone(), done.clone());
-        let helper = std::thread::spawn(move || {
-            let mut seen = 0;
-            loop {
-                let idle = Instant::now();
-                let next = loop {
-                    let now = e.load(Ordering::Acquire);
-                    if now != seen {
-                        break now;
-                    }
-                    if idle.elapsed() < spin {
-                        std::hint::spin_loop();
-                    } else {
-                        std::thread::park_timeout(Duration::from_millis(1));
-                    }
-                };
-                if next == u64::MAX {
-                    return;
-                }
-                kick(&mut x, &v, 1e-9);
-                seen = next;
-                d.store(next, Ordering::Release);
-            }
-        });
-        Team {
-            epoch,
-            done,
-            helper: Some(helper),
-        }
-    }
-
-    /// One region: the helper's half and the caller's `own` half, then the wait for both.
-    fn region(&self, own: impl FnOnce()) {
-        let next = self.epoch.load(Ordering::Relaxed) + 1;
-        self.epoch.store(next, Ordering::Release);
-        if let Some(h) = &self.helper {
-            h.thread().unpark();
-        }
-        own();
-        while self.done.load(Ordering::Acquire) != next {
-            std::hint::spin_loop();
-        }
-    }
-}
-
-impl Drop for Team {
-    fn drop(&mut self) {
-        self.epoch.store(u64::MAX, Ordering::Release);
-        if let Some(h) = self.helper.take() {
-            h.thread().unpark();
-            h.join().expect("the helper ends");
-        }
-    }
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let option = |name: &str, default: usize| {
@@ -142,12 +79,34 @@ fn main() {
             (join, empty)
         });
         let mut team_us = Vec::new();
-        for spin_us in [50, 1000] {
-            let spin = Duration::from_micros(spin_us);
-            let team = Team::new(x[half..].to_vec(), v[half..].to_vec(), spin);
-            let own = &mut x[..half];
-            let t = median_after_gap(reps, gap, || team.region(|| kick(own, &v[..half], 1e-9)));
-            team_us.push(json!({"spin_us": spin_us, "region_us": t}));
+        for spin_us in [50, 100, 1000] {
+            let waits = Waits {
+                spin: Duration::from_micros(spin_us),
+                ..Waits::default()
+            };
+            let team = Team::with_waits(2, waits);
+            let mut halves = || {
+                let (a, b) = x.split_at_mut(half);
+                let parts = vec![(a, &v[..half]), (b, &v[half..])];
+                team.run(parts, |(x, v)| kick(x, v, 1e-9));
+            };
+            let between_steps = median_after_gap(reps, gap, &mut halves);
+            let in_step = team.hold(|| median_after_gap(reps, gap, &mut halves));
+            let empty = median_after_gap(reps, gap, || {
+                team.run(vec![(), ()], |()| ());
+            });
+            let held_empty = team.hold(|| {
+                median_after_gap(reps, gap, || {
+                    team.run(vec![(), ()], |()| ());
+                })
+            });
+            team_us.push(json!({
+                "spin_us": spin_us,
+                "region_us": between_steps,
+                "held_region_us": in_step,
+                "empty_phase_us": empty,
+                "held_empty_phase_us": held_empty,
+            }));
         }
         rows.push(json!({
             "gap_us": gap,

@@ -15,12 +15,14 @@
 //! so a step is bit-identical to theirs; and it involves no other particle, so the result does
 //! not depend on how the particles are cut among the threads. A sweep splits into at most one
 //! task per thread, each of at least [`SWEEP_TASK`] particles: at 10⁴ particles two threads
-//! each take half.
+//! each take half. With a [`Team`] installed ([`crate::step::team`]) a sweep is one phase of
+//! the team, in tasks of at least [`TEAM_TASK`] particles, in place of a rayon region.
 
 use crate::solvers::local_damping::damp;
 use crate::step::local_particles::ParticleRuns;
 use crate::step::rigid_body::RigidBodies;
 use crate::step::state::Dofs;
+use crate::step::team::{self, Team};
 use crate::Vec3;
 use rayon::prelude::*;
 use std::ops::Range;
@@ -30,6 +32,11 @@ use std::ops::Range;
 /// 10–20 µs on the 2-core benchmark machine (qdem-bench's `fork_join` measures both), so a
 /// task of 4,096 particles is about what its wake-up costs.
 pub(crate) const SWEEP_TASK: usize = 4096;
+
+/// The fewest particles a sweep hands to a thread of a [`Team`]: a phase posted to a worker
+/// that is spinning costs about a microsecond (two cache lines crossing the cores), a few
+/// hundred particles' work.
+pub(crate) const TEAM_TASK: usize = 1024;
 
 /// One set of generalised degrees of freedom of some particles (their translations, or their
 /// rotations): positions, rates, accelerations, the force sums and the inertia.
@@ -123,11 +130,12 @@ pub(crate) fn cover(count: usize, only: Option<&ParticleRuns>) -> Vec<Range<usiz
     }
 }
 
-/// `ranges` (ascending) cut into tasks of about equal size, at most one per thread and none
-/// shorter than [`SWEEP_TASK`] unless there is only one.
-fn tasks(ranges: &[Range<usize>]) -> Vec<Vec<Range<usize>>> {
+/// `ranges` (ascending) cut into tasks of about equal size, at most one per thread of
+/// `threads` and none shorter than `least` unless there is only one: a function of the
+/// particles and the thread count alone.
+fn tasks(ranges: &[Range<usize>], threads: usize, least: usize) -> Vec<Vec<Range<usize>>> {
     let total: usize = ranges.iter().map(Range::len).sum();
-    let count = (total / SWEEP_TASK).clamp(1, rayon::current_num_threads().max(1));
+    let count = (total / least).clamp(1, threads.max(1));
     let size = total.div_ceil(count).max(1);
     let mut out = vec![Vec::new()];
     let mut room = size;
@@ -150,13 +158,30 @@ fn tasks(ranges: &[Range<usize>]) -> Vec<Vec<Range<usize>>> {
 }
 
 /// Runs `work` on every piece of `particles` within `ranges` (each piece with the index of its
-/// first particle), in tasks on the threads ([`tasks`]); returns the element-wise minimum of
-/// the results (`(usize::MAX, usize::MAX)` with nothing to do).
+/// first particle), in tasks on the threads ([`tasks`]): a phase of the current [`Team`], or
+/// a rayon region without one; returns the element-wise minimum of the results
+/// (`(usize::MAX, usize::MAX)` with nothing to do).
 fn sweep<W>(particles: Particles<'_>, ranges: &[Range<usize>], work: W) -> (usize, usize)
 where
     W: Fn(usize, Particles<'_>) -> (usize, usize) + Sync,
 {
-    let plan = tasks(ranges);
+    team::with_current(|team| sweep_on(team, particles, ranges, work))
+}
+
+/// [`sweep`] on `team`, or on rayon's threads without one.
+fn sweep_on<W>(
+    team: Option<&Team>,
+    particles: Particles<'_>,
+    ranges: &[Range<usize>],
+    work: W,
+) -> (usize, usize)
+where
+    W: Fn(usize, Particles<'_>) -> (usize, usize) + Sync,
+{
+    let plan = match team {
+        Some(team) => tasks(ranges, team.size(), TEAM_TASK),
+        None => tasks(ranges, rayon::current_num_threads(), SWEEP_TASK),
+    };
     let flat: Vec<Range<usize>> = plan.iter().flatten().cloned().collect();
     let mut pieces = particles.cut(&flat).into_iter();
     let run_task = |task: Vec<(usize, Particles<'_>)>| {
@@ -171,6 +196,11 @@ where
     if grouped.len() == 1 {
         return run_task(grouped.pop().expect("one task"));
     }
+    if let Some(team) = team {
+        let results = team.run(grouped, run_task);
+        return results.into_iter().fold((usize::MAX, usize::MAX), min2);
+    }
+    team::note_rayon_region();
     grouped
         .into_par_iter()
         .map(run_task)
@@ -336,17 +366,19 @@ mod tests {
     #[test]
     fn tasks_cover_the_ranges_in_order_and_are_never_shorter_than_a_task() {
         let ranges = vec![0..3000, 3500..9000, 9100..20000];
-        let plan = tasks(&ranges);
-        let flat: Vec<usize> = plan.iter().flatten().flat_map(Range::clone).collect();
-        let want: Vec<usize> = ranges.iter().flat_map(Range::clone).collect();
-        assert_eq!(flat, want);
-        let threads = rayon::current_num_threads();
-        assert!(plan.len() <= threads.max(1));
-        if plan.len() > 1 {
+        for (threads, least) in [(1, SWEEP_TASK), (2, SWEEP_TASK), (3, TEAM_TASK)] {
+            let plan = tasks(&ranges, threads, least);
+            let flat: Vec<usize> = plan.iter().flatten().flat_map(Range::clone).collect();
+            let want: Vec<usize> = ranges.iter().flat_map(Range::clone).collect();
+            assert_eq!(flat, want);
+            assert_eq!(plan.len(), threads);
             assert!(plan
                 .iter()
-                .all(|t| t.iter().map(Range::len).sum::<usize>() >= SWEEP_TASK));
+                .all(|t| t.iter().map(Range::len).sum::<usize>() >= least));
+            assert_eq!(
+                tasks(std::slice::from_ref(&(0..10)), threads, least).len(),
+                1
+            );
         }
-        assert_eq!(tasks(std::slice::from_ref(&(0..10))).len(), 1);
     }
 }

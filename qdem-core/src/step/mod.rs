@@ -3,7 +3,8 @@
 //! of forces) and its facets, the [`post_step`] hooks, [`stepper::Stepper`] (advances a state
 //! under the models) with the [`seam`] it evaluates forces through and the [`solve_report`]
 //! it gives, the [`tangent`] of implicit solves, the named, timed [`stages`] of a step and
-//! the step settings resolved once ([`step_settings`]). It names no other area but the
+//! the step settings resolved once ([`step_settings`]), and the persistent [`team`] of
+//! threads whose phases the stages of a step may run as. It names no other area but the
 //! split facets' `Reads` of [`crate::parallel`], until those facets move here.
 
 pub mod frames;
@@ -21,6 +22,7 @@ pub mod state;
 pub mod step_settings;
 pub mod stepper;
 pub mod tangent;
+pub mod team;
 
 pub use frames::ParticleFrames;
 pub use model::Deformable;

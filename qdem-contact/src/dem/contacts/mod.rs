@@ -99,6 +99,7 @@ mod pair_kernel;
 mod persistence;
 mod pipeline;
 mod rolling;
+mod run_threads;
 mod servo_loads;
 mod spatial_order;
 mod spheres;
@@ -119,6 +120,10 @@ const CONTACT_CHUNK: usize = 2048;
 
 /// Spheres per parallel task when reading their centres (a copy: a few ns each).
 const SPHERE_CHUNK: usize = 16384;
+
+/// The fewest spheres whose centres a thread of a team reads in a phase of its own (a phase
+/// posted to a spinning worker costs about a microsecond).
+const TEAM_SPHERES: usize = 1024;
 
 /// A candidate contact's work at each evaluation (the read of its partners, the narrow
 /// phase, the law and its share of the sums) in units of one particle's step (prediction

@@ -263,43 +263,38 @@ impl DemContacts {
             let scaled = self.time_delay.is_some();
             let (slot, early, lanes) = (&plan.slot, &plan.early, plan.lanes.0);
             let length = run_length(sums.len());
-            // Each run a task of its own on several threads: the runs' costs differ (a
-            // packing's floor layers carry its wall contacts), and rayon's halving split put
-            // them 2 : 1 on two threads at 10⁴ spheres. On one thread the splitting is waste.
-            let per_task = match rayon::current_num_threads() {
-                1 => usize::MAX,
-                _ => 1,
-            };
-            sums.par_chunks_mut(length)
-                .zip(plan.foreign.par_iter_mut())
+            let inputs: Vec<_> = sums
+                .chunks_mut(length)
+                .zip(plan.foreign.iter_mut())
                 .zip(lists)
-                .enumerate()
-                .with_max_len(per_task)
-                .for_each(|(r, ((own, foreign), lists))| {
-                    let run = &runs[r];
-                    let lo = (r * length) as u32;
-                    let slots = &slot[run.pairs.clone()];
-                    let partners = &this.candidates.partners()[run.partners.clone()];
-                    let sums = RunSums { own, foreign, lo };
-                    let input = (lists, slots, partners, sums);
-                    match scaled {
-                        true => this.evaluate_run::<LAW, SUM, true>(time, dt, lanes, input),
-                        false => this.evaluate_run::<LAW, SUM, false>(time, dt, lanes, input),
+                .collect();
+            let cost =
+                |r: usize| runs[r].pairs.len() + runs[r].walls.len() + runs[r].partners.len();
+            run_threads::for_each_run(inputs, cost, |(r, ((own, foreign), lists))| {
+                let run = &runs[r];
+                let lo = (r * length) as u32;
+                let slots = &slot[run.pairs.clone()];
+                let partners = &this.candidates.partners()[run.partners.clone()];
+                let sums = RunSums { own, foreign, lo };
+                let input = (lists, slots, partners, sums);
+                match scaled {
+                    true => this.evaluate_run::<LAW, SUM, true>(time, dt, lanes, input),
+                    false => this.evaluate_run::<LAW, SUM, false>(time, dt, lanes, input),
+                }
+                let (true, Some(carriers)) = (SUM, &carriers) else {
+                    return;
+                };
+                let early = &early[run.partners.clone()];
+                for (&s, _) in partners.iter().zip(early).filter(|(_, &e)| e) {
+                    if !this.adds_to(s) {
+                        continue;
                     }
-                    let (true, Some(carriers)) = (SUM, &carriers) else {
-                        return;
-                    };
-                    let early = &early[run.partners.clone()];
-                    for (&s, _) in partners.iter().zip(early).filter(|(_, &e)| e) {
-                        if !this.adds_to(s) {
-                            continue;
-                        }
-                        let (f, t) = &own[(s - lo) as usize];
-                        // SAFETY: an early sphere's particle and rotation are its own
-                        // (`exclusive_carriers`), and each sphere is in one run.
-                        unsafe { this.add_exclusive(s as usize, f, t, carriers) };
-                    }
-                });
+                    let (f, t) = &own[(s - lo) as usize];
+                    // SAFETY: an early sphere's particle and rotation are its own
+                    // (`exclusive_carriers`), and each sphere is in one run.
+                    unsafe { this.add_exclusive(s as usize, f, t, carriers) };
+                }
+            });
         }
         self.candidates.set_lists(pairs, walls);
         if SUM {

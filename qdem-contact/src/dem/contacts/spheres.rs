@@ -6,8 +6,9 @@
 //! of each pair of their materials.
 
 use super::spatial_order::permuted;
-use super::{SphereNow, NOT_RIGID, SPHERE_CHUNK};
+use super::{SphereNow, NOT_RIGID, SPHERE_CHUNK, TEAM_SPHERES};
 use crate::dem::laws::contact_law::PairElasticity;
+use qdem_core::step::team::{self, Team};
 use qdem_core::{step::State, Vec3};
 use rayon::prelude::*;
 
@@ -180,9 +181,51 @@ impl Spheres {
         self.elasticity[a.material as usize * self.materials + b.material as usize]
     }
 
-    /// Every sphere's centre and narrow-phase record from `state`, in parallel; returns the
-    /// largest distance one has moved from `built_at` (infinite without it).
+    /// Every sphere's centre and narrow-phase record from `state`, in parallel (a phase of
+    /// the current team, else a rayon region); returns the largest distance one has moved
+    /// from `built_at` (infinite without it).
     pub(super) fn read_every(&mut self, state: &State, built_at: Option<&[Vec3]>) -> f64 {
+        team::with_current(|team| match team {
+            Some(team) => self.read_every_on(team, state, built_at),
+            None => self.read_every_on_rayon(state, built_at),
+        })
+    }
+
+    /// [`Spheres::read_every`] on `team`: contiguous pieces of at least [`TEAM_SPHERES`]
+    /// spheres, one per thread; the largest displacement is the maximum of the pieces'.
+    fn read_every_on(&mut self, team: &Team, state: &State, built_at: Option<&[Vec3]>) -> f64 {
+        let n = self.center.len();
+        let parts = (n / TEAM_SPHERES).clamp(1, team.size());
+        let length = n.div_ceil(parts).max(1);
+        let (particle, turn) = (&self.particle, &self.turn);
+        let pieces: Vec<_> = self
+            .center
+            .chunks_mut(length)
+            .zip(self.now.chunks_mut(length))
+            .enumerate()
+            .collect();
+        let moved = team.run(pieces, |(k, (center, now))| {
+            let first = k * length;
+            let mut moved: f64 = 0.0;
+            for (i, (center, now)) in center.iter_mut().zip(now).enumerate() {
+                let s = first + i;
+                *center = state.position[particle[s] as usize];
+                read_motion(state, *center, particle[s], turn[s], now);
+                moved = moved.max(match built_at {
+                    Some(built_at) => (*center - built_at[s]).norm_squared(),
+                    None => f64::INFINITY,
+                });
+            }
+            moved
+        });
+        moved.into_iter().fold(0.0, f64::max).sqrt()
+    }
+
+    /// [`Spheres::read_every`] as a rayon region.
+    fn read_every_on_rayon(&mut self, state: &State, built_at: Option<&[Vec3]>) -> f64 {
+        if self.center.len() >= 2 * SPHERE_CHUNK && rayon::current_num_threads() > 1 {
+            team::note_rayon_region();
+        }
         let (particle, turn) = (&self.particle, &self.turn);
         self.center
             .par_iter_mut()
