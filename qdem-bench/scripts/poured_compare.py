@@ -806,7 +806,8 @@ def main() -> None:
                     help="copies of the settled bed along x and along y (the tiled part)")
     ap.add_argument("--wait-idle", type=float, default=0.0)
     ap.add_argument("--team", action="store_true",
-                    help="in the pour and tiled parts, also time qdem with QDEM_TEAM=1 (code qdem_team), "
+                    help="in the pour and tiled parts, also time qdem with QDEM_TEAM=1 "
+                         "(code qdem_team), "
                          "alternated with the default")
     args = ap.parse_args()
     args.np = [int(s) for s in args.np.split(",")]
