@@ -39,7 +39,10 @@
 //! decomposed over processes the strain pass's slot sums of a particle another rank owns go
 //! to the owner in a reverse exchange and the owner's averages come back forward
 //! ([`crate::step::split::Averaging`]), so the owner averages as one process does and every
-//! rank's force pass reads the same bits: byte-identical for any rank count.
+//! rank's force pass reads the same bits: byte-identical for any rank count. The outputs'
+//! stresses and the energy read the averages of the same strain pass and nodal average
+//! ([`nodal_average`], the one implementation of Eq. 9), so a reported pressure is the one
+//! the forces used, to the bit; the tangent's averaged divergence b̄_a sums in the same order.
 
 use crate::continuum::averaged_pressure_lanes::{force_sums, strain_sums, ForceInput, StrainInput};
 use crate::continuum::material::Material;
@@ -97,7 +100,8 @@ pub(crate) struct AveragedPressure {
     first: usize,
     /// Per particle from `first`, the range of its corners in `corners`.
     corner_start: Vec<u32>,
-    /// 4 · tet + corner of every particle's corners, tets ascending.
+    /// 4 · tet + corner of every particle's corners, the tetrahedra in block order (the
+    /// order of the nodal average's sums), for the tangent's averaged divergence.
     corners: Vec<u32>,
     /// 1 / V̄_a per particle from `first` (0 for a particle of no tetrahedron).
     inv_nodal_volume: Vec<f64>,
@@ -157,13 +161,17 @@ impl AveragedPressure {
         }
         let mut next = corner_start.clone();
         let mut corners = vec![0u32; 4 * tets.len()];
-        let mut nodal_volume = vec![0.0; count];
-        for (e, tet) in tets.iter().enumerate() {
-            for (c, &n) in tet.iter().enumerate() {
+        for &e in &blocks.order {
+            for (c, &n) in tets[e as usize].iter().enumerate() {
                 let i = n as usize - first;
-                corners[next[i] as usize] = (4 * e + c) as u32;
+                corners[next[i] as usize] = 4 * e + c as u32;
                 next[i] += 1;
-                nodal_volume[i] += 0.25 * volume[e];
+            }
+        }
+        let mut nodal_volume = vec![0.0; count];
+        for (tet, v) in tets.iter().zip(volume) {
+            for &n in tet {
+                nodal_volume[n as usize - first] += 0.25 * v;
             }
         }
         AveragedPressure {
@@ -193,54 +201,39 @@ impl AveragedPressure {
     /// The strain pass over the blocks `range` at `state`: each block's Σ (V_e/4) θ_e (and
     /// tr D_e) per node slot, the blocks in parallel.
     pub(crate) fn strain_pass(&mut self, blocks: &TetBlocks, range: Range<usize>, state: &State) {
-        if range.is_empty() {
-            return;
-        }
-        let start = &blocks.node_start;
-        let slots = start[range.start] as usize..start[range.end] as usize;
         let (quarter, viscous) = (&self.quarter_packs, self.viscous);
-        for_blocks(&mut self.partial[slots], range, start, &|b, out| {
-            SCRATCH.with_borrow_mut(|scratch| {
-                let nodes = &blocks.nodes[start[b] as usize..start[b + 1] as usize];
-                scratch.load(nodes, state, viscous);
-                out.fill(Vec3::zeros());
-                let packs = blocks.pack_start[b] as usize..blocks.pack_start[b + 1] as usize;
-                let input = StrainInput {
-                    x: &scratch.x,
-                    v: &scratch.v,
-                    quarter: &quarter[packs.clone()],
-                    count: (blocks.tet_start[b + 1] - blocks.tet_start[b]) as usize,
-                };
-                let (set, packs) = (LaneSet::detected(), &blocks.packs[packs]);
-                match viscous {
-                    true => strain_sums::<true>(set, packs, &input, out),
-                    false => strain_sums::<false>(set, packs, &input, out),
-                }
-            });
-            usize::MAX
-        });
+        strain_slots(blocks, range, quarter, viscous, state, &mut self.partial);
     }
 
     /// The averages θ̄_a (and tr(D)‾_a) of the particles `owned` (all when `None`; else those
-    /// whose owner is `me`): each particle's slot sums in ascending block order (Eq. 11's
-    /// order, the same bits for any thread or rank count) over its nodal volume.
+    /// whose owner is `me`) from the strain pass's slot sums ([`nodal_average`]).
     pub(crate) fn average(&mut self, blocks: &TetBlocks, owned: Option<(u32, &[u32])>) {
-        let (starts, entries, partial) = (&blocks.entry_start, &blocks.entries, &self.partial);
         let inv_volume = &self.inv_nodal_volume;
-        self.nodal
-            .par_iter_mut()
-            .with_min_len(PARTICLE_CHUNK)
-            .enumerate()
-            .for_each(|(i, average)| {
-                if owned.is_some_and(|(me, owner)| owner[i] != me) {
-                    return;
-                }
-                let mut sum = Vec3::zeros();
-                for &entry in &entries[starts[i] as usize..starts[i + 1] as usize] {
-                    sum += partial[entry as usize];
-                }
-                *average = sum * inv_volume[i];
-            });
+        nodal_average(blocks, &self.partial, inv_volume, owned, &mut self.nodal);
+    }
+
+    /// The particles' averages (θ̄_a, tr(D)‾_a, 0) at `state`, from `first`: the strain pass
+    /// and the average of a step over the whole body, the same bits as the forces of a step
+    /// at `state` read, for the outputs. With `small_strain`, of the linear tr ε = div u of a
+    /// static solve (elastic), summed in the same order.
+    fn averages_at(&self, blocks: &TetBlocks, state: &State, small_strain: bool) -> Vec<Vec3> {
+        let mut partial = vec![Vec3::zeros(); blocks.nodes.len()];
+        if small_strain {
+            small_strain_slots(blocks, &self.quarter, state, &mut partial);
+        } else {
+            let quarter = &self.quarter_packs;
+            strain_slots(
+                blocks,
+                0..blocks.len(),
+                quarter,
+                self.viscous,
+                state,
+                &mut partial,
+            );
+        }
+        let mut nodal = vec![Vec3::zeros(); self.nodal.len()];
+        nodal_average(blocks, &partial, &self.inv_nodal_volume, None, &mut nodal);
+        nodal
     }
 
     /// The per-slot sums of the strain pass, for the reverse exchange of a decomposed run.
@@ -298,86 +291,63 @@ impl AveragedPressure {
     /// pressure checkerboards as ν → ½. With `small_strain`, the linear ε = sym ∇u of a
     /// static solve in place of Eq. 4's, elastic only (the stress that belongs to the
     /// small-strain tangent of [`AveragedPressure::add_tangent`]).
-    pub(crate) fn stresses(&self, state: &State, small_strain: bool) -> Vec<Mat3> {
+    pub(crate) fn stresses(
+        &self,
+        blocks: &TetBlocks,
+        state: &State,
+        small_strain: bool,
+    ) -> Vec<Mat3> {
         let viscous = self.viscous && !small_strain;
-        let strains: Vec<(Mat3, Option<Mat3>)> = (0..self.tets.len())
+        let nodal = self.averages_at(blocks, state, small_strain);
+        (0..self.tets.len())
             .into_par_iter()
             .with_min_len(TET_CHUNK)
             .map(|e| {
                 let tet = self.tets[e];
+                let mean = |k: usize| corner_mean(&nodal, &tet, self.first, k);
                 if small_strain {
                     let u = tet.map(|n| state.displacement(n as usize));
                     let grad = edge_matrix(&u) * self.dm_inv[e];
-                    return ((grad + grad.transpose()) * 0.5, None);
+                    return self
+                        .moduli
+                        .stress(&((grad + grad.transpose()) * 0.5), mean(0), None);
                 }
                 let dx = edge_matrix(&tet.map(|n| state.position[n as usize]));
                 let rate = viscous.then(|| {
                     let v = tet.map(|n| state.velocity[n as usize]);
                     let cof = cofactor(&dx);
                     let l = velocity_gradient(&v, &cof, dx.determinant());
-                    (l + l.transpose()) * 0.5
+                    ((l + l.transpose()) * 0.5, mean(1))
                 });
-                (green_strain(&(dx * self.dm_inv[e])), rate)
-            })
-            .collect();
-        let theta: Vec<(f64, f64)> = strains
-            .iter()
-            .map(|(eps, d)| (eps.trace(), d.map_or(0.0, |d| d.trace())))
-            .collect();
-        let mut nodal = vec![(0.0, 0.0); self.nodal.len()];
-        average_per_particle(
-            &theta,
-            &self.quarter,
-            &self.corners,
-            &self.corner_start,
-            &self.inv_nodal_volume,
-            &mut nodal,
-        );
-        let mean = |tet: &[u32; 4], f: fn(&(f64, f64)) -> f64| {
-            0.25 * tet
-                .iter()
-                .map(|&n| f(&nodal[n as usize - self.first]))
-                .sum::<f64>()
-        };
-        self.tets
-            .iter()
-            .zip(strains)
-            .map(|(tet, (eps, rate))| {
-                let rate = rate.map(|d| (d, mean(tet, |a| a.1)));
-                self.moduli.stress(&eps, mean(tet, |a| a.0), rate)
+                self.moduli
+                    .stress(&green_strain(&(dx * self.dm_inv[e])), mean(0), rate)
             })
             .collect()
     }
 
-    /// The elastic energy Σ_e V_e μ dev ε:dev ε + Σ_a V̄_a κ θ̄_a²/2 at `state`.
-    pub(crate) fn energy(&self, state: &State) -> f64 {
-        let eps: Vec<Mat3> = (0..self.tets.len())
+    /// The elastic energy Σ_e V_e μ dev ε:dev ε + Σ_a V̄_a κ θ̄_a²/2 at `state`, with the
+    /// averages θ̄_a of a step at `state`.
+    pub(crate) fn energy(&self, blocks: &TetBlocks, state: &State) -> f64 {
+        let deviatoric: f64 = (0..self.tets.len())
             .map(|e| {
                 let x = self.tets[e].map(|n| state.position[n as usize]);
-                green_strain(&(edge_matrix(&x) * self.dm_inv[e]))
+                let eps = green_strain(&(edge_matrix(&x) * self.dm_inv[e]));
+                4.0 * self.quarter[e] * self.moduli.mu * deviator(&eps).norm_squared()
             })
-            .collect();
-        let deviatoric: f64 = eps
-            .iter()
-            .zip(&self.quarter)
-            .map(|(eps, q)| 4.0 * q * self.moduli.mu * deviator(eps).norm_squared())
             .sum();
-        let volumetric: f64 = (0..self.inv_nodal_volume.len())
-            .filter(|&i| self.inv_nodal_volume[i] > 0.0)
-            .map(|i| {
-                let range = self.corner_start[i] as usize..self.corner_start[i + 1] as usize;
-                let sum: f64 = self.corners[range]
-                    .iter()
-                    .map(|&k| self.quarter[k as usize / 4] * eps[k as usize / 4].trace())
-                    .sum();
-                0.5 * self.moduli.kappa * sum * sum * self.inv_nodal_volume[i]
-            })
+        let nodal = self.averages_at(blocks, state, false);
+        let volumetric: f64 = nodal
+            .iter()
+            .zip(&self.inv_nodal_volume)
+            .filter(|(_, &inv)| inv > 0.0)
+            .map(|(a, inv)| 0.5 * self.moduli.kappa * a.x * a.x / inv)
             .sum();
         deviatoric + volumetric
     }
 
     /// Adds the small-strain tangent at `state`'s positions: per tetrahedron the deviatoric
-    /// V Gᵀ D_dev G, per particle κ V̄_a b̄_a b̄_aᵀ (and the viscous pair alike for C).
+    /// V Gᵀ D_dev G, per particle κ V̄_a b̄_a b̄_aᵀ (and the viscous pair alike for C), b̄_a
+    /// summed over the particle's tetrahedra in block order, the nodal average's order.
     pub(crate) fn add_tangent(&self, state: &State, tangent: &mut Tangent) {
         let gradients: Vec<(f64, [Vec3; 4])> = self
             .tets
@@ -465,30 +435,98 @@ impl Moduli {
     }
 }
 
-/// Per particle, the reference-volume-weighted averages (Bonet & Burton Eq. 9) of its
-/// tetrahedra's `theta` pairs, into `nodal`: each particle's corners in ascending order, so
-/// the sums are the same bits for any number of threads.
-fn average_per_particle(
-    theta: &[(f64, f64)],
-    quarter: &[f64],
-    corners: &[u32],
-    starts: &[u32],
-    inv_volume: &[f64],
-    nodal: &mut [(f64, f64)],
+/// The strain pass over the blocks `range` at `state` into `partial` (the slot sums, laid out
+/// as the blocks' node lists): each block's Σ (V_e/4) θ_e, and Σ (V_e/4) tr D_e when
+/// `viscous`, per node slot, in the lanes' order
+/// ([`crate::continuum::averaged_pressure_lanes::strain_sums`]), the blocks in parallel.
+fn strain_slots(
+    blocks: &TetBlocks,
+    range: Range<usize>,
+    quarter: &[[f64; PACK]],
+    viscous: bool,
+    state: &State,
+    partial: &mut [Vec3],
 ) {
+    if range.is_empty() {
+        return;
+    }
+    let start = &blocks.node_start;
+    let slots = start[range.start] as usize..start[range.end] as usize;
+    for_blocks(&mut partial[slots], range, start, &|b, out| {
+        SCRATCH.with_borrow_mut(|scratch| {
+            let nodes = &blocks.nodes[start[b] as usize..start[b + 1] as usize];
+            scratch.load(nodes, state, viscous);
+            out.fill(Vec3::zeros());
+            let packs = blocks.pack_start[b] as usize..blocks.pack_start[b + 1] as usize;
+            let input = StrainInput {
+                x: &scratch.x,
+                v: &scratch.v,
+                quarter: &quarter[packs.clone()],
+                count: (blocks.tet_start[b + 1] - blocks.tet_start[b]) as usize,
+            };
+            let (set, packs) = (LaneSet::detected(), &blocks.packs[packs]);
+            match viscous {
+                true => strain_sums::<true>(set, packs, &input, out),
+                false => strain_sums::<false>(set, packs, &input, out),
+            }
+        });
+        usize::MAX
+    });
+}
+
+/// The slot sums Σ (V_e/4) tr ε_e of the small-strain ε = sym ∇u at `state`'s displacements
+/// into `partial`, each block's tetrahedra in block order as the strain pass adds them.
+fn small_strain_slots(blocks: &TetBlocks, quarter: &[f64], state: &State, partial: &mut [Vec3]) {
+    for b in 0..blocks.len() {
+        let nodes = &blocks.nodes[blocks.node_start[b] as usize..];
+        let out = &mut partial[blocks.node_start[b] as usize..];
+        for k in blocks.tet_start[b] as usize..blocks.tet_start[b + 1] as usize {
+            let hot = &blocks.hot[k];
+            let u = hot
+                .local
+                .map(|l| state.displacement(nodes[l as usize] as usize));
+            let theta = quarter[blocks.order[k] as usize] * (edge_matrix(&u) * hot.dm_inv).trace();
+            for &l in &hot.local {
+                out[l as usize].x += theta;
+            }
+        }
+    }
+}
+
+/// The nodal average of Bonet & Burton Eq. 9, the one every reader of θ̄ uses: per particle
+/// (from the blocks' `first`; those `owned` only, when given as (me, owner per particle)),
+/// its block slots' sums in `partial` added in ascending block order and multiplied by its
+/// `inv_volume`, into `nodal`. The order is fixed by the mesh: the same bits for any thread
+/// or rank count.
+fn nodal_average(
+    blocks: &TetBlocks,
+    partial: &[Vec3],
+    inv_volume: &[f64],
+    owned: Option<(u32, &[u32])>,
+    nodal: &mut [Vec3],
+) {
+    let (starts, entries) = (&blocks.entry_start, &blocks.entries);
     nodal
         .par_iter_mut()
         .with_min_len(PARTICLE_CHUNK)
         .enumerate()
-        .for_each(|(i, avg)| {
-            let (mut t, mut r) = (0.0, 0.0);
-            for &k in &corners[starts[i] as usize..starts[i + 1] as usize] {
-                let e = k as usize / 4;
-                t += quarter[e] * theta[e].0;
-                r += quarter[e] * theta[e].1;
+        .for_each(|(i, average)| {
+            if owned.is_some_and(|(me, owner)| owner[i] != me) {
+                return;
             }
-            *avg = (t * inv_volume[i], r * inv_volume[i]);
+            let mut sum = Vec3::zeros();
+            for &entry in &entries[starts[i] as usize..starts[i + 1] as usize] {
+                sum += partial[entry as usize];
+            }
+            *average = sum * inv_volume[i];
         });
+}
+
+/// ¼ (a₀ + a₁ + a₂ + a₃) of component `k` of the averages (from particle `first`) at the
+/// corners of `tet`, added in the force pass's order.
+fn corner_mean(nodal: &[Vec3], tet: &[u32; 4], first: usize, k: usize) -> f64 {
+    let at = |c: usize| nodal[tet[c] as usize - first][k];
+    0.25 * (((at(0) + at(1)) + at(2)) + at(3))
 }
 
 /// The strain ε = (F Fᵀ − I)/2 of Eq. 4.
@@ -513,4 +551,68 @@ fn quarter_packs(blocks: &TetBlocks, volume: &[f64]) -> Vec<[f64; PACK]> {
         }
     }
     packs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::continuum::tet_kernel::edge_matrix;
+
+    /// An averaged-pressure bar of 1,440 tetrahedra (several blocks), viscous, displaced and
+    /// moving irregularly: its averaging, blocks and state.
+    fn bar() -> (AveragedPressure, TetBlocks, State) {
+        let mesh = qdem_mesh::structured_box([0.0; 3], [2.0, 0.6, 0.5], [12, 4, 5]).unwrap();
+        let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
+        let dm_inv: Vec<Mat3> = mesh
+            .tets
+            .iter()
+            .map(|t| {
+                edge_matrix(&t.map(|n| reference[n as usize]))
+                    .try_inverse()
+                    .unwrap()
+            })
+            .collect();
+        let volume: Vec<f64> = mesh
+            .tets
+            .iter()
+            .map(|t| edge_matrix(&t.map(|n| reference[n as usize])).determinant() / 6.0)
+            .collect();
+        let blocks = TetBlocks::new(&reference, &mesh.tets, &dm_inv);
+        assert!(blocks.len() > 1, "the averages cross blocks");
+        let material = Material {
+            shear_viscosity: 40.0,
+            bulk_viscosity: 25.0,
+            ..Material::elastic(1100.0, 5e6, 0.499)
+        };
+        let averaged = AveragedPressure::new(&mesh.tets, dm_inv, &volume, &material, &blocks);
+        let mut state = State::at_rest(reference);
+        for (i, (x, v)) in state
+            .position
+            .iter_mut()
+            .zip(&mut state.velocity)
+            .enumerate()
+        {
+            let t = i as f64;
+            *x += Vec3::new((1.3 * t).sin(), (0.7 * t).cos(), (2.1 * t).sin()) * 1e-3;
+            *v = Vec3::new((0.9 * t).cos(), (1.7 * t).sin(), (0.4 * t).cos()) * 0.1;
+        }
+        (averaged, blocks, state)
+    }
+
+    /// The averages the outputs (stresses, energy) read are the bits the step's forces read:
+    /// one nodal average, not a second scalar one beside the strain pass.
+    #[test]
+    fn the_outputs_read_the_steps_averages_to_the_bit() {
+        let (mut averaged, blocks, state) = bar();
+        averaged.strain_pass(&blocks, 0..blocks.len(), &state);
+        averaged.average(&blocks, None);
+        let outputs = averaged.averages_at(&blocks, &state, false);
+        assert!(outputs.iter().any(|a| a.x != 0.0 && a.y != 0.0));
+        let differ = outputs
+            .iter()
+            .zip(&averaged.nodal)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(differ, 0, "of {} particles", outputs.len());
+    }
 }

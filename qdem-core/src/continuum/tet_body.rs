@@ -256,7 +256,7 @@ impl TetBody {
             .with_min_len(TET_CHUNK)
             .map(|e| self.volumetric_strain(e, &self.tets[e].map(|n| state.position[n as usize])))
             .collect();
-        (averaged.stresses(state, false), volumetric)
+        (averaged.stresses(&self.blocks, state, false), volumetric)
     }
 
     /// [`TetBody::tet_fields`] of the standard tetrahedron, in one pass.
@@ -289,7 +289,7 @@ impl TetBody {
     /// of that formulation's small-strain tangent.
     pub fn small_strain_stresses(&self, state: &State) -> Vec<Mat3> {
         if let Some(averaged) = &self.averaged {
-            return averaged.stresses(state, true);
+            return averaged.stresses(&self.blocks, state, true);
         }
         let (lambda, mu) = self.pair();
         (0..self.tets.len())
@@ -589,7 +589,7 @@ impl Model for TetBody {
 
     fn potential_energy(&self, state: &State) -> Option<f64> {
         if let Some(averaged) = &self.averaged {
-            return Some(averaged.energy(state));
+            return Some(averaged.energy(&self.blocks, state));
         }
         let (lambda, mu) = self.pair();
         let energy = (0..self.tets.len())
