@@ -10,6 +10,7 @@ use crate::vector_peak::vector_peak_flops;
 use qdem_core::continuum::averaged_pressure_lanes::{
     FLOPS_AVERAGED_ELASTIC, FLOPS_AVERAGED_VISCOELASTIC,
 };
+use qdem_core::continuum::tet_blocks::block_node_order;
 use qdem_core::continuum::tet_lanes::{LaneSet, FLOPS_ELASTIC, FLOPS_VISCOELASTIC};
 use qdem_core::{
     continuum::Formulation, continuum::Material, continuum::TetBody, solvers::Verlet, step::Model,
@@ -133,6 +134,26 @@ pub enum Ordering {
     Shuffled,
     /// Shuffled, then [`TetMesh::reorder_for_locality`] (reverse Cuthill–McKee).
     Reordered,
+    /// The generator's order, then renumbered in the order the kernel's blocks read the nodes
+    /// ([`block_node_order`]: each block's nodes one run, shared ones with their first block).
+    Blocked,
+}
+
+impl std::str::FromStr for Ordering {
+    type Err = String;
+
+    /// The ordering by its lower-case name (`structured`, `shuffled`, `reordered`, `blocked`).
+    fn from_str(name: &str) -> Result<Ordering, String> {
+        let all = [
+            Ordering::Structured,
+            Ordering::Shuffled,
+            Ordering::Reordered,
+            Ordering::Blocked,
+        ];
+        all.into_iter()
+            .find(|o| format!("{o:?}").to_lowercase() == name)
+            .ok_or_else(|| format!("`{name}`: structured, shuffled, reordered or blocked"))
+    }
 }
 
 /// The cells along each edge of the block of about `tets` tetrahedra (6 per cell).
@@ -202,6 +223,11 @@ pub fn block_mesh(tets: usize, ordering: Ordering) -> TetMesh {
     let n = block_cells(tets);
     let mut mesh =
         structured_box([0.0; 3], [1.0, 1.0, 1.0], [n, n, n]).expect("a size check_block takes");
+    if ordering == Ordering::Blocked {
+        let reference: Vec<Vec3> = mesh.nodes.iter().map(|p| Vec3::from(*p)).collect();
+        mesh.renumber_nodes(&block_node_order(&reference, &mesh.tets));
+        return mesh;
+    }
     if ordering != Ordering::Structured {
         let mut seed = 12345u64;
         let nodes = shuffled(mesh.nodes.len(), &mut seed);
@@ -469,7 +495,8 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
 }
 
 /// Effect of node ordering: the largest planned block, elastic, on the most threads, in
-/// generator order, shuffled, and shuffled then reordered (reverse Cuthill–McKee).
+/// generator order, shuffled, shuffled then reordered (reverse Cuthill–McKee), and in the
+/// order the blocks read the nodes.
 fn locality_rows(plan: &BenchPlan, as_json: bool) -> Vec<serde_json::Value> {
     let (Some(&tets), Some(&threads)) = (plan.tets.iter().max(), plan.threads.iter().max()) else {
         return Vec::new();
@@ -477,7 +504,13 @@ fn locality_rows(plan: &BenchPlan, as_json: bool) -> Vec<serde_json::Value> {
     if !as_json {
         println!("node ordering, {tets} tets, elastic, {threads} threads:");
     }
-    [Ordering::Structured, Ordering::Shuffled, Ordering::Reordered]
+    let orderings = [
+        Ordering::Structured,
+        Ordering::Shuffled,
+        Ordering::Reordered,
+        Ordering::Blocked,
+    ];
+    orderings
         .into_iter()
         .map(|ordering| {
             let r = measure_ordered(tets, ordering, false, threads, plan.steps);

@@ -11,6 +11,7 @@
 
 pub mod check;
 pub mod command;
+pub mod huge_pages;
 #[cfg(feature = "mpi")]
 pub mod mpi_ranks;
 pub mod progress;

@@ -11,6 +11,10 @@ use qdem_io::runner::RunError;
 use std::process::ExitCode;
 use std::sync::Arc;
 
+/// Transparent huge pages for the large arrays ([`qdem_cli::huge_pages`]).
+#[global_allocator]
+static ALLOCATOR: qdem_cli::huge_pages::HugePages = qdem_cli::huge_pages::HugePages;
+
 fn main() -> ExitCode {
     #[cfg(feature = "mpi")]
     let mpi = qdem_cli::mpi_ranks::start().map(|(universe, ranks)| (universe, Arc::new(ranks)));

@@ -9,17 +9,23 @@
 //! - `study dem-throughput --packing DIR --steps S [--grains spheres|clumps]`: times qdem on
 //!   that packing (with `clumps`, every sphere replaced by a rigid clump of 2–4 spheres inside
 //!   it) and prints one JSON object.
+//! - `study kernel-steps --tets N --steps S [--ordering structured|shuffled|reordered|blocked]
+//!   [--threads T] [--viscous]`: `qdem bench`'s measurement of one block in one node ordering
+//!   (3 warm steps, then S timed), one JSON object: the run to give a cache simulator
+//!   (`valgrind --tool=callgrind --cache-sim=yes`), where the orderings' misses can be counted
+//!   on a loaded machine.
 
 use qdem_bench::cantilever::fixtures_dir;
 use qdem_bench::granular::{clump_throughput, throughput, Packing};
 use qdem_bench::speed_vs_error::{run_family, write_page, Family, Setting, Size};
-use qdem_bench::throughput::{cpu_model, on_threads};
+use qdem_bench::throughput::{check_block, cpu_model, measure_ordered, on_threads, Ordering};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 const USAGE: &str = "usage: study speed-vs-error [--all | --families cantilever,bbm,boxtest,packing] [--quick] [--threads N] [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]
        study packing --spheres N --out DIR [--settle SECONDS]
-       study dem-throughput --packing DIR --steps S [--grains spheres|clumps]";
+       study dem-throughput --packing DIR --steps S [--grains spheres|clumps]
+       study kernel-steps --tets N --steps S [--ordering structured|shuffled|reordered|blocked] [--threads T] [--viscous]";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -42,6 +48,7 @@ fn main() -> ExitCode {
         Some("speed-vs-error") => speed_vs_error(&option, &flag),
         Some("packing") => packing(&option),
         Some("dem-throughput") => dem_throughput(&option),
+        Some("kernel-steps") => kernel_steps(&option, args.iter().any(|a| a == "--viscous")),
         _ => {
             eprintln!("{USAGE}");
             ExitCode::FAILURE
@@ -97,6 +104,38 @@ fn dem_throughput(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
             Some(other) => return Err(format!("--grains {other}: spheres or clumps\n{USAGE}")),
         };
         let record = record.map_err(|e| e.to_string())?;
+        Ok(record.to_string())
+    };
+    match run() {
+        Ok(json) => {
+            println!("{json}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn kernel_steps(option: &dyn Fn(&str) -> Option<String>, viscous: bool) -> ExitCode {
+    let run = || -> Result<String, String> {
+        let tets: usize = number(option, "--tets", None)?;
+        let steps: usize = number(option, "--steps", None)?;
+        let threads: usize = number(option, "--threads", Some(1))?;
+        let ordering: Ordering = option("--ordering")
+            .unwrap_or_else(|| "structured".into())
+            .parse()
+            .map_err(|e| format!("--ordering {e}\n{USAGE}"))?;
+        check_block(tets, false).map_err(|e| e.to_string())?;
+        let r = measure_ordered(tets, ordering, viscous, threads, Some(steps));
+        let record = serde_json::json!({
+            "tets": r.tets, "particles": r.particles, "block_nodes": r.block_nodes,
+            "ordering": format!("{ordering:?}").to_lowercase(), "viscous": viscous,
+            "threads": threads, "steps": r.steps,
+            "tet_steps_per_second": r.tet_steps_per_second(),
+            "bytes_per_tet_step": r.bytes_per_tet_step(),
+        });
         Ok(record.to_string())
     };
     match run() {

@@ -90,17 +90,7 @@ impl TetBlocks {
     /// Cuts `tets` (with the inverse reference edge matrices `dm_inv`) into blocks, by their
     /// centroids in `reference`.
     pub fn new(reference: &[Vec3], tets: &[[u32; 4]], dm_inv: &[Mat3]) -> TetBlocks {
-        let size = block_size(tets.len());
-        let centroid: Vec<Vec3> = tets
-            .iter()
-            .map(|t| t.iter().map(|&n| reference[n as usize]).sum::<Vec3>() / 4.0)
-            .collect();
-        let mut order: Vec<u32> = (0..tets.len() as u32).collect();
-        let mut tet_start = vec![0u32];
-        bisect(&mut order, &centroid, size, &mut tet_start);
-        for b in 0..tet_start.len() - 1 {
-            order[tet_start[b] as usize..tet_start[b + 1] as usize].sort_unstable();
-        }
+        let (order, tet_start) = cut(reference, tets);
         let mut rank = vec![0u32; tets.len()];
         for (k, &e) in order.iter().enumerate() {
             rank[e as usize] = k as u32;
@@ -144,6 +134,60 @@ impl TetBlocks {
     pub fn dm_inv(&self, e: usize) -> &Mat3 {
         &self.hot[self.rank[e] as usize].dm_inv
     }
+}
+
+/// The renumbering of the particles that puts each block's nodes together, in the order the
+/// blocks read them: `new_of_old[i]` is particle `i`'s new index. The blocks are the ones
+/// [`TetBlocks::new`] cuts (they depend on the reference centroids and the tetrahedron order
+/// alone, so a body built on the renumbered particles has the same blocks); walking the blocks
+/// in order and each block's tetrahedra in order, a particle gets the next index the first
+/// time a corner names it. A particle interior to a block is then numbered with that block's
+/// other particles, in the order of its first use, and a particle shared by several blocks
+/// with the first of them; particles no tetrahedron names keep their relative order after all
+/// others.
+///
+/// Each particle's force sums the same terms in the same order either way (tetrahedra within a
+/// block in ascending order, then the blocks in ascending order), so a body on the renumbered
+/// particles computes the same forces bit for bit, permuted.
+///
+/// ```
+/// use qdem_core::{continuum::tet_blocks::block_node_order, Vec3};
+///
+/// let nodes = vec![Vec3::z(), Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::new(5.0, 5.0, 5.0)];
+/// // One tetrahedron naming particles 1, 2, 3, 0; particle 4 is used by none.
+/// assert_eq!(block_node_order(&nodes, &[[1, 2, 3, 0]]), vec![3, 0, 1, 2, 4]);
+/// ```
+pub fn block_node_order(reference: &[Vec3], tets: &[[u32; 4]]) -> Vec<u32> {
+    let (order, _) = cut(reference, tets);
+    let mut new_of_old = vec![u32::MAX; reference.len()];
+    let mut next = 0u32;
+    let corners = order.iter().flat_map(|&e| tets[e as usize]);
+    let unused = 0..reference.len() as u32;
+    for n in corners.chain(unused) {
+        let slot = &mut new_of_old[n as usize];
+        if *slot == u32::MAX {
+            *slot = next;
+            next += 1;
+        }
+    }
+    new_of_old
+}
+
+/// The blocks of `tets`: the tetrahedra in block order, ascending within each block, and
+/// each block's start in that order (with the end appended).
+fn cut(reference: &[Vec3], tets: &[[u32; 4]]) -> (Vec<u32>, Vec<u32>) {
+    let size = block_size(tets.len());
+    let centroid: Vec<Vec3> = tets
+        .iter()
+        .map(|t| t.iter().map(|&n| reference[n as usize]).sum::<Vec3>() / 4.0)
+        .collect();
+    let mut order: Vec<u32> = (0..tets.len() as u32).collect();
+    let mut tet_start = vec![0u32];
+    bisect(&mut order, &centroid, size, &mut tet_start);
+    for b in 0..tet_start.len() - 1 {
+        order[tet_start[b] as usize..tet_start[b + 1] as usize].sort_unstable();
+    }
+    (order, tet_start)
 }
 
 /// Tetrahedra per block for a body of `tets`: at most [`MAX_BLOCK`], and small enough for
@@ -287,6 +331,56 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&s| s));
+    }
+
+    /// `tets` with node `i` renamed `new_of_old[i]`, and the nodes moved with them.
+    fn renumbered(x: &[Vec3], tets: &[[u32; 4]], new_of_old: &[u32]) -> (Vec<Vec3>, Vec<[u32; 4]>) {
+        let mut moved = vec![Vec3::zeros(); x.len()];
+        for (old, &new) in new_of_old.iter().enumerate() {
+            moved[new as usize] = x[old];
+        }
+        let tets = tets
+            .iter()
+            .map(|t| t.map(|n| new_of_old[n as usize]))
+            .collect();
+        (moved, tets)
+    }
+
+    #[test]
+    fn block_numbering_gives_each_block_its_new_nodes_as_one_run_in_first_use_order() {
+        // The bar's nodes scattered first (i -> 7919 i mod n, a permutation as 7919 is prime
+        // and does not divide n), so that the order below is the numbering's doing.
+        let (x, tets) = bar(3000);
+        let n = x.len() as u64;
+        let scatter: Vec<u32> = (0..n).map(|i| (i * 7919 % n) as u32).collect();
+        let (x, tets) = renumbered(&x, &tets, &scatter);
+        let dm_inv = vec![Mat3::identity(); tets.len()];
+        let before = TetBlocks::new(&x, &tets, &dm_inv);
+        let new_of_old = block_node_order(&x, &tets);
+        let (x, tets) = renumbered(&x, &tets, &new_of_old);
+        let after = TetBlocks::new(&x, &tets, &dm_inv);
+        // The same blocks, the same tetrahedra in the same order.
+        assert_eq!(
+            (&after.tet_start, &after.order),
+            (&before.tet_start, &before.order)
+        );
+        let mut next = 0u32;
+        for b in 0..after.len() {
+            let range = after.tet_start[b] as usize..after.tet_start[b + 1] as usize;
+            let mut first_use = Vec::new();
+            for &e in &after.order[range] {
+                for n in tets[e as usize] {
+                    if n >= next && !first_use.contains(&n) {
+                        first_use.push(n);
+                    }
+                }
+            }
+            // The particles no earlier block read are next, next + 1, ... in first-use order.
+            let run: Vec<u32> = (next..next + first_use.len() as u32).collect();
+            assert_eq!(first_use, run, "block {b}");
+            next += run.len() as u32;
+        }
+        assert_eq!(next as usize, x.len());
     }
 
     #[test]
