@@ -39,9 +39,13 @@ fn round_half_away(s: f64) -> f64 {
 }
 
 /// `s.floor()`, bit for bit, without the library call (as [`round_half_away`]): every body's
-/// anchor is tested against the cell at every step.
+/// anchor is tested against the cell at every step, and nearly every anchor is inside it,
+/// where `s` lies in [0, 1) and its floor is the zero of its sign, by two comparisons.
 #[inline]
 fn floor_inline(s: f64) -> f64 {
+    if (0.0..1.0).contains(&s) {
+        return 0.0f64.copysign(s);
+    }
     if s.is_nan() || s.abs() >= 4.5e15 {
         return s.floor();
     }
