@@ -137,12 +137,33 @@ impl DemContacts {
         contact: &Contact,
         shift: &mut Vec3,
     ) -> Option<(PairGeometry, PairElasticity)> {
+        if self.periodic.is_some() {
+            *shift = self.image_of(contact);
+        }
+        self.pair_through(contact, *shift)
+    }
+
+    /// The translation of the minimum image of `contact`'s second sphere (periodic only).
+    #[inline(always)]
+    pub(super) fn image_of(&self, contact: &Contact) -> Vec3 {
+        let (a, b) = (contact.first as usize, contact.second as usize);
+        let d = self.spheres.now(b).center - self.spheres.now(a).center;
+        self.periodic
+            .as_ref()
+            .map_or(Vec3::zeros(), |p| p.image_shift(&d))
+    }
+
+    /// The geometry and elasticity of the pair of spheres of `contact`, its second sphere's
+    /// image translated by `shift`; `None` when apart.
+    #[inline(always)]
+    pub(super) fn pair_through(
+        &self,
+        contact: &Contact,
+        shift: Vec3,
+    ) -> Option<(PairGeometry, PairElasticity)> {
         let (a, b) = (contact.first as usize, contact.second as usize);
         let (sa, sb) = (self.spheres.now(a), self.spheres.now(b));
-        if let Some(p) = &self.periodic {
-            *shift = p.image_shift(&(sb.center - sa.center));
-        }
-        let geometry = narrow_phase(sa, sb, *shift, self.settings.friction)?;
+        let geometry = narrow_phase(sa, sb, shift, self.settings.friction)?;
         let e = self.spheres.pair_elasticity(sa, sb);
         Some((geometry, e))
     }
