@@ -407,7 +407,7 @@ impl DemContacts {
                         Some(at) => *at,
                         None => Vec3::zeros(),
                     };
-                    let Some((g, e)) = self.pair_through(contact, shift) else {
+                    let Some((pair, e)) = self.spheres_through(contact, shift) else {
                         contact.part();
                         for at in [lists.turns.get_mut(k), lists.rolls.get_mut(k)]
                             .into_iter()
@@ -418,7 +418,7 @@ impl DemContacts {
                         continue;
                     };
                     if in_lanes {
-                        batch.pairs[batch.lanes.push(&g, &e, &contact.history)] = k;
+                        batch.pairs[batch.lanes.push_spheres(&pair, &e, &contact.history)] = k;
                         if batch.lanes.is_full() {
                             self.finish_batch::<SUM, SCALED>(
                                 dt, &mut batch, &mut lists, slots, &delay, &mut sums,
@@ -426,6 +426,7 @@ impl DemContacts {
                         }
                         continue;
                     }
+                    let g = pair.geometry();
                     let f = law.force(&g, &e, &mut contact.history, dt);
                     let touching = (g.normal, g.overlap);
                     self.record_pair(k, f, touching, || (g, e), &mut lists, dt)

@@ -140,7 +140,8 @@ impl DemContacts {
         if self.periodic.is_some() {
             *shift = self.image_of(contact);
         }
-        self.pair_through(contact, *shift)
+        let (pair, e) = self.spheres_through(contact, *shift)?;
+        Some((pair.geometry(), e))
     }
 
     /// The translation of the minimum image of `contact`'s second sphere (periodic only).
@@ -153,19 +154,19 @@ impl DemContacts {
             .map_or(Vec3::zeros(), |p| p.image_shift(&d))
     }
 
-    /// The geometry and elasticity of the pair of spheres of `contact`, its second sphere's
-    /// image translated by `shift`; `None` when apart.
+    /// The spheres of `contact` as the narrow phase finds them touching, its second sphere's
+    /// image translated by `shift`, with their elasticity; `None` when apart.
     #[inline(always)]
-    pub(super) fn pair_through(
+    pub(super) fn spheres_through(
         &self,
         contact: &Contact,
         shift: Vec3,
-    ) -> Option<(PairGeometry, PairElasticity)> {
+    ) -> Option<(SpherePair, PairElasticity)> {
         let (a, b) = (contact.first as usize, contact.second as usize);
         let (sa, sb) = (self.spheres.now(a), self.spheres.now(b));
-        let geometry = narrow_phase(sa, sb, shift, self.settings.friction)?;
+        let pair = touching_pair(sa, sb, shift, self.settings.friction)?;
         let e = self.spheres.pair_elasticity(sa, sb);
-        Some((geometry, e))
+        Some((pair, e))
     }
 
     /// The geometry and elasticity of the contact of sphere s with wall w: the contact point
