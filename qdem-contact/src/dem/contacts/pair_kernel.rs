@@ -347,6 +347,29 @@ impl DemContacts {
         self.kernel = plan;
     }
 
+    /// Pair `k`'s image translation as a law pass taking it now would write it, for what a
+    /// checkpoint or a merge of the ranks' records keeps: the column's whole periods (they
+    /// hold since the build), with the sign of each zero component from this evaluation's
+    /// separation d = x_b − x_a as [`PeriodicBox::image_shift`](crate::PeriodicBox::image_shift)
+    /// signs it, −l · (±0): −0 for d ≥ +0, +0 below. The column as it is when no law pass
+    /// ran since the lists were made (a restore, a merge: it holds what was written).
+    pub(super) fn image_as_written(&self, k: usize) -> Vec3 {
+        let pairs = self.candidates.pairs();
+        let mut t = pairs.shift(k);
+        let Some(cell) = self.periodic.as_ref().filter(|_| self.kernel.images) else {
+            return t;
+        };
+        let c = &pairs.items[k];
+        let d =
+            self.spheres.now(c.second as usize).center - self.spheres.now(c.first as usize).center;
+        for axis in 0..3 {
+            if cell.length(axis).is_some() && t[axis] == 0.0 {
+                t[axis] = -(0.0f64.copysign(d[axis]));
+            }
+        }
+        t
+    }
+
     /// Adds the complete sum of every partner this process or rank owns to its particle
     /// (`force`) and rotation (`torque`), in ascending sphere order: after a kernel pass that
     /// summed without them.
@@ -838,10 +861,11 @@ mod tests {
         }
     }
 
-    /// 10 × 10 × 3 spinning spheres 1.98 r apart in a cell periodic in x and y, thrown
+    /// 10 × 10 × 3 spinning spheres about 1.98 r apart in a cell periodic in x and y, thrown
     /// across its faces at about (5, 2.5) m/s with a spread of ±0.15 m/s, moved and wrapped
     /// (as `PeriodicWrap` wraps them) for `steps` steps of 10 µs: per step the particle
-    /// forces and torques, the pairs' springs and image translations (bits), with the images
+    /// forces and torques, the pairs' springs and image translations as a checkpoint writes
+    /// them (bits; some with a zero of either sign), with the images
     /// taken once per build, or at every step when `every_step`; and the rebuilds, the wraps
     /// and the touching pairs through the boundary.
     fn periodic_run(every_step: bool, steps: usize) -> (Vec<Vec<u64>>, u64, usize, usize) {
@@ -851,8 +875,10 @@ mod tests {
         for k in 0..3 {
             for j in 0..10 {
                 for i in 0..10 {
-                    let at = |n: usize| (n as f64 + 0.5) * a;
-                    centers.push(Vec3::new(at(i), at(j), at(k)));
+                    // ±20 µm off the lattice, so that separations cross zero between builds.
+                    let off = |m: usize| (((i + 10 * j + 100 * k) * m) % 97) as f64 / 97.0 - 0.5;
+                    let at = |n: usize, m: usize| (n as f64 + 0.5) * a + 4e-5 * off(m);
+                    centers.push(Vec3::new(at(i, 41), at(j, 43), at(k, 47)));
                 }
             }
         }
@@ -889,7 +915,7 @@ mod tests {
         let contacts = DemContacts::new(&state, &spheres, names, &[(5e7, 0.25)], settings, vec![]);
         let mut contacts = contacts.with_periodic(cell.clone()).unwrap();
         let (mut force, mut torque) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
-        let (mut rows, mut wraps, mut through) = (Vec::new(), 0, 0);
+        let (mut rows, mut wraps, mut through, mut positive_zeros) = (Vec::new(), 0, 0, 0);
         let bits = |v: &Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
         for step in 0..steps {
             state.time = 1e-5 * step as f64;
@@ -911,9 +937,26 @@ mod tests {
                 .count();
             let mut row: Vec<u64> = force.iter().chain(&torque).flat_map(bits).collect();
             row.extend(pairs.items.iter().flat_map(|c| bits(&c.history)));
-            row.extend(pairs.shift.iter().flat_map(bits));
+            // Taken at every step, the column is what the law pass wrote at this one.
+            let written: Vec<Vec3> = match every_step {
+                true => pairs.shift.clone(),
+                false => (0..pairs.len())
+                    .map(|k| contacts.image_as_written(k))
+                    .collect(),
+            };
+            row.extend(written.iter().flat_map(bits));
+            positive_zeros += written
+                .iter()
+                .filter(|t| {
+                    (t.x == 0.0 && t.x.is_sign_positive()) || (t.y == 0.0 && t.y.is_sign_positive())
+                })
+                .count();
             rows.push(row);
         }
+        assert!(
+            positive_zeros > 0,
+            "no separation below zero along a periodic axis"
+        );
         (rows, contacts.rebuilds(), wraps, through)
     }
 
@@ -922,7 +965,8 @@ mod tests {
         // The spheres cross both periodic faces and are wrapped back many times; each wrap
         // moves a sphere by a whole period, which must rebuild the lists before its pairs'
         // images are read again. The images kept from the build give every force, torque,
-        // spring and image translation of images taken afresh at every step, to the bit.
+        // spring and written image translation (the sign of a zero one included) of images
+        // taken afresh at every step, to the bit.
         let steps = 300;
         let (kept, rebuilds, wraps, through) = periodic_run(false, steps);
         let (fresh, ..) = periodic_run(true, steps);

@@ -10,14 +10,14 @@
 //!   force F_t = −k_t ξ − γ_t v_t, capped at μ F_n⁺ with ξ = −F_t/k_t on a slide;
 //! - the force on the first partner F_t − F_n n.
 //!
-//! A caller gathers touching contacts (after the narrow phase) into a [`LawLanes`] with
-//! [`LawLanes::push`], evaluates them with [`LawLanes::evaluate`] and reads each lane's force
-//! and spring back in lane order ([`LawLanes::force`], [`LawLanes::history`]), so it can add the
-//! forces in the same order as the scalar loop. A pair of spheres may come before its
-//! geometry ([`LawLanes::push_spheres`], the narrow phase's test passed): the lanes then take
-//! the narrow phase's tail first ([`SpherePair::geometry`]: the distance √|d|², the overlap,
-//! the normal d/|d|, the contact point's velocity, R* and m*), one square root and five
-//! divisions a pair, packed, where the scalar tail took them pair by pair.
+//! The pair kernel gathers touching pairs of spheres, as the narrow phase's test found them,
+//! into a [`LawLanes`] with [`LawLanes::push_spheres`], evaluates them with
+//! [`LawLanes::evaluate`] and reads each lane's force and spring back in lane order
+//! ([`LawLanes::force`], [`LawLanes::history`]), so it can add the forces in the same order as
+//! the scalar loop. The lanes take the narrow phase's tail first ([`SpherePair::geometry`]:
+//! the distance √|d|², the overlap, the normal d/|d|, the contact point's velocity, R* and m*),
+//! one square root and five divisions a pair, packed, where the scalar tail took them pair by
+//! pair; then the law.
 //!
 //! **The same bits as the scalar law.** Every operation is an IEEE addition, subtraction,
 //! product, quotient or square root, each rounded once, in the order the scalar law takes them
@@ -96,8 +96,9 @@ impl LawLanes {
     }
 
     /// Adds the contact `g` with elasticity `e` and spring `history`; returns its lane. A
-    /// batch holds contacts or sphere pairs ([`LawLanes::push_spheres`]), not both.
-    #[inline(always)]
+    /// batch holds contacts or sphere pairs ([`LawLanes::push_spheres`]), not both. The pair
+    /// kernel pushes sphere pairs; the tests push contacts of any geometry.
+    #[cfg(test)]
     pub(crate) fn push(&mut self, g: &PairGeometry, e: &PairElasticity, history: &Vec3) -> usize {
         let l = self.len;
         assert!(l < LANES, "a full batch of {LANES} contacts");
@@ -123,7 +124,7 @@ impl LawLanes {
 
     /// Adds the touching pair of spheres `pair` with elasticity `e` and spring `history`, its
     /// geometry to be taken by [`LawLanes::evaluate`]; returns its lane. A batch holds sphere
-    /// pairs or contacts ([`LawLanes::push`]), not both.
+    /// pairs or contacts (the tests' `push`), not both.
     #[inline(always)]
     pub(crate) fn push_spheres(
         &mut self,
