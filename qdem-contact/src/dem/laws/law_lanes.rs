@@ -549,16 +549,16 @@ unsafe fn geometry<S: Simd>(lanes: &mut LawLanes, o: usize) {
     let reach = S::add(ra, rb);
     let overlap = S::sub(reach, distance);
     let mut normal = [distance; 3];
-    for k in 0..3 {
-        normal[k] = S::div(S::load(&lanes.separation[k][o..]), distance);
+    for (n, d) in normal.iter_mut().zip(&lanes.separation) {
+        *n = S::div(S::load(&d[o..]), distance);
     }
     let half = S::mul(S::splat(0.5), overlap);
     let (arm_a, arm_b) = (S::sub(ra, half), S::sub(rb, half));
     let mut spin = normal;
-    for k in 0..3 {
-        spin[k] = S::add(
-            S::mul(arm_a, S::load(&lanes.spin_a[k][o..])),
-            S::mul(arm_b, S::load(&lanes.spin_b[k][o..])),
+    for ((w, a), b) in spin.iter_mut().zip(&lanes.spin_a).zip(&lanes.spin_b) {
+        *w = S::add(
+            S::mul(arm_a, S::load(&a[o..])),
+            S::mul(arm_b, S::load(&b[o..])),
         );
     }
     // spin × n, as nalgebra's `cross`.
