@@ -39,9 +39,13 @@ fn round_half_away(s: f64) -> f64 {
 }
 
 /// `s.floor()`, bit for bit, without the library call (as [`round_half_away`]): every body's
-/// anchor is tested against the cell at every step.
+/// anchor is tested against the cell at every step, and nearly every anchor is inside it,
+/// where `s` lies in [0, 1) and its floor is the zero of its sign, by two comparisons.
 #[inline]
 fn floor_inline(s: f64) -> f64 {
+    if (0.0..1.0).contains(&s) {
+        return 0.0f64.copysign(s);
+    }
     if s.is_nan() || s.abs() >= 4.5e15 {
         return s.floor();
     }
@@ -131,16 +135,27 @@ impl PeriodicBox {
         t
     }
 
+    /// Whether `x` lies in the cell along every periodic axis, (x_k − o_k)/L_k in [0, 1):
+    /// exactly where [`PeriodicBox::shift_into`] is zero (the floor of a quotient is ±0 there
+    /// and nowhere else, NaN included), by two comparisons an axis.
+    #[inline]
+    pub(crate) fn contains(&self, x: &Vec3) -> bool {
+        (0..3).all(|k| {
+            self.length[k].is_none_or(|l| (0.0..1.0).contains(&((x[k] - self.origin[k]) / l)))
+        })
+    }
+
     /// Moves every group whose anchor has left the cell back into it, all its particles
     /// (positions and reference positions) by the same whole periods. Returns how many groups
     /// moved.
     pub fn wrap_bodies(&self, state: &mut State, groups: &[WrapGroup]) -> usize {
         let mut moved = 0;
         for group in groups {
-            let shift = self.shift_into(&state.position[group.anchor]);
-            if shift == Vec3::zeros() {
+            let anchor = state.position[group.anchor];
+            if self.contains(&anchor) {
                 continue;
             }
+            let shift = self.shift_into(&anchor);
             for &p in &group.particles {
                 state.position[p] += shift;
                 state.reference[p] += shift;
@@ -239,6 +254,48 @@ mod tests {
             assert_eq!(floor_inline(s).to_bits(), s.floor().to_bits(), "{s:e}");
         }
         assert!(round_half_away(f64::NAN).is_nan() && floor_inline(f64::NAN).is_nan());
+    }
+
+    #[test]
+    fn the_cell_contains_a_point_exactly_where_it_takes_no_shift() {
+        // Along x in [−1, 1) and z in [0, 0.5), y not periodic: points on, just inside and
+        // just outside each face, far away, and NaN. The cell contains a point if and only if
+        // the shift into it is zero, so the wrap may skip the shift for contained anchors.
+        let p = PeriodicBox::new(Vec3::new(-1.0, 0.0, 0.0), [Some(2.0), None, Some(0.5)]).unwrap();
+        let edges = |lo: f64, hi: f64| {
+            let (below, above) = (|v: f64| v.next_down(), |v: f64| v.next_up());
+            vec![
+                lo,
+                below(lo),
+                above(lo),
+                hi,
+                below(hi),
+                above(hi),
+                -0.0,
+                0.3,
+                7.0,
+                -7.0,
+                f64::NAN,
+            ]
+        };
+        let (mut inside, mut outside) = (0, 0);
+        for x in edges(-1.0, 1.0) {
+            for z in edges(0.0, 0.5) {
+                for y in [0.0, 1e9] {
+                    let at = Vec3::new(x, y, z);
+                    let still = p.shift_into(&at) == Vec3::zeros();
+                    assert_eq!(p.contains(&at), still, "{at:?}");
+                    match still {
+                        true => inside += 1,
+                        false => outside += 1,
+                    }
+                }
+            }
+        }
+        assert!(
+            inside > 10 && outside > 100,
+            "{inside} inside, {outside} outside"
+        );
     }
 
     #[test]

@@ -220,16 +220,23 @@ impl ContactList {
     }
 
     /// Writes the list into a checkpoint: partners, springs, forces and image translations
-    /// (n × f and δ/2 are rewritten by every evaluation before they are read).
-    /// The spheres are written as `id` names them (and a second partner too when `pairs`).
-    pub(crate) fn save(&self, out: &mut Encoder, id: impl Fn(u32) -> u32, pairs: bool) {
+    /// (`shift` of each record; n × f and δ/2 are rewritten by every evaluation before they are
+    /// read). The spheres are written as `id` names them (and a second partner too when
+    /// `pairs`).
+    pub(crate) fn save(
+        &self,
+        out: &mut Encoder,
+        id: impl Fn(u32) -> u32,
+        pairs: bool,
+        shift: impl Fn(usize) -> Vec3,
+    ) {
         let column = |f: fn(&Contact) -> Vec3| self.items.iter().map(f).collect::<Vec<_>>();
         let second = |c: &Contact| if pairs { id(c.second) } else { c.second };
         out.u32s(&self.items.iter().map(|c| id(c.first)).collect::<Vec<_>>());
         out.u32s(&self.items.iter().map(second).collect::<Vec<_>>());
         out.vec3s(&column(|c| c.history));
         out.vec3s(&column(|c| c.force));
-        out.vec3s(&(0..self.len()).map(|k| self.shift(k)).collect::<Vec<_>>());
+        out.vec3s(&(0..self.len()).map(shift).collect::<Vec<_>>());
     }
 
     /// Reads back a list whose first partners index `0..firsts` and second partners

@@ -126,7 +126,12 @@ impl Candidates {
 
     /// Saves the build (flag, time, positions, count) and the lists, the spheres by their
     /// stable ids (`order`: `spatial_order.rs`), each pair as it is oriented here.
-    pub(super) fn save(&self, out: &mut Encoder, order: &SphereOrder) {
+    pub(super) fn save(
+        &self,
+        out: &mut Encoder,
+        order: &SphereOrder,
+        pair_shift: impl Fn(usize) -> Vec3,
+    ) {
         out.bool(self.built);
         out.f64(self.built_time);
         let built_at: Vec<Vec3> = (0..self.built_at.len() as u32)
@@ -134,8 +139,9 @@ impl Candidates {
             .collect();
         out.vec3s(&built_at);
         out.u64(self.rebuilds);
-        self.pairs.save(out, |s| order.id(s), true);
-        self.wall_contacts.save(out, |s| order.id(s), false);
+        self.pairs.save(out, |s| order.id(s), true, pair_shift);
+        let walls = &self.wall_contacts;
+        walls.save(out, |s| order.id(s), false, |k| walls.shift(k));
     }
 
     /// Restores what [`Candidates::save`] saved, for `spheres` spheres and `walls` walls;

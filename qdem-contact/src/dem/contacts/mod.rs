@@ -61,7 +61,7 @@ use crate::boundaries::time_delayed_boundary::{GhostScales, TimeDelayedBoundary}
 use crate::dem::broad_phase::{find_pairs, SphereSet};
 use crate::dem::contact_list::{Contact, ContactList};
 use crate::dem::contact_view::{Partner, SphereRecord, TouchingContact};
-use crate::dem::laws::contact_law::{ContactLaw, PairElasticity, PairGeometry};
+use crate::dem::laws::contact_law::{ContactLaw, PairElasticity, PairGeometry, SpherePair};
 use crate::dem::laws::rolling_resistance::RollingResistance;
 use crate::dem::spring_blocks::{add_spring, spring, Attachment};
 use crate::dem::walls::wall::Wall;
@@ -189,7 +189,7 @@ pub(crate) struct SphereNow {
 /// they are apart. With d = x_b + shift − x_a: overlap δ = r_a + r_b − |d|, normal n = d/|d|,
 /// the contact point at x_a + (r_a − δ/2) n, and the velocity of a's contact point relative to
 /// b's, v_a − v_b + (r_a − δ/2) ω_a × n + (r_b − δ/2) ω_b × n; R* = r_a r_b/(r_a + r_b),
-/// m* = m_a m_b/(m_a + m_b).
+/// m* = m_a m_b/(m_a + m_b) ([`SpherePair::geometry`]).
 #[inline(always)]
 pub(crate) fn narrow_phase(
     a: &SphereNow,
@@ -197,23 +197,32 @@ pub(crate) fn narrow_phase(
     shift: Vec3,
     friction: f64,
 ) -> Option<PairGeometry> {
+    touching_pair(a, b, shift, friction).map(|pair| pair.geometry())
+}
+
+/// The narrow phase's test: the spheres a and b (b's image translated by `shift`) as a
+/// [`SpherePair`] when they overlap, `None` when they are apart (|d| ≥ r_a + r_b) or
+/// concentric.
+#[inline(always)]
+pub(crate) fn touching_pair(
+    a: &SphereNow,
+    b: &SphereNow,
+    shift: Vec3,
+    friction: f64,
+) -> Option<SpherePair> {
     let d = b.center + shift - a.center;
     let distance_squared = d.norm_squared();
     let reach = a.radius + b.radius;
     if distance_squared >= reach * reach || distance_squared == 0.0 {
         return None;
     }
-    let distance = distance_squared.sqrt();
-    let overlap = reach - distance;
-    let normal = d / distance;
-    let half = 0.5 * overlap;
-    let spin = (a.radius - half) * a.spin + (b.radius - half) * b.spin;
-    Some(PairGeometry {
-        overlap,
-        normal,
-        velocity: a.velocity - b.velocity + spin.cross(&normal),
-        radius: reduced(a.radius, b.radius),
-        mass: a.mass * b.mass / (a.mass + b.mass),
+    Some(SpherePair {
+        separation: d,
+        distance_squared,
+        radii: (a.radius, b.radius),
+        masses: (a.mass, b.mass),
+        velocity: a.velocity - b.velocity,
+        spins: (a.spin, b.spin),
         friction,
     })
 }

@@ -27,6 +27,17 @@
 //!
 //! Per step a candidate pair costs its record (read and written once) and two additions into
 //! sums that are in cache, and the serial add runs over the partners of candidates only.
+//!
+//! Through a periodic boundary a pair's image translation t (the whole periods that make
+//! d + t the minimum image of d = x_b − x_a, paper 003 Eq. 1) is taken at the first law pass
+//! after each build of the lists, kept in the lists' column, and read from it at the passes
+//! after: between two builds no sphere moves half the skin, so the separation of a candidate,
+//! within reach + skin of its image at the build and L/2 > reach + skin
+//! ([`PeriodicBox::check_reach`](crate::boundaries::periodic_boundary::PeriodicBox::check_reach)),
+//! rounds to the same whole periods; a body that the periodic wrap moves by a whole period
+//! has moved beyond the skin, so the lists are rebuilt before the next law pass. Only a pair
+//! drawn L/2 apart along a periodic axis could keep an image the minimum image would change
+//! (in a cell shorter than 2 (reach + 2 skin)), and it is apart through either image.
 
 use super::rolling::{first_rolls, second_rolls};
 use super::*;
@@ -61,6 +72,11 @@ impl DemContacts {
     fn force_lanes(&mut self, set: LaneSet) {
         self.kernel.lanes = LawSet(set);
     }
+
+    /// Makes the next law pass take every pair's image translation again, as after a build.
+    fn forget_images(&mut self) {
+        self.kernel.images = false;
+    }
 }
 
 /// What the fused pass knows of the lists, made at each build, and its per-sphere sums.
@@ -84,6 +100,9 @@ pub(super) struct KernelPlan {
     early: Vec<bool>,
     /// The partners the serial pass adds, ascending.
     late: Vec<u32>,
+    /// Whether the lists' column of image translations was taken by a law pass since this
+    /// plan was made: a candidate's image is the same until the next build (module doc).
+    images: bool,
 }
 
 /// The lane set the pair kernel runs the law with: [`LaneSet::detected`], the tetrahedron
@@ -196,6 +215,7 @@ impl DemContacts {
         }
         // Spheres that touch nothing keep a zero sum until the next build.
         plan.sums.fill((Vec3::zeros(), Vec3::zeros()));
+        plan.images = false;
         self.kernel = plan;
     }
 
@@ -262,6 +282,7 @@ impl DemContacts {
             // kernel is compiled with unit scales (the multiplications folded away).
             let scaled = self.time_delay.is_some();
             let (slot, early, lanes) = (&plan.slot, &plan.early, plan.lanes.0);
+            let images = plan.images;
             let length = run_length(sums.len());
             let inputs: Vec<_> = sums
                 .chunks_mut(length)
@@ -278,8 +299,8 @@ impl DemContacts {
                 let sums = RunSums { own, foreign, lo };
                 let input = (lists, slots, partners, sums);
                 match scaled {
-                    true => this.evaluate_run::<LAW, SUM, true>(time, dt, lanes, input),
-                    false => this.evaluate_run::<LAW, SUM, false>(time, dt, lanes, input),
+                    true => this.evaluate_run::<LAW, SUM, true>(time, dt, lanes, images, input),
+                    false => this.evaluate_run::<LAW, SUM, false>(time, dt, lanes, images, input),
                 }
                 let (true, Some(carriers)) = (SUM, &carriers) else {
                     return;
@@ -297,6 +318,7 @@ impl DemContacts {
             });
         }
         self.candidates.set_lists(pairs, walls);
+        plan.images |= LAW;
         if SUM {
             let mut receive = plan.receive.iter().peekable();
             for &s in &plan.late {
@@ -316,6 +338,29 @@ impl DemContacts {
         }
         plan.sums = sums;
         self.kernel = plan;
+    }
+
+    /// Pair `k`'s image translation as a law pass taking it now would write it, for what a
+    /// checkpoint or a merge of the ranks' records keeps: the column's whole periods (they
+    /// hold since the build), with the sign of each zero component from this evaluation's
+    /// separation d = x_b − x_a as [`PeriodicBox::image_shift`](crate::PeriodicBox::image_shift)
+    /// signs it, −l · (±0): −0 for d ≥ +0, +0 below. The column as it is when no law pass
+    /// ran since the lists were made (a restore, a merge: it holds what was written).
+    pub(super) fn image_as_written(&self, k: usize) -> Vec3 {
+        let pairs = self.candidates.pairs();
+        let mut t = pairs.shift(k);
+        let Some(cell) = self.periodic.as_ref().filter(|_| self.kernel.images) else {
+            return t;
+        };
+        let c = &pairs.items[k];
+        let d =
+            self.spheres.now(c.second as usize).center - self.spheres.now(c.first as usize).center;
+        for axis in 0..3 {
+            if cell.length(axis).is_some() && t[axis] == 0.0 {
+                t[axis] = -(0.0f64.copysign(d[axis]));
+            }
+        }
+        t
     }
 
     /// Adds the complete sum of every partner this process or rank owns to its particle
@@ -340,13 +385,16 @@ impl DemContacts {
     /// ghost beyond a time-delayed boundary (paper 003 Eqs. 6–7) when `SCALED`. With a vector
     /// lane set, the touching pairs wait in a batch for the law across lanes
     /// ([`LawLanes`]) and are recorded and summed in list order when it is full: the sums
-    /// take the same additions in the same order, since an apart pair adds nothing.
+    /// take the same additions in the same order, since an apart pair adds nothing. A
+    /// pair's image translation is taken into the lists' column unless `images` says the
+    /// column holds it since the build.
     #[inline(always)]
     fn evaluate_run<const LAW: bool, const SUM: bool, const SCALED: bool>(
         &self,
         time: f64,
         dt: f64,
         lanes: LaneSet,
+        images: bool,
         (mut lists, slots, partners, mut sums): (RunLists<'_>, &[u32], &[u32], RunSums<'_>),
     ) {
         let law = &self.settings.law;
@@ -367,12 +415,15 @@ impl DemContacts {
             let turn = match LAW {
                 true => {
                     let contact = &mut lists.pairs[k];
-                    let mut shift = Vec3::zeros();
-                    let touching = self.pair_contact(contact, &mut shift);
-                    if let Some(at) = lists.shifts.get_mut(k) {
-                        *at = shift;
-                    }
-                    let Some((g, e)) = touching else {
+                    let shift = match lists.shifts.get_mut(k) {
+                        Some(at) if !images => {
+                            *at = self.image_of(contact);
+                            *at
+                        }
+                        Some(at) => *at,
+                        None => Vec3::zeros(),
+                    };
+                    let Some((pair, e)) = self.spheres_through(contact, shift) else {
                         contact.part();
                         for at in [lists.turns.get_mut(k), lists.rolls.get_mut(k)]
                             .into_iter()
@@ -383,7 +434,7 @@ impl DemContacts {
                         continue;
                     };
                     if in_lanes {
-                        batch.pairs[batch.lanes.push(&g, &e, &contact.history)] = k;
+                        batch.pairs[batch.lanes.push_spheres(&pair, &e, &contact.history)] = k;
                         if batch.lanes.is_full() {
                             self.finish_batch::<SUM, SCALED>(
                                 dt, &mut batch, &mut lists, slots, &delay, &mut sums,
@@ -391,6 +442,7 @@ impl DemContacts {
                         }
                         continue;
                     }
+                    let g = pair.geometry();
                     let f = law.force(&g, &e, &mut contact.history, dt);
                     let touching = (g.normal, g.overlap);
                     self.record_pair(k, f, touching, || (g, e), &mut lists, dt)
@@ -799,6 +851,127 @@ mod tests {
                     "torque on particle {p}, {threads} threads"
                 );
             }
+        }
+    }
+
+    /// 10 × 10 × 3 spinning spheres about 1.98 r apart in a cell periodic in x and y, thrown
+    /// across its faces at about (5, 2.5) m/s with a spread of ±0.15 m/s, moved and wrapped
+    /// (as `PeriodicWrap` wraps them) for `steps` steps of 10 µs: per step the particle
+    /// forces and torques, the pairs' springs and image translations as a checkpoint writes
+    /// them (bits; some with a zero of either sign), with the images
+    /// taken once per build, or at every step when `every_step`; and the rebuilds, the wraps
+    /// and the touching pairs through the boundary.
+    fn periodic_run(every_step: bool, steps: usize) -> (Vec<Vec<u64>>, u64, usize, usize) {
+        let (r, a) = (0.005, 1.98 * 0.005);
+        let side = 10.0 * a;
+        let mut centers = Vec::new();
+        for k in 0..3 {
+            for j in 0..10 {
+                for i in 0..10 {
+                    // ±20 µm off the lattice, so that separations cross zero between builds.
+                    let off = |m: usize| (((i + 10 * j + 100 * k) * m) % 97) as f64 / 97.0 - 0.5;
+                    let at = |n: usize, m: usize| (n as f64 + 0.5) * a + 4e-5 * off(m);
+                    centers.push(Vec3::new(at(i, 41), at(j, 43), at(k, 47)));
+                }
+            }
+        }
+        let n = centers.len();
+        let mut state = State::at_rest(centers);
+        state.mass = vec![1e-3; n];
+        for p in 0..n {
+            let f = |m: usize| ((p * m) % 101) as f64 / 101.0 - 0.5;
+            state.velocity[p] = Vec3::new(5.0 + 0.3 * f(37), 2.5 + 0.3 * f(53), 0.3 * f(71));
+            state.let_turn(p, 1e-8);
+            state.spin.velocity[p] = Vec3::new(f(11), f(17), f(23)) * 10.0;
+        }
+        let spheres: Vec<ContactSphere> = (0..n)
+            .map(|p| ContactSphere {
+                particle: p,
+                radius: r,
+                body: p,
+                material: 0,
+            })
+            .collect();
+        let settings = ContactSettings {
+            law: ContactLaw::HertzMindlin(HertzMindlin { damping_ratio: 0.2 }),
+            friction: 0.5,
+            skin: 0.001,
+        };
+        let names = (0..n).map(|p| p.to_string()).collect();
+        let cell = crate::PeriodicBox::new(Vec3::zeros(), [Some(side), Some(side), None]).unwrap();
+        let groups: Vec<_> = (0..n)
+            .map(|p| crate::WrapGroup {
+                anchor: p,
+                particles: vec![p],
+            })
+            .collect();
+        let contacts = DemContacts::new(&state, &spheres, names, &[(5e7, 0.25)], settings, vec![]);
+        let mut contacts = contacts.with_periodic(cell.clone()).unwrap();
+        let (mut force, mut torque) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
+        let (mut rows, mut wraps, mut through, mut positive_zeros) = (Vec::new(), 0, 0, 0);
+        let bits = |v: &Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+        for step in 0..steps {
+            state.time = 1e-5 * step as f64;
+            for p in 0..n {
+                let v = state.velocity[p];
+                state.position[p] += 1e-5 * v;
+            }
+            wraps += cell.wrap_bodies(&mut state, &groups);
+            force.fill(Vec3::zeros());
+            torque.fill(Vec3::zeros());
+            if every_step {
+                contacts.forget_images();
+            }
+            contacts.add_forces(&state, &mut force, &mut torque);
+            let pairs = contacts.candidates.pairs();
+            through += pairs
+                .with_shifts()
+                .filter(|(c, t)| c.force != Vec3::zeros() && *t != Vec3::zeros())
+                .count();
+            let mut row: Vec<u64> = force.iter().chain(&torque).flat_map(bits).collect();
+            row.extend(pairs.items.iter().flat_map(|c| bits(&c.history)));
+            // Taken at every step, the column is what the law pass wrote at this one.
+            let written: Vec<Vec3> = match every_step {
+                true => pairs.shift.clone(),
+                false => (0..pairs.len())
+                    .map(|k| contacts.image_as_written(k))
+                    .collect(),
+            };
+            row.extend(written.iter().flat_map(bits));
+            positive_zeros += written
+                .iter()
+                .filter(|t| {
+                    (t.x == 0.0 && t.x.is_sign_positive()) || (t.y == 0.0 && t.y.is_sign_positive())
+                })
+                .count();
+            rows.push(row);
+        }
+        assert!(
+            positive_zeros > 0,
+            "no separation below zero along a periodic axis"
+        );
+        (rows, contacts.rebuilds(), wraps, through)
+    }
+
+    #[test]
+    fn images_taken_once_per_build_give_the_bits_of_images_taken_at_every_step_across_wraps() {
+        // The spheres cross both periodic faces and are wrapped back many times; each wrap
+        // moves a sphere by a whole period, which must rebuild the lists before its pairs'
+        // images are read again. The images kept from the build give every force, torque,
+        // spring and written image translation (the sign of a zero one included) of images
+        // taken afresh at every step, to the bit.
+        let steps = 300;
+        let (kept, rebuilds, wraps, through) = periodic_run(false, steps);
+        let (fresh, ..) = periodic_run(true, steps);
+        assert!(wraps > 50, "{wraps} wraps");
+        assert!(rebuilds > 20, "{rebuilds} rebuilds");
+        assert!(
+            through > 20 * steps,
+            "{through} touching pair-steps through the faces"
+        );
+        for (step, (a, b)) in kept.iter().zip(&fresh).enumerate() {
+            assert_eq!(a.len(), b.len(), "step {step}");
+            assert!(a == b, "step {step}: the kept images change the run");
         }
     }
 

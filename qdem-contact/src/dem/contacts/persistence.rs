@@ -210,7 +210,8 @@ impl Persistent for DemContacts {
         out.tag("contact");
         out.u32s(&self.stable_particles());
         out.option_f64(self.evaluation.last_time());
-        self.candidates.save(out, &self.order);
+        self.candidates
+            .save(out, &self.order, |k| self.image_as_written(k));
         self.walls.save(out);
         out.bool(self.time_delay.is_some());
         if let Some(delay) = &self.time_delay {

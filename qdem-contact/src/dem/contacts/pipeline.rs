@@ -137,14 +137,36 @@ impl DemContacts {
         contact: &Contact,
         shift: &mut Vec3,
     ) -> Option<(PairGeometry, PairElasticity)> {
+        if self.periodic.is_some() {
+            *shift = self.image_of(contact);
+        }
+        let (pair, e) = self.spheres_through(contact, *shift)?;
+        Some((pair.geometry(), e))
+    }
+
+    /// The translation of the minimum image of `contact`'s second sphere (periodic only).
+    #[inline(always)]
+    pub(super) fn image_of(&self, contact: &Contact) -> Vec3 {
+        let (a, b) = (contact.first as usize, contact.second as usize);
+        let d = self.spheres.now(b).center - self.spheres.now(a).center;
+        self.periodic
+            .as_ref()
+            .map_or(Vec3::zeros(), |p| p.image_shift(&d))
+    }
+
+    /// The spheres of `contact` as the narrow phase finds them touching, its second sphere's
+    /// image translated by `shift`, with their elasticity; `None` when apart.
+    #[inline(always)]
+    pub(super) fn spheres_through(
+        &self,
+        contact: &Contact,
+        shift: Vec3,
+    ) -> Option<(SpherePair, PairElasticity)> {
         let (a, b) = (contact.first as usize, contact.second as usize);
         let (sa, sb) = (self.spheres.now(a), self.spheres.now(b));
-        if let Some(p) = &self.periodic {
-            *shift = p.image_shift(&(sb.center - sa.center));
-        }
-        let geometry = narrow_phase(sa, sb, *shift, self.settings.friction)?;
+        let pair = touching_pair(sa, sb, shift, self.settings.friction)?;
         let e = self.spheres.pair_elasticity(sa, sb);
-        Some((geometry, e))
+        Some((pair, e))
     }
 
     /// The geometry and elasticity of the contact of sphere s with wall w: the contact point

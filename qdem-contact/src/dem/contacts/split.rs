@@ -287,6 +287,10 @@ impl DemContacts {
             (&self.candidates.wall_contacts(), 1.0),
         ] {
             for (k, (c, shift)) in list.with_shifts().enumerate() {
+                let shift = match tag == 0.0 {
+                    true => self.image_as_written(k),
+                    false => shift,
+                };
                 out.extend([tag, c.first as f64, c.second as f64]);
                 for v in [c.history, c.force, list.turn[k]] {
                     out.extend_from_slice(v.as_slice());

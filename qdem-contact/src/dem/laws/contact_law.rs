@@ -26,6 +26,50 @@ pub struct PairGeometry {
     pub friction: f64,
 }
 
+/// The two spheres of a touching pair as the narrow phase finds them, before their
+/// [`PairGeometry`]: what [`SpherePair::geometry`] (one pair) and the lanes (`law_lanes.rs`,
+/// several at once, to the same bits) turn into it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SpherePair {
+    /// d = x_b − x_a, b's image when periodic (m).
+    pub(crate) separation: Vec3,
+    /// |d|², below (r_a + r_b)² and above 0.
+    pub(crate) distance_squared: f64,
+    /// (r_a, r_b) (m).
+    pub(crate) radii: (f64, f64),
+    /// The masses of the carriers (m_a, m_b) (kg).
+    pub(crate) masses: (f64, f64),
+    /// v_a − v_b, the centres' relative velocity (m/s).
+    pub(crate) velocity: Vec3,
+    /// The angular velocities (ω_a, ω_b) (rad/s).
+    pub(crate) spins: (Vec3, Vec3),
+    /// Coulomb friction coefficient of the pair.
+    pub(crate) friction: f64,
+}
+
+impl SpherePair {
+    /// The contact: overlap δ = r_a + r_b − |d|, normal n = d/|d|, the velocity of a's
+    /// contact point relative to b's, v_a − v_b + ((r_a − δ/2) ω_a + (r_b − δ/2) ω_b) × n,
+    /// R* = r_a r_b/(r_a + r_b) and m* = m_a m_b/(m_a + m_b).
+    #[inline(always)]
+    pub(crate) fn geometry(&self) -> PairGeometry {
+        let ((ra, rb), (ma, mb)) = (self.radii, self.masses);
+        let distance = self.distance_squared.sqrt();
+        let overlap = (ra + rb) - distance;
+        let normal = self.separation / distance;
+        let half = 0.5 * overlap;
+        let spin = (ra - half) * self.spins.0 + (rb - half) * self.spins.1;
+        PairGeometry {
+            overlap,
+            normal,
+            velocity: self.velocity + spin.cross(&normal),
+            radius: ra * rb / (ra + rb),
+            mass: ma * mb / (ma + mb),
+            friction: self.friction,
+        }
+    }
+}
+
 /// Elastic constants of a pair for Hertz–Mindlin: E* and G* from both sides' E and ν.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairElasticity {

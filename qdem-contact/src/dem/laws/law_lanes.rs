@@ -10,10 +10,14 @@
 //!   force F_t = −k_t ξ − γ_t v_t, capped at μ F_n⁺ with ξ = −F_t/k_t on a slide;
 //! - the force on the first partner F_t − F_n n.
 //!
-//! A caller gathers touching contacts (after the narrow phase) into a [`LawLanes`] with
-//! [`LawLanes::push`], evaluates them with [`LawLanes::evaluate`] and reads each lane's force
-//! and spring back in lane order ([`LawLanes::force`], [`LawLanes::history`]), so it can add the
-//! forces in the same order as the scalar loop.
+//! The pair kernel gathers touching pairs of spheres, as the narrow phase's test found them,
+//! into a [`LawLanes`] with [`LawLanes::push_spheres`], evaluates them with
+//! [`LawLanes::evaluate`] and reads each lane's force and spring back in lane order
+//! ([`LawLanes::force`], [`LawLanes::history`]), so it can add the forces in the same order as
+//! the scalar loop. The lanes take the narrow phase's tail first ([`SpherePair::geometry`]:
+//! the distance √|d|², the overlap, the normal d/|d|, the contact point's velocity, R* and m*),
+//! one square root and five divisions a pair, packed, where the scalar tail took them pair by
+//! pair; then the law.
 //!
 //! **The same bits as the scalar law.** Every operation is an IEEE addition, subtraction,
 //! product, quotient or square root, each rounded once, in the order the scalar law takes them
@@ -30,7 +34,7 @@
 //! [`LinearSpring::force`]: crate::dem::laws::linear_spring::LinearSpring::force
 //! [`tangential_force`]: crate::dem::laws::coulomb::tangential_force
 
-use crate::dem::laws::contact_law::{ContactLaw, PairElasticity, PairGeometry};
+use crate::dem::laws::contact_law::{ContactLaw, PairElasticity, PairGeometry, SpherePair};
 use crate::dem::laws::hertz_mindlin::DAMPING_PREFACTOR;
 use qdem_core::continuum::tet_lanes::LaneSet;
 use qdem_core::Vec3;
@@ -50,8 +54,11 @@ type Lane = [f64; LANES];
 pub(crate) struct LawLanes {
     overlap: Lane,
     normal: [Lane; 3],
+    /// The contact point's relative velocity (v_a − v_b of the centres while `spheres`).
     velocity: [Lane; 3],
+    /// R* (r_a while `spheres`).
     radius: Lane,
+    /// m* (m_a while `spheres`).
     mass: Lane,
     friction: Lane,
     e_star: Lane,
@@ -60,6 +67,15 @@ pub(crate) struct LawLanes {
     history: [Lane; 3],
     /// The force on the first partner, after [`LawLanes::evaluate`].
     force: [Lane; 3],
+    /// Of sphere pairs before their geometry ([`SpherePair`]): d, |d|², r_b, m_b, ω_a, ω_b.
+    separation: [Lane; 3],
+    distance_squared: Lane,
+    radius_b: Lane,
+    mass_b: Lane,
+    spin_a: [Lane; 3],
+    spin_b: [Lane; 3],
+    /// Whether the batch holds sphere pairs whose geometry the evaluation takes first.
+    spheres: bool,
     len: usize,
 }
 
@@ -79,11 +95,18 @@ impl LawLanes {
         self.len = 0;
     }
 
-    /// Adds the contact `g` with elasticity `e` and spring `history`; returns its lane.
-    #[inline(always)]
+    /// Adds the contact `g` with elasticity `e` and spring `history`; returns its lane. A
+    /// batch holds contacts or sphere pairs ([`LawLanes::push_spheres`]), not both. The pair
+    /// kernel pushes sphere pairs; the tests push contacts of any geometry.
+    #[cfg(test)]
     pub(crate) fn push(&mut self, g: &PairGeometry, e: &PairElasticity, history: &Vec3) -> usize {
         let l = self.len;
         assert!(l < LANES, "a full batch of {LANES} contacts");
+        debug_assert!(
+            l == 0 || !self.spheres,
+            "a contact in a batch of sphere pairs"
+        );
+        self.spheres = false;
         self.overlap[l] = g.overlap;
         self.radius[l] = g.radius;
         self.mass[l] = g.mass;
@@ -99,7 +122,55 @@ impl LawLanes {
         l
     }
 
-    /// The geometry and elasticity of the contact in lane `l`, as pushed.
+    /// Adds the touching pair of spheres `pair` with elasticity `e` and spring `history`, its
+    /// geometry to be taken by [`LawLanes::evaluate`]; returns its lane. A batch holds sphere
+    /// pairs or contacts (the tests' `push`), not both.
+    #[inline(always)]
+    pub(crate) fn push_spheres(
+        &mut self,
+        pair: &SpherePair,
+        e: &PairElasticity,
+        history: &Vec3,
+    ) -> usize {
+        let l = self.len;
+        assert!(l < LANES, "a full batch of {LANES} contacts");
+        debug_assert!(
+            l == 0 || self.spheres,
+            "a sphere pair in a batch of contacts"
+        );
+        self.spheres = true;
+        self.distance_squared[l] = pair.distance_squared;
+        (self.radius[l], self.radius_b[l]) = pair.radii;
+        (self.mass[l], self.mass_b[l]) = pair.masses;
+        self.friction[l] = pair.friction;
+        self.e_star[l] = e.e_star;
+        self.g_star[l] = e.g_star;
+        for k in 0..3 {
+            self.separation[k][l] = pair.separation[k];
+            self.velocity[k][l] = pair.velocity[k];
+            self.spin_a[k][l] = pair.spins.0[k];
+            self.spin_b[k][l] = pair.spins.1[k];
+            self.history[k][l] = history[k];
+        }
+        self.len = l + 1;
+        l
+    }
+
+    /// The sphere pair in lane `l`, as pushed (before the evaluation).
+    fn sphere_pair(&self, l: usize) -> SpherePair {
+        SpherePair {
+            separation: lane_vector(&self.separation, l),
+            distance_squared: self.distance_squared[l],
+            radii: (self.radius[l], self.radius_b[l]),
+            masses: (self.mass[l], self.mass_b[l]),
+            velocity: lane_vector(&self.velocity, l),
+            spins: (lane_vector(&self.spin_a, l), lane_vector(&self.spin_b, l)),
+            friction: self.friction[l],
+        }
+    }
+
+    /// The geometry and elasticity of the contact in lane `l`, as pushed or, for a sphere
+    /// pair, as the evaluation took it.
     #[inline(always)]
     pub(crate) fn contact(&self, l: usize) -> (PairGeometry, PairElasticity) {
         let g = PairGeometry {
@@ -143,17 +214,40 @@ impl LawLanes {
     }
 
     /// The law over a step `dt` for every contact of the batch, with the lanes of `set`: the
-    /// same bits as [`ContactLaw::force`] on each contact (module doc). A law without a lane
-    /// form, or the scalar set, runs the scalar law on each contact.
+    /// same bits as [`ContactLaw::force`] on each contact (module doc), after the geometry of
+    /// each sphere pair, the same bits as [`SpherePair::geometry`]. A law without a lane form,
+    /// or the scalar set, runs the scalar geometry and law on each contact.
     pub(crate) fn evaluate(&mut self, law: &ContactLaw, set: LaneSet, dt: f64) {
+        let spheres = std::mem::take(&mut self.spheres);
         match (set, Params::of(law)) {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `detected` chooses a set only when the CPU has its features.
-            (LaneSet::Avx512, Some(params)) => unsafe { evaluate_avx512(self, &params, dt) },
+            (LaneSet::Avx512, Some(params)) => unsafe {
+                evaluate_avx512(self, &params, spheres, dt)
+            },
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
-            (LaneSet::Avx2, Some(params)) => unsafe { evaluate_avx2(self, &params, dt) },
-            _ => self.evaluate_scalar(law, dt),
+            (LaneSet::Avx2, Some(params)) => unsafe { evaluate_avx2(self, &params, spheres, dt) },
+            _ => {
+                if spheres {
+                    self.geometry_scalar();
+                }
+                self.evaluate_scalar(law, dt)
+            }
+        }
+    }
+
+    /// The geometry of each sphere pair in turn, in place of what it was pushed with.
+    fn geometry_scalar(&mut self) {
+        for l in 0..self.len {
+            let g = self.sphere_pair(l).geometry();
+            self.overlap[l] = g.overlap;
+            self.radius[l] = g.radius;
+            self.mass[l] = g.mass;
+            for k in 0..3 {
+                self.normal[k][l] = g.normal[k];
+                self.velocity[k][l] = g.velocity[k];
+            }
         }
     }
 
@@ -215,14 +309,14 @@ impl Params {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2")]
-unsafe fn evaluate_avx512(lanes: &mut LawLanes, params: &Params, dt: f64) {
-    pass::<x86::Avx512>(lanes, params, dt)
+unsafe fn evaluate_avx512(lanes: &mut LawLanes, params: &Params, spheres: bool, dt: f64) {
+    pass::<x86::Avx512>(lanes, params, spheres, dt)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn evaluate_avx2(lanes: &mut LawLanes, params: &Params, dt: f64) {
-    pass::<x86::Avx2>(lanes, params, dt)
+unsafe fn evaluate_avx2(lanes: &mut LawLanes, params: &Params, spheres: bool, dt: f64) {
+    pass::<x86::Avx2>(lanes, params, spheres, dt)
 }
 
 /// The vector operations of the law, one implementation per instruction set. Every method is
@@ -393,11 +487,15 @@ type V3<S> = [<S as Simd>::V; 3];
 // No closures below: a closure does not inherit the target features of the function it is
 // inlined into, and one left out of line would call the intrinsics out of line.
 
-/// The law over the batch with `S::N` lanes per vector, `LANES / S::N` vectors per batch;
-/// compiled inside the functions that enable the features.
+/// The law over the batch with `S::N` lanes per vector, `LANES / S::N` vectors per batch,
+/// after the geometry of its sphere pairs when `spheres`; compiled inside the functions that
+/// enable the features.
 #[inline(always)]
-unsafe fn pass<S: Simd>(lanes: &mut LawLanes, params: &Params, dt: f64) {
+unsafe fn pass<S: Simd>(lanes: &mut LawLanes, params: &Params, spheres: bool, dt: f64) {
     for o in (0..lanes.len).step_by(S::N) {
+        if spheres {
+            geometry::<S>(lanes, o);
+        }
         let (n, v, h) = (&lanes.normal, &lanes.velocity, &lanes.history);
         let contact = Contact::<S> {
             overlap: S::load(&lanes.overlap[o..]),
@@ -439,6 +537,44 @@ unsafe fn pass<S: Simd>(lanes: &mut LawLanes, params: &Params, dt: f64) {
             S::store(force[k], &mut lanes.force[k][o..]);
         }
     }
+}
+
+/// [`SpherePair::geometry`] of the sphere pairs in lanes `o..o + S::N`, its operations in its
+/// order, stored in place of what they were pushed with.
+#[inline(always)]
+unsafe fn geometry<S: Simd>(lanes: &mut LawLanes, o: usize) {
+    let (ra, rb) = (S::load(&lanes.radius[o..]), S::load(&lanes.radius_b[o..]));
+    let (ma, mb) = (S::load(&lanes.mass[o..]), S::load(&lanes.mass_b[o..]));
+    let distance = S::sqrt(S::load(&lanes.distance_squared[o..]));
+    let reach = S::add(ra, rb);
+    let overlap = S::sub(reach, distance);
+    let mut normal = [distance; 3];
+    for (n, d) in normal.iter_mut().zip(&lanes.separation) {
+        *n = S::div(S::load(&d[o..]), distance);
+    }
+    let half = S::mul(S::splat(0.5), overlap);
+    let (arm_a, arm_b) = (S::sub(ra, half), S::sub(rb, half));
+    let mut spin = normal;
+    for ((w, a), b) in spin.iter_mut().zip(&lanes.spin_a).zip(&lanes.spin_b) {
+        *w = S::add(
+            S::mul(arm_a, S::load(&a[o..])),
+            S::mul(arm_b, S::load(&b[o..])),
+        );
+    }
+    // spin × n, as nalgebra's `cross`.
+    let turn = [
+        S::sub(S::mul(spin[1], normal[2]), S::mul(spin[2], normal[1])),
+        S::sub(S::mul(spin[2], normal[0]), S::mul(spin[0], normal[2])),
+        S::sub(S::mul(spin[0], normal[1]), S::mul(spin[1], normal[0])),
+    ];
+    for k in 0..3 {
+        let velocity = S::add(S::load(&lanes.velocity[k][o..]), turn[k]);
+        S::store(velocity, &mut lanes.velocity[k][o..]);
+        S::store(normal[k], &mut lanes.normal[k][o..]);
+    }
+    S::store(overlap, &mut lanes.overlap[o..]);
+    S::store(S::div(S::mul(ra, rb), reach), &mut lanes.radius[o..]);
+    S::store(S::div(S::mul(ma, mb), S::add(ma, mb)), &mut lanes.mass[o..]);
 }
 
 /// [`PairGeometry`] in lanes.
@@ -720,6 +856,78 @@ mod tests {
                 sliding > 500 && sticking > 500,
                 "{law:?}: {sliding} sliding, {sticking} sticking"
             );
+        }
+    }
+
+    /// A touching pair of spheres of 1–5 mm and 0.1–10 g (the narrow phase's test passed, by
+    /// up to 0.1 mm), spinning at up to 20 rad/s, with a spring as [`contact`]'s.
+    fn sphere_pair(random: &mut Random) -> (SpherePair, PairElasticity, Vec3) {
+        let radii = (random.within(1e-3, 5e-3), random.within(1e-3, 5e-3));
+        let separation = random.unit() * (radii.0 + radii.1 - random.within(1e-7, 1e-4));
+        let masses = (random.within(1e-4, 1e-2), random.within(1e-4, 1e-2));
+        let velocity = random.unit() * random.within(0.0, 2.0);
+        let spins = (
+            random.unit() * random.within(0.0, 20.0),
+            random.unit() * random.within(0.0, 20.0),
+        );
+        let pair = SpherePair {
+            separation,
+            distance_squared: separation.norm_squared(),
+            radii,
+            masses,
+            velocity,
+            spins,
+            friction: random.within(0.0, 0.8),
+        };
+        let (_, e, history) = contact(random);
+        (pair, e, history)
+    }
+
+    #[test]
+    fn every_lane_set_gives_the_scalar_narrow_phase_and_laws_bits_on_random_sphere_pairs() {
+        // 3,000 random touching sphere pairs per law, in batches of 1 to 8 (the last lanes of
+        // a short batch hold an earlier batch's pairs): every overlap, normal, contact-point
+        // velocity, R*, m*, force and spring bit for bit as `SpherePair::geometry` and the
+        // scalar law give them, on every lane set this CPU has.
+        let mut random = Random(58);
+        let dt = 1e-6;
+        for law in laws() {
+            let mut batches: Vec<(LaneSet, LawLanes)> = sets()
+                .into_iter()
+                .map(|set| (set, LawLanes::default()))
+                .collect();
+            let mut left = 3000;
+            while left > 0 {
+                let size = (1 + (random.next() * LANES as f64) as usize).min(left);
+                left -= size;
+                let pairs: Vec<_> = (0..size).map(|_| sphere_pair(&mut random)).collect();
+                let expected: Vec<_> = pairs
+                    .iter()
+                    .map(|(pair, e, spring)| {
+                        let (g, mut after) = (pair.geometry(), *spring);
+                        let f = law.force(&g, e, &mut after, dt);
+                        (g, f, after)
+                    })
+                    .collect();
+                for (set, batch) in &mut batches {
+                    batch.clear();
+                    for (pair, e, spring) in &pairs {
+                        batch.push_spheres(pair, e, spring);
+                    }
+                    batch.evaluate(&law, *set, dt);
+                    for (l, (g, f, after)) in expected.iter().enumerate() {
+                        let what = format!("{law:?}, {set:?}, lane {l} of {size}");
+                        let (lane, _) = batch.contact(l);
+                        let scalars =
+                            |g: &PairGeometry| [g.overlap, g.radius, g.mass].map(f64::to_bits);
+                        assert_eq!(scalars(&lane), scalars(g), "δ, R*, m*, {what}");
+                        assert_eq!(bits(&lane.normal), bits(&g.normal), "normal, {what}");
+                        assert_eq!(bits(&lane.velocity), bits(&g.velocity), "velocity, {what}");
+                        assert_eq!(bits(&batch.force(l)), bits(f), "force, {what}");
+                        assert_eq!(bits(&batch.history(l)), bits(after), "spring, {what}");
+                    }
+                }
+            }
         }
     }
 
