@@ -27,6 +27,7 @@ use std::time::Instant;
 pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<(), CliError> {
     let scene = Scene::load(path)?;
     let mut sim = progress::while_busy("building the scene", || Simulation::build(scene))?;
+    build_contact_lists(&mut sim);
     if let Some(r) = &ranks {
         sim.world
             .decompose(r.clone())
@@ -56,6 +57,20 @@ pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<
         print_cost(&sim, per_step);
     }
     Ok(())
+}
+
+/// Builds the contact lists at the state the run starts from, where no step has built them
+/// yet (a `[run] start_from` stage's), so that the contacts' step is estimated, and its
+/// one-contact bound found, from the contacts of that state.
+fn build_contact_lists(sim: &mut Simulation) {
+    let world = &mut sim.world;
+    let contacts = world.models.iter_mut().find_map(|m| {
+        let m: &mut dyn std::any::Any = m.as_mut();
+        m.downcast_mut::<DemContacts>()
+    });
+    if let Some(contacts) = contacts {
+        contacts.build_lists(&world.state);
+    }
 }
 
 /// `qdem check --advice json`: builds the scene at `path` and prints its advice as one JSON
@@ -199,7 +214,7 @@ fn print_contact_step(sim: &Simulation, contacts: &DemContacts) {
             "step limit of the contacts: {dt:.4e} s, estimated from the {} contacts present \
              (a larger dt is warned of, and the run stops if a contact comes to need a \
              shorter one){alone}",
-            contacts.contacts()
+            contacts.touching_at(state.time)
         );
     }
     let materials = &sim.scene.materials;
