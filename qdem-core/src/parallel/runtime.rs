@@ -227,6 +227,9 @@ impl ParallelRuntime {
         let Some(ranks) = &mut self.ranks else {
             return done;
         };
+        // The waits of the steps only, as the stage clock counts them (the initial
+        // evaluation's, with the first build of the lists, are not a step's).
+        ranks.exchanged.fill(0.0);
         ranks.share.share(state);
         ranks.share.gather(state, torques);
         match ranks.share.agree(done.err().map(|e| e.to_string())) {
