@@ -4,8 +4,10 @@
 //! that), an estimate of the memory the run keeps, checkpoint support, the measured
 //! cost of a step with the projected run time, and where a step's time goes, stage by stage of the world's step
 //! ([`qdem_core::step::stages`]). Under `mpirun` (N > 1) the run is decomposed as `qdem run`
-//! decomposes it, and rank 0 also prints each rank's tetrahedra, owned particles, halo and
-//! measured step cost, and the imbalance.
+//! decomposes it, and rank 0 also prints each rank's tetrahedra, owned particles, halo,
+//! contacts and measured stage times, the imbalance and the speed-up they predict; then the
+//! ranks are cut again by what each model's items were measured to cost
+//! ([`qdem_core::parallel::WorkWeights`]) and the table is printed again over as many steps.
 
 use crate::command::CliError;
 use crate::progress;
@@ -13,6 +15,7 @@ use crate::run_length;
 use qdem_contact::{rayleigh_time, DemContacts};
 use qdem_core::{
     parallel::Communicator, parallel::RankFigures, step::Model as _, step::Scheme, step::Stage,
+    step::StageTimes,
 };
 use qdem_io::build::{memory, BodyKind, Simulation};
 use qdem_io::runner::RunError;
@@ -27,6 +30,7 @@ use std::time::Instant;
 pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<(), CliError> {
     let scene = Scene::load(path)?;
     let mut sim = progress::while_busy("building the scene", || Simulation::build(scene))?;
+    build_contact_lists(&mut sim);
     if let Some(r) = &ranks {
         sim.world
             .decompose(r.clone())
@@ -42,12 +46,24 @@ pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<
             println!("{}", advice.line());
         }
     }
-    let (per_step, exchange) = measure_step_cost(&mut sim, 20)?;
+    initialize(&mut sim)?;
+    let start = Window::start(&sim);
+    let mut per_step = measure_steps(&mut sim, STEPS)?;
     if let Some(d) = sim.world.decomposition().cloned() {
         // The decomposition now: a re-partition moves grains and rigid bodies.
-        let table = rank_table(&sim, &d, per_step, exchange);
+        let table = rank_table(&sim, &d, &start, "the fixed shares");
         if leader {
             print!("{table}");
+        }
+        if let Some(weights) = sim.world.measured_weights() {
+            sim.world.repartition_weighted(weights);
+            let start = Window::start(&sim);
+            per_step = measure_steps(&mut sim, STEPS)?;
+            let d = sim.world.decomposition().cloned().expect("decomposed");
+            let table = rank_table(&sim, &d, &start, "the measured cost");
+            if leader {
+                print!("{table}");
+            }
         }
         // The whole contact lists for the counts below.
         sim.world.gather();
@@ -56,6 +72,23 @@ pub fn check_scene(path: &Path, ranks: Option<Arc<dyn Communicator>>) -> Result<
         print_cost(&sim, per_step);
     }
     Ok(())
+}
+
+/// The steps each measurement of `qdem check` takes.
+const STEPS: usize = 20;
+
+/// Builds the contact lists at the state the run starts from, where no step has built them
+/// yet (a `[run] start_from` stage's), so that the contacts' step is estimated, and its
+/// one-contact bound found, from the contacts of that state.
+fn build_contact_lists(sim: &mut Simulation) {
+    let world = &mut sim.world;
+    let contacts = world.models.iter_mut().find_map(|m| {
+        let m: &mut dyn std::any::Any = m.as_mut();
+        m.downcast_mut::<DemContacts>()
+    });
+    if let Some(contacts) = contacts {
+        contacts.build_lists(&world.state);
+    }
 }
 
 /// `qdem check --advice json`: builds the scene at `path` and prints its advice as one JSON
@@ -199,7 +232,7 @@ fn print_contact_step(sim: &Simulation, contacts: &DemContacts) {
             "step limit of the contacts: {dt:.4e} s, estimated from the {} contacts present \
              (a larger dt is warned of, and the run stops if a contact comes to need a \
              shorter one){alone}",
-            contacts.contacts()
+            contacts.touching_at(state.time)
         );
     }
     let materials = &sim.scene.materials;
@@ -260,70 +293,136 @@ fn print_cost(sim: &Simulation, per_step: f64) {
     print_stages(sim);
 }
 
-/// Each rank's share of a decomposed step, gathered to every rank (a collective: every rank
-/// calls it): tetrahedra, owned particles, halo (block sums received per step), particles
-/// whose motion it receives per step, the candidate contacts it evaluates, the contact
-/// spheres of other ranks it receives (ghosts) and those it owns after the measured steps,
-/// the work the partition gave it (in particle steps), its step and kernel seconds,
-/// and the imbalance of the kernel (the slowest rank's kernel time over the mean).
-fn rank_table(sim: &Simulation, d: &RankFigures, per_step: f64, exchange: f64) -> String {
+/// The stage clock and the seconds spent in collectives at the start of a window of
+/// measured steps.
+struct Window {
+    stages: StageTimes,
+    waited: Vec<f64>,
+}
+
+impl Window {
+    /// The window that starts now.
+    fn start(sim: &Simulation) -> Window {
+        let world = &sim.world;
+        Window {
+            stages: world.stages().clone(),
+            waited: (0..world.models.len())
+                .map(|i| world.waited_seconds(i))
+                .collect(),
+        }
+    }
+
+    /// The steps taken since the window started.
+    fn steps(&self, sim: &Simulation) -> f64 {
+        (sim.world.stages().steps() - self.stages.steps()).max(1) as f64
+    }
+
+    /// Seconds per step of `stage` since the window started.
+    fn per_step(&self, sim: &Simulation, stage: Stage) -> f64 {
+        (sim.world.stages().seconds(stage) - self.stages.seconds(stage)) / self.steps(sim)
+    }
+
+    /// Seconds per step of model `model`'s forces since the window started, less those
+    /// spent in collectives (waiting for the other ranks): the work this rank was given.
+    fn busy(&self, sim: &Simulation, model: usize) -> f64 {
+        let waited = sim.world.waited_seconds(model) - self.waited[model];
+        (self.per_step(sim, Stage::Forces(model)) - waited / self.steps(sim)).max(0.0)
+    }
+}
+
+/// Each rank's share of a decomposed step cut by `weighed` (the work of what), gathered to
+/// every rank (a collective: every rank calls it), over the steps since `window` started:
+/// tetrahedra, owned particles, halo (block sums received per step), particles whose motion
+/// it receives per step, the candidate contacts it evaluates, the contact spheres of other
+/// ranks it receives (ghosts) and those it owns, the work the partition gave it (in particle
+/// steps), its step, and the seconds per step of its tetrahedra (the deformable bodies'
+/// forces), its contacts and its particles' prediction and integration, without the waits
+/// in collectives, and of its share of the state; the imbalance of the kernel (the slowest
+/// rank's kernel time over the mean), and the speed-up over one process that these times
+/// predict (their sum over all ranks, what one process would compute, over the busiest
+/// rank's: no exchange counted).
+fn rank_table(sim: &Simulation, d: &RankFigures, window: &Window, weighed: &str) -> String {
     let world = &sim.world;
-    let steps = world.stages().steps().max(1) as f64;
-    // The bodies' force time without their exchange of block sums (which waits for the
-    // slowest rank) is the work each rank was given.
-    let bodies: f64 = world
-        .models
-        .iter()
-        .enumerate()
-        .filter(|(_, m)| m.deformable().is_some())
-        .map(|(i, _)| world.stages().seconds(Stage::Forces(i)))
+    let kinds = |deformable: bool| {
+        let models = world.models.iter().enumerate();
+        models
+            .filter(move |(_, m)| m.deformable().is_some() == deformable)
+            .map(|(i, _)| i)
+    };
+    let kernel: f64 = kinds(true).map(|i| window.busy(sim, i)).sum();
+    let contact: f64 = kinds(false)
+        .filter(|&i| {
+            let model: &dyn std::any::Any = world.models[i].as_ref();
+            model.is::<DemContacts>()
+        })
+        .map(|i| window.busy(sim, i))
         .sum();
-    let kernel = (bodies - exchange).max(0.0);
-    let share = world.stages().seconds(Stage::Share);
+    let particles = window.per_step(sim, Stage::Predict) + window.per_step(sim, Stage::Integrate);
+    let share = window.per_step(sim, Stage::Share);
+    let steps = window.steps(sim);
+    let forces: f64 = (0..world.models.len())
+        .map(|i| window.per_step(sim, Stage::Forces(i)))
+        .sum();
+    let step = forces + particles + share;
     // The spheres this rank owns, the contacts it evaluates and the ghosts it receives
     // (split contacts).
     let (spheres, contacts, ghosts) = sim
         .contacts()
         .map_or((0, 0, 0), |c| (c.own_spheres(), c.candidates(), c.ghosts()));
     let mine = [
-        per_step,
-        kernel / steps,
-        share / steps,
+        step,
+        kernel,
+        contact,
+        particles,
+        share,
         contacts as f64,
         ghosts as f64,
         spheres as f64,
     ];
     let all = world.rank_rows(&mine);
     let mut table = format!(
-        "decomposed over {} ranks ({} bodies cut between ranks):\n  rank  tets      owned     halo      received  contacts  ghosts    spheres   work      step (s)   kernel (s) share (s)\n",
+        "decomposed over {} ranks, cut by {weighed} ({} bodies cut between ranks), {steps} steps:\n  rank  tets      owned     halo      received  contacts  ghosts    spheres   work      step (s)   tets (s)   contacts (s) particles (s) share (s)\n",
         d.ranks, d.cut_bodies
     );
-    for (r, row) in all.chunks_exact(6).enumerate() {
+    for (r, row) in all.chunks_exact(8).enumerate() {
         table += &format!(
-            "  {r:<5} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9.0} {:.3e}  {:.3e}  {:.3e}\n",
+            "  {r:<5} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9} {:<9.0} {:.3e}  {:.3e}  {:.3e}    {:.3e}     {:.3e}\n",
             d.tets[r],
             d.owned[r],
             d.halo[r],
             d.received[r],
-            row[3],
-            row[4],
             row[5],
+            row[6],
+            row[7],
             d.work[r],
             row[0],
             row[1],
-            row[2]
+            row[2],
+            row[3],
+            row[4]
+        );
+    }
+    if let Some(weights) = world.work_weights().filter(|w| !w.models.is_empty()) {
+        let named = world.models.iter().zip(&weights.models);
+        let named: Vec<String> = named
+            .filter(|(_, &w)| w != 1.0)
+            .map(|(m, w)| format!("`{}` {w:.3}", m.name()))
+            .collect();
+        table += &format!(
+            "  weights of the items' fixed shares, measured: {}\n",
+            named.join(", ")
         );
     }
     if world.repartitions() > 0 {
         table += &format!(
-            "  re-partitioned {} times in the measured steps (by the work of the lists then built)\n",
+            "  re-partitioned {} times so far (by the work of the lists then built)\n",
             world.repartitions()
         );
     }
-    let column = |k: usize| all.chunks_exact(6).map(|row| row[k]).collect::<Vec<_>>();
+    let column = |k: usize| all.chunks_exact(8).map(|row| row[k]).collect::<Vec<_>>();
     match d.tets.iter().sum::<usize>() {
         0 => {
-            let contacts = imbalance(&column(3));
+            let contacts = imbalance(&column(5));
             table += &format!("  contact imbalance (most candidates / mean): {contacts:.3}\n");
         }
         _ => {
@@ -331,6 +430,16 @@ fn rank_table(sim: &Simulation, d: &RankFigures, per_step: f64, exchange: f64) -
             table += &format!("  kernel imbalance (slowest / mean): {kernel:.3}\n");
         }
     }
+    let busy: Vec<f64> = all
+        .chunks_exact(8)
+        .map(|row| row[1] + row[2] + row[3])
+        .collect();
+    let slowest = busy.iter().cloned().fold(0.0, f64::max);
+    table += &format!(
+        "  predicted speed-up over one process: {:.2}x (the ranks' tets, contacts and \
+         particles summed over the busiest rank's, no exchange counted)\n",
+        busy.iter().sum::<f64>() / slowest.max(f64::MIN_POSITIVE)
+    );
     table
 }
 
@@ -364,29 +473,15 @@ fn print_stages(sim: &Simulation) {
     }
 }
 
-/// The deformable bodies' seconds of block-sum exchange so far (a decomposed run).
-fn exchange_seconds(sim: &Simulation) -> f64 {
-    let models = &sim.world.models;
-    models
-        .iter()
-        .filter_map(|m| m.deformable())
-        .map(|body| body.exchange_seconds())
-        .sum()
-}
-
-/// Wall seconds per step of the scene's world, measured over `n` steps from its start, and
-/// the deformable bodies' seconds of block-sum exchange in those steps; for
-/// implicit and static scenes also prints the sparse system's size, non-zeros, Cholesky fill
-/// and factorisation time from the stepper's one factorisation (in `initialize`, which is not
-/// timed).
-fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<(f64, f64), CliError> {
+/// Initialises the scene's world for its first step; for implicit and static scenes also
+/// prints the sparse system's size, non-zeros, Cholesky fill and factorisation time from the
+/// stepper's one factorisation (in `initialize`, which is not timed).
+fn initialize(sim: &mut Simulation) -> Result<(), CliError> {
     let scene = sim.scene.path.clone();
-    let run_error = |source| RunError::Core {
-        scene: scene.clone(),
-        source,
-    };
     let world = &mut sim.world;
-    world.initialize().map_err(run_error)?;
+    world
+        .initialize()
+        .map_err(|source| RunError::Core { scene, source })?;
     if let Some(s) = world.stepper().report().factor {
         println!(
             "implicit system: {} unknowns, {} non-zeros (lower triangle), factor {} non-zeros (fill {:.1}x); symbolic {:.3e} s, numeric {:.3e} s",
@@ -398,14 +493,23 @@ fn measure_step_cost(sim: &mut Simulation, n: usize) -> Result<(f64, f64), CliEr
             s.numeric_seconds
         );
     }
-    let exchanged = exchange_seconds(sim);
+    Ok(())
+}
+
+/// Wall seconds per step of the scene's world over `n` more steps (fewer if it ends).
+fn measure_steps(sim: &mut Simulation, n: usize) -> Result<f64, CliError> {
+    let scene = sim.scene.path.clone();
     let world = &mut sim.world;
-    let start = Instant::now();
+    let (before, start) = (world.stages().steps(), Instant::now());
     for _ in 0..n {
-        if world.step().map_err(run_error)?.is_some() {
+        let step = world.step().map_err(|source| RunError::Core {
+            scene: scene.clone(),
+            source,
+        })?;
+        if step.is_some() {
             break;
         }
     }
-    let per_step = start.elapsed().as_secs_f64() / world.stages().steps().max(1) as f64;
-    Ok((per_step, exchange_seconds(sim) - exchanged))
+    let taken = (world.stages().steps() - before).max(1);
+    Ok(start.elapsed().as_secs_f64() / taken as f64)
 }

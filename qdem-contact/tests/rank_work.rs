@@ -6,7 +6,9 @@
 //! item (tetrahedra, particles, contact spheres, candidate pairs), two ranks (threads of this
 //! process) cut the stones and their contacts between them, a re-partition in the middle of
 //! the run cuts the bodies' blocks anew by the lists then built, and the run keeps one
-//! process's bits (the motion, the touching contacts and the checkpoint).
+//! process's bits (the motion, the touching contacts and the checkpoint). Weighed by what the
+//! items were measured to cost (`WorkWeights`), every rank gets the same weights, the cut
+//! follows the weights it is given, and the run keeps one process's bits whatever the cut.
 
 mod common;
 
@@ -16,6 +18,7 @@ use qdem_contact::{
     WallShape,
 };
 use qdem_core::parallel::thread_ranks::on_thread_ranks;
+use qdem_core::parallel::WorkWeights;
 use qdem_core::{
     checkpoint::Encoder, continuum::Material, continuum::TetBody, loads::Gravity, step::Model,
     step::Scheme, step::State, step::StepRequest, step::StepSettings, world::World, Vec3,
@@ -223,4 +226,76 @@ fn two_ranks_cut_the_stones_and_their_contacts_by_their_work_and_keep_one_proces
         work.iter().all(|w| (w - mean).abs() <= 0.15 * mean),
         "work per rank {work:?}"
     );
+}
+
+/// The sleeper's model (the first) weighed eight times its fixed share: its tetrahedra then
+/// outweigh the stones with their contact spheres and candidates, which outweigh them at the
+/// fixed shares (rank 0 then computes the sleeper and some stones).
+const SLEEPER_WEIGHT: f64 = 8.0;
+
+#[test]
+fn weighed_by_measured_cost_every_rank_cuts_alike_and_keeps_one_processs_bits() {
+    let mut alone = world();
+    alone.initialize().unwrap();
+    for _ in 0..STEPS {
+        alone.step().unwrap();
+    }
+    let sleeper_tets = 1800;
+    let runs = on_thread_ranks(2, |comm| {
+        let mut world = world();
+        world.decompose(comm).unwrap();
+        world.initialize().unwrap();
+        let mut measured = None;
+        for step in 1..=STEPS {
+            world.step().unwrap();
+            if step == STEPS / 2 {
+                measured = world.measured_weights();
+                // Weights given, whatever was measured: the sleeper's tetrahedra eight times
+                // their share.
+                let mut weights = WorkWeights {
+                    models: vec![1.0; world.models.len()],
+                };
+                weights.models[0] = SLEEPER_WEIGHT;
+                world.repartition_weighted(weights);
+            }
+        }
+        let figures = world.decomposition().unwrap().clone();
+        let rank = world.rank();
+        world.gather();
+        (
+            measured.expect("a run decomposed with a halo measures"),
+            figures.tets[rank],
+            figures.work,
+            motion(&world.state),
+            checkpoint(&world),
+        )
+    });
+    let weights = &runs[0].0;
+    eprintln!("measured weights {weights:?}");
+    for (rank, (measured, tets, work, bits, saved)) in runs.iter().enumerate() {
+        // The weights are computed from every rank's gathered timings in rank order: the
+        // same bits on every rank, so every rank cuts alike.
+        let same = measured.models.iter().zip(&weights.models);
+        assert!(
+            measured.models.len() == 4 && same.clone().all(|(a, b)| a.to_bits() == b.to_bits()),
+            "rank {rank} measured {measured:?}, rank 0 {weights:?}"
+        );
+        assert!(
+            measured.models.iter().all(|w| (0.1..=10.0).contains(w)),
+            "rank {rank}: {measured:?}"
+        );
+        assert!(*bits == motion(&alone.state), "rank {rank}: motion");
+        assert!(*saved == checkpoint(&alone), "rank {rank}: checkpoint");
+        // The sleeper's tetrahedra at eight times their share outweigh the stones with their
+        // contacts: rank 0 computes part of the sleeper only, rank 1 the rest and every
+        // stone; the weighed work within 15% of the mean (blocks of up to 256 tets).
+        if rank == 0 {
+            assert!(*tets < sleeper_tets, "rank 0 computes {tets} tets");
+        }
+        let mean = work.iter().sum::<f64>() / 2.0;
+        assert!(
+            work.iter().all(|w| (w - mean).abs() <= 0.15 * mean),
+            "rank {rank}: work per rank {work:?}"
+        );
+    }
 }

@@ -28,7 +28,7 @@
 
 use crate::checkpoint::{model_tag, whole_block, CheckpointError, Decoder, Encoder};
 use crate::error::CoreError;
-use crate::parallel::{Communicator, ParallelRuntime, RankFigures};
+use crate::parallel::{Communicator, ParallelRuntime, RankFigures, WorkWeights};
 use crate::solvers::stepper_for::stepper_for;
 use crate::step::instability::{EnergyGrowth, GROWTH_PER_STEP, GROWTH_STEPS};
 use crate::step::model::{find_model, Model, Persistence};
@@ -250,6 +250,51 @@ impl World {
     /// How many times [`World::repartition`] has run.
     pub fn repartitions(&self) -> usize {
         self.parallel.repartitions()
+    }
+
+    /// The weight of each model's items in the cut, from what they were measured to cost
+    /// on the ranks over the steps taken ([`WorkWeights`]): per model its force stage's
+    /// seconds less those spent in collectives, against its work in the fixed shares, both
+    /// summed over the ranks, per particle step of the prediction and integration. A
+    /// collective, which every rank calls after the same step; the same weights on every
+    /// rank. `None` unless the run is decomposed with a halo exchange (the only one that
+    /// re-partitions). The work of a split model is its items' at its last evaluation,
+    /// taken for every step measured.
+    pub fn measured_weights(&mut self) -> Option<WorkWeights> {
+        let (work, exchanged, computed) = self.parallel.rank_work(&mut self.models)?;
+        let steps = self.stages.steps() as f64;
+        let mut mine = Vec::with_capacity(2 * work.len() + 2);
+        for (i, (w, waited)) in work.iter().zip(&exchanged).enumerate() {
+            mine.push((self.stages.seconds(Stage::Forces(i)) - waited).max(0.0));
+            mine.push(w * steps);
+        }
+        let particles = self.stages.seconds(Stage::Predict) + self.stages.seconds(Stage::Integrate);
+        mine.extend([particles, computed as f64 * steps]);
+        let all = self.parallel.gather_values(&mine);
+        Some(WorkWeights::from_measured(&all, work.len()))
+    }
+
+    /// Re-partitions ([`World::repartition`]) with each model's items weighed by `weights`
+    /// (the same on every rank: [`World::measured_weights`]'s), which the later
+    /// re-partitions keep: a collective, which every rank calls after the same step. The cut
+    /// is a function of the weights and the items alone, and the run goes on bit for bit as
+    /// before whatever the cut.
+    pub fn repartition_weighted(&mut self, weights: WorkWeights) {
+        self.parallel.set_weights(weights);
+        self.repartition();
+    }
+
+    /// The seconds model `model`'s evaluations on this rank have spent in collectives so far
+    /// (waiting for the other ranks included), which [`World::measured_weights`] leaves out of
+    /// its items' cost; 0 in a run of one process.
+    pub fn waited_seconds(&self, model: usize) -> f64 {
+        self.parallel.waited_seconds(model)
+    }
+
+    /// The weights of the models' items in the cut ([`World::repartition_weighted`]): all 1,
+    /// the fixed shares, until set; `None` in a run of one process.
+    pub fn work_weights(&self) -> Option<&WorkWeights> {
+        self.parallel.weights()
     }
 
     /// Makes the state whole on every rank of a decomposed run, as one process holds it (and

@@ -12,7 +12,9 @@
 //! tetrahedron `TET_WORK` (1.2) times its body's cost relative to an elastic one, a particle one,
 //! and what a split model's items add to the particles they sit on
 //! ([`crate::step::split::Balance::add_costs`]: DEM contacts, a contact sphere and its share of
-//! each candidate pair). A block weighs its tetrahedra and the particles it owns, so the
+//! each candidate pair), each model's shares times its weight ([`WorkWeights`]: 1, or what its
+//! items were measured to cost on the ranks, [`crate::world::World::measured_weights`]). A
+//! block weighs its tetrahedra and the particles it owns, so the
 //! contact spheres on a deformable body's vertices and their candidates count where they are
 //! computed: a bed of deformable stones beside a deformable sleeper is cut through the stones
 //! when the contacts make them the heavier part (where weighing the tetrahedra alone left
@@ -54,6 +56,7 @@
 use crate::error::CoreError;
 use crate::parallel::communicator::Communicator;
 use crate::parallel::state_share::{StateHalo, StateShare};
+use crate::parallel::work_weights::WorkWeights;
 use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
 use crate::step::split::{BodyLayout, BodySplit, Facets, Reads, SumExchange};
@@ -103,8 +106,9 @@ pub(crate) struct Decomposed {
     pub local: Option<LocalParticles>,
     /// Per model, its blocks for this rank if it is a deformable body.
     pub splits: Vec<Option<BodySplit>>,
-    /// This rank's tetrahedra's work ([`TET_WORK`] each, times its body's cost).
-    pub tet_work: f64,
+    /// Per model, this rank's tetrahedra's work in the fixed shares ([`TET_WORK`] each,
+    /// times its body's cost; not weighed).
+    pub tet_work: Vec<f64>,
 }
 
 impl SumExchange {
@@ -252,12 +256,12 @@ fn assign_blocks(bodies: &[Vec<f64>], ranks: usize) -> Vec<Vec<u32>> {
 }
 
 /// The work of each of a body's blocks, in block order: its tetrahedra ([`TET_WORK`] each,
-/// times the body's cost) and the `cost` of the particles it owns (those whose first entry
-/// is in it).
-fn block_work(layout: &BodyLayout<'_>, cost: &[f64]) -> Vec<f64> {
+/// times the body's cost and its `weight`) and the `cost` of the particles it owns (those
+/// whose first entry is in it).
+fn block_work(layout: &BodyLayout<'_>, weight: f64, cost: &[f64]) -> Vec<f64> {
     let mut work: Vec<f64> = block_tets(layout)
         .into_iter()
-        .map(|tets| TET_WORK * layout.tet_cost * tets as f64)
+        .map(|tets| weight * TET_WORK * layout.tet_cost * tets as f64)
         .collect();
     let block_of_slot = slot_blocks(layout.node_start);
     for (i, first) in layout.entry_start[..layout.entry_start.len() - 1]
@@ -271,16 +275,21 @@ fn block_work(layout: &BodyLayout<'_>, cost: &[f64]) -> Vec<f64> {
 }
 
 /// Each particle's work (see the module documentation): one for its step, plus what the
-/// split models and hooks (`split`: whether each is, models first) add for the items on it,
-/// from their whole records.
+/// split models and hooks (`split`: each with its weight, models first) add for the items on
+/// it, from their whole records, times their weight.
 pub(crate) fn particle_costs<'a>(
     len: usize,
-    split: impl Iterator<Item = &'a mut dyn Facets>,
+    split: impl Iterator<Item = (f64, &'a mut dyn Facets)>,
 ) -> Vec<f64> {
     let mut cost = vec![1.0; len];
-    for facets in split {
+    let mut items = vec![0.0; len];
+    for (weight, facets) in split {
         if let Some(balance) = facets.balance() {
-            balance.add_costs(&mut cost);
+            items.fill(0.0);
+            balance.add_costs(&mut items);
+            for (c, w) in cost.iter_mut().zip(&items) {
+                *c += weight * w;
+            }
         }
     }
     cost
@@ -308,7 +317,8 @@ fn block_tets(layout: &BodyLayout<'_>) -> Vec<usize> {
 }
 
 /// Decomposes `models`' deformable bodies over `comm`'s ranks by the work of their items
-/// (`cost`: per particle, [`particle_costs`]): per model, the blocks of a deformable body
+/// (`cost`: per particle, [`particle_costs`]; a body's tetrahedra times its model's weight in
+/// `weights`): per model, the blocks of a deformable body
 /// this rank computes and the particles it owns, and the exchange that ends each step, the
 /// decomposition's figures and, when every model reads only what a rank steps itself and
 /// `halo_allowed` (no hook reads more), the particles this rank steps, with the free
@@ -318,7 +328,7 @@ pub(crate) fn decompose(
     models: &mut [Box<dyn Model>],
     comm: Arc<dyn Communicator>,
     halo_allowed: bool,
-    cost: &[f64],
+    (cost, weights): (&[f64], &WorkWeights),
 ) -> Result<Decomposed, CoreError> {
     let ranks = comm.size();
     let halo = halo_allowed && models.iter_mut().all(|m| !matches!(m.reads(), Reads::All));
@@ -328,8 +338,9 @@ pub(crate) fn decompose(
     let cost = if halo { cost } else { &unit[..] };
     let bodies: Vec<Vec<f64>> = models
         .iter_mut()
-        .filter_map(|m| body_of(m.as_mut()))
-        .map(|layout| block_work(&layout, cost))
+        .enumerate()
+        .filter_map(|(i, m)| body_of(m.as_mut()).map(|layout| (weights.of(i), layout)))
+        .map(|(weight, layout)| block_work(&layout, weight, cost))
         .collect();
     let block_ranks = assign_blocks(&bodies, ranks);
     let mut figures = RankFigures {
@@ -343,10 +354,10 @@ pub(crate) fn decompose(
     };
     let mut owner = vec![u32::MAX; state.len()];
     let mut needs = Vec::new();
-    let mut tet_work = 0.0;
+    let mut tet_work = vec![0.0; models.len()];
     let mut splits = Vec::with_capacity(models.len());
     let mut blocks = bodies.iter().zip(block_ranks);
-    for model in models.iter_mut() {
+    for (m, model) in models.iter_mut().enumerate() {
         let Some(layout) = body_of(model.as_mut()) else {
             splits.push(None);
             continue;
@@ -356,7 +367,7 @@ pub(crate) fn decompose(
             figures.tets[r as usize] += tets;
             figures.work[r as usize] += w;
             if r as usize == comm.rank() {
-                tet_work += TET_WORK * layout.tet_cost * tets as f64;
+                tet_work[m] += TET_WORK * layout.tet_cost * tets as f64;
             }
         }
         figures.cut_bodies += usize::from(block_rank.iter().any(|&r| r != block_rank[0]));

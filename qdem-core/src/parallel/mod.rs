@@ -6,7 +6,8 @@
 //! - [`Communicator`]: the collectives a decomposed run needs (MPI in `qdem`, threads in
 //!   tests: `thread_ranks`, with the `thread-ranks` feature);
 //! - [`decomposition`]: who owns what (the deformable bodies' blocks, the free particles'
-//!   runs) and the figures of it per rank ([`RankFigures`]);
+//!   runs) and the figures of it per rank ([`RankFigures`]), weighing each model's items by
+//!   their fixed shares or by their measured cost ([`WorkWeights`]);
 //! - [`ParallelRuntime`]: what a step exchanges (the models' forces through their facets,
 //!   the state after each integration, the gathers, the failure agreement, the hooks'
 //!   decisions, the re-partitions), with the state share (`state_share.rs`), the particles a
@@ -22,7 +23,9 @@ mod runtime;
 mod state_share;
 #[cfg(feature = "thread-ranks")]
 pub mod thread_ranks;
+mod work_weights;
 
 pub use communicator::Communicator;
 pub use decomposition::RankFigures;
 pub use runtime::ParallelRuntime;
+pub use work_weights::WorkWeights;

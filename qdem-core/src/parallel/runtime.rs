@@ -12,6 +12,7 @@ use crate::parallel::communicator::{max_over_ranks, Communicator};
 use crate::parallel::decomposition::{decompose, particle_costs, Decomposed, RankFigures};
 use crate::parallel::ghosts::GhostTable;
 use crate::parallel::state_share::StateShare;
+use crate::parallel::work_weights::WorkWeights;
 use crate::step::local_particles::{LocalParticles, ParticleRuns};
 use crate::step::model::Model;
 use crate::step::post_step::{Halt, PostStep};
@@ -61,8 +62,14 @@ struct Ranks {
     /// The particles this rank steps, when a step shares only the halo (the only run that
     /// re-partitions).
     local: Option<LocalParticles>,
-    /// This rank's tetrahedra's work (units of one particle's step).
-    tet_work: f64,
+    /// Per model, this rank's tetrahedra's work in the fixed shares (units of one
+    /// particle's step).
+    tet_work: Vec<f64>,
+    /// The weight of each model's items in the cut (the fixed shares until measured).
+    weights: WorkWeights,
+    /// Per model, the seconds of its evaluations spent in collectives (waiting for the
+    /// other ranks included): not the work of its items.
+    exchanged: Vec<f64>,
     /// Per model: whether a deformable body (split by its blocks in any mode).
     bodies: Vec<bool>,
     /// Per model, its split state when this rank computes it in part.
@@ -133,14 +140,17 @@ impl ParallelRuntime {
         steps_in_part: bool,
     ) -> Result<(), CoreError> {
         let halo_allowed = hooks.iter_mut().all(|h| !matches!(h.reads(), Reads::All));
-        let cost = particle_costs(state.len(), split_models(models, hooks));
-        let decomposed = decompose(state, models, comm.clone(), halo_allowed, &cost)?;
+        let weights = WorkWeights::default();
+        let cost = particle_costs(state.len(), split_models(models, hooks, &weights));
+        let decomposed = decompose(state, models, comm.clone(), halo_allowed, (&cost, &weights))?;
         let mut ranks = Ranks {
             comm,
             share: decomposed.share,
             figures: decomposed.figures,
             local: decomposed.local,
             tet_work: decomposed.tet_work,
+            weights,
+            exchanged: vec![0.0; models.len()],
             bodies: decomposed.splits.iter().map(Option::is_some).collect(),
             models: (0..models.len()).map(|_| None).collect(),
             hooks: vec![false; hooks.len()],
@@ -217,6 +227,9 @@ impl ParallelRuntime {
         let Some(ranks) = &mut self.ranks else {
             return done;
         };
+        // The waits of the steps only, as the stage clock counts them (the initial
+        // evaluation's, with the first build of the lists, are not a step's).
+        ranks.exchanged.fill(0.0);
         ranks.share.share(state);
         ranks.share.gather(state, torques);
         match ranks.share.agree(done.err().map(|e| e.to_string())) {
@@ -291,10 +304,12 @@ impl ParallelRuntime {
         };
         let mut rebuilt = false;
         let computed = ranks.local.as_ref().map_or(0, |l| l.computed.len());
-        let mut work = ranks.tet_work + computed as f64;
-        for balance in balances(models, hooks, &ranks.models, &ranks.hooks) {
+        let weights = &ranks.weights;
+        let tets = ranks.tet_work.iter().enumerate();
+        let mut work = computed as f64 + tets.map(|(m, w)| weights.of(m) * w).sum::<f64>();
+        for (weight, balance) in balances(models, hooks, &ranks.models, &ranks.hooks, weights) {
             rebuilt |= balance.rebuilt();
-            work += balance.work();
+            work += weight * balance.work();
         }
         if !rebuilt {
             return;
@@ -311,6 +326,48 @@ impl ParallelRuntime {
         }
     }
 
+    /// On a rank of a run decomposed with a halo exchange: per model, the work this rank
+    /// was given in the fixed shares (its tetrahedra; a split model's items at its last
+    /// evaluation, [`Balance::work`]) and the seconds its evaluations spent in collectives,
+    /// and the particles it integrates (its own and those every rank computes); `None`
+    /// otherwise.
+    pub(crate) fn rank_work(
+        &mut self,
+        models: &mut [Box<dyn Model>],
+    ) -> Option<(Vec<f64>, Vec<f64>, usize)> {
+        let ranks = self.halo_ranks()?;
+        let mut work = ranks.tet_work.clone();
+        for (i, model) in models.iter_mut().enumerate() {
+            let balance = split_facets(model.as_mut()).and_then(|f| f.balance());
+            if let Some(balance) = balance.filter(|_| ranks.models[i].is_some()) {
+                work[i] += balance.work();
+            }
+        }
+        let computed = ranks.local.as_ref().map_or(0, |l| l.computed.len());
+        Some((work, ranks.exchanged.clone(), computed))
+    }
+
+    /// Weighs each model's items by `weights` in the re-partitions from now on (a no-op in
+    /// a run of one process).
+    pub(crate) fn set_weights(&mut self, weights: WorkWeights) {
+        if let Some(ranks) = &mut self.ranks {
+            ranks.weights = weights;
+        }
+    }
+
+    /// The seconds model `model`'s evaluations spent in collectives on this rank (see
+    /// [`crate::world::World::waited_seconds`]).
+    pub(crate) fn waited_seconds(&self, model: usize) -> f64 {
+        let waited = self.ranks.as_ref().and_then(|r| r.exchanged.get(model));
+        waited.copied().unwrap_or(0.0)
+    }
+
+    /// The weights of the models' items in the cut: their fixed shares (all 1) until set;
+    /// `None` in a run of one process.
+    pub(crate) fn weights(&self) -> Option<&WorkWeights> {
+        self.ranks.as_ref().map(|r| &r.weights)
+    }
+
     /// Decomposes the run again by the work of its items now (see
     /// [`crate::world::World::repartition`]); a no-op unless the run shares only the halo.
     pub(crate) fn repartition(
@@ -324,8 +381,9 @@ impl ParallelRuntime {
             return;
         };
         ranks.gather(state, models, torques);
-        let cost = particle_costs(state.len(), split_models(models, hooks));
-        let decomposed = decompose(state, models, ranks.comm.clone(), true, &cost)
+        let weights = &ranks.weights;
+        let cost = particle_costs(state.len(), split_models(models, hooks, weights));
+        let decomposed = decompose(state, models, ranks.comm.clone(), true, (&cost, weights))
             .expect("the bodies decomposed once decompose again");
         let Decomposed {
             share,
@@ -448,18 +506,17 @@ impl Ranks {
     ) {
         let comm = self.comm.as_ref();
         let ghosts = self.models[i].as_mut().expect("a split model");
+        let mut waited = 0.0;
         let rebuild = facets.lists().is_some_and(|lists| {
-            let moved = max_over_ranks(comm, lists.moved(state));
+            let moved = timed(&mut waited, || max_over_ranks(comm, lists.moved(state)));
             lists.needs_rebuild(moved, state.time)
         });
         if rebuild {
             let table = ghosts
                 .as_mut()
                 .expect("a split model with lists has a ghost table");
-            table.borders(
-                comm,
-                facets.halo().expect("a split model with lists has a halo"),
-            );
+            let halo = facets.halo().expect("a split model with lists has a halo");
+            timed(&mut waited, || table.borders(comm, halo));
             facets.lists().expect("checked above").rebuild(state.time);
         }
         if let Some(halo) = facets.halo() {
@@ -467,21 +524,23 @@ impl Ranks {
                 .as_mut()
                 .expect("a split model with a halo has a ghost table");
             if let Some(wanted) = halo.new_ghosts() {
-                table.set_ghosts(comm, &wanted);
+                timed(&mut waited, || table.set_ghosts(comm, &wanted));
             }
             halo.read_partners(state);
-            table.forward(comm, halo);
+            timed(&mut waited, || table.forward(comm, halo));
         }
         if let Some(averaging) = facets.averaging() {
             averaging.partial(state);
             if let Some(sums) = averaging.partial_sums() {
-                sums.plan.run(comm, sums.sums);
+                timed(&mut waited, || sums.plan.run(comm, sums.sums));
             }
             averaging.average();
             if let Some(nodal) = averaging.averages() {
-                nodal
-                    .plan
-                    .run_forward(comm, nodal.nodes, nodal.first, nodal.values);
+                timed(&mut waited, || {
+                    nodal
+                        .plan
+                        .run_forward(comm, nodal.nodes, nodal.first, nodal.values)
+                });
             }
         }
         let evaluation = facets.evaluation().expect("a split model evaluates");
@@ -489,15 +548,17 @@ impl Ranks {
         if let Some(reduction) = facets.reduction() {
             self.mine.clear();
             if reduction.mine(&mut self.mine) {
-                comm.all_gather_varying(&self.mine, &mut self.all);
+                let (mine, all) = (&self.mine, &mut self.all);
+                timed(&mut waited, || comm.all_gather_varying(mine, all));
                 reduction.reduced(state.time, &self.all);
             }
         }
         if let Some(sums) = facets.reverse_sums() {
-            sums.plan.run(comm, sums.sums);
+            timed(&mut waited, || sums.plan.run(comm, sums.sums));
         }
         let evaluation = facets.evaluation().expect("a split model evaluates");
         evaluation.apply(force, torque);
+        self.exchanged[i] += waited;
     }
 
     /// Splits the models and hooks that a rank computes in part by the share's owners (the
@@ -592,38 +653,55 @@ fn split_facets(model: &mut dyn Model) -> Option<&mut dyn Facets> {
     }
 }
 
-/// The balance facets of the models and hooks that are split, models first.
+/// Runs `f`, adding its wall seconds to `waited`.
+fn timed<R>(waited: &mut f64, f: impl FnOnce() -> R) -> R {
+    let start = std::time::Instant::now();
+    let result = f();
+    *waited += start.elapsed().as_secs_f64();
+    result
+}
+
+/// The balance facets of the models and hooks that are split, models first, each with its
+/// weight in `weights` (a hook's: 1).
 fn balances<'a>(
     models: &'a mut [Box<dyn Model>],
     hooks: &'a mut [Box<dyn PostStep>],
     split_models: &'a [Option<Ghosts>],
     split_hooks: &'a [bool],
-) -> impl Iterator<Item = &'a mut dyn Balance> {
+    weights: &'a WorkWeights,
+) -> impl Iterator<Item = (f64, &'a mut dyn Balance)> {
     let models = models
         .iter_mut()
         .zip(split_models)
-        .filter(|(_, s)| s.is_some())
-        .filter_map(|(m, _)| split_facets(m.as_mut()));
+        .enumerate()
+        .filter(|(_, (_, s))| s.is_some())
+        .filter_map(|(i, (m, _))| split_facets(m.as_mut()).map(|f| (weights.of(i), f)));
     let hooks = hooks
         .iter_mut()
         .zip(split_hooks)
         .filter(|(_, &s)| s)
         .filter_map(|(h, _)| match h.reads() {
-            Reads::Split(facets) => Some(facets),
+            Reads::Split(facets) => Some((1.0, facets)),
             _ => None,
         });
-    models.chain(hooks).filter_map(|facets| facets.balance())
+    models
+        .chain(hooks)
+        .filter_map(|(w, facets)| facets.balance().map(|b| (w, b)))
 }
 
 /// The facets of every split model and hook, models first, whether or not this rank computes
-/// it in part yet.
+/// it in part yet, each with its weight in `weights` (a hook's: 1).
 fn split_models<'a>(
     models: &'a mut [Box<dyn Model>],
     hooks: &'a mut [Box<dyn PostStep>],
-) -> impl Iterator<Item = &'a mut dyn Facets> {
-    let models = models.iter_mut().filter_map(|m| split_facets(m.as_mut()));
+    weights: &'a WorkWeights,
+) -> impl Iterator<Item = (f64, &'a mut dyn Facets)> {
+    let models = models
+        .iter_mut()
+        .enumerate()
+        .filter_map(|(i, m)| split_facets(m.as_mut()).map(|f| (weights.of(i), f)));
     let hooks = hooks.iter_mut().filter_map(|h| match h.reads() {
-        Reads::Split(facets) => Some(facets),
+        Reads::Split(facets) => Some((1.0, facets)),
         _ => None,
     });
     models.chain(hooks)

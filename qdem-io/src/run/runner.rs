@@ -162,6 +162,12 @@ pub struct RunReport {
 /// cantilever job, probing every 26 steps, a copy at every probe sample cost 16% of the run).
 const GOOD_STATE_EVERY: f64 = 1.0;
 
+/// The steps after which a run decomposed over ranks cuts them again with each model's items
+/// weighed by what they were measured to cost over those steps
+/// ([`World::measured_weights`]): once, so that a long run pays for one gather, and late
+/// enough that the contact lists have been built on every rank.
+const MEASURED_STEPS: u64 = 20;
+
 /// How a run starts and when it stops early.
 #[derive(Clone, Copy, Default)]
 pub struct RunOptions<'a> {
@@ -261,6 +267,7 @@ pub fn run_with(
                 let begin = Instant::now();
                 halt = sim.world.step().map_err(|source| core_error(sim, source))?;
                 seconds = Some(begin.elapsed().as_secs_f64());
+                weigh_measured_cost(&mut sim.world, step - first_step);
                 if let Some(watch) = &watch {
                     watch
                         .check(sim, step)
@@ -477,6 +484,18 @@ impl Run {
     }
 }
 
+/// After the [`MEASURED_STEPS`]th step this process took (`taken`), a run decomposed with a
+/// halo exchange cuts its ranks again by the measured cost of each model's items (a
+/// collective, at the same step on every rank; the outputs do not depend on the cut).
+fn weigh_measured_cost(world: &mut World, taken: u64) {
+    if taken != MEASURED_STEPS {
+        return;
+    }
+    if let Some(weights) = world.measured_weights() {
+        world.repartition_weighted(weights);
+    }
+}
+
 /// A rank other than 0 of a decomposed run: the same steps, the same stop agreements, no
 /// outputs (rank 0 writes them from the same state).
 fn follow(sim: &mut Simulation, options: RunOptions<'_>) -> Result<RunReport, RunError> {
@@ -499,6 +518,7 @@ fn follow(sim: &mut Simulation, options: RunOptions<'_>) -> Result<RunReport, Ru
     for step in first_step..=steps {
         if step > 0 {
             halt = sim.world.step().map_err(|source| core_error(sim, source))?;
+            weigh_measured_cost(&mut sim.world, step - first_step);
         }
         stopped = options.stops_after(&mut sim.world, step, StateRead::Nothing, &probes);
         if stopped || halt.is_some() {

@@ -382,6 +382,71 @@ impl DemContacts {
         })
     }
 
+    /// Builds the candidate lists at `state`'s positions when they are not current (a
+    /// `[run] start_from` stage's hold the checkpoint's springs until the first evaluation
+    /// rebuilds them), keeping the springs of the contacts they list, as that rebuild does:
+    /// then [`DemContacts::touching_at`] counts, and [`Model::unstable_above`] reads, the
+    /// contacts of the state a run starts from. A no-op on a rank of a decomposed run (its
+    /// lists are its part's).
+    ///
+    /// ```
+    /// use qdem_contact::{ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring};
+    /// use qdem_core::{step::State, Vec3};
+    ///
+    /// // Two spheres of 1 cm overlapping by 1 mm: one contact before any step.
+    /// let mut state = State::at_rest(vec![Vec3::zeros(), Vec3::new(0.019, 0.0, 0.0)]);
+    /// state.mass = vec![0.01, 0.01];
+    /// let spheres: Vec<ContactSphere> = (0..2)
+    ///     .map(|i| ContactSphere { particle: i, radius: 0.01, body: i, material: 0 })
+    ///     .collect();
+    /// let settings = ContactSettings {
+    ///     law: ContactLaw::Linear(LinearSpring {
+    ///         normal_stiffness: 1e5,
+    ///         tangential_stiffness: 1e5,
+    ///         damping_ratio: 0.0,
+    ///     }),
+    ///     friction: 0.5,
+    ///     skin: 0.001,
+    /// };
+    /// let names = vec!["a".to_string(), "b".to_string()];
+    /// let mut contacts = DemContacts::new(&state, &spheres, names, &[(1e9, 0.25)], settings, vec![]);
+    /// assert_eq!(contacts.touching_at(state.time), 0);
+    /// contacts.build_lists(&state);
+    /// assert_eq!(contacts.touching_at(state.time), 1);
+    /// ```
+    pub fn build_lists(&mut self, state: &State) {
+        if self.lists_built() || self.split.is_some() {
+            return;
+        }
+        self.read_centers(state);
+        self.rebuild_all(state.time);
+    }
+
+    /// The contacts of the lists (a rank's, in a decomposed run) touching at the centres of
+    /// their last build or evaluation, walls at `time`: those [`Model::stable_dt`] and
+    /// [`Model::unstable_above`] take at that state; none before the lists are built
+    /// ([`DemContacts::build_lists`]).
+    pub fn touching_at(&self, time: f64) -> usize {
+        if !self.lists_built() {
+            return 0;
+        }
+        let pairs = self.candidates.pairs().items.iter().filter(|c| {
+            let (a, b) = (c.first as usize, c.second as usize);
+            let reach = self.spheres.radius()[a] + self.spheres.radius()[b];
+            self.separation(a, b).0.norm() < reach
+        });
+        let walls = self.candidates.wall_contacts().items.iter().filter(|c| {
+            let (s, w) = (c.first as usize, c.second as usize);
+            let r = self.spheres.radius()[s];
+            self.walls
+                .get(w)
+                .overlap(&self.spheres.center()[s], r, time)
+                .0
+                > 0.0
+        });
+        pairs.count() + walls.count()
+    }
+
     /// The exact mobility (C_n, C_t) of sphere `s`'s contact point along directions it
     /// surely has: translation, and a sphere's turn about its own centre.
     fn lower_mobility(&self, s: usize) -> (f64, f64) {
