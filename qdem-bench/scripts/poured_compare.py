@@ -505,7 +505,7 @@ def part_second(args, n, d, side, qdem, rows) -> None:
                          q["wall_s"] / q["steps"] / q["dt"],
                      "contacts": q["contacts"], "kinetic_energy": q["kinetic_energy"]})
         for r in [r for r in rows if r["part"] == "pour" and r["spheres"] == n
-                  and r["width"] == width and r["code"] != "qdem"]:
+                  and r["width"] == width and not r["code"].startswith("qdem")]:
             rows.append({"part": "second", "code": r["code"], "spheres": n, "width": width,
                          "steps": r["steps"], "dt": r["dt"], "wall_s": r["wall_s"],
                          "seconds_per_simulated_second": r["wall_s"] / r["steps"] / r["dt"],
