@@ -93,6 +93,20 @@ fn packing(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
     }
 }
 
+/// Prints a subcommand's JSON record, or its error on stderr with a failing exit code.
+fn print_record(record: Result<String, String>) -> ExitCode {
+    match record {
+        Ok(json) => {
+            println!("{json}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 fn dem_throughput(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
     let run = || -> Result<String, String> {
         let steps: usize = number(option, "--steps", None)?;
@@ -106,16 +120,7 @@ fn dem_throughput(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
         let record = record.map_err(|e| e.to_string())?;
         Ok(record.to_string())
     };
-    match run() {
-        Ok(json) => {
-            println!("{json}");
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    print_record(run())
 }
 
 fn kernel_steps(option: &dyn Fn(&str) -> Option<String>, viscous: bool) -> ExitCode {
@@ -138,16 +143,7 @@ fn kernel_steps(option: &dyn Fn(&str) -> Option<String>, viscous: bool) -> ExitC
         });
         Ok(record.to_string())
     };
-    match run() {
-        Ok(json) => {
-            println!("{json}");
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    print_record(run())
 }
 
 /// The families to run: `--all`, `--families a,b`, or the cantilever alone.
