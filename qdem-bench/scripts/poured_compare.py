@@ -420,35 +420,48 @@ def part_pour(args, n, d, side, pts, qdem, peers, rows) -> None:
         if not (d / peer / "settled.restart").exists():
             peer_pour(peer, exe, d, side, pts, args.settle, max(args.np))
     for width in args.np:
-        runs: dict[str, list] = {}
-        for _ in range(args.repeats):
+        qdem_runs = [(code, lambda team=team: qdem_window(
+            qdem, d, side, args.steps, width, common_dt(), "qdem_settled" + "_team" * team,
+            sample="insert.csv", start_from="qdem_pour/checkpoint.qdc", team=team))
+            for code, team in team_codes(args)]
+        peer_runs = [(peer, lambda peer=peer, exe=exe: peer_window(
+            peer, exe, d, side, pts, args.steps, width)) for peer, exe in peers.items()]
+        runs = timed_windows(args, qdem_runs + peer_runs, f"n={n} width={width}")
+        rows += window_rows("pour", n, args.steps, width, runs)
+
+
+def team_codes(args) -> list[tuple[str, bool]]:
+    """qdem's codes and whether each runs on the team: `qdem`, and `qdem_team` with --team."""
+    return [("qdem", False), ("qdem_team", True)][:1 + args.team]
+
+
+def timed_windows(args, windows, label: str) -> dict[str, list]:
+    """Runs `--repeats` rounds of the (code, run) windows in turn, each after the machine is
+    idle if `--wait-idle`; per code its results with the cores other processes kept busy."""
+    runs: dict[str, list] = {}
+    for _ in range(args.repeats):
+        for code, run in windows:
             if args.wait_idle:
                 lc.wait_idle(args.wait_idle)
-            for code, team in [("qdem", False), ("qdem_team", True)][:1 + args.team]:
-                if args.wait_idle:
-                    lc.wait_idle(args.wait_idle)
-                with lc.OtherLoad() as ol:
-                    q = qdem_window(qdem, d, side, args.steps, width, common_dt(),
-                                    "qdem_settled" + "_team" * team, sample="insert.csv",
-                                    start_from="qdem_pour/checkpoint.qdc", team=team)
-                runs.setdefault(code, []).append((q, ol.cores))
-                log(f"{code} n={n} width={width}: {q['wall_s']:.3f} s")
-            for peer, exe in peers.items():
-                if args.wait_idle:
-                    lc.wait_idle(args.wait_idle)
-                with lc.OtherLoad() as ol:
-                    p = peer_window(peer, exe, d, side, pts, args.steps, width)
-                runs.setdefault(peer, []).append((p, ol.cores))
-                log(f"{peer} n={n} width={width}: {p['wall_s']:.3f} s")
-        for code, rs in runs.items():
-            r, other = min(rs, key=lambda t: t[0]["wall_s"])
-            rows.append({"part": "pour", "code": code, "spheres": n, "width": width,
-                         "steps": args.steps, "dt": common_dt(), "wall_s": r["wall_s"],
-                         "particle_steps_per_s": n * args.steps / r["wall_s"],
-                         "contacts": r.get("contacts"), "kinetic_energy": r.get("kinetic_energy"),
-                         "all_wall_s": [t[0]["wall_s"] for t in rs],
-                         "other_cores_during": [round(t[1], 2) for t in rs]})
+            with lc.OtherLoad() as ol:
+                r = run()
+            runs.setdefault(code, []).append((r, ol.cores))
+            log(f"{code} {label}: {r['wall_s']:.3f} s")
+    return runs
 
+
+def window_rows(part: str, n: int, steps: int, width: int, runs: dict[str, list]) -> list[dict]:
+    """One row per code of `timed_windows`' runs: the fastest, with every run's wall time."""
+    rows = []
+    for code, rs in runs.items():
+        r, _ = min(rs, key=lambda t: t[0]["wall_s"])
+        rows.append({"part": part, "code": code, "spheres": n, "width": width,
+                     "steps": steps, "dt": common_dt(), "wall_s": r["wall_s"],
+                     "particle_steps_per_s": n * steps / r["wall_s"],
+                     "contacts": r.get("contacts"), "kinetic_energy": r.get("kinetic_energy"),
+                     "all_wall_s": [t[0]["wall_s"] for t in rs],
+                     "other_cores_during": [round(t[1], 2) for t in rs]})
+    return rows
 
 def orders(rows_in, side: float, seed: int = 7) -> dict[str, list]:
     """The three orders of the settled bed's rows."""
@@ -543,37 +556,22 @@ def part_tiled(args, n, d, side, qdem, peers, rows) -> None:
         (td / peer).mkdir(exist_ok=True)
         write_data(td / peer / "tiled.data", big, pts, f"{peer} tiled bed, poured_compare.py")
     log(f"tiled: {len(pts)} spheres ({k} x {k} copies of {n}), cell {big:.4f} m")
+    for peer in peers:
+        (td / peer / "tiled.in.template").write_text(window_deck(peer))
+    # the bed is as high as the copied one (`side`): its height sets LAMMPS's damping
+    subs = {peer: dict(peer_subs(peer, peer_meta(big, pts), side, common_dt()),
+                       DATA="tiled.data", STEPS=args.steps, THERMO=max(1000, args.steps // 4))
+            for peer in peers}
     for width in args.np:
-        runs: dict[str, list] = {}
-        for _ in range(args.repeats):
-            if args.wait_idle:
-                lc.wait_idle(args.wait_idle)
-            for code, team in [("qdem", False), ("qdem_team", True)][:1 + args.team]:
-                q = qdem_window(qdem, td, big, args.steps, width, common_dt(),
-                                "qdem_tiled" + "_team" * team, sample="tiled.csv", team=team)
-                runs.setdefault(code, []).append(q)
-                log(f"{code} tiled n={len(pts)} width={width}: {q['wall_s']:.3f} s")
-            for peer, exe in peers.items():
-                if args.wait_idle:
-                    lc.wait_idle(args.wait_idle)
-                meta = peer_meta(big, pts)
-                # the bed is as high as the copied one: its height sets LAMMPS's damping
-                subs = dict(peer_subs(peer, meta, side, common_dt()), DATA="tiled.data",
-                            STEPS=args.steps, THERMO=max(1000, args.steps // 4))
-                deck = td / peer / "in.tiled"
-                template = td / peer / "tiled.in.template"
-                template.write_text(window_deck(peer))
-                p = run_deck(exe, pc_launcher(width), fill(template, subs, deck), len(pts))
-                runs.setdefault(peer, []).append(p)
-                log(f"{peer} tiled n={len(pts)} width={width}: {p['wall_s']:.3f} s")
-        for code, rs in runs.items():
-            r = min(rs, key=lambda t: t["wall_s"])
-            rows.append({"part": "tiled", "code": code, "spheres": len(pts), "width": width,
-                         "steps": args.steps, "dt": common_dt(), "wall_s": r["wall_s"],
-                         "particle_steps_per_s": len(pts) * args.steps / r["wall_s"],
-                         "contacts": r.get("contacts"), "kinetic_energy": r.get("kinetic_energy"),
-                         "all_wall_s": [t["wall_s"] for t in rs]})
-
+        qdem_runs = [(code, lambda team=team: qdem_window(
+            qdem, td, big, args.steps, width, common_dt(), "qdem_tiled" + "_team" * team,
+            sample="tiled.csv", team=team)) for code, team in team_codes(args)]
+        peer_runs = [(peer, lambda peer=peer, exe=exe: run_deck(
+            exe, pc_launcher(width),
+            fill(td / peer / "tiled.in.template", subs[peer], td / peer / "in.tiled"), len(pts)))
+            for peer, exe in peers.items()]
+        runs = timed_windows(args, qdem_runs + peer_runs, f"tiled n={len(pts)} width={width}")
+        rows += window_rows("tiled", len(pts), args.steps, width, runs)
 
 CLUMP_RADIUS = 0.004    # the clumps' spheres (m)
 
