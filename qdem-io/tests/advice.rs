@@ -5,7 +5,8 @@
 //! at half its first mode (explicit); a light grain bed on stiff springs (softer) and a heavy
 //! body on soft ones (stiffer); a `[ballast]` stone set on soft contacts (rigid) and on Table
 //! 1's (deformable); a `[granular]` bed on soft springs (rigid) and on stiff ones
-//! (deformable).
+//! (deformable); a slender `[bonded]` beam under a slow load (implicit) and a stubby bonded
+//! block (explicit).
 
 mod common;
 
@@ -487,4 +488,90 @@ fn a_body_advised_rigid_is_told_the_step_of_the_scene_with_it_rigid() {
     let step = sim.world.settings().stable_dt.0;
     assert_eq!(a.figure("rigid_dt"), Some(step), "{a:#?}");
     assert!(step > a.figure("deformable_dt").unwrap(), "{a:#?}");
+}
+
+/// A concrete `[bonded]` beam (paper 001's material) of `size` at spacing `h`, simply
+/// supported, its top load ramped on over `ramp` seconds, run explicitly at 0.2 ∆t_crit.
+fn bonded_beam(size: [f64; 2], h: f64, ramp: f64) -> String {
+    format!(
+        r#"
+[run]
+t_end = 0.5
+integrator = "newmark"
+beta = 0.0
+gamma = 0.5
+[[material]]
+name = "concrete"
+density = 2400.0
+young = 30e9
+poisson = 0.25
+[bonded]
+name = "beam"
+material = "concrete"
+size = [{}, {}]
+element_size = {h}
+strength_mean = 6e6
+damping_ratio = 0.05
+critical_fraction = 0.2
+supports = "simple"
+top_load = 1e4
+load_ramp = {ramp}
+"#,
+        size[0], size[1]
+    )
+}
+
+/// How far the lattice's first frequency may lie from Timoshenko's beam's: f ∝ √E, the
+/// lattice's E is within 1.7% of the continuum's (docs/bbm.md), and its rows of particles give
+/// the depth and the span to a fraction of a spacing (1.3% measured at 0.02 m).
+const TOL_F1: f64 = 0.03;
+
+/// A slender bonded beam (1 m × 0.1 m) under a load ramped over 0.5 s: its first mode is
+/// Timoshenko's simply supported one, and implicit Newmark at the step that keeps its period
+/// within 0.1% takes far fewer steps than the explicit run: implicit, with that step.
+#[test]
+fn a_slender_bonded_beam_under_a_slow_load_is_advised_implicit_at_its_first_modes_step() {
+    let all = advice_of("bonded-slender", &bonded_beam([1.0, 0.1], 0.02, 0.5));
+    let a = on(&all, "bonded body `beam`", Topic::Integrator);
+    assert_eq!(
+        (a.now.as_str(), a.advised.as_str()),
+        ("explicit", "implicit"),
+        "{a:#?}"
+    );
+    let f1 = a.figure("lowest_frequency_hz").unwrap();
+    // Euler–Bernoulli ω = (π/L)² √(E h²/12ρ) = 1007 rad/s (160.3 Hz); Timoshenko's shear
+    // (κ = 5/6, E/κG = 3) lowers it by 1/√(1 + (πh/L)²(1 + 3)/12) to 157.7 Hz.
+    let euler = PI * (30e9 * 0.1f64.powi(2) / (12.0 * 2400.0)).sqrt() / 2.0;
+    let timoshenko = euler / (1.0 + (PI * 0.1f64).powi(2) * 4.0 / 12.0).sqrt();
+    assert!(
+        (f1 / timoshenko - 1.0).abs() < TOL_F1,
+        "{f1} against {timoshenko}"
+    );
+    let dt = a.figure("advised_dt").unwrap();
+    assert!(
+        (dt * 2.0 * PI * f1 - 0.012f64.sqrt()).abs() < 1e-12,
+        "{a:#?}"
+    );
+    assert!(a.figure("predicted_speed_up").unwrap() > 1.0, "{a:#?}");
+    // A load ramped over 0.5 s rings the 158 Hz mode by 1/(π f₁ 0.5 s).
+    let d = a.figure("dynamic_share").unwrap();
+    assert!((d - 1.0 / (PI * f1 * 0.5)).abs() < 1e-12, "{d}");
+}
+
+/// A stubby bonded block (0.2 m square at 0.05 m spacing, a few particles a side): its first
+/// mode is near the lattice's highest, so the step that keeps that mode accurate is hardly
+/// longer than the explicit one, and an implicit step costs several explicit ones: explicit.
+#[test]
+fn a_stubby_bonded_block_is_advised_explicit() {
+    let all = advice_of("bonded-stubby", &bonded_beam([0.2, 0.2], 0.05, 0.0));
+    let a = on(&all, "bonded body `beam`", Topic::Integrator);
+    assert_eq!(
+        (a.now.as_str(), a.advised.as_str()),
+        ("explicit", "explicit"),
+        "{a:#?}"
+    );
+    let ratio = a.figure("advised_dt").unwrap() / a.figure("explicit_dt").unwrap();
+    assert!(ratio < qdem_io::advice::IMPLICIT_BBM_STEP_COST, "{a:#?}");
+    // Applied at once, the load rings the mode by its whole static deflection.
+    assert_eq!(a.figure("dynamic_share"), Some(1.0), "{a:#?}");
 }

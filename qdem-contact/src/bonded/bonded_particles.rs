@@ -749,6 +749,12 @@ impl Model for BondedParticles {
 }
 
 impl Linearized for BondedParticles {
+    /// Every particle of the body: the modal analysis takes their DOFs as the body's, and a
+    /// singular implicit system names the body.
+    fn particles(&self) -> Vec<usize> {
+        (0..self.radius.len()).collect()
+    }
+
     fn add_tangent(&self, state: &State, tangent: &mut Tangent) {
         let n = state.len();
         if self.bond_tangent.nodes() == n {

@@ -13,7 +13,7 @@
 //!
 //! A stone of a `[ballast]` or `[granular]` set ([`of_stone`]) is excited by every load of the
 //! scene, which reaches it through the bed, and by its contacts, which strike it however it
-//! starts.
+//! starts. A `[bonded]` body by its top load's ramp ([`of_ramp`]).
 //!
 //! The body's Kelvin–Voigt damping ratio ζ at f₁ lowers these: the cyclic share becomes
 //! w |1/√((1 − r²)² + (2ζr)²) − 1|, and the transient ones are scaled by the step response's
@@ -69,6 +69,19 @@ pub(super) fn of_stone(
     let mut worst = loads(scene, None, (f1, zeta));
     worst.consider(impact(scene, material, (mass, radius), speed, (f1, zeta)));
     worst
+}
+
+/// The excitation of a `[bonded]` body's first mode at `f1` Hz (damping ratio `zeta`) by its
+/// top load rising linearly over `rise` seconds (at once where zero), then held.
+pub(super) fn of_ramp(rise: f64, (f1, zeta): (f64, f64)) -> Excitation {
+    let (share, _) = segments(&[(0.0, 0.0), (rise, 1.0)], f1);
+    Excitation {
+        dynamic_share: overshoot(zeta) * share,
+        source: match rise > 0.0 {
+            true => format!("its top load, ramped on over {rise:.4e} s,"),
+            false => "its top load, applied at once,".to_string(),
+        },
+    }
 }
 
 impl Excitation {

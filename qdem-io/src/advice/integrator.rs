@@ -14,7 +14,8 @@
 //!   advised where its steps are fewer than the explicit ones by more than an implicit step
 //!   costs ([`IMPLICIT_STEP_COST`]).
 //!
-//! A scene with contacts or a bonded body stays explicit: the implicit steppers take neither.
+//! A scene with contacts stays explicit: the implicit steppers do not take them. A `[bonded]`
+//! body's integrator is advised by [`super::bonded_integrator`].
 
 use super::body_modes::BodyModes;
 use super::{excitation, Advice, Topic, NEGLIGIBLE_DYNAMICS};
@@ -32,7 +33,7 @@ const PERIOD_ERROR: f64 = 1e-3;
 const RESOLUTION: f64 = 20.0;
 
 /// The advice for `sim`'s run, given the deformable bodies' modes alone (`lowest`); none for
-/// a scene with contacts, a bonded body or no deformable `[[body]]`.
+/// a scene with contacts, a bonded body (advised apart) or no deformable `[[body]]`.
 pub(super) fn advise(sim: &Simulation, lowest: &[(String, BodyModes)]) -> Option<Advice> {
     let scene = &sim.scene;
     if sim.contacts().is_some() || scene.bonded.is_some() || scene.granular.is_some() {

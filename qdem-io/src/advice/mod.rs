@@ -8,15 +8,18 @@
 //! natural modes with their fixes ([`body_modes`], Lanczos as `qdem modes`), the loads' time
 //! functions and the impacts' contact times ([`excitation`]), and measured costs cited where
 //! they are used. One file per kind of advice: [`rigidity`], [`stones`], [`formulation`],
-//! [`integrator`], [`contact_stiffness`].
+//! [`integrator`] (a `[bonded]` body's: [`bonded_integrator`]), [`contact_stiffness`].
 
 mod body_modes;
+mod bonded_integrator;
 mod contact_stiffness;
 mod excitation;
 mod formulation;
 mod integrator;
 mod rigidity;
 mod stones;
+
+pub use bonded_integrator::{EXPLICIT_FRACTION, IMPLICIT_BBM_STEP_COST};
 
 use crate::build::{BodyKind, Simulation};
 use crate::scene::Scene;
@@ -94,7 +97,8 @@ impl Advice {
 }
 
 /// Every piece of advice for `sim`'s scene, in the order: each `[[body]]` (rigidity, then
-/// formulation), the stone sets (`[ballast]`, `[granular]`), the integrator, the contacts.
+/// formulation), the stone sets (`[ballast]`, `[granular]`), the integrator (of the
+/// `[[body]]`s, or of a `[bonded]` body), the contacts.
 ///
 /// ```
 /// # let dir = std::env::temp_dir().join(format!("qdem-advice-doc-{}", std::process::id()));
@@ -149,6 +153,7 @@ pub fn advise(sim: &Simulation) -> Vec<Advice> {
     }
     advice.extend(stones::advise(sim));
     advice.extend(integrator::advise(sim, &lowest));
+    advice.extend(bonded_integrator::advise(sim));
     advice.extend(contact_stiffness::advise(sim));
     advice
 }
