@@ -6,8 +6,6 @@
 //! `speed-vs-error.md` has two SVG plots.
 
 use super::cpu::timed;
-use super::page::write_page;
-use super::Family;
 use crate::cantilever::{
     cantilever, cantilever_scene, newmark_variant, StudyError, CALCULIX_F1_HZ, CALCULIX_TIP_UZ_UM,
     EQ12_TIP_UZ_UM, EQ13_F1_HZ,
@@ -84,37 +82,6 @@ fn row(
 
 fn error(value: f64, reference: f64) -> f64 {
     100.0 * (value / reference - 1.0).abs()
-}
-
-/// Writes the cantilever's section of `speed-vs-error.md` into `docs` ([`write_page`]: the
-/// other families' sections and the hand-written part are kept) and its plots into
-/// `docs/figures`.
-///
-/// ```
-/// use qdem_bench::speed_vs_error::{write_report, StudyRow, KEPT_FROM};
-/// let docs = std::env::temp_dir().join(format!("qdem-svr-doc-{}", std::process::id()));
-/// std::fs::create_dir_all(&docs).unwrap();
-/// let page = docs.join("speed-vs-error.md");
-/// std::fs::write(&page, format!("# old table\n\n{KEPT_FROM}\n\nchecked by hand\n")).unwrap();
-/// let row = |integrator, tets| StudyRow {
-///     mesh: "100".into(), tets, integrator, dt: 1e-3, steps: 3000, cpu_seconds: 1.0,
-///     tip_uz_um: -63.4, f1_hz: 32.3,
-/// };
-/// write_report(&[row("verlet", 915), row("newmark", 915)], "test", &docs).unwrap();
-/// let text = std::fs::read_to_string(&page).unwrap();
-/// assert!(!text.contains("old table"));
-/// assert!(text.contains("| 100 | 915 | verlet |"));
-/// assert!(text.ends_with(&format!("{KEPT_FROM}\n\nchecked by hand\n")));
-/// # std::fs::remove_dir_all(&docs).unwrap();
-/// ```
-pub fn write_report(rows: &[StudyRow], machine: &str, docs: &Path) -> Result<(), StudyError> {
-    let figures = docs.join("figures");
-    std::fs::create_dir_all(&figures).map_err(|e| StudyError::Probes {
-        path: figures.clone(),
-        message: e.to_string(),
-    })?;
-    let markdown = section(rows, machine, &figures)?;
-    write_page(docs, &[(Family::Cantilever, markdown)])
 }
 
 /// The cantilever's section of the page, its plots written into `figures`; the reference of

@@ -15,7 +15,7 @@ pub mod packing;
 pub mod page;
 
 pub use crate::cantilever::StudyError;
-pub use cantilever::{run_study, write_report, StudyRow};
+pub use cantilever::{run_study, StudyRow};
 pub use cpu::{cpu_seconds, timed};
 pub use page::{write_page, KEPT_FROM};
 

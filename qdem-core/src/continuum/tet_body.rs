@@ -225,13 +225,6 @@ impl TetBody {
         }
     }
 
-    /// In a run decomposed over processes, the wall seconds this process has spent
-    /// exchanging block sums with the other ranks (waiting for them included); 0 otherwise.
-    pub fn exchange_seconds(&self) -> f64 {
-        let exchange = self.split.as_ref().and_then(|s| s.exchange.as_ref());
-        exchange.map_or(0.0, |e| e.seconds)
-    }
-
     /// Adds a quarter of each tetrahedron's mass to each of its particles (paper 000 §2.4).
     pub fn lump_mass(&self, mass: &mut [f64]) {
         for (tet, v) in self.tets.iter().zip(&self.volume) {
@@ -541,10 +534,6 @@ impl Deformable for TetBody {
 
     fn averages_pressure(&self) -> bool {
         self.averaged.is_some()
-    }
-
-    fn exchange_seconds(&self) -> f64 {
-        TetBody::exchange_seconds(self)
     }
 }
 

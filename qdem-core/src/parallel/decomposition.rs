@@ -116,7 +116,6 @@ impl SumExchange {
     /// others computed for this rank's particles into `sums`: the reverse exchange of
     /// [`crate::parallel::ParallelRuntime`].
     pub(crate) fn run(&mut self, comm: &dyn Communicator, sums: &mut [Vec3]) {
-        let start = std::time::Instant::now();
         self.send.clear();
         for &s in &self.send_slots {
             self.send.extend_from_slice(sums[s as usize].as_slice());
@@ -131,7 +130,6 @@ impl SumExchange {
         for (&s, v) in self.recv_slots.iter().zip(self.recv.chunks_exact(3)) {
             sums[s as usize] = Vec3::new(v[0], v[1], v[2]);
         }
-        self.seconds += start.elapsed().as_secs_f64();
     }
 
     /// The forward exchange of per-particle `values` (from `first`) over the slots of the
@@ -145,7 +143,6 @@ impl SumExchange {
         first: usize,
         values: &mut [Vec3],
     ) {
-        let start = std::time::Instant::now();
         self.send.clear();
         for &s in &self.recv_slots {
             let value = values[nodes[s as usize] as usize - first];
@@ -161,7 +158,6 @@ impl SumExchange {
         for (&s, v) in self.send_slots.iter().zip(self.recv.chunks_exact(3)) {
             values[nodes[s as usize] as usize - first] = Vec3::new(v[0], v[1], v[2]);
         }
-        self.seconds += start.elapsed().as_secs_f64();
     }
 }
 
@@ -212,7 +208,6 @@ pub(crate) fn split_body(
             recv_slots: recv.concat(),
             send: Vec::new(),
             recv: Vec::new(),
-            seconds: 0.0,
         }
     });
     BodySplit {

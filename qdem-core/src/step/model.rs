@@ -184,11 +184,6 @@ pub trait Deformable: Model {
     /// formulation for nearly incompressible materials), which needs the nodal averages of
     /// the whole body at every force evaluation.
     fn averages_pressure(&self) -> bool;
-
-    /// In a run decomposed over processes, the wall seconds this process has spent
-    /// exchanging the body's sums with the other ranks (waiting for them included); 0
-    /// otherwise.
-    fn exchange_seconds(&self) -> f64;
 }
 
 /// The events facet of a model: what happens within a step that the stepper must resolve.

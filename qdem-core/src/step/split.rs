@@ -412,8 +412,6 @@ pub struct SumExchange {
     pub(crate) recv_counts: Vec<usize>,
     pub(crate) send: Vec<f64>,
     pub(crate) recv: Vec<f64>,
-    /// Wall seconds spent in the exchange so far (waiting for the other ranks included).
-    pub seconds: f64,
 }
 
 impl std::fmt::Debug for SumExchange {
