@@ -561,6 +561,7 @@ fn a_slender_bonded_beam_under_a_slow_load_is_advised_implicit_at_its_first_mode
 /// A stubby bonded block (0.2 m square at 0.05 m spacing, a few particles a side): its first
 /// mode is near the lattice's highest, so the step that keeps that mode accurate is hardly
 /// longer than the explicit one, and an implicit step costs several explicit ones: explicit.
+/// The same block free gets no advice, in words.
 #[test]
 fn a_stubby_bonded_block_is_advised_explicit() {
     let all = advice_of("bonded-stubby", &bonded_beam([0.2, 0.2], 0.05, 0.0));
@@ -574,4 +575,9 @@ fn a_stubby_bonded_block_is_advised_explicit() {
     assert!(ratio < qdem_io::advice::IMPLICIT_BBM_STEP_COST, "{a:#?}");
     // Applied at once, the load rings the mode by its whole static deflection.
     assert_eq!(a.figure("dynamic_share"), Some(1.0), "{a:#?}");
+    // Free, it is told why it gets no advice (its rotation is no elastic mode).
+    let text = bonded_beam([0.2, 0.2], 0.05, 0.0).replace("\"simple\"", "\"none\"");
+    let free = advice_of("bonded-free", &text);
+    let a = on(&free, "bonded body `beam`", Topic::Integrator);
+    assert!(!a.changes() && a.reasoning.contains("free"), "{a:#?}");
 }

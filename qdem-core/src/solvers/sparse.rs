@@ -1066,8 +1066,9 @@ fn free_rigid_modes(
             t
         })
         .collect();
+    // A particle's rotation (a node past the particles: a bonded body's spins) is outside.
     let inside = |dof: usize| {
-        let k = local[dof / 3];
+        let k = local.get(dof / 3).copied().unwrap_or(usize::MAX);
         (k != usize::MAX).then(|| 3 * k + dof % 3)
     };
     let mut product = vec![vec![0.0; 3 * particles.len()]; null.len()];

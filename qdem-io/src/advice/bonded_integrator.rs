@@ -20,12 +20,16 @@
 //!   the period error can do to a deflection: the ringing on top of the quasi-static response
 //!   has amplitude d, and a period error shifts only its phase, so a deflection deviates by at
 //!   most 2d however long the step (docs/speed-vs-error.md, the BBM beam).
+//! - A free body (`supports = "none"`) gets no advice, in words: its in-plane rotation turns
+//!   the particles' spins too, which the modal analysis's rigid motions (translations and
+//!   rotations of positions) leave out, so its lowest "elastic" mode would be that rotation.
 //! - The figures hold until bonds break. The implicit stepper follows cracking (retakes and
 //!   an active set of contacts, docs/bbm.md), at far more than [`IMPLICIT_BBM_STEP_COST`] per
 //!   nominal step while a crack runs; the reasoning says so.
 
 use super::{excitation, Advice, Topic};
 use crate::build::Simulation;
+use crate::scene::Supports;
 use qdem_core::modal::lanczos::natural_modes;
 use std::f64::consts::PI;
 
@@ -46,7 +50,8 @@ pub const EXPLICIT_FRACTION: f64 = 0.2;
 /// Relative period error of the first mode the implicit step is chosen for.
 const PERIOD_ERROR: f64 = 1e-3;
 
-/// Modes asked for: a body on `supports = "none"` has three in-plane rigid ones first.
+/// Modes asked for: the lowest elastic one of a supported body, with room for the rigid
+/// motions its supports might leave.
 const MODES: usize = 4;
 
 /// What `sim`'s scene runs now: `explicit` for β = 0, else `implicit`.
@@ -63,7 +68,13 @@ pub(super) fn advise(sim: &Simulation) -> Option<Advice> {
     let model = sim.bonded()?;
     let now = integrator_now(sim);
     let subject = format!("bonded body `{}`", bonded.name);
-    let f1 = match lowest_frequency(sim) {
+    let modes = match bonded.supports {
+        // The in-plane rotation of a free body turns its particles' spins too, which the
+        // rigid motions of the modal analysis (translations) leave out.
+        Supports::None => Err("it is free (supports = \"none\")".to_string()),
+        _ => lowest_frequency(sim),
+    };
+    let f1 = match modes {
         Ok(f1) => f1,
         Err(why) => {
             return Some(Advice {
