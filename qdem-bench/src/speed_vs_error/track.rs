@@ -9,7 +9,7 @@
 //! the sleeper's rigid mode and first three bending modes on the bed; each against the
 //! reference variant (deformable stones, Table 1's stiffness).
 //!
-//! Why a softer contact pays, checked on one stone of the bed at rest on the ground
+//! What a softer contact buys, checked on one stone of the bed at rest on the ground
 //! ([`stone_at_rest`]):
 //! - the step a linear contact allows is that of its oscillator, ∆t = 2/ω with
 //!   ω = √(k_n/m): ∆t ∝ k_n^(-1/2), twice as long for k_n/4, unless another bound (a
@@ -443,7 +443,7 @@ pub fn section(
     let stone_table: String = stones.iter().map(stone_line).collect();
     let mut text = format!(
         "## The reduced track: stone kind and contact stiffness\n\n\
-         Why a softer contact pays, on one stone of the bed (`stone_00`, Table 1's granite) at \
+         What a softer contact buys, on one stone of the bed (`stone_00`, Table 1's granite) at \
          rest on the ground for 2 ms: a linear contact's step goes as k_n^(-1/2) (its \
          oscillator's 2/ω, ω = √(k_n/m)) and the mean overlap of n contacts carrying the \
          weight W is W/(n k_n).\n\n\
