@@ -1,9 +1,10 @@
 //! The speed-versus-error families at their quick size: each sweep makes physical sense
 //! (errors that shrink with the step or the element size as the integrators and the
 //! discretisation say they must), and `study speed-vs-error --families` writes the page's
-//! sections and figures, keeping the hand-written part. Timings are not asserted.
+//! sections and figures, keeping the hand-written part; the reduced track's contact stiffness
+//! sets its step and overlap as a linear spring does. Timings are not asserted.
 
-use qdem_bench::speed_vs_error::{bbm, boxtest, packing, Size, KEPT_FROM};
+use qdem_bench::speed_vs_error::{bbm, boxtest, packing, track, Size, KEPT_FROM};
 use std::path::PathBuf;
 
 fn scratch(name: &str) -> PathBuf {
@@ -71,6 +72,49 @@ fn boxtest_stiffer_contacts_deflect_less() {
         "ratio {ratio}, Hertz {hertz}: {rows:?}"
     );
     assert!(rows.iter().all(|r| r.settlement_mm > 0.0), "{rows:?}");
+    std::fs::remove_dir_all(&work).unwrap();
+}
+
+/// The reduced track's contact stiffness, on one stone of its bed at rest on the ground:
+/// a linear contact's own step bound goes as k_n^(-1/2), twice as long at k_n / 4 (to 1%,
+/// the spread of the estimate's floor contacts is the same at both stiffnesses); a rigid stone,
+/// whose step the contacts set, steps twice as long, a deformable one at most that (its
+/// tetrahedra bound it); and the mean overlap of the n contacts carrying its weight W is
+/// W/(n k_n), four times deeper at k_n / 4 (to 1%: the stone is at rest to 1e-6 of it).
+#[test]
+fn track_softer_contacts_step_longer_and_overlap_deeper() {
+    let work = scratch("track");
+    let sweep = track::Sweep::of(Size::Quick);
+    assert_eq!(sweep.softenings, [1.0, 4.0]);
+    let (stones, rows) = track::run(&sweep, &work).unwrap();
+    assert!(rows.is_empty());
+    let close = |a: f64, b: f64, tol: f64| (a / b - 1.0).abs() < tol;
+    for pair in stones.chunks(2) {
+        let (stiff, soft) = (&pair[0], &pair[1]);
+        assert_eq!(stiff.rigid, soft.rigid);
+        assert!(
+            close(soft.contact_dt / stiff.contact_dt, 2.0, 0.01),
+            "{pair:?}"
+        );
+        let step_ratio = soft.dt / stiff.dt;
+        match stiff.rigid {
+            true => assert!(close(step_ratio, 2.0, 0.01), "{pair:?}"),
+            false => assert!(step_ratio > 1.0 && step_ratio <= 2.0 + 1e-9, "{pair:?}"),
+        }
+        assert_eq!(stiff.touching, soft.touching, "{pair:?}");
+        assert!(stiff.touching >= 3, "{pair:?}");
+        assert!(
+            close(soft.mean_overlap / stiff.mean_overlap, 4.0, 0.01),
+            "{pair:?}"
+        );
+        for s in pair {
+            let hooke = s.weight / (s.touching as f64 * s.normal_stiffness);
+            assert!(
+                close(s.mean_overlap, hooke, 0.01),
+                "{s:?}: W/(n k_n) = {hooke}"
+            );
+        }
+    }
     std::fs::remove_dir_all(&work).unwrap();
 }
 

@@ -22,7 +22,7 @@ use qdem_bench::throughput::{check_block, cpu_model, measure_ordered, on_threads
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-const USAGE: &str = "usage: study speed-vs-error [--all | --families cantilever,bbm,boxtest,packing] [--quick] [--threads N] [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]
+const USAGE: &str = "usage: study speed-vs-error [--all | --families cantilever,bbm,boxtest,packing,track] [--quick] [--threads N] [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]
        study packing --spheres N --out DIR [--settle SECONDS]
        study dem-throughput --packing DIR --steps S [--grains spheres|clumps]
        study kernel-steps --tets N --steps S [--ordering structured|shuffled|reordered|blocked] [--threads T] [--viscous]";

@@ -5,7 +5,8 @@
 //! section of the page with a table and an SVG ([`page`] keeps the sections not run and the
 //! hand-written part). The families: [`cantilever`] (mesh, integrator), [`bbm`] (element
 //! size, ∆t, explicit or implicit), [`boxtest`] (contact stiffness), [`packing`] (∆t as a
-//! fraction of the Rayleigh time).
+//! fraction of the Rayleigh time), [`track`] (the reduced ballasted track: stone kind and
+//! contact stiffness).
 
 pub mod bbm;
 pub mod boxtest;
@@ -13,6 +14,7 @@ pub mod cantilever;
 mod cpu;
 pub mod packing;
 pub mod page;
+pub mod track;
 
 pub use crate::cantilever::StudyError;
 pub use cantilever::{run_study, StudyRow};
@@ -41,15 +43,18 @@ pub enum Family {
     Boxtest,
     /// An elastic sphere packing: ∆t against energy drift and contact force (`packing`).
     Packing,
+    /// The reduced ballasted track: stone kind and contact stiffness (`track`).
+    Track,
 }
 
 impl Family {
     /// Every family, in the page's order.
-    pub const ALL: [Family; 4] = [
+    pub const ALL: [Family; 5] = [
         Family::Cantilever,
         Family::Bbm,
         Family::Boxtest,
         Family::Packing,
+        Family::Track,
     ];
 
     /// The name on the command line and in the page's markers.
@@ -59,6 +64,7 @@ impl Family {
             Family::Bbm => "bbm",
             Family::Boxtest => "boxtest",
             Family::Packing => "packing",
+            Family::Track => "track",
         }
     }
 
@@ -67,7 +73,10 @@ impl Family {
     /// ```
     /// use qdem_bench::speed_vs_error::Family;
     /// assert_eq!(Family::parse("bbm"), Ok(Family::Bbm));
-    /// assert!(Family::parse("track").unwrap_err().contains("cantilever, bbm, boxtest, packing"));
+    /// assert_eq!(Family::parse("track"), Ok(Family::Track));
+    /// assert!(Family::parse("beam")
+    ///     .unwrap_err()
+    ///     .contains("cantilever, bbm, boxtest, packing, track"));
     /// ```
     pub fn parse(name: &str) -> Result<Family, String> {
         Family::ALL
@@ -122,6 +131,11 @@ pub fn run_family(family: Family, setting: &Setting<'_>) -> Result<String, Study
             let sweep = packing::Sweep::of(setting.size);
             let rows = packing::run(&sweep)?;
             packing::section(&sweep, &rows, setting.machine, setting.figures)
+        }
+        Family::Track => {
+            let sweep = track::Sweep::of(setting.size);
+            let (stones, rows) = track::run(&sweep, &setting.work.join("track"))?;
+            track::section(&sweep, &stones, &rows, setting.machine, setting.figures)
         }
     }
 }
