@@ -11,8 +11,8 @@
 use std::sync::OnceLock;
 
 /// Packs ahead of the one computed whose lines the lane pass prefetches: 4 packs of 640 B,
-/// about 1 µs of one core's work ahead, far enough to cover a miss to memory and near enough
-/// to stay in L1 until it is read.
+/// 32 tetrahedra or about half a microsecond of one core's work ahead, far enough to cover a
+/// miss to memory and near enough to stay in L1 until it is read.
 pub(crate) const PACKS_AHEAD: usize = 4;
 
 /// Nodes ahead of the one copied whose position (and velocity) the block's copy prefetches.
