@@ -1,6 +1,6 @@
 //! Throughput of the QDEM kernel (one Verlet step: tetrahedron forces, gather, integration) on
-//! structured meshes, elastic and viscoelastic, for several thread counts, in
-//! tetrahedron-steps per second. A STREAM-like triad measured in the same process gives the
+//! structured meshes (or many small stones as one body, [`stones_mesh`]), elastic and
+//! viscoelastic, for several thread counts, in tetrahedron-steps per second. A STREAM-like triad measured in the same process gives the
 //! machine's memory bandwidth, the peer against which the kernel's compulsory memory traffic
 //! per tet-step is judged; the vector peak ([`crate::vector_peak`]) is the peer of its
 //! floating-point operations per tet-step. [`run_and_print`] is `qdem bench`: the measurements as a table or as
@@ -10,6 +10,7 @@ use crate::vector_peak::vector_peak_flops;
 use qdem_core::continuum::averaged_pressure_lanes::{
     FLOPS_AVERAGED_ELASTIC, FLOPS_AVERAGED_VISCOELASTIC,
 };
+use qdem_core::continuum::prefetch;
 use qdem_core::continuum::tet_blocks::block_node_order;
 use qdem_core::continuum::tet_lanes::{LaneSet, FLOPS_ELASTIC, FLOPS_VISCOELASTIC};
 use qdem_core::{
@@ -17,8 +18,9 @@ use qdem_core::{
     step::State, step::Stepper, Vec3,
 };
 use qdem_io::build::memory;
-use qdem_mesh::{structured_box, GridError, TetMesh};
+use qdem_mesh::{parse_msh, structured_box, GridError, TetMesh};
 use serde_json::json;
+use std::path::Path;
 use std::time::Instant;
 
 /// What to measure.
@@ -32,6 +34,9 @@ pub struct BenchPlan {
     pub steps: Option<usize>,
     /// The tetrahedron measured.
     pub formulation: Formulation,
+    /// Instead of the cubes of `tets`: this many stones as one body ([`stones_mesh`]) and a
+    /// cube of about their total.
+    pub stones: Option<usize>,
 }
 
 impl BenchPlan {
@@ -47,6 +52,7 @@ impl BenchPlan {
             threads: threads.unwrap_or_else(|| vec![1, 2]),
             steps,
             formulation,
+            stones: None,
         }
     }
 }
@@ -257,6 +263,108 @@ fn shuffled(n: usize, seed: &mut u64) -> Vec<u32> {
     p
 }
 
+/// The fine stone meshes of `fixtures/ballast/stones/fine` (about 100 tetrahedra of 10 mm
+/// edges each, paper 000's ballast), built into the binary so that `qdem bench --stones` runs
+/// from anywhere.
+const FINE_STONES: [&[u8]; 16] = [
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_00.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_01.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_02.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_03.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_04.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_05.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_06.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_07.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_08.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_09.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_10.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_11.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_12.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_13.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_14.msh"),
+    include_bytes!("../../fixtures/ballast/stones/fine/stone_15.msh"),
+];
+
+/// The side of the cubic cell each stone of [`stones_mesh`] gets (m): the fine stones' longest
+/// bounding-box edge is under 0.1 m.
+const STONE_CELL: f64 = 0.12;
+
+/// The fine stones, each read and reordered for locality as `[ballast]` reads its meshes.
+fn fine_stones() -> Vec<TetMesh> {
+    FINE_STONES
+        .iter()
+        .enumerate()
+        .map(|(k, bytes)| {
+            let name = format!("fixtures/ballast/stones/fine/stone_{k:02}.msh");
+            let (mut mesh, _) = parse_msh(bytes, Path::new(&name)).expect("a fixture stone");
+            mesh.reorder_for_locality();
+            mesh
+        })
+        .collect()
+}
+
+/// Nodes and tetrahedra of [`stones_mesh`]`(count)`, counted without building it (as
+/// floats: a count too large to build still has a size to refuse).
+pub fn stones_size(count: usize) -> (f64, f64) {
+    let shapes = fine_stones();
+    let (cycles, rest) = (count / shapes.len(), count % shapes.len());
+    let (mut nodes, mut tets) = (0.0, 0.0);
+    for (k, stone) in shapes.iter().enumerate() {
+        let copies = cycles as f64 + f64::from(u8::from(k < rest));
+        nodes += copies * stone.nodes.len() as f64;
+        tets += copies * stone.tets.len() as f64;
+    }
+    (nodes, tets)
+}
+
+/// Refuses `count` stones ([`stones_mesh`]) that, with the cube of as many tetrahedra timed
+/// beside them, need more memory than this process may use, or more nodes than a mesh can
+/// number.
+///
+/// # Errors
+/// [`BlockTooLarge`] naming the count, the memory and the fix.
+pub fn check_stones(count: usize) -> Result<(), BlockTooLarge> {
+    let (nodes, tets) = stones_size(count);
+    let what = format!("--stones {count}: {tets:.3e} tetrahedra and {nodes:.3e} nodes");
+    if let Some(message) = memory::refusal(
+        &what,
+        memory::estimate(nodes, tets),
+        "give a smaller --stones",
+    ) {
+        return Err(BlockTooLarge { message });
+    }
+    if nodes > f64::from(u32::MAX) {
+        return Err(BlockTooLarge {
+            message: format!("{what}: more nodes than a mesh can number; give a smaller --stones"),
+        });
+    }
+    check_block(tets as usize, false)
+}
+
+/// `count` stones as one mesh, as `[ballast]` builds its stones into one body: stone `k` is
+/// fine stone `k mod 16` (`fixtures/ballast/stones/fine`), moved into cell `k` of a cubic
+/// lattice of [`STONE_CELL`], stone after stone in the node and tetrahedron order. 5,700 of
+/// them are paper 000's ballast (about 100 tetrahedra each).
+pub fn stones_mesh(count: usize) -> TetMesh {
+    let shapes = fine_stones();
+    let side = (count as f64).cbrt().ceil().max(1.0) as usize;
+    let mut mesh = TetMesh::default();
+    for k in 0..count {
+        let stone = &shapes[k % shapes.len()];
+        let cell = [k % side, (k / side) % side, k / (side * side)];
+        let shift = cell.map(|c| STONE_CELL * c as f64);
+        let first = mesh.nodes.len() as u32;
+        let moved = stone
+            .nodes
+            .iter()
+            .map(|p| std::array::from_fn(|c| p[c] + shift[c]));
+        mesh.nodes.extend(moved);
+        mesh.tets
+            .extend(stone.tets.iter().map(|t| t.map(|n| n + first)));
+    }
+    mesh
+}
+
 /// A body over `mesh` with the cantilever's material (viscous: μ_D = 10⁴, κ_D = 10³ Pa s) and
 /// its state with a small smooth velocity, so that the kernel works on a deformed state.
 pub fn body_on(mesh: TetMesh, viscous: bool) -> (TetBody, State) {
@@ -297,6 +405,44 @@ pub fn measure_formulation(
     measure_body(mesh, viscous, formulation, threads, steps)
 }
 
+/// A body `qdem bench` times.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BenchBody {
+    /// A structured cube of about this many tetrahedra ([`block_mesh`]).
+    Cube(usize),
+    /// This many stones as one body ([`stones_mesh`]).
+    Stones(usize),
+}
+
+impl BenchBody {
+    /// Its mesh.
+    pub fn mesh(self) -> TetMesh {
+        match self {
+            BenchBody::Cube(tets) => block_mesh(tets, Ordering::Structured),
+            BenchBody::Stones(count) => stones_mesh(count),
+        }
+    }
+
+    /// `cube` or `stones`.
+    pub fn label(self) -> &'static str {
+        match self {
+            BenchBody::Cube(_) => "cube",
+            BenchBody::Stones(_) => "stones",
+        }
+    }
+
+    /// The bodies of `plan`: its cubes, or its stones and a cube of about their total.
+    pub fn of(plan: &BenchPlan) -> Vec<BenchBody> {
+        match plan.stones {
+            Some(count) => vec![
+                BenchBody::Stones(count),
+                BenchBody::Cube(stones_size(count).1 as usize),
+            ],
+            None => plan.tets.iter().map(|&t| BenchBody::Cube(t)).collect(),
+        }
+    }
+}
+
 /// Times Verlet steps of a block in the given node ordering on `threads` threads.
 pub fn measure_ordered(
     tets: usize,
@@ -311,7 +457,7 @@ pub fn measure_ordered(
 
 /// Times Verlet steps of the body of [`body_on`] over `mesh` in `formulation` on `threads`
 /// threads.
-fn measure_body(
+pub fn measure_body(
     mesh: TetMesh,
     viscous: bool,
     formulation: Formulation,
@@ -425,7 +571,8 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
             );
         }
         println!(
-            "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14} {:>10} {:>10} {:>10}",
+            "{:>7} {:>9} {:>9} {:>8} {:>7} {:>6} {:>14} {:>10} {:>10} {:>10}",
+            "body",
             "tets",
             "particles",
             "material",
@@ -437,10 +584,10 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
             "% of peak"
         );
     }
-    for &tets in &plan.tets {
+    for body in BenchBody::of(plan) {
         for viscous in [false, true] {
             for &threads in &plan.threads {
-                let r = measure_formulation(tets, viscous, plan.formulation, threads, plan.steps);
+                let r = measure_body(body.mesh(), viscous, plan.formulation, threads, plan.steps);
                 let bw = bandwidth
                     .iter()
                     .find(|b| b.0 == threads)
@@ -453,7 +600,8 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
                 let of_peak = r.tet_steps_per_second() * r.flops_per_tet_step() as f64 / peak;
                 if !as_json {
                     println!(
-                        "{:>9} {:>9} {:>8} {:>7} {:>6} {:>14.4e} {:>10.0} {:>9.0}% {:>9.0}%",
+                        "{:>7} {:>9} {:>9} {:>8} {:>7} {:>6} {:>14.4e} {:>10.0} {:>9.0}% {:>9.0}%",
+                        body.label(),
                         r.tets,
                         r.particles,
                         if viscous { "visco" } else { "elastic" },
@@ -466,6 +614,7 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
                     );
                 }
                 results.push(json!({
+                    "body": body.label(),
                     "tets": r.tets, "particles": r.particles, "block_nodes": r.block_nodes,
                     "material": if viscous { "viscoelastic" } else { "elastic" },
                     "formulation": r.formulation.name(),
@@ -486,6 +635,7 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
             "locality": locality,
             "machine": { "cpu": cpu_model(), "cores": std::thread::available_parallelism().map_or(0, |n| n.get()) },
             "kernel_lanes": format!("{:?}", LaneSet::detected()).to_lowercase(),
+            "prefetch": prefetch::enabled(),
             "vector_peak_flops_per_second": peak.iter().map(|(t, p)| json!({"threads": t, "value": p})).collect::<Vec<_>>(),
             "triad_bandwidth_bytes_per_second": bandwidth.iter().map(|(t, b)| json!({"threads": t, "value": b})).collect::<Vec<_>>(),
             "results": results,
@@ -496,11 +646,14 @@ pub fn run_and_print(plan: &BenchPlan, as_json: bool) {
 
 /// Effect of node ordering: the largest planned block, elastic, on the most threads, in
 /// generator order, shuffled, shuffled then reordered (reverse Cuthill–McKee), and in the
-/// order the blocks read the nodes.
+/// order the blocks read the nodes; none for a plan of stones.
 fn locality_rows(plan: &BenchPlan, as_json: bool) -> Vec<serde_json::Value> {
     let (Some(&tets), Some(&threads)) = (plan.tets.iter().max(), plan.threads.iter().max()) else {
         return Vec::new();
     };
+    if plan.stones.is_some() {
+        return Vec::new();
+    }
     if !as_json {
         println!("node ordering, {tets} tets, elastic, {threads} threads:");
     }

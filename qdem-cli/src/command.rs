@@ -263,6 +263,12 @@ pub struct BenchArgs {
     /// formulation)
     #[arg(long, value_name = "NAME", default_value = "standard")]
     pub formulation: BenchFormulation,
+    /// Instead of the cubes of --tets: N stones of about 100 tetrahedra (the fine stones of
+    /// fixtures/ballast/stones) as one body, as [ballast] builds them, beside one cube of
+    /// about the same total
+    #[arg(long, value_name = "N", value_parser = positive_whole, allow_negative_numbers = true,
+          conflicts_with_all = ["tets", "implicit"])]
+    pub stones: Option<usize>,
 }
 
 /// The tetrahedron `qdem bench` measures (`[[material]] formulation`).
@@ -467,9 +473,15 @@ pub fn dispatch(cli: Cli, ranks: Option<Arc<dyn Communicator>>) -> Result<(), Cl
                 }
                 return Ok(implicit::run_and_print(Some(sizes), threads, a.json)?);
             }
-            let plan = BenchPlan::new(a.tets, a.threads, a.steps, a.formulation.core());
-            for &tets in &plan.tets {
-                throughput::check_block(tets, false)?;
+            let mut plan = BenchPlan::new(a.tets, a.threads, a.steps, a.formulation.core());
+            plan.stones = a.stones;
+            match a.stones {
+                Some(count) => throughput::check_stones(count)?,
+                None => {
+                    for &tets in &plan.tets {
+                        throughput::check_block(tets, false)?;
+                    }
+                }
             }
             throughput::run_and_print(&plan, a.json);
             Ok(())

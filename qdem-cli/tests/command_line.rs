@@ -120,6 +120,68 @@ fn bench_measures_the_averaged_pressure_tetrahedron() {
 }
 
 #[test]
+fn bench_times_stones_as_one_body_beside_a_cube_of_as_many_tetrahedra() {
+    // 20 stones: the 16 fine stones of the ballast fixture, then the first 4 again, as one
+    // body; their tetrahedra are the fixture table's `tets_fine` (stones.csv).
+    let table = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../fixtures/ballast/stones/stones.csv"
+    ))
+    .expect("stones.csv");
+    let fine: Vec<u64> = table
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .nth(1)
+                .and_then(|t| t.parse().ok())
+                .expect("tets_fine")
+        })
+        .collect();
+    assert_eq!(fine.len(), 16);
+    let want: u64 = (0..20).map(|k| fine[k % 16]).sum();
+    let stdout = success(&[
+        "bench",
+        "--json",
+        "--stones",
+        "20",
+        "--threads",
+        "1",
+        "--steps",
+        "2",
+    ]);
+    let doc: serde_json::Value = serde_json::from_str(&stdout)
+        .unwrap_or_else(|e| panic!("stdout is not JSON ({e}):\n{stdout}"));
+    assert_eq!(doc["locality"].as_array().map(Vec::len), Some(0), "{doc:#}");
+    let prefetch = std::env::var("QDEM_PREFETCH").as_deref() == Ok("1");
+    assert_eq!(doc["prefetch"].as_bool(), Some(prefetch), "{doc:#}");
+    let rows = doc["results"].as_array().expect("results");
+    // (stones, cube) x (elastic, viscoelastic) x 1 thread count.
+    assert_eq!(rows.len(), 4, "{doc:#}");
+    let number = |row: &serde_json::Value, key: &str| row[key].as_f64().expect(key);
+    for (stones, cube) in rows[..2].iter().zip(&rows[2..]) {
+        assert_eq!(
+            (&stones["body"], &cube["body"]),
+            (&"stones".into(), &"cube".into())
+        );
+        assert_eq!(stones["material"], cube["material"]);
+        assert_eq!(stones["tets"].as_u64(), Some(want), "{stones}");
+        // The cube is the nearest of 6 n^3 tetrahedra: within half a cell layer of the total.
+        let ratio = number(cube, "tets") / want as f64;
+        assert!((0.85..1.15).contains(&ratio), "{cube}");
+        // Small stones have far more particles per tetrahedron than the cube (0.4 against
+        // 0.2 at this size), so the model gives them more bytes per tet-step.
+        let per_tet = |row| number(row, "particles") / number(row, "tets");
+        assert!(
+            per_tet(stones) > 0.35 && per_tet(cube) < 0.25,
+            "{stones}\n{cube}"
+        );
+        assert!(number(stones, "bytes_per_tet_step") > number(cube, "bytes_per_tet_step"));
+        assert!(number(stones, "tet_steps_per_second") > 0.0);
+    }
+}
+
+#[test]
 fn bench_takes_comma_separated_lists() {
     let stdout = success(&[
         "bench",

@@ -13,19 +13,24 @@
 //!   [--threads T] [--viscous]`: `qdem bench`'s measurement of one block in one node ordering
 //!   (3 warm steps, then S timed), one JSON object: the run to give a cache simulator
 //!   (`valgrind --tool=callgrind --cache-sim=yes`), where the orderings' misses can be counted
-//!   on a loaded machine.
+//!   on a loaded machine. `--stones N` in place of `--tets`: N fine stones as one body
+//!   (`qdem bench --stones`).
 
 use qdem_bench::cantilever::fixtures_dir;
 use qdem_bench::granular::{clump_throughput, throughput, Packing};
 use qdem_bench::speed_vs_error::{run_family, write_page, Family, Setting, Size};
-use qdem_bench::throughput::{check_block, cpu_model, measure_ordered, on_threads, Ordering};
+use qdem_bench::throughput::{
+    check_block, check_stones, cpu_model, measure_body, measure_ordered, on_threads, stones_mesh,
+    Ordering,
+};
+use qdem_core::continuum::Formulation;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 const USAGE: &str = "usage: study speed-vs-error [--all | --families cantilever,bbm,boxtest,packing,track] [--quick] [--threads N] [--docs DIR] [--work DIR] [--meshes 100,070,050] [--dts 1e-3,3e-4,1e-4]
        study packing --spheres N --out DIR [--settle SECONDS]
        study dem-throughput --packing DIR --steps S [--grains spheres|clumps]
-       study kernel-steps --tets N --steps S [--ordering structured|shuffled|reordered|blocked] [--threads T] [--viscous]";
+       study kernel-steps (--tets N | --stones N) --steps S [--ordering structured|shuffled|reordered|blocked] [--threads T] [--viscous]";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -125,15 +130,30 @@ fn dem_throughput(option: &dyn Fn(&str) -> Option<String>) -> ExitCode {
 
 fn kernel_steps(option: &dyn Fn(&str) -> Option<String>, viscous: bool) -> ExitCode {
     let run = || -> Result<String, String> {
-        let tets: usize = number(option, "--tets", None)?;
         let steps: usize = number(option, "--steps", None)?;
         let threads: usize = number(option, "--threads", Some(1))?;
         let ordering: Ordering = option("--ordering")
             .unwrap_or_else(|| "structured".into())
             .parse()
             .map_err(|e| format!("--ordering {e}\n{USAGE}"))?;
-        check_block(tets, false).map_err(|e| e.to_string())?;
-        let r = measure_ordered(tets, ordering, viscous, threads, Some(steps));
+        let r = match option("--stones") {
+            Some(_) => {
+                if option("--ordering").is_some() || option("--tets").is_some() {
+                    return Err(format!(
+                        "--stones takes neither --tets nor --ordering\n{USAGE}"
+                    ));
+                }
+                let stones: usize = number(option, "--stones", None)?;
+                check_stones(stones).map_err(|e| e.to_string())?;
+                let mesh = stones_mesh(stones);
+                measure_body(mesh, viscous, Formulation::Standard, threads, Some(steps))
+            }
+            None => {
+                let tets: usize = number(option, "--tets", None)?;
+                check_block(tets, false).map_err(|e| e.to_string())?;
+                measure_ordered(tets, ordering, viscous, threads, Some(steps))
+            }
+        };
         let record = serde_json::json!({
             "tets": r.tets, "particles": r.particles, "block_nodes": r.block_nodes,
             "ordering": format!("{ordering:?}").to_lowercase(), "viscous": viscous,

@@ -16,7 +16,7 @@
 //! buffer: what crosses memory per tetrahedron is its reference data and local corners, and
 //! per node of a block one position in, one sum out and back.
 
-use crate::continuum::tet_lanes::{self, TetPack};
+use crate::continuum::tet_lanes::{self, TetPack, PACK};
 use crate::{Mat3, Vec3};
 
 /// The most tetrahedra in one block: its nodes (at most four per tetrahedron) must be
@@ -97,7 +97,13 @@ impl TetBlocks {
         }
         let (node_start, nodes, hot) = block_nodes(tets, dm_inv, &order, &tet_start);
         let (first, entry_start, entries) = entry_lists(&nodes);
-        let (mut packs, mut pack_start) = (Vec::new(), vec![0u32]);
+        // Sized once, so that the whole array is allocated (and advised huge pages) before
+        // it is written, instead of growing by doublings whose older parts keep small pages.
+        let total = tet_start
+            .windows(2)
+            .map(|r| (r[1] - r[0]).div_ceil(PACK as u32));
+        let mut packs = Vec::with_capacity(total.sum::<u32>() as usize);
+        let mut pack_start = vec![0u32];
         for range in tet_start.windows(2) {
             packs.extend(tet_lanes::packs(&hot[range[0] as usize..range[1] as usize]));
             pack_start.push(packs.len() as u32);
@@ -381,6 +387,25 @@ mod tests {
             next += run.len() as u32;
         }
         assert_eq!(next as usize, x.len());
+    }
+
+    #[test]
+    fn the_packs_are_allocated_once_at_their_final_size() {
+        // Every block's tetrahedra in packs of PACK, the last padded; the array sized once
+        // (a grown one would have room to spare, and its older parts no huge pages). 4,230
+        // tetrahedra cut into blocks of 264 and 265, 33 and 34 packs: no doubling ends there.
+        let (x, tets) = bar(705);
+        let blocks = TetBlocks::new(&x, &tets, &vec![Mat3::identity(); tets.len()]);
+        for b in 0..blocks.len() {
+            let count = (blocks.tet_start[b + 1] - blocks.tet_start[b]) as usize;
+            let packs = (blocks.pack_start[b + 1] - blocks.pack_start[b]) as usize;
+            assert_eq!(packs, count.div_ceil(PACK), "block {b}");
+        }
+        assert_eq!(
+            blocks.packs.len(),
+            *blocks.pack_start.last().unwrap() as usize
+        );
+        assert_eq!(blocks.packs.capacity(), blocks.packs.len());
     }
 
     #[test]

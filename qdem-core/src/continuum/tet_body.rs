@@ -18,6 +18,7 @@
 
 use crate::continuum::averaged_pressure_tet::{AveragedPressure, Formulation};
 use crate::continuum::material::{Lame, Material};
+use crate::continuum::prefetch;
 use crate::continuum::stable_step::{critical_step, element_rate_bound};
 use crate::continuum::tet_blocks::{BlockLayout, TetBlocks};
 use crate::continuum::tet_kernel::{
@@ -346,10 +347,12 @@ impl TetBody {
     ) -> usize {
         let blocks = &self.blocks;
         let nodes = &blocks.nodes[blocks.node_start[b] as usize..blocks.node_start[b + 1] as usize];
+        let prefetch = prefetch::enabled();
         scratch.load(
             nodes,
             &state.position,
             VISCOUS.then_some(&state.velocity[..]),
+            prefetch,
         );
         out.fill(Vec3::zeros());
         let (elastic, viscous) = (self.pair(), self.vpair());
@@ -361,6 +364,7 @@ impl TetBody {
             elastic,
             viscous,
             count: range.len(),
+            prefetch,
         };
         if let Some(inverted) = block_forces::<VISCOUS>(LaneSet::detected(), packs, &input, out) {
             return inverted.map_or(usize::MAX, |k| blocks.order[range.start + k] as usize);
@@ -450,15 +454,36 @@ struct Scratch {
 }
 
 impl Scratch {
-    /// Copies the positions (and velocities, when given) of `nodes`.
-    fn load(&mut self, nodes: &[u32], position: &[Vec3], velocity: Option<&[Vec3]>) {
-        self.x.clear();
-        self.x.extend(nodes.iter().map(|&n| position[n as usize]));
+    /// Copies the positions (and velocities, when given) of `nodes`, with `prefetch` asking
+    /// for the values [`prefetch::NODES_AHEAD`] nodes ahead (the same copies either way).
+    fn load(
+        &mut self,
+        nodes: &[u32],
+        position: &[Vec3],
+        velocity: Option<&[Vec3]>,
+        prefetch: bool,
+    ) {
+        copy_nodes(&mut self.x, nodes, position, prefetch);
         if let Some(velocity) = velocity {
-            self.v.clear();
-            self.v.extend(nodes.iter().map(|&n| velocity[n as usize]));
+            copy_nodes(&mut self.v, nodes, velocity, prefetch);
         }
     }
+}
+
+/// `to` = the `values` of `nodes`, in order; with `prefetch`, each copy asks for the value
+/// [`prefetch::NODES_AHEAD`] nodes further on.
+fn copy_nodes(to: &mut Vec<Vec3>, nodes: &[u32], values: &[Vec3], prefetch: bool) {
+    to.clear();
+    if !prefetch {
+        to.extend(nodes.iter().map(|&n| values[n as usize]));
+        return;
+    }
+    to.extend(nodes.iter().enumerate().map(|(k, &n)| {
+        if let Some(&ahead) = nodes.get(k + prefetch::NODES_AHEAD) {
+            prefetch::lines(&values[ahead as usize]);
+        }
+        values[n as usize]
+    }));
 }
 
 /// One [`Scratch`] per worker thread, kept from step to step (no allocation once warm). A
@@ -712,5 +737,28 @@ impl Linearized for TetBody {
             .filter(|(_, w)| w[1] > w[0])
             .map(|(i, _)| self.blocks.first + i)
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_block_copies_the_same_bits_with_prefetch() {
+        // Nodes out of order and with gaps, more than the prefetch looks ahead.
+        let values: Vec<Vec3> = (0..500)
+            .map(|i| Vec3::new(i as f64 / 7.0, (i as f64).sin(), -(i as f64).sqrt()))
+            .collect();
+        let nodes: Vec<u32> = (0..3 * prefetch::NODES_AHEAD as u32)
+            .map(|k| (k * 37 + 11) % 500)
+            .collect();
+        let (mut without, mut with) = (Vec::new(), vec![Vec3::zeros(); 3]);
+        copy_nodes(&mut without, &nodes, &values, false);
+        copy_nodes(&mut with, &nodes, &values, true);
+        let want: Vec<Vec3> = nodes.iter().map(|&n| values[n as usize]).collect();
+        assert_eq!(without, want);
+        let bits = |v: &[Vec3]| -> Vec<u64> { v.iter().flatten().map(|c| c.to_bits()).collect() };
+        assert_eq!(bits(&with), bits(&want));
     }
 }

@@ -17,6 +17,7 @@
 //! ([`LaneSet::detected`]), so one binary serves both; a CPU with neither runs the scalar
 //! kernel.
 
+use crate::continuum::prefetch;
 use crate::continuum::tet_blocks::HotTet;
 use crate::Vec3;
 use std::sync::OnceLock;
@@ -127,13 +128,15 @@ fn cpu_lane_set() -> LaneSet {
 }
 
 /// What a block pass reads besides its packs: the block's node positions and velocities
-/// (read only when viscous), the Lamé pairs and the number of real tetrahedra.
+/// (read only when viscous), the Lamé pairs, the number of real tetrahedra and whether to
+/// prefetch the packs ahead ([`crate::continuum::prefetch`]: the same sums either way).
 pub(crate) struct BlockInput<'a> {
     pub x: &'a [Vec3],
     pub v: &'a [Vec3],
     pub elastic: (f64, f64),
     pub viscous: (f64, f64),
     pub count: usize,
+    pub prefetch: bool,
 }
 
 /// The forces of a block's tetrahedra (`packs`) added into `out` (its node sums) with the lane
@@ -337,6 +340,11 @@ unsafe fn pass<S: Simd, const VISCOUS: bool>(
     let mut f = [[0.0f64; PACK]; 12];
     let mut six_volume = [0.0f64; PACK];
     for (p, pack) in packs.iter().enumerate() {
+        if input.prefetch {
+            if let Some(ahead) = packs.get(p + prefetch::PACKS_AHEAD) {
+                prefetch::lines(ahead);
+            }
+        }
         for o in (0..PACK).step_by(S::N) {
             let base = p * PACK + o;
             if base >= input.count {
@@ -621,6 +629,7 @@ mod tests {
             elastic: (3.0e9, 2.0e9),
             viscous: (4.0e4, 7.0e4),
             count,
+            prefetch: false,
         };
         let want = scalar::<VISCOUS>(&hot, &input);
         let scale = want.iter().map(|f| f.norm()).fold(0.0, f64::max);
@@ -663,6 +672,62 @@ mod tests {
         lanes_agree::<true>();
     }
 
+    /// Prefetching the packs ahead moves no value: every lane set gives the same sums, bit for
+    /// bit, with it and without, over a block of more packs than it looks ahead.
+    fn prefetch_keeps_the_bits<const VISCOUS: bool>() {
+        let count = 8 * (3 * prefetch::PACKS_AHEAD) + 3;
+        let (hot, x, v) = block(count);
+        let packs = packs(&hot);
+        let sums = |set: LaneSet, prefetch: bool| {
+            let input = BlockInput {
+                x: &x,
+                v: &v,
+                elastic: (3.0e9, 2.0e9),
+                viscous: (4.0e4, 7.0e4),
+                count,
+                prefetch,
+            };
+            let mut out = vec![Vec3::zeros(); x.len()];
+            let inverted = block_forces::<VISCOUS>(set, &packs, &input, &mut out);
+            (inverted, out)
+        };
+        let mut sets = Vec::new();
+        if cpu_lane_set() != LaneSet::Scalar {
+            sets.push(LaneSet::Avx2);
+        }
+        if cpu_lane_set() == LaneSet::Avx512 {
+            sets.push(LaneSet::Avx512);
+        }
+        for set in &sets {
+            let (without, with) = (sums(*set, false), sums(*set, true));
+            assert_eq!(without.0, Some(None), "{set:?}");
+            assert!(
+                without.1.iter().any(|f| f.norm() > 0.0),
+                "{set:?}: no force"
+            );
+            let bits = |out: &[Vec3]| -> Vec<u64> {
+                out.iter()
+                    .flat_map(|f| f.iter().map(|c| c.to_bits()))
+                    .collect()
+            };
+            assert_eq!(bits(&with.1), bits(&without.1), "{set:?}");
+            assert_eq!(with.0, without.0, "{set:?}");
+        }
+        if sets.is_empty() {
+            eprintln!("skipped: this CPU has neither AVX2+FMA nor AVX-512");
+        }
+    }
+
+    #[test]
+    fn elastic_sums_are_the_same_bits_with_prefetch() {
+        prefetch_keeps_the_bits::<false>();
+    }
+
+    #[test]
+    fn viscous_sums_are_the_same_bits_with_prefetch() {
+        prefetch_keeps_the_bits::<true>();
+    }
+
     #[test]
     fn an_inverted_tetrahedron_is_found_in_its_lane() {
         let count = 13;
@@ -677,6 +742,7 @@ mod tests {
             elastic: (1.0, 1.0),
             viscous: (0.0, 0.0),
             count,
+            prefetch: false,
         };
         let set = LaneSet::detected();
         let mut out = vec![Vec3::zeros(); x.len()];
