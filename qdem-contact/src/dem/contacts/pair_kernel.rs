@@ -113,6 +113,8 @@ pub(super) struct KernelPlan {
     /// The delay axis, when [`DemContacts::boundary_laws`] ran the law of the pairs through
     /// it in this evaluation: the fused pass reads their records instead.
     boundary: Option<usize>,
+    /// The indices of those pairs, ascending (what the boundary's reduction reads).
+    boundary_pairs: Vec<u32>,
 }
 
 /// The lane set the pair kernel runs the law with: [`LaneSet::detected`], the tetrahedron
@@ -400,11 +402,14 @@ impl DemContacts {
             pairs.keep_rolling();
         }
         let law = &self.settings.law;
+        let mut through = std::mem::take(&mut self.kernel.boundary_pairs);
+        through.clear();
         for k in 0..pairs.items.len() {
             let shift = pairs.shift[k];
             if shift[axis] == 0.0 {
                 continue;
             }
+            through.push(k as u32);
             let contact = &mut pairs.items[k];
             let Some((pair, e)) = self.spheres_through(contact, shift) else {
                 contact.part();
@@ -423,7 +428,16 @@ impl DemContacts {
         }
         *self.candidates.pairs_mut() = pairs;
         self.kernel.boundary = Some(axis);
+        self.kernel.boundary_pairs = through;
         true
+    }
+
+    /// The pairs through the time-delayed boundary whose law [`DemContacts::boundary_laws`]
+    /// ran in this evaluation, by index in the list; `None` where it did not run.
+    pub(super) fn boundary_pairs(&self) -> Option<&[u32]> {
+        self.kernel
+            .boundary
+            .map(|_| self.kernel.boundary_pairs.as_slice())
     }
 
     /// Adds the complete sum of every partner this process or rank owns to its particle

@@ -205,7 +205,7 @@ impl DemContacts {
     /// when the model has neither.
     pub(super) fn reduction_stage(&mut self, out: &mut Vec<f64>) -> bool {
         if let Some(delay) = &self.time_delay {
-            delay.reduction(self.candidates.pairs(), out);
+            delay.reduction(self.candidates.pairs(), self.boundary_pairs(), out);
         }
         let spheres = (self.spheres.records(), self.spheres.radius());
         let servo = self.walls.servo_contacts(
