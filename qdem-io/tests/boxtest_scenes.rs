@@ -110,7 +110,7 @@ fn check_cell_bed(dir: &Path, bed: &Simulation) {
             );
         }
     }
-    assert_wrapped(&bed, "deposit_cell_bed");
+    assert_wrapped(bed, "deposit_cell_bed");
     // At rest: the stones' kinetic energy is below a millimetre's worth of their weight.
     let info = bed.granular.as_ref().unwrap();
     let weight: f64 = info
