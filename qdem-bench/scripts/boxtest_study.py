@@ -4,7 +4,10 @@ sample of the periodic single-sleeper cell (bed, then the sleeper and the crib),
 it in the three-sleeper box (the cell's sample three times along y), in the single-sleeper
 box with fixed walls, and with ordinary and time-delayed periodic boundaries (paper 003's
 Eqs. 6-7, and qdem's shared faces); collect the middle sleeper's settlement after every load
-cycle. All five cases of a seed load the same middle sample from the same sleeper pose.
+cycle. All five cases of a seed load the same stones: the periodic boxes and the middle of
+the three-sleeper box the cell's sample from the same sleeper pose, the fixed-wall box the
+same sample with its stones astride the walls poured back under the sleeper's 3 kN first
+(`deposit_fixed_crib`), so that it holds the cell's stone count and mass.
 
     cargo build --release -p qdem-cli
     python3 qdem-bench/scripts/boxtest_study.py [--size study|small|paper] [--seeds 1-5]
@@ -95,10 +98,11 @@ def run(size, name, seed, out, qdem, threads, variant=None):
 
 def run_all(size, seeds, base, qdem, jobs, threads, variant=None):
     """Every run of every seed, `jobs` at a time on `threads` threads each: a seed's bed, then
-    its crib, then its five loading cases (the three-sleeper box first, the longest); with a
-    `variant`, only the loading cases, on the samples already deposited. Returns the runs'
-    summaries in a fixed order (seed, then run), whatever order they finished in."""
-    deposits = [] if variant else ["deposit_cell_bed", "deposit_cell_crib"]
+    its crib, then its five loading cases (the three-sleeper box first, the longest), the
+    fixed-wall box's after the pour of its stones astride the walls (`deposit_fixed_crib`);
+    with a `variant`, only the loading cases, on the samples already deposited. Returns the
+    runs' summaries in a fixed order (seed, then run), whatever order they finished in."""
+    deposits = [] if variant else ["deposit_cell_bed", "deposit_cell_crib", "deposit_fixed_crib"]
     ready = ([(seed, 0, "deposit_cell_bed") for seed in seeds] if deposits else
              [(seed, 1 + k, case) for seed in seeds for k, case in enumerate(CASES)])
     done, failed = {}, []
@@ -133,7 +137,11 @@ def run_all(size, seeds, base, qdem, jobs, threads, variant=None):
                 if name == "deposit_cell_bed":
                     ready.append((seed, 0, "deposit_cell_crib"))
                 elif name == "deposit_cell_crib":
-                    ready.extend((seed, 1 + k, case) for k, case in enumerate(CASES))
+                    ready.append((seed, 0, "deposit_fixed_crib"))
+                    ready.extend((seed, 1 + k, case) for k, case in enumerate(CASES)
+                                 if case != "single_fixed")
+                elif name == "deposit_fixed_crib":
+                    ready.append((seed, 1 + CASES.index("single_fixed"), "single_fixed"))
                 lock.notify_all()
 
     pool = [threading.Thread(target=worker) for _ in range(jobs)]

@@ -97,6 +97,14 @@ pub enum BuildError {
         /// What is wrong.
         source: qdem_contact::samples::clump_sample::SampleError,
     },
+    /// `[granular] refill` cannot hold the sample's stones.
+    #[error("{scene}: [granular] refill: {source}")]
+    Refill {
+        /// The scene file.
+        scene: PathBuf,
+        /// What is wrong.
+        source: super::refill::RefillError,
+    },
     /// A body's `rest_on` finds no stone beneath it.
     #[error(
         "{scene}: body `{body}`: rest_on: no stone lies beneath its contact spheres, so it has \

@@ -18,7 +18,9 @@
 //! it took the whole bottom layer and the stones along the side walls out of every cropped
 //! sample, and the sample collapsed into the gap. A sample and a generation together give the
 //! sample's stones then new ones (deposition in stages: a bed, then the sleepers laid on it,
-//! then the crib ballast poured around them).
+//! then the crib ballast poured around them). `refill` ([`super::refill`]) keeps a walled
+//! box's whole sample: the stones astride its sides, which a crop would drop, are moved
+//! inside and stacked above the sample, to be poured back.
 //!
 //! A stone of several spheres becomes a rigid body: a centre particle at its centre of mass
 //! with its mass (the union of its spheres at the material's density,
@@ -91,7 +93,8 @@ fn copied(stones: &[Stone], copies: &[[f64; 3]]) -> Vec<Stone> {
         .collect()
 }
 
-/// The stones of `granular`: its sample file's, copied and cropped, then the generated ones;
+/// The stones of `granular`: its sample file's, copied, cropped and refilled, then the
+/// generated ones;
 /// with the number of the sample's.
 pub(crate) fn stones(
     scene: &Scene,
@@ -112,6 +115,14 @@ pub(crate) fn stones(
                 .zip(&s.radii)
                 .all(|(c, &r)| inside_crop(&lo, &hi, c, r))
         });
+    }
+    if let Some(area) = granular.refill {
+        stones = super::refill::refill(stones, area)
+            .map_err(|source| BuildError::Refill {
+                scene: scene.path.clone(),
+                source,
+            })?
+            .0;
     }
     let sampled = stones.len();
     if let (Some([lo, hi]), Some(count), Some(grading)) =

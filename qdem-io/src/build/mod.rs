@@ -46,6 +46,7 @@ mod overlap_advice;
 mod periodic;
 pub mod pose_from;
 pub mod probes;
+pub mod refill;
 mod rest_on;
 mod start_from;
 mod step_check;

@@ -24,6 +24,13 @@
 //! time-delayed boundary's ghost scales, a servo wall's load: `stages.rs`), the kernel runs
 //! in two passes over the same runs, the law (keeping each contact's n × f beside its
 //! record) and then the sums, which add the same shares in the same order as the fused pass.
+//! A time-delayed boundary reads only the pairs through it, so once the lists' image
+//! translations are taken (below) its first pass is the law of those pairs alone
+//! ([`DemContacts::boundary_laws`]), and the fused pass runs the law of every other contact
+//! and adds every share, a boundary pair's from its record: the same forces (a pair's law
+//! reads its own record only, and the lanes give the scalar law's bits) added in the same
+//! order, without a second pass over the lists. One process only: a rank keeps the two
+//! passes.
 //!
 //! Per step a candidate pair costs its record (read and written once) and two additions into
 //! sums that are in cache, and the serial add runs over the partners of candidates only.
@@ -103,6 +110,11 @@ pub(super) struct KernelPlan {
     /// Whether the lists' column of image translations was taken by a law pass since this
     /// plan was made: a candidate's image is the same until the next build (module doc).
     images: bool,
+    /// The delay axis, when [`DemContacts::boundary_laws`] ran the law of the pairs through
+    /// it in this evaluation: the fused pass reads their records instead.
+    boundary: Option<usize>,
+    /// The indices of those pairs, ascending (what the boundary's reduction reads).
+    boundary_pairs: Vec<u32>,
 }
 
 /// The lane set the pair kernel runs the law with: [`LaneSet::detected`], the tetrahedron
@@ -234,11 +246,15 @@ impl DemContacts {
     ) {
         let keep_turn = LAW && (!SUM || self.split.is_some());
         let mut plan = std::mem::take(&mut self.kernel);
+        let boundary = plan.boundary.take();
         let mut pairs = std::mem::take(self.candidates.pairs_mut());
         let mut walls = std::mem::take(self.candidates.wall_contacts_mut());
         if LAW {
-            for list in [&mut pairs, &mut walls] {
-                list.turn.clear();
+            for (list, pair_list) in [(&mut pairs, true), (&mut walls, false)] {
+                // The boundary pairs' n × f, from `boundary_laws`, stays for this pass.
+                if !(pair_list && boundary.is_some()) {
+                    list.turn.clear();
+                }
                 if keep_turn {
                     list.turn.resize(list.items.len(), Vec3::zeros());
                 }
@@ -298,9 +314,10 @@ impl DemContacts {
                 let partners = &this.candidates.partners()[run.partners.clone()];
                 let sums = RunSums { own, foreign, lo };
                 let input = (lists, slots, partners, sums);
+                let known = (images, boundary);
                 match scaled {
-                    true => this.evaluate_run::<LAW, SUM, true>(time, dt, lanes, images, input),
-                    false => this.evaluate_run::<LAW, SUM, false>(time, dt, lanes, images, input),
+                    true => this.evaluate_run::<LAW, SUM, true>(time, dt, lanes, known, input),
+                    false => this.evaluate_run::<LAW, SUM, false>(time, dt, lanes, known, input),
                 }
                 let (true, Some(carriers)) = (SUM, &carriers) else {
                     return;
@@ -363,6 +380,66 @@ impl DemContacts {
         t
     }
 
+    /// Stage 5 with a time-delayed boundary along `axis`, on one process, once the lists'
+    /// image translations are taken (module doc): the law of the pairs whose image crosses
+    /// `axis` alone, each one's n × f kept beside its record for the reduction and for the
+    /// fused pass of stage 6, which runs the law of every other contact. Returns false, and
+    /// runs nothing, where that does not hold (a rank, a servo wall, the first law pass after
+    /// a build): the caller then runs the law of every contact.
+    pub(super) fn boundary_laws(&mut self, dt: f64, axis: usize) -> bool {
+        let pairs = self.candidates.pairs();
+        if !self.kernel.images
+            || self.split.is_some()
+            || self.has_servo()
+            || pairs.shift.len() != pairs.items.len()
+        {
+            return false;
+        }
+        let mut pairs = std::mem::take(self.candidates.pairs_mut());
+        pairs.turn.clear();
+        pairs.turn.resize(pairs.items.len(), Vec3::zeros());
+        if self.rolling().is_some() {
+            pairs.keep_rolling();
+        }
+        let law = &self.settings.law;
+        let mut through = std::mem::take(&mut self.kernel.boundary_pairs);
+        through.clear();
+        for k in 0..pairs.items.len() {
+            let shift = pairs.shift[k];
+            if shift[axis] == 0.0 {
+                continue;
+            }
+            through.push(k as u32);
+            let contact = &mut pairs.items[k];
+            let Some((pair, e)) = self.spheres_through(contact, shift) else {
+                contact.part();
+                pairs.turn[k] = Vec3::zeros();
+                if let Some(roll) = pairs.roll.get_mut(k) {
+                    *roll = Vec3::zeros();
+                }
+                continue;
+            };
+            let g = pair.geometry();
+            let f = law.force(&g, &e, &mut contact.history, dt);
+            if let Some(roll) = pairs.roll.get_mut(k) {
+                self.roll_pair(contact, (&g, &e), &f, roll, dt);
+            }
+            pairs.turn[k] = contact.touch(f, &g.normal, g.overlap);
+        }
+        *self.candidates.pairs_mut() = pairs;
+        self.kernel.boundary = Some(axis);
+        self.kernel.boundary_pairs = through;
+        true
+    }
+
+    /// The pairs through the time-delayed boundary whose law [`DemContacts::boundary_laws`]
+    /// ran in this evaluation, by index in the list; `None` where it did not run.
+    pub(super) fn boundary_pairs(&self) -> Option<&[u32]> {
+        self.kernel
+            .boundary
+            .map(|_| self.kernel.boundary_pairs.as_slice())
+    }
+
     /// Adds the complete sum of every partner this process or rank owns to its particle
     /// (`force`) and rotation (`torque`), in ascending sphere order: after a kernel pass that
     /// summed without them.
@@ -387,14 +464,16 @@ impl DemContacts {
     /// ([`LawLanes`]) and are recorded and summed in list order when it is full: the sums
     /// take the same additions in the same order, since an apart pair adds nothing. A
     /// pair's image translation is taken into the lists' column unless `images` says the
-    /// column holds it since the build.
+    /// column holds it since the build. With `boundary` (the delay axis, `SCALED` only), the
+    /// pairs through it had their law in [`DemContacts::boundary_laws`]: each is summed from
+    /// its record, after the waiting batch, so that the shares stay in list order.
     #[inline(always)]
     fn evaluate_run<const LAW: bool, const SUM: bool, const SCALED: bool>(
         &self,
         time: f64,
         dt: f64,
         lanes: LaneSet,
-        images: bool,
+        (images, boundary): (bool, Option<usize>),
         (mut lists, slots, partners, mut sums): (RunLists<'_>, &[u32], &[u32], RunSums<'_>),
     ) {
         let law = &self.settings.law;
@@ -423,6 +502,18 @@ impl DemContacts {
                         Some(at) => *at,
                         None => Vec3::zeros(),
                     };
+                    if SCALED && boundary.is_some_and(|axis| shift[axis] != 0.0) {
+                        if in_lanes && batch.lanes.len() > 0 {
+                            self.finish_batch::<SUM, SCALED>(
+                                dt, &mut batch, &mut lists, slots, &delay, &mut sums,
+                            );
+                        }
+                        if SUM {
+                            let turn = lists.turns[k];
+                            self.add_pair::<SCALED>(k, &turn, &lists, slots[k], &delay, &mut sums);
+                        }
+                        continue;
+                    }
                     let Some((pair, e)) = self.spheres_through(contact, shift) else {
                         contact.part();
                         for at in [lists.turns.get_mut(k), lists.rolls.get_mut(k)]

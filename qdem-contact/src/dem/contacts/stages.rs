@@ -29,6 +29,9 @@ pub(super) enum Evaluated {
     Nothing,
     /// The law (the sums need the ghost scales of a time-delayed boundary first).
     Laws,
+    /// The law of the pairs through a time-delayed boundary alone (`boundary_laws`): the
+    /// apply stage runs the fused pass, which reads their records.
+    Boundary,
     /// The law and the sums (a servo wall's reduction read the forces).
     Sums,
 }
@@ -177,11 +180,15 @@ impl DemContacts {
     }
 
     /// Stage 5: the pair kernel's law pass, when the reduction reads this evaluation's
-    /// forces: without the sums when they wait for a time-delayed boundary's scales, with
-    /// them for a servo wall's load alone; otherwise nothing yet.
+    /// forces: without the sums when they wait for a time-delayed boundary's scales (on one
+    /// process, once the images are taken, of the pairs through it alone), with them for a
+    /// servo wall's load alone; otherwise nothing yet.
     pub(super) fn compute_stage(&mut self, time: f64) {
         let dt = self.evaluation.dt;
-        self.evaluation.evaluated = if self.time_delay.is_some() {
+        let axis = self.time_delay.as_ref().map(|delay| delay.ghosts().0);
+        self.evaluation.evaluated = if axis.is_some_and(|axis| self.boundary_laws(dt, axis)) {
+            Evaluated::Boundary
+        } else if self.time_delay.is_some() {
             self.run_kernel::<true, false>(time, dt, None);
             Evaluated::Laws
         } else if self.has_servo() {
@@ -198,7 +205,7 @@ impl DemContacts {
     /// when the model has neither.
     pub(super) fn reduction_stage(&mut self, out: &mut Vec<f64>) -> bool {
         if let Some(delay) = &self.time_delay {
-            delay.reduction(self.candidates.pairs(), out);
+            delay.reduction(self.candidates.pairs(), self.boundary_pairs(), out);
         }
         let spheres = (self.spheres.records(), self.spheres.radius());
         let servo = self.walls.servo_contacts(
@@ -246,7 +253,9 @@ impl DemContacts {
     pub(super) fn apply_stage(&mut self, force: &mut [Vec3], torque: &mut [Vec3]) {
         let (time, dt) = (self.evaluation.last_time.unwrap_or(0.0), self.evaluation.dt);
         match std::mem::take(&mut self.evaluation.evaluated) {
-            Evaluated::Nothing => self.run_kernel::<true, true>(time, dt, Some((force, torque))),
+            Evaluated::Nothing | Evaluated::Boundary => {
+                self.run_kernel::<true, true>(time, dt, Some((force, torque)))
+            }
             Evaluated::Laws => self.run_kernel::<false, true>(time, dt, Some((force, torque))),
             Evaluated::Sums => self.add_partner_sums(force, torque),
         }

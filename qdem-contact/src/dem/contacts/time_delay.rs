@@ -5,7 +5,7 @@
 //! scales the sums of that same evaluation apply.
 
 use crate::boundaries::time_delayed_boundary::{GhostScales, TimeDelayedBoundary};
-use crate::dem::contact_list::ContactList;
+use crate::dem::contact_list::{Contact, ContactList};
 use qdem_core::{checkpoint::CheckpointError, checkpoint::Decoder, checkpoint::Encoder, Vec3};
 
 /// A time-delayed periodic boundary along one periodic axis, and its latest state.
@@ -41,9 +41,23 @@ impl TimeDelay {
 
     /// Appends to `out`, one entry of six values each (kind 0, partners, force magnitude,
     /// two zeros), the touching pairs of `pairs` whose second sphere's image crosses the
-    /// delay axis.
-    pub(super) fn reduction(&self, pairs: &ContactList, out: &mut Vec<f64>) {
-        for (c, shift) in pairs.with_shifts() {
+    /// delay axis, in list order; `through`, where known, lists those pairs' indices
+    /// (ascending), so that the others are not read.
+    pub(super) fn reduction(
+        &self,
+        pairs: &ContactList,
+        through: Option<&[u32]>,
+        out: &mut Vec<f64>,
+    ) {
+        let records: Box<dyn Iterator<Item = (&Contact, Vec3)>> = match through {
+            Some(through) => Box::new(
+                through
+                    .iter()
+                    .map(|&k| (&pairs.items[k as usize], pairs.shift(k as usize))),
+            ),
+            None => Box::new(pairs.with_shifts()),
+        };
+        for (c, shift) in records {
             if c.force != Vec3::zeros() && shift[self.axis] != 0.0 {
                 out.extend([
                     0.0,

@@ -27,6 +27,8 @@ scene_table! {
     /// # or: sample = "stones.csv", crop = [[0, 0.7, 0], [0.3, 1.4, 0.45]]
     /// # a periodic cell's sample repeated along y:
     /// # sample = "stones.csv", copies = [[0, -0.7, 0], [0, 0, 0], [0, 0.7, 0]]
+    /// # a periodic cell's whole sample between walls at y = 0.7 and 1.4, to pour back:
+    /// # sample = "stones.csv", refill = [[0, 0.7, 0.5], [0.3, 1.4, 2.0]]
     /// ```
     #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
     #[serde(deny_unknown_fields)]
@@ -48,6 +50,14 @@ scene_table! {
         crop: Option<[[f64; 3]; 2]> => "[[x, y, z], [x, y, z]]", optional,
             "Keep only the sample's stones whose spheres all lie inside this box (m), up to \
              `CROP_TOLERANCE` of a radius (a stone resting on a wall of the box stays).";
+        #[serde(default)]
+        refill: Option<[[f64; 3]; 2]> => "[[x, y, z], [x, y, z]]", optional,
+            "A walled box's whole sample, to be poured back in a deposition run: after `copies` \
+             and `crop`, the sample's stones not wholly inside this box along x and y (those \
+             astride a wall a crop would drop) are moved inside it by their overhang and \
+             stacked from its lower z up, clear of each other (m; the other stones must lie \
+             below its lower z, the stack below its upper z). The box keeps every stone, so the \
+             same count and mass as the sample.";
         #[serde(default)]
         region: Option<[[f64; 3]; 2]> => "[[x, y, z], [x, y, z]]", optional,
             "Generation: the box filled with stones on a loose lattice (m).";

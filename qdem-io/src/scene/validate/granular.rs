@@ -9,7 +9,7 @@ use super::checker::{box_corners, quoted_names, Checker};
 use super::material::Materials;
 
 /// `[granular]`: its material (returned as an index), a sample file or a generation (region,
-/// count, grading), a crop.
+/// count, grading), a crop, a refill (only with a sample).
 pub(super) fn granular_table(
     c: &mut Checker<'_>,
     raw: &RawScene,
@@ -60,12 +60,24 @@ pub(super) fn granular_table(
             );
         }
     }
-    for (key, b) in [("region", &g.region), ("crop", &g.crop)] {
+    for (key, b) in [
+        ("region", &g.region),
+        ("crop", &g.crop),
+        ("refill", &g.refill),
+    ] {
         if let Some(b) = b {
             box_corners(c, "granular", &l, key, b);
         }
     }
     copies_key(c, &l, g);
+    if g.refill.is_some() && g.sample.is_none() {
+        c.error(
+            &["granular", "refill"],
+            format!(
+                "{l}: refill moves a `sample` file's stones into a box; give one or drop refill"
+            ),
+        );
+    }
     motion_keys(c, &l, g);
     material
 }
