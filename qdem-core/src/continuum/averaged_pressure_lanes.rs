@@ -17,11 +17,11 @@
 //! ([`Scalar`]: one lane): the sums are the same bits on any CPU, for any thread or rank count.
 
 use crate::continuum::tet_lanes::{
-    cross, dot, edges, face_force, gather, green_strain, lame, rate_of_deformation, LaneSet, Simd,
-    TetPack, PACK, V3,
+    cofactor, corner_offsets, dm_inv_lanes, edges, face_force, force_pass, gather, green_strain,
+    lame, lane_force_sums, lane_set_fns, rate_of_deformation, LaneForces, LaneSet, Simd, TetPack,
+    PACK, V3,
 };
 use crate::Vec3;
-use std::cmp::Ordering::Greater;
 
 /// Floating-point operations of one elastic tet-step of the averaged-pressure tetrahedron, a
 /// multiply-add counted as two: the standard kernel's
@@ -87,57 +87,15 @@ pub(crate) fn force_sums<const VISCOUS: bool>(
     input: &ForceInput,
     out: &mut [Vec3],
 ) -> Option<usize> {
-    match set {
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: `LaneSet::detected` chooses a set only when the CPU has its features.
-        LaneSet::Avx512 => unsafe { force_avx512::<VISCOUS>(packs, input, out) },
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: as above.
-        LaneSet::Avx2 => unsafe { force_avx2::<VISCOUS>(packs, input, out) },
+    match lane_force_sums::<ForceInput, VISCOUS>(set, packs, input, out) {
+        Some(first) => first,
         // SAFETY: the scalar lane needs no feature.
-        _ => unsafe { force_pass::<Scalar, VISCOUS>(packs, input, out) },
+        None => unsafe { force_pass::<Scalar, ForceInput, VISCOUS>(packs, input, out) },
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
-unsafe fn strain_avx512<const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &StrainInput,
-    out: &mut [Vec3],
-) {
-    strain_pass::<crate::continuum::tet_lanes::x86::Avx512, VISCOUS>(packs, input, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn strain_avx2<const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &StrainInput,
-    out: &mut [Vec3],
-) {
-    strain_pass::<crate::continuum::tet_lanes::x86::Avx2, VISCOUS>(packs, input, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
-unsafe fn force_avx512<const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &ForceInput,
-    out: &mut [Vec3],
-) -> Option<usize> {
-    force_pass::<crate::continuum::tet_lanes::x86::Avx512, VISCOUS>(packs, input, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn force_avx2<const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &ForceInput,
-    out: &mut [Vec3],
-) -> Option<usize> {
-    force_pass::<crate::continuum::tet_lanes::x86::Avx2, VISCOUS>(packs, input, out)
-}
+lane_set_fns!(strain_avx512, strain_avx2 = strain_pass [const VISCOUS: bool] [VISCOUS]
+    (packs: &[TetPack], input: &StrainInput, out: &mut [Vec3]) -> ());
 
 /// One lane of plain f64, with the fused multiply-add of the vector sets, so that a CPU
 /// without AVX2 computes the same bits.
@@ -193,32 +151,6 @@ impl Simd for Scalar {
     }
 }
 
-/// The corner offsets and dX⁻¹ of lanes `o..o + S::N` of `pack`.
-#[inline(always)]
-unsafe fn lanes_of<S: Simd>(pack: &TetPack, o: usize) -> ([S::Idx; 4], [S::V; 9]) {
-    let mut corners = [S::offsets(&pack.local[0][o..]); 4];
-    for (c, offsets) in corners.iter_mut().enumerate().skip(1) {
-        *offsets = S::offsets(&pack.local[c][o..]);
-    }
-    let mut dm = [S::splat(0.0); 9];
-    for (entry, lanes) in dm.iter_mut().zip(&pack.dm_inv) {
-        *entry = S::load(&lanes[o..]);
-    }
-    (corners, dm)
-}
-
-/// The cofactor columns c_j (area vectors A_j = −½ c_j) and 6 × the volume of edges `d`.
-#[inline(always)]
-unsafe fn cofactor<S: Simd>(d: &[V3<S>; 3]) -> ([V3<S>; 3], S::V) {
-    let c = [
-        cross::<S>(&d[1], &d[2]),
-        cross::<S>(&d[2], &d[0]),
-        cross::<S>(&d[0], &d[1]),
-    ];
-    let six_volume = dot::<S>(&d[0], &c[0]);
-    (c, six_volume)
-}
-
 /// The strain pass with `S::N` lanes per vector.
 #[inline(always)]
 unsafe fn strain_pass<S: Simd, const VISCOUS: bool>(
@@ -233,7 +165,8 @@ unsafe fn strain_pass<S: Simd, const VISCOUS: bool>(
             if base >= input.count {
                 break;
             }
-            let (corners, dm) = lanes_of::<S>(pack, o);
+            let corners = corner_offsets::<S>(pack, o);
+            let dm = dm_inv_lanes::<S>(pack, o);
             let d = edges::<S>(&gather::<S>(input.x, &corners));
             let e = green_strain::<S>(&d, &dm);
             let quarter = S::load(&input.quarter[p][o..]);
@@ -275,41 +208,19 @@ unsafe fn corner_mean<S: Simd>(values: &[Vec3], corners: &[S::Idx; 4], k: usize)
     S::mul(S::splat(0.25), sum)
 }
 
-/// The force pass with `S::N` lanes per vector.
-#[inline(always)]
-unsafe fn force_pass<S: Simd, const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &ForceInput,
-    out: &mut [Vec3],
-) -> Option<usize> {
-    let mut first = None;
-    let mut f = [[0.0f64; PACK]; 12];
-    let mut six_volumes = [0.0f64; PACK];
-    for (p, pack) in packs.iter().enumerate() {
-        for o in (0..PACK).step_by(S::N) {
-            let base = p * PACK + o;
-            if base >= input.count {
-                break;
-            }
-            let (corners, dm) = lanes_of::<S>(pack, o);
-            let (forces, six_volume) = lane_forces::<S, VISCOUS>(&corners, &dm, input);
-            for (to, from) in f.iter_mut().zip(forces.iter().flatten()) {
-                S::store(*from, to);
-            }
-            S::store(six_volume, &mut six_volumes);
-            for l in 0..S::N.min(input.count - base) {
-                for c in 0..4 {
-                    let at = pack.local[c][o + l] as usize;
-                    out[at] += Vec3::new(f[3 * c][l], f[3 * c + 1][l], f[3 * c + 2][l]);
-                }
-                // B = FFᵀ cannot tell an inverted tetrahedron from its mirror image.
-                if first.is_none() && six_volumes[l].partial_cmp(&0.0) != Some(Greater) {
-                    first = Some(base + l);
-                }
-            }
-        }
+impl LaneForces for ForceInput<'_> {
+    #[inline(always)]
+    fn count(&self) -> usize {
+        self.count
     }
-    first
+    #[inline(always)]
+    unsafe fn lane_forces<S: Simd, const VISCOUS: bool>(
+        &self,
+        corners: &[S::Idx; 4],
+        dm: &[S::V; 9],
+    ) -> ([V3<S>; 4], S::V) {
+        lane_forces::<S, VISCOUS>(corners, dm, self)
+    }
 }
 
 /// The forces on the four corners of `S::N` tetrahedra and 6 × their volumes.
