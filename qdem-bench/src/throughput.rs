@@ -96,7 +96,8 @@ impl BenchResult {
     ///
     /// The averaged-pressure tetrahedron
     /// ([`qdem_core::continuum::averaged_pressure_tet`]) adds its strain pass and average:
-    /// per tetrahedron the pack read again and its volume (88 B); per block node its index
+    /// per tetrahedron the pack's corners read again (8 B) and its strain weights (56 B, 64 B
+    /// with the viscous weight V_e/4); per block node its index
     /// and position copied in again (28 B, 52 B with velocities), its slot sum written and
     /// read back (48 B), the average's entry index (4 B) and the average copied into the force
     /// pass (24 B); per particle the average's range, inverse volume and average written
@@ -110,7 +111,7 @@ impl BenchResult {
             Formulation::AveragedPressure => {
                 per_block_node += 28.0 + visco + 48.0 + 4.0 + 24.0;
                 per_particle += 36.0;
-                per_tet + 88.0
+                per_tet + 8.0 + if self.viscous { 64.0 } else { 56.0 }
             }
         };
         (per_tet * self.tets as f64

@@ -5,7 +5,10 @@
 //!
 //! - the **strain pass** sums (V_e/4) θ_e, θ_e = tr ε_e (Eq. 4), and, when viscous,
 //!   (V_e/4) tr D_e (Eq. 6) into the block's node slots: the numerators of the particles'
-//!   averages θ̄_a = Σ_{e∋a} (V_e/4) θ_e / V̄_a;
+//!   averages θ̄_a = Σ_{e∋a} (V_e/4) θ_e / V̄_a. It computes only what these traces need:
+//!   (V_e/4) tr ε_e = (V_e/8)(tr FᵀF − 3) from the six products d_k · d_l of the current
+//!   edges and weights fixed by the reference ([`StrainPack`]: G = dX⁻¹ dX⁻ᵀ), not F's nine
+//!   entries; tr D_e = Σ_k dv_k · c_k / 6V, not D's diagonal;
 //! - the **force pass** computes each tetrahedron's stress from its own deviatoric strain and
 //!   the mean of its corners' averages, T = κ θ̄_e I + 2μ dev ε_e (+ κ_D tr(D)‾_e I +
 //!   2μ_D dev D_e), the deviatoric part as the Lamé law with λ = −⅔μ, and adds the forces of
@@ -17,31 +20,79 @@
 //! ([`Scalar`]: one lane): the sums are the same bits on any CPU, for any thread or rank count.
 
 use crate::continuum::tet_lanes::{
-    cross, dot, edges, face_force, gather, green_strain, lame, rate_of_deformation, LaneSet, Simd,
-    TetPack, PACK, V3,
+    cofactor, corner_offsets, dot, edges, face_force, force_pass, gather, green_strain, lame,
+    lane_force_sums, lane_set_fns, rate_of_deformation, LaneForces, LaneSet, Simd, TetPack, PACK,
+    V3,
 };
-use crate::Vec3;
-use std::cmp::Ordering::Greater;
+use crate::{Mat3, Vec3};
 
 /// Floating-point operations of one elastic tet-step of the averaged-pressure tetrahedron, a
 /// multiply-add counted as two: the standard kernel's
 /// ([`crate::continuum::tet_lanes::FLOPS_ELASTIC`], the deviatoric law costing what the Lamé
-/// law does), the strain pass (edges 9, F 45, tr ε 21, the weight 3, the slot sums 4) and the
-/// corners' mean pressure (8).
-pub const FLOPS_AVERAGED_ELASTIC: usize = crate::continuum::tet_lanes::FLOPS_ELASTIC + 90;
+/// law does), the strain pass (edges 9, the six products d_k · d_l 30, their weighted sum 12,
+/// the slot sums 4) and the corners' mean pressure (8).
+pub const FLOPS_AVERAGED_ELASTIC: usize = crate::continuum::tet_lanes::FLOPS_ELASTIC + 63;
 /// Floating-point operations of one viscoelastic tet-step of the averaged-pressure
 /// tetrahedron: the standard viscoelastic kernel's, the elastic strain pass and pressure
-/// (90), and the strain pass's rate (cofactor and volume 32, velocity edges 9, 1/det 1,
-/// tr D 18, weight and slot sums 7) and its mean (6).
+/// (63), and the strain pass's rate (cofactor and volume 32, velocity edges 9, Σ dv_k · c_k
+/// 17, weight and 1/det 2, slot sums 4) and its mean (6).
 pub const FLOPS_AVERAGED_VISCOELASTIC: usize =
-    crate::continuum::tet_lanes::FLOPS_VISCOELASTIC + 90 + 73;
+    crate::continuum::tet_lanes::FLOPS_VISCOELASTIC + 63 + 70;
+
+/// The weights of the strain pass for `PACK` tetrahedra (by lane, as [`TetPack`]): with
+/// G = dX⁻¹ dX⁻ᵀ, (V_e/4) tr ε_e = (V_e/8)(tr FᵀF − 3) = Σ_{k≤l} w_kl (d_k · d_l) − 3V_e/8 for
+/// the current edges d_k (F = [d₀ d₁ d₂] dX⁻¹, so tr FᵀF = Σ_kl G_kl d_k · d_l): six
+/// products of edges in place of F's nine entries and ε's diagonal.
+#[derive(Clone, Debug)]
+#[repr(C, align(64))]
+pub(crate) struct StrainPack {
+    /// w_kl: (V_e/8) G_kk for k = 0, 1, 2, then (V_e/4) G_kl for (k, l) = (0, 1), (1, 2),
+    /// (0, 2).
+    pub(crate) metric: [[f64; PACK]; 6],
+    /// −3V_e/8, the weighted sum at rest.
+    pub(crate) rest: [f64; PACK],
+    /// V_e/4, the weight of tr D_e.
+    pub(crate) quarter: [f64; PACK],
+}
+
+impl StrainPack {
+    /// The weights of tetrahedra `lanes` (dX⁻¹ and the reference volume V_e of each, at most
+    /// [`PACK`], at least one), the last repeated in the unused lanes as
+    /// [`crate::continuum::tet_lanes::packs`] does.
+    pub(crate) fn new(lanes: &[(Mat3, f64)]) -> StrainPack {
+        let mut pack = StrainPack {
+            metric: [[0.0; PACK]; 6],
+            rest: [0.0; PACK],
+            quarter: [0.0; PACK],
+        };
+        for l in 0..PACK {
+            let (dm_inv, volume) = &lanes[l.min(lanes.len() - 1)];
+            let g = dm_inv * dm_inv.transpose();
+            let (eighth, quarter) = (0.125 * volume, 0.25 * volume);
+            let w = [
+                eighth * g[(0, 0)],
+                eighth * g[(1, 1)],
+                eighth * g[(2, 2)],
+                quarter * g[(0, 1)],
+                quarter * g[(1, 2)],
+                quarter * g[(0, 2)],
+            ];
+            for (lanes, w) in pack.metric.iter_mut().zip(w) {
+                lanes[l] = w;
+            }
+            pack.rest[l] = -3.0 * eighth;
+            pack.quarter[l] = quarter;
+        }
+        pack
+    }
+}
 
 /// What the strain pass reads: the block's node positions (and velocities, read only when
-/// viscous), each pack's reference volumes / 4 by lane, and the number of real tetrahedra.
+/// viscous), each pack's strain weights and the number of real tetrahedra.
 pub(crate) struct StrainInput<'a> {
     pub x: &'a [Vec3],
     pub v: &'a [Vec3],
-    pub quarter: &'a [[f64; PACK]],
+    pub weights: &'a [StrainPack],
     pub count: usize,
 }
 
@@ -67,6 +118,7 @@ pub(crate) fn strain_sums<const VISCOUS: bool>(
     out: &mut [Vec3],
 ) {
     assert_eq!(out.len(), input.x.len(), "a slot per node of the block");
+    assert_eq!(packs.len(), input.weights.len(), "strain weights per pack");
     match set {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: `LaneSet::detected` chooses a set only when the CPU has its features.
@@ -87,57 +139,15 @@ pub(crate) fn force_sums<const VISCOUS: bool>(
     input: &ForceInput,
     out: &mut [Vec3],
 ) -> Option<usize> {
-    match set {
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: `LaneSet::detected` chooses a set only when the CPU has its features.
-        LaneSet::Avx512 => unsafe { force_avx512::<VISCOUS>(packs, input, out) },
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: as above.
-        LaneSet::Avx2 => unsafe { force_avx2::<VISCOUS>(packs, input, out) },
+    match lane_force_sums::<ForceInput, VISCOUS>(set, packs, input, out) {
+        Some(first) => first,
         // SAFETY: the scalar lane needs no feature.
-        _ => unsafe { force_pass::<Scalar, VISCOUS>(packs, input, out) },
+        None => unsafe { force_pass::<Scalar, ForceInput, VISCOUS>(packs, input, out) },
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
-unsafe fn strain_avx512<const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &StrainInput,
-    out: &mut [Vec3],
-) {
-    strain_pass::<crate::continuum::tet_lanes::x86::Avx512, VISCOUS>(packs, input, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn strain_avx2<const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &StrainInput,
-    out: &mut [Vec3],
-) {
-    strain_pass::<crate::continuum::tet_lanes::x86::Avx2, VISCOUS>(packs, input, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
-unsafe fn force_avx512<const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &ForceInput,
-    out: &mut [Vec3],
-) -> Option<usize> {
-    force_pass::<crate::continuum::tet_lanes::x86::Avx512, VISCOUS>(packs, input, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn force_avx2<const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &ForceInput,
-    out: &mut [Vec3],
-) -> Option<usize> {
-    force_pass::<crate::continuum::tet_lanes::x86::Avx2, VISCOUS>(packs, input, out)
-}
+lane_set_fns!(strain_avx512, strain_avx2 = strain_pass [const VISCOUS: bool] [VISCOUS]
+    (packs: &[TetPack], input: &StrainInput, out: &mut [Vec3]) -> ());
 
 /// One lane of plain f64, with the fused multiply-add of the vector sets, so that a CPU
 /// without AVX2 computes the same bits.
@@ -193,30 +203,42 @@ impl Simd for Scalar {
     }
 }
 
-/// The corner offsets and dX⁻¹ of lanes `o..o + S::N` of `pack`.
+/// Σ_{k≤l} w_kl (d_k · d_l) − 3V_e/8 = (V_e/4) tr ε_e of the lanes `o..o + S::N` of
+/// `weights` ([`StrainPack`]) with edges `d`.
 #[inline(always)]
-unsafe fn lanes_of<S: Simd>(pack: &TetPack, o: usize) -> ([S::Idx; 4], [S::V; 9]) {
-    let mut corners = [S::offsets(&pack.local[0][o..]); 4];
-    for (c, offsets) in corners.iter_mut().enumerate().skip(1) {
-        *offsets = S::offsets(&pack.local[c][o..]);
+unsafe fn weighted_dilatation<S: Simd>(d: &[V3<S>; 3], weights: &StrainPack, o: usize) -> S::V {
+    let products = [
+        dot::<S>(&d[0], &d[0]),
+        dot::<S>(&d[1], &d[1]),
+        dot::<S>(&d[2], &d[2]),
+        dot::<S>(&d[0], &d[1]),
+        dot::<S>(&d[1], &d[2]),
+        dot::<S>(&d[0], &d[2]),
+    ];
+    let mut sum = S::load(&weights.rest[o..]);
+    for (product, lanes) in products.iter().zip(&weights.metric) {
+        sum = S::mul_add(S::load(&lanes[o..]), *product, sum);
     }
-    let mut dm = [S::splat(0.0); 9];
-    for (entry, lanes) in dm.iter_mut().zip(&pack.dm_inv) {
-        *entry = S::load(&lanes[o..]);
-    }
-    (corners, dm)
+    sum
 }
 
-/// The cofactor columns c_j (area vectors A_j = −½ c_j) and 6 × the volume of edges `d`.
+/// (V_e/4) tr D_e = (V_e/4) Σ_k dv_k · c_k / (6V) (Eqs. 5–6: tr L with L = Σ_k dv_k ⊗ c_k /
+/// 6V) of the lanes `o..o + S::N` of `weights` with edges `d` and velocity edges `dv`.
 #[inline(always)]
-unsafe fn cofactor<S: Simd>(d: &[V3<S>; 3]) -> ([V3<S>; 3], S::V) {
-    let c = [
-        cross::<S>(&d[1], &d[2]),
-        cross::<S>(&d[2], &d[0]),
-        cross::<S>(&d[0], &d[1]),
-    ];
-    let six_volume = dot::<S>(&d[0], &c[0]);
-    (c, six_volume)
+unsafe fn weighted_rate<S: Simd>(
+    d: &[V3<S>; 3],
+    dv: &[V3<S>; 3],
+    weights: &StrainPack,
+    o: usize,
+) -> S::V {
+    let (c, six_volume) = cofactor::<S>(d);
+    let mut trace = dot::<S>(&dv[0], &c[0]);
+    for k in 1..3 {
+        for i in 0..3 {
+            trace = S::mul_add(dv[k][i], c[k][i], trace);
+        }
+    }
+    S::div(S::mul(S::load(&weights.quarter[o..]), trace), six_volume)
 }
 
 /// The strain pass with `S::N` lanes per vector.
@@ -227,26 +249,18 @@ unsafe fn strain_pass<S: Simd, const VISCOUS: bool>(
     out: &mut [Vec3],
 ) {
     let (mut theta, mut rate) = ([0.0f64; PACK], [0.0f64; PACK]);
-    for (p, pack) in packs.iter().enumerate() {
+    for (p, (pack, weights)) in packs.iter().zip(input.weights).enumerate() {
         for o in (0..PACK).step_by(S::N) {
             let base = p * PACK + o;
             if base >= input.count {
                 break;
             }
-            let (corners, dm) = lanes_of::<S>(pack, o);
+            let corners = corner_offsets::<S>(pack, o);
             let d = edges::<S>(&gather::<S>(input.x, &corners));
-            let e = green_strain::<S>(&d, &dm);
-            let quarter = S::load(&input.quarter[p][o..]);
-            S::store(
-                S::mul(quarter, S::add(S::add(e[0], e[1]), e[2])),
-                &mut theta,
-            );
+            S::store(weighted_dilatation::<S>(&d, weights, o), &mut theta);
             if VISCOUS {
-                let (c, six_volume) = cofactor::<S>(&d);
                 let dv = edges::<S>(&gather::<S>(input.v, &corners));
-                let inv_det = S::div(S::splat(1.0), six_volume);
-                let r = rate_of_deformation::<S>(&dv, &c, inv_det);
-                S::store(S::mul(quarter, S::add(S::add(r[0], r[1]), r[2])), &mut rate);
+                S::store(weighted_rate::<S>(&d, &dv, weights, o), &mut rate);
             }
             for l in 0..S::N.min(input.count - base) {
                 for local in &pack.local {
@@ -275,41 +289,19 @@ unsafe fn corner_mean<S: Simd>(values: &[Vec3], corners: &[S::Idx; 4], k: usize)
     S::mul(S::splat(0.25), sum)
 }
 
-/// The force pass with `S::N` lanes per vector.
-#[inline(always)]
-unsafe fn force_pass<S: Simd, const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &ForceInput,
-    out: &mut [Vec3],
-) -> Option<usize> {
-    let mut first = None;
-    let mut f = [[0.0f64; PACK]; 12];
-    let mut six_volumes = [0.0f64; PACK];
-    for (p, pack) in packs.iter().enumerate() {
-        for o in (0..PACK).step_by(S::N) {
-            let base = p * PACK + o;
-            if base >= input.count {
-                break;
-            }
-            let (corners, dm) = lanes_of::<S>(pack, o);
-            let (forces, six_volume) = lane_forces::<S, VISCOUS>(&corners, &dm, input);
-            for (to, from) in f.iter_mut().zip(forces.iter().flatten()) {
-                S::store(*from, to);
-            }
-            S::store(six_volume, &mut six_volumes);
-            for l in 0..S::N.min(input.count - base) {
-                for c in 0..4 {
-                    let at = pack.local[c][o + l] as usize;
-                    out[at] += Vec3::new(f[3 * c][l], f[3 * c + 1][l], f[3 * c + 2][l]);
-                }
-                // B = FFᵀ cannot tell an inverted tetrahedron from its mirror image.
-                if first.is_none() && six_volumes[l].partial_cmp(&0.0) != Some(Greater) {
-                    first = Some(base + l);
-                }
-            }
-        }
+impl LaneForces for ForceInput<'_> {
+    #[inline(always)]
+    fn count(&self) -> usize {
+        self.count
     }
-    first
+    #[inline(always)]
+    unsafe fn lane_forces<S: Simd, const VISCOUS: bool>(
+        &self,
+        corners: &[S::Idx; 4],
+        dm: &[S::V; 9],
+    ) -> ([V3<S>; 4], S::V) {
+        lane_forces::<S, VISCOUS>(corners, dm, self)
+    }
 }
 
 /// The forces on the four corners of `S::N` tetrahedra and 6 × their volumes.
@@ -358,10 +350,19 @@ mod tests {
     use crate::continuum::tet_lanes::packs;
     use crate::Mat3;
 
+    /// A block of tetrahedra with their reference volumes, and its nodes' reference
+    /// positions, positions and velocities.
+    struct Chain {
+        hot: Vec<HotTet>,
+        volume: Vec<f64>,
+        reference: Vec<Vec3>,
+        x: Vec<Vec3>,
+        v: Vec<Vec3>,
+    }
+
     /// `count` tetrahedra along a chain (each sharing a corner with the next: every node in
-    /// one or two), strained by a smooth map and moving, with their packs' quarter volumes;
-    /// and the block's positions and velocities.
-    fn block(count: usize) -> (Vec<HotTet>, Vec<[f64; PACK]>, Vec<Vec3>, Vec<Vec3>) {
+    /// one or two), strained by a smooth map and moving.
+    fn chain(count: usize) -> Chain {
         let nodes = 3 * count + 1;
         let wobble = |i: usize, k: f64| ((i as f64 + 1.0) * k).sin() * 0.1;
         let reference: Vec<Vec3> = (0..nodes)
@@ -398,11 +399,19 @@ mod tests {
                 HotTet { dm_inv, local }
             })
             .collect();
-        let quarter = volume
-            .chunks(PACK)
-            .map(|c| std::array::from_fn(|l| 0.25 * c[l.min(c.len() - 1)]))
-            .collect();
-        (hot, quarter, x, v)
+        Chain {
+            hot,
+            volume,
+            reference,
+            x,
+            v,
+        }
+    }
+
+    /// The strain weights of the packs of `hot` with reference volumes `volume`.
+    fn weights(hot: &[HotTet], volume: &[f64]) -> Vec<StrainPack> {
+        let lanes: Vec<(Mat3, f64)> = hot.iter().map(|t| t.dm_inv).zip(volume.to_vec()).collect();
+        lanes.chunks(PACK).map(StrainPack::new).collect()
     }
 
     /// The lane sets this CPU runs, the scalar lane first.
@@ -420,7 +429,10 @@ mod tests {
     /// with the stress of Bonet & Burton computed with matrices to round-off.
     fn passes_agree<const VISCOUS: bool>() {
         let count = 45; // five packs, the last with 5 of 8 lanes
-        let (hot, quarter, x, v) = block(count);
+        let Chain {
+            hot, volume, x, v, ..
+        } = chain(count);
+        let weights = weights(&hot, &volume);
         let packs = packs(&hot);
         let (kappa, mu, kappa_d, mu_d) = (5.0e9, 2.0e9, 3.0e4, 7.0e4);
         let mut results = Vec::new();
@@ -428,7 +440,7 @@ mod tests {
             let strain = StrainInput {
                 x: &x,
                 v: &v,
-                quarter: &quarter,
+                weights: &weights,
                 count,
             };
             let mut sums = vec![Vec3::zeros(); x.len()];
@@ -437,7 +449,7 @@ mod tests {
             let mut nodal_volume = vec![0.0; x.len()];
             for (e, t) in hot.iter().enumerate() {
                 for &l in &t.local {
-                    nodal_volume[l as usize] += quarter[e / PACK][e % PACK];
+                    nodal_volume[l as usize] += 0.25 * volume[e];
                 }
             }
             let averages: Vec<Vec3> = sums
@@ -504,6 +516,60 @@ mod tests {
         let scale = want.iter().map(|f| f.norm()).fold(0.0, f64::max);
         for (got, want) in forces.iter().zip(&want) {
             assert!((got - want).norm() <= 1e-12 * scale, "{got} vs {want}");
+        }
+    }
+
+    /// The strain weights give (V_e/4) tr ε_e of Eq. 4 from the current edges alone, on every
+    /// lane set: nothing under a rigid rotation, and (V_e/4) · 3((1 + s)² − 1)/2 under a
+    /// uniform stretch 1 + s. The sums cancel terms of about 3V_e/8 each (six per
+    /// tetrahedron), so the tolerance is round-off of those: 1e-13 of a node's Σ V_e/4.
+    #[test]
+    fn the_strain_weights_give_the_trace_of_the_green_strain() {
+        let count = 45; // five packs, the last with 5 of 8 lanes
+        let Chain {
+            hot,
+            volume,
+            reference,
+            v,
+            ..
+        } = chain(count);
+        let weights = weights(&hot, &volume);
+        let packs = packs(&hot);
+        let mut nodal_quarter = vec![0.0; reference.len()];
+        for (t, volume) in hot.iter().zip(&volume) {
+            for &l in &t.local {
+                nodal_quarter[l as usize] += 0.25 * volume;
+            }
+        }
+        let rotation = nalgebra::Rotation3::from_euler_angles(0.3, -1.1, 0.7).into_inner();
+        let s = 0.01;
+        let cases = [
+            (rotation, 0.0),
+            (
+                Mat3::identity() * (1.0 + s),
+                1.5 * ((1.0 + s) * (1.0 + s) - 1.0),
+            ),
+        ];
+        for set in sets() {
+            for (map, trace) in cases {
+                let x: Vec<Vec3> = reference.iter().map(|p| map * p).collect();
+                let input = StrainInput {
+                    x: &x,
+                    v: &v,
+                    weights: &weights,
+                    count,
+                };
+                let mut sums = vec![Vec3::zeros(); x.len()];
+                strain_sums::<false>(set, &packs, &input, &mut sums);
+                for (got, quarter) in sums.iter().zip(&nodal_quarter) {
+                    let want = quarter * trace;
+                    assert!(
+                        (got.x - want).abs() <= 1e-13 * quarter,
+                        "{set:?}: {} vs {want}",
+                        got.x
+                    );
+                }
+            }
         }
     }
 

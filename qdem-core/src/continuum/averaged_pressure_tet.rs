@@ -44,7 +44,9 @@
 //! ([`nodal_average`], the one implementation of Eq. 9), so a reported pressure is the one
 //! the forces used, to the bit; the tangent's averaged divergence b̄_a sums in the same order.
 
-use crate::continuum::averaged_pressure_lanes::{force_sums, strain_sums, ForceInput, StrainInput};
+use crate::continuum::averaged_pressure_lanes::{
+    force_sums, strain_sums, ForceInput, StrainInput, StrainPack,
+};
 use crate::continuum::material::Material;
 use crate::continuum::tet_blocks::TetBlocks;
 use crate::continuum::tet_body::{current_gradients, for_blocks, lame_block};
@@ -94,8 +96,8 @@ pub(crate) struct AveragedPressure {
     dm_inv: Vec<Mat3>,
     /// Reference volume / 4 of each tetrahedron.
     quarter: Vec<f64>,
-    /// Reference volume / 4 of the tetrahedra of the blocks' packs, by lane.
-    quarter_packs: Vec<[f64; PACK]>,
+    /// The strain pass's weights of the tetrahedra of the blocks' packs.
+    strain_packs: Vec<StrainPack>,
     /// The first particle any tetrahedron uses.
     first: usize,
     /// Per particle from `first`, the range of its corners in `corners`.
@@ -185,7 +187,7 @@ impl AveragedPressure {
             tets: tets.to_vec(),
             dm_inv,
             quarter: volume.iter().map(|v| 0.25 * v).collect(),
-            quarter_packs: quarter_packs(blocks, volume),
+            strain_packs: strain_packs(blocks, volume),
             first,
             corner_start,
             corners,
@@ -201,8 +203,8 @@ impl AveragedPressure {
     /// The strain pass over the blocks `range` at `state`: each block's Σ (V_e/4) θ_e (and
     /// tr D_e) per node slot, the blocks in parallel.
     pub(crate) fn strain_pass(&mut self, blocks: &TetBlocks, range: Range<usize>, state: &State) {
-        let (quarter, viscous) = (&self.quarter_packs, self.viscous);
-        strain_slots(blocks, range, quarter, viscous, state, &mut self.partial);
+        let (weights, viscous) = (&self.strain_packs, self.viscous);
+        strain_slots(blocks, range, weights, viscous, state, &mut self.partial);
     }
 
     /// The averages θ̄_a (and tr(D)‾_a) of the particles `owned` (all when `None`; else those
@@ -221,11 +223,11 @@ impl AveragedPressure {
         if small_strain {
             small_strain_slots(blocks, &self.quarter, state, &mut partial);
         } else {
-            let quarter = &self.quarter_packs;
+            let weights = &self.strain_packs;
             strain_slots(
                 blocks,
                 0..blocks.len(),
-                quarter,
+                weights,
                 self.viscous,
                 state,
                 &mut partial,
@@ -442,7 +444,7 @@ impl Moduli {
 fn strain_slots(
     blocks: &TetBlocks,
     range: Range<usize>,
-    quarter: &[[f64; PACK]],
+    weights: &[StrainPack],
     viscous: bool,
     state: &State,
     partial: &mut [Vec3],
@@ -461,7 +463,7 @@ fn strain_slots(
             let input = StrainInput {
                 x: &scratch.x,
                 v: &scratch.v,
-                quarter: &quarter[packs.clone()],
+                weights: &weights[packs.clone()],
                 count: (blocks.tet_start[b + 1] - blocks.tet_start[b]) as usize,
             };
             let (set, packs) = (LaneSet::detected(), &blocks.packs[packs]);
@@ -539,15 +541,20 @@ fn deviator(e: &Mat3) -> Mat3 {
     e - Mat3::from_diagonal_element(e.trace() / 3.0)
 }
 
-/// Reference volume / 4 of each tetrahedron of the blocks' packs, by lane: a block's last pack
-/// repeats its last tetrahedron's, as [`crate::continuum::tet_lanes::packs`] does.
-fn quarter_packs(blocks: &TetBlocks, volume: &[f64]) -> Vec<[f64; PACK]> {
+/// The strain pass's weights ([`StrainPack`]) of the tetrahedra of the blocks' packs: a
+/// block's last pack repeats its last tetrahedron's, as
+/// [`crate::continuum::tet_lanes::packs`] does.
+fn strain_packs(blocks: &TetBlocks, volume: &[f64]) -> Vec<StrainPack> {
     let mut packs = Vec::with_capacity(blocks.packs.len());
+    let mut lanes = Vec::with_capacity(PACK);
     for range in blocks.tet_start.windows(2) {
-        let order = &blocks.order[range[0] as usize..range[1] as usize];
-        for chunk in order.chunks(PACK) {
-            let lane = |l: usize| 0.25 * volume[chunk[l.min(chunk.len() - 1)] as usize];
-            packs.push(std::array::from_fn(lane));
+        for chunk in (range[0] as usize..range[1] as usize).step_by(PACK) {
+            lanes.clear();
+            lanes.extend(
+                (chunk..(chunk + PACK).min(range[1] as usize))
+                    .map(|k| (blocks.hot[k].dm_inv, volume[blocks.order[k] as usize])),
+            );
+            packs.push(StrainPack::new(&lanes));
         }
     }
     packs

@@ -148,38 +148,55 @@ pub(crate) fn block_forces<const VISCOUS: bool>(
     input: &BlockInput,
     out: &mut [Vec3],
 ) -> Option<Option<usize>> {
+    lane_force_sums::<BlockInput, VISCOUS>(set, packs, input, out)
+}
+
+/// The force pass of `input`'s kernel ([`LaneForces`]) over a block's `packs` with the lanes
+/// of `set`, the forces added into `out`; the block index of the first tetrahedron whose
+/// volume is not positive. `None` when `set` is [`LaneSet::Scalar`] (no vector kernel).
+pub(crate) fn lane_force_sums<I: LaneForces, const VISCOUS: bool>(
+    set: LaneSet,
+    packs: &[TetPack],
+    input: &I,
+    out: &mut [Vec3],
+) -> Option<Option<usize>> {
     match set {
         LaneSet::Scalar => None,
         #[cfg(target_arch = "x86_64")]
         // SAFETY: `detected` chooses a set only when the CPU has its features.
-        LaneSet::Avx512 => Some(unsafe { pass_avx512::<VISCOUS>(packs, input, out) }),
+        LaneSet::Avx512 => Some(unsafe { force_avx512::<I, VISCOUS>(packs, input, out) }),
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
-        LaneSet::Avx2 => Some(unsafe { pass_avx2::<VISCOUS>(packs, input, out) }),
+        LaneSet::Avx2 => Some(unsafe { force_avx2::<I, VISCOUS>(packs, input, out) }),
         #[cfg(not(target_arch = "x86_64"))]
         _ => None,
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
-unsafe fn pass_avx512<const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &BlockInput,
-    out: &mut [Vec3],
-) -> Option<usize> {
-    pass::<x86::Avx512, VISCOUS>(packs, input, out)
-}
+/// Defines `$avx512` and `$avx2`: the generic block pass `$pass::<S, ...>` compiled with the
+/// target features of AVX-512 and of AVX2 with FMA (S the matching [`Simd`] set), the
+/// functions a dispatch on [`LaneSet`] calls. The generic parameters after `S` are given
+/// twice, declared (`[I: Bound, const VISCOUS: bool]`) and passed (`[I, VISCOUS]`).
+macro_rules! lane_set_fns {
+    ($avx512:ident, $avx2:ident = $pass:ident [$($decl:tt)*] [$($pass_args:tt)*]
+        ($($arg:ident: $ty:ty),* $(,)?) -> $ret:ty) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+        unsafe fn $avx512<$($decl)*>($($arg: $ty),*) -> $ret {
+            $pass::<$crate::continuum::tet_lanes::x86::Avx512, $($pass_args)*>($($arg),*)
+        }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn pass_avx2<const VISCOUS: bool>(
-    packs: &[TetPack],
-    input: &BlockInput,
-    out: &mut [Vec3],
-) -> Option<usize> {
-    pass::<x86::Avx2, VISCOUS>(packs, input, out)
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn $avx2<$($decl)*>($($arg: $ty),*) -> $ret {
+            $pass::<$crate::continuum::tet_lanes::x86::Avx2, $($pass_args)*>($($arg),*)
+        }
+    };
 }
+pub(crate) use lane_set_fns;
+
+lane_set_fns!(force_avx512, force_avx2 = force_pass [I: LaneForces, const VISCOUS: bool] [I, VISCOUS]
+    (packs: &[TetPack], input: &I, out: &mut [Vec3]) -> Option<usize>);
 
 /// The vector operations of the lane kernel, one implementation per instruction set. Every
 /// method is `unsafe`: it may run only on a CPU with the set's features, inlined into a
@@ -327,18 +344,50 @@ pub(crate) mod x86 {
     }
 }
 
+/// A block pass's force kernel: what the generic [`force_pass`] computes per lane vector.
+pub(crate) trait LaneForces {
+    /// The number of real tetrahedra of the block.
+    fn count(&self) -> usize;
+    /// The forces on the four corners of `S::N` tetrahedra (corner offsets `corners`, dX⁻¹
+    /// `dm`) and 6 × their volumes.
+    ///
+    /// # Safety
+    /// Only on a CPU with `S`'s features, inlined into a function that enables them.
+    unsafe fn lane_forces<S: Simd, const VISCOUS: bool>(
+        &self,
+        corners: &[S::Idx; 4],
+        dm: &[S::V; 9],
+    ) -> ([V3<S>; 4], S::V);
+}
+
+impl LaneForces for BlockInput<'_> {
+    #[inline(always)]
+    fn count(&self) -> usize {
+        self.count
+    }
+    #[inline(always)]
+    unsafe fn lane_forces<S: Simd, const VISCOUS: bool>(
+        &self,
+        corners: &[S::Idx; 4],
+        dm: &[S::V; 9],
+    ) -> ([V3<S>; 4], S::V) {
+        lane_forces::<S, VISCOUS>(corners, dm, self)
+    }
+}
+
 /// The block pass with `S::N` lanes per vector: each pack in `PACK / S::N` steps, the forces
 /// of the real lanes added in lane order. Compiled inside the functions that enable the
 /// features.
 #[inline(always)]
-unsafe fn pass<S: Simd, const VISCOUS: bool>(
+pub(crate) unsafe fn force_pass<S: Simd, I: LaneForces, const VISCOUS: bool>(
     packs: &[TetPack],
-    input: &BlockInput,
+    input: &I,
     out: &mut [Vec3],
 ) -> Option<usize> {
     let mut first = None;
     let mut f = [[0.0f64; PACK]; 12];
     let mut six_volume = [0.0f64; PACK];
+    let count = input.count();
     for (p, pack) in packs.iter().enumerate() {
         if input.prefetch {
             if let Some(ahead) = packs.get(p + prefetch::PACKS_AHEAD) {
@@ -347,23 +396,17 @@ unsafe fn pass<S: Simd, const VISCOUS: bool>(
         }
         for o in (0..PACK).step_by(S::N) {
             let base = p * PACK + o;
-            if base >= input.count {
+            if base >= count {
                 break;
             }
-            let mut corners = [S::offsets(&pack.local[0][o..]); 4];
-            for (c, offsets) in corners.iter_mut().enumerate().skip(1) {
-                *offsets = S::offsets(&pack.local[c][o..]);
-            }
-            let mut dm = [S::splat(0.0); 9];
-            for (entry, lanes) in dm.iter_mut().zip(&pack.dm_inv) {
-                *entry = S::load(&lanes[o..]);
-            }
-            let (forces, volume) = lane_forces::<S, VISCOUS>(&corners, &dm, input);
+            let corners = corner_offsets::<S>(pack, o);
+            let dm = dm_inv_lanes::<S>(pack, o);
+            let (forces, volume) = input.lane_forces::<S, VISCOUS>(&corners, &dm);
             for (to, from) in f.iter_mut().zip(forces.iter().flatten()) {
                 S::store(*from, to);
             }
             S::store(volume, &mut six_volume);
-            for l in 0..S::N.min(input.count - base) {
+            for l in 0..S::N.min(count - base) {
                 for c in 0..4 {
                     let at = pack.local[c][o + l] as usize;
                     out[at] += Vec3::new(f[3 * c][l], f[3 * c + 1][l], f[3 * c + 2][l]);
@@ -376,6 +419,26 @@ unsafe fn pass<S: Simd, const VISCOUS: bool>(
         }
     }
     first
+}
+
+/// The corner offsets of lanes `o..o + S::N` of `pack`.
+#[inline(always)]
+pub(crate) unsafe fn corner_offsets<S: Simd>(pack: &TetPack, o: usize) -> [S::Idx; 4] {
+    let mut corners = [S::offsets(&pack.local[0][o..]); 4];
+    for (c, offsets) in corners.iter_mut().enumerate().skip(1) {
+        *offsets = S::offsets(&pack.local[c][o..]);
+    }
+    corners
+}
+
+/// dX⁻¹ (row major) of lanes `o..o + S::N` of `pack`.
+#[inline(always)]
+pub(crate) unsafe fn dm_inv_lanes<S: Simd>(pack: &TetPack, o: usize) -> [S::V; 9] {
+    let mut dm = [S::splat(0.0); 9];
+    for (entry, lanes) in dm.iter_mut().zip(&pack.dm_inv) {
+        *entry = S::load(&lanes[o..]);
+    }
+    dm
 }
 
 use std::cmp::Ordering::Greater;
@@ -504,6 +567,19 @@ pub(crate) unsafe fn rate_of_deformation<S: Simd>(
     ]
 }
 
+/// The columns c_j of cof(dx) (the area vectors A_j = −½ c_j of the faces opposite vertices
+/// 1–3) and 6 × the volume, d₀ · c₀, of edges `d`.
+#[inline(always)]
+pub(crate) unsafe fn cofactor<S: Simd>(d: &[V3<S>; 3]) -> ([V3<S>; 3], S::V) {
+    let c = [
+        cross::<S>(&d[1], &d[2]),
+        cross::<S>(&d[2], &d[0]),
+        cross::<S>(&d[0], &d[1]),
+    ];
+    let six_volume = dot::<S>(&d[0], &c[0]);
+    (c, six_volume)
+}
+
 /// −(T · a)/6 for the symmetric T.
 #[inline(always)]
 pub(crate) unsafe fn face_force<S: Simd>(t: &Sym<S>, a: &V3<S>) -> V3<S> {
@@ -524,13 +600,7 @@ unsafe fn lane_forces<S: Simd, const VISCOUS: bool>(
     input: &BlockInput,
 ) -> ([V3<S>; 4], S::V) {
     let d = edges::<S>(&gather::<S>(input.x, corners));
-    // Columns of cof(dx): the area vectors A_j = −½ c_j of the faces opposite vertices 1–3.
-    let c = [
-        cross::<S>(&d[1], &d[2]),
-        cross::<S>(&d[2], &d[0]),
-        cross::<S>(&d[0], &d[1]),
-    ];
-    let six_volume = dot::<S>(&d[0], &c[0]);
+    let (c, six_volume) = cofactor::<S>(&d);
     let mut t = lame::<S>(&green_strain::<S>(&d, dm), input.elastic);
     if VISCOUS {
         let dv = edges::<S>(&gather::<S>(input.v, corners));
