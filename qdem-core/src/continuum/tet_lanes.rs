@@ -348,6 +348,10 @@ pub(crate) mod x86 {
 pub(crate) trait LaneForces {
     /// The number of real tetrahedra of the block.
     fn count(&self) -> usize;
+    /// Whether the pass prefetches the packs ahead ([`crate::continuum::prefetch`]).
+    fn prefetch(&self) -> bool {
+        false
+    }
     /// The forces on the four corners of `S::N` tetrahedra (corner offsets `corners`, dX⁻¹
     /// `dm`) and 6 × their volumes.
     ///
@@ -364,6 +368,10 @@ impl LaneForces for BlockInput<'_> {
     #[inline(always)]
     fn count(&self) -> usize {
         self.count
+    }
+    #[inline(always)]
+    fn prefetch(&self) -> bool {
+        self.prefetch
     }
     #[inline(always)]
     unsafe fn lane_forces<S: Simd, const VISCOUS: bool>(
@@ -389,7 +397,7 @@ pub(crate) unsafe fn force_pass<S: Simd, I: LaneForces, const VISCOUS: bool>(
     let mut six_volume = [0.0f64; PACK];
     let count = input.count();
     for (p, pack) in packs.iter().enumerate() {
-        if input.prefetch {
+        if input.prefetch() {
             if let Some(ahead) = packs.get(p + prefetch::PACKS_AHEAD) {
                 prefetch::lines(ahead);
             }
