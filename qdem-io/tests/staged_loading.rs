@@ -219,7 +219,11 @@ fn a_stage_may_start_its_lid_at_its_point_and_is_checked_where_the_bed_is() {
 fn stones(file: &str) -> Vec<([f64; 3], f64)> {
     let text = std::fs::read_to_string(dir().join(file).join("stones.csv")).unwrap();
     let row = |line: &str| {
-        let v: Vec<f64> = line.split(',').skip(1).map(|x| x.parse().unwrap()).collect();
+        let v: Vec<f64> = line
+            .split(',')
+            .skip(1)
+            .map(|x| x.parse().unwrap())
+            .collect();
         ([v[0], v[1], v[2]], v[3])
     };
     text.lines().skip(1).map(row).collect()
@@ -272,7 +276,10 @@ fn a_stage_checks_what_it_places_not_the_contacts_its_checkpoint_left() {
         .err()
         .unwrap();
     eprintln!("{refused}");
-    assert!(refused.to_string().contains("penetrates wall 6"), "{refused}");
+    assert!(
+        refused.to_string().contains("penetrates wall 6"),
+        "{refused}"
+    );
 }
 
 #[test]

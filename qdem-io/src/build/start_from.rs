@@ -122,7 +122,10 @@ pub(crate) fn restore_state(
 /// best-fit pose or placed unstressed at theirs.
 fn placed_anew(units: &[Unit], was_rigid: &[bool], particles: usize) -> Vec<bool> {
     let mut placed = vec![false; particles];
-    let turned = units.iter().zip(was_rigid).filter(|(u, &was)| u.rigid() != was);
+    let turned = units
+        .iter()
+        .zip(was_rigid)
+        .filter(|(u, &was)| u.rigid() != was);
     for piece in turned.flat_map(|(u, _)| &u.pieces) {
         piece.nodes.clone().for_each(|i| placed[i] = true);
         if let Some((_, center)) = piece.rigid {
