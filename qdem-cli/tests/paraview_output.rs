@@ -91,7 +91,7 @@ fn assert_consistent(name: &str, file: &Value) {
     assert_eq!(file["finite"], true, "{name}: non-finite values");
 }
 
-/// The bed of the small box test, its stones starting lower and run for 0.2 s: 110 clumps of
+/// The bed of the small box test, its stones starting lower and run for 0.2 s: 52 clumps of
 /// one or two spheres falling in a periodic cell onto a floor between two walls.
 fn granular_scene(tmp: &Path, vtu_every: &str) -> PathBuf {
     let output = format!("[output]\nvtu_every = {vtu_every}");

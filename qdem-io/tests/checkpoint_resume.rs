@@ -26,9 +26,10 @@ fn cantilever_scene(dir: &Path) -> PathBuf {
     )
 }
 
-/// A rigid sleeper dropped onto 40 falling clumps in a cell periodic along y, its ghosts
-/// scaled by a time-delayed boundary that follows its cyclic load. Stones first touch through
-/// the boundary at about t = 0.26 s.
+/// A rigid sleeper dropped onto 16 falling clumps (about as much rock as the 40 were before the
+/// generator scaled each clump to measure its sieve size; seed 2, whose stones press through the
+/// boundary on both sides of the checkpoint at t = 0.3 s) in a cell periodic along y, its ghosts
+/// scaled by a time-delayed boundary that follows its cyclic load.
 fn boxtest_scene(dir: &Path) -> PathBuf {
     let text = format!(
         r#"
@@ -59,10 +60,10 @@ local_damping = 0.2
 name = "ballast"
 material = "granite"
 region = [[0.0, 0.7, 0.0], [0.3, 1.4, 0.4]]
-count = 40
+count = 16
 grading = [[0.07, 0.0], [0.09, 0.5], [0.11, 1.0]]
 spheres_per_stone = [1, 3]
-seed = 3
+seed = 2
 
 [[body]]
 name = "sleeper"

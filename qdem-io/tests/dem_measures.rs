@@ -158,8 +158,11 @@ fn the_contact_stress_of_a_settled_bed_of_clumps_is_its_weight() {
     const T_END: f64 = 2.0;
     let dir = test_dir("measures-clumps");
     let extra = "[[measure]]\nname = \"all\"\ncenter = [0.02, 0.02, 0.1]\nradius = 1.0\n";
+    // Clumps scaled to measure their sieve size are longer than the grains: they are generated
+    // in a taller region (the default's 0.25 m holds 71 of them).
     let scene = grain_bed(T_END, 0.01, 100, extra)
-        .replace("spheres_per_stone = [1, 1]", "spheres_per_stone = [2, 3]");
+        .replace("spheres_per_stone = [1, 1]", "spheres_per_stone = [2, 3]")
+        .replace(", 0.25]]\ncount", ", 0.45]]\ncount");
     let path = dir.join("scene.toml");
     std::fs::write(&path, scene).unwrap();
     let mut sim = Simulation::build(Scene::load(&path).unwrap()).unwrap();

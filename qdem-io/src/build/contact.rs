@@ -100,18 +100,22 @@ pub(crate) fn build_contacts(
     }
     // A stage's bodies and walls are where its checkpoint left them: checked once there.
     if scene.run.start_from.is_none() {
-        check_start(scene, &mut model, state)?;
+        check_start(scene, &mut model, state, |_| true)?;
     }
     Ok(Some(model))
 }
 
 /// Refuses bodies that start overlapping each other or a wall beyond `overlap_tolerance`, or
 /// inside another body or a mesh wall, at the positions of `state` (a `start_from` stage's:
-/// the checkpoint's, with its walls where they begin).
+/// the checkpoint's, with its walls where they begin). Two bodies' overlap is checked only
+/// when `placed` holds for a particle carrying one of them: a `start_from` stage places only
+/// its walls and the bodies whose kind it changes; the rest overlap as the checkpoint's
+/// contacts left them.
 pub(crate) fn check_start(
     scene: &Scene,
     model: &mut DemContacts,
     state: &State,
+    placed: impl Fn(usize) -> bool,
 ) -> Result<(), BuildError> {
     let start_error = |source| match super::overlap_advice::advice(scene, &source) {
         Some(fix) => BuildError::InitialOverlap {
@@ -126,7 +130,7 @@ pub(crate) fn check_start(
     };
     let tolerance = scene.contact.as_ref().map_or(0.0, |c| c.overlap_tolerance);
     model
-        .check_initial_overlaps(state, tolerance)
+        .check_placed_overlaps(state, tolerance, placed)
         .map_err(start_error)?;
     model.check_initial_passage(state).map_err(start_error)
 }

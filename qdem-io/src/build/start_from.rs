@@ -13,8 +13,12 @@
 //! a sphere is known by the particle that carries it, so a spring whose sphere or wall this
 //! scene does not have is dropped, and counted in a line ([`carry_springs`]). Its walls begin
 //! where the checkpoint's walls of the same order stood, a servo wall with the speed its servo
-//! had set, unless a wall says `start = "scene"` ([`carry_walls`]); the bodies' overlaps are
-//! checked there, with the checkpoint's positions (`contact::check_start`).
+//! had set, unless a wall says `start = "scene"` ([`carry_walls`]). What the stage places is
+//! checked for overlaps there, with the checkpoint's positions (`contact::check_start`): every
+//! wall against the bodies, and the bodies whose kind changed against the others; two bodies
+//! that both stand where the checkpoint left them are not, since their overlap is a contact
+//! the previous stage loaded (a bed under a servo lid overlaps as its load asks), not a
+//! placement ([`placed_anew`]).
 //!
 //! A body's kind may differ from the checkpoint's scene (`rigid` on a `[[body]]` or on the
 //! `[ballast]`): the particles are then mapped and the bodies turned as `kind_change` says.
@@ -102,7 +106,8 @@ pub(crate) fn restore_state(
         lines.extend(carry_walls(scene, &walls, saved.time, contacts).map_err(refused)?);
         // The overlaps where this stage starts, before the springs (the check builds the
         // lists, which the springs replace until the first evaluation rebuilds them).
-        super::contact::check_start(scene, contacts, state)?;
+        let placed = placed_anew(units, &was_rigid, state.len());
+        super::contact::check_start(scene, contacts, state, |p| placed[p])?;
     }
     lines.extend(carry_springs(&springs, &layout, saved.len(), contacts));
     let from = path.display();
@@ -110,6 +115,24 @@ pub(crate) fn restore_state(
         .into_iter()
         .map(|t| format!("[run] start_from {from}: {t}"))
         .collect())
+}
+
+/// Whether each of `particles` is placed by this stage rather than left where the checkpoint
+/// had it: those of the units whose kind changed (`was_rigid` in the checkpoint), turned to a
+/// best-fit pose or placed unstressed at theirs.
+fn placed_anew(units: &[Unit], was_rigid: &[bool], particles: usize) -> Vec<bool> {
+    let mut placed = vec![false; particles];
+    let turned = units
+        .iter()
+        .zip(was_rigid)
+        .filter(|(u, &was)| u.rigid() != was);
+    for piece in turned.flat_map(|(u, _)| &u.pieces) {
+        piece.nodes.clone().for_each(|i| placed[i] = true);
+        if let Some((_, center)) = piece.rigid {
+            placed[center] = true;
+        }
+    }
+    placed
 }
 
 /// The name of the contact model ([`DemContacts`]) in a checkpoint.

@@ -163,9 +163,45 @@ impl DemContacts {
         state: &State,
         tolerance: f64,
     ) -> Result<(), ContactError> {
+        self.check_placed_overlaps(state, tolerance, |_| true)
+    }
+
+    /// [`DemContacts::check_initial_overlaps`] for what a start places anew: every wall
+    /// against every sphere, but a pair of spheres only when `placed` holds for the particle
+    /// carrying one of them. A stage that starts from a checkpoint passes `false` for the
+    /// particles the checkpoint put where they are: their overlaps with each other are the
+    /// contacts the previous stage left, loaded as it loaded them, not a placement to refuse.
+    ///
+    /// ```
+    /// use qdem_contact::{ContactLaw, ContactSettings, ContactSphere, DemContacts, LinearSpring};
+    /// use qdem_core::{step::State, Vec3};
+    ///
+    /// // Two spheres of 10 mm radius, 5 mm deep in each other: 50% of the reduced radius.
+    /// let mut state = State::at_rest(vec![Vec3::zeros(), Vec3::new(0.015, 0.0, 0.0)]);
+    /// state.mass = vec![1.0; 2];
+    /// let spheres: Vec<ContactSphere> = (0..2)
+    ///     .map(|i| ContactSphere { particle: i, radius: 0.01, body: i, material: 0 })
+    ///     .collect();
+    /// let law = LinearSpring { normal_stiffness: 1e5, tangential_stiffness: 5e4, damping_ratio: 0.0 };
+    /// let settings = ContactSettings { law: ContactLaw::Linear(law), friction: 0.5, skin: 1e-3 };
+    /// let names = vec!["a".to_string(), "b".to_string()];
+    /// let mut model = DemContacts::new(&state, &spheres, names, &[(1e9, 0.25)], settings, vec![]);
+    /// assert!(model.check_initial_overlaps(&state, 0.05).is_err());
+    /// // Both where a checkpoint left them: their contact is not checked.
+    /// assert!(model.check_placed_overlaps(&state, 0.05, |_| false).is_ok());
+    /// ```
+    pub fn check_placed_overlaps(
+        &mut self,
+        state: &State,
+        tolerance: f64,
+        placed: impl Fn(usize) -> bool,
+    ) -> Result<(), ContactError> {
         self.read_centers(state);
         self.rebuild_all(state.time);
-        for c in &self.candidates.pairs().items {
+        let particle = self.spheres.particle();
+        let new = |s: u32| placed(particle[s as usize] as usize);
+        let pairs = self.candidates.pairs().items.iter();
+        for c in pairs.filter(|c| new(c.first) || new(c.second)) {
             let (a, b) = (c.first as usize, c.second as usize);
             let radius = reduced(self.spheres.radius()[a], self.spheres.radius()[b]);
             let overlap = self.spheres.radius()[a] + self.spheres.radius()[b]

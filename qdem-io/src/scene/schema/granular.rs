@@ -80,8 +80,11 @@ scene_table! {
         shape: ClumpShapeName => "\"elongated\" or \"angular\"", optional = "\"elongated\"",
             "Generation: the stones' shape: `\"elongated\"` (default) a row of spheres along a \
              long axis, a flaky stone; `\"angular\"` a core sphere with the other spheres as \
-             corners out towards an ellipsoid, like crushed ballast. Both stay within 0.65 of the \
-             sieve size of the stone's origin; one sphere is a plain sphere of radius d/2.";
+             corners out towards an ellipsoid, like crushed ballast. Either is scaled so that \
+             its sieve size as `grading.csv` measures it (the middle extent of its spheres' \
+             union) is the size drawn from `grading`: a stone's longest extent is then 1.4–2.0 \
+             times its sieve size if elongated, 1.1–1.6 if angular (10th to 90th percentile); \
+             one sphere is a plain sphere of diameter d.";
         #[serde(default = "super::default_seed")]
         seed: u64 => "integer", optional = "1",
             "Generation: seed; default 1.";

@@ -52,7 +52,9 @@ scene_table! {
              reference positions are taken from it, time restarts at 0, and the tangential contact \
              springs are carried between the same spheres and walls (a spring whose sphere or wall \
              this scene lacks is dropped and counted); the walls begin where the checkpoint left \
-             them (`[[wall]] start`), and overlaps are checked at the checkpoint's positions.";
+             them (`[[wall]] start`), and the overlaps of what the stage places (its walls, and \
+             bodies whose `rigid` changed) are checked at the checkpoint's positions; two bodies \
+             both where the checkpoint left them overlap as its contacts did and are not.";
     }
 }
 
