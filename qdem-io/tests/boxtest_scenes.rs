@@ -185,9 +185,12 @@ fn check_poured_back(deposit: &Simulation) {
             on_top += 9.81 * state.mass[*c];
         }
     }
-    // A stone or two may come to rest on the sleeper (the crib is level with its top): their
-    // weight is under 1% of the load's 3 kN minimum.
-    assert!(on_top < 30.0, "{on_top} N of stones on the sleeper");
+    // Stones may come to rest on the sleeper (the crib is level with its top, and the stones
+    // poured back are stacked at the walls they overhung, from where some roll inwards). The
+    // small box's stones measure their drawn 70-110 mm now (1.5 kg on average): a handful of
+    // them, under 3% of the load's 3 kN minimum and 0.25% of its 40 kN peak, adds no more to
+    // the sleeper's load than the servo-free box's own scatter of a stone's placement.
+    assert!(on_top < 90.0, "{on_top} N of stones on the sleeper");
     assert!(kinetic < 1e-3 * weight, "{kinetic} J");
 }
 
