@@ -153,7 +153,7 @@ fn bench_times_stones_as_one_body_beside_a_cube_of_as_many_tetrahedra() {
     let doc: serde_json::Value = serde_json::from_str(&stdout)
         .unwrap_or_else(|e| panic!("stdout is not JSON ({e}):\n{stdout}"));
     assert_eq!(doc["locality"].as_array().map(Vec::len), Some(0), "{doc:#}");
-    let prefetch = std::env::var("QDEM_PREFETCH").as_deref() == Ok("1");
+    let prefetch = std::env::var("QDEM_PREFETCH").as_deref() != Ok("0");
     assert_eq!(doc["prefetch"].as_bool(), Some(prefetch), "{doc:#}");
     let rows = doc["results"].as_array().expect("results");
     // (stones, cube) x (elastic, viscoelastic) x 1 thread count.
