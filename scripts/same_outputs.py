@@ -5,8 +5,8 @@ binaries and compares what they wrote.
     python3 scripts/same_outputs.py BEFORE_QDEM AFTER_QDEM [--threads N] [--keep DIR]
 
 Scenes: the cantilever lc100 (the README's main job), the contact collision and incline, the
-small box tests (the cell's bed and crib deposits, then the single-sleeper boxes and the
-three-sleeper box on their sample), the small BBM beam and the implicit 0.025 m beam, and the
+small box tests (the cell's bed and crib deposits, the walled box's stones poured back, then
+the single-sleeper boxes and the three-sleeper box on their sample), the small BBM beam and the implicit 0.025 m beam, and the
 reduced ballast deposit cut to 4 ms. Every CSV, SVG, VTU and PVD file is compared byte for byte,
 `summary.json` field by field without the timing fields (wall time, rates, the stage
 counters, the thread and rank counts). Prints one JSON line per scene and exits non-zero on any
@@ -39,6 +39,7 @@ SCENES = [
     "contact/grains.toml",
     "boxtest/small_deposit_cell_bed.toml",
     "boxtest/small_deposit_cell_crib.toml",
+    "boxtest/small_deposit_fixed_crib.toml",
     "boxtest/small_single_fixed.toml",
     "boxtest/small_single_periodic.toml",
     "boxtest/small_single_delayed.toml",
