@@ -102,6 +102,21 @@ fn largest_jump(before: f64, walls: &HashMap<String, Vec<f64>>) -> f64 {
         .fold(0.0f64, |m, f| m.max((f / before - 1.0).abs()))
 }
 
+/// The unload stage with its lid's scene `point` at height `z` (named `name`) is refused for
+/// the lid's overlap with the grains, naming the lid.
+fn lid_is_refused(name: &str, z: f64) {
+    let point = format!("point = [0.0, 0.0, {z}]\nstart = \"scene\"");
+    let scene = stage("unload", name, &[("point = [0.0, 0.0, 0.16]", &point)]);
+    let refused = Simulation::build(Scene::load(&scene).unwrap())
+        .err()
+        .unwrap();
+    eprintln!("{refused}");
+    assert!(
+        refused.to_string().contains("penetrates wall 6"),
+        "{refused}"
+    );
+}
+
 #[test]
 fn the_floor_force_is_continuous_across_the_stages() {
     let stages = stages();
@@ -184,23 +199,7 @@ fn a_stage_may_start_its_lid_at_its_point_and_is_checked_where_the_bed_is() {
         "{warnings:?}"
     );
     // 3 mm lower it would start in the bed's top grains: refused, naming the lid.
-    let into = format!(
-        "point = [0.0, 0.0, {}]\nstart = \"scene\"",
-        lid_reached - 0.003
-    );
-    let scene = stage(
-        "unload",
-        "unload-into-bed",
-        &[("point = [0.0, 0.0, 0.16]", &into)],
-    );
-    let refused = Simulation::build(Scene::load(&scene).unwrap())
-        .err()
-        .unwrap();
-    eprintln!("{refused}");
-    assert!(
-        refused.to_string().contains("penetrates wall 6"),
-        "{refused}"
-    );
+    lid_is_refused("unload-into-bed", lid_reached - 0.003);
     // At its scene `point`, 0.16 m high, the lid leaves the bed: the floor carries its weight.
     let walls = run_stage(
         "unload",
@@ -266,20 +265,7 @@ fn a_stage_checks_what_it_places_not_the_contacts_its_checkpoint_left() {
     // A wall it places is still checked against them: the lid at its scene point 0.5 mm
     // below where the servo left it is 0.5 mm into the top grains (10-12.5% of a radius of
     // 4-5 mm), beyond the default 5%.
-    let point = format!("point = [0.0, 0.0, {}]\nstart = \"scene\"", lid - 5e-4);
-    let scene = stage(
-        "unload",
-        "unload-lid-in-grains",
-        &[("point = [0.0, 0.0, 0.16]", &point)],
-    );
-    let refused = Simulation::build(Scene::load(&scene).unwrap())
-        .err()
-        .unwrap();
-    eprintln!("{refused}");
-    assert!(
-        refused.to_string().contains("penetrates wall 6"),
-        "{refused}"
-    );
+    lid_is_refused("unload-lid-in-grains", lid - 5e-4);
 }
 
 #[test]
