@@ -40,8 +40,12 @@ fn build_scene(dir: &Path, name: &str) -> Simulation {
         "mesh = \"sleeper.msh\"",
         &format!("mesh = {:?}", mesh.display().to_string()),
     );
+    // Tests running at once write the same scene: each writes its own file and renames it
+    // into place, so none reads another's half-written copy.
     let path = dir.join(format!("{name}.toml"));
-    std::fs::write(&path, text).unwrap();
+    let own = dir.join(format!("{name}.toml.{:?}", std::thread::current().id()));
+    std::fs::write(&own, text).unwrap();
+    std::fs::rename(&own, &path).unwrap();
     Simulation::build(Scene::load(&path).unwrap()).unwrap()
 }
 
