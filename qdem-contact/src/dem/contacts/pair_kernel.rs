@@ -404,27 +404,30 @@ impl DemContacts {
         let law = &self.settings.law;
         let mut through = std::mem::take(&mut self.kernel.boundary_pairs);
         through.clear();
-        for k in 0..pairs.items.len() {
-            let shift = pairs.shift[k];
+        let mut lists = RunLists {
+            pairs: &mut pairs.items,
+            shifts: &mut pairs.shift,
+            turns: &mut pairs.turn,
+            walls: &mut [],
+            wall_turns: &mut [],
+            rolls: &mut pairs.roll,
+            wall_rolls: &mut [],
+        };
+        for k in 0..lists.pairs.len() {
+            let shift = lists.shifts[k];
             if shift[axis] == 0.0 {
                 continue;
             }
             through.push(k as u32);
-            let contact = &mut pairs.items[k];
+            let contact = &mut lists.pairs[k];
             let Some((pair, e)) = self.spheres_through(contact, shift) else {
-                contact.part();
-                pairs.turn[k] = Vec3::zeros();
-                if let Some(roll) = pairs.roll.get_mut(k) {
-                    *roll = Vec3::zeros();
-                }
+                part(contact, [lists.turns.get_mut(k), lists.rolls.get_mut(k)]);
                 continue;
             };
             let g = pair.geometry();
             let f = law.force(&g, &e, &mut contact.history, dt);
-            if let Some(roll) = pairs.roll.get_mut(k) {
-                self.roll_pair(contact, (&g, &e), &f, roll, dt);
-            }
-            pairs.turn[k] = contact.touch(f, &g.normal, g.overlap);
+            let touching = (g.normal, g.overlap);
+            self.record_pair(k, f, touching, || (g, e), &mut lists, dt);
         }
         *self.candidates.pairs_mut() = pairs;
         self.kernel.boundary = Some(axis);
@@ -515,13 +518,7 @@ impl DemContacts {
                         continue;
                     }
                     let Some((pair, e)) = self.spheres_through(contact, shift) else {
-                        contact.part();
-                        for at in [lists.turns.get_mut(k), lists.rolls.get_mut(k)]
-                            .into_iter()
-                            .flatten()
-                        {
-                            *at = Vec3::zeros();
-                        }
+                        part(contact, [lists.turns.get_mut(k), lists.rolls.get_mut(k)]);
                         continue;
                     };
                     if in_lanes {
@@ -559,13 +556,7 @@ impl DemContacts {
             let turn = match LAW {
                 true => {
                     let Some((g, e)) = self.wall_contact(time, s, contact.second as usize) else {
-                        contact.part();
-                        for at in [wall_turns.get_mut(k), wall_rolls.get_mut(k)]
-                            .into_iter()
-                            .flatten()
-                        {
-                            *at = Vec3::zeros();
-                        }
+                        part(contact, [wall_turns.get_mut(k), wall_rolls.get_mut(k)]);
                         continue;
                     };
                     let f = law.force(&g, &e, &mut contact.history, dt);
@@ -703,6 +694,16 @@ impl Carriers {
     unsafe fn add(&self, i: usize, v: &Vec3) {
         assert!(i < self.len, "carrier {i} beyond {}", self.len);
         *self.at.add(i) += v;
+    }
+}
+
+/// Parts a contact whose spheres are apart: its record, and its n × f and rolling columns
+/// zeroed where the lists hold them.
+#[inline(always)]
+fn part(contact: &mut Contact, columns: [Option<&mut Vec3>; 2]) {
+    contact.part();
+    for at in columns.into_iter().flatten() {
+        *at = Vec3::zeros();
     }
 }
 
