@@ -27,6 +27,7 @@
 //!   an active set of contacts, docs/bbm.md), at far more than [`IMPLICIT_BBM_STEP_COST`] per
 //!   nominal step while a crack runs; the reasoning says so.
 
+use super::integrator::{newmark_step, PERIOD_ERROR};
 use super::{excitation, Advice, Topic};
 use crate::build::Simulation;
 use crate::scene::Supports;
@@ -46,9 +47,6 @@ pub const IMPLICIT_BBM_STEP_COST: f64 = 6.4;
 /// The explicit step of paper 001's runs over its Eq. 28 ∆t_crit
 /// (`fixtures/bbm/beam_explicit_*.toml`: `critical_fraction = 0.2`).
 pub const EXPLICIT_FRACTION: f64 = 0.2;
-
-/// Relative period error of the first mode the implicit step is chosen for.
-const PERIOD_ERROR: f64 = 1e-3;
 
 /// Modes asked for: the lowest elastic one of a supported body, with room for the rigid
 /// motions its supports might leave.
@@ -88,7 +86,7 @@ pub(super) fn advise(sim: &Simulation) -> Option<Advice> {
         }
     };
     let omega = 2.0 * PI * f1;
-    let implicit_dt = (12.0 * PERIOD_ERROR).sqrt() / omega;
+    let implicit_dt = newmark_step(omega);
     let eq28 = EXPLICIT_FRACTION * model.initial_critical_step();
     let explicit_dt = eq28.min(sim.world.settings().stable_dt.0);
     let dynamic = excitation::of_ramp(bonded.load_ramp, (f1, 0.0));

@@ -27,7 +27,13 @@ use crate::scene::Integrator;
 pub const IMPLICIT_STEP_COST: f64 = 6.2;
 
 /// Relative period error of the first mode the dynamic step is chosen for.
-const PERIOD_ERROR: f64 = 1e-3;
+pub(super) const PERIOD_ERROR: f64 = 1e-3;
+
+/// The Newmark (β = ¼, γ = ½) step that lengthens the period of a mode of angular frequency
+/// `omega` by [`PERIOD_ERROR`]: (ω∆t)²/12 = PERIOD_ERROR.
+pub(super) fn newmark_step(omega: f64) -> f64 {
+    (12.0 * PERIOD_ERROR).sqrt() / omega
+}
 
 /// Steps per relaxation time or load segment of a quasi-static implicit run.
 const RESOLUTION: f64 = 20.0;
@@ -90,7 +96,7 @@ pub(super) fn advise(sim: &Simulation, lowest: &[(String, BodyModes)]) -> Option
             ("static", load_dt.min(t_end), dynamic, why)
         }
     } else {
-        let dt = (12.0 * PERIOD_ERROR).sqrt() / omega;
+        let dt = newmark_step(omega);
         let gain = dt / explicit_dt / IMPLICIT_STEP_COST;
         let advised = if gain > 1.0 { "newmark" } else { "verlet" };
         let why = format!(
