@@ -422,9 +422,16 @@ fn wait_for_phase(shared: &Shared, w: usize, seen: u64) -> u64 {
 }
 
 /// Parks worker `w` until a phase after `seen` unparks it (or one was posted meanwhile).
+///
+/// The flag is raised again before every check of the epoch: a caller still posting the
+/// phase this worker has already run can clear it late (and leave a wake-up that ends the
+/// first `park` at once), and a flag left down would hide the worker from the next phase.
 fn park(shared: &Shared, w: usize, seen: u64) {
-    shared.parked[w].store(true, Ordering::SeqCst);
-    while shared.epoch.load(Ordering::SeqCst) == seen {
+    loop {
+        shared.parked[w].store(true, Ordering::SeqCst);
+        if shared.epoch.load(Ordering::SeqCst) != seen {
+            break;
+        }
         std::thread::park();
     }
     shared.parked[w].store(false, Ordering::SeqCst);
@@ -451,6 +458,34 @@ mod tests {
         let after = counts();
         assert_eq!(after.phases - before.phases, 200);
         assert_eq!(after.regions - before.regions, 200);
+    }
+
+    #[test]
+    fn a_worker_that_parks_before_its_phase_is_fully_posted_is_still_woken_by_the_next() {
+        // Workers that park as soon as they are idle, three teams of four on a machine of
+        // fewer cores: a caller often loses its core while it posts a phase, and a worker it
+        // already reached runs its part and parks for the next phase before the caller posts
+        // this one to it. Every phase must still reach every worker; a lost wake-up leaves a
+        // caller waiting for ever, caught by the deadline.
+        let waits = Waits {
+            spin: Duration::ZERO,
+            patience: Duration::ZERO,
+        };
+        let (tx, rx) = std::sync::mpsc::channel();
+        for _ in 0..3 {
+            let tx = tx.clone();
+            std::thread::spawn(move || {
+                let team = Team::with_waits(4, waits);
+                for round in 0..20_000u64 {
+                    assert_eq!(team.run(vec![round; 4], |r| r + 1), vec![round + 1; 4]);
+                }
+                tx.send(()).expect("the test waits");
+            });
+        }
+        for _ in 0..3 {
+            let ended = rx.recv_timeout(Duration::from_secs(60));
+            assert!(ended.is_ok(), "a phase never reached a parked worker");
+        }
     }
 
     #[test]
