@@ -41,6 +41,7 @@ import subprocess
 import sys
 import threading
 import time
+import tomllib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FIXTURES = os.path.join(ROOT, "fixtures", "boxtest")
@@ -73,10 +74,11 @@ def scene_for(size, name, seed, out):
     return text
 
 
-def run(size, name, seed, out, qdem, threads, variant=None):
+def run(size, name, seed, out, qdem, threads, variant=None, resume=False):
     """One run of `seed` with its samples under `out`; a `variant` (dict of `name`, `young`,
     `t_end`) loads those samples at another stiffness or for fewer cycles and writes its runs
-    under `out`_NAME."""
+    under `out`_NAME. With `resume`, a run that finished from the same scene text (its
+    summary.json newer than its scene file) is read back instead of run again."""
     text = scene_for(size, name, seed, out)
     if variant:
         text = re.sub(r'^dir = "(.*)/([a-z_]+)"$', rf'dir = "\1_{variant["name"]}/\2"', text,
@@ -88,20 +90,27 @@ def run(size, name, seed, out, qdem, threads, variant=None):
         out = f"{out}_{variant['name']}"
         os.makedirs(out, exist_ok=True)
     path = os.path.join(out, f"{name}.toml")
+    summary = os.path.join(out, name.replace("deposit_", ""), "summary.json")
+    if resume and os.path.exists(summary) and os.path.exists(path) \
+            and open(path).read() == text and os.path.getmtime(summary) > os.path.getmtime(path):
+        with open(summary) as f:
+            return json.load(f)
     with open(path, "w") as f:
         f.write(text)
     subprocess.run([qdem, "run", path, "--threads", str(threads)], check=True,
                    stdout=subprocess.DEVNULL, env=dict(os.environ, CI="true"))
-    with open(os.path.join(out, name.replace("deposit_", ""), "summary.json")) as f:
+    with open(summary) as f:
         return json.load(f)
 
 
-def run_all(size, seeds, base, qdem, jobs, threads, variant=None):
+def run_all(size, seeds, base, qdem, jobs, threads, variant=None, resume=False):
     """Every run of every seed, `jobs` at a time on `threads` threads each: a seed's bed, then
     its crib, then its five loading cases (the three-sleeper box first, the longest), the
     fixed-wall box's after the pour of its stones astride the walls (`deposit_fixed_crib`);
     with a `variant`, only the loading cases, on the samples already deposited. Returns the
-    runs' summaries in a fixed order (seed, then run), whatever order they finished in."""
+    runs' summaries in a fixed order (seed, then run), whatever order they finished in. Seeds
+    are taken in order (a seed's runs before the next seed's), so a study stopped early has
+    its first samples whole."""
     deposits = [] if variant else ["deposit_cell_bed", "deposit_cell_crib", "deposit_fixed_crib"]
     ready = ([(seed, 0, "deposit_cell_bed") for seed in seeds] if deposits else
              [(seed, 1 + k, case) for seed in seeds for k, case in enumerate(CASES)])
@@ -117,13 +126,13 @@ def run_all(size, seeds, base, qdem, jobs, threads, variant=None):
                 if not ready or failed:
                     lock.notify_all()
                     return
-                seed, rank, name = min(ready, key=lambda t: (t[1], t[0]))
+                seed, rank, name = min(ready, key=lambda t: (t[0], t[1]))
                 ready.remove((seed, rank, name))
                 running[0] += 1
             out = os.path.join(base, f"{size}_seed{seed}")
             os.makedirs(out, exist_ok=True)
             try:
-                s = run(size, name, seed, out, qdem, threads, variant)
+                s = run(size, name, seed, out, qdem, threads, variant, resume)
             except Exception as e:  # a failed run stops the study after the running ones
                 with lock:
                     failed.append(f"seed {seed} {name}: {e}")
@@ -229,6 +238,9 @@ def main():
                     "with --young and/or --cycles; runs under out/boxtest_study/SIZE_seedN_NAME")
     ap.add_argument("--young", type=float, help="the variant's Young's modulus (Pa)")
     ap.add_argument("--cycles", type=int, help="the variant's load cycles")
+    ap.add_argument("--resume", action="store_true",
+                    help="read back the runs that finished from the same scene instead of "
+                         "running them again (a study stopped part-way, the same qdem)")
     ap.add_argument("--tables-only", action="store_true",
                     help="no runs: the tables and plots again from the outputs of the last study")
     ap.add_argument("--docs", action="store_true",
@@ -254,7 +266,8 @@ def main():
         args.jobs, args.threads = saved["jobs"], saved["threads"]
     else:
         started = time.time()
-        runs = run_all(args.size, seeds, base, args.qdem, args.jobs, args.threads, variant)
+        runs = run_all(args.size, seeds, base, args.qdem, args.jobs, args.threads, variant,
+                       args.resume)
         wall = time.time() - started
     series = [(case, seed, settlement(os.path.join(base, f"{args.size}_seed{seed}{suffix}"),
                                       case, settle, cycles))
@@ -289,9 +302,9 @@ def main():
     return 0
 
 
-# Two-sided 95% Student t quantiles by degrees of freedom (1-10; 1.96 beyond).
-T95 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365, 8: 2.306,
-       9: 2.262, 10: 2.228}
+def t95(df):
+    """The two-sided 95% quantile of Student's t with `df` degrees of freedom."""
+    return t_quantile(df, 0.475)
 
 
 def mean_ci(values):
@@ -301,7 +314,7 @@ def mean_ci(values):
     if n < 2:
         return mean, float("nan")
     sd = math.sqrt(sum((v - mean) ** 2 for v in values) / (n - 1))
-    return mean, T95.get(n - 1, 1.96) * sd / math.sqrt(n)
+    return mean, t95(n - 1) * sd / math.sqrt(n)
 
 
 def error(values, case, seed):
@@ -338,6 +351,113 @@ def beside_base(series, seeds, cycles, base, name):
     return "\n".join(lines)
 
 
+def t_power(df):
+    """The one-sided 80% quantile of Student's t with `df` degrees of freedom (bisection on
+    the density's integral from 0 reaching 0.3, as in `t95`)."""
+    return t_quantile(df, 0.3)
+
+
+def t_quantile(df, above_zero):
+    """The x where Student's t density with `df` degrees of freedom, integrated from 0
+    (Simpson, 2,000 panels), reaches `above_zero`; by bisection."""
+    density = lambda t: math.exp(math.lgamma((df + 1) / 2) - math.lgamma(df / 2)
+                                 - 0.5 * math.log(df * math.pi)
+                                 - (df + 1) / 2 * math.log1p(t * t / df))
+
+    def cdf0(x):
+        n = 2000
+        h = x / n
+        inner = sum((4 if k % 2 else 2) * density(k * h) for k in range(1, n))
+        return h / 3 * (density(0) + inner + density(x))
+    lo, hi = 0.0, 20.0
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if cdf0(mid) < above_zero else (lo, mid)
+    return (lo + hi) / 2
+
+
+def samples_needed(sd, delta, power):
+    """The fewest paired samples n whose 95% interval on a mean difference is at most
+    ±`delta` (`power` False), or which detect a true difference `delta` at 5% with 80% power
+    (`power` True), for paired differences of standard deviation `sd`; Student t."""
+    for n in range(2, 1000):
+        need = t95(n - 1) + (t_power(n - 1) if power else 0.0)
+        if need * sd / math.sqrt(n) <= delta:
+            return n
+    return float("inf")
+
+
+PAIRS = [("single_delayed", "single_periodic"), ("single_shared", "single_periodic"),
+         ("single_periodic", "single_fixed"), ("single_delayed", "single_fixed"),
+         ("single_shared", "single_fixed"), ("single_shared", "single_delayed")]
+
+
+def power_table(last, seeds):
+    """The paired scatter of each error and each difference between boundaries, the
+    difference this study resolves (the half-width of its 95% interval), and the samples that
+    ±2 mm at 95% and 2 mm at 80% power would need at that scatter."""
+    n = len(seeds)
+    rows = [(f"{LABELS[c]} against the three-sleeper box", [error(last, c, s) for s in seeds])
+            for c in CASES[1:]]
+    rows += [(f"{LABELS[a]} − {LABELS[b]}",
+              [error(last, a, s) - error(last, b, s) for s in seeds]) for a, b in PAIRS]
+    lines = [f"How finely {n} paired samples resolve (s: the paired standard deviation over the "
+             "samples; the resolved difference: the half-width of the 95% interval, t·s/√n; "
+             "the samples that s would need):", "",
+             "| compared | s (mm) | resolved at 95% (mm) | n: ±2 mm at 95% | n: 2 mm, 80% power |",
+             "| --- | --- | --- | --- | --- |"]
+    for name, d in rows:
+        mean = sum(d) / n
+        sd = math.sqrt(sum((v - mean) ** 2 for v in d) / (n - 1))
+        lines.append(f"| {name} | {1000 * sd:.2f} | ±{1000 * t95(n - 1) * sd / math.sqrt(n):.2f} | "
+                     f"{samples_needed(sd, 2e-3, False)} | {samples_needed(sd, 2e-3, True)} |")
+    return "\n".join(lines)
+
+
+def grading_of(path):
+    """Sieve sizes (m) and masses (kg) of the stones in a run's grading.csv."""
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return [float(r["sieve_size"]) for r in rows], [float(r["mass"]) for r in rows]
+
+
+def passing(sizes, masses, sieve, basis):
+    """The fraction of the stones (by number, or by mass) whose sieve size is at most `sieve`."""
+    if basis == "mass":
+        return sum(m for d, m in zip(sizes, masses) if d <= sieve) / sum(masses)
+    return sum(d <= sieve for d in sizes) / len(sizes)
+
+
+def sample_table(size, seeds, base):
+    """Per sample, the stones and rock mass every case loads (from each run's grading.csv, at
+    its start) and the largest deviation of the loaded sample's grading (the periodic cell's,
+    the single boxes' sample) from the asked curve, in points passing on the asked basis."""
+    with open(os.path.join(FIXTURES, f"{size}_deposit_cell_bed.toml"), "rb") as f:
+        asked = tomllib.load(f)["granular"]
+    curve, basis = asked["grading"], asked.get("grading_basis", "number")
+    lines = ["The stones each case loads (count, rock mass at 2,600 kg/m³ from each run's "
+             "grading.csv at its start) and the loaded sample's grading against the asked curve "
+             f"(the largest deviation over its sieves, in points passing by {basis}; the "
+             "three-sleeper box holds the cell's sample three times, less the stones astride its "
+             "two end walls; its middle third is the cell's sample):", "",
+             "| sample | " + " | ".join(LABELS[c] for c in CASES) + " | grading: largest deviation |",
+             "| --- |" + " --- |" * (len(CASES) + 1)]
+    worst = 0.0
+    for seed in seeds:
+        cells = []
+        for c in CASES:
+            sizes, masses = grading_of(os.path.join(base, f"{size}_seed{seed}", c, "grading.csv"))
+            cells.append(f"{len(sizes)}, {sum(masses):.2f} kg")
+        sizes, masses = grading_of(os.path.join(base, f"{size}_seed{seed}", "single_periodic",
+                                                "grading.csv"))
+        dev = max(abs(100 * (passing(sizes, masses, a, basis) - want)) for a, want in curve)
+        worst = max(worst, dev)
+        lines.append(f"| {seed} | " + " | ".join(cells) + f" | {dev:.1f} points |")
+    lines += ["", f"Largest deviation of any sample's grading from the asked curve: {worst:.1f} "
+              "points passing."]
+    return "\n".join(lines)
+
+
 def tables(series, runs, seeds, cycles, wall, args):
     last = {(c, s): v[-1] for c, s, v in series}
     # Settlement per cycle over the last five cycles: has the rate settled?
@@ -370,13 +490,13 @@ def tables(series, runs, seeds, cycles, wall, args):
     lines += ["", "Which boundary is closer, paired by sample: the difference of the absolute "
               "errors, |e_A| − |e_B| (negative: A closer):", "",
               "| A | B | mean (mm) | 95% interval (mm) | A closer on |", "| --- | --- | --- | --- | --- |"]
-    for a, b in [("single_delayed", "single_periodic"), ("single_shared", "single_periodic"),
-                 ("single_periodic", "single_fixed"), ("single_delayed", "single_fixed"),
-                 ("single_shared", "single_fixed"), ("single_shared", "single_delayed")]:
+    for a, b in PAIRS:
         d = [abs(error(last, a, s)) - abs(error(last, b, s)) for s in seeds]
         m, h = mean_ci(d)
         lines.append(f"| {LABELS[a]} | {LABELS[b]} | {1000 * m:+.2f} | [{1000 * (m - h):+.2f}, "
                      f"{1000 * (m + h):+.2f}] | {sum(v < 0 for v in d)} of {len(seeds)} |")
+    lines += ["", power_table(last, seeds)]
+    lines += ["", sample_table(args.size, seeds, os.path.join(ROOT, "out", "boxtest_study"))]
     lines += ["", f"The runs ({args.jobs} at a time, {args.threads} thread(s) each; the study took "
               f"{wall:.0f} s of wall time):", "",
               "| sample | run | stones | spheres | steps | dt (s) | wall (s) | sphere-steps/s |",
