@@ -13,11 +13,16 @@ same sample with its stones astride the walls poured back under the sleeper's 3 
     python3 qdem-bench/scripts/boxtest_study.py [--size study|small|paper] [--seeds 1-5]
         [--jobs 2] [--threads 1] [--docs]
     python3 qdem-bench/scripts/boxtest_study.py --variant stiff4 --young 4e9 --cycles 10
+    python3 qdem-bench/scripts/boxtest_study.py --seeds 1 --replicas 0.47,0.49,0.51,0.53
 
 The second form loads the samples the first deposited again, here at 4 GPa for 10 cycles
 (out/boxtest_study/SIZE_seedN_stiff4/), and prints its errors beside the first study's after
 as many cycles: does the stiffness change which boundary comes closest? `--tables-only`
-writes the tables and plots again from the last outputs without running anything.
+writes the tables and plots again from the last outputs without running anything. The third
+form loads sample 1 again with its step a few percent off the study's (0.5 of the contacts'
+estimate): how far a run's settlement moves under a perturbation that changes no physics,
+beside the scatter between samples. `--resume` reads back the runs that finished from the
+same scene (a study stopped part-way, or extended with more seeds).
 
 Runs `--jobs` qdem runs at once (`--threads` each; on a 2-core machine two one-thread runs
 beat one two-thread run). Writes out/boxtest_study/settlement.csv (case, seed, cycle,
@@ -87,6 +92,9 @@ def run(size, name, seed, out, qdem, threads, variant=None, resume=False):
             text = re.sub(r"^young = .*$", f"young = {variant['young']}", text, flags=re.M)
         if variant["t_end"]:
             text = re.sub(r"^t_end = .*$", f"t_end = {variant['t_end']}", text, flags=re.M)
+        if variant.get("dt_safety"):
+            text = re.sub(r"^dt_safety = .*$", f"dt_safety = {variant['dt_safety']}", text,
+                          flags=re.M)
         out = f"{out}_{variant['name']}"
         os.makedirs(out, exist_ok=True)
     path = os.path.join(out, f"{name}.toml")
@@ -238,6 +246,9 @@ def main():
                     "with --young and/or --cycles; runs under out/boxtest_study/SIZE_seedN_NAME")
     ap.add_argument("--young", type=float, help="the variant's Young's modulus (Pa)")
     ap.add_argument("--cycles", type=int, help="the variant's load cycles")
+    ap.add_argument("--replicas", help="load the samples already deposited again at these "
+                    "dt_safety values (e.g. 0.47,0.49,0.51,0.53) and print how far one run's "
+                    "settlement moves with its step: the scatter of a run beside a sample's")
     ap.add_argument("--resume", action="store_true",
                     help="read back the runs that finished from the same scene instead of "
                          "running them again (a study stopped part-way, the same qdem)")
@@ -252,6 +263,8 @@ def main():
     cycles = int(re.search(r"cycles=(\d+)", params).group(1))
     settle = float(re.search(r"settle=([\d.]+)", params).group(1))
     variant, suffix = None, ""
+    if args.replicas:
+        return replicas(args, seeds, cycles, settle)
     if args.variant:
         cycles = args.cycles or cycles
         variant = dict(name=args.variant, young=args.young, t_end=settle + cycles / 3.0)
@@ -325,6 +338,57 @@ def error(values, case, seed):
 def closest(values, seed):
     """The single-sleeper box whose settlement is nearest the three-sleeper box's on `seed`."""
     return min(CASES[1:], key=lambda c: abs(error(values, c, seed)))
+
+
+def replicas(args, seeds, cycles, settle):
+    """Each seed's loading cases again at each of `args.replicas`' steps (the base runs step
+    at 0.5 of the estimate): a perturbation far below any physical change, which a granular
+    packing under cycles amplifies. Prints each case's settlement per step with its standard
+    deviation (a run's own scatter) beside the base study's scatter between samples, and
+    writes replicas.md."""
+    base = os.path.join(ROOT, "out", "boxtest_study")
+    values = [float(v) for v in args.replicas.split(",")]
+    series = {}
+    for v in values:
+        name = f"dt{round(1000 * v):03d}"
+        variant = dict(name=name, young=None, t_end=None, dt_safety=v)
+        run_all(args.size, seeds, base, args.qdem, args.jobs, args.threads, variant, args.resume)
+        for seed in seeds:
+            for case in CASES:
+                out = os.path.join(base, f"{args.size}_seed{seed}_{name}")
+                series[(case, seed, v)] = settlement(out, case, settle, cycles)[-1]
+    between = {}
+    path = os.path.join(base, "settlement.csv")
+    if os.path.exists(path):
+        with open(path) as f:
+            rows = [r for r in csv.DictReader(f) if int(r["cycle"]) == cycles]
+        for seed in {int(r["seed"]) for r in rows}:
+            for r in rows:
+                if int(r["seed"]) == seed:
+                    series.setdefault((r["case"], seed, 0.5), float(r["settlement_m"]))
+                    between.setdefault(r["case"], []).append(float(r["settlement_m"]))
+    steps = sorted({v for _, _, v in series})
+    sd = lambda xs: math.sqrt(sum((x - sum(xs) / len(xs)) ** 2 for x in xs) / (len(xs) - 1))
+    lines = [f"Settlement after {cycles} cycles (mm) of sample(s) {', '.join(map(str, seeds))} "
+             "loaded at steps of 0.47-0.53 of the contacts' estimate (0.5: the study's run), "
+             "the standard deviation over these runs beside the study's over its samples:", "",
+             "| sample | case | " + " | ".join(f"dt_safety {v}" for v in steps) +
+             " | s over the steps | s over the study's samples |",
+             "| --- | --- |" + " --- |" * (len(steps) + 2)]
+    for seed in seeds:
+        for case in CASES:
+            xs = [series[(case, seed, v)] for v in steps if (case, seed, v) in series]
+            cells = " | ".join(f"{1000 * series[(case, seed, v)]:.2f}"
+                               if (case, seed, v) in series else "" for v in steps)
+            spread = between.get(case, [])
+            lines.append(f"| {seed} | {LABELS[case]} | {cells} | {1000 * sd(xs):.2f} | "
+                         + (f"{1000 * sd(spread):.2f} ({len(spread)} samples)" if len(spread) > 1
+                            else "") + " |")
+    table = "\n".join(lines)
+    with open(os.path.join(base, "replicas.md"), "w") as f:
+        f.write(table + "\n")
+    print(table)
+    return 0
 
 
 def beside_base(series, seeds, cycles, base, name):

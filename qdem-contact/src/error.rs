@@ -43,7 +43,7 @@ pub enum ContactError {
     /// Two bodies interpenetrate at the start beyond the tolerance.
     #[error(
         "bodies `{a}` and `{b}` overlap by {overlap:.3e} m at the start (spheres at {at_a:?} and \
-         {at_b:?}), more than {tolerance:.0}% of their reduced radius {radius:.3e} m; fix: move \
+         {at_b:?}), more than {tolerance:.2}% of their reduced radius {radius:.3e} m; fix: move \
          them apart, use smaller contact spheres or allow a larger initial overlap"
     )]
     InitialOverlap {
@@ -65,7 +65,7 @@ pub enum ContactError {
     /// A body penetrates a wall at the start beyond the tolerance.
     #[error(
         "body `{body}` penetrates wall {wall} by {overlap:.3e} m at the start (sphere at {at:?}), \
-         more than {tolerance:.0}% of the contact radius {radius:.3e} m; fix: move the body or \
+         more than {tolerance:.2}% of the contact radius {radius:.3e} m; fix: move the body or \
          the wall, or allow a larger initial overlap"
     )]
     InitialWallOverlap {
