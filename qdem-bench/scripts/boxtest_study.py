@@ -4,11 +4,12 @@ sample of the periodic single-sleeper cell (bed, then the sleeper and the crib),
 it in the three-sleeper box (the cell's sample three times along y), in the single-sleeper
 box with fixed walls, and with ordinary and time-delayed periodic boundaries (paper 003's
 Eqs. 6-7, and qdem's shared faces); collect the middle sleeper's settlement after every load
-cycle. All six cases of a seed load the same stones: the periodic boxes and the middle of
+cycle. The cases of a seed load the same stones: the periodic boxes and the middle of
 the three-sleeper box the cell's sample from the same sleeper pose, the fixed-wall box the
 same sample with its stones astride the walls poured back under the sleeper's 3 kN first
 (`deposit_fixed_crib`), so that it holds the cell's stone count and mass, and the cropped
-fixed-wall box the cell's sample less those stones (paper 003's cut).
+fixed-wall box the cell's sample less those stones (paper 003's cut); the last fixed-wall box
+deposits the same stones drawn between its own walls (`deposit_walled_bed`, `_crib`).
 
     cargo build --release -p qdem-cli
     python3 qdem-bench/scripts/boxtest_study.py [--size study|small|paper] [--seeds 1-5]
@@ -53,13 +54,21 @@ import tomllib
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FIXTURES = os.path.join(ROOT, "fixtures", "boxtest")
 QDEM = os.path.join(ROOT, "target", "release", "qdem")
-CASES = ["three_sleeper", "single_fixed", "single_cropped", "single_periodic", "single_delayed",
-         "single_shared"]
+CASES = ["three_sleeper", "single_fixed", "single_cropped", "single_walled", "single_periodic",
+         "single_delayed", "single_shared"]
+DEPOSITS = ["deposit_cell_bed", "deposit_cell_crib", "deposit_fixed_crib", "deposit_walled_bed",
+            "deposit_walled_crib"]
+# The run each run reads (a loading case not named here reads the cell's crib).
+NEEDS = {"deposit_cell_crib": "deposit_cell_bed", "deposit_fixed_crib": "deposit_cell_crib",
+         "deposit_walled_crib": "deposit_walled_bed", "single_fixed": "deposit_fixed_crib",
+         "single_walled": "deposit_walled_crib"}
 LABELS = {"three_sleeper": "three-sleeper (middle)", "single_fixed": "single, fixed walls",
-          "single_cropped": "single, fixed walls, cropped", "single_periodic": "single, periodic",
+          "single_cropped": "single, fixed walls, cropped",
+          "single_walled": "single, fixed walls, own deposit", "single_periodic": "single, periodic",
           "single_delayed": "single, time-delayed",
           "single_shared": "single, time-delayed, shared faces"}
 COLOURS = {"three_sleeper": "#000000", "single_fixed": "#1f77b4", "single_cropped": "#9467bd",
+           "single_walled": "#8c564b",
            "single_periodic": "#ff7f0e", "single_delayed": "#2ca02c", "single_shared": "#d62728"}
 
 
@@ -116,16 +125,19 @@ def run(size, name, seed, out, qdem, threads, variant=None, resume=False):
 
 
 def run_all(size, seeds, base, qdem, jobs, threads, variant=None, resume=False):
-    """Every run of every seed, `jobs` at a time on `threads` threads each: a seed's bed, then
-    its crib, then its six loading cases (the three-sleeper box first, the longest), the
-    fixed-wall box's after the pour of its stones astride the walls (`deposit_fixed_crib`);
-    with a `variant`, only the loading cases, on the samples already deposited. Returns the
+    """Every run of every seed, `jobs` at a time on `threads` threads each, each once the run
+    it reads has finished (`NEEDS`): a seed's bed, then its crib, then its loading cases (the
+    three-sleeper box first, the longest), the poured-back fixed-wall box's after the pour of
+    its stones astride the walls (`deposit_fixed_crib`), the walled box's after its own bed
+    and crib; with a `variant`, only the loading cases, on the samples already deposited. Returns the
     runs' summaries in a fixed order (seed, then run), whatever order they finished in. Seeds
     are taken in order (a seed's runs before the next seed's), so a study stopped early has
     its first samples whole."""
-    deposits = [] if variant else ["deposit_cell_bed", "deposit_cell_crib", "deposit_fixed_crib"]
-    ready = ([(seed, 0, "deposit_cell_bed") for seed in seeds] if deposits else
-             [(seed, 1 + k, case) for seed in seeds for k, case in enumerate(CASES)])
+    deposits = [] if variant else DEPOSITS
+    order = lambda name: 1 + CASES.index(name) if name in CASES else 0
+    needs = lambda name: NEEDS.get(name, "deposit_cell_crib" if name in CASES else None)
+    ready = [(seed, order(name), name) for seed in seeds for name in deposits + CASES
+             if not deposits or needs(name) is None]
     done, failed = {}, []
     lock = threading.Condition()
     running = [0]
@@ -155,14 +167,8 @@ def run_all(size, seeds, base, qdem, jobs, threads, variant=None, resume=False):
             with lock:
                 done[(seed, name)] = s
                 running[0] -= 1
-                if name == "deposit_cell_bed":
-                    ready.append((seed, 0, "deposit_cell_crib"))
-                elif name == "deposit_cell_crib":
-                    ready.append((seed, 0, "deposit_fixed_crib"))
-                    ready.extend((seed, 1 + k, case) for k, case in enumerate(CASES)
-                                 if case != "single_fixed")
-                elif name == "deposit_fixed_crib":
-                    ready.append((seed, 1 + CASES.index("single_fixed"), "single_fixed"))
+                ready.extend((seed, order(after), after) for after in deposits + CASES
+                             if deposits and needs(after) == name)
                 lock.notify_all()
 
     pool = [threading.Thread(target=worker) for _ in range(jobs)]
@@ -469,7 +475,8 @@ PAIRS = [("single_delayed", "single_periodic"), ("single_shared", "single_period
          ("single_periodic", "single_fixed"), ("single_delayed", "single_fixed"),
          ("single_shared", "single_fixed"), ("single_shared", "single_delayed"),
          ("single_cropped", "single_fixed"), ("single_periodic", "single_cropped"),
-         ("single_delayed", "single_cropped"), ("single_shared", "single_cropped")]
+         ("single_delayed", "single_cropped"), ("single_shared", "single_cropped"),
+         ("single_walled", "single_cropped"), ("single_periodic", "single_walled")]
 
 
 def power_table(last, seeds):
