@@ -464,11 +464,11 @@ def samples_needed(sd, delta, power):
     """The fewest paired samples n whose 95% interval on a mean difference is at most
     ±`delta` (`power` False), or which detect a true difference `delta` at 5% with 80% power
     (`power` True), for paired differences of standard deviation `sd`; Student t."""
-    for n in range(2, 1000):
+    for n in range(2, 10_001):
         need = t95(n - 1) + (t_power(n - 1) if power else 0.0)
         if need * sd / math.sqrt(n) <= delta:
-            return n
-    return float("inf")
+            return f"{n:,}"
+    return "> 10,000"
 
 
 PAIRS = [("single_delayed", "single_periodic"), ("single_shared", "single_periodic"),
