@@ -342,6 +342,29 @@ fn a_free_body_under_a_load_or_gravity_is_refused() {
     assert!(error.to_string().contains("gravity pushes it"), "{error}");
 }
 
+/// A bonded beam without supports under gravity is refused the same way, and told to hold it
+/// with `[bonded] supports`: a bonded scene takes no `[[fix]]`.
+#[test]
+fn a_free_bonded_beam_under_gravity_is_told_to_take_supports() {
+    let dir = test_dir("rigid-modes-free-bonded");
+    let path = dir.join("beam.toml");
+    let text = "[run]\nt_end = 0.1\nintegrator = \"newmark\"\nbeta = 0.0\ngamma = 0.5\n\
+                gravity = [0.0, -9.81, 0.0]\n\
+                [[material]]\nname = \"concrete\"\ndensity = 2400.0\nyoung = 30e9\n\
+                poisson = 0.25\n\
+                [bonded]\nname = \"beam\"\nmaterial = \"concrete\"\nsize = [0.4, 0.1]\n\
+                element_size = 0.05\nstrength_mean = 6e6\nsupports = \"none\"\n";
+    std::fs::write(&path, text).unwrap();
+    let mut sim = Simulation::build(Scene::load(&path).unwrap()).unwrap();
+    let error = compute_and_write(&mut sim, 6, &dir.join("modes")).unwrap_err();
+    let message = error.to_string();
+    assert!(
+        matches!(error, ModesError::UnsupportedBonded { .. }),
+        "{message}"
+    );
+    assert!(message.contains("supports = \"simple\""), "{message}");
+}
+
 /// The same cube made deformable (E = 10 GPa, about 10⁴ times stiffer than its springs, see
 /// `contact_modes.rs`) heaves at the rigid cube's frequency to the stiffness ratio: the two
 /// representations agree within 10⁻³. (Its vertex spheres do not turn, so its rocking modes

@@ -53,6 +53,22 @@ pub enum ModesError {
         /// What pushes it: `[[load]] #k` or `gravity`.
         load: String,
     },
+    /// A bonded body with `supports = "none"`: its lattice is held out of its plane only, so
+    /// its rigid motions in the plane are free and it has no elastic modes to report.
+    #[error(
+        "scene {}: bonded body `{body}` has no supports ([bonded] supports = \"none\"), so \
+         {modes} of its rigid-body motions in its plane are free; fix: give it supports = \
+         \"simple\" or \"pinned\" (a bonded body takes no [[fix]])",
+        .scene.display()
+    )]
+    UnsupportedBonded {
+        /// The scene file.
+        scene: PathBuf,
+        /// The bonded body.
+        body: String,
+        /// Its free rigid-body motions.
+        modes: usize,
+    },
     /// The output directory could not be created.
     #[error("cannot create the output directory {}: {source}", .path.display())]
     CreateDir {
@@ -91,10 +107,7 @@ pub fn compute_and_write(
     let push = evaluate_once(sim);
     let world = &sim.world;
     let modes =
-        natural_modes(&world.state, &world.models, count).map_err(|source| ModesError::Modal {
-            scene: sim.scene.path.clone(),
-            source: named(sim, source),
-        })?;
+        natural_modes(&world.state, &world.models, count).map_err(|source| refused(sim, source))?;
     refuse_loaded_free_bodies(sim, &modes, &push)?;
     let vtu_dir = dir.join("vtu");
     std::fs::create_dir_all(&vtu_dir).map_err(|source| ModesError::CreateDir {
@@ -135,6 +148,28 @@ pub fn compute_and_write(
         csv,
         pvd,
     })
+}
+
+/// The modal analysis's refusal as the scene's: a bonded body free in its plane is told
+/// to take `[bonded] supports` (the lattice is held out of its plane, and takes no
+/// `[[fix]]`); any other refusal names its body or fix by the scene's names.
+fn refused(sim: &Simulation, error: ModalError) -> ModesError {
+    let scene = sim.scene.path.clone();
+    if let (ModalError::PartlyConstrained { body, modes }, Some(bonded)) =
+        (&error, &sim.scene.bonded)
+    {
+        if *body == bonded.name {
+            return ModesError::UnsupportedBonded {
+                scene,
+                body: body.clone(),
+                modes: *modes,
+            };
+        }
+    }
+    ModesError::Modal {
+        scene,
+        source: named(sim, error),
+    }
 }
 
 /// A refusal of a rigid body by its index, given the body's scene name instead.
