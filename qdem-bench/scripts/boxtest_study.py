@@ -585,12 +585,34 @@ def tables(series, runs, seeds, cycles, wall, args):
                      f"{1000 * (m + h):+.2f}] | {sum(v < 0 for v in d)} of {len(seeds)} |")
     lines += ["", power_table(last, seeds)]
     lines += ["", sample_table(args.size, seeds, os.path.join(ROOT, "out", "boxtest_study"))]
-    lines += ["", f"The runs ({args.jobs} at a time, {args.threads} thread(s) each; the study took "
-              f"{wall:.0f} s of wall time):", "",
-              "| sample | run | stones | spheres | steps | dt (s) | wall (s) | sphere-steps/s |",
-              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
-    for r in runs:
-        lines.append(f"| {r['seed']} | {r['run']} | {r['stones']} | {r['spheres']} | {r['steps']} | {r['dt']:.3e} | {r['wall_seconds']:.1f} | {r['sphere_steps_per_second']:.3e} |")
+    lines += ["", runs_table(runs, args.jobs, args.threads, wall)]
+    return "\n".join(lines)
+
+
+def runs_table(runs, jobs, threads, wall):
+    """Each run of the study over its samples: the range of its stones, spheres and step, its
+    median steps, wall time and speed (every run is in runs.json)."""
+    lines = [f"The runs over the samples ({jobs} at a time, {threads} thread(s) each, range and "
+             f"median; the study's runs took {wall:.0f} s of wall time in all, every run in "
+             "`out/boxtest_study/runs.json`):", "",
+             "| run | stones | spheres | dt (s) | steps (median) | wall (s): median, range | "
+             "sphere-steps/s (median) |", "| --- | --- | --- | --- | --- | --- | --- |"]
+    median = lambda xs: sorted(xs)[len(xs) // 2]
+    for name in dict.fromkeys(r["run"] for r in runs):
+        rs = [r for r in runs if r["run"] == name]
+        col = lambda key: [r[key] for r in rs]
+        span = lambda key, f="{}": f"{f.format(min(col(key)))}–{f.format(max(col(key)))}"
+        lines.append(f"| {name} | {span('stones')} | {span('spheres')} | "
+                     f"{span('dt', '{:.2e}')} | {median(col('steps'))} | "
+                     f"{median(col('wall_seconds')):.1f} ({span('wall_seconds', '{:.1f}')}) | "
+                     f"{median(col('sphere_steps_per_second')):.2e} |")
+    wall_of = {(r["seed"], r["run"]): r["wall_seconds"] for r in runs}
+    seeds = sorted({r["seed"] for r in runs})
+    for case in ("single_delayed", "single_shared"):
+        ratio = sorted(wall_of[(s, case)] / wall_of[(s, "single_periodic")] for s in seeds)
+        lines.append(f"\n{LABELS[case]} over the same sample's ordinary periodic box, wall "
+                     f"time: median {median(ratio):.2f}, range {ratio[0]:.2f}–{ratio[-1]:.2f} "
+                     "(two runs at a time: each beside another one).")
     return "\n".join(lines)
 
 
