@@ -592,8 +592,10 @@ def tables(series, runs, seeds, cycles, wall, args):
 def runs_table(runs, jobs, threads, wall):
     """Each run of the study over its samples: the range of its stones, spheres and step, its
     median steps, wall time and speed (every run is in runs.json)."""
+    total = sum(r["wall_seconds"] for r in runs)
     lines = [f"The runs over the samples ({jobs} at a time, {threads} thread(s) each, range and "
-             f"median; the study's runs took {wall:.0f} s of wall time in all, every run in "
+             f"median; {total:,.0f} s of run time in all, {wall:,.0f} s of wall time in this "
+             "call (runs read back with `--resume` take none); every run in "
              "`out/boxtest_study/runs.json`):", "",
              "| run | stones | spheres | dt (s) | steps (median) | wall (s): median, range | "
              "sphere-steps/s (median) |", "| --- | --- | --- | --- | --- | --- | --- |"]
