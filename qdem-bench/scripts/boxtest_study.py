@@ -53,6 +53,8 @@ import tomllib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FIXTURES = os.path.join(ROOT, "fixtures", "boxtest")
+sys.path.insert(0, FIXTURES)
+import grading_table  # noqa: E402  (fixtures/boxtest: a sample's percent passing a sieve)
 QDEM = os.path.join(ROOT, "target", "release", "qdem")
 CASES = ["three_sleeper", "single_fixed", "single_cropped", "single_walled", "single_periodic",
          "single_delayed", "single_shared"]
@@ -330,14 +332,19 @@ def t95(df):
     return t_quantile(df, 0.475)
 
 
+def std_dev(values):
+    """The sample standard deviation (n − 1 in the denominator)."""
+    mean = sum(values) / len(values)
+    return math.sqrt(sum((v - mean) ** 2 for v in values) / (len(values) - 1))
+
+
 def mean_ci(values):
     """Mean and the half-width of its 95% interval (Student t over the samples)."""
     n = len(values)
     mean = sum(values) / n
     if n < 2:
         return mean, float("nan")
-    sd = math.sqrt(sum((v - mean) ** 2 for v in values) / (n - 1))
-    return mean, t95(n - 1) * sd / math.sqrt(n)
+    return mean, t95(n - 1) * std_dev(values) / math.sqrt(n)
 
 
 def error(values, case, seed):
@@ -371,14 +378,11 @@ def replicas(args, seeds, cycles, settle):
     path = os.path.join(base, "settlement.csv")
     if os.path.exists(path):
         with open(path) as f:
-            rows = [r for r in csv.DictReader(f) if int(r["cycle"]) == cycles]
-        for seed in {int(r["seed"]) for r in rows}:
-            for r in rows:
-                if int(r["seed"]) == seed:
-                    series.setdefault((r["case"], seed, 0.5), float(r["settlement_m"]))
+            for r in csv.DictReader(f):
+                if int(r["cycle"]) == cycles:
+                    series.setdefault((r["case"], int(r["seed"]), 0.5), float(r["settlement_m"]))
                     between.setdefault(r["case"], []).append(float(r["settlement_m"]))
     steps = sorted({v for _, _, v in series})
-    sd = lambda xs: math.sqrt(sum((x - sum(xs) / len(xs)) ** 2 for x in xs) / (len(xs) - 1))
     lines = [f"Settlement after {cycles} cycles (mm) of sample(s) {', '.join(map(str, seeds))} "
              "loaded at steps of 0.47-0.53 of the contacts' estimate (0.5: the study's run), "
              "the standard deviation over these runs beside the study's over its samples:", "",
@@ -391,8 +395,8 @@ def replicas(args, seeds, cycles, settle):
             cells = " | ".join(f"{1000 * series[(case, seed, v)]:.2f}"
                                if (case, seed, v) in series else "" for v in steps)
             spread = between.get(case, [])
-            lines.append(f"| {seed} | {LABELS[case]} | {cells} | {1000 * sd(xs):.2f} | "
-                         + (f"{1000 * sd(spread):.2f} ({len(spread)} samples)" if len(spread) > 1
+            lines.append(f"| {seed} | {LABELS[case]} | {cells} | {1000 * std_dev(xs):.2f} | "
+                         + (f"{1000 * std_dev(spread):.2f} ({len(spread)} samples)" if len(spread) > 1
                             else "") + " |")
     table = "\n".join(lines)
     with open(os.path.join(base, "replicas.md"), "w") as f:
@@ -494,25 +498,16 @@ def power_table(last, seeds):
              "| compared | s (mm) | resolved at 95% (mm) | n: ±2 mm at 95% | n: 2 mm, 80% power |",
              "| --- | --- | --- | --- | --- |"]
     for name, d in rows:
-        mean = sum(d) / n
-        sd = math.sqrt(sum((v - mean) ** 2 for v in d) / (n - 1))
+        sd = std_dev(d)
         lines.append(f"| {name} | {1000 * sd:.2f} | ±{1000 * t95(n - 1) * sd / math.sqrt(n):.2f} | "
                      f"{samples_needed(sd, 2e-3, False)} | {samples_needed(sd, 2e-3, True)} |")
     return "\n".join(lines)
 
 
-def grading_of(path):
-    """Sieve sizes (m) and masses (kg) of the stones in a run's grading.csv."""
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return [float(r["sieve_size"]) for r in rows], [float(r["mass"]) for r in rows]
-
-
-def passing(sizes, masses, sieve, basis):
-    """The fraction of the stones (by number, or by mass) whose sieve size is at most `sieve`."""
-    if basis == "mass":
-        return sum(m for d, m in zip(sizes, masses) if d <= sieve) / sum(masses)
-    return sum(d <= sieve for d in sizes) / len(sizes)
+def grading_rows(path):
+    """The rows of a run's grading.csv as numbers (sorted by sieve size, as qdem writes them)."""
+    with open(path, newline="") as f:
+        return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
 
 
 def sample_table(size, seeds, base):
@@ -529,15 +524,14 @@ def sample_table(size, seeds, base):
              "two end walls; its middle third is the cell's sample):", "",
              "| sample | " + " | ".join(LABELS[c] for c in CASES) + " | grading: largest deviation |",
              "| --- |" + " --- |" * (len(CASES) + 1)]
+    column = "mass_passing" if basis == "mass" else "number_passing"
     worst = 0.0
     for seed in seeds:
-        cells = []
-        for c in CASES:
-            sizes, masses = grading_of(os.path.join(base, f"{size}_seed{seed}", c, "grading.csv"))
-            cells.append(f"{len(sizes)}, {sum(masses):.2f} kg")
-        sizes, masses = grading_of(os.path.join(base, f"{size}_seed{seed}", "single_periodic",
-                                                "grading.csv"))
-        dev = max(abs(100 * (passing(sizes, masses, a, basis) - want)) for a, want in curve)
+        rows = {c: grading_rows(os.path.join(base, f"{size}_seed{seed}", c, "grading.csv"))
+                for c in CASES}
+        cells = [f"{len(rows[c])}, {sum(r['mass'] for r in rows[c]):.2f} kg" for c in CASES]
+        dev = max(abs(grading_table.passing(rows["single_periodic"], a, column) - 100 * want)
+                  for a, want in curve)
         worst = max(worst, dev)
         lines.append(f"| {seed} | " + " | ".join(cells) + f" | {dev:.1f} points |")
     lines += ["", f"Largest deviation of any sample's grading from the asked curve: {worst:.1f} "
