@@ -342,10 +342,10 @@ fn a_free_body_under_a_load_or_gravity_is_refused() {
     assert!(error.to_string().contains("gravity pushes it"), "{error}");
 }
 
-/// A bonded beam without supports under gravity is refused the same way, and told to hold it
-/// with `[bonded] supports`: a bonded scene takes no `[[fix]]`.
+/// A bonded beam without supports (its lattice held out of its plane only) is refused, and
+/// told to take `[bonded] supports`, not `[[fix]]`, which a bonded scene does not take.
 #[test]
-fn a_free_bonded_beam_under_gravity_is_told_to_take_supports() {
+fn a_bonded_beam_without_supports_is_told_to_take_supports() {
     let dir = test_dir("rigid-modes-free-bonded");
     let path = dir.join("beam.toml");
     let text = "[run]\nt_end = 0.1\nintegrator = \"newmark\"\nbeta = 0.0\ngamma = 0.5\n\
