@@ -11,6 +11,7 @@ use qdem_core::step::team::Team;
 use qdem_core::{error::CoreError, parallel::Communicator, step::Halt, step::Scheme};
 use qdem_io::analyze::AnalyzeOptions;
 use qdem_io::build::{BuildError, Simulation};
+use qdem_io::mode_marks::ReferenceMark;
 use qdem_io::runner::{run_with, RunError, RunOptions};
 use qdem_io::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
@@ -319,6 +320,10 @@ pub struct AnalyzeArgs {
     /// the spectra and mobility plots
     #[arg(long, value_name = "MODES_CSV")]
     pub modes: Option<PathBuf>,
+    /// A frequency to mark on the spectra and mobility plots in red, HZ=LABEL (a paper's
+    /// peak: `--mark 100=paper:rigid --mark 200=paper:bending`); repeat for more
+    #[arg(long = "mark", value_name = "HZ=LABEL")]
+    pub marks: Vec<ReferenceMark>,
 }
 
 /// A count (tetrahedra, threads or steps of `bench`): a whole number of at least 1.
@@ -451,6 +456,7 @@ pub fn dispatch(cli: Cli, ranks: Option<Arc<dyn Communicator>>) -> Result<(), Cl
                 bandwidth: a.bandwidth,
                 max_frequency: a.fmax,
                 modes: a.modes,
+                references: a.marks,
             };
             analyze_run(&a.scene, a.out.as_deref(), &options)
         }

@@ -13,7 +13,7 @@
 
 use crate::build::BuildError;
 use crate::linear_spectrum::{linear_spectrum, mobility, parzen_smooth};
-use crate::mode_marks::{read_mode_marks, ModeMark, ModeMarksError};
+use crate::mode_marks::{read_mode_marks, ModeMark, ModeMarksError, ReferenceMark};
 use crate::output::{write_atomic, OutputError, OUTPUT_FORMAT, PROBE_COLUMNS, TIME_COLUMN};
 use crate::plot::{line_plot_svg, marked_plot_svg, Labels, Mark, Series};
 use crate::scene::Scene;
@@ -34,6 +34,8 @@ pub struct AnalyzeOptions {
     /// A `modes.csv` of `qdem modes` whose modes are marked on the spectra and mobility
     /// plots ([`crate::mode_marks`]).
     pub modes: Option<PathBuf>,
+    /// Frequencies given by hand to mark beside the modes (a paper's peaks).
+    pub references: Vec<ReferenceMark>,
 }
 
 impl Default for AnalyzeOptions {
@@ -45,6 +47,7 @@ impl Default for AnalyzeOptions {
             bandwidth: 20.0,
             max_frequency: 1000.0,
             modes: None,
+            references: Vec::new(),
         }
     }
 }
@@ -143,7 +146,13 @@ pub fn analyze(
         .map(|(m, label)| Mark {
             x: m.frequency_hz,
             label,
+            reference: false,
         })
+        .chain(options.references.iter().map(|r| Mark {
+            x: r.frequency_hz,
+            label: &r.label,
+            reference: true,
+        }))
         .collect();
     let probes = read_probes(&out_dir.join("probes.csv"), options)?;
     let dt = sampling_step(&probes, &out_dir.join("probes.csv"))?;

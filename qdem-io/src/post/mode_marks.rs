@@ -1,7 +1,8 @@
 //! Natural frequencies to mark on spectra (`qdem analyze --modes`): the modes of a
 //! `modes.csv` written by `qdem modes` that move a sizeable share of the mass, so that a
 //! spectrum's peaks can be read against them (paper 000 §4.2 reads the sleeper's spectra
-//! against its rigid vertical and bending modes).
+//! against its rigid vertical and bending modes); and reference frequencies given by hand
+//! (`qdem analyze --mark 100=paper`: a peak a paper reports).
 
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -26,6 +27,48 @@ impl ModeMark {
     /// The label drawn beside its line: `mode 44 (ry)`.
     pub fn label(&self) -> String {
         format!("mode {} ({})", self.mode, self.direction)
+    }
+}
+
+/// A frequency given by hand to mark (`--mark HZ=LABEL`): a peak a paper or a peer reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceMark {
+    /// Its frequency (Hz).
+    pub frequency_hz: f64,
+    /// What it is, drawn beside its line.
+    pub label: String,
+}
+
+impl std::str::FromStr for ReferenceMark {
+    type Err = String;
+
+    /// Reads `HZ=LABEL` (`100=paper rigid`); `HZ` alone labels the line with its frequency.
+    ///
+    /// ```
+    /// use qdem_io::mode_marks::ReferenceMark;
+    /// let mark: ReferenceMark = "320=paper: ballast-sleeper".parse().unwrap();
+    /// assert_eq!(mark.frequency_hz, 320.0);
+    /// assert_eq!(mark.label, "paper: ballast-sleeper");
+    /// assert!("-5=x".parse::<ReferenceMark>().is_err());
+    /// ```
+    fn from_str(text: &str) -> Result<Self, String> {
+        let (hz, label) = text.split_once('=').unwrap_or((text, ""));
+        let frequency_hz = hz
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|f| f.is_finite() && *f > 0.0)
+            .ok_or_else(|| {
+                format!("`{text}`: expected HZ=LABEL with HZ a positive frequency, e.g. 100=paper")
+            })?;
+        let label = match label.trim() {
+            "" => format!("{frequency_hz} Hz"),
+            l => l.to_string(),
+        };
+        Ok(ReferenceMark {
+            frequency_hz,
+            label,
+        })
     }
 }
 

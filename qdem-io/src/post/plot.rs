@@ -19,6 +19,8 @@ pub struct Mark<'a> {
     pub x: f64,
     /// What it is, written beside the line.
     pub label: &'a str,
+    /// A reference given by hand (a paper's peak), drawn in red; else a computed mode, grey.
+    pub reference: bool,
 }
 
 /// Axis titles and the plot title.
@@ -119,24 +121,34 @@ pub fn marked_plot_svg(
                     .label(s.label)
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
             }
-            let grey = RGBColor(110, 110, 110);
             for (i, mark) in marks
                 .iter()
                 .filter(|m| (x0..=x1).contains(&m.x))
                 .enumerate()
             {
+                let colour = if mark.reference {
+                    RGBColor(190, 30, 30)
+                } else {
+                    RGBColor(110, 110, 110)
+                };
                 chart.draw_series(DashedLineSeries::new(
                     [(mark.x, y0), (mark.x, y1)],
                     4,
                     3,
-                    grey.stroke_width(1),
+                    colour.stroke_width(1),
                 ))?;
-                // Labels step down the panel so that neighbouring marks stay readable.
-                let at = y1 - (y1 - y0) * (0.03 + 0.05 * (i % 6) as f64);
+                // Labels step down the panel so that neighbouring marks stay readable;
+                // references from the bottom, modes from the top.
+                let step = (y1 - y0) * (0.03 + 0.05 * (i % 6) as f64);
+                let at = if mark.reference {
+                    y0 + step + (y1 - y0) * 0.03
+                } else {
+                    y1 - step
+                };
                 chart.draw_series(std::iter::once(Text::new(
                     mark.label.to_string(),
                     (mark.x, at),
-                    ("sans-serif", 11).into_font().color(&grey),
+                    ("sans-serif", 11).into_font().color(&colour),
                 )))?;
             }
             chart
@@ -178,15 +190,27 @@ mod tests {
             Mark {
                 x: 42.6,
                 label: "mode 44",
+                reference: false,
+            },
+            Mark {
+                x: 60.0,
+                label: "paper 60 Hz",
+                reference: true,
             },
             Mark {
                 x: 500.0,
                 label: "beyond",
+                reference: false,
             },
         ];
         marked_plot_svg(&path, &labels, &series, &marks).unwrap();
         let svg = std::fs::read_to_string(&path).unwrap();
         assert!(svg.contains("mode 44"));
+        assert!(svg.contains("paper 60 Hz"));
+        assert!(
+            svg.contains("#BE1E1E"),
+            "a reference is drawn in red, apart from the modes"
+        );
         assert!(
             !svg.contains("beyond"),
             "a mark outside the x range is left out"
