@@ -5,6 +5,7 @@ Usage:
     python3 qdem-bench/scripts/scaling_model.py [--kernel-core-ms 28.8] [--rest-core-ms 18.5]
         [--particles 293541] [--spheres 279074] [--cores 64] [--bandwidth-gbs 12.5]
         [--latency-us 2] [--bed 3.0,0.6,0.55] [--stone 0.055] [--rebuild-every 1000]
+        [--dt 7.30e-8] [--passage 3.67] [--sleepers 1] [--efficiency 1.0] [--nodes 1,8,64]
         [--json FILE]
 
 The inputs are measured on this project's 2-core machine (docs/scaling.md says where each
@@ -29,10 +30,13 @@ about 2 us). Per step, on P nodes:
       t = kernel / (P cores) + rest / cores + share(P)
       share(P) = (P - 1) / P * 48 B * particles / bandwidth + log2(P) * latency
 
-The core-milliseconds assume the work divides perfectly over a node's cores, so the
-projections are lower bounds. Prints JSON: per P of 1, 8 and 64 the step time and the wall
-time of the 1 s deposition (13.7 M steps at dt = 7.30e-8 s) and of the 3.67 s five-car
-passage (50 M steps).
+The core-milliseconds divide over a node's cores at EFFICIENCY (1: perfectly, so the
+projections are lower bounds; the measured two-thread speed-up over two gives a stated
+figure). SLEEPERS K makes the track K one-sleeper cells long (the paper's Figure 13: 24
+sleepers): the work, particles and spheres times K, the bed K times longer along the track
+(its second extent). Prints JSON: per P of NODES the step time and the wall time of the 1 s
+deposition (1/DT steps: 13.7 M at dt = 7.30e-8 s) and of the PASSAGE s five-car passage
+(3.67 s: 50 M steps).
 """
 
 from __future__ import annotations
@@ -41,16 +45,13 @@ import argparse
 import json
 import math
 
-DEPOSITION_STEPS = 13.7e6
-PASSAGE_STEPS = 50.3e6
-
-
 def step_replicated(a, p: int) -> float:
     share = 0.0
     if p > 1:
         share = (p - 1) / p * 48 * a.particles / (a.bandwidth_gbs * 1e9) \
             + math.log2(p) * a.latency_us * 1e-6
-    return a.kernel_core_ms * 1e-3 / (p * a.cores) + a.rest_core_ms * 1e-3 / a.cores + share
+    return (a.kernel_core_ms * 1e-3 / (p * a.cores) + a.rest_core_ms * 1e-3 / a.cores) \
+        / a.efficiency + share
 
 
 def halo_fraction(a, p: int) -> float:
@@ -72,7 +73,7 @@ def step_as_built(a, p: int) -> float:
         exchange = 144 * halo_fraction(a, p) * a.particles / bandwidth \
             + 10 * a.latency_us * 1e-6 \
             + (p - 1) / p * 72 * a.spheres / bandwidth / a.rebuild_every
-    return (a.kernel_core_ms + a.rest_core_ms) * 1e-3 / (p * a.cores) + exchange
+    return (a.kernel_core_ms + a.rest_core_ms) * 1e-3 / (p * a.cores * a.efficiency) + exchange
 
 
 def main() -> None:
@@ -91,16 +92,25 @@ def main() -> None:
     ap.add_argument("--bed", type=lambda t: [float(v) for v in t.split(",")],
                     default=[3.0, 0.6, 0.55], help="the settled bed's extent x,y,z (m)")
     ap.add_argument("--stone", type=float, default=0.055, help="a stone's size (m)")
+    ap.add_argument("--dt", type=float, default=7.30e-8, help="the step (s)")
+    ap.add_argument("--passage", type=float, default=3.67, help="the passage's duration (s)")
+    ap.add_argument("--sleepers", type=int, default=1, help="one-sleeper cells along the track")
+    ap.add_argument("--efficiency", type=float, default=1.0,
+                    help="the share of a node's cores' speed the work gets")
+    ap.add_argument("--nodes", type=lambda t: [int(v) for v in t.split(",")], default=[1, 8, 64])
     ap.add_argument("--json", default=None)
     a = ap.parse_args()
+    for key in ("kernel_core_ms", "rest_core_ms", "particles", "spheres"):
+        setattr(a, key, getattr(a, key) * a.sleepers)
+    a.bed[1] *= a.sleepers
     rows = []
-    for p in (1, 8, 64):
+    for p in a.nodes:
         for design, step in (("as built", step_as_built), ("replicated", step_replicated)):
             t = step(a, p)
             rows.append({"nodes": p, "design": design, "step_ms": 1e3 * t,
                          "halo_fraction": halo_fraction(a, p) if design == "as built" else 1.0,
-                         "deposition_h": t * DEPOSITION_STEPS / 3600,
-                         "passage_h": t * PASSAGE_STEPS / 3600})
+                         "deposition_h": t / a.dt / 3600,
+                         "passage_h": t * a.passage / a.dt / 3600})
     out = {"inputs": vars(a), "rows": rows}
     text = json.dumps(out, indent=2)
     print(text)
