@@ -535,6 +535,14 @@ fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliErro
         eprintln!("warning: {w}");
     }
     let report = qdem_io::modes::compute_and_write(&mut sim, count, &out_dir)?;
+    if report.loose_stone_modes > 0 {
+        eprintln!(
+            "warning: gravity or a load does work along {} rigid-body modes of [ballast] \
+             stones that touch nothing (stones in flight above the bed): kept as rigid, the \
+             elastic modes are the bed's without those stones",
+            report.loose_stone_modes
+        );
+    }
     for name in &report.ignored {
         eprintln!("note: model `{name}` gives no stiffness and is left out of the modes");
     }

@@ -316,6 +316,45 @@ fn two_stacked_rigid_cubes_match_the_dense_twelve_dof_solve() {
     }
 }
 
+/// A `[ballast]` stone touching nothing (in flight above a bed) under gravity is not refused:
+/// the stones are many bodies, and one in the air leaves the bed's modes as they are. Its
+/// six rigid-body modes are kept as rigid, the one gravity does work along (its fall) is
+/// counted; the cube resting on its springs keeps the frequencies it has alone, to rounding.
+#[test]
+fn a_ballast_stone_in_flight_is_counted_and_leaves_the_bed_modes_alone() {
+    let dir = test_dir("rigid-modes-stone-in-flight");
+    let stone = fixture("ballast/stones/coarse/stone_00.msh");
+    let ballast = format!(
+        "[ballast]\nname = \"ballast\"\nmaterial = \"stiff\"\nmeshes = [{stone:?}]\n\
+         contact_radius = 0.01\ncount = 1\nregion = [[-0.5, -0.5, 1.0], [0.5, 0.5, 1.5]]\n\
+         seed = 1\nrigid = true\n"
+    );
+    let mut alone = scene(&dir, true, "");
+    alone.run.gravity = [0.0, 0.0, -9.81];
+    let mut sim = Simulation::build(alone).unwrap();
+    let cube = compute_and_write(&mut sim, 6, &dir.join("alone")).unwrap();
+    assert_eq!(cube.loose_stone_modes, 0);
+    let mut with_stone = scene(&dir, true, &ballast);
+    with_stone.run.gravity = [0.0, 0.0, -9.81];
+    let mut sim = Simulation::build(with_stone).unwrap();
+    let report = compute_and_write(&mut sim, 12, &dir.join("with-stone")).unwrap();
+    assert_eq!(
+        report.loose_stone_modes, 1,
+        "gravity works along the stone's fall only"
+    );
+    let (rigid, elastic): (Vec<_>, Vec<_>) = report.modes.modes.iter().partition(|m| m.rigid);
+    assert_eq!(rigid.len(), 6);
+    for (mode, alone) in elastic.iter().zip(&cube.modes.modes) {
+        let error = mode.frequency_hz / alone.frequency_hz - 1.0;
+        assert!(
+            error.abs() < 1e-8,
+            "{} Hz against {} Hz",
+            mode.frequency_hz,
+            alone.frequency_hz
+        );
+    }
+}
+
 /// A body that nothing fixes or holds but a load or gravity pushes is not in equilibrium:
 /// refused, naming the body and what pushes it, and no file is written.
 #[test]
