@@ -12,6 +12,7 @@ use qdem_core::{error::CoreError, parallel::Communicator, step::Halt, step::Sche
 use qdem_io::analyze::AnalyzeOptions;
 use qdem_io::build::{BuildError, Simulation};
 use qdem_io::mode_marks::ReferenceMark;
+use qdem_io::modes::Shapes;
 use qdem_io::runner::{run_with, RunError, RunOptions};
 use qdem_io::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
@@ -176,6 +177,10 @@ pub struct ModesArgs {
     /// Worker threads [default: one per core]
     #[arg(long, value_name = "N", value_parser = thread_count, allow_negative_numbers = true)]
     pub threads: Option<usize>,
+    /// Write modes.csv only, no mode shapes (a bed's hundreds of modes would write a mesh
+    /// each)
+    #[arg(long)]
+    pub no_shapes: bool,
 }
 
 /// `qdem run`.
@@ -443,7 +448,13 @@ pub fn dispatch(cli: Cli, ranks: Option<Arc<dyn Communicator>>) -> Result<(), Cl
     match cli.command {
         Command::Run(a) => thread_pool(a.threads)?.install(|| with_team(|| run_scene(&a, ranks))),
         Command::Modes(a) => {
-            thread_pool(a.threads)?.install(|| modes_of(&a.scene, a.count, a.out.as_deref()))
+            let shapes = if a.no_shapes {
+                Shapes::None
+            } else {
+                Shapes::Vtu
+            };
+            thread_pool(a.threads)?
+                .install(|| modes_of(&a.scene, a.count, a.out.as_deref(), shapes))
         }
         Command::Check(a) => thread_pool(a.threads)?.install(|| match a.advice {
             Some(AdviceFormat::Json) => check::print_advice_json(&a.scene),
@@ -524,7 +535,7 @@ fn analyze_run(path: &Path, out: Option<&Path>, options: &AnalyzeOptions) -> Res
 }
 
 /// `qdem modes`: builds the scene, computes and writes the modes, prints the table.
-fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliError> {
+fn modes_of(path: &Path, count: usize, out: Option<&Path>, shapes: Shapes) -> Result<(), CliError> {
     let scene = Scene::load(path)?;
     let out_dir = match out {
         Some(dir) => dir.to_path_buf(),
@@ -534,7 +545,7 @@ fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliErro
     for w in &sim.warnings {
         eprintln!("warning: {w}");
     }
-    let report = qdem_io::modes::compute_and_write(&mut sim, count, &out_dir)?;
+    let report = qdem_io::modes::compute_and_write_as(&mut sim, count, &out_dir, shapes)?;
     if report.loose_stone_modes > 0 {
         eprintln!(
             "warning: gravity or a load does work along {} rigid-body modes of [ballast] \
@@ -564,11 +575,10 @@ fn modes_of(path: &Path, count: usize, out: Option<&Path>) -> Result<(), CliErro
     let mut table = Vec::new();
     qdem_io::modes::write_table(&mut table, m).expect("writing to memory");
     print!("{}", String::from_utf8_lossy(&table));
-    eprintln!(
-        "{} and {} written",
-        report.csv.display(),
-        report.pvd.display()
-    );
+    match &report.pvd {
+        Some(pvd) => eprintln!("{} and {} written", report.csv.display(), pvd.display()),
+        None => eprintln!("{} written (no mode shapes)", report.csv.display()),
+    }
     Ok(())
 }
 

@@ -14,7 +14,7 @@ mod common;
 use common::{fixture, test_dir};
 use nalgebra::{DMatrix, Matrix3, SymmetricEigen, Vector3};
 use qdem_io::build::Simulation;
-use qdem_io::modes::{compute_and_write, ModesError};
+use qdem_io::modes::{compute_and_write, compute_and_write_as, ModesError, Shapes};
 use qdem_io::scene::Scene;
 use std::f64::consts::PI;
 
@@ -353,6 +353,23 @@ fn a_ballast_stone_in_flight_is_counted_and_leaves_the_bed_modes_alone() {
             alone.frequency_hz
         );
     }
+}
+
+/// Without the shapes (`qdem modes --no-shapes`) the same modes.csv is written, byte for
+/// byte, and no mesh: neither modes.pvd nor vtu/.
+#[test]
+fn modes_without_shapes_write_the_same_table_and_no_mesh() {
+    let dir = test_dir("rigid-modes-no-shapes");
+    let mut sim = Simulation::build(scene(&dir, true, "")).unwrap();
+    let with = compute_and_write(&mut sim, 6, &dir.join("with")).unwrap();
+    let mut sim = Simulation::build(scene(&dir, true, "")).unwrap();
+    let without = compute_and_write_as(&mut sim, 6, &dir.join("without"), Shapes::None).unwrap();
+    assert!(with.pvd.is_some() && without.pvd.is_none());
+    assert_eq!(
+        std::fs::read(&with.csv).unwrap(),
+        std::fs::read(&without.csv).unwrap()
+    );
+    assert!(!dir.join("without/vtu").exists() && !dir.join("without/modes.pvd").exists());
 }
 
 /// A body that nothing fixes or holds but a load or gravity pushes is not in equilibrium:

@@ -96,8 +96,18 @@ pub struct ModesReport {
     pub loose_stone_modes: usize,
     /// `modes.csv`.
     pub csv: PathBuf,
-    /// `modes.pvd`.
-    pub pvd: PathBuf,
+    /// `modes.pvd`, unless the shapes were left out ([`Shapes::None`]).
+    pub pvd: Option<PathBuf>,
+}
+
+/// Whether the mode shapes are written beside `modes.csv`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shapes {
+    /// `modes.pvd` and one VTU a mode (the whole mesh each: about 24 MB a mode on a bed of
+    /// 3,000 paper stones).
+    Vtu,
+    /// `modes.csv` only: the hundreds of modes a bed needs before its sleeper's.
+    None,
 }
 
 /// Computes the `count` lowest modes of `sim`'s deformable bodies about its starting state
@@ -109,18 +119,48 @@ pub fn compute_and_write(
     count: usize,
     dir: &Path,
 ) -> Result<ModesReport, ModesError> {
+    compute_and_write_as(sim, count, dir, Shapes::Vtu)
+}
+
+/// [`compute_and_write`], with the mode shapes written or left out as `shapes` says.
+pub fn compute_and_write_as(
+    sim: &mut Simulation,
+    count: usize,
+    dir: &Path,
+    shapes: Shapes,
+) -> Result<ModesReport, ModesError> {
     let push = evaluate_once(sim);
     let world = &sim.world;
     let modes =
         natural_modes(&world.state, &world.models, count).map_err(|source| refused(sim, source))?;
     let loose_stone_modes = refuse_loaded_free_bodies(sim, &modes, &push)?;
+    std::fs::create_dir_all(dir).map_err(|source| ModesError::CreateDir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let csv = dir.join("modes.csv");
+    write_atomic(&csv, |w| write_table(w, &modes))?;
+    let pvd = match shapes {
+        Shapes::Vtu => Some(write_shapes(sim, &modes, dir)?),
+        Shapes::None => None,
+    };
+    Ok(ModesReport {
+        ignored: modes.ignored.clone(),
+        loose_stone_modes,
+        modes,
+        csv,
+        pvd,
+    })
+}
+
+/// Each mode's shape as `vtu/mode_NNNN.vtu`, indexed by `modes.pvd`; returns its path.
+fn write_shapes(sim: &Simulation, modes: &Modes, dir: &Path) -> Result<PathBuf, ModesError> {
+    let world = &sim.world;
     let vtu_dir = dir.join("vtu");
     std::fs::create_dir_all(&vtu_dir).map_err(|source| ModesError::CreateDir {
         path: vtu_dir.clone(),
         source,
     })?;
-    let csv = dir.join("modes.csv");
-    write_atomic(&csv, |w| write_table(w, &modes))?;
     let pvd = dir.join("modes.pvd");
     let tets: Vec<[u32; 4]> = sim
         .bodies
@@ -147,13 +187,7 @@ pub fn compute_and_write(
         index.push((k + 1) as f64, name);
     }
     index.write(&pvd)?;
-    Ok(ModesReport {
-        ignored: modes.ignored.clone(),
-        loose_stone_modes,
-        modes,
-        csv,
-        pvd,
-    })
+    Ok(pvd)
 }
 
 /// The modal analysis's refusal as the scene's: a bonded body free in its plane is told
