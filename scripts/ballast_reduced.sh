@@ -18,6 +18,14 @@
 # "A bed of 5 cm stones"): the layer poured and consolidated rigid (fine_deposit_rigid.toml,
 # fine_consolidate_rigid.toml), then both bogies on it with rigid stones at friction 0.577 and
 # 1.73 side by side (fine_load_rigid.toml, fine_load_rigid_mu173.toml).
+# With --paper, the same reduced layout with 3,100 of the paper's stones (docs/ballast.md, "The
+# reduced track with the paper's stones"): poured and consolidated rigid (paper_deposit_rigid,
+# paper_consolidate_rigid), both bogies with rigid stones at friction 0.577 and 1.73 side by
+# side (paper_load_rigid, paper_load_rigid_mu173; about 45 min each on one thread alone), the
+# bed's modes (qdem modes --no-shapes: the free stones' rigid modes come first), and the
+# spectra and mobility of the window both carry (0.02-0.15 s) with those modes and the paper's
+# peaks marked, read by spectrum_peaks.py. The dashpot run (paper_load_rigid_dashpot.toml,
+# 1.5 M steps) is run by hand.
 # Step 1 is skipped when its checkpoint exists, unless --redeposit is given.
 # Outputs: out/ballast/{reduced,stiff}_*/ (probes.csv, vtu/, analysis/*.csv|svg, modes/).
 set -euo pipefail
@@ -30,6 +38,7 @@ track=reduced
 friction=false
 rigid=false
 fine=false
+paper=false
 for arg in "$@"; do
     case "$arg" in
         --redeposit) redeposit=true ;;
@@ -37,7 +46,8 @@ for arg in "$@"; do
         --stiff) track=stiff ;;
         --rigid-forming) rigid=true ;;
         --fine) fine=true ;;
-        *) echo "usage: $0 [--stiff [--rigid-forming]] [--fine] [--redeposit] [--friction-study]" >&2; exit 2 ;;
+        --paper) paper=true ;;
+        *) echo "usage: $0 [--stiff [--rigid-forming]] [--fine] [--paper] [--redeposit] [--friction-study]" >&2; exit 2 ;;
     esac
 done
 forming=(reduced_deposit)
@@ -55,6 +65,11 @@ if $fine; then
     track=stiff
     forming=(fine_deposit_rigid fine_consolidate_rigid)
     runs=(fine_load_rigid fine_load_rigid_mu173)
+fi
+if $paper; then
+    track=stiff
+    forming=(paper_deposit_rigid paper_consolidate_rigid)
+    runs=(paper_load_rigid paper_load_rigid_mu173)
 fi
 if $redeposit || [ ! -f "out/ballast/${forming[-1]}/checkpoint.qdc" ]; then
     for scene in "${forming[@]}"; do $qdem run $dir/$scene.toml; done
@@ -76,6 +91,20 @@ done
 for pid in "${pids[@]}"; do wait "$pid"; done
 if $fine; then
     for run in "${runs[@]}"; do python3 $dir/track_profile.py --motion out/ballast/$run; done
+    exit 0
+fi
+if $paper; then
+    # Paper 000 §4.2's readings: the rigid vertical mode, the three vertical bending modes,
+    # the ballast-sleeper resonance (and S2/S3 boundary) and the ballast's wheel-load response.
+    marks=(--mark 100=paper:rigid --mark 200=paper:bending-1 --mark 400=paper:bending-2
+           --mark 800=paper:bending-3 --mark 320=paper:ballast-sleeper --mark 45=paper:ballast)
+    modes=out/ballast/paper_load_rigid_mu173/modes
+    $qdem modes $dir/paper_load_rigid_mu173.toml --count 1500 --no-shapes --out $modes
+    for run in "${runs[@]}"; do
+        $qdem analyze $dir/$run.toml --from 0.02 --to 0.15 --modes $modes/modes.csv "${marks[@]}"
+        python3 $dir/spectrum_peaks.py out/ballast/$run --modes $modes/modes.csv --from 0.02 --to 0.15
+        python3 $dir/track_profile.py --motion out/ballast/$run
+    done
     exit 0
 fi
 modes=out/ballast/${runs[0]}/modes
