@@ -21,11 +21,10 @@
 # With --paper, the same reduced layout with 3,100 of the paper's stones (docs/ballast.md, "The
 # reduced track with the paper's stones"): poured and consolidated rigid (paper_deposit_rigid,
 # paper_consolidate_rigid), both bogies with rigid stones at friction 0.577 and 1.73 side by
-# side (paper_load_rigid, paper_load_rigid_mu173; about 45 min each on one thread alone), the
-# bed's modes (qdem modes --no-shapes: the free stones' rigid modes come first), and the
-# spectra and mobility of the window both carry (0.02-0.15 s) with those modes and the paper's
-# peaks marked, read by spectrum_peaks.py. The dashpot run (paper_load_rigid_dashpot.toml,
-# 1.5 M steps) is run by hand.
+# side (paper_load_rigid, paper_load_rigid_mu173; about 45 min each on one thread alone), and
+# the spectra and mobility of the window both carry (0.02-0.15 s) with the paper's peaks and
+# the free sleeper's bending modes marked, read by spectrum_peaks.py. The dashpot run
+# (paper_load_rigid_dashpot.toml, 1.5 M steps) is run by hand.
 # Step 1 is skipped when its checkpoint exists, unless --redeposit is given.
 # Outputs: out/ballast/{reduced,stiff}_*/ (probes.csv, vtu/, analysis/*.csv|svg, modes/).
 set -euo pipefail
@@ -94,15 +93,18 @@ if $fine; then
     exit 0
 fi
 if $paper; then
-    # Paper 000 §4.2's readings: the rigid vertical mode, the three vertical bending modes,
-    # the ballast-sleeper resonance (and S2/S3 boundary) and the ballast's wheel-load response.
+    # Paper 000 §4.2's readings (the rigid vertical mode, the three vertical bending modes,
+    # the ballast-sleeper resonance and S2/S3 boundary, the ballast's wheel-load response) and
+    # the coarse sleeper's free-free vertical bending modes (sleeper_modes.toml with
+    # sleeper_coarse.msh). The bed's own modes are not marked: in the consolidated rigid bed
+    # at least 150 stones touch nothing, so its lowest 900 modes are all rigid-body ones.
     marks=(--mark 100=paper:rigid --mark 200=paper:bending-1 --mark 400=paper:bending-2
-           --mark 800=paper:bending-3 --mark 320=paper:ballast-sleeper --mark 45=paper:ballast)
-    modes=out/ballast/paper_load_rigid_mu173/modes
-    $qdem modes $dir/paper_load_rigid_mu173.toml --count 1500 --no-shapes --out $modes
+           --mark 800=paper:bending-3 --mark 320=paper:ballast-sleeper --mark 45=paper:ballast
+           --mark 186.1=free-sleeper:bending-1 --mark 523.2=free-sleeper:bending-2
+           --mark 984.3=free-sleeper:bending-3)
     for run in "${runs[@]}"; do
-        $qdem analyze $dir/$run.toml --from 0.02 --to 0.15 --modes $modes/modes.csv "${marks[@]}"
-        python3 $dir/spectrum_peaks.py out/ballast/$run --modes $modes/modes.csv --from 0.02 --to 0.15
+        $qdem analyze $dir/$run.toml --from 0.02 --to 0.15 "${marks[@]}"
+        python3 $dir/spectrum_peaks.py out/ballast/$run --from 0.02 --to 0.15
         python3 $dir/track_profile.py --motion out/ballast/$run
     done
     exit 0
