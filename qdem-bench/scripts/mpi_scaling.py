@@ -182,12 +182,19 @@ dir = "out"
     return scene
 
 
+def qdem_run_command(qdem: str, scene, ranks: int, threads: int, out, extra=()) -> list[str]:
+    """`qdem run SCENE --out OUT --threads T` and `extra`, under `mpirun -np R` for R > 1
+    ranks (run it with MPI_ENV)."""
+    cmd = [qdem, "run", str(scene), "--out", str(out), "--threads", str(threads), *extra]
+    if ranks > 1:
+        cmd = ["mpirun", "--oversubscribe", "--bind-to", "none", "-np", str(ranks)] + cmd
+    return cmd
+
+
 def run(qdem: str, scene: Path, ranks: int, threads: int, out: Path) -> tuple[float, int]:
     """Seconds per step of one run (the stepping loop's wall time over its steps), and the
     elements it steps (tetrahedra, or particles for a scene without)."""
-    cmd = [qdem, "run", str(scene), "--out", str(out), "--threads", str(threads)]
-    if ranks > 1:
-        cmd = ["mpirun", "--oversubscribe", "--bind-to", "none", "-np", str(ranks)] + cmd
+    cmd = qdem_run_command(qdem, scene, ranks, threads, out)
     p = subprocess.run(cmd, capture_output=True, text=True, env={**os.environ, **MPI_ENV})
     if p.returncode != 0:
         sys.exit(f"error: {' '.join(cmd)} failed:\n{p.stderr}")

@@ -24,18 +24,21 @@ import subprocess
 import tempfile
 import time
 
+from mpi_scaling import MPI_ENV, qdem_run_command
+
+# Configurations: (ranks, threads).
+CONFIGS = {"t1": (1, 1), "t2": (1, 2), "r2": (2, 1)}
+
 
 def window(qdem, scene, config, steps):
     """Wall seconds of one `qdem run` stopped after `steps` steps."""
     out = tempfile.mkdtemp(prefix="qdem-window-")
-    threads = "2" if config == "t2" else "1"
-    cmd = [qdem, "run", scene, "--out", out, "--stop-after", str(steps), "--yes",
-           "--threads", threads]
-    if config == "r2":
-        cmd = ["mpirun", "--oversubscribe", "--bind-to", "none", "-np", "2"] + cmd
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    ranks, threads = CONFIGS[config]
+    cmd = qdem_run_command(qdem, scene, ranks, threads, out,
+                           ["--stop-after", str(steps), "--yes"])
     start = time.perf_counter()
-    done = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    done = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                          env={**os.environ, **MPI_ENV})
     seconds = time.perf_counter() - start
     shutil.rmtree(out, ignore_errors=True)
     # --stop-after ends as Ctrl-C does: exit status 130 with the checkpoint written.
